@@ -1,0 +1,7 @@
+"""``python -m robokudo``."""
+
+import sys
+
+from robokudo.cli import main
+
+sys.exit(main())

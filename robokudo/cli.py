@@ -1,0 +1,102 @@
+"""The ``robokudo`` command line."""
+
+from __future__ import annotations
+
+import argparse
+import importlib
+import sys
+from collections.abc import Sequence
+
+from py_trees.common import Status
+
+# Subcommands implemented in other packages: name -> (module, help). Each module provides
+# ``add_arguments(parser)`` and ``run(args) -> int``; they are imported only when used.
+_EXTERNAL_COMMANDS: dict[str, tuple[str, str]] = {
+    "parse": ("queries.cli", "parse a perception query and print its canonical form"),
+}
+
+
+def _tree_list(_: argparse.Namespace) -> int:
+    from trees import available_trees
+
+    for name, spec in sorted(available_trees().items()):
+        print(f"{name:24s} {spec.summary}")
+    return 0
+
+
+def _tree_show(args: argparse.Namespace) -> int:
+    from robokudo.render import dot_tree, svg_tree, unicode_tree
+    from trees import load_tree
+
+    root = load_tree(args.name).create()
+    if args.format == "dot":
+        sys.stdout.write(dot_tree(root))
+    elif args.format == "svg":
+        sys.stdout.write(svg_tree(root))
+    else:
+        print(unicode_tree(root, show_ports=True))
+    return 0
+
+
+def _run(args: argparse.Namespace) -> int:
+    from robokudo.engine import Engine
+    from robokudo.render import stats_table, unicode_tree
+    from trees import load_tree
+
+    root = load_tree(args.name).create(input_path=args.input, frame=args.frame)
+    engine = Engine(root, hz=args.hz)
+    status = engine.run(ticks=args.ticks, until=(lambda s: s is not Status.RUNNING) if args.once else None)
+    print(unicode_tree(root, show_status=True, show_reasons=False))
+    print()
+    print(stats_table(root))
+    return 0 if status is Status.SUCCESS else 1
+
+
+def build_parser() -> argparse.ArgumentParser:
+    """The argument parser of the ``robokudo`` command."""
+    parser = argparse.ArgumentParser(prog="robokudo", description="Knowledge-enabled robot perception.")
+    commands = parser.add_subparsers(dest="command", required=True, metavar="COMMAND")
+
+    tree = commands.add_parser("tree", help="list or show the hand-authored trees")
+    tree_commands = tree.add_subparsers(dest="tree_command", required=True, metavar="ACTION")
+    tree_commands.add_parser("list", help="list the trees").set_defaults(handler=_tree_list)
+    show = tree_commands.add_parser("show", help="print one tree")
+    show.add_argument("name")
+    show.add_argument("--format", choices=("text", "dot", "svg"), default="text")
+    show.set_defaults(handler=_tree_show)
+
+    run = commands.add_parser("run", help="run a tree with the engine")
+    run.add_argument("name")
+    run.add_argument("--input", help="input path (default: the built-in kitchen scene)")
+    run.add_argument("--frame", type=int, default=0, help="frame number in a sequence input")
+    run.add_argument("--ticks", type=int, default=None, help="tick this many times (default: until it finishes)")
+    run.add_argument("--hz", type=float, default=30.0, help="tick frequency")
+    run.set_defaults(handler=_run)
+
+    for name, (module_name, help_text) in _EXTERNAL_COMMANDS.items():
+        sub = commands.add_parser(name, help=help_text)
+        sub.set_defaults(external=module_name)
+        _add_external_arguments(sub, module_name)
+    return parser
+
+
+def _add_external_arguments(parser: argparse.ArgumentParser, module_name: str) -> None:
+    module = importlib.import_module(module_name)
+    module.add_arguments(parser)
+    parser.set_defaults(handler=module.run)
+
+
+def main(argv: Sequence[str] | None = None) -> int:
+    """Entry point of the console script."""
+    args = build_parser().parse_args(argv)
+    if args.command == "run":
+        args.once = args.ticks is None
+    try:
+        return int(args.handler(args))
+    except KeyError as error:
+        print(f"robokudo: {error.args[0]}", file=sys.stderr)
+        return 2
+
+
+if __name__ == "__main__":
+    sys.exit(main())

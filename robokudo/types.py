@@ -1,0 +1,277 @@
+"""The CAS type system: observation views and annotation dataclasses.
+
+Every type a CAS can hold derives from :class:`CasType` and is tied to the ontology by its class name
+(``rk:<ClassName>``). Two families exist:
+
+* :class:`View` - one per CAS (the colour image, the point cloud, ...); writing a view replaces it.
+* :class:`Annotation` - any number per CAS or per object hypothesis (planes, hypotheses, colours, ...).
+
+Arrays are held by reference; nothing here copies frame data.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass, field
+from typing import ClassVar, TypeVar
+
+import numpy as np
+
+ONTOLOGY_NAMESPACE = "http://robokudo.org/ontology#"
+
+A = TypeVar("A", bound="Annotation")
+
+
+class CasType:
+    """Base of everything a CAS holds; the class name is the ontology term."""
+
+    ontology_namespace: ClassVar[str] = ONTOLOGY_NAMESPACE
+
+    @classmethod
+    def iri(cls) -> str:
+        """The ontology IRI of this type."""
+        return cls.ontology_namespace + cls.__name__
+
+    @classmethod
+    def type_name(cls) -> str:
+        """The short name used in the ontology and in messages."""
+        return cls.__name__
+
+
+# --------------------------------------------------------------------------------------------- views
+
+
+class View(CasType):
+    """An observation slot: at most one per CAS."""
+
+
+@dataclass(frozen=True)
+class CameraIntrinsics:
+    """Pinhole intrinsics in pixels."""
+
+    fx: float
+    fy: float
+    cx: float
+    cy: float
+    width: int
+    height: int
+
+    def is_valid(self) -> bool:
+        """True when focal lengths are positive and the image size is non-empty."""
+        return self.fx > 0 and self.fy > 0 and self.width > 0 and self.height > 0
+
+    def matrix(self) -> np.ndarray:
+        """The 3x3 camera matrix K."""
+        return np.array([[self.fx, 0.0, self.cx], [0.0, self.fy, self.cy], [0.0, 0.0, 1.0]])
+
+
+@dataclass(eq=False)
+class ColorImage(View):
+    """An RGB image, HxWx3 uint8."""
+
+    image: np.ndarray
+
+
+@dataclass(eq=False)
+class DepthImage(View):
+    """A depth image in metres along the optical axis, HxW float32; 0 or NaN means no data."""
+
+    depth: np.ndarray
+
+
+@dataclass(eq=False)
+class CameraInfo(View):
+    """Intrinsics, the camera pose in the world (None when unknown), the frame id and the timestamp."""
+
+    intrinsics: CameraIntrinsics
+    cam_to_world: np.ndarray | None = None
+    frame_id: str = "camera"
+    timestamp: float = 0.0
+
+
+@dataclass(eq=False)
+class PointCloud(View):
+    """An organized point cloud in the camera frame.
+
+    ``points`` is HxWx3 float32 (NaN where invalid) so every point keeps its pixel; ``mask`` (HxW bool) marks
+    the points still of interest after filtering; ``colors`` is HxWx3 uint8 RGB or None.
+    Filters narrow ``mask`` and share ``points``; they never copy them.
+    """
+
+    points: np.ndarray
+    mask: np.ndarray
+    colors: np.ndarray | None = None
+
+    @property
+    def shape(self) -> tuple[int, int]:
+        """Grid size (rows, columns)."""
+        return self.points.shape[0], self.points.shape[1]
+
+    def selected_indices(self) -> np.ndarray:
+        """Flat indices of the points still of interest."""
+        return np.flatnonzero(self.mask)
+
+    def selected_points(self) -> np.ndarray:
+        """Nx3 array of the points still of interest."""
+        return self.points.reshape(-1, 3)[self.selected_indices()]
+
+    def with_mask(self, mask: np.ndarray) -> PointCloud:
+        """A new view sharing the points and colours but with another mask."""
+        return PointCloud(points=self.points, mask=mask, colors=self.colors)
+
+
+@dataclass(eq=False)
+class Normals(View):
+    """Per-point unit normals on the organized grid, HxWx3 float32 (NaN where unknown)."""
+
+    normals: np.ndarray
+
+
+@dataclass(eq=False)
+class QueryView(View):
+    """The perception query this CAS is answering (a ``queries.Query`` or any task description)."""
+
+    query: object
+
+
+# ----------------------------------------------------------------------------------------- annotations
+
+
+@dataclass(eq=False, kw_only=True)
+class Annotation(CasType):
+    """Something an expert says; ``source`` names the annotator, ``confidence`` is in [0, 1]."""
+
+    source: str = ""
+    confidence: float = 1.0
+
+
+@dataclass(eq=False, kw_only=True)
+class Plane(Annotation):
+    """A plane a*x + b*y + c*z + d = 0 in the camera frame (unit normal pointing to the camera)."""
+
+    model: np.ndarray
+    inlier_indices: np.ndarray
+
+
+@dataclass(eq=False, kw_only=True)
+class ObjectHypothesis(Annotation):
+    """A segment believed to be one object, with the annotations experts attached to it.
+
+    ``point_indices`` are flat indices into the organized grid, ``mask`` is HxW bool and ``roi`` is the image
+    box ``(x0, y0, x1, y1)`` in pixels, x1/y1 exclusive.
+    """
+
+    point_indices: np.ndarray
+    mask: np.ndarray
+    roi: tuple[int, int, int, int]
+    annotations: list[Annotation] = field(default_factory=list)
+
+    def find(self, annotation_type: type[A]) -> list[A]:
+        """The attached annotations of this type or a subtype."""
+        return [a for a in self.annotations if isinstance(a, annotation_type)]
+
+    def first(self, annotation_type: type[A]) -> A | None:
+        """The most confident attached annotation of this type, or None."""
+        found = self.find(annotation_type)
+        return max(found, key=lambda a: a.confidence) if found else None
+
+
+@dataclass(eq=False, kw_only=True)
+class SemanticColor(Annotation):
+    """A colour name (an ontology colour class, lower case) with its share of the object's pixels."""
+
+    color: str
+    ratio: float = 1.0
+
+
+@dataclass(eq=False, kw_only=True)
+class ColorHistogram(Annotation):
+    """A normalised hue/saturation histogram of the object's pixels."""
+
+    histogram: np.ndarray
+    bins: tuple[int, ...]
+
+
+@dataclass(eq=False, kw_only=True)
+class Shape(Annotation):
+    """A primitive shape: box, cylinder, sphere or flat."""
+
+    shape: str
+
+
+@dataclass(eq=False, kw_only=True)
+class Size(Annotation):
+    """Metric extents (metres, sorted largest first) and a size class (small, medium, large)."""
+
+    dimensions: tuple[float, float, float]
+    size_class: str
+
+
+@dataclass(eq=False, kw_only=True)
+class Pose(Annotation):
+    """An object pose: position and unit quaternion (x, y, z, w) in ``frame``."""
+
+    position: np.ndarray
+    orientation: np.ndarray
+    frame: str = "camera"
+
+    def matrix(self) -> np.ndarray:
+        """The 4x4 homogeneous transform."""
+        x, y, z, w = self.orientation
+        rotation = np.array(
+            [
+                [1 - 2 * (y * y + z * z), 2 * (x * y - z * w), 2 * (x * z + y * w)],
+                [2 * (x * y + z * w), 1 - 2 * (x * x + z * z), 2 * (y * z - x * w)],
+                [2 * (x * z - y * w), 2 * (y * z + x * w), 1 - 2 * (x * x + y * y)],
+            ]
+        )
+        transform = np.eye(4)
+        transform[:3, :3] = rotation
+        transform[:3, 3] = self.position
+        return transform
+
+
+@dataclass(eq=False, kw_only=True)
+class Classification(Annotation):
+    """An object class (the ontology class name, e.g. ``Milk``)."""
+
+    class_name: str
+
+
+@dataclass(eq=False, kw_only=True)
+class Text(Annotation):
+    """Text read on the object, with its image box ``(x0, y0, x1, y1)``."""
+
+    text: str
+    box: tuple[int, int, int, int] | None = None
+
+
+@dataclass(eq=False, kw_only=True)
+class Location(Annotation):
+    """The named semantic-map region the object is in (e.g. ``fridge``)."""
+
+    region: str
+    region_class: str = ""
+
+
+VIEW_TYPES: tuple[type[View], ...] = (ColorImage, DepthImage, CameraInfo, PointCloud, Normals, QueryView)
+ANNOTATION_TYPES: tuple[type[Annotation], ...] = (
+    Plane,
+    ObjectHypothesis,
+    SemanticColor,
+    ColorHistogram,
+    Shape,
+    Size,
+    Pose,
+    Classification,
+    Text,
+    Location,
+)
+
+
+def type_by_name(name: str) -> type[CasType]:
+    """Look up a CAS type by its ontology name; raises KeyError listing the known names."""
+    for cas_type in VIEW_TYPES + ANNOTATION_TYPES:
+        if cas_type.__name__ == name:
+            return cas_type
+    known = ", ".join(t.__name__ for t in VIEW_TYPES + ANNOTATION_TYPES)
+    raise KeyError(f"unknown CAS type {name!r}; known: {known}")
