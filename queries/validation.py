@@ -1,0 +1,183 @@
+"""Semantic checks that need no ontology, raising located :class:`QueryError`.
+
+Checked: the kind is known; the body and nested blocks are not empty; no
+key is given twice in one block; ``stop`` names a ``task``; sizes,
+distances, durations, counts and ids are not negative (counts and ids are
+whole numbers, ``max_results`` at least 1) and carry a fitting unit; range
+bounds are scalars of one type, numbers share a unit and ``low <= high``;
+nesting is at most :data:`MAX_DEPTH` deep.  Whether an object class exists
+is left to the reasoning layer.
+"""
+
+from __future__ import annotations
+
+from types import MappingProxyType
+
+from queries.errors import QueryError, describe_alternatives, located_error, offset_to_position
+from queries.model import (
+    KINDS,
+    Block,
+    Field,
+    ListValue,
+    Number,
+    Query,
+    Range,
+    Span,
+    String,
+    Symbol,
+    Value,
+)
+
+MAX_QUERY_LENGTH = 10_000
+"""Longest query text accepted, in characters."""
+
+MAX_DEPTH = 32
+"""Deepest nesting of blocks and lists accepted."""
+
+NON_NEGATIVE_KEYS: frozenset[str] = frozenset(
+    {
+        "size",
+        "min_size",
+        "max_size",
+        "width",
+        "height",
+        "depth",
+        "length",
+        "radius",
+        "diameter",
+        "distance",
+        "timeout",
+        "duration",
+        "max_results",
+        "task",
+        "id",
+    }
+)
+"""Keys whose numbers must not be negative."""
+
+WHOLE_NUMBER_KEYS: frozenset[str] = frozenset({"max_results", "task", "id"})
+"""Keys whose numbers must be whole (and unit-less)."""
+
+KEY_UNITS: MappingProxyType[str, str] = MappingProxyType(
+    {
+        "size": "m",
+        "min_size": "m",
+        "max_size": "m",
+        "width": "m",
+        "height": "m",
+        "depth": "m",
+        "length": "m",
+        "radius": "m",
+        "diameter": "m",
+        "distance": "m",
+        "timeout": "s",
+        "duration": "s",
+    }
+)
+"""The SI unit a number under these keys must have, if it has one."""
+
+
+def check_length(text: str, limit: int = MAX_QUERY_LENGTH) -> None:
+    """Raise :class:`QueryError` if ``text`` is longer than ``limit`` characters."""
+    if len(text) > limit:
+        line, column = offset_to_position(text, limit)
+        raise located_error(text, f"query is longer than {limit} characters", line, column)
+
+
+def validate_query(query: Query) -> None:
+    """Raise :class:`QueryError` at the first semantic problem in ``query``."""
+    if query.kind not in KINDS:
+        raise _error(
+            query,
+            query.kind_span,
+            f"unknown query kind '{query.kind}', expected {describe_alternatives(KINDS)}",
+            KINDS,
+        )
+    if query.kind == "stop" and query.body.field("task") is None:
+        raise _error(query, query.kind_span, "'stop' needs a 'task' to stop", ["task"])
+    if not query.body.fields:
+        raise _error(query, query.kind_span, f"'{query.kind}' needs at least one key")
+    stack: list[tuple[Block, int]] = [(query.body, 1)]
+    while stack:
+        block, depth = stack.pop()
+        seen: dict[str, Field] = {}
+        nested: list[tuple[Block, int]] = []
+        for item in block.fields:
+            first = seen.get(item.key)
+            if first is not None:
+                where = ""
+                if first.span.line:
+                    where = f" (first at line {first.span.line}, column {first.span.column})"
+                raise _error(query, item.span, f"key '{item.key}' is given twice{where}")
+            seen[item.key] = item
+            nested.extend(_check_field(query, item, depth))
+        stack.extend(reversed(nested))
+
+
+def _error(query: Query, span: Span, message: str, expected: tuple[str, ...] | list[str] = ()) -> QueryError:
+    """Build an error located at the start of ``span`` in the query's source."""
+    return located_error(query.source, message, span.line, span.column, expected)
+
+
+def _check_field(query: Query, item: Field, depth: int) -> list[tuple[Block, int]]:
+    """Check one field's value; return nested blocks to check with their depth."""
+    nested: list[tuple[Block, int]] = []
+    pending: list[tuple[Value, int]] = [(item.value, depth)]
+    while pending:
+        value, level = pending.pop()
+        if level > MAX_DEPTH:
+            raise _error(query, item.span, f"'{item.key}' is nested deeper than {MAX_DEPTH} levels")
+        if isinstance(value, Block):
+            if not value.fields:
+                raise _error(query, item.span, f"'{item.key}' has an empty block")
+            nested.append((value, level + 1))
+        elif isinstance(value, ListValue):
+            pending.extend((entry, level + 1) for entry in reversed(value.items))
+        elif isinstance(value, Range):
+            _check_range(query, item, value)
+        elif isinstance(value, Number):
+            _check_number(query, item, value)
+    return nested
+
+
+def _check_number(query: Query, item: Field, number: Number) -> None:
+    """Check a number against what its key allows."""
+    key = item.key
+    if key in NON_NEGATIVE_KEYS and number.value < 0:
+        raise _error(query, item.span, f"'{key}' must not be negative")
+    if key in WHOLE_NUMBER_KEYS:
+        if number.unit is not None or not number.value.is_integer():
+            raise _error(query, item.span, f"'{key}' must be a whole number without a unit")
+        if key == "max_results" and number.value < 1:
+            raise _error(query, item.span, "'max_results' must be at least 1")
+    wanted = KEY_UNITS.get(key)
+    if wanted is not None and number.unit is not None and number.unit != wanted:
+        raise _error(query, item.span, f"'{key}' needs a unit of '{wanted}', not '{number.unit}'")
+
+
+def _check_range(query: Query, item: Field, bounds: Range) -> None:
+    """Check that range bounds are comparable scalars in order."""
+    low, high = bounds.low, bounds.high
+    scalars = (Symbol, String, Number)
+    if not isinstance(low, scalars) or not isinstance(high, scalars):
+        raise _error(query, item.span, f"range bounds of '{item.key}' must be symbols, strings or numbers")
+    if type(low) is not type(high):
+        raise _error(query, item.span, f"range bounds of '{item.key}' must be of one type")
+    if isinstance(low, Number) and isinstance(high, Number):
+        if low.unit != high.unit:
+            raise _error(query, item.span, f"range bounds of '{item.key}' must have the same unit")
+        if low.value > high.value:
+            raise _error(query, item.span, f"range of '{item.key}' has its low bound above its high bound")
+        _check_number(query, item, low)
+        _check_number(query, item, high)
+
+
+__all__ = [
+    "KEY_UNITS",
+    "MAX_DEPTH",
+    "MAX_QUERY_LENGTH",
+    "NON_NEGATIVE_KEYS",
+    "WHOLE_NUMBER_KEYS",
+    "check_length",
+    "validate_query",
+]
