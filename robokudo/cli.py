@@ -13,6 +13,7 @@ from py_trees.common import Status
 # ``add_arguments(parser)`` and ``run(args) -> int``; they are imported only when used.
 _EXTERNAL_COMMANDS: dict[str, tuple[str, str]] = {
     "parse": ("queries.cli", "parse a perception query and print its canonical form"),
+    "plan": ("robokudo.plan_cli", "synthesize the perception tree for a query and print it"),
 }
 
 
@@ -52,8 +53,12 @@ def _run(args: argparse.Namespace) -> int:
     return 0 if status is Status.SUCCESS else 1
 
 
-def build_parser() -> argparse.ArgumentParser:
-    """The argument parser of the ``robokudo`` command."""
+def build_parser(selected: str | None = None) -> argparse.ArgumentParser:
+    """The argument parser of the ``robokudo`` command.
+
+    Subcommands from other packages are imported only when ``selected`` names them, so ``robokudo parse``
+    does not load the ontology and ``robokudo --help`` stays fast.
+    """
     parser = argparse.ArgumentParser(prog="robokudo", description="Knowledge-enabled robot perception.")
     commands = parser.add_subparsers(dest="command", required=True, metavar="COMMAND")
 
@@ -74,9 +79,9 @@ def build_parser() -> argparse.ArgumentParser:
     run.set_defaults(handler=_run)
 
     for name, (module_name, help_text) in _EXTERNAL_COMMANDS.items():
-        sub = commands.add_parser(name, help=help_text)
-        sub.set_defaults(external=module_name)
-        _add_external_arguments(sub, module_name)
+        sub = commands.add_parser(name, help=help_text, description=help_text)
+        if name == selected:
+            _add_external_arguments(sub, module_name)
     return parser
 
 
@@ -88,7 +93,9 @@ def _add_external_arguments(parser: argparse.ArgumentParser, module_name: str) -
 
 def main(argv: Sequence[str] | None = None) -> int:
     """Entry point of the console script."""
-    args = build_parser().parse_args(argv)
+    arguments = list(sys.argv[1:] if argv is None else argv)
+    selected = next((a for a in arguments if not a.startswith("-")), None)
+    args = build_parser(selected).parse_args(arguments)
     if args.command == "run":
         args.once = args.ticks is None
     try:

@@ -140,3 +140,19 @@ def stats_table(root: py_trees.behaviour.Behaviour) -> str:
         cells = [cell.ljust(width) if i == 0 else cell.rjust(width) for i, (cell, width) in pairs]
         lines.append("  ".join(cells))
     return "\n".join(lines)
+
+
+def tree_to_dict(root: py_trees.behaviour.Behaviour) -> dict[str, object]:
+    """A machine-readable tree: node type, name, annotator class, reason and children."""
+    node: dict[str, object] = {"type": node_kind(root), "name": root.name}
+    if isinstance(root, Annotator):
+        node["class"] = f"{type(root).__module__}.{type(root).__name__}"
+        node["inputs"] = [t.__name__ for t in root.inputs]
+        node["outputs"] = [t.__name__ for t in root.outputs]
+    if isinstance(root, ThresholdParallel):
+        node["n_success"] = root.n_success
+        node["n_failure"] = root.n_failure
+    node["reason"] = getattr(root, "reason", "")
+    if root.children:
+        node["children"] = [tree_to_dict(child) for child in root.children]
+    return node

@@ -32,7 +32,6 @@ def check_structure(root: py_trees.behaviour.Behaviour, attach_to: py_trees.beha
         raise StructureError(f"Pipeline names must be unique in a tree; repeated: {', '.join(duplicated)}")
 
 
-
 def _pipeline_names_outside(root: py_trees.behaviour.Behaviour, excluded: py_trees.behaviour.Behaviour) -> list[str]:
     """Names of the Pipelines in ``root``'s tree that are not below ``excluded``."""
     names = []

@@ -1,0 +1,36 @@
+"""Sensor sources: which reader starts a plan for a given input, as a plan step."""
+
+from __future__ import annotations
+
+from reasoning.knowledge_base import KnowledgeBase
+from reasoning.plan import Step
+from reasoning.planner import SensorSource
+
+
+def sensor_source(kb: KnowledgeBase, input_path: str | None, frame: int = 0, region: str | None = None) -> SensorSource:
+    """The reader for ``input_path`` (the built-in kitchen when None, looking at ``region`` if given)."""
+    if input_path is None:
+        from annotators.kitchen_scene import camera_looking_at
+
+        view = "table"
+        if region is not None:
+            try:
+                view = camera_looking_at(region)
+            except ValueError:
+                view = "overview"
+        spec = kb.annotator("KitchenSceneReader")
+        parameters: tuple[tuple[str, object], ...] = (("view", view),)
+        reason = f"renders the built-in kitchen from the {view!r} camera (the robot looks at the queried region)"
+    else:
+        spec = kb.annotator("ColorDepthPairReader")
+        parameters = (("folder", input_path), ("frame", frame))
+        reason = f"reads frame {frame} of {input_path}"
+    step = Step(
+        annotator=spec.name,
+        implemented_by=spec.implemented_by,
+        inputs=spec.inputs,
+        outputs=spec.outputs,
+        parameters=parameters,
+        reason=f"{spec.name}: {reason}",
+    )
+    return SensorSource(step)

@@ -1,0 +1,86 @@
+"""Turn a Plan into a Perception Pipeline Tree: Pipeline > stages (Parallel when independent) > Fallbacks.
+
+Annotator classes are looked up by the ``implemented_by`` path the ontology names; only classes of the
+project's ``annotators`` package can be instantiated.
+"""
+
+from __future__ import annotations
+
+import importlib
+from collections.abc import Sequence
+
+import py_trees
+
+from reasoning.plan import Alternatives, Plan, Step, Unit
+from robokudo.annotator import Annotator
+from robokudo.dataflow import validate_data_flow
+from robokudo.parallel import ThresholdParallel
+from robokudo.pipeline import Pipeline
+
+ALLOWED_PACKAGE = "annotators"
+
+
+class SynthesisError(Exception):
+    """A plan names an annotator class that cannot be used."""
+
+
+def annotator_class(implemented_by: str) -> type[Annotator]:
+    """Import the class ``annotators.module.Class``; anything outside the annotators package is refused."""
+    module_name, _, class_name = implemented_by.rpartition(".")
+    if not module_name.startswith(ALLOWED_PACKAGE + ".") and module_name != ALLOWED_PACKAGE:
+        raise SynthesisError(f"{implemented_by!r} is not in the {ALLOWED_PACKAGE!r} package")
+    try:
+        cls = getattr(importlib.import_module(module_name), class_name)
+    except (ImportError, AttributeError) as error:
+        raise SynthesisError(f"cannot load annotator class {implemented_by!r}: {error}") from error
+    if not (isinstance(cls, type) and issubclass(cls, Annotator)):
+        raise SynthesisError(f"{implemented_by!r} is not an Annotator")
+    return cls
+
+
+def instantiate(step: Step) -> Annotator:
+    """A fresh annotator node for a plan step, carrying the step's reason."""
+    node = annotator_class(step.implemented_by)(name=step.annotator, **dict(step.parameters))
+    node.reason = step.reason
+    return node
+
+
+def _unit_node(unit: Unit) -> py_trees.behaviour.Behaviour:
+    if isinstance(unit, Step):
+        return instantiate(unit)
+    return _fallback(unit)
+
+
+def _fallback(alternatives: Alternatives) -> py_trees.composites.Selector:
+    branches: list[py_trees.behaviour.Behaviour] = []
+    for branch in alternatives.branches:
+        if len(branch) == 1:
+            branches.append(instantiate(branch[0]))
+        else:
+            sequence = py_trees.composites.Sequence(
+                f"via {branch[-1].annotator}", memory=True, children=[instantiate(step) for step in branch]
+            )
+            sequence.reason = f"{branch[-1].annotator} with the steps only it needs"
+            branches.append(sequence)
+    node = py_trees.composites.Selector(f"{alternatives.provides} providers", memory=True, children=branches)
+    node.reason = alternatives.reason
+    return node
+
+
+def _stage_node(index: int, stage: Sequence[Unit]) -> py_trees.behaviour.Behaviour:
+    if len(stage) == 1:
+        return _unit_node(stage[0])
+    parallel = ThresholdParallel(f"stage {index}", [_unit_node(unit) for unit in stage])
+    parallel.reason = "independent experts run side by side; all must succeed"
+    return parallel
+
+
+def build_tree(
+    plan: Plan, name: str = "query", final_steps: Sequence[py_trees.behaviour.Behaviour] = ()
+) -> Pipeline:
+    """The Pipeline for ``plan`` (stages in order, then ``final_steps`` such as the answer step), validated."""
+    children = [_stage_node(index, stage) for index, stage in enumerate(plan.stages, start=1)]
+    pipeline = Pipeline(name, [*children, *final_steps])
+    pipeline.reason = f"answers the {plan.task.kind} query"
+    validate_data_flow(pipeline)
+    return pipeline
