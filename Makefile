@@ -17,11 +17,13 @@ lint: setup
 
 setup: system-deps $(STAMP)
 
-# open3d needs libusb-1.0; graphviz renders trees as SVG. Installed only when missing.
+# open3d needs libusb-1.0; graphviz renders trees as SVG; HermiT (ontology reasoning) needs Java.
+# Each is installed only when missing.
 system-deps:
-	@if ! ldconfig -p | grep -q 'libusb-1.0.so.0' || ! command -v dot >/dev/null; then \
+	@if ! ldconfig -p | grep -q 'libusb-1.0.so.0' || ! command -v dot >/dev/null || ! command -v java >/dev/null; then \
 		SUDO=$$( [ "$$(id -u)" = 0 ] && echo "" || echo sudo ); \
-		$$SUDO apt-get update -qq && $$SUDO apt-get install -y -qq libusb-1.0-0 graphviz >/dev/null; \
+		$$SUDO apt-get update -qq && \
+		$$SUDO apt-get install -y -qq libusb-1.0-0 graphviz default-jre-headless >/dev/null; \
 	fi
 
 $(STAMP): pyproject.toml

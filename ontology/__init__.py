@@ -2,7 +2,23 @@
 
 from pathlib import Path
 
+VOCABULARY_FILES: tuple[str, ...] = ("perception.ttl", "regions.ttl", "objects.ttl", "annotators.ttl")
+"""The shipped files every knowledge base loads, in load order."""
+
+DEFAULT_MAP_FILE = "kitchen_map.ttl"
+"""The semantic map of the built-in kitchen scene, loaded unless another map is given."""
+
+EXAMPLE_USER_MAP_FILE = "example_user_map.ttl"
+"""An example of a user's own kitchen map (not loaded by default)."""
+
 
 def ontology_dir() -> Path:
     """The folder holding the shipped ``*.ttl`` files."""
     return Path(__file__).resolve().parent
+
+
+def shipped_files(map_file: Path | None = None) -> tuple[Path, ...]:
+    """The shipped vocabulary files plus a semantic map (default: the built-in kitchen's)."""
+    folder = ontology_dir()
+    semantic_map = map_file if map_file is not None else folder / DEFAULT_MAP_FILE
+    return (*(folder / name for name in VOCABULARY_FILES), semantic_map)

@@ -14,6 +14,7 @@ from py_trees.common import Status
 _EXTERNAL_COMMANDS: dict[str, tuple[str, str]] = {
     "parse": ("queries.cli", "parse a perception query and print its canonical form"),
     "plan": ("robokudo.plan_cli", "synthesize the perception tree for a query and print it"),
+    "ontology": ("reasoning.ontology_cli", "show, check and edit the ontology"),
 }
 
 
@@ -40,7 +41,9 @@ def _tree_show(args: argparse.Namespace) -> int:
 
 
 def _run(args: argparse.Namespace) -> int:
+    from annotators.report import describe_hypotheses, write_annotated_image
     from robokudo.engine import Engine
+    from robokudo.pipeline import pipelines
     from robokudo.render import stats_table, unicode_tree
     from trees import load_tree
 
@@ -50,6 +53,11 @@ def _run(args: argparse.Namespace) -> int:
     print(unicode_tree(root, show_status=True, show_reasons=False))
     print()
     print(stats_table(root))
+    cas = next(pipelines(root)).cas
+    print()
+    print(describe_hypotheses(cas))
+    if args.annotated_image:
+        print(f"annotated image: {write_annotated_image(cas, args.annotated_image)}")
     return 0 if status is Status.SUCCESS else 1
 
 
@@ -76,6 +84,7 @@ def build_parser(selected: str | None = None) -> argparse.ArgumentParser:
     run.add_argument("--frame", type=int, default=0, help="frame number in a sequence input")
     run.add_argument("--ticks", type=int, default=None, help="tick this many times (default: until it finishes)")
     run.add_argument("--hz", type=float, default=30.0, help="tick frequency")
+    run.add_argument("--annotated-image", metavar="PATH", help="write the colour image with the hypotheses drawn")
     run.set_defaults(handler=_run)
 
     for name, (module_name, help_text) in _EXTERNAL_COMMANDS.items():

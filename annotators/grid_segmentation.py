@@ -1,0 +1,264 @@
+"""Segmentation primitives on the organized pixel grid: cuts, labelling, growing and merging of parts.
+
+All functions take HxW (or HxWx3) arrays of one region of the image and work with whole-array operations
+and OpenCV, never with per-point Python loops; labels are int32 with 0 meaning "no part".
+"""
+
+from __future__ import annotations
+
+from collections.abc import Callable
+
+import cv2
+import numpy as np
+from scipy import sparse
+from scipy.sparse import csgraph
+
+
+def _neighbour_views(array: np.ndarray) -> list[tuple[np.ndarray, np.ndarray]]:
+    """The (first, second) views of every horizontally and vertically adjacent pixel pair."""
+    return [(array[:, :-1], array[:, 1:]), (array[:-1, :], array[1:, :])]
+
+
+def depth_jump(z_a: np.ndarray, z_b: np.ndarray, absolute: float, relative: float) -> np.ndarray:
+    """True where two neighbouring depths differ by more than ``absolute + relative * nearer depth``."""
+    with np.errstate(invalid="ignore"):
+        return np.abs(z_a - z_b) > absolute + relative * np.fmin(z_a, z_b)
+
+
+def depth_seams(depth: np.ndarray, candidates: np.ndarray, absolute: float, relative: float) -> np.ndarray:
+    """HxW bool: candidate pixels with a nearer candidate 4-neighbour across a depth discontinuity.
+
+    Only the far pixel of such a pair is marked, so an occluding object keeps its full outline while the
+    pixel behind it is cut away; 4-connected labelling then cannot cross the discontinuity.
+    """
+    seams = np.zeros(candidates.shape, dtype=bool)
+    seam_views = _neighbour_views(seams)
+    for (z_a, z_b), (c_a, c_b), (s_a, s_b) in zip(
+        _neighbour_views(depth), _neighbour_views(candidates), seam_views, strict=True
+    ):
+        broken = c_a & c_b & depth_jump(z_a, z_b, absolute, relative)
+        a_farther = z_a > z_b
+        s_a |= broken & a_farther
+        s_b |= broken & ~a_farther
+    return seams
+
+
+def chroma_image(colors: np.ndarray) -> np.ndarray:
+    """A shading-invariant 3-channel uint8 image: hue as an angle scaled by saturation, faded out on dark pixels.
+
+    Channels 0 and 1 are ``128 + 127 * s * w * (cos h, sin h)`` with ``w`` ramping from 0 to 1 between values
+    25 and 65, so shading of one surface (same hue and saturation) gives no edge while a change of hue does.
+    """
+    hsv = cv2.cvtColor(cv2.GaussianBlur(colors, (5, 5), 0), cv2.COLOR_RGB2HSV_FULL)
+    angle = hsv[..., 0].astype(np.float32) * np.float32(2 * np.pi / 256)
+    value_weight = np.clip((hsv[..., 2].astype(np.float32) - 25) / 40, 0, 1)
+    weight = hsv[..., 1].astype(np.float32) * value_weight * np.float32(127 / 255)
+    chroma = np.full(colors.shape, 128, dtype=np.uint8)
+    chroma[..., 0] = np.clip(128 + weight * np.cos(angle), 0, 255)
+    chroma[..., 1] = np.clip(128 + weight * np.sin(angle), 0, 255)
+    return chroma
+
+
+def color_edges(colors: np.ndarray, low: float, high: float) -> np.ndarray:
+    """HxW bool: Canny edges (thresholds ``low``/``high``) of the :func:`chroma_image` - changes of hue."""
+    return cv2.Canny(chroma_image(np.ascontiguousarray(colors)), low, high) > 0
+
+
+def label_parts(region: np.ndarray, min_points: int) -> np.ndarray:
+    """4-connected components of ``region`` with at least ``min_points`` pixels, labelled 1..n (int32)."""
+    _, labels, stats, _ = cv2.connectedComponentsWithStats(np.ascontiguousarray(region).view(np.uint8), connectivity=4)
+    keep = stats[:, cv2.CC_STAT_AREA] >= min_points
+    keep[0] = False
+    renumber = (np.cumsum(keep) * keep).astype(np.int32)
+    return renumber[labels]
+
+
+def grow_labels(labels: np.ndarray, region: np.ndarray, max_distance: float) -> np.ndarray:
+    """Give every unlabelled pixel of ``region`` the label of the nearest labelled pixel within ``max_distance`` px."""
+    unlabelled = region & (labels == 0)
+    if not unlabelled.any() or not labels.any():
+        return labels
+    distance, nearest = cv2.distanceTransformWithLabels(
+        (labels == 0).view(np.uint8), cv2.DIST_L2, 3, labelType=cv2.DIST_LABEL_PIXEL
+    )
+    lookup = np.zeros(int(nearest.max()) + 1, dtype=labels.dtype)
+    seeds = labels > 0
+    lookup[nearest[seeds]] = labels[seeds]
+    reach = unlabelled & (distance <= max_distance)
+    grown = labels.copy()
+    grown[reach] = lookup[nearest[reach]]
+    return grown
+
+
+def touching_pairs(labels: np.ndarray) -> np.ndarray:
+    """Kx2 int array of the distinct label pairs ``(a, b)``, ``0 < a < b``, that touch as 4-neighbours."""
+    found = []
+    for l_a, l_b in _neighbour_views(labels):
+        touching = (l_a != l_b) & (l_a > 0) & (l_b > 0)
+        a, b = l_a[touching], l_b[touching]
+        found.append(np.column_stack([np.minimum(a, b), np.maximum(a, b)]))
+    pairs = np.concatenate(found).astype(np.int64)
+    if pairs.shape[0] == 0:
+        return pairs.reshape(0, 2)
+    keys = np.unique(pairs[:, 0] * (int(labels.max()) + 1) + pairs[:, 1])
+    return np.column_stack([keys // (int(labels.max()) + 1), keys % (int(labels.max()) + 1)])
+
+
+def label_groups(labels: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """Flat pixel indices sorted by label and ``starts`` so label k owns ``pixels[starts[k]:starts[k + 1]]``."""
+    flat = labels.reshape(-1)
+    pixels = np.flatnonzero(flat)
+    pixels = pixels[np.argsort(flat[pixels], kind="stable")]
+    starts = np.searchsorted(flat[pixels], np.arange(int(flat.max(initial=0)) + 2))
+    return pixels, starts
+
+
+def footprint_overlap(first: np.ndarray, second: np.ndarray, cell: float) -> float:
+    """Area shared by two convex polygons (Nx2, metres) over the smaller one's, measured on a ``cell`` raster.
+
+    The raster gives even a degenerate footprint (a wall seen edge-on is a line) an area of one cell width.
+    """
+    low = np.minimum(first.min(axis=0), second.min(axis=0))
+    high = np.maximum(first.max(axis=0), second.max(axis=0))
+    shape = tuple(int(v) for v in (np.ceil((high - low) / cell) + 2)[::-1])
+    rasters = []
+    for hull in (first, second):
+        raster = np.zeros(shape, dtype=np.uint8)
+        cv2.fillConvexPoly(raster, np.round((hull - low) / cell).astype(np.int32), 1)
+        rasters.append(raster.view(bool))
+    shared = np.count_nonzero(rasters[0] & rasters[1])
+    return shared / max(1, min(np.count_nonzero(rasters[0]), np.count_nonzero(rasters[1])))
+
+
+def join_labels(labels: np.ndarray, pairs: list[tuple[int, int]]) -> np.ndarray:
+    """Labels with every connected group of ``pairs`` joined, renumbered 1..n in order of first label."""
+    count = int(labels.max(initial=0)) + 1
+    rows = [a for a, _ in pairs]
+    cols = [b for _, b in pairs]
+    graph = sparse.csr_matrix((np.ones(len(pairs)), (rows, cols)), shape=(count, count))
+    _, component = csgraph.connected_components(graph, directed=False)
+    present = np.flatnonzero(np.bincount(labels.reshape(-1), minlength=count))
+    present = present[present > 0]
+    renumber = np.zeros(count, dtype=np.int32)
+    _, dense = np.unique(component[present], return_inverse=True)
+    renumber[present] = dense.reshape(-1) + 1
+    return renumber[labels]
+
+
+def _range(values: np.ndarray, low: float, high: float) -> tuple[float, float]:
+    """The ``low`` and ``high`` quantiles (0..1) of a 1-D array, by sorting (cheap for a few hundred values)."""
+    ordered = np.sort(values)
+    last = ordered.size - 1
+    return float(ordered[round(low * last)]), float(ordered[round(high * last)])
+
+
+def looks_like_inside(near: np.ndarray, far: np.ndarray, tolerance: float, depth_ratio: float) -> bool:
+    """Could part ``far`` be the inside of an open container whose outside is part ``near``?
+
+    Both are Nx3 plane coordinates ``(u, v, height)`` with the camera's foot at ``u = v = 0``. Seen from above,
+    the front rim of a cup or bowl hides part of its inside: the inside is then farther along the line of sight,
+    within the outside's width across it, no higher than its rim, and no deeper than ``depth_ratio`` times its
+    width. A separate object behind is wider, taller or elsewhere. Robust 5 % / 95 % quantiles are used.
+    """
+    if near.shape[0] < 3 or far.shape[0] < 3:
+        return False
+    centre = near[:, :2].mean(axis=0)
+    distance = float(np.linalg.norm(centre))
+    if distance < 1e-6:
+        return False
+    along = centre / distance
+    across = np.array([-along[1], along[0]], dtype=near.dtype)
+    near_low, near_high = _range(near[:, :2] @ across, 0.05, 0.95)
+    width = near_high - near_low
+    margin = max(tolerance, 0.1 * width)
+    far_low, far_high = _range(far[:, :2] @ across, 0.05, 0.95)
+    if far_low < near_low - margin or far_high > near_high + margin:
+        return False
+    if _range(far[:, 2], 0.5, 0.95)[1] > _range(near[:, 2], 0.5, 0.95)[1] + margin:
+        return False
+    near_front, near_middle = _range(near[:, :2] @ along, 0.05, 0.5)
+    far_middle, far_back = _range(far[:, :2] @ along, 0.5, 0.95)
+    return far_middle > near_middle and far_back <= near_front + depth_ratio * width
+
+
+class _Parts:
+    """Per-label data merge decisions need, computed once on demand: plane coordinates, hull, median depth."""
+
+    def __init__(self, labels: np.ndarray, depth: np.ndarray, plane_coordinates: Callable[[np.ndarray], np.ndarray]):
+        self.pixels, self.starts = label_groups(labels)
+        self.depth = depth.reshape(-1)
+        self.plane_coordinates = plane_coordinates
+        self._coordinates: dict[int, np.ndarray] = {}
+        self._hulls: dict[int, np.ndarray] = {}
+        self._depths: dict[int, float] = {}
+
+    def own(self, label: int) -> np.ndarray:
+        return self.pixels[self.starts[label] : self.starts[label + 1]]
+
+    def coordinates(self, label: int) -> np.ndarray:
+        """Plane coordinates of about 400 of the part's pixels, evenly sampled."""
+        if label not in self._coordinates:
+            own = self.own(label)
+            self._coordinates[label] = self.plane_coordinates(own[:: max(1, own.size // 400)])
+        return self._coordinates[label]
+
+    def hull(self, label: int) -> np.ndarray:
+        """The convex hull of the part's footprint (Kx2)."""
+        if label not in self._hulls:
+            self._hulls[label] = cv2.convexHull(np.ascontiguousarray(self.coordinates(label)[:, :2])).reshape(-1, 2)
+        return self._hulls[label]
+
+    def depth_of(self, label: int) -> float:
+        """The median depth of the part."""
+        if label not in self._depths:
+            own = self.own(label)
+            self._depths[label] = float(np.median(self.depth[own[:: max(1, own.size // 500)]]))
+        return self._depths[label]
+
+
+def merge_parts(
+    labels: np.ndarray,
+    depth: np.ndarray,
+    plane_coordinates: Callable[[np.ndarray], np.ndarray],
+    overlap: float,
+    cell: float,
+    inside_tolerance: float,
+    inside_depth_ratio: float,
+) -> np.ndarray:
+    """Join touching parts that are pieces of one object; labels renumbered 1..n (0 = none).
+
+    ``plane_coordinates(pixels)`` gives Nx3 float32 ``(u, v, height)`` on the supporting plane for flat pixel
+    indices. Two parts are joined when they touch on the grid and
+
+    * their footprints (convex hulls on the plane) share more than ``overlap`` of the smaller one: objects
+      standing side by side have (nearly) disjoint footprints, while the pieces one object was cut into by a
+      colour edge (a can's label, a box's print) share theirs; or
+    * the far one :func:`looks_like_inside` the near one (the inside and outside of a cup or bowl, split by
+      the depth jump or the shading edge at the front rim).
+    """
+    pairs = touching_pairs(labels)
+    if pairs.shape[0] == 0:
+        return labels
+    parts = _Parts(labels, depth, plane_coordinates)
+    joined = []
+    for first, second in pairs.tolist():
+        if footprint_overlap(parts.hull(first), parts.hull(second), cell) > overlap:
+            joined.append((first, second))
+            continue
+        near, far = sorted((first, second), key=parts.depth_of)
+        if looks_like_inside(parts.coordinates(near), parts.coordinates(far), inside_tolerance, inside_depth_ratio):
+            joined.append((first, second))
+    return join_labels(labels, joined)
+
+
+def bounding_box(mask: np.ndarray, margin: int = 0) -> tuple[int, int, int, int]:
+    """``(x0, y0, x1, y1)`` (exclusive) of the True pixels, grown by ``margin`` and clipped to the grid."""
+    rows = np.flatnonzero(mask.any(axis=1))
+    cols = np.flatnonzero(mask.any(axis=0))
+    height, width = mask.shape
+    return (
+        max(int(cols[0]) - margin, 0),
+        max(int(rows[0]) - margin, 0),
+        min(int(cols[-1]) + 1 + margin, width),
+        min(int(rows[-1]) + 1 + margin, height),
+    )

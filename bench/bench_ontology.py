@@ -1,0 +1,250 @@
+"""Benchmark of the knowledge base: load time (cold, with and without HermiT) and question latency.
+
+Runs on the shipped ontology and on a generated one (the shipped files plus 1,000 object classes and 200
+annotators). Cold load = a fresh Python process importing the package and loading; warm load = another load
+in the same process. Question latency = median and p99 over 10,000 mixed questions (word resolution,
+subsumption, profiles, default locations, regions, providers, query keys, annotator inputs).
+
+    python bench/bench_ontology.py [--questions N] [--no-reasoner]
+"""
+
+from __future__ import annotations
+
+import argparse
+import json
+import random
+import statistics
+import subprocess
+import sys
+import tempfile
+import time
+from collections import defaultdict
+from collections.abc import Callable
+from pathlib import Path
+
+from ontology import ontology_dir, shipped_files
+from reasoning.knowledge_base import KnowledgeBase
+from reasoning.model import Conditions
+
+GENERATED_CLASSES = 1000
+GENERATED_ANNOTATORS = 200
+GENERATED_REGIONS = 40
+SEED = 7
+
+_COLD_LOAD = """
+import json, sys, time
+start = time.perf_counter()
+from pathlib import Path
+from reasoning.knowledge_base import KnowledgeBase
+imported = time.perf_counter()
+files = [Path(p) for p in json.loads(sys.argv[1])] or None
+KnowledgeBase.load(Path(sys.argv[2]), files=files, reason=sys.argv[3] == "1")
+done = time.perf_counter()
+print(json.dumps({"import": imported - start, "load": done - imported}))
+"""
+
+
+def generate(folder: Path, rng: random.Random) -> list[Path]:
+    """Write the generated object classes, regions and annotators; return the full file list."""
+    base = KnowledgeBase.load(folder / "none.ttl")
+    colors = base.names_of_kind("color")
+    shapes = base.names_of_kind("shape")
+    sizes = base.names_of_kind("size")
+    materials = base.names_of_kind("material")
+    region_classes = [c for c in base.names_of_kind("region_class") if c != "Region"]
+    classes = [c for c in base.names_of_kind("class") if c not in ("RefrigeratedItem", "TransparentObject")]
+    lines = ["@prefix rk: <http://robokudo.org/ontology#> .", "@prefix owl: <http://www.w3.org/2002/07/owl#> .",
+             "@prefix rdfs: <http://www.w3.org/2000/01/rdf-schema#> .", ""]  # fmt: skip
+
+    def restriction(prop: str, value: str, literal: bool = False) -> str:
+        kind = "owl:hasValue" if literal else "owl:someValuesFrom"
+        return f"[ a owl:Restriction ; owl:onProperty rk:{prop} ; {kind} {value} ]"
+
+    generated: list[str] = []
+    for i in range(GENERATED_CLASSES):
+        name = f"GenObject{i:04d}"
+        parent = rng.choice(classes + generated)
+        supers = [f"rk:{parent}"]
+        if rng.random() < 0.5:
+            supers.append(restriction("typicalColor", "rk:" + rng.choice(colors)))
+        if rng.random() < 0.3:
+            supers.append(restriction("typicalShape", "rk:" + rng.choice(shapes)))
+        if rng.random() < 0.3:
+            supers.append(restriction("sizeClass", "rk:" + rng.choice(sizes)))
+        if rng.random() < 0.2:
+            supers.append(restriction("madeOf", "rk:" + rng.choice(materials)))
+        if rng.random() < 0.2:
+            supers.append(restriction("storedIn", "rk:" + rng.choice(region_classes)))
+        if rng.random() < 0.2:
+            supers.append(restriction("printedText", f'"text {i}"', literal=True))
+        lines.append(f'rk:{name} a owl:Class ; rdfs:label "generated object {i}" ;')
+        lines.append("    rdfs:subClassOf " + " ,\n        ".join(supers) + " .")
+        generated.append(name)
+    for i in range(GENERATED_REGIONS):
+        lines.append(f'rk:gen_region_{i} a owl:NamedIndividual , rk:{rng.choice(region_classes)} ; rk:frame "map" ;')
+        lines.append(f"    rk:positionX {i * 0.5} ; rk:positionY 1.0 ; rk:positionZ 0.8 ;")
+        lines.append("    rk:orientationX 0.0 ; rk:orientationY 0.0 ; rk:orientationZ 0.0 ; rk:orientationW 1.0 ;")
+        lines.append("    rk:sizeX 0.4 ; rk:sizeY 0.4 ; rk:sizeZ 0.4 .")
+    types = base.cas_types()
+    preconditions = ["NeedsDepth", "NeedsRegion", "NotForTransparentObjects"]
+    all_classes = classes + generated
+    for i in range(GENERATED_ANNOTATORS):
+        facts = [
+            f'rk:implementedBy "annotators.generated.GenAnnotator{i:03d}"',
+            "rk:requiresInput " + " , ".join(f"rk:{t}" for t in rng.sample(types, rng.randint(1, 3))),
+            "rk:providesOutput " + " , ".join(f"rk:{t}" for t in rng.sample(types, rng.randint(1, 2))),
+            f"rk:expectedCostMs {rng.uniform(1, 100):.1f}",
+            f"rk:reliability {rng.uniform(0.3, 1.0):.2f}",
+        ]
+        if rng.random() < 0.4:
+            facts.append("rk:canReportColor " + " , ".join(f"rk:{c}" for c in rng.sample(colors, 4)))
+        if rng.random() < 0.4:
+            facts.append("rk:canReportClass " + " , ".join(f"rk:{c}" for c in rng.sample(all_classes, 5)))
+        if rng.random() < 0.3:
+            facts.append(f"rk:precondition rk:{rng.choice(preconditions)}")
+        lines.append(f"rk:GenAnnotator{i:03d} a owl:NamedIndividual , rk:Annotator ;")
+        lines.append("    " + " ;\n    ".join(facts) + " .")
+    extra = folder / "generated.ttl"
+    extra.write_text("\n".join(lines) + "\n", encoding="utf-8")
+    return [*shipped_files(), extra]
+
+
+def cold_load(files: list[Path], user_file: Path, reason: bool) -> dict[str, float]:
+    """Import + load in a fresh interpreter."""
+    argv = [json.dumps([str(f) for f in files]), str(user_file), "1" if reason else "0"]
+    output = subprocess.run(
+        [sys.executable, "-c", _COLD_LOAD, *argv], check=True, capture_output=True, text=True, cwd=ontology_dir().parent
+    )
+    return json.loads(output.stdout.strip().splitlines()[-1])
+
+
+def plural(word: str) -> str:
+    """A regular English plural of the last word."""
+    if word.endswith(("s", "x", "ch", "sh")):
+        return word + "es"
+    if word.endswith("y") and word[-2:-1] not in "aeiou":
+        return word[:-1] + "ies"
+    return word + "s"
+
+
+def questions(kb: KnowledgeBase, count: int, rng: random.Random) -> list[tuple[str, Callable[[], object]]]:
+    """A reproducible mix of ``count`` typed questions a planner asks."""
+    classes = kb.names_of_kind("class")
+    words = [w for c in classes for w in (kb.label(c), *kb.synonyms(c))]
+    variants = [str.lower, str.upper, lambda w: w.replace(" ", "_"), plural, str.title]
+    region_classes = kb.names_of_kind("region_class")
+    colors = [kb.label(c) for c in kb.names_of_kind("color")]
+    annotators = [a.name for a in kb.annotators()]
+    keys = ["color", "colour", "type", "shape", "size", "text", "pose", "location"]
+    no_depth = Conditions(depth=False)
+    made: list[tuple[str, Callable[[], object]]] = []
+    for _ in range(count):
+        kind = rng.randrange(10)
+        if kind == 0:
+            word = rng.choice(variants)(rng.choice(words))
+            made.append(("resolve", lambda w=word: kb.resolve(w)))
+        elif kind == 1:
+            a, b = rng.choice(classes), rng.choice(classes)
+            made.append(("is_subclass", lambda a=a, b=b: kb.is_subclass(a, b)))
+        elif kind == 2:
+            name = rng.choice(classes)
+            made.append(("object_profile", lambda n=name: kb.object_profile(n)))
+        elif kind == 3:
+            name = rng.choice(classes)
+            made.append(("default_location", lambda n=name: kb.default_location(n)))
+        elif kind == 4:
+            name = rng.choice(region_classes)
+            made.append(("regions_of_class", lambda n=name: kb.regions_of_class(n)))
+        elif kind == 5:
+            color = rng.choice(colors)
+            made.append(("providers(color)", lambda c=color: kb.providers("SemanticColor", value=c)))
+        elif kind == 6:
+            name = rng.choice(classes)
+            made.append(
+                (
+                    "providers(class)",
+                    lambda n=name: kb.providers("ObjectHypothesis", object_class=n, conditions=no_depth),
+                )
+            )
+        elif kind == 7:
+            key = rng.choice(keys)
+            made.append(("annotation_type_for_key", lambda k=key: kb.annotation_type_for_key(k)))
+        elif kind == 8:
+            name = rng.choice(annotators)
+            made.append(("inputs_of", lambda n=name: kb.inputs_of(n)))
+        else:
+            name = rng.choice(classes)
+            made.append(("subclasses(direct)", lambda n=name: kb.subclasses(n, direct=True)))
+    return made
+
+
+def latency(kb: KnowledgeBase, count: int, rng: random.Random) -> dict[str, list[float]]:
+    """Seconds per question, grouped by question kind (plus "all")."""
+    asked = questions(kb, count, rng)
+    for _, question in asked[:500]:  # warm-up
+        question()
+    timings: dict[str, list[float]] = defaultdict(list)
+    clock = time.perf_counter_ns
+    for name, question in asked:
+        start = clock()
+        question()
+        elapsed = (clock() - start) / 1e9
+        timings[name].append(elapsed)
+        timings["all"].append(elapsed)
+    return timings
+
+
+def p99(values: list[float]) -> float:
+    """The 99th percentile."""
+    return statistics.quantiles(values, n=100)[98] if len(values) > 1 else values[0]
+
+
+def bench(label: str, files: list[Path], user_file: Path, count: int, reason: bool, rng: random.Random) -> None:
+    """Print load times and question latencies for one ontology."""
+    print(f"\n== {label}")
+    cold = cold_load(files, user_file, reason=False)
+    print(f"cold load, no reasoning : import {cold['import'] * 1e3:7.0f} ms + load {cold['load'] * 1e3:7.0f} ms")
+    if reason:
+        cold_reasoned = cold_load(files, user_file, reason=True)
+        print(
+            f"cold load, with HermiT  : import {cold_reasoned['import'] * 1e3:7.0f} ms + "
+            f"load {cold_reasoned['load'] * 1e3:7.0f} ms"
+        )
+    warm = []
+    for _ in range(3):
+        start = time.perf_counter()
+        kb = KnowledgeBase.load(user_file, files=files)
+        warm.append(time.perf_counter() - start)
+    print(f"warm load, no reasoning : {min(warm) * 1e3:7.0f} ms (best of 3)")
+    start = time.perf_counter()
+    kb.reload()
+    print(f"reload (files unchanged): {(time.perf_counter() - start) * 1e3:7.0f} ms")
+    print(
+        f"size: {len(kb.names_of_kind('class'))} object classes, {len(kb.annotators())} annotators, "
+        f"{len(kb.regions())} regions, {len(kb.index.words)} word keys"
+    )
+    timings = latency(kb, count, rng)
+    print(f"{'question':26s} {'n':>6s} {'median µs':>10s} {'p99 µs':>10s}")
+    for name in sorted(timings, key=lambda n: (n == "all", n)):
+        values = timings[name]
+        print(f"{name:26s} {len(values):6d} {statistics.median(values) * 1e6:10.1f} {p99(values) * 1e6:10.1f}")
+
+
+def main() -> int:
+    """Run the benchmark."""
+    parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    parser.add_argument("--questions", type=int, default=10_000)
+    parser.add_argument("--no-reasoner", action="store_true", help="skip the HermiT cold loads")
+    args = parser.parse_args()
+    rng = random.Random(SEED)
+    with tempfile.TemporaryDirectory() as folder:
+        user_file = Path(folder) / "user.ttl"
+        bench("shipped ontology", list(shipped_files()), user_file, args.questions, not args.no_reasoner, rng)
+        files = generate(Path(folder), rng)
+        label = f"generated: shipped + {GENERATED_CLASSES} classes, {GENERATED_ANNOTATORS} annotators"
+        bench(label, files, user_file, args.questions, not args.no_reasoner, rng)
+    return 0
+
+
+if __name__ == "__main__":
+    sys.exit(main())

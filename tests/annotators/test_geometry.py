@@ -1,0 +1,113 @@
+"""Plane RANSAC, oriented boxes and quaternions on synthetic point sets."""
+
+from __future__ import annotations
+
+import numpy as np
+import pytest
+
+from annotators.boxes import object_box, principal_box, quaternion_from_matrix, upright_box
+from annotators.grid_segmentation import looks_like_inside
+from annotators.plane import ransac_support_plane, up_in_camera
+from robokudo.types import CameraInfo, CameraIntrinsics, Pose
+
+
+def scene_cloud(rows: int = 120, cols: int = 160) -> np.ndarray:
+    """An organized cloud (focal length 100 px): a wall 0.8 m ahead above a floor 0.3 m below the camera.
+
+    The wall covers most pixels, so only the gravity prior makes the floor the support.
+    """
+    v, u = np.mgrid[0:rows, 0:cols].astype(np.float64)
+    rays = np.stack([(u - cols / 2) / 100, (v - rows / 2) / 100, np.ones_like(u)], axis=-1)
+    with np.errstate(divide="ignore"):
+        floor_depth = np.where(rays[..., 1] > 0, 0.3 / rays[..., 1], np.inf)
+    return (rays * np.minimum(floor_depth, 0.8)[..., None]).astype(np.float32)
+
+
+def test_ransac_is_deterministic_and_finds_the_floor_when_up_is_known() -> None:
+    points = scene_cloud()
+    mask = np.isfinite(points[..., 2])
+    up = np.array([0.0, -1.0, 0.0])  # camera y points down
+    first = ransac_support_plane(points, mask, seed=3, up=up)
+    second = ransac_support_plane(points, mask, seed=3, up=up)
+    assert first is not None and second is not None
+    assert np.array_equal(first.model, second.model)
+    assert np.array_equal(first.inlier_indices, second.inlier_indices)
+    assert first.model[:3] @ up > 0.999 and first.model[3] == pytest.approx(0.3, abs=1e-3)
+
+
+def test_plane_normal_points_toward_the_camera() -> None:
+    points = scene_cloud()
+    mask = np.isfinite(points[..., 2])
+    fit = ransac_support_plane(points, mask, up=np.array([0.0, -1.0, 0.0]))
+    assert fit is not None and fit.model[3] > 0  # the origin lies on the positive side
+    wall = ransac_support_plane(points, mask)  # without gravity: the dominant plane
+    assert wall is not None and wall.model[2] < -0.999 and wall.model[3] == pytest.approx(0.8, abs=1e-3)
+
+
+def test_up_in_camera_follows_the_camera_pose() -> None:
+    k = CameraIntrinsics(1.0, 1.0, 0.0, 0.0, 1, 1)
+    assert up_in_camera(CameraInfo(k)) is None
+    looking_forward = np.array([[1.0, 0, 0, 0], [0, 0, 1, 0], [0, -1, 0, 1.5], [0, 0, 0, 1]])
+    assert np.allclose(up_in_camera(CameraInfo(k, looking_forward)), [0, -1, 0])
+
+
+@pytest.mark.parametrize(
+    "points",
+    [
+        np.zeros((0, 3)),
+        np.array([[0.1, 0.2, 0.3]]),
+        np.array([[0.0, 0.0, 1.0], [0.1, 0.0, 1.0]]),
+        np.array([[0.0, 0.0, 1.0]] * 50),
+        np.column_stack([np.linspace(0, 1, 30), np.zeros(30), np.ones(30)]),  # a line
+        np.column_stack([np.random.default_rng(0).random((40, 2)), np.ones(40)]),  # flat
+        np.full((10, 3), np.nan),
+    ],
+)
+def test_boxes_of_degenerate_point_sets_never_raise(points: np.ndarray) -> None:
+    for fit in (principal_box, upright_box):
+        box = fit(points)
+        assert box.centre.shape == (3,) and np.all(np.isfinite(box.centre))
+        assert np.allclose(box.rotation @ box.rotation.T, np.eye(3), atol=1e-6)
+        assert np.all(box.extents >= 0)
+
+
+def test_upright_box_recovers_a_rotated_box() -> None:
+    rng = np.random.default_rng(1)
+    local = (rng.random((2000, 3)) - 0.5) * [0.2, 0.1, 0.3]
+    yaw = np.radians(30)
+    rotation = np.array([[np.cos(yaw), -np.sin(yaw), 0], [np.sin(yaw), np.cos(yaw), 0], [0, 0, 1]])
+    world = local @ rotation.T + [1.0, 2.0, 0.9]
+    box = upright_box(world)
+    assert np.allclose(box.centre, [1.0, 2.0, 0.9], atol=0.005)
+    assert np.allclose(sorted(box.extents), [0.1, 0.2, 0.3], atol=0.01)
+    assert box.rotation[2, 2] == pytest.approx(1.0)
+
+
+def test_object_box_reports_world_frame_only_with_a_camera_pose() -> None:
+    points = np.random.default_rng(2).random((100, 3))
+    assert object_box(points, None)[1] == "camera"
+    box, frame = object_box(points, np.eye(4))
+    assert frame == "world" and np.allclose(box.centre, (points.min(0) + points.max(0)) / 2, atol=0.2)
+
+
+def test_quaternions_round_trip_through_pose_matrix() -> None:
+    rng = np.random.default_rng(3)
+    for _ in range(20):
+        q, _ = np.linalg.qr(rng.normal(size=(3, 3)))
+        rotation = q * np.sign(np.linalg.det(q))
+        quaternion = quaternion_from_matrix(rotation)
+        pose = Pose(position=np.zeros(3), orientation=quaternion)
+        assert np.allclose(pose.matrix()[:3, :3], rotation, atol=1e-9)
+
+
+def test_the_inside_of_a_cup_is_recognised_and_a_neighbour_is_not() -> None:
+    angles = np.linspace(0, np.pi, 50)
+    # plane coordinates (u across, v along the line of sight, height); the cup stands 0.6 m ahead
+    front = np.column_stack([0.04 * np.cos(angles), 0.6 - 0.04 * np.sin(angles), np.full(50, 0.08)])
+    front = np.vstack([front, front * [1, 1, 0.2]])
+    back = np.column_stack([0.038 * np.cos(angles), 0.6 + 0.038 * np.sin(angles), np.full(50, 0.07)])
+    beside = back + np.array([0.09, 0.0, 0.0])
+    taller_behind = back * np.array([1, 1, 0]) + np.array([0, 0.06, 0.2])
+    assert looks_like_inside(front, back, 0.01, 1.5)
+    assert not looks_like_inside(front, beside, 0.01, 1.5)
+    assert not looks_like_inside(front, taller_behind, 0.01, 1.5)

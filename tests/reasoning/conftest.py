@@ -1,0 +1,30 @@
+"""Fixtures of the reasoning tests: a shared knowledge base and per-test user ontology files."""
+
+from __future__ import annotations
+
+from collections.abc import Iterator
+from pathlib import Path
+
+import pytest
+
+from reasoning.knowledge_base import KnowledgeBase
+from reasoning.sources import USER_ONTOLOGY_ENV
+
+
+@pytest.fixture(autouse=True)
+def _private_user_ontology(tmp_path: Path, monkeypatch: pytest.MonkeyPatch) -> Iterator[None]:
+    """Never read or write the real user data directory: the default user file is a temporary one."""
+    monkeypatch.setenv(USER_ONTOLOGY_ENV, str(tmp_path / "default-user.ttl"))
+    yield
+
+
+@pytest.fixture(scope="session")
+def kb(tmp_path_factory: pytest.TempPathFactory) -> KnowledgeBase:
+    """The shipped ontology with the built-in kitchen map and an empty user file (shared: do not edit)."""
+    return KnowledgeBase.load(tmp_path_factory.mktemp("kb") / "user.ttl")
+
+
+@pytest.fixture()
+def user_file(tmp_path: Path) -> Path:
+    """A user ontology path that does not exist yet."""
+    return tmp_path / "data" / "user.ttl"
