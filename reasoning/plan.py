@@ -39,7 +39,10 @@ class Task:
 
 @dataclass(frozen=True)
 class Step:
-    """One annotator in the plan: its ontology name, implementing class, ports, parameters and why it is there."""
+    """One annotator in the plan: its ontology name, implementing class, ports, parameters and why it is there.
+
+    ``provides`` is the type it was chosen to provide ("" for the reader, refinements and steps inside a branch).
+    """
 
     annotator: str
     implemented_by: str
@@ -47,6 +50,7 @@ class Step:
     outputs: tuple[str, ...]
     parameters: tuple[tuple[str, Any], ...] = ()
     reason: str = ""
+    provides: str = ""
 
 
 @dataclass(frozen=True)

@@ -2,24 +2,27 @@
 
 The algorithm, polynomial in annotators x types:
 
-1. *Requirements*: each required type carries an optional requested value and a reason.
-2. *Provider choice* (memoised per type): the knowledge base ranks the annotators whose outputs include
-   the type, whose value domain covers the requested value under class subsumption and whose
-   preconditions hold. Annotators that refine a type (read and write it, like a crop filter) are not
-   providers of it. A provider is feasible when all its inputs are feasible; infeasible ones are dropped,
-   and a type with no feasible provider is an error naming what was missing and why.
-3. *Backward chaining* from the providers' inputs to the sensor types the reader supplies. Each annotator
-   appears once. Refinements of a type whose preconditions hold run after the type's providers and
-   before its consumers.
-4. *Grouping*: a type with several feasible providers becomes an Alternatives unit (a Fallback, in rank
-   order); inputs only one alternative needs move into that alternative's branch so that a failing
-   branch hands over to the next. Units are staged by dependency depth; a stage's units are independent.
+1. *Candidates*: the knowledge base ranks the providers of a type - annotators whose outputs include it,
+   whose value domain covers the requested value under class subsumption and whose preconditions hold.
+   An annotator that reads and writes a type (a crop filter) refines it rather than providing it.
+2. *Feasibility* by a forward fixpoint from the sensor types (what some chain of providers can produce).
+   A provider is a valid choice for a type when its inputs can be produced without that type, so choices
+   never depend on themselves. A type with no valid provider is an error naming what was missing and why.
+3. *Assignment*, breadth first from the requirements back to the sensors: each needed type gets one unit
+   - its single valid provider, or all of them as Alternatives (a Fallback, in rank order) - and each
+   annotator belongs to at most one unit. A type that an already planned unit guarantees needs no unit.
+4. *Pruning and cycle breaking*: units nothing needs are dropped; an alternative whose inputs would close a
+   dependency cycle is dropped from its Fallback.
+5. *Refinements* of planned types whose preconditions hold run after the type's unit and before its readers.
+6. *Grouping*: inputs that only one alternative needs move into that alternative's branch, so a failing
+   branch hands over to the next; units are staged by dependency depth (a stage's units are independent).
 """
 
 from __future__ import annotations
 
+from collections import deque
 from collections.abc import Iterable, Mapping, Sequence
-from dataclasses import dataclass, field
+from dataclasses import dataclass
 from typing import Protocol
 
 from reasoning.model import AnnotatorSpec, Conditions
@@ -28,6 +31,10 @@ from reasoning.plan import Alternatives, Plan, Step, Task, Unit
 
 class PlanningError(Exception):
     """No tree can satisfy the query; the message says which requirement failed and why."""
+
+
+class _OrderingError(PlanningError):
+    """The chosen alternatives cannot be ordered without a cycle (the planner then chooses more strictly)."""
 
 
 class ProviderIndex(Protocol):
@@ -41,6 +48,10 @@ class ProviderIndex(Protocol):
         conditions: Conditions | None = None,
     ) -> Sequence[AnnotatorSpec]:
         """Annotators providing ``annotation_type`` that can report ``value`` for ``object_class``, best first."""
+        ...
+
+    def annotators(self) -> Sequence[AnnotatorSpec]:
+        """Every annotator."""
         ...
 
 
@@ -65,66 +76,6 @@ class SensorSource:
         return frozenset(self.step.outputs)
 
 
-@dataclass
-class _Search:
-    """State of one planning run (memo tables); discarded afterwards."""
-
-    index: ProviderIndex
-    sensors: frozenset[str]
-    object_class: str | None
-    conditions: Conditions
-    values: dict[str, str | None] = field(default_factory=dict)
-    chosen: dict[str, list[AnnotatorSpec]] = field(default_factory=dict)
-    failures: dict[str, str] = field(default_factory=dict)
-    visiting: set[str] = field(default_factory=set)
-    reasons: dict[str, list[str]] = field(default_factory=dict)
-
-    def feasible(self, type_name: str, value: str | None, reason: str) -> bool:
-        """Choose providers for ``type_name`` (memoised); False with a recorded reason when impossible."""
-        self.reasons.setdefault(type_name, [])
-        if reason and reason not in self.reasons[type_name]:
-            self.reasons[type_name].append(reason)
-        if type_name in self.sensors:
-            return True
-        if type_name in self.chosen:
-            return True
-        if type_name in self.failures or type_name in self.visiting:
-            return False
-        self.visiting.add(type_name)
-        candidates = [
-            spec
-            for spec in self.index.providers(type_name, value, self.object_class, self.conditions)
-            if type_name not in spec.inputs
-        ]
-        feasible = []
-        blocked: list[str] = []
-        for spec in candidates:
-            missing = [needed for needed in spec.inputs if not self.feasible(needed, None, f"needed by {spec.name}")]
-            if missing:
-                blocked.append(f"{spec.name} needs {', '.join(missing)}, which cannot be produced")
-            else:
-                feasible.append(spec)
-        self.visiting.discard(type_name)
-        if not feasible:
-            self.failures[type_name] = self._why_none(type_name, value, blocked)
-            return False
-        self.chosen[type_name] = feasible
-        self.values[type_name] = value
-        return True
-
-    def _why_none(self, type_name: str, value: str | None, blocked: list[str]) -> str:
-        asked = f"{type_name} with value {value!r}" if value else type_name
-        usable = {spec.name for spec in self.index.providers(type_name, value, self.object_class, self.conditions)}
-        details = [
-            f"{spec.name} {_exclusion(spec, type_name, value, self.object_class, self.conditions)}"
-            for spec in self.index.providers(type_name)
-            if spec.name not in usable and type_name not in spec.inputs
-        ] + blocked
-        if not details:
-            return f"no annotator in the ontology provides {asked}"
-        return f"no usable annotator provides {asked} ({'; '.join(details)})"
-
-
 def plan_requirements(
     task: Task,
     requirements: Sequence[Requirement],
@@ -138,154 +89,485 @@ def plan_requirements(
     ``conditions`` say whether depth and a region are available; ``parameters`` are constructor arguments
     per annotator name (e.g. the region box for a region filter).
     """
-    search = _Search(index, source.types, task.object_class, conditions or Conditions())
-    for requirement in requirements:
-        if not search.feasible(requirement.annotation_type, requirement.value, requirement.reason):
-            raise PlanningError(
-                f"cannot satisfy '{requirement.reason or requirement.annotation_type}': "
-                f"{search.failures[requirement.annotation_type]}"
-            )
-    refinements = _refinements(index, search, source.types)
-    graph = _UnitGraph(search, refinements, source, dict(parameters or {}))
-    return Plan(task=task, stages=graph.stages(), sensor_types=source.types)
+    catalog = _Catalog(index, source.types, task.object_class, conditions or Conditions())
+    try:
+        assignment = _Assignment(catalog, requirements)
+    except _OrderingError:
+        # the greedy choice of alternatives painted itself into a cycle: choose again, allowing only
+        # providers whose inputs are derived in earlier fixpoint rounds (always acyclic, fewer alternatives)
+        catalog.by_rounds = True
+        assignment = _Assignment(catalog, requirements)
+    layout = _Layout(catalog, assignment, source, dict(parameters or {}))
+    return Plan(task=task, stages=layout.stages(), sensor_types=source.types)
 
 
-def _refinements(index: ProviderIndex, search: _Search, sensors: frozenset[str]) -> dict[str, list[AnnotatorSpec]]:
-    """Annotators that read and write a planned type and whose preconditions and other inputs hold."""
-    planned = set(search.chosen) | set(sensors)
-    found: dict[str, list[AnnotatorSpec]] = {}
-    for type_name in sorted(planned):
-        applicable = [
-            spec
-            for spec in index.providers(type_name, None, search.object_class, search.conditions)
-            if type_name in spec.inputs
-            and all(
-                needed == type_name or search.feasible(needed, None, f"needed by {spec.name}") for needed in spec.inputs
-            )
+class _Catalog:
+    """Candidate providers (memoised per type and value) and what can be produced from the sensors."""
+
+    def __init__(
+        self, index: ProviderIndex, sensors: frozenset[str], object_class: str | None, conditions: Conditions
+    ) -> None:
+        self.index = index
+        self.sensors = sensors
+        self.object_class = object_class
+        self.conditions = conditions
+        self._providers: dict[tuple[str, str | None], tuple[AnnotatorSpec, ...]] = {}
+        self._without: dict[frozenset[str], frozenset[str]] = {}
+        outputs = sorted({t for spec in index.annotators() for t in spec.outputs})
+        self.edges = [(spec, t) for t in outputs for spec in self.providers(t)]
+        self.rounds = self._rounds()
+        self.producible = frozenset(self.rounds)
+        self.by_rounds = False
+
+    def _rounds(self) -> dict[str, int]:
+        """The fixpoint round in which each producible type first becomes producible (sensors: 0)."""
+        rounds = dict.fromkeys(self.sensors, 0)
+        current = 0
+        while True:
+            current += 1
+            known = set(rounds)
+            new = {t for spec, t in self.edges if t not in known and known.issuperset(spec.inputs)}
+            if not new:
+                return rounds
+            rounds.update(dict.fromkeys(new, current))
+
+    def providers(self, type_name: str, value: str | None = None) -> tuple[AnnotatorSpec, ...]:
+        """Ranked providers of ``type_name`` for ``value`` (refiners of the type excluded)."""
+        key = (type_name, value)
+        if key not in self._providers:
+            found = self.index.providers(type_name, value, self.object_class, self.conditions)
+            self._providers[key] = tuple(s for s in found if type_name not in s.inputs)
+        return self._providers[key]
+
+    def refiners(self, type_name: str) -> list[AnnotatorSpec]:
+        """Annotators that read and write ``type_name`` and whose preconditions hold, cheapest first."""
+        found = self.index.providers(type_name, None, self.object_class, self.conditions)
+        return sorted((s for s in found if type_name in s.inputs), key=lambda s: (s.cost_ms, s.name))
+
+    def _fixpoint(self, forbidden: frozenset[str]) -> frozenset[str]:
+        known = set(self.sensors)
+        changed = True
+        while changed:
+            changed = False
+            for spec, produced in self.edges:
+                if produced not in known and produced not in forbidden and known.issuperset(spec.inputs):
+                    known.add(produced)
+                    changed = True
+        return frozenset(known)
+
+    def producible_without(self, forbidden: frozenset[str]) -> frozenset[str]:
+        """What can be produced when the ``forbidden`` types may not be used."""
+        if forbidden not in self._without:
+            self._without[forbidden] = self._fixpoint(forbidden)
+        return self._without[forbidden]
+
+    def valid(self, type_name: str, value: str | None, above: frozenset[str] = frozenset()) -> list[AnnotatorSpec]:
+        """Providers of ``type_name`` whose inputs can be produced without it and without the types ``above`` it
+        (those that need it), so that choosing them cannot create a cycle."""
+        usable = self.producible_without(above | {type_name})
+        found = [s for s in self.providers(type_name, value) if usable.issuperset(s.inputs)]
+        if self.by_rounds and found:
+            depth = {s.name: max((self.rounds.get(t, 0) for t in s.inputs), default=0) for s in found}
+            limit = min(depth.values())
+            found = [s for s in found if depth[s.name] <= limit]
+        return found
+
+    def why_not(self, type_name: str, value: str | None) -> str:
+        """Why no provider of ``type_name`` is usable, naming each excluded annotator."""
+        asked = f"{type_name} with value {value!r}" if value else type_name
+        usable = {s.name for s in self.providers(type_name, value)}
+        details = [
+            f"{s.name} {_exclusion(s, type_name, value, self.object_class, self.conditions)}"
+            for s in self.index.providers(type_name)
+            if s.name not in usable and type_name not in s.inputs
         ]
-        if applicable:
-            found[type_name] = sorted(applicable, key=lambda s: (s.cost_ms, s.name))
-    return found
+        producible = self.producible_without(frozenset({type_name}))
+        for spec in self.providers(type_name, value):
+            missing = sorted(set(spec.inputs) - producible)
+            details.append(f"{spec.name} needs {', '.join(missing)}, which cannot be produced")
+        if not details:
+            return f"no annotator in the ontology provides {asked}"
+        return f"no usable annotator provides {asked} ({'; '.join(details)})"
 
 
-class _UnitGraph:
-    """Units (the reader, one per provided type, one per refinement) with their dependencies, staged by depth.
+@dataclass
+class _UnitChoice:
+    """The providers chosen for one needed type (one unit of the plan)."""
 
-    Unit keys: ``reader``, ``type:<T>`` (the providers of T: a Step or Alternatives) and ``refine:<name>``.
+    type_name: str
+    providers: list[AnnotatorSpec]
+    value: str | None
+
+    def guaranteed(self) -> set[str]:
+        """Types the unit produces for others: outputs every provider writes without having read them."""
+        return set.intersection(*(set(s.outputs) - set(s.inputs) for s in self.providers))
+
+
+class _Assignment:
+    """Which unit provides each needed type, with each annotator in at most one unit and no cycles.
+
+    Units are keyed by the type they were made for. ``above[T]`` holds the types whose units (transitively)
+    need unit T; a provider for T may not need any of them, which keeps the unit graph acyclic.
+    """
+
+    def __init__(self, catalog: _Catalog, requirements: Sequence[Requirement]) -> None:
+        self.catalog = catalog
+        self.requirements = requirements
+        self.values = {r.annotation_type: r.value for r in requirements}
+        self.reasons: dict[str, list[str]] = {}
+        for requirement in requirements:
+            self._note(requirement.annotation_type, requirement.reason)
+        self.units: dict[str, _UnitChoice] = {}
+        self.above: dict[str, set[str]] = {}
+        self._check_feasible()
+        self._assign()
+        self._prune()
+
+    def _note(self, type_name: str, reason: str) -> None:
+        reasons = self.reasons.setdefault(type_name, [])
+        if reason and reason not in reasons:
+            reasons.append(reason)
+
+    def _check_feasible(self) -> None:
+        for requirement in self.requirements:
+            type_name, value = requirement.annotation_type, requirement.value
+            if type_name in self.catalog.sensors:
+                continue
+            if type_name not in self.catalog.producible or not self.catalog.valid(type_name, value):
+                raise PlanningError(
+                    f"cannot satisfy '{requirement.reason or type_name}': {self.catalog.why_not(type_name, value)}"
+                )
+
+    def owner(self) -> dict[str, str]:
+        """Annotator name -> the type of the unit it belongs to."""
+        return {s.name: key for key, unit in self.units.items() for s in unit.providers}
+
+    def guaranteed_by(self) -> dict[str, str]:
+        """Type -> the unit (by its type) that guarantees it."""
+        found: dict[str, str] = {}
+        rounds = self.catalog.rounds
+        # by-products come from the unit derived earliest, the one least likely to depend on their readers
+        for key in sorted(self.units, key=lambda k: (rounds.get(k, 0), k)):
+            providers = self.units[key].providers
+            for type_name in sorted(self.units[key].guaranteed()):
+                if self.catalog.by_rounds and any(
+                    max((rounds.get(t, 0) for t in s.inputs), default=0) >= rounds.get(type_name, 0)
+                    for s in providers
+                ):
+                    continue  # a by-product made from later types could close a cycle in the strict mode
+                found.setdefault(type_name, key)
+        for key in self.units:  # a unit always guarantees its own type
+            found[key] = key
+        return found
+
+    def dependencies(self) -> dict[str, set[str]]:
+        """Unit -> the units its providers' required inputs come from."""
+        guaranteed = self.guaranteed_by()
+        return {
+            key: {guaranteed[t] for s in unit.providers for t in s.inputs if t in guaranteed} - {key}
+            for key, unit in self.units.items()
+        }
+
+    def _below(self, key: str) -> set[str]:
+        """The unit and every unit it (transitively) needs."""
+        graph = self.dependencies()
+        seen = {key}
+        frontier = [key]
+        while frontier:
+            for dep in graph.get(frontier.pop(), ()):
+                if dep not in seen:
+                    seen.add(dep)
+                    frontier.append(dep)
+        return seen
+
+    def _reuse(self, key: str, above: set[str]) -> bool:
+        """Let the types ``above`` use unit ``key`` when that makes no cycle."""
+        below = self._below(key)
+        if below & above:
+            return False
+        for unit in below:
+            self.above.setdefault(unit, set()).update(above)
+        return True
+
+    def _cut(self, key: str, above: set[str], path: frozenset[str] = frozenset()) -> bool:
+        """Drop the alternatives below unit ``key`` that need a type in ``above`` (or close a cycle on ``path``);
+        False when none can remain."""
+        if key in above or key in path:
+            return False
+        unit = self.units[key]
+        guaranteed = self.guaranteed_by()
+        keep = []
+        for spec in unit.providers:
+            inputs = {guaranteed[t] for t in spec.inputs if t in guaranteed} - {key}
+            if all(self._cut(dep, above, path | {key}) for dep in sorted(inputs)):
+                keep.append(spec)
+        if not keep:
+            return False
+        unit.providers = keep
+        return True
+
+    def _drop_needing(self, key: str, type_name: str) -> bool:
+        """Drop the alternatives of unit ``key`` that need ``type_name``, if others remain."""
+        unit = self.units[key]
+        keep = [spec for spec in unit.providers if type_name not in spec.inputs]
+        if not keep or len(keep) == len(unit.providers):
+            return False
+        unit.providers = keep
+        return True
+
+    def _take_over(self, type_name: str, valid: list[AnnotatorSpec], consumer: str | None, above: set[str]) -> bool:
+        """Every valid provider runs as an alternative elsewhere: commit that unit to one of them, or drop the
+        consumer's alternatives that needed the type."""
+        owner = self.owner()
+        for spec in valid:
+            key = owner[spec.name]
+            if consumer is not None and (key == consumer or key in above):
+                if self._drop_needing(consumer, type_name):
+                    return True
+                continue
+            previous = list(self.units[key].providers)
+            self.units[key].providers = [spec]
+            if self._cut(key, above) and self._reuse(key, above):
+                self._note(type_name, f"{spec.name} also provides it")
+                return True
+            self.units[key].providers = previous
+        return False
+
+    def _assign(self) -> None:
+        queue: deque[tuple[str, str | None]] = deque((r.annotation_type, None) for r in self.requirements)
+        while queue:
+            type_name, consumer = queue.popleft()
+            if type_name in self.catalog.sensors:
+                continue
+            if consumer is not None and (
+                consumer not in self.units or not any(type_name in s.inputs for s in self.units[consumer].providers)
+            ):
+                continue  # the consumer's alternatives that needed it were dropped
+            above = set() if consumer is None else self.above.get(consumer, set()) | {consumer}
+            existing = self.guaranteed_by().get(type_name)
+            if existing is not None and self._cut(existing, above) and self._reuse(existing, above):
+                continue
+            if existing is not None and consumer is not None and self._drop_needing(consumer, type_name):
+                continue
+            if existing == type_name:
+                raise _OrderingError(f"cannot order the annotators for {type_name}: its providers need {consumer}")
+            value = self.values.get(type_name)
+            valid = self.catalog.valid(type_name, value, frozenset(above))
+            owner = self.owner()
+            free = [s for s in valid if s.name not in owner]
+            if not free:
+                if not self._take_over(type_name, valid, consumer, above):
+                    raise _OrderingError(f"cannot produce {type_name}: {self.catalog.why_not(type_name, value)}")
+                continue
+            self.units[type_name] = _UnitChoice(type_name, free, value)
+            self.above[type_name] = set(above)
+            for spec in free:
+                for needed in spec.inputs:
+                    self._note(needed, f"needed by {spec.name}")
+                    queue.append((needed, type_name))
+
+    def _prune(self) -> None:
+        """Drop units that no requirement needs any more (after a unit was committed to one provider)."""
+        while True:
+            guaranteed = self.guaranteed_by()
+            needed: set[str] = set()
+            frontier = [r.annotation_type for r in self.requirements]
+            while frontier:
+                type_name = frontier.pop()
+                key = guaranteed.get(type_name)
+                if key is None or key in needed:
+                    continue
+                needed.add(key)
+                frontier.extend(t for s in self.units[key].providers for t in s.inputs)
+            unneeded = set(self.units) - needed
+            if not unneeded:
+                return
+            for key in unneeded:
+                del self.units[key]
+
+
+def _find_cycle(graph: Mapping[str, set[str]]) -> list[str] | None:
+    """A cycle of the graph (each node followed by a node it depends on), or None."""
+    state: dict[str, int] = {}
+    path: list[str] = []
+
+    def visit(node: str) -> list[str] | None:
+        state[node] = 1
+        path.append(node)
+        for dep in sorted(graph.get(node, ())):
+            if state.get(dep) == 1:
+                return path[path.index(dep) :]
+            if dep not in state:
+                found = visit(dep)
+                if found:
+                    return found
+        state[node] = 2
+        path.pop()
+        return None
+
+    for node in sorted(graph):
+        if node not in state:
+            found = visit(node)
+            if found:
+                return found
+    return None
+
+
+class _Layout:
+    """Units (the reader, provider units, refinements) with their dependencies, staged by depth.
+
+    Unit keys: ``reader``, ``type:<T>`` and ``refine:<annotator>``.
     """
 
     def __init__(
         self,
-        search: _Search,
-        refinements: dict[str, list[AnnotatorSpec]],
+        catalog: _Catalog,
+        assignment: _Assignment,
         source: SensorSource,
         parameters: dict[str, Mapping[str, object]],
     ) -> None:
-        self.search = search
-        self.refinements = refinements
+        self.catalog = catalog
+        self.assignment = assignment
+        self.units = assignment.units
         self.source = source
         self.parameters = parameters
         self.branches = self._branches()
         absorbed = {t for owned in self.branches.values() for types in owned.values() for t in types}
         self.final: dict[str, str] = dict.fromkeys(source.types, "reader")
+        for type_name, key in sorted(assignment.guaranteed_by().items()):
+            if key not in absorbed:
+                self.final[type_name] = f"type:{key}"
+        for owner_type, owned in self.branches.items():
+            for types in owned.values():
+                for type_name in types:
+                    self.final[type_name] = f"type:{owner_type}"
+        self.unrefined = dict(self.final)
+        self.refinements = self._refinements()
+        while True:
+            self._connect()
+            cycle = self._required_cycle()
+            if cycle is None:
+                break
+            # a refinement that would close a cycle is left out (refinements are improvements, never required)
+            dropped = next((key.split(":", 1)[1] for key in cycle if key.startswith("refine:")), None)
+            if dropped is None:
+                raise PlanningError(f"the annotators for {' -> '.join(cycle)} depend on each other in a cycle")
+            self.refinements = {
+                t: [s for s in specs if s.name != dropped] for t, specs in self.refinements.items()
+            }
+            self.refinements = {t: specs for t, specs in self.refinements.items() if specs}
+
+    def _connect(self) -> None:
+        """Compute the final producer of each type and every unit's dependencies for the current refinements."""
+        absorbed = {t for owned in self.branches.values() for types in owned.values() for t in types}
+        self.final = dict(self.unrefined)
+        for type_name, specs in self.refinements.items():
+            self.final[type_name] = f"refine:{specs[-1].name}"
         self.dependencies: dict[str, set[str]] = {"reader": set()}
-        provided = [t for t in sorted(search.chosen) if t not in absorbed]
-        for type_name in provided:
-            self.final[type_name] = f"type:{type_name}"
-        for type_name in absorbed:
-            owner = next(f"type:{t}" for t, owned in self.branches.items() for ts in owned.values() if type_name in ts)
-            self.final[type_name] = owner
-        unrefined = dict(self.final)
-        for type_name, specs in sorted(refinements.items()):
-            for spec in specs:
-                self.final[type_name] = f"refine:{spec.name}"
+        self.optional_edges: set[tuple[str, str]] = set()
         self.refines_output_of: dict[str, str] = {}
-        for type_name, specs in sorted(refinements.items()):
-            previous = unrefined.get(type_name)
+        for type_name, specs in sorted(self.refinements.items()):
+            previous = self.unrefined[type_name]
             for spec in specs:
                 key = f"refine:{spec.name}"
-                if previous:
-                    self.refines_output_of[spec.name] = previous
-                self.dependencies[key] = ({previous} if previous else set()) | self._producers(
-                    [t for t in spec.inputs if t != type_name], spec.optional_inputs
-                )
+                self.refines_output_of[spec.name] = previous
+                required = {previous} | self._producers([t for t in spec.inputs if t != type_name])
+                optional = self._producers(spec.optional_inputs) - required
+                self.optional_edges |= {(key, dep) for dep in optional}
+                self.dependencies[key] = (required | optional) - {key}
                 previous = key
-        for type_name in provided:
+        for type_name in sorted(self.units):
+            if type_name in absorbed:
+                continue
             key = f"type:{type_name}"
             deps: set[str] = set()
-            for spec in search.chosen[type_name]:
+            optional: set[str] = set()
+            for spec in self.units[type_name].providers:
                 members = self._members(type_name, spec)
                 inside = set(self.branches.get(type_name, {}).get(spec.name, []))
-                inputs = [t for m in members for t in m.inputs if t not in inside]
-                optional = [t for m in members for t in m.optional_inputs if t not in inside]
-                deps |= self._producers(inputs, optional)
-            deps.discard(key)
-            self.dependencies[key] = deps
-        self._drop_cycles()
+                deps |= self._producers([t for m in members for t in m.inputs if t not in inside])
+                optional |= self._producers([t for m in members for t in m.optional_inputs if t not in inside])
+            self.optional_edges |= {(key, dep) for dep in optional - deps}
+            self.dependencies[key] = (deps | optional) - {key}
 
-    def _producers(self, inputs: Iterable[str], optional: Iterable[str] = ()) -> set[str]:
-        keys = {self.final[t] for t in inputs if t in self.final}
-        keys |= {self.final[t] for t in optional if t in self.final}
-        return keys
+    def _refinements(self) -> dict[str, list[AnnotatorSpec]]:
+        """Refiners of planned types whose other inputs are planned too and that are not otherwise used."""
+        used = set(self.assignment.owner())
+        read = {r.annotation_type for r in self.assignment.requirements}
+        read |= {t for unit in self.units.values() for s in unit.providers for t in s.inputs}
+        found: dict[str, list[AnnotatorSpec]] = {}
+        for type_name in sorted(self.final.keys() & read):
+            specs = [
+                s
+                for s in self.catalog.refiners(type_name)
+                if s.name not in used and all(t == type_name or t in self.final for t in s.inputs)
+            ]
+            if specs:
+                found[type_name] = specs
+                used |= {s.name for s in specs}
+        return found
+
+    def _producers(self, types: Iterable[str]) -> set[str]:
+        return {self.final[t] for t in types if t in self.final}
 
     def _members(self, type_name: str, spec: AnnotatorSpec) -> list[AnnotatorSpec]:
         """The annotators of one branch: absorbed providers in dependency order, then the alternative."""
         owned = self.branches.get(type_name, {}).get(spec.name, [])
-        return [self.search.chosen[t][0] for t in _topological(owned, self.search.chosen)] + [spec]
+        return [self.units[t].providers[0] for t in _topological(owned, self.units)] + [spec]
 
     def _branches(self) -> dict[str, dict[str, list[str]]]:
-        """For each type with alternatives: the types only one alternative needs, moved into its branch.
+        """For each unit with alternatives: the units only one alternative needs, moved into its branch.
 
-        A type moves when it has a single provider, is not refined, and is consumed only inside that branch.
+        A unit moves when it has a single provider, guarantees nothing else that is used, and is needed
+        only inside that branch.
         """
         consumers: dict[str, set[str]] = {}
-        planned = [s for specs in self.search.chosen.values() for s in specs]
-        planned += [s for specs in self.refinements.values() for s in specs]
-        for spec in planned:
-            for needed in (*spec.inputs, *spec.optional_inputs):
-                consumers.setdefault(needed, set()).add(spec.name)
+        for unit in self.units.values():
+            for spec in unit.providers:
+                for needed in (*spec.inputs, *spec.optional_inputs):
+                    consumers.setdefault(needed, set()).add(spec.name)
+        for type_name in sorted(set(self.units) | set(self.source.types)):
+            for spec in self.catalog.refiners(type_name):
+                for needed in (*spec.inputs, *spec.optional_inputs):
+                    consumers.setdefault(needed, set()).add(spec.name)
+        guaranteed = self.assignment.guaranteed_by()
         branches: dict[str, dict[str, list[str]]] = {}
-        for type_name in sorted(self.search.chosen):
-            specs = self.search.chosen[type_name]
-            if len(specs) < 2:
+        for type_name in sorted(self.units):
+            unit = self.units[type_name]
+            if len(unit.providers) < 2:
                 continue
             branches[type_name] = {}
-            for spec in specs:
+            for spec in unit.providers:
                 owned: list[str] = []
                 members = {spec.name}
                 frontier = list(spec.inputs)
                 while frontier:
                     needed = frontier.pop(0)
-                    providers = self.search.chosen.get(needed, [])
-                    if (
-                        needed in owned
-                        or len(providers) != 1
-                        or needed in self.refinements
-                        or not consumers.get(needed, set()) <= members
-                    ):
+                    key = guaranteed.get(needed)
+                    if key is None or key in owned or key == type_name or len(self.units[key].providers) != 1:
                         continue
-                    owned.append(needed)
-                    members.add(providers[0].name)
-                    frontier.extend(providers[0].inputs)
+                    outputs = [t for t, k in guaranteed.items() if k == key]
+                    if any(not consumers.get(t, set()) <= members for t in outputs):
+                        continue
+                    owned.append(key)
+                    inner = self.units[key].providers[0]
+                    members.add(inner.name)
+                    frontier.extend(inner.inputs)
                 branches[type_name][spec.name] = owned
         return branches
 
-    def _drop_cycles(self) -> None:
-        """Optional inputs may point backwards; such ordering edges are dropped (required ones never cycle)."""
-        state: dict[str, int] = {}
-
-        def visit(key: str) -> None:
-            state[key] = 1
-            for dep in sorted(self.dependencies.get(key, set())):
-                if state.get(dep) == 1:
-                    self.dependencies[key].discard(dep)
-                elif dep not in state:
-                    visit(dep)
-            state[key] = 2
-
-        for key in sorted(self.dependencies):
-            if key not in state:
-                visit(key)
+    def _required_cycle(self) -> list[str] | None:
+        """Drop optional ordering edges that close cycles; return a cycle of required edges, if any."""
+        while True:
+            cycle = _find_cycle(self.dependencies)
+            if cycle is None:
+                return None
+            edges = list(zip(cycle, cycle[1:] + cycle[:1], strict=True))
+            optional = [edge for edge in edges if edge in self.optional_edges]
+            if not optional:
+                return cycle
+            consumer, producer = optional[0]
+            self.dependencies[consumer].discard(producer)
 
     def stages(self) -> tuple[tuple[Unit, ...], ...]:
         """Units grouped by dependency depth, in a deterministic order."""
@@ -304,21 +586,22 @@ class _UnitGraph:
     def _label(self, key: str) -> str:
         if key == "reader":
             return self.source.step.annotator
-        if key.startswith("refine:"):
-            return key.split(":", 1)[1]
-        return " / ".join(s.name for s in self.search.chosen[key.split(":", 1)[1]])
+        kind, name = key.split(":", 1)
+        if kind == "refine":
+            return name
+        return " / ".join(s.name for s in self.units[name].providers)
 
-    def _step(self, spec: AnnotatorSpec, why: str, inside: Iterable[str] = ()) -> Step:
-        inside = set(inside)
+    def _step(self, spec: AnnotatorSpec, why: str, provides: str = "", inside: Iterable[str] = ()) -> Step:
+        inside_types = {t for key in inside for t in self.units[key].guaranteed()}
+        guaranteed = self.assignment.guaranteed_by()
         feeds = []
         for needed in spec.inputs:
-            if needed in inside:
-                feeds.append(f"{needed} from {self.search.chosen[needed][0].name}")
+            if needed in inside_types:
+                feeds.append(f"{needed} from {self.units[guaranteed[needed]].providers[0].name}")
+            elif needed in spec.outputs and spec.name in self.refines_output_of:
+                feeds.append(f"{needed} from {self._label(self.refines_output_of[spec.name])}")
             elif needed in self.final:
-                producer = self.final[needed]
-                if needed in spec.outputs and spec.name in self.refines_output_of:
-                    producer = self.refines_output_of[spec.name]
-                feeds.append(f"{needed} from {self._label(producer)}")
+                feeds.append(f"{needed} from {self._label(self.final[needed])}")
         reason = f"{spec.name}: {why}"
         if feeds:
             reason += f"; needs {', '.join(feeds)}"
@@ -329,10 +612,11 @@ class _UnitGraph:
             outputs=tuple(spec.outputs),
             parameters=tuple(sorted(self.parameters.get(spec.name, {}).items())),
             reason=reason,
+            provides=provides,
         )
 
     def _why(self, type_name: str) -> str:
-        reasons = self.search.reasons.get(type_name, [])
+        reasons = self.assignment.reasons.get(type_name, [])
         return "; ".join(reasons) if reasons else f"provides {type_name}"
 
     def _unit(self, key: str) -> Unit:
@@ -343,43 +627,42 @@ class _UnitGraph:
             spec = next(s for specs in self.refinements.values() for s in specs if s.name == name)
             refined = next(t for t in spec.outputs if t in spec.inputs)
             return self._step(spec, f"refines {refined} before it is used ({_precondition_note(spec)})")
-        specs = self.search.chosen[name]
-        if len(specs) == 1:
-            return self._step(specs[0], self._why(name))
+        unit = self.units[name]
+        if len(unit.providers) == 1:
+            return self._step(unit.providers[0], self._why(name), provides=name)
         branches = []
-        for spec in specs:
+        for spec in unit.providers:
             members = self._members(name, spec)
             owned = self.branches[name][spec.name]
-            inner = tuple(self._step(m, f"needed only by {spec.name}", owned) for m in members[:-1])
-            branches.append((*inner, self._step(spec, self._why(name), owned)))
-        ranking = ", ".join(f"{s.name} (reliability {s.reliability:g}, {s.cost_ms:g} ms)" for s in specs)
+            inner = tuple(self._step(m, f"needed only by {spec.name}", inside=owned) for m in members[:-1])
+            branches.append((*inner, self._step(spec, self._why(name), provides=name, inside=owned)))
+        ranking = ", ".join(f"{s.name} (reliability {s.reliability:g}, {s.cost_ms:g} ms)" for s in unit.providers)
         return Alternatives(
             provides=name,
             branches=tuple(branches),
-            reason=f"{len(specs)} annotators can provide {name}; tried in rank order: {ranking}",
+            reason=f"{len(unit.providers)} annotators can provide {name}; tried in rank order: {ranking}",
         )
 
 
-def _topological(types: list[str], chosen: Mapping[str, list[AnnotatorSpec]]) -> list[str]:
-    """Order types so that each comes after the types its provider needs."""
+def _topological(keys: list[str], units: Mapping[str, _UnitChoice]) -> list[str]:
+    """Order units so that each comes after the units of the same list whose types it needs."""
     ordered: list[str] = []
-    remaining = list(types)
+    remaining = list(keys)
     while remaining:
-        for type_name in sorted(remaining):
-            needs = set(chosen[type_name][0].inputs) & set(remaining)
-            if not needs:
-                ordered.append(type_name)
-                remaining.remove(type_name)
+        for key in sorted(remaining):
+            needs = set(units[key].providers[0].inputs)
+            if not any(units[other].guaranteed() & needs for other in remaining if other != key):
+                ordered.append(key)
+                remaining.remove(key)
                 break
-        else:  # a cycle cannot occur in a feasible plan; keep order stable anyway
+        else:
             ordered.extend(sorted(remaining))
             break
     return ordered
 
 
 def _precondition_note(spec: AnnotatorSpec) -> str:
-    preconditions = getattr(spec, "preconditions", ())
-    return "its preconditions hold: " + ", ".join(preconditions) if preconditions else "applies to every plan"
+    return "its preconditions hold: " + ", ".join(spec.preconditions) if spec.preconditions else "applies to every plan"
 
 
 def _exclusion(

@@ -7,7 +7,7 @@ project's ``annotators`` package can be instantiated.
 from __future__ import annotations
 
 import importlib
-from collections.abc import Sequence
+from collections.abc import Callable, Sequence
 
 import py_trees
 
@@ -45,20 +45,23 @@ def instantiate(step: Step) -> Annotator:
     return node
 
 
-def _unit_node(unit: Unit) -> py_trees.behaviour.Behaviour:
+NodeFactory = Callable[[Step], py_trees.behaviour.Behaviour]
+
+
+def _unit_node(unit: Unit, make: NodeFactory) -> py_trees.behaviour.Behaviour:
     if isinstance(unit, Step):
-        return instantiate(unit)
-    return _fallback(unit)
+        return make(unit)
+    return _fallback(unit, make)
 
 
-def _fallback(alternatives: Alternatives) -> py_trees.composites.Selector:
+def _fallback(alternatives: Alternatives, make: NodeFactory) -> py_trees.composites.Selector:
     branches: list[py_trees.behaviour.Behaviour] = []
     for branch in alternatives.branches:
         if len(branch) == 1:
-            branches.append(instantiate(branch[0]))
+            branches.append(make(branch[0]))
         else:
             sequence = py_trees.composites.Sequence(
-                f"via {branch[-1].annotator}", memory=True, children=[instantiate(step) for step in branch]
+                f"via {branch[-1].annotator}", memory=True, children=[make(step) for step in branch]
             )
             sequence.reason = f"{branch[-1].annotator} with the steps only it needs"
             branches.append(sequence)
@@ -67,19 +70,25 @@ def _fallback(alternatives: Alternatives) -> py_trees.composites.Selector:
     return node
 
 
-def _stage_node(index: int, stage: Sequence[Unit]) -> py_trees.behaviour.Behaviour:
+def _stage_node(index: int, stage: Sequence[Unit], make: NodeFactory) -> py_trees.behaviour.Behaviour:
     if len(stage) == 1:
-        return _unit_node(stage[0])
-    parallel = ThresholdParallel(f"stage {index}", [_unit_node(unit) for unit in stage])
+        return _unit_node(stage[0], make)
+    parallel = ThresholdParallel(f"stage {index}", [_unit_node(unit, make) for unit in stage])
     parallel.reason = "independent experts run side by side; all must succeed"
     return parallel
 
 
 def build_tree(
-    plan: Plan, name: str = "query", final_steps: Sequence[py_trees.behaviour.Behaviour] = ()
+    plan: Plan,
+    name: str = "query",
+    final_steps: Sequence[py_trees.behaviour.Behaviour] = (),
+    make: NodeFactory = instantiate,
 ) -> Pipeline:
-    """The Pipeline for ``plan`` (stages in order, then ``final_steps`` such as the answer step), validated."""
-    children = [_stage_node(index, stage) for index, stage in enumerate(plan.stages, start=1)]
+    """The Pipeline for ``plan`` (stages in order, then ``final_steps`` such as the answer step), validated.
+
+    ``make`` turns a step into a node (default: the annotator class the ontology names).
+    """
+    children = [_stage_node(index, stage, make) for index, stage in enumerate(plan.stages, start=1)]
     pipeline = Pipeline(name, [*children, *final_steps])
     pipeline.reason = f"answers the {plan.task.kind} query"
     validate_data_flow(pipeline)
