@@ -1,0 +1,1 @@
+"""Tests of hypothesis fusion, identity across frames, the belief store and answers."""

@@ -1,0 +1,318 @@
+"""Answers: object designators (Python and JSON), the AnswerStep leaf, query -> filter, and `robokudo beliefs`."""
+
+from __future__ import annotations
+
+import argparse
+import json
+from dataclasses import dataclass
+from pathlib import Path
+from typing import ClassVar
+
+import numpy as np
+import pytest
+from py_trees.common import Status
+
+from reasoning.fusion import Evidence
+from reasoning.fusion_frame import FrameObject
+from reasoning.fusion_tracking import BeliefTracker
+from robokudo import beliefs_cli
+from robokudo.annotator import Annotator
+from robokudo.answer import AnswerStep, answer_from_memory, class_iri, class_label, designator
+from robokudo.belief_query import belief_filter
+from robokudo.belief_store import BeliefFilter, BeliefStore
+from robokudo.engine import Engine
+from robokudo.pipeline import Pipeline
+from robokudo.types import (
+    ONTOLOGY_NAMESPACE,
+    CameraInfo,
+    CameraIntrinsics,
+    CasType,
+    Classification,
+    ObjectHypothesis,
+    Pose,
+    SemanticColor,
+)
+
+SUBCLASSES = {("LactoseFreeMilk", "Milk")}
+
+
+def is_subclass(a: str, b: str) -> bool:
+    return a == b or (a, b) in SUBCLASSES
+
+
+@dataclass(frozen=True)
+class Box:
+    name: str
+    region_class: str
+    pose: np.ndarray
+    size: tuple[float, float, float]
+    frame: str = "world"
+
+
+def box(name: str, centre: tuple[float, float, float], size: tuple[float, float, float]) -> Box:
+    pose = np.eye(4)
+    pose[:3, 3] = centre
+    return Box(name, "FridgeInterior" if name == "fridge" else "TableTop", pose, size)
+
+
+FRIDGE = box("fridge", (1.3, 0.85, 0.8), (0.5, 0.5, 1.5))
+TABLE = box("table", (0.0, 0.0, 0.95), (1.2, 0.8, 0.5))
+
+
+def kitchen_objects() -> list[FrameObject]:
+    def item(position: tuple[float, float, float], evidence: list[Evidence]) -> FrameObject:
+        return FrameObject(
+            position=np.array(position),
+            frame="world",
+            orientation=np.array([0.0, 0.0, 0.0, 1.0]),
+            dimensions=np.array([0.2, 0.07, 0.07]),
+            evidence=evidence,
+            sources={"ClusterExtractor", *(e.source for e in evidence)},
+            roi=(10, 20, 50, 90),
+            confidence=0.9,
+        )
+
+    return [
+        item(
+            (1.3, 0.8, 1.05),
+            [
+                Evidence("class", "Milk", 0.8, "MilkDetector"),
+                Evidence("class", "LactoseFreeMilk", 0.7, "TextReader"),
+                Evidence("color", "white", 0.9, "SemanticColorAnnotator"),
+            ],
+        ),
+        item(
+            (0.0, -0.12, 0.8),
+            [Evidence("class", "Cup", 0.9, "CupDetector"), Evidence("color", "red", 0.9, "SemanticColorAnnotator")],
+        ),
+    ]
+
+
+@pytest.fixture
+def filled(tmp_path: Path) -> Path:
+    path = tmp_path / "beliefs.sqlite"
+    with BeliefStore(path, tracker=BeliefTracker(class_test=is_subclass, regions=(FRIDGE, TABLE))) as store:
+        store.integrate(kitchen_objects(), 100.0)
+    return path
+
+
+def test_a_designator_has_everything_the_robot_needs(filled: Path) -> None:
+    with BeliefStore(filled) as store:
+        milk = store.query(BeliefFilter(object_class="Milk", class_test=is_subclass))[0]
+    d = designator(milk, class_test=is_subclass, roi=(10, 20, 50, 90))
+    assert d.class_iri == ONTOLOGY_NAMESPACE + "LactoseFreeMilk"
+    assert d.class_label == "lactose free milk"
+    assert d.pose.frame == "world" and d.pose.position == pytest.approx((1.3, 0.8, 1.05))
+    assert d.pose.orientation == (0.0, 0.0, 0.0, 1.0)
+    assert d.size == pytest.approx((0.2, 0.07, 0.07)) and d.region == "fridge"
+    assert d.roi == (10, 20, 50, 90)
+    assert {"ClusterExtractor", "MilkDetector", "TextReader", "SemanticColorAnnotator"} <= set(d.experts)
+    classification = d.attributes["class"]
+    assert classification.value == "LactoseFreeMilk" and not classification.conflict
+    assert set(classification.experts) == {"MilkDetector", "TextReader"}
+    assert {a.value for a in classification.alternatives} == {"Milk", "LactoseFreeMilk"}
+    assert d.attributes["color"].value == "white" and d.attributes["color"].confidence == pytest.approx(0.9)
+
+    data = json.loads(json.dumps(d.to_dict()))
+    assert set(data) >= {"id", "class", "pose", "size", "region", "attributes", "roi", "experts", "confidence"}
+    assert data["class"] == {"iri": d.class_iri, "label": "lactose free milk"}
+    assert data["pose"]["frame"] == "world" and len(data["pose"]["orientation"]) == 4
+    assert data["roi"] == [10, 20, 50, 90]
+    assert data["attributes"]["color"]["experts"] == ["SemanticColorAnnotator"]
+
+
+def test_class_names_become_iris_and_labels() -> None:
+    assert class_iri("Milk") == ONTOLOGY_NAMESPACE + "Milk"
+    assert class_iri("http://example.org/onto#Cup") == "http://example.org/onto#Cup"
+    assert class_label("LactoseFreeMilk") == "lactose free milk"
+    assert class_label("http://example.org/onto#CerealBox") == "cereal box"
+    assert class_label("RGBCamera") == "rgb camera"
+
+
+def test_answers_from_memory_with_subsumption_and_region(filled: Path) -> None:
+    with BeliefStore(filled) as store:
+        answer = answer_from_memory(
+            store, BeliefFilter(object_class="Milk", class_test=is_subclass, region="fridge"), "milk in fridge"
+        )
+        assert [o.class_label for o in answer.objects] == ["lactose free milk"]
+        assert answer.from_memory and answer.objects[0].roi is None  # no current image
+        assert json.loads(answer.to_json())["objects"][0]["region"] == "fridge"
+        assert answer_from_memory(store, BeliefFilter(object_class="Milk", region="table")).objects == ()
+        assert "lactose free milk" in answer.summary()
+
+
+# ------------------------------------------------------------------------------------------- AnswerStep
+
+
+class ScriptedExperts(Annotator):
+    """Stands in for the readers and experts: writes camera info, two hypotheses and their annotations."""
+
+    outputs: ClassVar[tuple[type[CasType], ...]] = (
+        CameraInfo,
+        ObjectHypothesis,
+        SemanticColor,
+        Pose,
+        Classification,
+    )
+
+    def __init__(self, stamp: float) -> None:
+        super().__init__(name="ScriptedExperts")
+        self.stamp = stamp
+
+    def analyse(self) -> None:
+        intrinsics = CameraIntrinsics(fx=500.0, fy=500.0, cx=32.0, cy=24.0, width=64, height=48)
+        self.write(CameraInfo(intrinsics=intrinsics, cam_to_world=np.eye(4), timestamp=self.stamp))
+        for index, (position, color, cls) in enumerate(
+            [((0.0, 0.0, 1.0), "red", "Cup"), ((0.3, 0.0, 1.0), "blue", "Bowl")]
+        ):
+            mask = np.zeros((48, 64), bool)
+            mask[10:20, 10 + 30 * index : 20 + 30 * index] = True
+            roi = (10 + 30 * index, 10, 20 + 30 * index, 20)
+            hypothesis = ObjectHypothesis(point_indices=np.flatnonzero(mask), mask=mask, roi=roi)
+            self.write(hypothesis)
+            self.attach(hypothesis, SemanticColor(color=color, confidence=0.8))
+            self.attach(hypothesis, Pose(position=np.array(position), orientation=np.array([0.0, 0.0, 0.0, 1.0])))
+            self.attach(hypothesis, Classification(class_name=cls, confidence=0.7, source="Detector"))
+
+
+def test_the_answer_step_fuses_into_the_store_and_answers_with_rois(tmp_path: Path) -> None:
+    path = tmp_path / "beliefs.sqlite"
+    ids = []
+    for stamp in (10.0, 11.0):
+        step = AnswerStep(path, belief_filter=BeliefFilter(attributes={"color": "red"}))
+        root = Pipeline("perceive", [ScriptedExperts(stamp), step])
+        assert Engine(root).tick() is Status.SUCCESS
+        assert step.answer is not None
+        (cup,) = step.answer.objects
+        assert cup.class_label == "cup" and cup.roi == (10, 10, 20, 20)
+        assert cup.pose.frame == "world" and cup.pose.position == pytest.approx((0.0, 0.0, 1.0))
+        assert {"ScriptedExperts", "Detector"} <= set(cup.experts)
+        ids.append(cup.id)
+        step.store.close()
+    assert ids[0] == ids[1]  # the second run updates the same belief
+    with BeliefStore(path) as store:
+        assert store.count() == 2 and store.get(ids[0]).observations == 2  # type: ignore[union-attr]
+
+
+def test_the_answer_step_can_fail_when_nothing_matches(tmp_path: Path) -> None:
+    step = AnswerStep(
+        tmp_path / "b.sqlite", belief_filter=BeliefFilter(attributes={"color": "green"}), fail_when_empty=True
+    )
+    root = Pipeline("perceive", [ScriptedExperts(5.0), step])
+    assert Engine(root).tick() is Status.FAILURE
+    assert "no object matches" in step.feedback_message
+    step.store.close()
+
+
+# --------------------------------------------------------------------------------------- query -> filter
+
+
+class FakeKnowledgeBase:
+    """Duck-typed like reasoning.knowledge_base.KnowledgeBase (resolve, is_subclass, region, regions_of_class)."""
+
+    words: ClassVar[dict[str, str]] = {"milk": "Milk", "cup": "Cup", "red": "Red", "fridge": "fridge"}
+
+    def resolve(self, word: str, kinds: tuple[str, ...] | None = None) -> str:
+        if word.lower() not in self.words:
+            raise KeyError(word)
+        return self.words[word.lower()]
+
+    def is_subclass(self, name: str, ancestor: str) -> bool:
+        return is_subclass(name, ancestor)
+
+    def region(self, name: str) -> Box:
+        if name.lower() != "fridge":
+            raise KeyError(name)
+        return FRIDGE
+
+    def regions_of_class(self, name: str) -> list[Box]:
+        return [FRIDGE] if name == "FridgeInterior" else []
+
+
+def parse(text: str) -> object:
+    queries = pytest.importorskip("queries.dispatch")
+    return queries.parse_query(text)
+
+
+def test_query_to_filter_with_a_fake_knowledge_base() -> None:
+    f = belief_filter(parse("find milk in fridge"), FakeKnowledgeBase())
+    assert f.object_class == "Milk" and f.region == "fridge" and f.region_boxes == (FRIDGE,)
+    assert f.class_test is not None and f.class_test("LactoseFreeMilk", "Milk")
+    f = belief_filter(parse("find the red cup"), FakeKnowledgeBase())
+    assert f.object_class == "Cup" and f.attributes == {"color": "Red"} and f.limit == 1
+    nested = belief_filter(parse("detect { type: milk, location: { in: fridge }, color: white }"), None)
+    assert nested.object_class == "milk" and nested.region == "fridge" and nested.attributes == {"color": "white"}
+
+
+def test_query_to_filter_with_the_real_knowledge_base(filled: Path) -> None:
+    knowledge_base = pytest.importorskip("reasoning.knowledge_base")
+    kb = knowledge_base.KnowledgeBase.load()
+    f = belief_filter(parse("find milk in fridge"), kb)
+    assert f.object_class == "Milk" and f.region == "fridge" and len(f.region_boxes) == 1
+    with BeliefStore(filled) as store:
+        (milk,) = store.query(f)
+        assert milk.class_name == "LactoseFreeMilk"
+
+
+# -------------------------------------------------------------------------------------------------- CLI
+
+
+def cli(store: Path, query: str | None = None, *, as_json: bool = False, clear: bool = False) -> argparse.Namespace:
+    parser = argparse.ArgumentParser()
+    beliefs_cli.add_arguments(parser)
+    argv = ([query] if query else []) + (["--json"] if as_json else []) + (["--clear"] if clear else [])
+    return parser.parse_args([*argv, "--store", str(store)])
+
+
+def test_beliefs_cli_lists_answers_and_clears(filled: Path, capsys: pytest.CaptureFixture) -> None:
+    assert beliefs_cli.run(cli(filled)) == 0
+    listing = capsys.readouterr().out
+    assert "lactose free milk" in listing and "cup" in listing
+
+    pytest.importorskip("queries.dispatch")
+    assert beliefs_cli.run(cli(filled, "milk in fridge", as_json=True)) == 0
+    answer = json.loads(capsys.readouterr().out)
+    assert [o["class"]["label"] for o in answer["objects"]] == ["lactose free milk"]
+    assert answer["objects"][0]["region"] == "fridge" and answer["from_memory"]
+
+    assert beliefs_cli.run(cli(filled, "red cup on the table", as_json=True)) == 0
+    assert [o["class"]["label"] for o in json.loads(capsys.readouterr().out)["objects"]] == ["cup"]
+
+    assert beliefs_cli.run(cli(filled, clear=True)) == 0
+    assert "forgot 2 object(s)" in capsys.readouterr().out
+    assert beliefs_cli.run(cli(filled, as_json=True)) == 0
+    assert json.loads(capsys.readouterr().out)["objects"] == []
+
+
+def test_beliefs_cli_store_path_from_the_environment(
+    tmp_path: Path, monkeypatch: pytest.MonkeyPatch, capsys: pytest.CaptureFixture
+) -> None:
+    path = tmp_path / "env" / "beliefs.sqlite"
+    monkeypatch.setenv("ROBOKUDO_BELIEF_STORE", str(path))
+    assert BeliefStore.default_path() == path
+    parser = argparse.ArgumentParser()
+    beliefs_cli.add_arguments(parser)
+    assert beliefs_cli.run(parser.parse_args(["--json"])) == 0
+    assert json.loads(capsys.readouterr().out)["objects"] == []
+    assert not path.exists()  # reading an empty memory creates nothing
+
+
+def test_beliefs_cli_reports_a_bad_query(filled: Path, capsys: pytest.CaptureFixture) -> None:
+    pytest.importorskip("queries.dispatch")
+    assert beliefs_cli.run(cli(filled, "detect { type: }")) == 2
+    assert "robokudo beliefs:" in capsys.readouterr().err
+
+
+def test_the_answer_step_answers_with_what_it_sees_even_under_a_limit(tmp_path: Path) -> None:
+    path = tmp_path / "beliefs.sqlite"
+    with BeliefStore(path) as store:  # a cup known from earlier, elsewhere, with a smaller id
+        far = FrameObject(
+            position=np.array([5.0, 5.0, 1.0]), frame="world", evidence=[Evidence("class", "Cup", 0.9, "X")]
+        )
+        store.integrate([far], 1.0)
+    step = AnswerStep(path, belief_filter=BeliefFilter(object_class="Cup", limit=1))
+    assert Engine(Pipeline("perceive", [ScriptedExperts(10.0), step])).tick() is Status.SUCCESS
+    assert step.answer is not None
+    (cup,) = step.answer.objects
+    assert cup.id != 1 and cup.roi == (10, 10, 20, 20)
+    step.shutdown()
