@@ -115,6 +115,12 @@ class _Catalog:
         self._without: dict[frozenset[str], frozenset[str]] = {}
         outputs = sorted({t for spec in index.annotators() for t in spec.outputs})
         self.edges = [(spec, t) for t in outputs for spec in self.providers(t)]
+        self._waiting: dict[str, list[int]] = {}
+        for index, (spec, _) in enumerate(self.edges):
+            for needed in set(spec.inputs) - self.sensors:
+                self._waiting.setdefault(needed, []).append(index)
+        self._missing_at_start = [len(set(spec.inputs) - self.sensors) for spec, _ in self.edges]
+        self._ready_at_start = [i for i, count in enumerate(self._missing_at_start) if count == 0]
         self.rounds = self._rounds()
         self.producible = frozenset(self.rounds)
         self.by_rounds = False
@@ -136,7 +142,8 @@ class _Catalog:
         key = (type_name, value)
         if key not in self._providers:
             found = self.index.providers(type_name, value, self.object_class, self.conditions)
-            self._providers[key] = tuple(s for s in found if type_name not in s.inputs)
+            # annotators without inputs are sensor readers: the plan's source is chosen by its input, not here
+            self._providers[key] = tuple(s for s in found if s.inputs and type_name not in s.inputs)
         return self._providers[key]
 
     def refiners(self, type_name: str) -> list[AnnotatorSpec]:
@@ -145,14 +152,19 @@ class _Catalog:
         return sorted((s for s in found if type_name in s.inputs), key=lambda s: (s.cost_ms, s.name))
 
     def _fixpoint(self, forbidden: frozenset[str]) -> frozenset[str]:
+        """Worklist closure: each provider fires once all its inputs are known (linear in the ports)."""
         known = set(self.sensors)
-        changed = True
-        while changed:
-            changed = False
-            for spec, produced in self.edges:
-                if produced not in known and produced not in forbidden and known.issuperset(spec.inputs):
-                    known.add(produced)
-                    changed = True
+        missing = list(self._missing_at_start)
+        queue = list(self._ready_at_start)
+        while queue:
+            produced = self.edges[queue.pop()][1]
+            if produced in known or produced in forbidden:
+                continue
+            known.add(produced)
+            for index in self._waiting.get(produced, ()):
+                missing[index] -= 1
+                if missing[index] == 0:
+                    queue.append(index)
         return frozenset(known)
 
     def producible_without(self, forbidden: frozenset[str]) -> frozenset[str]:
@@ -219,6 +231,9 @@ class _Assignment:
             self._note(requirement.annotation_type, requirement.reason)
         self.units: dict[str, _UnitChoice] = {}
         self.above: dict[str, set[str]] = {}
+        self._guaranteed: dict[str, str] | None = None
+        self._dependencies: dict[str, set[str]] | None = None
+        self.pinned: dict[str, str] = {}  # type -> unit chosen for it when several units write it
         self._check_feasible()
         self._assign()
         self._prune()
@@ -242,8 +257,21 @@ class _Assignment:
         """Annotator name -> the type of the unit it belongs to."""
         return {s.name: key for key, unit in self.units.items() for s in unit.providers}
 
+    def _invalidate(self) -> None:
+        self._guaranteed = None
+        self._dependencies = None
+
+    def _set_providers(self, key: str, providers: list[AnnotatorSpec]) -> None:
+        self.units[key].providers = providers
+        self._invalidate()
+
     def guaranteed_by(self) -> dict[str, str]:
-        """Type -> the unit (by its type) that guarantees it."""
+        """Type -> the unit (by its type) that guarantees it (cached until the units change)."""
+        if self._guaranteed is None:
+            self._guaranteed = self._compute_guaranteed()
+        return self._guaranteed
+
+    def _compute_guaranteed(self) -> dict[str, str]:
         found: dict[str, str] = {}
         rounds = self.catalog.rounds
         # by-products come from the unit derived earliest, the one least likely to depend on their readers
@@ -256,12 +284,20 @@ class _Assignment:
                 ):
                     continue  # a by-product made from later types could close a cycle in the strict mode
                 found.setdefault(type_name, key)
+        for type_name, key in self.pinned.items():
+            if key in self.units and type_name in self.units[key].guaranteed():
+                found[type_name] = key
         for key in self.units:  # a unit always guarantees its own type
             found[key] = key
         return found
 
     def dependencies(self) -> dict[str, set[str]]:
-        """Unit -> the units its providers' required inputs come from."""
+        """Unit -> the units its providers' required inputs come from (cached until the units change)."""
+        if self._dependencies is None:
+            self._dependencies = self._compute_dependencies()
+        return self._dependencies
+
+    def _compute_dependencies(self) -> dict[str, set[str]]:
         guaranteed = self.guaranteed_by()
         return {
             key: {guaranteed[t] for s in unit.providers for t in s.inputs if t in guaranteed} - {key}
@@ -289,22 +325,26 @@ class _Assignment:
             self.above.setdefault(unit, set()).update(above)
         return True
 
-    def _cut(self, key: str, above: set[str], path: frozenset[str] = frozenset()) -> bool:
-        """Drop the alternatives below unit ``key`` that need a type in ``above`` (or close a cycle on ``path``);
-        False when none can remain."""
+    def _cut(self, key: str, above: set[str]) -> bool:
+        """Drop the alternatives below unit ``key`` that need a type in ``above``; False when none can remain."""
+        return self._cut_below(key, above, frozenset(), {})
+
+    def _cut_below(self, key: str, above: set[str], path: frozenset[str], memo: dict[str, bool]) -> bool:
         if key in above or key in path:
             return False
+        if key in memo:
+            return memo[key]
         unit = self.units[key]
         guaranteed = self.guaranteed_by()
         keep = []
         for spec in unit.providers:
             inputs = {guaranteed[t] for t in spec.inputs if t in guaranteed} - {key}
-            if all(self._cut(dep, above, path | {key}) for dep in sorted(inputs)):
+            if all(self._cut_below(dep, above, path | {key}, memo) for dep in sorted(inputs)):
                 keep.append(spec)
-        if not keep:
-            return False
-        unit.providers = keep
-        return True
+        memo[key] = bool(keep)
+        if keep and len(keep) < len(unit.providers):
+            self._set_providers(key, keep)
+        return bool(keep)
 
     def _drop_needing(self, key: str, type_name: str) -> bool:
         """Drop the alternatives of unit ``key`` that need ``type_name``, if others remain."""
@@ -312,7 +352,7 @@ class _Assignment:
         keep = [spec for spec in unit.providers if type_name not in spec.inputs]
         if not keep or len(keep) == len(unit.providers):
             return False
-        unit.providers = keep
+        self._set_providers(key, keep)
         return True
 
     def _take_over(self, type_name: str, valid: list[AnnotatorSpec], consumer: str | None, above: set[str]) -> bool:
@@ -326,11 +366,13 @@ class _Assignment:
                     return True
                 continue
             previous = list(self.units[key].providers)
-            self.units[key].providers = [spec]
+            self._set_providers(key, [spec])
             if self._cut(key, above) and self._reuse(key, above):
                 self._note(type_name, f"{spec.name} also provides it")
+                self.pinned[type_name] = key
+                self._invalidate()
                 return True
-            self.units[key].providers = previous
+            self._set_providers(key, previous)
         return False
 
     def _assign(self) -> None:
@@ -360,6 +402,7 @@ class _Assignment:
                     raise _OrderingError(f"cannot produce {type_name}: {self.catalog.why_not(type_name, value)}")
                 continue
             self.units[type_name] = _UnitChoice(type_name, free, value)
+            self._invalidate()
             self.above[type_name] = set(above)
             for spec in free:
                 for needed in spec.inputs:
@@ -384,6 +427,7 @@ class _Assignment:
                 return
             for key in unneeded:
                 del self.units[key]
+            self._invalidate()
 
 
 def _find_cycle(graph: Mapping[str, set[str]]) -> list[str] | None:
@@ -624,8 +668,7 @@ class _Layout:
             return self.source.step
         kind, name = key.split(":", 1)
         if kind == "refine":
-            spec = next(s for specs in self.refinements.values() for s in specs if s.name == name)
-            refined = next(t for t in spec.outputs if t in spec.inputs)
+            refined, spec = next((t, s) for t, specs in self.refinements.items() for s in specs if s.name == name)
             return self._step(spec, f"refines {refined} before it is used ({_precondition_note(spec)})")
         unit = self.units[name]
         if len(unit.providers) == 1:

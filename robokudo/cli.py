@@ -15,6 +15,7 @@ _EXTERNAL_COMMANDS: dict[str, tuple[str, str]] = {
     "parse": ("queries.cli", "parse a perception query and print its canonical form"),
     "plan": ("robokudo.plan_cli", "synthesize the perception tree for a query and print it"),
     "ontology": ("reasoning.ontology_cli", "show, check and edit the ontology"),
+    "query": ("robokudo.query_cli", "plan and run a query on an input and print the answer"),
     "beliefs": ("robokudo.beliefs_cli", "answer from the belief store, without running perception"),
 }
 

@@ -8,7 +8,8 @@ The analysis walks the tree with the set of CAS types guaranteed to be present:
 * ThresholdParallel: each child sees only what was present before it (children interleave); afterwards a
   type is guaranteed when every set of children large enough to make the parallel succeed contains a
   producer of it.
-* Pipeline: owns a fresh CAS, so its children start from nothing; it adds nothing to the outer CAS.
+* Pipeline: owns a fresh CAS, so its children start from nothing (but its query, when it has one); it adds
+  nothing to the outer CAS.
 * Decorators that can succeed without their child succeeding add nothing.
 """
 
@@ -23,7 +24,7 @@ from robokudo.annotator import Annotator
 from robokudo.parallel import ThresholdParallel
 from robokudo.pipeline import Pipeline
 from robokudo.slot import TaskSlot
-from robokudo.types import CasType
+from robokudo.types import CasType, QueryView
 
 TypeSet = frozenset[type[CasType]]
 _PASS_THROUGH_DECORATORS = (py_trees.decorators.Timeout, py_trees.decorators.Retry)
@@ -83,7 +84,7 @@ class _Walker:
             return available | frozenset(node.outputs)
         children = self.children(node)
         if isinstance(node, Pipeline):
-            self.sequence(children, frozenset())
+            self.sequence(children, frozenset({QueryView}) if node.query is not None else frozenset())
             return available
         if isinstance(node, py_trees.composites.Selector):
             results = [self.flow(child, available) for child in children]

@@ -7,26 +7,39 @@ from collections.abc import Iterator, Sequence
 import py_trees
 
 from robokudo.cas import CAS
+from robokudo.types import QueryView
 
 
 class Pipeline(py_trees.composites.Sequence):
     """A Sequence owning a CAS; every annotator below it (up to a nested Pipeline) works on this CAS.
 
     A fresh CAS is created each time the pipeline starts a new run, so every frame is analysed on a clean
-    structure; the last run's CAS stays readable (``pipeline.cas``) until the next run begins.
+    structure; the last run's CAS stays readable (``pipeline.cas``) until the next run begins. A pipeline
+    made for a query puts it into every new CAS as the QueryView.
     """
 
     def __init__(
-        self, name: str, children: Sequence[py_trees.behaviour.Behaviour] | None = None, memory: bool = True
+        self,
+        name: str,
+        children: Sequence[py_trees.behaviour.Behaviour] | None = None,
+        memory: bool = True,
+        query: object | None = None,
     ) -> None:
         super().__init__(name=name, memory=memory, children=list(children or []))
-        self.cas = CAS()
+        self.query = query
+        self.cas = self._new_cas()
         self.reason = ""
+
+    def _new_cas(self) -> CAS:
+        cas = CAS()
+        if self.query is not None:
+            cas.set_view(QueryView(self.query))
+        return cas
 
     def initialise(self) -> None:
         """Start a new run on a new CAS."""
         super().initialise()
-        self.cas = CAS()
+        self.cas = self._new_cas()
 
 
 class StructureError(Exception):

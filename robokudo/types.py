@@ -270,7 +270,7 @@ ANNOTATION_TYPES: tuple[type[Annotation], ...] = (
 
 def type_by_name(name: str) -> type[CasType]:
     """Look up a CAS type by its ontology name; raises KeyError listing the known names."""
-    for cas_type in VIEW_TYPES + ANNOTATION_TYPES:
+    for cas_type in (CasType, View, Annotation, *VIEW_TYPES, *ANNOTATION_TYPES):
         if cas_type.__name__ == name:
             return cas_type
     known = ", ".join(t.__name__ for t in VIEW_TYPES + ANNOTATION_TYPES)

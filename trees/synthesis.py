@@ -83,13 +83,15 @@ def build_tree(
     name: str = "query",
     final_steps: Sequence[py_trees.behaviour.Behaviour] = (),
     make: NodeFactory = instantiate,
+    query: object | None = None,
 ) -> Pipeline:
     """The Pipeline for ``plan`` (stages in order, then ``final_steps`` such as the answer step), validated.
 
-    ``make`` turns a step into a node (default: the annotator class the ontology names).
+    ``make`` turns a step into a node (default: the annotator class the ontology names); ``query`` is put
+    into every new CAS of the pipeline.
     """
     children = [_stage_node(index, stage, make) for index, stage in enumerate(plan.stages, start=1)]
-    pipeline = Pipeline(name, [*children, *final_steps])
+    pipeline = Pipeline(name, [*children, *final_steps], query=query)
     pipeline.reason = f"answers the {plan.task.kind} query"
     validate_data_flow(pipeline)
     return pipeline
