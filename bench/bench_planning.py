@@ -14,6 +14,7 @@ import sys
 import tempfile
 import time
 from pathlib import Path
+from types import ModuleType
 
 from queries import parse_query
 from reasoning.knowledge_base import KnowledgeBase
@@ -68,7 +69,7 @@ def measure(label: str, kb: KnowledgeBase, texts: list[str], source: SensorSourc
     )
 
 
-def load_generator():  # noqa: ANN201 - a module object
+def load_generator() -> ModuleType:
     path = Path(__file__).with_name("bench_ontology.py")
     spec = importlib.util.spec_from_file_location("bench_ontology", path)
     module = importlib.util.module_from_spec(spec)
