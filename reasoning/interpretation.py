@@ -31,8 +31,12 @@ class Interpretation:
     region_box: RegionBox | None
 
 
-def interpret(query: Query, kb: KnowledgeBase) -> Interpretation:
-    """Resolve the query's words and list the annotation types its answer needs."""
+def interpret(query: Query, kb: KnowledgeBase, depth: bool = True) -> Interpretation:
+    """Resolve the query's words and list the annotation types its answer needs.
+
+    ``depth`` says whether the sensor measures depth; without it objects are reported by their image region
+    and no pose is required.
+    """
     if query.kind == "stop":
         raise PlanningError("a stop query cancels a running task; there is no perception tree to plan for it")
     if query.kind == "scan":
@@ -40,12 +44,13 @@ def interpret(query: Query, kb: KnowledgeBase) -> Interpretation:
     obj = query.get("obj")
     if not isinstance(obj, Block):
         raise PlanningError(f"a {query.kind} query needs an obj block describing the object")
-    requirements = [
-        Requirement("ObjectHypothesis", None, f"a {query.kind} query needs object hypotheses"),
-        Requirement("Pose", None, f"a {query.kind} query reports each object's pose"),
-    ]
+    requirements = [Requirement("ObjectHypothesis", None, f"a {query.kind} query needs object hypotheses")]
     constraints: list[Constraint] = []
     inferences: list[str] = []
+    if depth or isinstance(obj.get("pose"), Asked):
+        requirements.append(Requirement("Pose", None, f"a {query.kind} query reports each object's pose"))
+    else:
+        inferences.append("the sensor measures no depth, so objects are reported by image region without a pose")
     object_class = _object_class(obj.get("type"), kb)
     if object_class is not None:
         constraints.append(Constraint("type", "Classification", object_class))
@@ -59,10 +64,11 @@ def interpret(query: Query, kb: KnowledgeBase) -> Interpretation:
             constraints.append(Constraint(field.key, annotation_type, name))
             asked = f"query asks {field.key} = {name}" if name is not None else f"query asks for {field.key}"
             requirements.append(Requirement(annotation_type, _domain_value(annotation_type, name), asked))
-    if object_class is not None and kb.variants_differ_by_text(object_class) and not obj.get("text"):
-        why = f"{object_class} differs from its sibling classes only by printed text, so text must be read"
-        inferences.append(why)
-        requirements.append(Requirement("Text", None, why))
+    if object_class is not None and not obj.get("text"):
+        why = _why_text_matters(object_class, kb)
+        if why:
+            inferences.append(why)
+            requirements.append(Requirement("Text", None, why))
     region_box = _region(obj.get("location"), kb)
     if region_box is None and object_class is not None:
         region_box, note = _default_region(object_class, kb)
@@ -78,6 +84,31 @@ def interpret(query: Query, kb: KnowledgeBase) -> Interpretation:
         object_id=_whole(obj.get("id")),
     )
     return Interpretation(task, tuple(requirements), region_box)
+
+
+def _why_text_matters(object_class: str, kb: KnowledgeBase) -> str:
+    """Why text must be read to recognise ``object_class`` ("" when it need not be).
+
+    Text matters when the class's variants differ only by printed text, or when another, unrelated class
+    looks the same (same colours, shape and size) and the class carries printed text that tells them apart.
+    """
+    if kb.variants_differ_by_text(object_class):
+        return f"{object_class} differs from its sibling classes only by printed text, so text must be read"
+    profile = kb.object_profile(object_class)
+    if not profile.texts:
+        return ""
+    looks = (frozenset(profile.colors), profile.shape, profile.size_class)
+    for other in kb.names_of_kind("class"):
+        if kb.is_subclass(other, object_class) or kb.is_subclass(object_class, other):
+            continue
+        seen = kb.object_profile(other)
+        if (frozenset(seen.colors), seen.shape, seen.size_class) == looks:
+            texts = ", ".join(repr(t) for t in profile.texts)
+            return (
+                f"{object_class} looks like {other} (same colour, shape and size); the text printed on it "
+                f"({texts}) tells them apart, so text must be read"
+            )
+    return ""
 
 
 def _interpret_scan(query: Query, kb: KnowledgeBase) -> Interpretation:

@@ -13,7 +13,9 @@ The algorithm, polynomial in annotators x types:
    annotator belongs to at most one unit. A type that an already planned unit guarantees needs no unit.
 4. *Pruning and cycle breaking*: units nothing needs are dropped; an alternative whose inputs would close a
    dependency cycle is dropped from its Fallback.
-5. *Refinements* of planned types whose preconditions hold run after the type's unit and before its readers.
+5. *Refinements* of planned types run after the type's unit and before its readers: every refiner whose
+   preconditions hold and that has some (a region filter when a region is named), plus the cheapest
+   general-purpose one (a crop).
 6. *Grouping*: inputs that only one alternative needs move into that alternative's branch, so a failing
    branch hands over to the next; units are staged by dependency depth (a stage's units are independent).
 """
@@ -541,11 +543,18 @@ class _Layout:
         read |= {t for unit in self.units.values() for s in unit.providers for t in s.inputs}
         found: dict[str, list[AnnotatorSpec]] = {}
         for type_name in sorted(self.final.keys() & read):
-            specs = [
+            usable = [
                 s
                 for s in self.catalog.refiners(type_name)
                 if s.name not in used and all(t == type_name or t in self.final for t in s.inputs)
             ]
+            # refiners made for a situation (with preconditions, which hold) all apply; of the general-purpose
+            # ones only the cheapest does, so two interchangeable crops are never chained
+            specs = [s for s in usable if s.preconditions]
+            general = [s for s in usable if not s.preconditions]
+            if general:
+                specs.append(min(general, key=lambda s: (s.cost_ms, -s.reliability, s.name)))
+            specs.sort(key=lambda s: (s.cost_ms, s.name))
             if specs:
                 found[type_name] = specs
                 used |= {s.name for s in specs}

@@ -13,6 +13,7 @@ from reasoning.planner import SensorSource, plan_requirements
 
 DEPTH_TYPES = frozenset({"DepthImage", "PointCloud"})
 REGION_PRECONDITION = "NeedsRegion"
+ROOT_CLASS = "PhysicalObject"
 
 
 @dataclass(frozen=True)
@@ -32,16 +33,53 @@ def region_parameters(box: RegionBox) -> dict[str, object]:
     }
 
 
+def class_profiles(kb: KnowledgeBase) -> tuple[dict[str, object], ...]:
+    """What every object class typically looks like, as plain data for a knowledge-based classifier.
+
+    Colours, shape and size are the ontology's lower-case labels; classes that say nothing visible are left out.
+    """
+    profiles = []
+    for name in kb.names_of_kind("class"):
+        profile = kb.object_profile(name)
+        if not (profile.colors or profile.shape or profile.size_class or profile.texts):
+            continue
+        profiles.append(
+            {
+                "class": name,
+                "colors": tuple(kb.label(c) for c in profile.colors),
+                "shape": kb.label(profile.shape) if profile.shape else None,
+                "size": kb.label(profile.size_class) if profile.size_class else None,
+                "texts": profile.texts,
+                "ancestors": (name, *kb.superclasses(name)),
+            }
+        )
+    return tuple(profiles)
+
+
+def annotator_parameters(kb: KnowledgeBase, box: RegionBox | None) -> dict[str, dict[str, object]]:
+    """Constructor arguments the plan hands to annotators, from the ontology.
+
+    An annotator that needs a region gets the region box; one that can report any object class (its class
+    domain is the root class) is a classifier by knowledge and gets the profiles of the classes.
+    """
+    parameters: dict[str, dict[str, object]] = {}
+    profiles: tuple[dict[str, object], ...] | None = None
+    for spec in kb.annotators():
+        if box is not None and REGION_PRECONDITION in spec.preconditions:
+            parameters[spec.name] = region_parameters(box)
+        if "Classification" in spec.outputs and ROOT_CLASS in spec.classes:
+            profiles = profiles if profiles is not None else class_profiles(kb)
+            parameters.setdefault(spec.name, {})["profiles"] = profiles
+    return parameters
+
+
 def plan_query(query: Query, kb: KnowledgeBase, source: SensorSource) -> QueryPlan:
     """Interpret ``query`` and synthesize the plan that answers it from ``source``'s sensor types."""
-    interpretation = interpret(query, kb)
+    depth = bool(source.types & DEPTH_TYPES)
+    interpretation = interpret(query, kb, depth=depth)
     box = interpretation.region_box
-    conditions = Conditions(depth=bool(source.types & DEPTH_TYPES), region=box is not None)
-    parameters: dict[str, dict[str, object]] = {}
-    if box is not None:
-        for spec in kb.annotators():
-            if REGION_PRECONDITION in spec.preconditions:
-                parameters[spec.name] = region_parameters(box)
+    conditions = Conditions(depth=depth, region=box is not None)
+    parameters = annotator_parameters(kb, box)
     plan = plan_requirements(
         interpretation.task, interpretation.requirements, kb, source, conditions=conditions, parameters=parameters
     )

@@ -13,14 +13,15 @@ def sensor_source(kb: KnowledgeBase, input_path: str | None, frame: int = 0, reg
         from annotators.kitchen_scene import camera_looking_at
 
         view = "table"
+        reason = "renders the built-in kitchen from the 'table' camera"
         if region is not None:
             try:
                 view = camera_looking_at(region)
             except ValueError:
                 view = "overview"
+            reason = f"renders the built-in kitchen from the {view!r} camera (the robot looks at region {region!r})"
         spec = kb.annotator("KitchenSceneReader")
         parameters: tuple[tuple[str, object], ...] = (("view", view),)
-        reason = f"renders the built-in kitchen from the {view!r} camera (the robot looks at the queried region)"
     else:
         spec = kb.annotator("ColorDepthPairReader")
         parameters = (("folder", input_path), ("frame", frame))
