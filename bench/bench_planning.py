@@ -20,7 +20,7 @@ from queries import parse_query
 from reasoning.knowledge_base import KnowledgeBase
 from reasoning.plan import Step
 from reasoning.planner import PlanningError, SensorSource
-from reasoning.query_planner import plan_query
+from reasoning.query_planner import QueryPlanner
 from robokudo.annotator import Annotator
 from robokudo.sources import sensor_source
 from robokudo.types import type_by_name
@@ -49,13 +49,14 @@ def generic_node(step: Step) -> Annotator:
 def measure(label: str, kb: KnowledgeBase, texts: list[str], source: SensorSource | None, generic: bool) -> None:
     samples: list[float] = []
     planned = failed = 0
+    planner = QueryPlanner(kb)
     for _ in range(REPEATS):
         for text in texts:
             start = time.perf_counter()
             try:
                 query = parse_query(text)
                 chosen = source if source is not None else sensor_source(kb, None)
-                result = plan_query(query, kb, chosen)
+                result = planner.plan(query, chosen)
                 build_tree(result.plan, make=generic_node if generic else build_tree.__defaults__[2])
                 planned += 1
             except PlanningError:

@@ -85,20 +85,28 @@ def plan_requirements(
     source: SensorSource,
     conditions: Conditions | None = None,
     parameters: Mapping[str, Mapping[str, object]] | None = None,
+    catalogs: dict[tuple[object, ...], object] | None = None,
 ) -> Plan:
     """Synthesize the staged plan that produces every requirement from the sensor source.
 
     ``conditions`` say whether depth and a region are available; ``parameters`` are constructor arguments
-    per annotator name (e.g. the region box for a region filter).
+    per annotator name (e.g. the region box for a region filter). ``catalogs`` is a cache of the
+    requirement-independent work (providers, fixpoints) that callers planning many queries against one
+    ontology keep; it is keyed by object class, conditions and sensor types.
     """
-    catalog = _Catalog(index, source.types, task.object_class, conditions or Conditions())
+    conditions = conditions or Conditions()
+    key = (task.object_class, conditions, source.types)
+    catalog = catalogs.get(key) if catalogs is not None else None
+    if not isinstance(catalog, _Catalog):
+        catalog = _Catalog(index, source.types, task.object_class, conditions)
+        if catalogs is not None:
+            catalogs[key] = catalog
     try:
-        assignment = _Assignment(catalog, requirements)
+        assignment = _Assignment(catalog, requirements, by_rounds=False)
     except _OrderingError:
         # the greedy choice of alternatives painted itself into a cycle: choose again, allowing only
         # providers whose inputs are derived in earlier fixpoint rounds (always acyclic, fewer alternatives)
-        catalog.by_rounds = True
-        assignment = _Assignment(catalog, requirements)
+        assignment = _Assignment(catalog, requirements, by_rounds=True)
     layout = _Layout(catalog, assignment, source, dict(parameters or {}))
     return Plan(task=task, stages=layout.stages(), sensor_types=source.types)
 
@@ -125,7 +133,6 @@ class _Catalog:
         self._ready_at_start = [i for i, count in enumerate(self._missing_at_start) if count == 0]
         self.rounds = self._rounds()
         self.producible = frozenset(self.rounds)
-        self.by_rounds = False
 
     def _rounds(self) -> dict[str, int]:
         """The fixpoint round in which each producible type first becomes producible (sensors: 0)."""
@@ -175,12 +182,15 @@ class _Catalog:
             self._without[forbidden] = self._fixpoint(forbidden)
         return self._without[forbidden]
 
-    def valid(self, type_name: str, value: str | None, above: frozenset[str] = frozenset()) -> list[AnnotatorSpec]:
+    def valid(
+        self, type_name: str, value: str | None, above: frozenset[str] = frozenset(), by_rounds: bool = False
+    ) -> list[AnnotatorSpec]:
         """Providers of ``type_name`` whose inputs can be produced without it and without the types ``above`` it
-        (those that need it), so that choosing them cannot create a cycle."""
+        (those that need it), so that choosing them cannot create a cycle; ``by_rounds`` keeps only those whose
+        inputs are derived earliest."""
         usable = self.producible_without(above | {type_name})
         found = [s for s in self.providers(type_name, value) if usable.issuperset(s.inputs)]
-        if self.by_rounds and found:
+        if by_rounds and found:
             depth = {s.name: max((self.rounds.get(t, 0) for t in s.inputs), default=0) for s in found}
             limit = min(depth.values())
             found = [s for s in found if depth[s.name] <= limit]
@@ -204,17 +214,27 @@ class _Catalog:
         return f"no usable annotator provides {asked} ({'; '.join(details)})"
 
 
-@dataclass
 class _UnitChoice:
     """The providers chosen for one needed type (one unit of the plan)."""
 
-    type_name: str
-    providers: list[AnnotatorSpec]
-    value: str | None
+    def __init__(self, type_name: str, providers: list[AnnotatorSpec], value: str | None) -> None:
+        self.type_name = type_name
+        self.value = value
+        self.providers = providers
 
-    def guaranteed(self) -> set[str]:
+    @property
+    def providers(self) -> list[AnnotatorSpec]:
+        """The alternatives, best first."""
+        return self._providers
+
+    @providers.setter
+    def providers(self, providers: list[AnnotatorSpec]) -> None:
+        self._providers = providers
+        self._guaranteed = frozenset.intersection(*(frozenset(s.outputs) - frozenset(s.inputs) for s in providers))
+
+    def guaranteed(self) -> frozenset[str]:
         """Types the unit produces for others: outputs every provider writes without having read them."""
-        return set.intersection(*(set(s.outputs) - set(s.inputs) for s in self.providers))
+        return self._guaranteed
 
 
 class _Assignment:
@@ -224,8 +244,9 @@ class _Assignment:
     need unit T; a provider for T may not need any of them, which keeps the unit graph acyclic.
     """
 
-    def __init__(self, catalog: _Catalog, requirements: Sequence[Requirement]) -> None:
+    def __init__(self, catalog: _Catalog, requirements: Sequence[Requirement], by_rounds: bool) -> None:
         self.catalog = catalog
+        self.by_rounds = by_rounds
         self.requirements = requirements
         self.values = {r.annotation_type: r.value for r in requirements}
         self.reasons: dict[str, list[str]] = {}
@@ -280,7 +301,7 @@ class _Assignment:
         for key in sorted(self.units, key=lambda k: (rounds.get(k, 0), k)):
             providers = self.units[key].providers
             for type_name in sorted(self.units[key].guaranteed()):
-                if self.catalog.by_rounds and any(
+                if self.by_rounds and any(
                     max((rounds.get(t, 0) for t in s.inputs), default=0) >= rounds.get(type_name, 0)
                     for s in providers
                 ):
@@ -393,10 +414,23 @@ class _Assignment:
                 continue
             if existing is not None and consumer is not None and self._drop_needing(consumer, type_name):
                 continue
-            if existing == type_name:
-                raise _OrderingError(f"cannot order the annotators for {type_name}: its providers need {consumer}")
             value = self.values.get(type_name)
-            valid = self.catalog.valid(type_name, value, frozenset(above))
+            if existing == type_name:
+                # the type's own unit leads back to this consumer: choose its providers again under all constraints
+                combined = above | self.above.get(type_name, set())
+                owner = self.owner()
+                again = [
+                    s
+                    for s in self.catalog.valid(type_name, value, frozenset(combined), self.by_rounds)
+                    if owner.get(s.name) in (None, type_name)
+                ]
+                if not again:
+                    raise _OrderingError(f"cannot order the annotators for {type_name}: its providers need {consumer}")
+                self._set_providers(type_name, again)
+                self.above[type_name] = combined
+                queue.extend((needed, type_name) for spec in again for needed in spec.inputs)
+                continue
+            valid = self.catalog.valid(type_name, value, frozenset(above), self.by_rounds)
             owner = self.owner()
             free = [s for s in valid if s.name not in owner]
             if not free:

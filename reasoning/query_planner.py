@@ -56,14 +56,15 @@ def class_profiles(kb: KnowledgeBase) -> tuple[dict[str, object], ...]:
     return tuple(profiles)
 
 
-def annotator_parameters(kb: KnowledgeBase, box: RegionBox | None) -> dict[str, dict[str, object]]:
+def annotator_parameters(
+    kb: KnowledgeBase, box: RegionBox | None, profiles: tuple[dict[str, object], ...] | None = None
+) -> dict[str, dict[str, object]]:
     """Constructor arguments the plan hands to annotators, from the ontology.
 
     An annotator that needs a region gets the region box; one that can report any object class (its class
     domain is the root class) is a classifier by knowledge and gets the profiles of the classes.
     """
     parameters: dict[str, dict[str, object]] = {}
-    profiles: tuple[dict[str, object], ...] | None = None
     for spec in kb.annotators():
         if box is not None and REGION_PRECONDITION in spec.preconditions:
             parameters[spec.name] = region_parameters(box)
@@ -73,14 +74,46 @@ def annotator_parameters(kb: KnowledgeBase, box: RegionBox | None) -> dict[str, 
     return parameters
 
 
+class QueryPlanner:
+    """Plans queries against one knowledge base, keeping what only changes with the ontology (class profiles)."""
+
+    def __init__(self, kb: KnowledgeBase) -> None:
+        self.kb = kb
+        self._index: object | None = None
+        self._profiles: tuple[dict[str, object], ...] = ()
+        self._catalogs: dict[tuple[object, ...], object] = {}
+
+    def _refresh(self) -> None:
+        """Drop what was derived from an older ontology (after the knowledge base reloaded)."""
+        if self._index is not self.kb.index:
+            self._index = self.kb.index
+            self._profiles = class_profiles(self.kb)
+            self._catalogs = {}
+
+    def profiles(self) -> tuple[dict[str, object], ...]:
+        """The class profiles of the current ontology."""
+        self._refresh()
+        return self._profiles
+
+    def plan(self, query: Query, source: SensorSource) -> QueryPlan:
+        """Interpret ``query`` and synthesize the plan that answers it from ``source``'s sensor types."""
+        depth = bool(source.types & DEPTH_TYPES)
+        interpretation = interpret(query, self.kb, depth=depth)
+        box = interpretation.region_box
+        conditions = Conditions(depth=depth, region=box is not None)
+        parameters = annotator_parameters(self.kb, box, self.profiles())
+        plan = plan_requirements(
+            interpretation.task,
+            interpretation.requirements,
+            self.kb,
+            source,
+            conditions=conditions,
+            parameters=parameters,
+            catalogs=self._catalogs,
+        )
+        return QueryPlan(plan, interpretation)
+
+
 def plan_query(query: Query, kb: KnowledgeBase, source: SensorSource) -> QueryPlan:
-    """Interpret ``query`` and synthesize the plan that answers it from ``source``'s sensor types."""
-    depth = bool(source.types & DEPTH_TYPES)
-    interpretation = interpret(query, kb, depth=depth)
-    box = interpretation.region_box
-    conditions = Conditions(depth=depth, region=box is not None)
-    parameters = annotator_parameters(kb, box)
-    plan = plan_requirements(
-        interpretation.task, interpretation.requirements, kb, source, conditions=conditions, parameters=parameters
-    )
-    return QueryPlan(plan, interpretation)
+    """Interpret ``query`` and synthesize the plan that answers it (one-off; see QueryPlanner to plan many)."""
+    return QueryPlanner(kb).plan(query, source)
