@@ -8,6 +8,7 @@ STAMP := $(VENV)/.installed
 
 demo: setup
 	$(PY) -m robokudo run tabletop --annotated-image robokudo-demo.png
+	$(PY) -m robokudo query --explain "find milk in fridge"
 
 test: setup
 	$(PY) -m pytest -q
@@ -26,10 +27,14 @@ system-deps:
 		$$SUDO apt-get install -y -qq libusb-1.0-0 graphviz default-jre-headless >/dev/null; \
 	fi
 
-$(STAMP): pyproject.toml
+# rapidocr-onnxruntime (OCR, models inside its wheel) requires opencv-python, which would clash with
+# opencv-python-headless: it is installed without its requirements, which pyproject.toml lists instead.
+$(STAMP): pyproject.toml Makefile
 	test -x $(PY) || $(PYTHON) -m venv $(VENV)
 	$(PY) -m pip install -q --upgrade pip
 	$(PY) -m pip install -q -e '.[dev]'
+	$(PY) -m pip install -q --no-deps 'rapidocr-onnxruntime==1.4.4'
+	$(PY) -m pip uninstall -q -y opencv-python 2>/dev/null || true
 	touch $(STAMP)
 
 bench: setup
