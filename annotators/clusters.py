@@ -7,10 +7,13 @@ box of the candidates; the clusters found are carried back to full resolution at
    the plane's extent (the convex hull of its inliers, shrunk by ``hull_margin``);
 2. the grid is cut at depth discontinuities (the far pixel of each jump) and at hue edges of the colour image
    (shading-invariant, so a shaded face is not cut but touching objects of different colour are);
-3. the 4-connected parts are labelled, small parts dropped and the cut pixels given to the nearest part;
-4. touching parts that are pieces of one object (overlapping footprints on the plane, or the inside and
-   outside of a container) are joined, see :func:`annotators.grid_segmentation.merge_parts`; clusters of at
-   least ``min_points`` remain.
+3. the 4-connected parts are labelled, small parts dropped and the cut pixels given back: hue-edge pixels to the
+   nearest part, depth-seam pixels only to a neighbour on their own surface, so an occluder never touches what it
+   hides;
+4. touching parts that are pieces of one object (overlapping footprints on the plane, the inside and outside of
+   a container, or a surface going on smoothly or over a convex edge across a hue edge, judged with normals on
+   the grid) are joined, see :func:`annotators.grid_segmentation.merge_parts`; clusters of at least
+   ``min_points`` remain.
 
 Each hypothesis gets its flat point indices, an image mask and the ROI ``(x0, y0, x1, y1)``, x1/y1 exclusive.
 """
@@ -24,15 +27,19 @@ import cv2
 import numpy as np
 
 from annotators.grid_segmentation import (
+    MergeRules,
+    boundaries,
     bounding_box,
     color_edges,
     depth_jump,
     depth_seams,
     grow_labels,
+    grow_on_surface,
     label_groups,
     label_parts,
     merge_parts,
 )
+from annotators.normals import grid_normals
 from annotators.plane import plane_basis, plane_distances
 from annotators.point_cloud import cloud_problem
 from robokudo.annotator import Annotator
@@ -67,7 +74,25 @@ class ClusterParameters:
     footprint_overlap: float = 0.5
     inside_tolerance: float = 0.01
     inside_depth_ratio: float = 1.5
+    continuous_share: float = 0.6
+    smooth_degrees: float = 35.0
+    convexity: float = 0.15
+    small_part_points: int = 100
     stride: int = 2
+
+    def merge_rules(self) -> MergeRules:
+        """The thresholds of :func:`annotators.grid_segmentation.merge_parts` on the ``stride`` grid."""
+        step = max(1, self.stride)
+        return MergeRules(
+            overlap=self.footprint_overlap,
+            cell=self.footprint_cell,
+            inside_tolerance=self.inside_tolerance,
+            inside_depth_ratio=self.inside_depth_ratio,
+            continuous=self.continuous_share,
+            smooth_cosine=float(np.cos(np.radians(self.smooth_degrees))),
+            convex=self.convexity,
+            small_part=max(1, self.small_part_points // (step * step)),
+        )
 
 
 def inside_plane_extent(feet: np.ndarray, plane_feet: np.ndarray, margin: float, cell: float) -> np.ndarray:
@@ -126,22 +151,20 @@ def extract_clusters(
     x0, y0, x1, y1 = bounding_box(coarse, margin=2)
     region = coarse[y0:y1, x0:x1]
     depth = coarse_points[y0:y1, x0:x1, 2]
-    cuts = depth_seams(depth, region, p.jump_absolute, p.jump_relative)
+    seams = depth_seams(depth, region, p.jump_absolute, p.jump_relative)
+    cuts = seams
     if colors is not None:
-        cuts |= color_edges(colors[::step, ::step][y0:y1, x0:x1], p.edge_low, p.edge_high)
+        cuts = seams | color_edges(colors[::step, ::step][y0:y1, x0:x1], p.edge_low, p.edge_high)
     labels = label_parts(region & ~cuts, max(1, p.min_part_points // (step * step)))
-    labels = grow_labels(labels, region, p.grow_distance / step)
-    crop_points = np.ascontiguousarray(coarse_points[y0:y1, x0:x1]).reshape(-1, 3)
+    labels = grow_labels(labels, region & ~seams, p.grow_distance / step)
+    labels = grow_on_surface(labels, region, depth, p.jump_absolute, p.jump_relative)
+    grid = np.ascontiguousarray(coarse_points[y0:y1, x0:x1])
+    surface = boundaries(labels, grid, grid_normals(grid, 1, 3), p.jump_absolute, p.jump_relative)
+    crop_points = grid.reshape(-1, 3)
     to_plane = np.column_stack([basis, np.asarray(model[:3], dtype=np.float32)])
     offset = np.array([0.0, 0.0, model[3]], dtype=np.float32)
     labels = merge_parts(
-        labels,
-        depth,
-        lambda pixels: crop_points[pixels] @ to_plane + offset,
-        p.footprint_overlap,
-        p.footprint_cell,
-        p.inside_tolerance,
-        p.inside_depth_ratio,
+        labels, depth, lambda pixels: crop_points[pixels] @ to_plane + offset, p.merge_rules(), surface
     )
 
     return _full_resolution(labels, depth, (x0, y0, x1, y1), step, points, mask, model, p)

@@ -145,7 +145,7 @@ class SemanticColorAnnotator(Annotator):
     inputs: ClassVar[tuple[type[CasType], ...]] = (ObjectHypothesis, ColorImage)
     outputs: ClassVar[tuple[type[CasType], ...]] = (SemanticColor,)
 
-    def __init__(self, max_pixels: int = 2000, name: str | None = None) -> None:
+    def __init__(self, max_pixels: int = 1000, name: str | None = None) -> None:
         super().__init__(name=name)
         self.max_pixels = max_pixels
 

@@ -7,6 +7,7 @@ and OpenCV, never with per-point Python loops; labels are int32 with 0 meaning "
 from __future__ import annotations
 
 from collections.abc import Callable
+from dataclasses import dataclass
 
 import cv2
 import numpy as np
@@ -90,6 +91,36 @@ def grow_labels(labels: np.ndarray, region: np.ndarray, max_distance: float) -> 
     return grown
 
 
+_SHIFTS: tuple[tuple[tuple[slice, slice], tuple[slice, slice]], ...] = (
+    ((slice(None), slice(1, None)), (slice(None), slice(None, -1))),  # (pixel, its left neighbour)
+    ((slice(None), slice(None, -1)), (slice(None), slice(1, None))),  # right neighbour
+    ((slice(1, None), slice(None)), (slice(None, -1), slice(None))),  # upper neighbour
+    ((slice(None, -1), slice(None)), (slice(1, None), slice(None))),  # lower neighbour
+)
+
+
+def grow_on_surface(
+    labels: np.ndarray, region: np.ndarray, depth: np.ndarray, absolute: float, relative: float, rounds: int = 2
+) -> np.ndarray:
+    """Give unlabelled pixels of ``region`` the label of a 4-neighbour on the same surface (no depth jump).
+
+    Used for the far pixels of depth discontinuities: they join the surface they belong to, never the occluder
+    in front of them, so an occluder and what it hides do not touch in the label image.
+    """
+    grown = labels.copy()
+    for _ in range(rounds):
+        before = grown.copy()
+        open_ = region & (before == 0)
+        if not open_.any():
+            break
+        for pixel, neighbour in _SHIFTS:
+            value = before[neighbour]
+            take = open_[pixel] & (value > 0) & ~depth_jump(depth[pixel], depth[neighbour], absolute, relative)
+            target = grown[pixel]
+            target[take & (target == 0)] = value[take & (target == 0)]
+    return grown
+
+
 def touching_pairs(labels: np.ndarray) -> np.ndarray:
     """Kx2 int array of the distinct label pairs ``(a, b)``, ``0 < a < b``, that touch as 4-neighbours."""
     found = []
@@ -152,13 +183,19 @@ def _range(values: np.ndarray, low: float, high: float) -> tuple[float, float]:
     return float(ordered[round(low * last)]), float(ordered[round(high * last)])
 
 
+INNER_SPREAD = 0.1
+"""An inner surface of a container falls away from the rim: its 50 %-95 % height spread is at least this share of
+the rim height (or it lies in the lower half); the flat top of an object standing behind does not."""
+
+
 def looks_like_inside(near: np.ndarray, far: np.ndarray, tolerance: float, depth_ratio: float) -> bool:
     """Could part ``far`` be the inside of an open container whose outside is part ``near``?
 
     Both are Nx3 plane coordinates ``(u, v, height)`` with the camera's foot at ``u = v = 0``. Seen from above,
     the front rim of a cup or bowl hides part of its inside: the inside is then farther along the line of sight,
     within the outside's width across it, no higher than its rim, and no deeper than ``depth_ratio`` times its
-    width. A separate object behind is wider, taller or elsewhere. Robust 5 % / 95 % quantiles are used.
+    width, and it falls away below the rim (:data:`INNER_SPREAD`). A separate object behind is wider, taller,
+    elsewhere or flat on top. Robust 5 % / 95 % quantiles are used.
     """
     if near.shape[0] < 3 or far.shape[0] < 3:
         return False
@@ -178,7 +215,11 @@ def looks_like_inside(near: np.ndarray, far: np.ndarray, tolerance: float, depth
         return False
     near_front, near_middle = _range(near[:, :2] @ along, 0.05, 0.5)
     far_middle, far_back = _range(far[:, :2] @ along, 0.5, 0.95)
-    return far_middle > near_middle and far_back <= near_front + depth_ratio * width
+    if far_middle <= near_middle or far_back > near_front + depth_ratio * width:
+        return False
+    rim = _range(near[:, 2], 0.5, 0.95)[1]
+    far_median, far_top = _range(far[:, 2], 0.5, 0.95)
+    return far_top - far_median >= INNER_SPREAD * rim or far_median <= 0.5 * rim
 
 
 class _Parts:
@@ -216,38 +257,206 @@ class _Parts:
         return self._depths[label]
 
 
+@dataclass(frozen=True)
+class Boundaries:
+    """What the shared boundary of each pair of touching parts looks like in 3-D.
+
+    ``pairs`` (Kx2, a < b) are the touching labels; ``length`` counts their 4-neighbour pixel pairs;
+    ``continuous`` is the share of those without a depth jump; ``close`` the share whose points are at most
+    ``close_factor`` pixel footprints apart in 3-D (one surface going on, not two objects side by side a few
+    millimetres apart in depth); over the continuous ones with known normals,
+    ``alignment`` is the mean cosine between the two normals and ``convexity`` the mean of
+    ``(n_a - n_b) . (p_a - p_b) / |p_a - p_b|`` (positive across a convex edge, negative in a concave crease).
+    """
+
+    pairs: np.ndarray
+    length: np.ndarray
+    continuous: np.ndarray
+    close: np.ndarray
+    alignment: np.ndarray
+    convexity: np.ndarray
+
+
+def pixel_footprint(points: np.ndarray) -> float:
+    """The angle (radians) between horizontally adjacent pixels of an organized cloud: ``step / fx``."""
+    with np.errstate(invalid="ignore", divide="ignore"):
+        ratio = points[..., 0] / points[..., 2]
+        steps = np.abs(np.diff(ratio, axis=1))
+    steps = steps[np.isfinite(steps) & (steps > 0)]
+    return float(np.median(steps)) if steps.size else 0.0
+
+
+def _beside_views(array: np.ndarray, reach: int) -> list[tuple[np.ndarray, np.ndarray]]:
+    """For every horizontal / vertical neighbour pair (as :func:`_neighbour_views`), the values ``reach`` pixels
+    further out on each side: left of the left pixel and right of the right one (above / below for vertical)."""
+    width = [(0, 0)] * array.ndim
+    rows, cols = array.shape[:2]
+    fill = 0 if array.dtype.kind in "iub" else np.nan
+    horizontal = np.pad(array, [(0, 0), (reach, reach), *width[2:]], constant_values=fill)
+    vertical = np.pad(array, [(reach, reach), (0, 0), *width[2:]], constant_values=fill)
+    return [
+        (horizontal[:, : cols - 1], horizontal[:, 2 * reach + 1 :]),
+        (vertical[: rows - 1], vertical[2 * reach + 1 :]),
+    ]
+
+
+def boundaries(
+    labels: np.ndarray,
+    points: np.ndarray,
+    normals: np.ndarray,
+    absolute: float,
+    relative: float,
+    close_factor: float = 2.5,
+    reach: int = 2,
+) -> Boundaries:
+    """The :class:`Boundaries` of every touching pair of parts (``points``/``normals`` HxWx3, camera frame).
+
+    Normals and positions for ``alignment`` and ``convexity`` are taken ``reach`` pixels away from the boundary on
+    either side (where those pixels still belong to the two parts), since normals right at a crease are blurred
+    across it.
+    """
+    footprint = pixel_footprint(points)
+    keys, jumps, dots, convex, near = [], [], [], [], []
+    base = int(labels.max(initial=0)) + 1
+    for (l_a, l_b), (p_a, p_b), (s_la, s_lb), (s_pa, s_pb), (s_na, s_nb) in zip(
+        _neighbour_views(labels),
+        _neighbour_views(points),
+        _beside_views(labels, reach),
+        _beside_views(points, reach),
+        _beside_views(normals, reach),
+        strict=True,
+    ):
+        touching = (l_a != l_b) & (l_a > 0) & (l_b > 0)
+        a, b = l_a[touching].astype(np.int64), l_b[touching].astype(np.int64)
+        keys.append(np.minimum(a, b) * base + np.maximum(a, b))
+        pa, pb = p_a[touching], p_b[touching]
+        jumps.append(depth_jump(pa[:, 2], pb[:, 2], absolute, relative))
+        with np.errstate(invalid="ignore"):
+            near.append(np.linalg.norm(pa - pb, axis=1) <= close_factor * footprint * np.fmin(pa[:, 2], pb[:, 2]))
+        same = (s_la[touching] == a) & (s_lb[touching] == b)
+        na, nb = s_na[touching], s_nb[touching]
+        offset = s_pa[touching] - s_pb[touching]
+        with np.errstate(invalid="ignore", divide="ignore"):
+            dots.append(np.where(same, np.einsum("ij,ij->i", na, nb), np.nan))
+            convex.append(
+                np.where(same, np.einsum("ij,ij->i", na - nb, offset) / np.linalg.norm(offset, axis=1), np.nan)
+            )
+    key = np.concatenate(keys)
+    if key.size == 0:
+        empty = np.zeros(0)
+        return Boundaries(np.zeros((0, 2), np.int64), empty, empty, empty, empty, empty)
+    unique, inverse = np.unique(key, return_inverse=True)
+    jump, dot, convexity = np.concatenate(jumps), np.concatenate(dots), np.concatenate(convex)
+    length = np.bincount(inverse, minlength=unique.size).astype(np.float64)
+    smooth = ~jump
+    known = smooth & np.isfinite(dot) & np.isfinite(convexity)
+    known_count = np.bincount(inverse, weights=known, minlength=unique.size)
+    with np.errstate(invalid="ignore", divide="ignore"):
+        alignment = np.bincount(inverse, weights=np.where(known, dot, 0.0), minlength=unique.size) / known_count
+        mean_convexity = np.bincount(inverse, weights=np.where(known, convexity, 0.0), minlength=unique.size)
+        mean_convexity /= known_count
+    continuous = np.bincount(inverse, weights=smooth, minlength=unique.size) / length
+    close = np.bincount(inverse, weights=np.concatenate(near), minlength=unique.size) / length
+    pairs = np.column_stack([unique // base, unique % base])
+    return Boundaries(pairs, length, continuous, close, alignment, mean_convexity)
+
+
+@dataclass(frozen=True)
+class MergeRules:
+    """Thresholds of :func:`merge_parts` (metres, raster cells, shares, cosines, pixels)."""
+
+    overlap: float = 0.5
+    cell: float = 0.005
+    inside_tolerance: float = 0.01
+    inside_depth_ratio: float = 1.5
+    continuous: float = 0.6
+    min_boundary: int = 3
+    boundary_share: float = 0.6
+    smooth_cosine: float = float(np.cos(np.radians(35.0)))
+    convex: float = 0.15
+    concave: float = -0.15
+    coplanar_cosine: float = float(np.cos(np.radians(18.0)))
+    small_part: int = 40
+    occlusion: float = 0.5
+
+
 def merge_parts(
     labels: np.ndarray,
     depth: np.ndarray,
     plane_coordinates: Callable[[np.ndarray], np.ndarray],
-    overlap: float,
-    cell: float,
-    inside_tolerance: float,
-    inside_depth_ratio: float,
+    rules: MergeRules,
+    surface: Boundaries | None = None,
 ) -> np.ndarray:
     """Join touching parts that are pieces of one object; labels renumbered 1..n (0 = none).
 
     ``plane_coordinates(pixels)`` gives Nx3 float32 ``(u, v, height)`` on the supporting plane for flat pixel
-    indices. Two parts are joined when they touch on the grid and
+    indices. Two touching parts are pieces of one object when
 
-    * their footprints (convex hulls on the plane) share more than ``overlap`` of the smaller one: objects
+    * their footprints (convex hulls on the plane) share more than ``rules.overlap`` of the smaller one: objects
       standing side by side have (nearly) disjoint footprints, while the pieces one object was cut into by a
       colour edge (a can's label, a box's print) share theirs; or
     * the far one :func:`looks_like_inside` the near one (the inside and outside of a cup or bowl, split by
-      the depth jump or the shading edge at the front rim).
+      the depth jump or the shading edge at the front rim); or
+    * (with ``surface``) their shared boundary is mostly close in 3-D (see :class:`Boundaries`), at least
+      ``rules.boundary_share`` times the square root of the smaller part's size long, and the surface
+      goes on across it smoothly (normals within ~35°) or over a convex edge (a box's top and front face), never
+      into a concave crease (a can standing on a box); below ~18° between the normals the surfaces count as one
+      plane, whatever the (then noisy) convexity says.
+
+    A pair whose shared boundary is mostly a depth jump (continuous on less than ``rules.occlusion`` of it) is an
+    occluder and what it hides, or a container's rim and its inside: only the inside rule may join it. Parts
+    smaller than ``rules.small_part`` pixels join at most one neighbour (the one they share the longest boundary
+    with among those a rule allows), so a crumb between two objects cannot glue them together.
     """
     pairs = touching_pairs(labels)
     if pairs.shape[0] == 0:
         return labels
     parts = _Parts(labels, depth, plane_coordinates)
-    joined = []
+    sizes = np.diff(parts.starts)
+    lengths: dict[tuple[int, int], float] = {}
+    smooth: set[tuple[int, int]] = set()
+    occluding: set[tuple[int, int]] = set()
+    if surface is not None:
+        for (a, b), length, continuous, close, alignment, convexity in zip(
+            surface.pairs.tolist(),
+            surface.length,
+            surface.continuous,
+            surface.close,
+            surface.alignment,
+            surface.convexity,
+            strict=True,
+        ):
+            lengths[(a, b)] = float(length)
+            if continuous < rules.occlusion:
+                occluding.add((a, b))
+            if (
+                close >= rules.continuous
+                and close * length >= max(rules.min_boundary, rules.boundary_share * np.sqrt(min(sizes[a], sizes[b])))
+                and (convexity >= rules.concave or alignment >= rules.coplanar_cosine)
+                and (alignment >= rules.smooth_cosine or convexity >= rules.convex)
+            ):
+                smooth.add((a, b))
+    allowed: list[tuple[int, int]] = []
     for first, second in pairs.tolist():
-        if footprint_overlap(parts.hull(first), parts.hull(second), cell) > overlap:
-            joined.append((first, second))
+        if (first, second) in smooth or (
+            (first, second) not in occluding
+            and footprint_overlap(parts.hull(first), parts.hull(second), rules.cell) > rules.overlap
+        ):
+            allowed.append((first, second))
             continue
         near, far = sorted((first, second), key=parts.depth_of)
-        if looks_like_inside(parts.coordinates(near), parts.coordinates(far), inside_tolerance, inside_depth_ratio):
-            joined.append((first, second))
+        if looks_like_inside(
+            parts.coordinates(near), parts.coordinates(far), rules.inside_tolerance, rules.inside_depth_ratio
+        ):
+            allowed.append((first, second))
+    joined = [(a, b) for a, b in allowed if sizes[a] >= rules.small_part and sizes[b] >= rules.small_part]
+    best: dict[int, tuple[float, int]] = {}
+    for a, b in allowed:
+        length = lengths.get((a, b), 1.0)
+        for small, other in ((a, b), (b, a)):
+            if sizes[small] < rules.small_part and length > best.get(small, (-1.0, 0))[0]:
+                best[small] = (length, other)
+    joined += [(small, other) for small, (_, other) in best.items()]
     return join_labels(labels, joined)
 
 

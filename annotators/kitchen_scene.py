@@ -31,6 +31,7 @@ import numpy as np
 import open3d as o3d
 from numpy.typing import NDArray
 
+from annotators.size import SIZE_CLASS_THRESHOLDS, size_class_for
 from robokudo.types import CameraIntrinsics
 
 __all__ = (
@@ -57,9 +58,6 @@ FloatArray = NDArray[np.float64]
 
 MAX_DEPTH: float = 4.0
 """Hits farther than this (metres, along the optical axis) get depth 0."""
-
-SIZE_CLASS_THRESHOLDS: tuple[float, float] = (0.12, 0.25)
-"""Largest extent < 0.12 m -> "small", < 0.25 m -> "medium", else "large"."""
 
 COLOR_NOISE_SIGMA: float = 2.0
 """Std-dev of the per-pixel, per-channel colour noise (uint8 levels)."""
@@ -319,16 +317,6 @@ _PLAIN, _CHECKER, _WOOD, _LABEL = 0, 1, 2, 3
 _BACKGROUND_RGB = (28, 30, 36)
 _LIGHT_DIR: tuple[float, float, float] = (0.35, -0.6, 1.0)  # towards the key light (normalised on use)
 _AMBIENT, _KEY, _HEAD = 0.5, 0.35, 0.2
-
-
-def size_class_for(size: tuple[float, float, float]) -> str:
-    """Size class from the largest extent (see ``SIZE_CLASS_THRESHOLDS``)."""
-    largest = max(size)
-    if largest < SIZE_CLASS_THRESHOLDS[0]:
-        return "small"
-    if largest < SIZE_CLASS_THRESHOLDS[1]:
-        return "medium"
-    return "large"
 
 
 def kitchen_regions() -> tuple[RegionBox, ...]:

@@ -66,10 +66,12 @@ def _support(sample: np.ndarray, normals: np.ndarray, offsets: np.ndarray, dista
     return np.count_nonzero(np.abs(residuals) < distance, axis=0)
 
 
-def _triples(valid: np.ndarray, count: int, radius: int, rng: np.random.Generator) -> np.ndarray:
-    """``count`` triples of flat indices of valid pixels: an anchor and two partners within ``radius`` px."""
+def _triples(
+    valid: np.ndarray, candidates: np.ndarray, count: int, radius: int, rng: np.random.Generator
+) -> np.ndarray:
+    """``count`` triples of flat indices of valid pixels (``candidates``, the flat indices of ``valid``): an
+    anchor and two partners within ``radius`` px."""
     rows, cols = valid.shape
-    candidates = np.flatnonzero(valid)
     anchors = candidates[rng.integers(0, candidates.size, size=count)]
     offsets = rng.integers(-radius, radius + 1, size=(count, 2, 2))
     r = np.clip(anchors[:, None] // cols + offsets[..., 0], 0, rows - 1)
@@ -102,7 +104,7 @@ def ransac_support_plane(
     if valid_indices.size < MIN_PLANE_POINTS:
         return None
     rng = np.random.default_rng(seed)
-    triples = _triples(valid, iterations, triple_radius, rng)
+    triples = _triples(valid, valid_indices, iterations, triple_radius, rng)
     if triples.shape[0] == 0:
         return None
     p0, p1, p2 = (flat[triples[:, i]].astype(np.float64) for i in range(3))
@@ -139,10 +141,26 @@ def ransac_support_plane(
         if refined is None or (up is not None and refined[:3] @ up / np.linalg.norm(up) < max_tilt):
             break
         model = refined
-    inliers = largest_region(_inliers(points, valid, model, distance), valid.shape)
+    with np.errstate(invalid="ignore"):
+        near = valid & (np.abs(plane_distances(points, model)) < distance)
+    inliers = np.flatnonzero(largest_region_mask(near))
     if inliers.size < MIN_PLANE_POINTS:
         return None
     return PlaneFit(model=model, inlier_indices=inliers)
+
+
+def largest_region_mask(mask: np.ndarray, step: int = 2) -> np.ndarray:
+    """``mask`` (HxW bool) reduced to its largest 8-connected region, found on every ``step``-th pixel as in
+    :func:`largest_region` (a pixel stays when its coarse cell or a neighbour belongs to the largest region)."""
+    coarse = np.ascontiguousarray(mask[::step, ::step]).view(np.uint8)
+    count, labels, stats, _ = cv2.connectedComponentsWithStats(coarse, connectivity=8)
+    if count <= 2:
+        return mask
+    biggest = 1 + int(np.argmax(stats[1:, cv2.CC_STAT_AREA]))
+    keep = cv2.dilate((labels == biggest).view(np.uint8), np.ones((3, 3), np.uint8))
+    rows, cols = mask.shape
+    keep = cv2.resize(keep, (keep.shape[1] * step, keep.shape[0] * step), interpolation=cv2.INTER_NEAREST)
+    return mask & (keep[:rows, :cols] > 0)
 
 
 def largest_region(indices: np.ndarray, shape: tuple[int, int], step: int = 2) -> np.ndarray:

@@ -28,7 +28,7 @@ class PoseAnnotator(Annotator):
     optional_inputs: ClassVar[tuple[type[CasType], ...]] = (CameraInfo,)
     outputs: ClassVar[tuple[type[CasType], ...]] = (Pose,)
 
-    def __init__(self, max_points: int = 2000, name: str | None = None) -> None:
+    def __init__(self, max_points: int = 1000, name: str | None = None) -> None:
         super().__init__(name=name)
         self.max_points = max_points
 

@@ -7,7 +7,9 @@ Three measurements in one run, on frame 000003 of ../shared/data/uoc_tabletop_re
 * bare: the same functions the annotators call (back-projection, range mask, RANSAC plane, cluster extraction,
   colour naming, oriented boxes) called directly in a loop, without tree or CAS;
 * reference: a common Open3D recipe for the same job (5 mm voxel grid, ``segment_plane``, DBSCAN above the plane),
-  to put the numbers in context.
+  to put the numbers in context;
+* segmentation recall on the labelled mOSD scenes (../shared/data/pcl_mosd_tabletop): the share of ground-truth
+  objects matched by a hypothesis with point IoU >= 0.5.
 
 Tree and bare rounds alternate so machine noise hits both alike. The reader decodes the PNGs once and then
 serves the cached frame (as it does on repeated ticks of the same frame); decoding is reported separately.
@@ -29,22 +31,28 @@ sys.path.insert(0, str(ROOT))
 
 from annotators.boxes import object_box  # noqa: E402
 from annotators.clusters import ClusterParameters, extract_clusters  # noqa: E402
-from annotators.color import hypothesis_pixels, name_color  # noqa: E402
+from annotators.color import SemanticColorAnnotator, hypothesis_pixels, name_color  # noqa: E402
 from annotators.filters import range_mask  # noqa: E402
 from annotators.frame_io import read_color_depth_pair  # noqa: E402
 from annotators.plane import ransac_support_plane  # noqa: E402
 from annotators.point_cloud import back_project, pixel_rays  # noqa: E402
-from annotators.pose import hypothesis_points  # noqa: E402
+from annotators.pose import PoseAnnotator, hypothesis_points  # noqa: E402
+from annotators.readers import PcdReader  # noqa: E402
 from robokudo.engine import Engine  # noqa: E402
 from robokudo.stats import RunStats  # noqa: E402
 from robokudo.types import ObjectHypothesis, PointCloud  # noqa: E402
-from trees.tabletop import create_tree  # noqa: E402
+from trees.tabletop import create_pipeline, create_tree  # noqa: E402
 
 DATA = (ROOT.parent / "shared" / "data" / "uoc_tabletop_realsense").resolve()
 FRAME = 3
 ROUNDS = 10
 TICKS_PER_ROUND = 10
 REFERENCE_RUNS = 5
+COLOR_PIXELS = SemanticColorAnnotator().max_pixels  # the bare loop uses the annotators' own settings
+POSE_POINTS = PoseAnnotator().max_points
+MOSD = (ROOT.parent / "shared" / "data" / "pcl_mosd_tabletop" / "learn").resolve()
+MOSD_SCENES = ("learn0", "learn35")
+MIN_IOU = 0.5
 
 STAGES = (
     "PointCloudGenerator",
@@ -75,8 +83,11 @@ def bare_frame(frame, rays, timings: dict[str, list[float]]) -> int:
     )
     hypotheses = [ObjectHypothesis(point_indices=s.indices, mask=s.mask, roi=s.roi) for s in segments]
     cloud = PointCloud(points=points, mask=mask, colors=frame.color)
-    timed("SemanticColorAnnotator", lambda: [name_color(hypothesis_pixels(frame.color, h)) for h in hypotheses])
-    timed("PoseAnnotator", lambda: [object_box(hypothesis_points(cloud, h), None) for h in hypotheses])
+    timed(
+        "SemanticColorAnnotator",
+        lambda: [name_color(hypothesis_pixels(frame.color, h, COLOR_PIXELS)) for h in hypotheses],
+    )
+    timed("PoseAnnotator", lambda: [object_box(hypothesis_points(cloud, h, POSE_POINTS), None) for h in hypotheses])
     return len(segments)
 
 
@@ -94,6 +105,29 @@ def reference_open3d(frame) -> float:
     above = rest.select_by_index(np.flatnonzero(np.abs(heights) > 0.01).tolist())
     np.asarray(above.cluster_dbscan(eps=0.015, min_points=10))
     return time.perf_counter() - start
+
+
+def mosd_recall(scene: str) -> tuple[int, int, list[float], float]:
+    """Objects matched (IoU >= MIN_IOU), objects, each object's best IoU and the tree's ms on a labelled mOSD scene."""
+    reader = PcdReader(MOSD / f"{scene}.pcd")
+    root = create_pipeline(reader)
+    engine = Engine(root, hz=1000.0)
+    engine.tick()
+    times = []
+    for _ in range(5):
+        start = time.perf_counter()
+        engine.tick()
+        times.append(time.perf_counter() - start)
+    frame = reader.last_frame
+    labels, valid = frame.labels, np.isfinite(frame.points[..., 2])
+    hypotheses = root.cas.annotations(ObjectHypothesis)
+    ious = []
+    for object_id in sorted({int(label) // 10 for label in np.unique(labels) if label >= 20}):
+        truth = (labels >= 20) & (labels // 10 == object_id) & valid
+        ious.append(
+            max((np.count_nonzero(h.mask & truth) / np.count_nonzero(h.mask | truth) for h in hypotheses), default=0)
+        )
+    return sum(iou >= MIN_IOU for iou in ious), len(ious), ious, statistics.median(times) * 1e3
 
 
 def main() -> None:
@@ -146,8 +180,15 @@ def main() -> None:
     print("-" * len(header))
     print(f"{'total per frame':24s} {tree_total:9.2f} {bare_total:9.2f} {tree_total / bare_total:7.2f}")
     print(f"{'frames per second':24s} {1e3 / tree_total:9.1f} {1e3 / bare_total:9.1f}")
-    print(f"hypotheses per frame: {clusters}; goal (later): >= 30 Hz, i.e. <= 33.3 ms per frame")
+    print(f"hypotheses per frame: {clusters}; goal: >= 30 Hz, i.e. <= 33.3 ms per frame")
     print(f"reference, Open3D voxel 5 mm + segment_plane + DBSCAN (no colour, no pose): {reference * 1e3:.1f} ms")
+    if MOSD.is_dir():
+        print(f"\nsegmentation recall on mOSD (object matched when a hypothesis has point IoU >= {MIN_IOU}):")
+        for scene in MOSD_SCENES:
+            found, total, ious, ms = mosd_recall(scene)
+            listed = ", ".join(f"{iou:.2f}" for iou in ious)
+            recall = f"recall {found}/{total} = {found / total:.2f}"
+            print(f"  {scene:8s} {recall}   IoU per object: {listed}   tree {ms:.1f} ms")
 
 
 if __name__ == "__main__":

@@ -53,7 +53,7 @@ DOMAIN_PROPERTIES: Mapping[str, Kind] = {
 }
 """Annotator value-domain property -> kind of its values."""
 
-PRECONDITION_KEYS: frozenset[str] = frozenset({"depth", "region", "opaque"})
+PRECONDITION_KEYS: frozenset[str] = frozenset({"depth", "region", "opaque", "model"})
 """The condition keys the planner knows how to evaluate."""
 
 _SINGLE_FIELDS = ("shape", "size_class", "material", "stored_in", "transparent", "brand")

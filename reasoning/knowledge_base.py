@@ -333,7 +333,7 @@ class KnowledgeBase:
         WhiteCeramicBowl serves a query for Bowl); an empty domain means any value. ``object_class`` keeps
         the annotators whose class domain (if any) is related to it the same way and drops those whose
         preconditions exclude it (not for transparent objects). ``conditions`` says whether depth and a
-        region are available (default: both).
+        region are available (default: both) and whether a detector model is configured (default: not).
         """
         index = self._index
         if annotation_type not in index.cas_types:
@@ -371,6 +371,7 @@ class KnowledgeBase:
             if needs and (
                 ("depth" in needs and not conditions.depth)
                 or ("region" in needs and not conditions.region)
+                or ("model" in needs and not conditions.model)
                 or ("opaque" in needs and transparent)
             ):
                 continue

@@ -131,7 +131,9 @@ class AnnotatorSpec:
 
 @dataclass(frozen=True, slots=True)
 class Conditions:
-    """What holds where the planner plans: is a depth image available, is a region known."""
+    """What holds where the planner plans: is a depth image available, is a region known, is a detector model
+    configured (False by default, so plans include model-based detectors only when one is)."""
 
     depth: bool = True
     region: bool = True
+    model: bool = False

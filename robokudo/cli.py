@@ -111,8 +111,8 @@ def main(argv: Sequence[str] | None = None) -> int:
         args.once = args.ticks is None
     try:
         return int(args.handler(args))
-    except KeyError as error:
-        print(f"robokudo: {error.args[0]}", file=sys.stderr)
+    except (KeyError, ValueError) as error:
+        print(f"robokudo: {error.args[0] if error.args else error}", file=sys.stderr)
         return 2
 
 

@@ -1,7 +1,8 @@
 """The seed's Fig. 2 tabletop tree: capture, cloud, filter, support plane, clusters, then colour and pose in parallel.
 
-Without an input path the capture is the built-in kitchen scene (view "table"); with one it reads frame
-``frame`` of a colour/depth folder in the uoc layout (NNNNNN-color.png, NNNNNN-depth.png, camera_params.json).
+Without an input path the capture is the built-in kitchen scene (view "table"); with one, the reader is chosen
+from the path by :func:`annotators.sources.reader_for` (TUM, uoc, PCL TIFF, PCD layouts; ValueError for others).
+A reader that writes the point cloud itself (PcdReader) needs no PointCloudGenerator.
 """
 
 from __future__ import annotations
@@ -12,20 +13,22 @@ from annotators.filters import RangeFilter
 from annotators.plane import SupportPlaneSegmenter
 from annotators.point_cloud import PointCloudGenerator
 from annotators.pose import PoseAnnotator
-from annotators.readers import ColorDepthPairReader, KitchenSceneReader
+from annotators.readers import KitchenSceneReader
+from annotators.sources import reader_for
 from robokudo.annotator import Annotator
 from robokudo.parallel import ThresholdParallel
 from robokudo.pipeline import Pipeline
+from robokudo.types import PointCloud
 
 
 def create_reader(input_path: str | None = None, frame: int = 0) -> Annotator:
-    """The capture node: the built-in kitchen scene, or frame ``frame`` of a colour/depth pair folder."""
+    """The capture node: the built-in kitchen scene, or the reader of ``input_path`` (ValueError when none fits)."""
     if input_path is None:
         reader: Annotator = KitchenSceneReader()
         reader.reason = "capture: renders the built-in kitchen scene (camera looking at the table)"
     else:
-        reader = ColorDepthPairReader(input_path, frame=frame)
-        reader.reason = f"capture: reads frame {frame} of the colour/depth pairs in {input_path}"
+        reader = reader_for(input_path, frame)
+        reader.reason = f"capture: reads frame {frame} of {input_path} ({type(reader).__name__})"
     return reader
 
 
@@ -36,8 +39,11 @@ def create_tree(input_path: str | None = None, frame: int = 0) -> Pipeline:
 
 def create_pipeline(reader: Annotator) -> Pipeline:
     """The tabletop Pipeline behind any capture node that writes ColorImage, DepthImage and CameraInfo."""
-    cloud = PointCloudGenerator()
-    cloud.reason = "back-projects depth with the intrinsics into an organized, coloured point cloud"
+    front: list[Annotator] = [reader]
+    if PointCloud not in reader.outputs:
+        cloud = PointCloudGenerator()
+        cloud.reason = "back-projects depth with the intrinsics into an organized, coloured point cloud"
+        front.append(cloud)
     crop = RangeFilter(min_depth=0.2, max_depth=2.5)
     crop.reason = "drops points outside the sensor's useful range (0.2-2.5 m) before any geometry"
     plane = SupportPlaneSegmenter()
@@ -50,6 +56,6 @@ def create_pipeline(reader: Annotator) -> Pipeline:
     pose.reason = "gives each hypothesis the pose of its oriented bounding box"
     describe = ThresholdParallel("describe", [color, pose])
     describe.reason = "colour and pose are independent given the hypotheses; both must succeed"
-    root = Pipeline("tabletop", [reader, cloud, crop, plane, clusters, describe])
+    root = Pipeline("tabletop", [*front, crop, plane, clusters, describe])
     root.reason = "the seed's Fig. 2 tabletop perception pipeline"
     return root

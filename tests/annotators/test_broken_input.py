@@ -12,6 +12,7 @@ import inspect
 import json
 import pkgutil
 import re
+import time
 from collections.abc import Callable
 from pathlib import Path
 
@@ -23,11 +24,26 @@ from py_trees.common import Status
 import annotators
 from annotators.clusters import ClusterExtractor
 from annotators.color import SemanticColorAnnotator
-from annotators.filters import RangeFilter
+from annotators.filters import CropBoxFilter, RangeFilter, RegionFilter
+from annotators.histogram import ColorHistogramAnnotator
+from annotators.image_regions import ImageRegionSegmenter
+from annotators.knowledge_classifier import KnowledgeClassifier
+from annotators.normals import NormalEstimator
+from annotators.onnx_detector import OnnxDetector
 from annotators.plane import SupportPlaneSegmenter
 from annotators.point_cloud import PointCloudGenerator
 from annotators.pose import PoseAnnotator
-from annotators.readers import ColorDepthPairReader, KitchenSceneReader
+from annotators.readers import (
+    ColorDepthPairReader,
+    KitchenSceneReader,
+    PcdReader,
+    TiffSequenceReader,
+    TumPairReader,
+    TumSequenceReader,
+)
+from annotators.shape import ShapeAnnotator
+from annotators.size import SizeAnnotator
+from annotators.text import TextReader
 from robokudo.annotator import Annotator
 from robokudo.pipeline import Pipeline
 from robokudo.types import (
@@ -38,11 +54,16 @@ from robokudo.types import (
     CameraIntrinsics,
     ColorImage,
     DepthImage,
+    Normals,
     ObjectHypothesis,
     Plane,
     PointCloud,
+    SemanticColor,
+    Shape,
+    Size,
     View,
 )
+from tests.annotators.onnx_models import detection_model, one_box_model
 
 H, W = 48, 64
 K = CameraIntrinsics(fx=60.0, fy=60.0, cx=32.0, cy=24.0, width=W, height=H)
@@ -88,6 +109,27 @@ def nan_cloud() -> PointCloud:
     return PointCloud(points=np.full((H, W, 3), np.nan, np.float32), mask=np.ones((H, W), bool), colors=color().image)
 
 
+def nan_normals() -> Normals:
+    return Normals(np.full((H, W, 3), np.nan, np.float32))
+
+
+def up_normals() -> Normals:
+    normals = np.zeros((H, W, 3), np.float32)
+    normals[..., 2] = -1.0
+    return Normals(normals)
+
+
+def posed_camera(x: float = 0.0) -> CameraInfo:
+    """A camera 1 m above the world origin looking down (shifted ``x`` m along world x)."""
+    pose = np.array([[1.0, 0, 0, x], [0, -1, 0, 0], [0, 0, -1, 1.0], [0, 0, 0, 1]])
+    return CameraInfo(K, cam_to_world=pose)
+
+
+def evidence_types() -> Seeds:
+    """Scene-level colour, shape and size: the classifier's inputs are present, yet no hypothesis carries them."""
+    return [SemanticColor(color="red"), Shape(shape="box"), Size(dimensions=(0.1, 0.1, 0.1), size_class="small")]
+
+
 def line_cloud() -> PointCloud:
     cloud = flat_cloud()
     cloud.points[..., 0] = np.linspace(0, 1, W)[None, :]
@@ -125,24 +167,67 @@ BROKEN_CASES: dict[str, tuple[Callable[[], Seeds], tuple[type[Annotator], ...]]]
         lambda: [
             PointCloud(points=np.zeros((0, 0, 3), np.float32), mask=np.zeros((0, 0), bool)),
             ColorImage(np.zeros((0, 0, 3), np.uint8)),
+            Normals(np.zeros((0, 0, 3), np.float32)),
+            posed_camera(),
             wall_plane(),
             ObjectHypothesis(point_indices=np.zeros(0, np.int64), mask=np.zeros((0, 0), bool), roi=(0, 0, 0, 0)),
         ],
-        (RangeFilter, SupportPlaneSegmenter, ClusterExtractor, SemanticColorAnnotator, PoseAnnotator),
+        (
+            RangeFilter,
+            CropBoxFilter,
+            RegionFilter,
+            NormalEstimator,
+            SupportPlaneSegmenter,
+            ClusterExtractor,
+            SemanticColorAnnotator,
+            ColorHistogramAnnotator,
+            PoseAnnotator,
+            ShapeAnnotator,
+            SizeAnnotator,
+            TextReader,
+            OnnxDetector,
+            ImageRegionSegmenter,
+        ),
     ),
     "all-NaN cloud": (
-        lambda: [nan_cloud(), wall_plane(), hypothesis()],
-        (RangeFilter, SupportPlaneSegmenter, ClusterExtractor, PoseAnnotator),
+        lambda: [nan_cloud(), nan_normals(), posed_camera(), wall_plane(), hypothesis()],
+        (
+            RangeFilter,
+            CropBoxFilter,
+            RegionFilter,
+            NormalEstimator,
+            SupportPlaneSegmenter,
+            ClusterExtractor,
+            PoseAnnotator,
+            ShapeAnnotator,
+            SizeAnnotator,
+        ),
     ),
     "cloud without points of interest": (
-        lambda: [flat_cloud(mask_value=False), wall_plane(), hypothesis()],
-        (RangeFilter, SupportPlaneSegmenter, ClusterExtractor, PoseAnnotator),
+        lambda: [flat_cloud(mask_value=False), up_normals(), posed_camera(), wall_plane(), hypothesis()],
+        (
+            RangeFilter,
+            CropBoxFilter,
+            RegionFilter,
+            NormalEstimator,
+            SupportPlaneSegmenter,
+            ClusterExtractor,
+            PoseAnnotator,
+            ShapeAnnotator,
+            SizeAnnotator,
+        ),
+    ),
+    "cloud too small for normals": (
+        lambda: [PointCloud(points=np.ones((2, 2, 3), np.float32), mask=np.ones((2, 2), bool))],
+        (NormalEstimator,),
     ),
     "collinear cloud": (lambda: [line_cloud()], (SupportPlaneSegmenter,)),
     "cloud out of range": (
         lambda: [PointCloud(points=flat_cloud().points * 10, mask=np.ones((H, W), bool))],
-        (RangeFilter,),
+        (RangeFilter, CropBoxFilter),
     ),
+    "camera pose unknown": (lambda: [flat_cloud(), CameraInfo(K)], (RegionFilter,)),
+    "no point inside the region": (lambda: [flat_cloud(), posed_camera(x=50.0)], (RegionFilter,)),
     "degenerate plane": (
         lambda: [flat_cloud(), Plane(model=np.array([0.0, 0.0, 0.0, np.nan]), inlier_indices=np.arange(10))],
         (ClusterExtractor,),
@@ -152,20 +237,80 @@ BROKEN_CASES: dict[str, tuple[Callable[[], Seeds], tuple[type[Annotator], ...]]]
         (ClusterExtractor,),
     ),
     "nothing stands on the plane": (lambda: [flat_cloud(), wall_plane()], (ClusterExtractor,)),
-    "no hypotheses": (lambda: [color(), flat_cloud(), CameraInfo(K)], (SemanticColorAnnotator, PoseAnnotator)),
+    "no hypotheses": (
+        lambda: [color(), flat_cloud(), up_normals(), CameraInfo(K), *evidence_types()],
+        (
+            SemanticColorAnnotator,
+            ColorHistogramAnnotator,
+            PoseAnnotator,
+            ShapeAnnotator,
+            SizeAnnotator,
+            KnowledgeClassifier,
+            TextReader,
+            OnnxDetector,
+        ),
+    ),
     "hypothesis and image sizes differ": (
         lambda: [color(H // 2, W // 2), hypothesis((H, W))],
-        (SemanticColorAnnotator,),
+        (SemanticColorAnnotator, ColorHistogramAnnotator, TextReader),
+    ),
+    "hypothesis box outside the image": (
+        lambda: [
+            color(),
+            ObjectHypothesis(point_indices=np.arange(3), mask=np.zeros((H, W), bool), roi=(90, 70, 99, 80)),
+        ],
+        (TextReader, OnnxDetector),
     ),
     "hypothesis without valid points": (
-        lambda: [nan_cloud(), hypothesis(), CameraInfo(K)],
-        (PoseAnnotator,),
+        lambda: [nan_cloud(), nan_normals(), hypothesis(), CameraInfo(K)],
+        (PoseAnnotator, ShapeAnnotator, SizeAnnotator),
+    ),
+    "normals and cloud sizes differ": (
+        lambda: [flat_cloud(), Normals(np.zeros((H // 2, W, 3), np.float32)), hypothesis()],
+        (ShapeAnnotator,),
     ),
     "camera pose not a transform": (
         lambda: [flat_cloud(), hypothesis(), CameraInfo(K, cam_to_world=np.full((3, 3), np.nan))],
-        (PoseAnnotator,),
+        (PoseAnnotator, RegionFilter),
     ),
+    "uniform colour image": (lambda: [color()], (ImageRegionSegmenter,)),
+    "tiny colour image": (lambda: [color(4, 4)], (ImageRegionSegmenter,)),
+    "hypothesis without evidence": (lambda: [hypothesis(), *evidence_types()], (KnowledgeClassifier,)),
 }
+
+PROFILES = ({"class": "Milk", "colors": ("white",), "shape": "box", "size": "medium", "texts": ("milk",)},)
+
+# experts that need constructor arguments: class -> factory(tmp_path); the others are built with no arguments
+FACTORIES: dict[type[Annotator], Callable[[Path], Annotator]] = {
+    RegionFilter: lambda tmp: RegionFilter("table", np.eye(4).ravel(), (4.0, 4.0, 4.0)),
+    KnowledgeClassifier: lambda tmp: KnowledgeClassifier(PROFILES),
+    OnnxDetector: lambda tmp: OnnxDetector(str(one_box_model(tmp / "model.onnx"))),
+}
+
+# experts broken through their configuration: class -> {case: factory(tmp_path)}
+BROKEN_CONFIGURATIONS: dict[type[Annotator], dict[str, Callable[[Path], Annotator]]] = {
+    KnowledgeClassifier: {"no profiles": lambda tmp: KnowledgeClassifier([])},
+    OnnxDetector: {
+        "missing model file": lambda tmp: OnnxDetector(str(tmp / "nowhere.onnx")),
+        "malformed model file": lambda tmp: OnnxDetector(str(junk_file(tmp / "junk.onnx"))),
+        "truncated model file": lambda tmp: OnnxDetector(str(truncated(one_box_model(tmp / "cut.onnx")))),
+        "no class names": lambda tmp: OnnxDetector(str(detection_model(tmp / "m.onnx", np.zeros((1, 6, 3))))),
+        "missing class name file": lambda tmp: OnnxDetector(str(one_box_model(tmp / "m.onnx")), str(tmp / "x.txt")),
+        "output it cannot decode": lambda tmp: OnnxDetector(
+            str(detection_model(tmp / "m.onnx", np.zeros((2, 2, 2)))), ["a"]
+        ),
+    },
+}
+
+
+def junk_file(path: Path) -> Path:
+    path.write_bytes(b"this is not an ONNX model")
+    return path
+
+
+def truncated(path: Path) -> Path:
+    path.write_bytes(path.read_bytes()[:40])
+    return path
 
 
 def write_uoc(folder: Path, color_size: tuple[int, int] = (H, W), params: dict | None = None) -> Path:
@@ -177,8 +322,71 @@ def write_uoc(folder: Path, color_size: tuple[int, int] = (H, W), params: dict |
     return folder
 
 
+ZERO_FOCAL_XML = (
+    "<depth><focal_length_x>0</focal_length_x><focal_length_y>0</focal_length_y>"
+    "<principal_point_x>32</principal_point_x><principal_point_y>24</principal_point_y></depth>"
+)
+
+
+def truncated_uoc(folder: Path) -> Path:
+    write_uoc(folder)
+    color = folder / "000000-color.png"
+    color.write_bytes(color.read_bytes()[:60])
+    return folder
+
+
 def zero_intrinsics_params() -> dict:
     return {"img_width": W, "img_height": H, "fx": 0.0, "fy": 0.0, "x_offset": 0.0, "y_offset": 0.0}
+
+
+def write_tum_pair(folder: Path, truncate: str | None = None) -> Path:
+    """A TUM-style pair at the PrimeSense size (the default intrinsics fit it); ``truncate`` cuts one file short."""
+    folder.mkdir(parents=True, exist_ok=True)
+    cv2.imwrite(str(folder / "a_color.png"), np.zeros((480, 640, 3), np.uint8))
+    cv2.imwrite(str(folder / "a_depth.png"), np.full((480, 640), 5000, np.uint16))
+    if truncate is not None:
+        path = folder / f"a_{truncate}.png"
+        path.write_bytes(path.read_bytes()[:200])
+    return folder / "a_color.png"
+
+
+def write_tum_sequence(folder: Path, depth_list: str = "1.0 a_depth.png\n", truncate: str | None = None) -> Path:
+    write_tum_pair(folder, truncate)
+    (folder / "rgb.txt").write_text("# colour\n1.0 a_color.png\n")
+    (folder / "depth.txt").write_text(depth_list)
+    return folder
+
+
+def write_pcd(path: Path, organized: bool = True, truncate: bool = False) -> Path:
+    """A small ASCII PCD (x y z rgb), organized 4x3 or a single row; optionally cut short."""
+    width, height = (4, 3) if organized else (12, 1)
+    header = (
+        "VERSION 0.7\nFIELDS x y z rgb\nSIZE 4 4 4 4\nTYPE F F F F\nCOUNT 1 1 1 1\n"
+        f"WIDTH {width}\nHEIGHT {height}\nVIEWPOINT 0 0 0 1 0 0 0\nPOINTS {width * height}\nDATA ascii\n"
+    )
+    rows = [f"{(c - 1.5) / 10} {(r - 1) / 10} 1.0 0" for r in range(height) for c in range(width)]
+    path.parent.mkdir(parents=True, exist_ok=True)
+    path.write_text(header + "\n".join(rows[: 5 if truncate else None]) + "\n")
+    return path
+
+
+def write_tiff(folder: Path, xml: str | None = None, truncate: bool = False) -> Path:
+    """A PCL ImageGrabber layout with one frame (tiff/ and pclzf/)."""
+    (folder / "tiff").mkdir(parents=True, exist_ok=True)
+    (folder / "pclzf").mkdir(parents=True, exist_ok=True)
+    stamp = "20121214T142255.814212"
+    cv2.imwrite(str(folder / "tiff" / f"frame_{stamp}_rgb.tiff"), np.zeros((H, W, 3), np.uint8))
+    cv2.imwrite(str(folder / "tiff" / f"frame_{stamp}_depth.tiff"), np.full((H, W), 900, np.uint16))
+    if truncate:
+        depth = folder / "tiff" / f"frame_{stamp}_depth.tiff"
+        depth.write_bytes(depth.read_bytes()[:100])
+    camera = "<focal_length_x>60</focal_length_x><focal_length_y>60</focal_length_y>"
+    camera += "<principal_point_x>32</principal_point_x><principal_point_y>24</principal_point_y>"
+    default = f'<?xml version="1.0"?>\n<rgb>{camera}</rgb>\n<depth>{camera}'
+    default += "<z_multiplication_factor>0.001</z_multiplication_factor></depth>\n"
+    if xml != "missing":
+        (folder / "pclzf" / f"frame_{stamp}.xml").write_text(default if xml is None else xml)
+    return folder
 
 
 # readers read no CAS input; they are broken through their configuration: name -> factory(tmp_path)
@@ -193,6 +401,44 @@ BROKEN_READERS: dict[type[Annotator], dict[str, Callable[[Path], Annotator]]] = 
         "image sizes differ": lambda tmp: ColorDepthPairReader(write_uoc(tmp / "b", color_size=(H // 2, W))),
         "zero intrinsics": lambda tmp: ColorDepthPairReader(write_uoc(tmp / "c", params=zero_intrinsics_params())),
         "negative depth scale": lambda tmp: ColorDepthPairReader(write_uoc(tmp / "d"), depth_scale=-1.0),
+        "truncated colour file": lambda tmp: ColorDepthPairReader(truncated_uoc(tmp / "e")),
+    },
+    TumSequenceReader: {
+        "missing folder": lambda tmp: TumSequenceReader(tmp / "nowhere"),
+        "no depth within the time tolerance": lambda tmp: TumSequenceReader(write_tum_sequence(tmp, "9.0 a.png\n")),
+        "malformed list line": lambda tmp: TumSequenceReader(write_tum_sequence(tmp, "not-a-time\n")),
+        "missing frame": lambda tmp: TumSequenceReader(write_tum_sequence(tmp), frame=3),
+        "truncated depth file": lambda tmp: TumSequenceReader(write_tum_sequence(tmp, truncate="depth")),
+        "zero intrinsics": lambda tmp: TumSequenceReader(
+            write_tum_sequence(tmp), intrinsics=CameraIntrinsics(0, 0, 0, 0, 0, 0)
+        ),
+        "intrinsics for another image size": lambda tmp: TumSequenceReader(write_tum_sequence(tmp), intrinsics=K),
+    },
+    TumPairReader: {
+        "missing depth file": lambda tmp: TumPairReader((write_tum_pair(tmp), (tmp / "a_depth.png").unlink())[0]),
+        "truncated colour file": lambda tmp: TumPairReader(write_tum_pair(tmp, truncate="color")),
+        "zero depth scale": lambda tmp: TumPairReader(write_tum_pair(tmp), depth_scale=0.0),
+        "zero intrinsics": lambda tmp: TumPairReader(
+            write_tum_pair(tmp), intrinsics=CameraIntrinsics(0, 0, 0, 0, 0, 0)
+        ),
+        "name without colour or depth": lambda tmp: TumPairReader(tmp / "picture.png"),
+    },
+    PcdReader: {
+        "missing file": lambda tmp: PcdReader(tmp / "nowhere.pcd"),
+        "truncated file": lambda tmp: PcdReader(write_pcd(tmp / "cut.pcd", truncate=True)),
+        "unorganized cloud": lambda tmp: PcdReader(write_pcd(tmp / "row.pcd", organized=False)),
+        "not a PCD file": lambda tmp: PcdReader((tmp / "junk.pcd", (tmp / "junk.pcd").write_text("hello"))[0]),
+        "zero intrinsics": lambda tmp: PcdReader(
+            write_pcd(tmp / "a.pcd"), intrinsics=CameraIntrinsics(0, 0, 0, 0, 0, 0)
+        ),
+    },
+    TiffSequenceReader: {
+        "missing folder": lambda tmp: TiffSequenceReader(tmp / "nowhere"),
+        "missing frame": lambda tmp: TiffSequenceReader(write_tiff(tmp), frame=1),
+        "missing intrinsics file": lambda tmp: TiffSequenceReader(write_tiff(tmp, xml="missing")),
+        "malformed intrinsics file": lambda tmp: TiffSequenceReader(write_tiff(tmp, xml="<rgb><focal")),
+        "zero focal length": lambda tmp: TiffSequenceReader(write_tiff(tmp, xml=ZERO_FOCAL_XML)),
+        "truncated depth file": lambda tmp: TiffSequenceReader(write_tiff(tmp, truncate=True)),
     },
 }
 
@@ -212,7 +458,12 @@ class Seed(Annotator):
 
 
 def assert_fails_with_a_reason(annotator: Annotator, seeds: Seeds) -> None:
-    Pipeline("broken", [Seed(seeds), annotator]).tick_once()  # must not raise
+    pipeline = Pipeline("broken", [Seed(seeds), annotator])
+    pipeline.tick_once()  # must not raise
+    deadline = time.monotonic() + 20.0
+    while annotator.status is Status.RUNNING and time.monotonic() < deadline:  # threaded annotators
+        time.sleep(0.005)
+        pipeline.tick_once()
     assert annotator.status is Status.FAILURE, f"{type(annotator).__name__} did not fail"
     message = annotator.feedback_message
     assert message.strip(), f"{type(annotator).__name__} failed without a reason"
@@ -225,8 +476,11 @@ READERS = [cls for cls in discovered_annotators() if not cls.inputs]
 
 def test_the_tables_cover_every_discovered_annotator() -> None:
     assert {c.__name__ for c in discovered_annotators()} >= {
-        "KitchenSceneReader", "ColorDepthPairReader", "PointCloudGenerator", "RangeFilter",
-        "SupportPlaneSegmenter", "ClusterExtractor", "SemanticColorAnnotator", "PoseAnnotator",
+        "KitchenSceneReader", "ColorDepthPairReader", "TumSequenceReader", "TumPairReader", "PcdReader",
+        "TiffSequenceReader", "PointCloudGenerator", "RangeFilter", "RegionFilter", "CropBoxFilter",
+        "NormalEstimator", "SupportPlaneSegmenter", "ClusterExtractor", "SemanticColorAnnotator",
+        "ColorHistogramAnnotator", "PoseAnnotator", "ShapeAnnotator", "SizeAnnotator", "KnowledgeClassifier",
+        "TextReader", "OnnxDetector", "ImageRegionSegmenter",
     }  # fmt: skip
     targeted = {cls for _, targets in BROKEN_CASES.values() for cls in targets}
     assert set(EXPERTS) <= targeted, f"no broken case targets {set(EXPERTS) - targeted}"
@@ -248,9 +502,20 @@ def expert_cases() -> list[tuple[type[Annotator], str]]:
 @pytest.mark.parametrize(
     ("expert", "case"), expert_cases(), ids=lambda value: value.__name__ if isinstance(value, type) else value
 )
-def test_experts_fail_with_a_reason_on_broken_input(expert: type[Annotator], case: str) -> None:
+def test_experts_fail_with_a_reason_on_broken_input(expert: type[Annotator], case: str, tmp_path: Path) -> None:
     make_seeds, _ = BROKEN_CASES[case]
-    assert_fails_with_a_reason(expert(), make_seeds())
+    factory = FACTORIES.get(expert, lambda tmp: expert())
+    assert_fails_with_a_reason(factory(tmp_path), make_seeds())
+
+
+@pytest.mark.parametrize(
+    ("expert", "case"),
+    [(expert, case) for expert, cases in BROKEN_CONFIGURATIONS.items() for case in sorted(cases)],
+    ids=lambda value: value.__name__ if isinstance(value, type) else value,
+)
+def test_experts_fail_with_a_reason_on_broken_configuration(expert: type[Annotator], case: str, tmp_path) -> None:
+    seeds = [color(), flat_cloud(), up_normals(), CameraInfo(K), hypothesis(), *evidence_types()]
+    assert_fails_with_a_reason(BROKEN_CONFIGURATIONS[expert][case](tmp_path), seeds)
 
 
 @pytest.mark.parametrize(

@@ -105,9 +105,12 @@ def test_the_inside_of_a_cup_is_recognised_and_a_neighbour_is_not() -> None:
     # plane coordinates (u across, v along the line of sight, height); the cup stands 0.6 m ahead
     front = np.column_stack([0.04 * np.cos(angles), 0.6 - 0.04 * np.sin(angles), np.full(50, 0.08)])
     front = np.vstack([front, front * [1, 1, 0.2]])
-    back = np.column_stack([0.038 * np.cos(angles), 0.6 + 0.038 * np.sin(angles), np.full(50, 0.07)])
+    # the inner back wall, seen over the front rim, from the rim (0.07 m) down to 0.02 m
+    back = np.column_stack([0.038 * np.cos(angles), 0.6 + 0.038 * np.sin(angles), np.linspace(0.02, 0.07, 50)])
     beside = back + np.array([0.09, 0.0, 0.0])
     taller_behind = back * np.array([1, 1, 0]) + np.array([0, 0.06, 0.2])
+    flat_top_behind = back * np.array([1, 1, 0]) + np.array([0, 0.0, 0.075])  # a box's top face behind the cup
     assert looks_like_inside(front, back, 0.01, 1.5)
     assert not looks_like_inside(front, beside, 0.01, 1.5)
     assert not looks_like_inside(front, taller_behind, 0.01, 1.5)
+    assert not looks_like_inside(front, flat_top_behind, 0.01, 1.5)

@@ -135,4 +135,5 @@ def test_tree_module_is_listed_explained_and_valid() -> None:
     describe = root.children[5]
     assert [type(c).__name__ for c in describe.children] == ["SemanticColorAnnotator", "PoseAnnotator"]
     assert all(getattr(node, "reason", "") for node in root.iterate())
-    assert type(create_tree("/some/folder", 2).children[0]).__name__ == "ColorDepthPairReader"
+    with pytest.raises(ValueError, match="supported inputs"):
+        create_tree("/some/folder", 2)

@@ -1,7 +1,7 @@
 """End to end: `robokudo query "find milk in fridge" --json` on the built-in scene, twice.
 
 The answer is one milk with a pose, region fridge and its contributing experts, written to the belief store;
-the second run updates the same belief. Runs once `robokudo query` is wired (it needs the planner).
+the second run updates the same belief.
 """
 
 from __future__ import annotations
@@ -15,20 +15,9 @@ from robokudo import cli
 from robokudo.belief_store import BeliefStore
 
 
-def query_command_available() -> bool:
-    try:
-        parser = cli.build_parser()
-        parser.parse_args(["query", "find milk", "--json"])
-    except SystemExit:
-        return False
-    return True
-
-
 def test_find_milk_in_fridge_twice_updates_one_belief(
     tmp_path: Path, monkeypatch: pytest.MonkeyPatch, capsys: pytest.CaptureFixture
 ) -> None:
-    if not query_command_available():
-        pytest.skip("`robokudo query` is not wired yet (it comes with the planner)")
     store_path = tmp_path / "beliefs.sqlite"
     monkeypatch.setenv("ROBOKUDO_BELIEF_STORE", str(store_path))
     ids = []

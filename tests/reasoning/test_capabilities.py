@@ -80,12 +80,15 @@ def test_detector_of_a_subclass_serves_a_query_for_the_superclass(test_kb: Knowl
 
 
 def test_detector_of_a_superclass_serves_a_query_for_a_subclass(test_kb: KnowledgeBase) -> None:
-    assert names(test_kb.providers("Classification", value="LactoseFreeMilk")) == ["MilkDetector"]
+    found = names(test_kb.providers("Classification", value="LactoseFreeMilk"))
+    # the KnowledgeClassifier reports any PhysicalObject, so it serves every class too
+    assert [name for name in found if name != "KnowledgeClassifier"] == ["MilkDetector"]
+    assert "KnowledgeClassifier" in found
 
 
 def test_annotators_without_class_domain_serve_any_class(test_kb: KnowledgeBase) -> None:
     found = names(test_kb.providers("ObjectHypothesis", object_class="Cup"))
-    assert found == ["ClusterExtractor"]
+    assert found == ["ClusterExtractor", "ImageRegionSegmenter"]  # by reliability
 
 
 def test_not_transparent_precondition_excludes_glass(kb: KnowledgeBase) -> None:
@@ -104,7 +107,10 @@ def test_depth_and_region_preconditions(test_kb: KnowledgeBase) -> None:
 
 
 def test_providers_include_subtypes_and_views(kb: KnowledgeBase) -> None:
-    assert set(names(kb.providers("ColorImage"))) == {"KitchenSceneReader", "ColorDepthPairReader"}
+    assert set(names(kb.providers("ColorImage"))) == {
+        "KitchenSceneReader", "ColorDepthPairReader", "TumSequenceReader", "TumPairReader", "PcdReader",
+        "TiffSequenceReader",
+    }  # fmt: skip
     assert "SemanticColorAnnotator" in names(kb.providers("Annotation"))
 
 

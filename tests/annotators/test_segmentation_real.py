@@ -1,0 +1,143 @@
+"""Segmentation and object experts on real RGB-D data read in place from ../shared/data.
+
+* mOSD (pcl_mosd_tabletop learn0: two stacked cereal boxes; learn35: bowl, tub, tin) with its ground-truth labels
+  (1-9 table, object id = label // 10 for labels >= 20): the table plane is found and every labelled object is
+  matched by a hypothesis with point IoU >= 0.5.
+* uoc_tabletop_realsense frames 0-4: every listed object has its own hypothesis; the red Cheez-It box is named
+  red and OCR reads "CHEEZ" inside its image box. Objects standing on or in another object (frame 2: a soup can on
+  a spam can, a small can in a bowl) share their support's hypothesis: their footprints overlap (a known limit).
+"""
+
+from __future__ import annotations
+
+import time
+from pathlib import Path
+
+import numpy as np
+import pytest
+from py_trees.common import Status
+
+from annotators.readers import PcdReader
+from annotators.sources import reader_for
+from annotators.text import TextReader
+from robokudo.annotator import Annotator
+from robokudo.engine import Engine
+from robokudo.pipeline import Pipeline
+from robokudo.types import ColorImage, ObjectHypothesis, Plane, SemanticColor, Text
+from tests.annotators.conftest import require_folder
+from trees.tabletop import create_pipeline
+
+pytestmark = pytest.mark.real_data
+
+MIN_IOU = 0.5
+
+
+def object_ious(labels: np.ndarray, valid: np.ndarray, hypotheses: list[ObjectHypothesis]) -> dict[int, float]:
+    """Each ground-truth object id with the best point IoU any hypothesis reaches on it."""
+    ids = sorted({int(label) // 10 for label in np.unique(labels) if label >= 20})
+    best = {}
+    for object_id in ids:
+        truth = (labels >= 20) & (labels // 10 == object_id) & valid
+        best[object_id] = max(
+            (np.count_nonzero(h.mask & truth) / np.count_nonzero(h.mask | truth) for h in hypotheses), default=0.0
+        )
+    return best
+
+
+@pytest.mark.parametrize(("scene", "objects"), [("learn0", 2), ("learn35", 3)])
+def test_mosd_table_and_objects_are_found(shared_data: Path, scene: str, objects: int) -> None:
+    path = require_folder(shared_data / "pcl_mosd_tabletop" / "learn") / f"{scene}.pcd"
+    reader = PcdReader(path)
+    root = create_pipeline(reader)
+    assert Engine(root).tick() is Status.SUCCESS, [(c.name, c.feedback_message) for c in root.children]
+    frame = reader.last_frame
+    labels, valid = frame.labels, np.isfinite(frame.points[..., 2])
+
+    (plane,) = root.cas.annotations(Plane)
+    inliers = np.zeros(labels.size, dtype=bool)
+    inliers[plane.inlier_indices] = True
+    inliers = inliers.reshape(labels.shape)
+    table = (labels >= 1) & (labels <= 9) & valid
+    assert np.count_nonzero(inliers & table) >= 0.95 * np.count_nonzero(table)
+    on_objects = inliers & (labels >= 20)
+    assert np.count_nonzero(on_objects) <= 0.05 * np.count_nonzero(labels >= 20)
+
+    ious = object_ious(labels, valid, root.cas.annotations(ObjectHypothesis))
+    assert len(ious) == objects
+    assert all(iou >= MIN_IOU for iou in ious.values()), ious
+
+
+# a pixel (x, y) well inside each object of each frame, looked up on the colour images
+UOC_OBJECTS: dict[int, dict[str, tuple[int, int]]] = {
+    0: {
+        "cheez-it box": (490, 250), "mustard bottle": (280, 100), "blue mug": (200, 195), "white mug": (290, 260),
+        "soup can": (540, 375), "teal bowl": (185, 350), "spam can": (70, 300),
+    },
+    1: {
+        "cheez-it box": (480, 320), "mustard bottle": (280, 170), "blue mug": (220, 230), "white mug": (325, 285),
+        "teal bowl": (140, 330), "soup can": (175, 185), "spam can": (70, 320),
+    },
+    2: {  # the soup can stands on the spam can and a small can inside the bowl: one hypothesis per stack (known)
+        "cheez-it box": (260, 60), "mustard bottle": (180, 110), "soup can on spam can": (150, 260),
+        "teal bowl": (360, 200), "blue mug": (480, 140), "white bowl": (410, 235),
+    },
+    3: {
+        "cheez-it box": (260, 70), "water bottle": (560, 150), "teal bowl": (340, 185), "white bowl": (410, 250),
+        "blue mug": (490, 130), "mustard bottle": (190, 160), "soup can": (150, 170),
+    },
+    4: {"wipes tub": (240, 120), "cashew can": (425, 190), "purple cup": (470, 290), "duplo brick": (245, 300)},
+}  # fmt: skip
+
+
+def hypothesis_at(hypotheses: list[ObjectHypothesis], x: int, y: int) -> int:
+    """The number (1-based) of the hypothesis most of the 5x5 pixels around (x, y) belong to, 0 for none."""
+    labels = np.zeros(hypotheses[0].mask.shape, dtype=int)
+    for number, hypothesis in enumerate(hypotheses, start=1):
+        labels[hypothesis.mask] = number
+    return int(np.bincount(labels[y - 2 : y + 3, x - 2 : x + 3].ravel()).argmax())
+
+
+class _Hand(Annotator):
+    """Writes a colour image and one hypothesis (test helper)."""
+
+    outputs = (ColorImage, ObjectHypothesis)
+
+    def __init__(self, image: np.ndarray, hypothesis: ObjectHypothesis) -> None:
+        super().__init__(name="hand")
+        self.items = (ColorImage(image), hypothesis)
+
+    def analyse(self) -> None:
+        for item in self.items:
+            self.write(item)
+
+
+def read_text(image: np.ndarray, hypothesis: ObjectHypothesis) -> list[Text]:
+    """Run a TextReader on one hypothesis; the Text annotations it attached."""
+    reader = TextReader()
+    pipeline = Pipeline("ocr", [_Hand(image, hypothesis), reader])
+    deadline = time.monotonic() + 60
+    pipeline.tick_once()
+    while reader.status is Status.RUNNING and time.monotonic() < deadline:
+        time.sleep(0.01)
+        pipeline.tick_once()
+    assert reader.status is Status.SUCCESS, reader.feedback_message
+    return hypothesis.find(Text)
+
+
+@pytest.mark.parametrize("frame", sorted(UOC_OBJECTS))
+def test_uoc_objects_get_their_own_hypotheses_and_the_cheez_it_box_is_red_and_read(uoc_folder: Path, frame: int):
+    root = create_pipeline(reader_for(str(uoc_folder), frame))
+    assert Engine(root).tick() is Status.SUCCESS, [(c.name, c.feedback_message) for c in root.children]
+    hypotheses = root.cas.annotations(ObjectHypothesis)
+    found = {name: hypothesis_at(hypotheses, x, y) for name, (x, y) in UOC_OBJECTS[frame].items()}
+    assert all(found.values()), f"objects without a hypothesis: {[n for n, k in found.items() if not k]}"
+    assert len(set(found.values())) == len(found), f"objects sharing a hypothesis: {found}"
+    if "cheez-it box" not in found:
+        return
+    box = hypotheses[found["cheez-it box"] - 1]
+    assert box.first(SemanticColor).color == "red"
+    texts = read_text(root.cas.view(ColorImage).image, box)
+    assert texts and "CHEEZ" in texts[0].text.upper(), texts
+    x0, y0, x1, y1 = texts[0].box
+    rx0, ry0, rx1, ry1 = box.roi
+    assert rx0 - 8 <= x0 < x1 <= rx1 + 8 and ry0 - 8 <= y0 < y1 <= ry1 + 8

@@ -1,0 +1,210 @@
+"""The automatic PPT synthesis tests: queries -> expected experts, order constraints and tree structure."""
+
+from __future__ import annotations
+
+from dataclasses import dataclass, field
+from pathlib import Path
+
+import py_trees
+import pytest
+
+from queries import parse_query
+from reasoning.knowledge_base import KnowledgeBase
+from reasoning.plan import Alternatives, Plan, Step
+from reasoning.planner import PlanningError, SensorSource
+from reasoning.query_planner import plan_query
+from robokudo.belief_store import BeliefStore
+from robokudo.dataflow import validate_data_flow
+from robokudo.parallel import ThresholdParallel
+from robokudo.render import unicode_tree
+from robokudo.sources import sensor_source
+from trees.synthesis import build_tree
+
+
+@pytest.fixture(scope="module")
+def kb(tmp_path_factory: pytest.TempPathFactory) -> KnowledgeBase:
+    return KnowledgeBase.load(tmp_path_factory.mktemp("kb") / "user.ttl")
+
+
+@dataclass(frozen=True)
+class Case:
+    """A query and what its tree must (not) contain; ``before`` pairs must run in that order."""
+
+    query: str
+    contains: frozenset[str] = frozenset()
+    excludes: frozenset[str] = frozenset()
+    before: tuple[tuple[str, str], ...] = ()
+    fallback_for: tuple[str, ...] = ()
+    side_by_side: tuple[frozenset[str], ...] = ()
+    source: str = "kitchen"
+    inference: str = ""
+    region: str | None = None
+    marks: tuple = field(default=())
+
+
+def case(query: str, contains: str = "", excludes: str = "", **options: object) -> Case:
+    return Case(query, frozenset(contains.split()), frozenset(excludes.split()), **options)  # type: ignore[arg-type]
+
+
+CORE = "PointCloudGenerator RangeFilter SupportPlaneSegmenter ClusterExtractor PoseAnnotator"
+CLASSIFY = "KnowledgeClassifier SemanticColorAnnotator ShapeAnnotator SizeAnnotator"
+
+CASES = [
+    case(
+        "find milk in fridge",
+        f"{CORE} RegionFilter {CLASSIFY} TextReader",
+        before=(("RegionFilter", "SupportPlaneSegmenter"), ("TextReader", "KnowledgeClassifier")),
+        region="fridge",
+    ),
+    case("find milk", "RegionFilter KnowledgeClassifier", inference="stored in the Fridge", region="fridge"),
+    case("detect { obj: { type: Milk, location: Fridge } }", "RegionFilter KnowledgeClassifier TextReader"),
+    case(
+        "is there a lactose free milk in the fridge",
+        "TextReader KnowledgeClassifier RegionFilter",
+        inference="printed text",
+    ),
+    case('detect { obj: { type: Milk, text: "lactose free" } }', "TextReader KnowledgeClassifier"),
+    case(
+        "detect { obj: { shape: cylinder } }",
+        "NormalEstimator ShapeAnnotator",
+        "KnowledgeClassifier RegionFilter TextReader SemanticColorAnnotator",
+        before=(("NormalEstimator", "ShapeAnnotator"), ("ClusterExtractor", "ShapeAnnotator")),
+    ),
+    case(
+        "detect { obj: { color: red } }",
+        f"{CORE} SemanticColorAnnotator",
+        "ShapeAnnotator NormalEstimator KnowledgeClassifier TextReader RegionFilter",
+        side_by_side=(frozenset({"SemanticColorAnnotator", "PoseAnnotator"}),),
+    ),
+    case("find the red cup on the table", f"RegionFilter {CLASSIFY}", region="table"),
+    case("track the blue cup", CLASSIFY, "RegionFilter"),
+    case("where is the cereal box?", "KnowledgeClassifier", "RegionFilter", inference="Cupboard"),
+    case(
+        "inspect { obj: { id: 12, pose: ?, color: ? } }", "PoseAnnotator SemanticColorAnnotator", "KnowledgeClassifier"
+    ),
+    case("detect { obj: { size: small } }", "SizeAnnotator", "ShapeAnnotator KnowledgeClassifier"),
+    case("detect { obj: { type: Bowl } }", CLASSIFY),
+    case("detect { obj: { color: [white, blue] } }", "SemanticColorAnnotator"),
+    case("scan { region: table, for: free_space }", "RegionFilter SupportPlaneSegmenter ClusterExtractor"),
+    case(
+        "detect { obj: { type: Cup, color: red, size: small, location: { on: Table } } }",
+        f"RegionFilter {CLASSIFY}",
+    ),
+    case("find a glass", "ImageRegionSegmenter", "ClusterExtractor", inference=""),
+    case(
+        "detect { obj: { color: red } }",
+        "ImageRegionSegmenter SemanticColorAnnotator",
+        "PointCloudGenerator PoseAnnotator ClusterExtractor",
+        source="rgb",
+        inference="no depth",
+    ),
+    case(
+        "detect { obj: { color: red } }", "SemanticColorAnnotator ClusterExtractor", "PointCloudGenerator", source="pcd"
+    ),
+    case(
+        "find the red thing",
+        "SemanticColorAnnotator ClusterExtractor ImageRegionSegmenter",
+        fallback_for=("ObjectHypothesis",),
+    ),
+    case("detect { obj: { type: Milk, color: white, shape: box } }", f"{CLASSIFY} NormalEstimator"),
+    case("find cups", "KnowledgeClassifier"),
+    case("track { obj: { type: Cup, color: blue } }", "KnowledgeClassifier SemanticColorAnnotator"),
+    case(
+        "look for free space on the table",
+        "RegionFilter SupportPlaneSegmenter",
+        "KnowledgeClassifier SemanticColorAnnotator",
+    ),
+    case('{"detect": {"obj": {"type": "milk", "location": "fridge"}}}', "RegionFilter KnowledgeClassifier TextReader"),
+]
+
+FAILURES = [
+    ("detect { obj: { color: teal } }", "SemanticColor with value 'Teal'.*SemanticColorAnnotator can report only"),
+    ("stop { task: 7 }", "cancels a running task"),
+    ("find the flux capacitor", "unknown object class 'flux_capacitor'"),
+    ("detect { obj: { flavour: sweet } }", "query key 'flavour'"),
+    ("scan { region: CounterTop, for: free_space }", "no region of class CounterTop"),
+]
+
+
+def source_for(kind: str, kb: KnowledgeBase, region: str | None) -> SensorSource:
+    if kind == "kitchen":
+        return sensor_source(kb, None, region=region)
+    reader = kb.annotator("PcdReader" if kind == "pcd" else "TumPairReader")
+    outputs = reader.outputs if kind == "pcd" else ("ColorImage", "CameraInfo")
+    return SensorSource(Step(reader.name, reader.implemented_by, (), outputs, reason="test source"))
+
+
+def order(plan: Plan) -> list[str]:
+    return [step.annotator for step in plan.steps()]
+
+
+@pytest.mark.parametrize("expected", CASES, ids=[f"{c.source}: {c.query}" for c in CASES])
+def test_synthesized_tree(expected: Case, kb: KnowledgeBase) -> None:
+    query = parse_query(expected.query)
+    result = plan_query(query, kb, source_for(expected.source, kb, expected.region))
+    names = set(order(result.plan))
+    assert expected.contains <= names, f"missing {expected.contains - names}"
+    assert not expected.excludes & names, f"unexpected {expected.excludes & names}"
+    sequence = order(result.plan)
+    for first, second in expected.before:
+        assert sequence.index(first) < sequence.index(second), (first, second, sequence)
+    alternatives = [u for u in result.plan.units() if isinstance(u, Alternatives)]
+    for provided in expected.fallback_for:
+        assert provided in {a.provides for a in alternatives}, f"no Fallback for {provided}"
+    if expected.inference:
+        assert any(expected.inference in note for note in result.interpretation.task.inferences)
+    if expected.region:
+        assert result.interpretation.task.region == expected.region
+    if expected.source != "kitchen":
+        return  # the test sources have no reader implementation to build
+    tree = build_tree(result.plan, query=query)
+    validate_data_flow(tree)
+    for group in expected.side_by_side:
+        parallels = [n for n in tree.iterate() if isinstance(n, ThresholdParallel)]
+        assert any(group <= {c.name for c in p.children} for p in parallels), f"{group} not in one Parallel"
+    for node in tree.iterate():
+        assert getattr(node, "reason", ""), f"{node.name} has no reason"
+    again = build_tree(plan_query(query, kb, source_for(expected.source, kb, expected.region)).plan, query=query)
+    assert unicode_tree(again) == unicode_tree(tree)  # deterministic
+
+
+def test_fallback_branches_are_in_rank_order_with_their_own_steps(kb: KnowledgeBase) -> None:
+    result = plan_query(parse_query("find the red thing"), kb, sensor_source(kb, None))
+    (segmenters,) = [u for u in result.plan.units() if isinstance(u, Alternatives)]
+    providers = [branch[-1].annotator for branch in segmenters.branches]
+    assert providers == ["ClusterExtractor", "ImageRegionSegmenter"]  # reliability first
+    depth_branch = [s.annotator for s in segmenters.branches[0]]
+    assert depth_branch == ["SupportPlaneSegmenter", "ClusterExtractor"]  # the plane only this branch needs
+    tree = build_tree(result.plan)
+    fallback = next(n for n in tree.iterate() if isinstance(n, py_trees.composites.Selector))
+    assert "ObjectHypothesis" in fallback.name and "rank order" in fallback.reason
+
+
+@pytest.mark.parametrize(("query", "message"), FAILURES)
+def test_unplannable_queries_fail_with_a_clear_reason(query: str, message: str, kb: KnowledgeBase) -> None:
+    with pytest.raises(PlanningError, match=message):
+        plan_query(parse_query(query), kb, sensor_source(kb, None))
+
+
+def test_explanations_name_the_query_and_the_producers(kb: KnowledgeBase) -> None:
+    result = plan_query(parse_query("detect { obj: { color: red } }"), kb, sensor_source(kb, None))
+    color = next(s for s in result.plan.steps() if s.annotator == "SemanticColorAnnotator")
+    assert "query asks color = Red" in color.reason
+    assert "needs ColorImage from KitchenSceneReader" in color.reason and "ObjectHypothesis from" in color.reason
+
+
+def test_a_new_object_class_plans_and_runs_at_once(tmp_path: Path) -> None:
+    from reasoning.editing import OntologyEditor
+    from robokudo.query_cli import answer_query
+
+    kb = KnowledgeBase.load(tmp_path / "user.ttl")
+    with pytest.raises(PlanningError, match="unknown object class 'picnic_cup'"):
+        plan_query(parse_query("find the picnic cup"), kb, sensor_source(kb, None))
+    editor = OntologyEditor(kb, user_file=tmp_path / "user.ttl", use_reasoner=False)
+    editor.add_object("PicnicCup", ["Cup"], colors=["red"], shape="cylinder", size="small")
+    result = plan_query(parse_query("find the picnic cup"), kb, sensor_source(kb, None))
+    assert "KnowledgeClassifier" in order(result.plan)
+    with BeliefStore(tmp_path / "beliefs.sqlite") as store:
+        answer, _ = answer_query("find the picnic cup", kb, store=store)
+    assert answer.objects, "the new class was not found in the kitchen"
+    assert answer.objects[0].class_iri.endswith("PicnicCup")
