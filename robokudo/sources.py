@@ -8,7 +8,11 @@ from reasoning.planner import SensorSource
 
 
 def sensor_source(kb: KnowledgeBase, input_path: str | None, frame: int = 0, region: str | None = None) -> SensorSource:
-    """The reader for ``input_path`` (the built-in kitchen when None, looking at ``region`` if given)."""
+    """The reader for ``input_path`` (the built-in kitchen when None, looking at ``region`` if given).
+
+    The reader is picked from the path's layout (``annotators.sources.reader_choice``); a path of no known
+    layout raises ValueError listing the supported ones.
+    """
     if input_path is None:
         from annotators.kitchen_scene import camera_looking_at
 
@@ -23,8 +27,11 @@ def sensor_source(kb: KnowledgeBase, input_path: str | None, frame: int = 0, reg
         spec = kb.annotator("KitchenSceneReader")
         parameters: tuple[tuple[str, object], ...] = (("view", view),)
     else:
-        spec = kb.annotator("ColorDepthPairReader")
-        parameters = (("folder", input_path), ("frame", frame))
+        from annotators.sources import reader_choice
+
+        choice = reader_choice(input_path, frame)
+        spec = kb.annotator(choice.name)
+        parameters = tuple(sorted(choice.parameters.items()))
         reason = f"reads frame {frame} of {input_path}"
     step = Step(
         annotator=spec.name,
