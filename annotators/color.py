@@ -13,8 +13,8 @@ from typing import ClassVar
 import cv2
 import numpy as np
 
-from robokudo.annotator import Annotator
-from robokudo.types import CasType, ColorImage, ObjectHypothesis, SemanticColor
+from annotators.pixel_expert import PixelExpert
+from robokudo.types import CasType, SemanticColor
 
 
 @dataclass(frozen=True)
@@ -128,44 +128,14 @@ def name_color(rgb: np.ndarray) -> tuple[str, float, dict[str, float]]:
     return winner, shares[winner], shares
 
 
-def hypothesis_pixels(image: np.ndarray, hypothesis: ObjectHypothesis, max_pixels: int = 2000) -> np.ndarray:
-    """Up to ``max_pixels`` RGB pixels of the hypothesis, its outline left out when enough remain."""
-    x0, y0, x1, y1 = hypothesis.roi
-    local = hypothesis.mask[y0:y1, x0:x1]
-    inner = cv2.erode(local.view(np.uint8), np.ones((3, 3), np.uint8)).view(bool)
-    if np.count_nonzero(inner) >= max(20, np.count_nonzero(local) // 3):
-        local = inner
-    pixels = image[y0:y1, x0:x1][local]
-    return pixels[:: max(1, pixels.shape[0] // max_pixels)]
-
-
-class SemanticColorAnnotator(Annotator):
+class SemanticColorAnnotator(PixelExpert):
     """Names the dominant colour of every object hypothesis; confidence is the winning colour's share."""
 
-    inputs: ClassVar[tuple[type[CasType], ...]] = (ObjectHypothesis, ColorImage)
     outputs: ClassVar[tuple[type[CasType], ...]] = (SemanticColor,)
+    purpose: ClassVar[str] = "name colours for"
 
-    def __init__(self, max_pixels: int = 1000, name: str | None = None) -> None:
-        super().__init__(name=name)
-        self.max_pixels = max_pixels
+    def describe(self, pixels: np.ndarray) -> SemanticColor:
+        """The dominant colour name of the pixels."""
+        color, share, _ = name_color(pixels)
+        return SemanticColor(color=color, ratio=share, confidence=share)
 
-    def analyse(self) -> None:
-        """Attach one SemanticColor to each hypothesis; fail on missing or inconsistent input."""
-        image = self.view(ColorImage).image
-        if image.ndim != 3 or image.shape[2] != 3 or image.size == 0:
-            self.fail(f"colour image must be HxWx3, got shape {image.shape}")
-        hypotheses = self.annotations(ObjectHypothesis)
-        if not hypotheses:
-            self.fail("no object hypotheses to name colours for")
-        named = 0
-        for hypothesis in hypotheses:
-            if hypothesis.mask.shape != image.shape[:2]:
-                self.fail(f"hypothesis mask {hypothesis.mask.shape} and colour image {image.shape[:2]} sizes differ")
-            pixels = hypothesis_pixels(image, hypothesis, self.max_pixels)
-            if pixels.shape[0] == 0:
-                continue
-            color, share, _ = name_color(pixels)
-            self.attach(hypothesis, SemanticColor(color=color, ratio=share, confidence=share))
-            named += 1
-        if named == 0:
-            self.fail("every object hypothesis has an empty mask")

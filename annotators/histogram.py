@@ -11,9 +11,8 @@ from typing import ClassVar
 import cv2
 import numpy as np
 
-from annotators.color import hypothesis_pixels
-from robokudo.annotator import Annotator
-from robokudo.types import CasType, ColorHistogram, ColorImage, ObjectHypothesis
+from annotators.pixel_expert import PixelExpert
+from robokudo.types import CasType, ColorHistogram
 
 MIN_VALUE = 30
 """Pixels with a value (brightness, 0-255) below this are left out of the histogram when others remain."""
@@ -30,36 +29,17 @@ def hue_saturation_histogram(rgb: np.ndarray, bins: tuple[int, int]) -> np.ndarr
     return (histogram / total).astype(np.float32) if total > 0 else histogram.astype(np.float32)
 
 
-class ColorHistogramAnnotator(Annotator):
+class ColorHistogramAnnotator(PixelExpert):
     """Attaches a normalised hue/saturation ColorHistogram to every object hypothesis."""
 
-    inputs: ClassVar[tuple[type[CasType], ...]] = (ObjectHypothesis, ColorImage)
     outputs: ClassVar[tuple[type[CasType], ...]] = (ColorHistogram,)
 
     def __init__(self, bins: tuple[int, int] = (16, 4), max_pixels: int = 4000, name: str | None = None) -> None:
-        super().__init__(name=name)
+        super().__init__(max_pixels=max_pixels, name=name)
         if len(bins) != 2 or min(bins) < 1:
             raise ValueError(f"bins must be two positive counts (hue, saturation), got {bins}")
         self.bins = (int(bins[0]), int(bins[1]))
-        self.max_pixels = max_pixels
 
-    def analyse(self) -> None:
-        """Attach one histogram per hypothesis with pixels; fail on missing or inconsistent input."""
-        image = self.view(ColorImage).image
-        if image.ndim != 3 or image.shape[2] != 3 or image.size == 0:
-            self.fail(f"colour image must be HxWx3, got shape {image.shape}")
-        hypotheses = self.annotations(ObjectHypothesis)
-        if not hypotheses:
-            self.fail("no object hypotheses to describe")
-        described = 0
-        for hypothesis in hypotheses:
-            if hypothesis.mask.shape != image.shape[:2]:
-                self.fail(f"hypothesis mask {hypothesis.mask.shape} and colour image {image.shape[:2]} sizes differ")
-            pixels = hypothesis_pixels(image, hypothesis, self.max_pixels)
-            if pixels.shape[0] == 0:
-                continue
-            histogram = hue_saturation_histogram(pixels, self.bins)
-            self.attach(hypothesis, ColorHistogram(histogram=histogram, bins=self.bins))
-            described += 1
-        if described == 0:
-            self.fail("every object hypothesis has an empty mask")
+    def describe(self, pixels: np.ndarray) -> ColorHistogram:
+        """The hue/saturation histogram of the pixels."""
+        return ColorHistogram(histogram=hue_saturation_histogram(pixels, self.bins), bins=self.bins)

@@ -31,9 +31,10 @@ sys.path.insert(0, str(ROOT))
 
 from annotators.boxes import object_box  # noqa: E402
 from annotators.clusters import ClusterParameters, extract_clusters  # noqa: E402
-from annotators.color import SemanticColorAnnotator, hypothesis_pixels, name_color  # noqa: E402
+from annotators.color import SemanticColorAnnotator, name_color  # noqa: E402
 from annotators.filters import range_mask  # noqa: E402
 from annotators.frame_io import read_color_depth_pair  # noqa: E402
+from annotators.pixel_expert import hypothesis_pixels  # noqa: E402
 from annotators.plane import ransac_support_plane  # noqa: E402
 from annotators.point_cloud import back_project, pixel_rays  # noqa: E402
 from annotators.pose import PoseAnnotator, hypothesis_points  # noqa: E402
