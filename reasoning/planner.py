@@ -23,7 +23,7 @@ The algorithm, polynomial in annotators x types:
 from __future__ import annotations
 
 from collections import deque
-from collections.abc import Iterable, Mapping, Sequence
+from collections.abc import Callable, Iterable, Mapping, Sequence
 from dataclasses import dataclass
 from typing import Protocol
 
@@ -54,6 +54,10 @@ class ProviderIndex(Protocol):
 
     def annotators(self) -> Sequence[AnnotatorSpec]:
         """Every annotator."""
+        ...
+
+    def superclasses(self, name: str, direct: bool = False) -> list[str]:
+        """The proper superclasses of a class (CAS types included)."""
         ...
 
 
@@ -118,12 +122,14 @@ class _Catalog:
         self, index: ProviderIndex, sensors: frozenset[str], object_class: str | None, conditions: Conditions
     ) -> None:
         self.index = index
-        self.sensors = sensors
+        self._supertypes: dict[str, frozenset[str]] = {}
+        # a type is present when it or a subtype of it is: track each written type together with its supertypes
+        self.sensors = self.with_supertypes(sensors)
         self.object_class = object_class
         self.conditions = conditions
         self._providers: dict[tuple[str, str | None], tuple[AnnotatorSpec, ...]] = {}
         self._without: dict[frozenset[str], frozenset[str]] = {}
-        outputs = sorted({t for spec in index.annotators() for t in spec.outputs})
+        outputs = sorted({t for spec in index.annotators() for t in self.with_supertypes(spec.outputs)})
         self.edges = [(spec, t) for t in outputs for spec in self.providers(t)]
         self._waiting: dict[str, list[int]] = {}
         for index, (spec, _) in enumerate(self.edges):
@@ -145,6 +151,19 @@ class _Catalog:
             if not new:
                 return rounds
             rounds.update(dict.fromkeys(new, current))
+
+    def with_supertypes(self, types: Iterable[str]) -> frozenset[str]:
+        """The types and all their supertypes."""
+        found: set[str] = set()
+        for type_name in types:
+            if type_name not in self._supertypes:
+                self._supertypes[type_name] = frozenset({type_name, *self.index.superclasses(type_name)})
+            found |= self._supertypes[type_name]
+        return frozenset(found)
+
+    def written(self, spec: AnnotatorSpec) -> frozenset[str]:
+        """What an annotator makes present for others: its outputs and their supertypes, minus what it reads."""
+        return self.with_supertypes(spec.outputs) - self.with_supertypes(spec.inputs)
 
     def providers(self, type_name: str, value: str | None = None) -> tuple[AnnotatorSpec, ...]:
         """Ranked providers of ``type_name`` for ``value`` (refiners of the type excluded)."""
@@ -217,9 +236,12 @@ class _Catalog:
 class _UnitChoice:
     """The providers chosen for one needed type (one unit of the plan)."""
 
-    def __init__(self, type_name: str, providers: list[AnnotatorSpec], value: str | None) -> None:
+    def __init__(
+        self, type_name: str, providers: list[AnnotatorSpec], value: str | None, written: Callable[..., frozenset[str]]
+    ) -> None:
         self.type_name = type_name
         self.value = value
+        self._written = written
         self.providers = providers
 
     @property
@@ -230,7 +252,7 @@ class _UnitChoice:
     @providers.setter
     def providers(self, providers: list[AnnotatorSpec]) -> None:
         self._providers = providers
-        self._guaranteed = frozenset.intersection(*(frozenset(s.outputs) - frozenset(s.inputs) for s in providers))
+        self._guaranteed = frozenset.intersection(*(self._written(s) for s in providers))
 
     def guaranteed(self) -> frozenset[str]:
         """Types the unit produces for others: outputs every provider writes without having read them."""
@@ -437,7 +459,7 @@ class _Assignment:
                 if not self._take_over(type_name, valid, consumer, above):
                     raise _OrderingError(f"cannot produce {type_name}: {self.catalog.why_not(type_name, value)}")
                 continue
-            self.units[type_name] = _UnitChoice(type_name, free, value)
+            self.units[type_name] = _UnitChoice(type_name, free, value, self.catalog.written)
             self._invalidate()
             self.above[type_name] = set(above)
             for spec in free:
@@ -513,7 +535,7 @@ class _Layout:
         self.parameters = parameters
         self.branches = self._branches()
         absorbed = {t for owned in self.branches.values() for types in owned.values() for t in types}
-        self.final: dict[str, str] = dict.fromkeys(source.types, "reader")
+        self.final: dict[str, str] = dict.fromkeys(catalog.sensors, "reader")
         for type_name, key in sorted(assignment.guaranteed_by().items()):
             if key not in absorbed:
                 self.final[type_name] = f"type:{key}"
@@ -613,7 +635,7 @@ class _Layout:
             for spec in unit.providers:
                 for needed in (*spec.inputs, *spec.optional_inputs):
                     consumers.setdefault(needed, set()).add(spec.name)
-        for type_name in sorted(set(self.units) | set(self.source.types)):
+        for type_name in sorted(set(self.units) | set(self.catalog.sensors)):
             for spec in self.catalog.refiners(type_name):
                 for needed in (*spec.inputs, *spec.optional_inputs):
                     consumers.setdefault(needed, set()).add(spec.name)
