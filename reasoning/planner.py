@@ -128,6 +128,7 @@ class _Catalog:
         self.object_class = object_class
         self.conditions = conditions
         self._providers: dict[tuple[str, str | None], tuple[AnnotatorSpec, ...]] = {}
+        self._refiners: dict[str, list[AnnotatorSpec]] = {}
         self._without: dict[frozenset[str], frozenset[str]] = {}
         outputs = sorted({t for spec in index.annotators() for t in self.with_supertypes(spec.outputs)})
         self.edges = [(spec, t) for t in outputs for spec in self.providers(t)]
@@ -176,8 +177,12 @@ class _Catalog:
 
     def refiners(self, type_name: str) -> list[AnnotatorSpec]:
         """Annotators that read and write ``type_name`` and whose preconditions hold, cheapest first."""
-        found = self.index.providers(type_name, None, self.object_class, self.conditions)
-        return sorted((s for s in found if type_name in s.inputs), key=lambda s: (s.cost_ms, s.name))
+        if type_name not in self._refiners:
+            found = self.index.providers(type_name, None, self.object_class, self.conditions)
+            self._refiners[type_name] = sorted(
+                (s for s in found if type_name in s.inputs), key=lambda s: (s.cost_ms, s.name)
+            )
+        return self._refiners[type_name]
 
     def _fixpoint(self, forbidden: frozenset[str]) -> frozenset[str]:
         """Worklist closure: each provider fires once all its inputs are known (linear in the ports)."""
@@ -550,12 +555,12 @@ class _Layout:
             cycle = self._required_cycle()
             if cycle is None:
                 break
-            # a refinement that would close a cycle is left out (refinements are improvements, never required)
-            dropped = next((key.split(":", 1)[1] for key in cycle if key.startswith("refine:")), None)
-            if dropped is None:
+            # refinements that would close a cycle are left out (refinements are improvements, never required)
+            dropped = {key.split(":", 1)[1] for key in cycle if key.startswith("refine:")}
+            if not dropped:
                 raise PlanningError(f"the annotators for {' -> '.join(cycle)} depend on each other in a cycle")
             self.refinements = {
-                t: [s for s in specs if s.name != dropped] for t, specs in self.refinements.items()
+                t: [s for s in specs if s.name not in dropped] for t, specs in self.refinements.items()
             }
             self.refinements = {t: specs for t, specs in self.refinements.items() if specs}
 
