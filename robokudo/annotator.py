@@ -48,7 +48,7 @@ class _Run:
         self.cas = cas
         self.thread_ident = thread_ident
         self.writes: list[CasWrite] = []
-        self.cancel = threading.Event()
+        self.cancelled = False  # set once by the tick thread; a plain flag is enough for the worker to poll
 
 
 class Annotator(py_trees.behaviour.Behaviour):
@@ -128,7 +128,7 @@ class Annotator(py_trees.behaviour.Behaviour):
     def cancelled(self) -> bool:
         """True once this run was interrupted; long loops may poll it to stop early."""
         run = self._current_run()
-        return run.cancel.is_set()
+        return run.cancelled
 
     def view(self, view_type: type[V]) -> V:
         """The CAS view of a declared input type; fails the run when it is missing."""
@@ -173,7 +173,7 @@ class Annotator(py_trees.behaviour.Behaviour):
             raise RuntimeError(f"annotator {self.name!r} used its CAS outside a run")
         if run.thread_ident is not None and run.thread_ident != threading.get_ident():
             raise RunCancelledError()
-        if run.cancel.is_set():
+        if run.cancelled:
             raise RunCancelledError()
         return run
 

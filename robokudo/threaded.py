@@ -72,7 +72,7 @@ class ThreadedAnnotator(Annotator):
     def _cancel(self) -> None:
         run = self._active_run
         if run is not None:
-            run.cancel.set()
+            run.cancelled = True
         self._active_run = None
 
     def is_working(self) -> bool:
