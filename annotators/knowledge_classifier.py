@@ -18,7 +18,9 @@ Text) a profile gets an agreement in [0, 1]:
 Colour, shape and size agreements are pulled toward 0.5 by the expert's confidence (``0.5 + (a - 0.5) * c``), so
 uncertain evidence counts less. The score is the weighted mean over the observed cues with :data:`WEIGHTS`
 (text is strong evidence). A hypothesis is classified as the best profile when its score is at least
-``min_score`` and beats every profile not related to it by subsumption by ``margin``. Among related profiles
+``min_score`` and beats every profile not related to it by subsumption by ``margin``. When none is clear and
+the query asked for a class (``expected``), a match of that class within ``margin`` of the best wins: the query
+is a prior, deciding only between near-equal candidates. Among related profiles
 with the same score, the most specific one with the most matched texts wins when text was read and matched
 (lactose-free milk over milk), else the most general one (no evidence for a variant).
 """
@@ -166,6 +168,18 @@ def choose(matches: Sequence[Match], min_score: float, margin: float) -> Match |
     return best
 
 
+def choose_expected(matches: Sequence[Match], expected: str, min_score: float, margin: float) -> Match | None:
+    """When no match is clear: the best match of the expected class (or a subclass of it) if it scores at least
+    ``min_score`` and lies within ``margin`` of the best score - the query's class acts as a prior."""
+    if not matches:
+        return None
+    top = max(m.score for m in matches)
+    wanted = expected.lower()
+    candidates = [m for m in matches if wanted in m.profile.ancestors and m.score >= min_score]
+    candidates = [m for m in candidates if top - m.score < margin]
+    return max(candidates, key=lambda m: (m.score, -len(m.profile.ancestors)), default=None)
+
+
 class KnowledgeClassifier(Annotator):
     """Names each hypothesis' class from its colour, shape, size and text, compared with candidate profiles."""
 
@@ -179,11 +193,14 @@ class KnowledgeClassifier(Annotator):
         name: str | None = None,
         min_score: float = 0.6,
         margin: float = 0.1,
+        expected: str | None = None,
     ) -> None:
+        """``expected`` is the class the query asks for; it decides between near-equal candidates."""
         super().__init__(name=name)
         self.profiles = tuple(Profile.from_mapping(p) for p in profiles)
         self.min_score = min_score
         self.margin = margin
+        self.expected = expected
 
     def evidence(self, hypothesis: ObjectHypothesis) -> Evidence:
         """The most confident colour, shape, size and the text read on the hypothesis."""
@@ -199,7 +216,7 @@ class KnowledgeClassifier(Annotator):
         )
 
     def analyse(self) -> None:
-        """Attach a Classification to every hypothesis with a clear best profile; fail when there is none."""
+        """Attach a Classification to every hypothesis with a clear best profile (unclear ones stay unclassified)."""
         if not self.profiles:
             self.fail("no candidate class profiles to compare the hypotheses with")
         hypotheses = self.annotations(ObjectHypothesis)
@@ -216,13 +233,12 @@ class KnowledgeClassifier(Annotator):
             if best_seen is None or top.score > best_seen.score:
                 best_seen = top
             winner = choose(matches, self.min_score, self.margin)
+            if winner is None and self.expected:
+                winner = choose_expected(matches, self.expected, self.min_score, self.margin)
             if winner is not None:
                 self.attach(hypothesis, Classification(class_name=winner.profile.class_name, confidence=winner.score))
                 classified += 1
-        if classified == 0:
-            if best_seen is None:
-                self.fail("no object hypothesis carries a colour, shape, size or text to classify by")
-            self.fail(
-                f"no hypothesis matches a profile clearly (best: {best_seen.profile.class_name} "
-                f"with score {best_seen.score:.2f}, needed {self.min_score:.2f})"
-            )
+        if classified == 0 and best_seen is None:
+            self.fail("no object hypothesis carries a colour, shape, size or text to classify by")
+        # hypotheses that match no profile clearly stay unclassified: "none of these is a known class" is an
+        # answer, so the tree goes on and the query is answered with the objects that did match (maybe none)

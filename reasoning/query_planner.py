@@ -57,12 +57,16 @@ def class_profiles(kb: KnowledgeBase) -> tuple[dict[str, object], ...]:
 
 
 def annotator_parameters(
-    kb: KnowledgeBase, box: RegionBox | None, profiles: tuple[dict[str, object], ...] | None = None
+    kb: KnowledgeBase,
+    box: RegionBox | None,
+    profiles: tuple[dict[str, object], ...] | None = None,
+    expected: str | None = None,
 ) -> dict[str, dict[str, object]]:
     """Constructor arguments the plan hands to annotators, from the ontology.
 
     An annotator that needs a region gets the region box; one that can report any object class (its class
-    domain is the root class) is a classifier by knowledge and gets the profiles of the classes.
+    domain is the root class) is a classifier by knowledge and gets the profiles of the classes and the class
+    the query asks for (``expected``).
     """
     parameters: dict[str, dict[str, object]] = {}
     for spec in kb.annotators():
@@ -71,6 +75,8 @@ def annotator_parameters(
         if "Classification" in spec.outputs and ROOT_CLASS in spec.classes:
             profiles = profiles if profiles is not None else class_profiles(kb)
             parameters.setdefault(spec.name, {})["profiles"] = profiles
+            if expected is not None:
+                parameters[spec.name]["expected"] = expected
     return parameters
 
 
@@ -101,7 +107,7 @@ class QueryPlanner:
         interpretation = interpret(query, self.kb, depth=depth)
         box = interpretation.region_box
         conditions = Conditions(depth=depth, region=box is not None)
-        parameters = annotator_parameters(self.kb, box, self.profiles())
+        parameters = annotator_parameters(self.kb, box, self.profiles(), interpretation.task.object_class)
         plan = plan_requirements(
             interpretation.task,
             interpretation.requirements,

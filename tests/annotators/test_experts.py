@@ -297,3 +297,17 @@ def test_image_regions_find_the_table_objects_without_depth() -> None:
         rows, cols = np.nonzero(hypothesis.mask)
         assert hypothesis.roi == (cols.min(), rows.min(), cols.max() + 1, rows.max() + 1)
         assert np.array_equal(hypothesis.point_indices, np.flatnonzero(hypothesis.mask))
+
+
+def test_the_queried_class_decides_between_near_equal_candidates() -> None:
+    from annotators.knowledge_classifier import Evidence, Profile, choose, choose_expected, score
+
+    cola = Profile.from_mapping({"class": "Cola", "colors": ("red",), "shape": "cylinder", "size": "small"})
+    cup = Profile.from_mapping({"class": "Cup", "shape": "cylinder", "size": "small", "ancestors": ("Container",)})
+    bowl = Profile.from_mapping({"class": "Bowl", "shape": "sphere", "size": "medium"})
+    evidence = Evidence(color=("red", 0.3), shape=("cylinder", 0.8), size=("small", 1.0))
+    matches = [score(p, evidence) for p in (cola, cup, bowl)]
+    assert choose(matches, 0.6, 0.1) is None  # Cola and Cup are too close to call without a prior
+    assert choose_expected(matches, "Cup", 0.6, 0.1).profile.class_name == "Cup"
+    assert choose_expected(matches, "Container", 0.6, 0.1).profile.class_name == "Cup"
+    assert choose_expected(matches, "Bowl", 0.6, 0.1) is None  # the prior never overrides clear evidence

@@ -67,3 +67,18 @@ def test_bad_query_exits_2_with_the_reason(capsys: pytest.CaptureFixture) -> Non
 
 def _walk(node: dict) -> list[dict]:
     return [node, *(n for child in node.get("children", []) for n in _walk(child))]
+
+
+@pytest.mark.parametrize(
+    ("query", "name"),
+    [("find a bowl", "bowl"), ("find the red cup on the table", "red_cup"), ("where is the cereal box?", "cereal_box")],
+)
+def test_kitchen_objects_are_found_by_class(
+    query: str, name: str, tmp_path: Path, monkeypatch: pytest.MonkeyPatch, capsys: pytest.CaptureFixture
+) -> None:
+    monkeypatch.setenv("ROBOKUDO_BELIEF_STORE", str(tmp_path / "beliefs.sqlite"))
+    answer = run_query([query], capsys)
+    truth = next(o for o in render_kitchen("table").objects if o.name == name)
+    (found,) = answer["objects"]
+    assert np.linalg.norm(np.asarray(found["pose"]["position"]) - truth.pose[:3, 3]) < 0.03
+    assert "KnowledgeClassifier" in found["experts"]
