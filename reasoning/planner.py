@@ -731,7 +731,11 @@ class _Layout:
 
     def _why(self, type_name: str) -> str:
         reasons = self.assignment.reasons.get(type_name, [])
-        return "; ".join(reasons) if reasons else f"provides {type_name}"
+        consumers = [r.removeprefix("needed by ") for r in reasons if r.startswith("needed by ")]
+        others = [r for r in reasons if not r.startswith("needed by ")]
+        if consumers:
+            others.append(f"{type_name} is needed by {', '.join(consumers)}")
+        return "; ".join(others) if others else f"provides {type_name}"
 
     def _unit(self, key: str) -> Unit:
         if key == "reader":
@@ -775,7 +779,9 @@ def _topological(keys: list[str], units: Mapping[str, _UnitChoice]) -> list[str]
 
 
 def _precondition_note(spec: AnnotatorSpec) -> str:
-    return "its preconditions hold: " + ", ".join(spec.preconditions) if spec.preconditions else "applies to every plan"
+    if spec.preconditions:
+        return "its preconditions hold: " + ", ".join(spec.preconditions)
+    return "the cheapest general-purpose one"
 
 
 def _exclusion(
