@@ -7,8 +7,7 @@ from typing import ClassVar
 import numpy as np
 
 from annotators.boxes import finite_points, object_box, quaternion_from_matrix
-from annotators.point_cloud import cloud_problem
-from robokudo.annotator import Annotator
+from annotators.cloud_expert import CloudExpert
 from robokudo.types import CameraInfo, CasType, ObjectHypothesis, PointCloud, Pose
 
 
@@ -20,13 +19,14 @@ def hypothesis_points(cloud: PointCloud, hypothesis: ObjectHypothesis, max_point
     return finite_points(cloud.points.reshape(-1, 3)[indices])
 
 
-class PoseAnnotator(Annotator):
+class PoseAnnotator(CloudExpert):
     """Attaches the oriented-box pose of every hypothesis: upright in the world frame when the camera pose is
     known, else principal axes in the camera frame."""
 
     inputs: ClassVar[tuple[type[CasType], ...]] = (ObjectHypothesis, PointCloud)
     optional_inputs: ClassVar[tuple[type[CasType], ...]] = (CameraInfo,)
     outputs: ClassVar[tuple[type[CasType], ...]] = (Pose,)
+    purpose: ClassVar[str] = "estimate poses for"
 
     def __init__(self, max_points: int = 1000, name: str | None = None) -> None:
         super().__init__(name=name)
@@ -34,13 +34,8 @@ class PoseAnnotator(Annotator):
 
     def analyse(self) -> None:
         """Attach one Pose per hypothesis with points; fail when no hypothesis has any valid point."""
-        cloud = self.view(PointCloud)
-        problem = cloud_problem(cloud)
-        if problem:
-            self.fail(problem)
-        hypotheses = self.annotations(ObjectHypothesis)
-        if not hypotheses:
-            self.fail("no object hypotheses to estimate poses for")
+        cloud = self.usable_cloud()
+        hypotheses = self.hypotheses()
         camera = self.optional_view(CameraInfo)
         cam_to_world = camera.cam_to_world if camera is not None else None
         if cam_to_world is not None and (np.shape(cam_to_world) != (4, 4) or not np.all(np.isfinite(cam_to_world))):

@@ -24,9 +24,8 @@ from typing import ClassVar
 import cv2
 import numpy as np
 
-from annotators.point_cloud import cloud_problem
+from annotators.cloud_expert import CloudExpert
 from annotators.support_frame import sampled_indices, support_frame, usable_plane
-from robokudo.annotator import Annotator
 from robokudo.types import CameraInfo, CasType, Normals, ObjectHypothesis, Plane, PointCloud, Shape
 
 SHAPES: tuple[str, ...] = ("box", "cylinder", "sphere", "flat")
@@ -198,7 +197,7 @@ def classify_shape(points: np.ndarray, normals: np.ndarray, on_plane: bool) -> S
     return ShapeFit(best_shape, float(confidence), dict(scores))
 
 
-class ShapeAnnotator(Annotator):
+class ShapeAnnotator(CloudExpert):
     """Attaches a Shape (box, cylinder, sphere or flat, with a confidence) to every object hypothesis.
 
     Measures in the supporting plane's frame when there is a Plane, else in the world frame when the camera pose
@@ -208,6 +207,7 @@ class ShapeAnnotator(Annotator):
     inputs: ClassVar[tuple[type[CasType], ...]] = (ObjectHypothesis, PointCloud, Normals)
     optional_inputs: ClassVar[tuple[type[CasType], ...]] = (CameraInfo, Plane)
     outputs: ClassVar[tuple[type[CasType], ...]] = (Shape,)
+    purpose: ClassVar[str] = "fit shapes to"
 
     def __init__(self, max_points: int = 1500, name: str | None = None) -> None:
         super().__init__(name=name)
@@ -215,16 +215,11 @@ class ShapeAnnotator(Annotator):
 
     def analyse(self) -> None:
         """Fit the models to each hypothesis; fail when no hypothesis has enough valid points."""
-        cloud = self.view(PointCloud)
-        problem = cloud_problem(cloud)
-        if problem:
-            self.fail(problem)
+        cloud = self.usable_cloud()
         normals = self.view(Normals).normals
         if normals.shape != cloud.points.shape:
             self.fail(f"normals {normals.shape} and point cloud {cloud.points.shape} sizes differ")
-        hypotheses = self.annotations(ObjectHypothesis)
-        if not hypotheses:
-            self.fail("no object hypotheses to fit shapes to")
+        hypotheses = self.hypotheses()
         frame = support_frame(usable_plane(self.annotations(Plane)), self.optional_view(CameraInfo))
         flat_points, flat_normals = cloud.points.reshape(-1, 3), normals.reshape(-1, 3)
         fitted = 0

@@ -15,9 +15,8 @@ import cv2
 import numpy as np
 
 from annotators.boxes import principal_box
-from annotators.point_cloud import cloud_problem
+from annotators.cloud_expert import CloudExpert
 from annotators.support_frame import SupportFrame, sampled_indices, support_frame, usable_plane
-from robokudo.annotator import Annotator
 from robokudo.types import CameraInfo, CasType, ObjectHypothesis, Plane, PointCloud, Size
 
 SIZE_CLASS_THRESHOLDS: tuple[float, float] = (0.12, 0.25)
@@ -69,12 +68,13 @@ def measure(points_camera: np.ndarray, frame: SupportFrame) -> tuple[float, floa
     return ordered[0], ordered[1], ordered[2]
 
 
-class SizeAnnotator(Annotator):
+class SizeAnnotator(CloudExpert):
     """Attaches metric dimensions (largest first) and a size class (small, medium, large) to every hypothesis."""
 
     inputs: ClassVar[tuple[type[CasType], ...]] = (ObjectHypothesis, PointCloud)
     optional_inputs: ClassVar[tuple[type[CasType], ...]] = (CameraInfo, Plane)
     outputs: ClassVar[tuple[type[CasType], ...]] = (Size,)
+    purpose: ClassVar[str] = "measure"
 
     def __init__(self, max_points: int = 3000, name: str | None = None) -> None:
         super().__init__(name=name)
@@ -82,13 +82,8 @@ class SizeAnnotator(Annotator):
 
     def analyse(self) -> None:
         """Measure each hypothesis; fail when none has enough valid points."""
-        cloud = self.view(PointCloud)
-        problem = cloud_problem(cloud)
-        if problem:
-            self.fail(problem)
-        hypotheses = self.annotations(ObjectHypothesis)
-        if not hypotheses:
-            self.fail("no object hypotheses to measure")
+        cloud = self.usable_cloud()
+        hypotheses = self.hypotheses()
         frame = support_frame(usable_plane(self.annotations(Plane)), self.optional_view(CameraInfo))
         confidence = GUESSED_FRAME_CONFIDENCE if frame.guessed else 1.0
         flat = cloud.points.reshape(-1, 3)
