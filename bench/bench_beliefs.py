@@ -23,12 +23,12 @@ ROOT = Path(__file__).resolve().parents[1]
 if str(ROOT) not in sys.path:
     sys.path.insert(0, str(ROOT))
 
-from reasoning.fusion import AttributeBelief, ValueSupport  # noqa: E402
-from reasoning.fusion_frame import FrameContext, FrameObject, frame_objects  # noqa: E402
-from reasoning.fusion_tracking import BeliefTracker, ObjectBelief  # noqa: E402
-from robokudo.answer import answer_from_memory  # noqa: E402
-from robokudo.belief_store import BeliefFilter, BeliefStore  # noqa: E402
-from robokudo.types import Classification, ObjectHypothesis, Pose, SemanticColor, Shape, Size  # noqa: E402
+from reasoning.beliefs.answer import answer_from_memory  # noqa: E402
+from reasoning.beliefs.store import BeliefFilter, BeliefStore  # noqa: E402
+from reasoning.fusion.frame import FrameContext, FrameObject, frame_objects  # noqa: E402
+from reasoning.fusion.rule import AttributeBelief, ValueSupport  # noqa: E402
+from reasoning.fusion.tracking import BeliefTracker, ObjectBelief  # noqa: E402
+from robokudo.core.types import Classification, ObjectHypothesis, Pose, SemanticColor, Shape, Size  # noqa: E402
 
 CLASSES = [f"Thing{i}" for i in range(40)] + ["Milk", "LactoseFreeMilk", "WholeMilk", "Cup", "Bowl", "CerealBox"]
 PARENT = {"LactoseFreeMilk": "Milk", "WholeMilk": "Milk"}

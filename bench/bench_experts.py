@@ -23,23 +23,23 @@ sys.path.insert(0, str(ROOT))
 from py_trees.common import Status  # noqa: E402
 
 from annotators import kitchen_scene  # noqa: E402
-from annotators.filters import RegionFilter  # noqa: E402
-from annotators.histogram import ColorHistogramAnnotator  # noqa: E402
-from annotators.image_regions import ImageRegionSegmenter  # noqa: E402
-from annotators.knowledge_classifier import KnowledgeClassifier  # noqa: E402
-from annotators.normals import NormalEstimator  # noqa: E402
-from annotators.onnx_detector import OnnxDetector  # noqa: E402
-from annotators.point_cloud import PointCloudGenerator  # noqa: E402
-from annotators.readers import KitchenSceneReader  # noqa: E402
-from annotators.shape import ShapeAnnotator  # noqa: E402
-from annotators.size import SizeAnnotator  # noqa: E402
-from annotators.sources import reader_for  # noqa: E402
-from annotators.text import TextReader  # noqa: E402
-from robokudo.annotator import Annotator  # noqa: E402
-from robokudo.engine import Engine  # noqa: E402
-from robokudo.pipeline import Pipeline  # noqa: E402
-from robokudo.stats import RunStats  # noqa: E402
-from robokudo.types import ANNOTATION_TYPES, VIEW_TYPES, ColorImage, ObjectHypothesis, SemanticColor, Text  # noqa: E402
+from annotators.classification.knowledge_classifier import KnowledgeClassifier  # noqa: E402
+from annotators.cloud.filters import RegionFilter  # noqa: E402
+from annotators.cloud.normals import NormalEstimator  # noqa: E402
+from annotators.cloud.point_cloud import PointCloudGenerator  # noqa: E402
+from annotators.cloud.shape import ShapeAnnotator  # noqa: E402
+from annotators.cloud.size import SizeAnnotator  # noqa: E402
+from annotators.image.histogram import ColorHistogramAnnotator  # noqa: E402
+from annotators.image.image_regions import ImageRegionSegmenter  # noqa: E402
+from annotators.image.onnx_detector import OnnxDetector  # noqa: E402
+from annotators.readers.choice import reader_for  # noqa: E402
+from annotators.readers.frame_readers import KitchenSceneReader  # noqa: E402
+from annotators.text.reader import TextReader  # noqa: E402
+from robokudo.core.annotator import Annotator  # noqa: E402
+from robokudo.core.engine import Engine  # noqa: E402
+from robokudo.core.pipeline import Pipeline  # noqa: E402
+from robokudo.core.stats import RunStats  # noqa: E402
+from robokudo.core.types import ANNOTATION_TYPES, VIEW_TYPES, ColorImage, ObjectHypothesis, SemanticColor, Text  # noqa: E402
 from trees.tabletop import create_pipeline  # noqa: E402
 
 DATA = (ROOT.parent / "shared" / "data" / "uoc_tabletop_realsense").resolve()

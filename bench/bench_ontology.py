@@ -23,8 +23,8 @@ from collections.abc import Callable
 from pathlib import Path
 
 from ontology import ontology_dir, shipped_files
-from reasoning.knowledge_base import KnowledgeBase
-from reasoning.model import Conditions
+from reasoning.knowledge.knowledge_base import KnowledgeBase
+from reasoning.knowledge.model import Conditions
 
 GENERATED_CLASSES = 1000
 GENERATED_ANNOTATORS = 200
@@ -35,7 +35,7 @@ _COLD_LOAD = """
 import json, sys, time
 start = time.perf_counter()
 from pathlib import Path
-from reasoning.knowledge_base import KnowledgeBase
+from reasoning.knowledge.knowledge_base import KnowledgeBase
 imported = time.perf_counter()
 files = [Path(p) for p in json.loads(sys.argv[1])] or None
 KnowledgeBase.load(Path(sys.argv[2]), files=files, reason=sys.argv[3] == "1")

@@ -17,13 +17,13 @@ from pathlib import Path
 from types import ModuleType
 
 from queries import parse_query
-from reasoning.knowledge_base import KnowledgeBase
-from reasoning.plan import Step
-from reasoning.planner import PlanningError, SensorSource
-from reasoning.query_planner import QueryPlanner
-from robokudo.annotator import Annotator
-from robokudo.sources import sensor_source
-from robokudo.types import type_by_name
+from reasoning.knowledge.knowledge_base import KnowledgeBase
+from reasoning.planning.plan import Step
+from reasoning.planning.planner import PlanningError, SensorSource
+from reasoning.planning.query_planner import QueryPlanner
+from robokudo.application.sensor_sources import sensor_source
+from robokudo.core.annotator import Annotator
+from robokudo.core.types import type_by_name
 from trees.synthesis import build_tree, instantiate
 
 QUERIES = [

@@ -29,19 +29,19 @@ import open3d as o3d
 ROOT = Path(__file__).resolve().parents[1]
 sys.path.insert(0, str(ROOT))
 
-from annotators.boxes import object_box  # noqa: E402
-from annotators.clusters import ClusterParameters, extract_clusters  # noqa: E402
-from annotators.color import SemanticColorAnnotator, name_color  # noqa: E402
-from annotators.filters import range_mask  # noqa: E402
-from annotators.frame_io import read_color_depth_pair  # noqa: E402
-from annotators.pixel_expert import hypothesis_pixels  # noqa: E402
-from annotators.plane import ransac_support_plane  # noqa: E402
-from annotators.point_cloud import back_project, pixel_rays  # noqa: E402
-from annotators.pose import PoseAnnotator, hypothesis_points  # noqa: E402
-from annotators.readers import PcdReader  # noqa: E402
-from robokudo.engine import Engine  # noqa: E402
-from robokudo.stats import RunStats  # noqa: E402
-from robokudo.types import ObjectHypothesis, PointCloud  # noqa: E402
+from annotators.cloud.clusters import ClusterParameters, extract_clusters  # noqa: E402
+from annotators.cloud.filters import range_mask  # noqa: E402
+from annotators.cloud.plane import ransac_support_plane  # noqa: E402
+from annotators.cloud.point_cloud import back_project, pixel_rays  # noqa: E402
+from annotators.cloud.pose import PoseAnnotator, hypothesis_points  # noqa: E402
+from annotators.geometry.boxes import object_box  # noqa: E402
+from annotators.image.color import SemanticColorAnnotator, name_color  # noqa: E402
+from annotators.image.pixel_expert import hypothesis_pixels  # noqa: E402
+from annotators.readers.frame_io import read_color_depth_pair  # noqa: E402
+from annotators.readers.frame_readers import PcdReader  # noqa: E402
+from robokudo.core.engine import Engine  # noqa: E402
+from robokudo.core.stats import RunStats  # noqa: E402
+from robokudo.core.types import ObjectHypothesis, PointCloud  # noqa: E402
 from trees.tabletop import create_pipeline, create_tree  # noqa: E402
 
 DATA = (ROOT.parent / "shared" / "data" / "uoc_tabletop_realsense").resolve()

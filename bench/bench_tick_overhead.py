@@ -14,7 +14,7 @@ import time
 import py_trees
 
 from robokudo import Annotator, Pipeline, ThresholdParallel
-from robokudo.types import Plane
+from robokudo.core.types import Plane
 
 LEAVES = 50
 ROUNDS = 15

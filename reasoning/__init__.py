@@ -1,3 +1,3 @@
-"""Reasoning over the ontology: the knowledge base (``reasoning.knowledge_base``), validated editing
-(``reasoning.editing``), code/ontology agreement (``reasoning.capabilities``) and the ``robokudo ontology``
-subcommand (``reasoning.ontology_cli``)."""
+"""Reasoning over knowledge: the ontology's knowledge base (``reasoning.knowledge``), query planning
+(``reasoning.planning``), fusion of expert statements (``reasoning.fusion``) and the belief store with the
+answers drawn from it (``reasoning.beliefs``)."""

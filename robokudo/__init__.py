@@ -1,14 +1,14 @@
 """robokudo: a knowledge-enabled perception framework for mobile manipulation (the runtime package)."""
 
-from robokudo.annotator import Annotator, AnnotatorError, ConditionAnnotator, PortError
-from robokudo.cas import CAS
-from robokudo.dataflow import DataFlowError, data_flow_violations, validate_data_flow
-from robokudo.engine import Engine, TaskInterface
-from robokudo.parallel import ThresholdParallel
-from robokudo.pipeline import Pipeline, StructureError
-from robokudo.slot import TaskSlot
-from robokudo.structure import check_structure
-from robokudo.threaded import ThreadedAnnotator
+from robokudo.core.annotator import Annotator, AnnotatorError, ConditionAnnotator, PortError
+from robokudo.core.cas import CAS
+from robokudo.core.dataflow import DataFlowError, data_flow_violations, validate_data_flow
+from robokudo.core.engine import Engine, TaskInterface
+from robokudo.core.parallel import ThresholdParallel
+from robokudo.core.pipeline import Pipeline, StructureError
+from robokudo.core.slot import TaskSlot
+from robokudo.core.structure import check_structure
+from robokudo.core.threaded import ThreadedAnnotator
 
 __all__ = [
     "CAS",

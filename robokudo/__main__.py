@@ -2,6 +2,6 @@
 
 import sys
 
-from robokudo.cli import main
+from robokudo.application.cli import main
 
 sys.exit(main())

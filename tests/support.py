@@ -9,9 +9,9 @@ import numpy as np
 import py_trees
 from py_trees.common import Status
 
-from robokudo.annotator import Annotator
-from robokudo.threaded import ThreadedAnnotator
-from robokudo.types import Annotation, CasType, ObjectHypothesis, Plane
+from robokudo.core.annotator import Annotator
+from robokudo.core.threaded import ThreadedAnnotator
+from robokudo.core.types import Annotation, CasType, ObjectHypothesis, Plane
 
 
 class Scripted(py_trees.behaviour.Behaviour):

@@ -6,7 +6,7 @@ import py_trees
 import pytest
 from py_trees.common import Status
 
-from robokudo.parallel import ThresholdParallel
+from robokudo.core.parallel import ThresholdParallel
 from tests.support import Scripted
 
 S, F, R, INV = Status.SUCCESS, Status.FAILURE, Status.RUNNING, Status.INVALID

@@ -8,7 +8,7 @@ import pytest
 from py_trees.common import Status
 
 from robokudo import CAS, Engine, Pipeline, PortError, StructureError
-from robokudo.types import (
+from robokudo.core.types import (
     Annotation,
     ColorImage,
     ObjectHypothesis,

@@ -8,7 +8,7 @@ from pathlib import Path
 import cv2
 import pytest
 
-from robokudo import cli
+from robokudo.application import cli
 
 
 def test_help_lists_every_command(capsys: pytest.CaptureFixture) -> None:

@@ -1,4 +1,4 @@
-"""Tests of the synthetic kitchen RGB-D renderer (annotators.kitchen_scene)."""
+"""Tests of the synthetic kitchen RGB-D renderer (annotators.simulation.kitchen_scene)."""
 
 from __future__ import annotations
 
@@ -7,7 +7,7 @@ import numpy as np
 import pytest
 from numpy.typing import NDArray
 
-from annotators.kitchen_scene import (
+from annotators.simulation.kitchen_scene import (
     DEFAULT_INTRINSICS,
     MAX_DEPTH,
     RenderedScene,

@@ -11,8 +11,8 @@ import pytest
 from py_trees.common import Status
 
 from robokudo import DataFlowError, Engine, Pipeline, StructureError, TaskSlot, ThresholdParallel
-from robokudo.render import dot_tree, stats_table, unicode_tree
-from robokudo.types import ObjectHypothesis, Plane
+from robokudo.core.render import dot_tree, stats_table, unicode_tree
+from robokudo.core.types import ObjectHypothesis, Plane
 from tests.support import GatedWork, Scripted, annotator_class
 
 

@@ -26,8 +26,9 @@ def test_threshold_parallel_follows_its_rule_tick_by_tick(children: list[tuple[i
     parallel = ThresholdParallel("p", nodes, n_success=n_success, n_failure=n_failure)
     for _ in range(10):
         parallel.tick_once()
-        finished = [(running, final) for (running, final), node in zip(children, nodes, strict=True)
-                    if node.updates > running]
+        finished = [
+            (running, final) for (running, final), node in zip(children, nodes, strict=True) if node.updates > running
+        ]
         succeeded = sum(final is S for _, final in finished)
         failed = sum(final is F for _, final in finished)
         if failed > n_failure:

@@ -11,11 +11,11 @@ from collections.abc import Callable, Sequence
 
 import py_trees
 
-from reasoning.plan import Alternatives, Plan, Step, Unit
-from robokudo.annotator import Annotator
-from robokudo.dataflow import validate_data_flow
-from robokudo.parallel import ThresholdParallel
-from robokudo.pipeline import Pipeline
+from reasoning.planning.plan import Alternatives, Plan, Step, Unit
+from robokudo.core.annotator import Annotator
+from robokudo.core.dataflow import validate_data_flow
+from robokudo.core.parallel import ThresholdParallel
+from robokudo.core.pipeline import Pipeline
 
 ALLOWED_PACKAGE = "annotators"
 

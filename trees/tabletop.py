@@ -1,24 +1,24 @@
 """The seed's Fig. 2 tabletop tree: capture, cloud, filter, support plane, clusters, then colour and pose in parallel.
 
 Without an input path the capture is the built-in kitchen scene (view "table"); with one, the reader is chosen
-from the path by :func:`annotators.sources.reader_for` (TUM, uoc, PCL TIFF, PCD layouts; ValueError for others).
+from the path by :func:`annotators.readers.choice.reader_for` (TUM, uoc, PCL TIFF, PCD layouts; ValueError for others).
 A reader that writes the point cloud itself (PcdReader) needs no PointCloudGenerator.
 """
 
 from __future__ import annotations
 
-from annotators.clusters import ClusterExtractor
-from annotators.color import SemanticColorAnnotator
-from annotators.filters import RangeFilter
-from annotators.plane import SupportPlaneSegmenter
-from annotators.point_cloud import PointCloudGenerator
-from annotators.pose import PoseAnnotator
-from annotators.readers import KitchenSceneReader
-from annotators.sources import reader_for
-from robokudo.annotator import Annotator
-from robokudo.parallel import ThresholdParallel
-from robokudo.pipeline import Pipeline
-from robokudo.types import PointCloud
+from annotators.cloud.clusters import ClusterExtractor
+from annotators.cloud.filters import RangeFilter
+from annotators.cloud.plane import SupportPlaneSegmenter
+from annotators.cloud.point_cloud import PointCloudGenerator
+from annotators.cloud.pose import PoseAnnotator
+from annotators.image.color import SemanticColorAnnotator
+from annotators.readers.choice import reader_for
+from annotators.readers.frame_readers import KitchenSceneReader
+from robokudo.core.annotator import Annotator
+from robokudo.core.parallel import ThresholdParallel
+from robokudo.core.pipeline import Pipeline
+from robokudo.core.types import PointCloud
 
 
 def create_reader(input_path: str | None = None, frame: int = 0) -> Annotator:

@@ -7,10 +7,7 @@ seeded by a first leaf inside a Pipeline; every expert whose inputs are missing 
 
 from __future__ import annotations
 
-import importlib
-import inspect
 import json
-import pkgutil
 import re
 import time
 from collections.abc import Callable
@@ -21,19 +18,21 @@ import numpy as np
 import pytest
 from py_trees.common import Status
 
-import annotators
-from annotators.clusters import ClusterExtractor
-from annotators.color import SemanticColorAnnotator
-from annotators.filters import CropBoxFilter, RangeFilter, RegionFilter
-from annotators.histogram import ColorHistogramAnnotator
-from annotators.image_regions import ImageRegionSegmenter
-from annotators.knowledge_classifier import KnowledgeClassifier
-from annotators.normals import NormalEstimator
-from annotators.onnx_detector import OnnxDetector
-from annotators.plane import SupportPlaneSegmenter
-from annotators.point_cloud import PointCloudGenerator
-from annotators.pose import PoseAnnotator
-from annotators.readers import (
+from annotators.catalog import discover_annotators
+from annotators.classification.knowledge_classifier import KnowledgeClassifier
+from annotators.cloud.clusters import ClusterExtractor
+from annotators.cloud.filters import CropBoxFilter, RangeFilter, RegionFilter
+from annotators.cloud.normals import NormalEstimator
+from annotators.cloud.plane import SupportPlaneSegmenter
+from annotators.cloud.point_cloud import PointCloudGenerator
+from annotators.cloud.pose import PoseAnnotator
+from annotators.cloud.shape import ShapeAnnotator
+from annotators.cloud.size import SizeAnnotator
+from annotators.image.color import SemanticColorAnnotator
+from annotators.image.histogram import ColorHistogramAnnotator
+from annotators.image.image_regions import ImageRegionSegmenter
+from annotators.image.onnx_detector import OnnxDetector
+from annotators.readers.frame_readers import (
     ColorDepthPairReader,
     KitchenSceneReader,
     PcdReader,
@@ -41,12 +40,10 @@ from annotators.readers import (
     TumPairReader,
     TumSequenceReader,
 )
-from annotators.shape import ShapeAnnotator
-from annotators.size import SizeAnnotator
-from annotators.text import TextReader
-from robokudo.annotator import Annotator
-from robokudo.pipeline import Pipeline
-from robokudo.types import (
+from annotators.text.reader import TextReader
+from robokudo.core.annotator import Annotator
+from robokudo.core.pipeline import Pipeline
+from robokudo.core.types import (
     ANNOTATION_TYPES,
     VIEW_TYPES,
     Annotation,
@@ -68,17 +65,6 @@ from tests.annotators.onnx_models import detection_model, one_box_model
 H, W = 48, 64
 K = CameraIntrinsics(fx=60.0, fy=60.0, cx=32.0, cy=24.0, width=W, height=H)
 CRASH = re.compile(r"^[A-Z]\w*(Error|Exception)\b")
-
-
-def discovered_annotators() -> list[type[Annotator]]:
-    """Every Annotator subclass defined in a module of the annotators package."""
-    found = []
-    for info in pkgutil.iter_modules(annotators.__path__):
-        module = importlib.import_module(f"annotators.{info.name}")
-        for _, value in inspect.getmembers(module, inspect.isclass):
-            if issubclass(value, Annotator) and value.__module__ == module.__name__ and not inspect.isabstract(value):
-                found.append(value)
-    return sorted(found, key=lambda cls: cls.__name__)
 
 
 # ------------------------------------------------------------------------------------------ broken CASes
@@ -470,12 +456,12 @@ def assert_fails_with_a_reason(annotator: Annotator, seeds: Seeds) -> None:
     assert not CRASH.match(message), f"{type(annotator).__name__} crashed instead of failing: {message}"
 
 
-EXPERTS = [cls for cls in discovered_annotators() if cls.inputs]
-READERS = [cls for cls in discovered_annotators() if not cls.inputs]
+EXPERTS = [cls for cls in discover_annotators() if cls.inputs]
+READERS = [cls for cls in discover_annotators() if not cls.inputs]
 
 
 def test_the_tables_cover_every_discovered_annotator() -> None:
-    assert {c.__name__ for c in discovered_annotators()} >= {
+    assert {c.__name__ for c in discover_annotators()} >= {
         "KitchenSceneReader", "ColorDepthPairReader", "TumSequenceReader", "TumPairReader", "PcdReader",
         "TiffSequenceReader", "PointCloudGenerator", "RangeFilter", "RegionFilter", "CropBoxFilter",
         "NormalEstimator", "SupportPlaneSegmenter", "ClusterExtractor", "SemanticColorAnnotator",

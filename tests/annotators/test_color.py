@@ -6,7 +6,7 @@ import cv2
 import numpy as np
 import pytest
 
-from annotators.color import COLOR_NAMES, COLOR_RULES, classify_names, name_color
+from annotators.image.color import COLOR_NAMES, COLOR_RULES, classify_names, name_color
 
 
 def patch(rgb: tuple[int, int, int], shading: float = 1.0, count: int = 400) -> np.ndarray:

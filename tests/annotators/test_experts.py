@@ -7,19 +7,19 @@ import numpy as np
 import pytest
 from py_trees.common import Status
 
-from annotators import kitchen_scene
-from annotators.filters import CropBoxFilter, RegionFilter
-from annotators.histogram import ColorHistogramAnnotator, hue_saturation_histogram
-from annotators.image_regions import ImageRegionSegmenter
-from annotators.knowledge_classifier import Evidence, KnowledgeClassifier, Profile, choose, score
-from annotators.normals import grid_normals
-from annotators.point_cloud import PointCloudGenerator
-from annotators.readers import KitchenSceneReader
-from annotators.shape import classify_shape
-from annotators.size import SIZE_CLASS_THRESHOLDS, size_class_for
-from robokudo.annotator import Annotator
-from robokudo.pipeline import Pipeline
-from robokudo.types import (
+from annotators.classification.knowledge_classifier import Evidence, KnowledgeClassifier, Profile, choose, score
+from annotators.cloud.filters import CropBoxFilter, RegionFilter
+from annotators.cloud.normals import grid_normals
+from annotators.cloud.point_cloud import PointCloudGenerator
+from annotators.cloud.shape import classify_shape
+from annotators.cloud.size import SIZE_CLASS_THRESHOLDS, size_class_for
+from annotators.image.histogram import ColorHistogramAnnotator, hue_saturation_histogram
+from annotators.image.image_regions import ImageRegionSegmenter
+from annotators.readers.frame_readers import KitchenSceneReader
+from annotators.simulation import kitchen_scene
+from robokudo.core.annotator import Annotator
+from robokudo.core.pipeline import Pipeline
+from robokudo.core.types import (
     ANNOTATION_TYPES,
     VIEW_TYPES,
     Classification,
@@ -300,7 +300,7 @@ def test_image_regions_find_the_table_objects_without_depth() -> None:
 
 
 def test_the_queried_class_decides_between_near_equal_candidates() -> None:
-    from annotators.knowledge_classifier import Evidence, Profile, choose, choose_expected, score
+    from annotators.classification.knowledge_classifier import Evidence, Profile, choose, choose_expected, score
 
     cola = Profile.from_mapping({"class": "Cola", "colors": ("red",), "shape": "cylinder", "size": "small"})
     cup = Profile.from_mapping({"class": "Cup", "shape": "cylinder", "size": "small", "ancestors": ("Container",)})

@@ -7,19 +7,19 @@ import numpy as np
 import pytest
 from py_trees.common import Status
 
-from annotators.histogram import ColorHistogramAnnotator
-from annotators.kitchen_scene import RenderedScene, SceneObject
-from annotators.knowledge_classifier import KnowledgeClassifier
-from annotators.normals import NormalEstimator
-from annotators.readers import KitchenSceneReader
-from annotators.shape import ShapeAnnotator
-from annotators.size import SizeAnnotator
-from annotators.text import TextReader
-from reasoning.knowledge_base import KnowledgeBase
-from robokudo.engine import Engine
-from robokudo.parallel import ThresholdParallel
-from robokudo.pipeline import Pipeline
-from robokudo.types import Classification, ColorHistogram, ObjectHypothesis, Pose, SemanticColor, Shape, Size, Text
+from annotators.classification.knowledge_classifier import KnowledgeClassifier
+from annotators.cloud.normals import NormalEstimator
+from annotators.cloud.shape import ShapeAnnotator
+from annotators.cloud.size import SizeAnnotator
+from annotators.image.histogram import ColorHistogramAnnotator
+from annotators.readers.frame_readers import KitchenSceneReader
+from annotators.simulation.kitchen_scene import RenderedScene, SceneObject
+from annotators.text.reader import TextReader
+from reasoning.knowledge.knowledge_base import KnowledgeBase
+from robokudo.core.engine import Engine
+from robokudo.core.parallel import ThresholdParallel
+from robokudo.core.pipeline import Pipeline
+from robokudo.core.types import Classification, ColorHistogram, ObjectHypothesis, Pose, SemanticColor, Shape, Size, Text
 from trees.tabletop import create_pipeline
 
 CLASSES = ("Milk", "LactoseFreeMilk", "WholeMilk", "CerealBox", "Cup", "Bowl", "Mug", "CrackerBox")

@@ -5,10 +5,10 @@ from __future__ import annotations
 import numpy as np
 import pytest
 
-from annotators.boxes import object_box, principal_box, quaternion_from_matrix, upright_box
-from annotators.grid_segmentation import looks_like_inside
-from annotators.plane import ransac_support_plane, up_in_camera
-from robokudo.types import CameraInfo, CameraIntrinsics, Pose
+from annotators.cloud.plane import ransac_support_plane, up_in_camera
+from annotators.geometry.boxes import object_box, principal_box, quaternion_from_matrix, upright_box
+from annotators.geometry.grid_segmentation import looks_like_inside
+from robokudo.core.types import CameraInfo, CameraIntrinsics, Pose
 
 
 def scene_cloud(rows: int = 120, cols: int = 160) -> np.ndarray:

@@ -9,12 +9,12 @@ import numpy as np
 import pytest
 from py_trees.common import Status
 
-from annotators.onnx_detector import Detections, OnnxDetector, camel_case, decode_outputs, letterbox
-from reasoning.knowledge_base import KnowledgeBase
-from reasoning.model import Conditions
-from robokudo.annotator import Annotator
-from robokudo.pipeline import Pipeline
-from robokudo.types import Classification, ColorImage, ObjectHypothesis
+from annotators.image.onnx_detector import Detections, OnnxDetector, camel_case, decode_outputs, letterbox
+from reasoning.knowledge.knowledge_base import KnowledgeBase
+from reasoning.knowledge.model import Conditions
+from robokudo.core.annotator import Annotator
+from robokudo.core.pipeline import Pipeline
+from robokudo.core.types import Classification, ColorImage, ObjectHypothesis
 from tests.annotators.onnx_models import detection_model, one_box_model
 
 IMAGE = np.zeros((480, 640, 3), np.uint8)  # letterboxed into 64x64: scale 0.1, 8 px padding top and bottom

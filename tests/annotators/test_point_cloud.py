@@ -6,11 +6,11 @@ import numpy as np
 import pytest
 from py_trees.common import Status
 
-from annotators.filters import RangeFilter, range_mask, voxel_mask
-from annotators.point_cloud import PointCloudGenerator, back_project, pixel_rays
-from robokudo.annotator import Annotator
-from robokudo.pipeline import Pipeline
-from robokudo.types import CameraInfo, CameraIntrinsics, ColorImage, DepthImage, PointCloud, View
+from annotators.cloud.filters import RangeFilter, range_mask, voxel_mask
+from annotators.cloud.point_cloud import PointCloudGenerator, back_project, pixel_rays
+from robokudo.core.annotator import Annotator
+from robokudo.core.pipeline import Pipeline
+from robokudo.core.types import CameraInfo, CameraIntrinsics, ColorImage, DepthImage, PointCloud, View
 
 K = CameraIntrinsics(fx=612.937, fy=613.173, cx=322.549, cy=248.158, width=640, height=480)
 

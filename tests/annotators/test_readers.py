@@ -10,10 +10,10 @@ import numpy as np
 import pytest
 from py_trees.common import Status
 
-from annotators.frame_io import FrameError, read_camera_params, read_color_depth_pair
-from annotators.readers import ColorDepthPairReader, KitchenSceneReader
-from robokudo.pipeline import Pipeline
-from robokudo.types import CameraInfo, ColorImage, DepthImage
+from annotators.readers.frame_io import FrameError, read_camera_params, read_color_depth_pair
+from annotators.readers.frame_readers import ColorDepthPairReader, KitchenSceneReader
+from robokudo.core.pipeline import Pipeline
+from robokudo.core.types import CameraInfo, ColorImage, DepthImage
 
 PARAMS = {"img_width": 8, "img_height": 6, "fx": 10.0, "fy": 11.0, "x_offset": 4.0, "y_offset": 3.0}
 

@@ -14,12 +14,18 @@ import open3d as o3d
 import pytest
 from py_trees.common import Status
 
-from annotators.point_cloud import PointCloudGenerator
-from annotators.readers import ColorDepthPairReader, PcdReader, TiffSequenceReader, TumPairReader, TumSequenceReader
-from annotators.sources import reader_for, reader_name_for
-from robokudo.annotator import Annotator
-from robokudo.pipeline import Pipeline
-from robokudo.types import CameraInfo, ColorImage, PointCloud
+from annotators.cloud.point_cloud import PointCloudGenerator
+from annotators.readers.choice import reader_for, reader_name_for
+from annotators.readers.frame_readers import (
+    ColorDepthPairReader,
+    PcdReader,
+    TiffSequenceReader,
+    TumPairReader,
+    TumSequenceReader,
+)
+from robokudo.core.annotator import Annotator
+from robokudo.core.pipeline import Pipeline
+from robokudo.core.types import CameraInfo, ColorImage, PointCloud
 from tests.annotators.conftest import require_folder
 
 pytestmark = pytest.mark.real_data

@@ -17,13 +17,13 @@ import numpy as np
 import pytest
 from py_trees.common import Status
 
-from annotators.readers import PcdReader
-from annotators.sources import reader_for
-from annotators.text import TextReader
-from robokudo.annotator import Annotator
-from robokudo.engine import Engine
-from robokudo.pipeline import Pipeline
-from robokudo.types import ColorImage, ObjectHypothesis, Plane, SemanticColor, Text
+from annotators.readers.choice import reader_for
+from annotators.readers.frame_readers import PcdReader
+from annotators.text.reader import TextReader
+from robokudo.core.annotator import Annotator
+from robokudo.core.engine import Engine
+from robokudo.core.pipeline import Pipeline
+from robokudo.core.types import ColorImage, ObjectHypothesis, Plane, SemanticColor, Text
 from tests.annotators.conftest import require_folder
 from trees.tabletop import create_pipeline
 

@@ -11,8 +11,8 @@ import cv2
 import numpy as np
 import pytest
 
-from annotators.sources import SUPPORTED_LAYOUTS, reader_choice, reader_for, reader_name_for
-from annotators.tum_io import TimedImage, associate, pair_paths
+from annotators.readers.choice import SUPPORTED_LAYOUTS, reader_choice, reader_for, reader_name_for
+from annotators.readers.tum_io import TimedImage, associate, pair_paths
 
 
 def touch_image(path: Path, channels: int = 3) -> Path:
@@ -82,9 +82,9 @@ def test_choosing_a_reader_does_not_import_open3d(tmp_path: Path) -> None:
     color = touch_image(tmp_path / "x_color.png")
     touch_image(tmp_path / "x_depth.png", channels=1)
     code = (
-        "import sys; from annotators.sources import reader_name_for; "
+        "import sys; from annotators.readers.choice import reader_name_for; "
         f"assert reader_name_for({str(color)!r}) == 'TumPairReader'; "
-        "assert 'open3d' not in sys.modules and 'annotators.readers' not in sys.modules"
+        "assert 'open3d' not in sys.modules and 'annotators.readers.frame_readers' not in sys.modules"
     )
     subprocess.run([sys.executable, "-c", code], check=True, cwd=Path(__file__).resolve().parents[2])
 

@@ -7,12 +7,12 @@ import pytest
 from py_trees.common import Status
 
 import trees
-from annotators.kitchen_scene import RenderedScene
-from annotators.readers import KitchenSceneReader
-from annotators.report import describe_hypotheses, draw_hypotheses, write_annotated_image
-from robokudo.engine import Engine
-from robokudo.pipeline import Pipeline
-from robokudo.types import ColorImage, ObjectHypothesis, Plane, Pose, SemanticColor
+from annotators.readers.frame_readers import KitchenSceneReader
+from annotators.simulation.kitchen_scene import RenderedScene
+from robokudo.application.report import describe_hypotheses, draw_hypotheses, write_annotated_image
+from robokudo.core.engine import Engine
+from robokudo.core.pipeline import Pipeline
+from robokudo.core.types import ColorImage, ObjectHypothesis, Plane, Pose, SemanticColor
 from trees.tabletop import create_pipeline, create_tree
 
 MIN_VISIBLE_PIXELS = 200

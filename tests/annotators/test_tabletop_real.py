@@ -8,9 +8,9 @@ import numpy as np
 import pytest
 from py_trees.common import Status
 
-from robokudo.engine import Engine
-from robokudo.pipeline import Pipeline
-from robokudo.types import ObjectHypothesis, Plane, Pose, SemanticColor
+from robokudo.core.engine import Engine
+from robokudo.core.pipeline import Pipeline
+from robokudo.core.types import ObjectHypothesis, Plane, Pose, SemanticColor
 from trees.tabletop import create_tree
 
 pytestmark = pytest.mark.real_data

@@ -12,17 +12,17 @@ import numpy as np
 import pytest
 from py_trees.common import Status
 
-from reasoning.fusion import Evidence
-from reasoning.fusion_frame import FrameObject
-from reasoning.fusion_tracking import BeliefTracker
-from robokudo import beliefs_cli
-from robokudo.annotator import Annotator
-from robokudo.answer import AnswerStep, answer_from_memory, class_iri, class_label, designator
-from robokudo.belief_query import belief_filter
-from robokudo.belief_store import BeliefFilter, BeliefStore
-from robokudo.engine import Engine
-from robokudo.pipeline import Pipeline
-from robokudo.types import (
+from reasoning.beliefs.answer import AnswerStep, answer_from_memory, class_iri, class_label, designator
+from reasoning.beliefs.filters import belief_filter
+from reasoning.beliefs.store import BeliefFilter, BeliefStore
+from reasoning.fusion.frame import FrameObject
+from reasoning.fusion.rule import Evidence
+from reasoning.fusion.tracking import BeliefTracker
+from robokudo.application.commands import beliefs as beliefs_cli
+from robokudo.core.annotator import Annotator
+from robokudo.core.engine import Engine
+from robokudo.core.pipeline import Pipeline
+from robokudo.core.types import (
     ONTOLOGY_NAMESPACE,
     CameraInfo,
     CameraIntrinsics,
@@ -208,7 +208,7 @@ def test_the_answer_step_can_fail_when_nothing_matches(tmp_path: Path) -> None:
 
 
 class FakeKnowledgeBase:
-    """Duck-typed like reasoning.knowledge_base.KnowledgeBase (resolve, is_subclass, region, regions_of_class)."""
+    """Duck-typed like the KnowledgeBase (resolve, is_subclass, region, regions_of_class)."""
 
     words: ClassVar[dict[str, str]] = {"milk": "Milk", "cup": "Cup", "red": "Red", "fridge": "fridge"}
 
@@ -245,7 +245,7 @@ def test_query_to_filter_with_a_fake_knowledge_base() -> None:
 
 
 def test_query_to_filter_with_the_real_knowledge_base(filled: Path) -> None:
-    knowledge_base = pytest.importorskip("reasoning.knowledge_base")
+    knowledge_base = pytest.importorskip("reasoning.knowledge.knowledge_base")
     kb = knowledge_base.KnowledgeBase.load()
     f = belief_filter(parse("find milk in fridge"), kb)
     assert f.object_class == "Milk" and f.region == "fridge" and len(f.region_boxes) == 1

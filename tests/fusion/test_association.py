@@ -10,7 +10,7 @@ from __future__ import annotations
 import numpy as np
 import pytest
 
-from reasoning.association import (
+from reasoning.fusion.association import (
     INFEASIBLE,
     AssociationConfig,
     CameraModel,
@@ -20,11 +20,11 @@ from reasoning.association import (
     pair_cost,
     visible_from,
 )
-from reasoning.fusion import Evidence
-from reasoning.fusion_frame import FrameObject
-from reasoning.fusion_tracking import GONE, PRESENT, BeliefTracker, TrackerConfig
+from reasoning.fusion.frame import FrameObject
+from reasoning.fusion.rule import Evidence
+from reasoning.fusion.tracking import GONE, PRESENT, BeliefTracker, TrackerConfig
 
-kitchen_scene = pytest.importorskip("annotators.kitchen_scene")
+kitchen_scene = pytest.importorskip("annotators.simulation.kitchen_scene")
 
 
 def obs(x: float, y: float = 0.0, z: float = 0.0, **kwargs: object) -> FrameObject:

@@ -11,11 +11,11 @@ from pathlib import Path
 import numpy as np
 import pytest
 
-from reasoning.association import CameraModel
-from reasoning.fusion import Evidence
-from reasoning.fusion_frame import FrameObject
-from reasoning.fusion_tracking import GONE, PRESENT, BeliefTracker, ObjectBelief, TrackerConfig
-from robokudo.belief_store import BeliefFilter, BeliefStore
+from reasoning.beliefs.store import BeliefFilter, BeliefStore
+from reasoning.fusion.association import CameraModel
+from reasoning.fusion.frame import FrameObject
+from reasoning.fusion.rule import Evidence
+from reasoning.fusion.tracking import GONE, PRESENT, BeliefTracker, ObjectBelief, TrackerConfig
 
 SUBCLASSES = {("LactoseFreeMilk", "Milk"), ("Milk", "Drink"), ("LactoseFreeMilk", "Drink")}
 

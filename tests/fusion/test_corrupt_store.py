@@ -10,10 +10,10 @@ from pathlib import Path
 import numpy as np
 import pytest
 
-from reasoning.fusion import Evidence
-from reasoning.fusion_frame import FrameObject
-from robokudo import beliefs_cli
-from robokudo.belief_store import BeliefStore, BeliefStoreError
+from reasoning.beliefs.store import BeliefStore, BeliefStoreError
+from reasoning.fusion.frame import FrameObject
+from reasoning.fusion.rule import Evidence
+from robokudo.application.commands import beliefs as beliefs_cli
 
 
 def digest(path: Path) -> str:

@@ -14,16 +14,16 @@ from pathlib import Path
 
 import pytest
 
-from robokudo.belief_store import BeliefStore
+from reasoning.beliefs.store import BeliefStore
 
 REPO_ROOT = Path(__file__).resolve().parents[2]
 
 WRITER = """
 import sys
 import numpy as np
-from reasoning.fusion import Evidence
-from reasoning.fusion_frame import FrameObject
-from robokudo.belief_store import BeliefStore
+from reasoning.fusion.rule import Evidence
+from reasoning.fusion.frame import FrameObject
+from reasoning.beliefs.store import BeliefStore
 
 store = BeliefStore(sys.argv[1])
 base = int(sys.argv[2])

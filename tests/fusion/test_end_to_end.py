@@ -11,8 +11,8 @@ from pathlib import Path
 
 import pytest
 
-from robokudo import cli
-from robokudo.belief_store import BeliefStore
+from reasoning.beliefs.store import BeliefStore
+from robokudo.application import cli
 
 
 def test_find_milk_in_fridge_twice_updates_one_belief(

@@ -7,9 +7,9 @@ import math
 import numpy as np
 import pytest
 
-from reasoning.fusion import MAX_LOG_ODDS, AttributeBelief, Evidence, accumulate, fuse_evidence, logit
-from reasoning.fusion_frame import FrameContext, duplicate_groups, frame_objects, quaternion_from_matrix
-from robokudo.types import Classification, ObjectHypothesis, Pose, SemanticColor, Shape, Size
+from reasoning.fusion.frame import FrameContext, duplicate_groups, frame_objects, quaternion_from_matrix
+from reasoning.fusion.rule import MAX_LOG_ODDS, AttributeBelief, Evidence, accumulate, fuse_evidence, logit
+from robokudo.core.types import Classification, ObjectHypothesis, Pose, SemanticColor, Shape, Size
 
 SUBCLASSES = {("LactoseFreeMilk", "Milk"), ("Milk", "Drink"), ("LactoseFreeMilk", "Drink"), ("Cup", "Container")}
 

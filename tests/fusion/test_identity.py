@@ -18,15 +18,15 @@ import numpy as np
 import pytest
 from py_trees.common import Status
 
-from reasoning.fusion_tracking import GONE, PRESENT, BeliefTracker, TrackerConfig
-from robokudo.annotator import Annotator
-from robokudo.answer import AnswerStep
-from robokudo.belief_store import BeliefStore
-from robokudo.engine import Engine
-from robokudo.pipeline import Pipeline
-from robokudo.types import CameraInfo, CameraIntrinsics, CasType, ColorImage, DepthImage, ObjectHypothesis
+from reasoning.beliefs.answer import AnswerStep
+from reasoning.beliefs.store import BeliefStore
+from reasoning.fusion.tracking import GONE, PRESENT, BeliefTracker, TrackerConfig
+from robokudo.core.annotator import Annotator
+from robokudo.core.engine import Engine
+from robokudo.core.pipeline import Pipeline
+from robokudo.core.types import CameraInfo, CameraIntrinsics, CasType, ColorImage, DepthImage, ObjectHypothesis
 
-kitchen_scene = pytest.importorskip("annotators.kitchen_scene")
+kitchen_scene = pytest.importorskip("annotators.simulation.kitchen_scene")
 tabletop = pytest.importorskip("trees.tabletop")
 
 REPO_ROOT = Path(__file__).resolve().parents[2]

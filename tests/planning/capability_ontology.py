@@ -12,7 +12,7 @@ from dataclasses import dataclass
 from pathlib import Path
 
 from ontology import shipped_files
-from reasoning.knowledge_base import KnowledgeBase
+from reasoning.knowledge.knowledge_base import KnowledgeBase
 
 PREFIXES = (
     "@prefix rk: <http://robokudo.org/ontology#> .\n"
@@ -45,10 +45,10 @@ class CapabilityOntology:
         """The ontology as Turtle (types as CAS classes, annotators as individuals)."""
         lines = [PREFIXES]
         for sensor in self.sensors:
-            lines.append(f"rk:{sensor} a owl:Class ; rdfs:subClassOf rk:View ; rdfs:label \"{sensor.lower()}\" .\n")
+            lines.append(f'rk:{sensor} a owl:Class ; rdfs:subClassOf rk:View ; rdfs:label "{sensor.lower()}" .\n')
         for type_name in self.types:
             lines.append(
-                f"rk:{type_name} a owl:Class ; rdfs:subClassOf rk:Annotation ; rdfs:label \"{type_name.lower()}\" .\n"
+                f'rk:{type_name} a owl:Class ; rdfs:subClassOf rk:Annotation ; rdfs:label "{type_name.lower()}" .\n'
             )
         for spec in self.annotators:
             lines.append(f"rk:{spec.name} a owl:NamedIndividual , rk:Annotator ;\n")

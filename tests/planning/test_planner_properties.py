@@ -10,12 +10,12 @@ import pytest
 from hypothesis import HealthCheck, given, settings
 from hypothesis import strategies as st
 
-from reasoning.plan import Alternatives, Plan, Step, Task
-from reasoning.planner import PlanningError, Requirement, SensorSource, plan_requirements
-from robokudo.annotator import Annotator
-from robokudo.dataflow import validate_data_flow
-from robokudo.render import unicode_tree
-from robokudo.types import Annotation, CasType, View
+from reasoning.planning.plan import Alternatives, Plan, Step, Task
+from reasoning.planning.planner import PlanningError, Requirement, SensorSource, plan_requirements
+from robokudo.core.annotator import Annotator
+from robokudo.core.dataflow import validate_data_flow
+from robokudo.core.render import unicode_tree
+from robokudo.core.types import Annotation, CasType, View
 from tests.planning.capability_ontology import CapabilityOntology, random_ontology
 from trees.synthesis import build_tree
 

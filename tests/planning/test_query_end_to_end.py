@@ -8,8 +8,8 @@ from pathlib import Path
 import numpy as np
 import pytest
 
-from annotators.kitchen_scene import render_kitchen
-from robokudo import cli
+from annotators.simulation.kitchen_scene import render_kitchen
+from robokudo.application import cli
 from tests.annotators.conftest import SHARED_DATA, require_folder
 
 
@@ -54,7 +54,7 @@ def test_plan_cli_prints_the_tree_with_reasons_and_json(capsys: pytest.CaptureFi
     document = json.loads(capsys.readouterr().out)
     assert document["tree"]["type"] == "Pipeline"
     classes = [node.get("class") for node in _walk(document["tree"])]
-    assert "annotators.color.SemanticColorAnnotator" in classes
+    assert "annotators.image.color.SemanticColorAnnotator" in classes
     assert all(node["reason"] for node in _walk(document["tree"]))
 
 

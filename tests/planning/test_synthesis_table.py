@@ -9,15 +9,15 @@ import py_trees
 import pytest
 
 from queries import parse_query
-from reasoning.knowledge_base import KnowledgeBase
-from reasoning.plan import Alternatives, Plan, Step
-from reasoning.planner import PlanningError, SensorSource
-from reasoning.query_planner import plan_query
-from robokudo.belief_store import BeliefStore
-from robokudo.dataflow import validate_data_flow
-from robokudo.parallel import ThresholdParallel
-from robokudo.render import unicode_tree
-from robokudo.sources import sensor_source
+from reasoning.beliefs.store import BeliefStore
+from reasoning.knowledge.knowledge_base import KnowledgeBase
+from reasoning.planning.plan import Alternatives, Plan, Step
+from reasoning.planning.planner import PlanningError, SensorSource
+from reasoning.planning.query_planner import plan_query
+from robokudo.application.sensor_sources import sensor_source
+from robokudo.core.dataflow import validate_data_flow
+from robokudo.core.parallel import ThresholdParallel
+from robokudo.core.render import unicode_tree
 from trees.synthesis import build_tree
 
 
@@ -194,8 +194,8 @@ def test_explanations_name_the_query_and_the_producers(kb: KnowledgeBase) -> Non
 
 
 def test_a_new_object_class_plans_and_runs_at_once(tmp_path: Path) -> None:
-    from reasoning.editing import OntologyEditor
-    from robokudo.query_cli import answer_query
+    from reasoning.knowledge.editing import OntologyEditor
+    from robokudo.application.commands.query import answer_query
 
     kb = KnowledgeBase.load(tmp_path / "user.ttl")
     with pytest.raises(PlanningError, match="unknown object class 'picnic_cup'"):

@@ -11,7 +11,7 @@ import sys
 import pytest
 
 from queries import parse_query, query_from_json
-from queries.cli import EXIT_BAD_QUERY, add_arguments, main, run
+from robokudo.application.commands.parse import EXIT_BAD_QUERY, add_arguments, main, run
 
 
 def parse_args(argv: list[str]) -> argparse.Namespace:
@@ -55,13 +55,18 @@ def test_dash_reads_the_query_from_stdin(capsys: pytest.CaptureFixture[str], mon
 
 def test_module_runs_as_a_command() -> None:
     result = subprocess.run(
-        [sys.executable, "-m", "queries.cli", "stop", "{", "task:", "x", "}"],
+        [sys.executable, "-m", "robokudo.application.commands.parse", "stop", "{", "task:", "x", "}"],
         capture_output=True,
         text=True,
         check=False,
     )
     assert result.returncode == 0
     assert result.stdout == "stop { task: x }\n"
-    bad = subprocess.run([sys.executable, "-m", "queries.cli", "stop {}"], capture_output=True, text=True, check=False)
+    bad = subprocess.run(
+        [sys.executable, "-m", "robokudo.application.commands.parse", "stop {}"],
+        capture_output=True,
+        text=True,
+        check=False,
+    )
     assert bad.returncode == 2
     assert "'stop' needs a 'task'" in bad.stderr

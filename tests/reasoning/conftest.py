@@ -7,8 +7,8 @@ from pathlib import Path
 
 import pytest
 
-from reasoning.knowledge_base import KnowledgeBase
-from reasoning.sources import USER_ONTOLOGY_ENV
+from reasoning.knowledge.knowledge_base import KnowledgeBase
+from reasoning.knowledge.sources import USER_ONTOLOGY_ENV
 
 
 @pytest.fixture(autouse=True)

@@ -9,9 +9,9 @@ from pathlib import Path
 import pytest
 
 from ontology import ontology_dir
-from reasoning.capabilities import ImplementationError, check_implementations, load_implementation
-from reasoning.knowledge_base import KnowledgeBase
-from reasoning.model import AnnotatorSpec
+from reasoning.knowledge.capabilities import ImplementationError, check_implementations, load_implementation
+from reasoning.knowledge.knowledge_base import KnowledgeBase
+from reasoning.knowledge.model import AnnotatorSpec
 from tests.reasoning.helpers import shipped_without, write_ttl
 
 
@@ -30,7 +30,7 @@ def test_ports_that_disagree_are_reported(tmp_path: Path) -> None:
     extra = write_ttl(
         tmp_path / "wrong.ttl",
         """rk:WrongRangeFilter a owl:NamedIndividual , rk:Annotator ;
-    rk:implementedBy "annotators.filters.RangeFilter" ;
+    rk:implementedBy "annotators.cloud.filters.RangeFilter" ;
     rk:requiresInput rk:DepthImage ;
     rk:providesOutput rk:PointCloud , rk:Plane ;
     rk:expectedCostMs 1.0 ;
@@ -39,7 +39,7 @@ def test_ports_that_disagree_are_reported(tmp_path: Path) -> None:
     )
     kb = KnowledgeBase.load(tmp_path / "user.ttl", extra_files=[extra])
     problems = "\n".join(check_implementations(kb))
-    assert re.search(r"annotators\.filters\.RangeFilter: inputs disagree: code has \[PointCloud\]", problems)
+    assert re.search(r"annotators\.cloud\.filters\.RangeFilter: inputs disagree: code has \[PointCloud\]", problems)
     assert re.search(
         r"RangeFilter: outputs disagree: code has \[PointCloud\], ontology .* \[Plane, PointCloud\]", problems
     )
@@ -49,7 +49,7 @@ def test_declared_annotator_without_implementation_is_reported(tmp_path: Path) -
     extra = write_ttl(
         tmp_path / "ghost.ttl",
         """rk:GhostFilter a owl:NamedIndividual , rk:Annotator ;
-    rk:implementedBy "annotators.filters.GhostFilter" ;
+    rk:implementedBy "annotators.cloud.filters.GhostFilter" ;
     rk:requiresInput rk:PointCloud ;
     rk:providesOutput rk:PointCloud ;
     rk:expectedCostMs 1.0 ;
@@ -69,7 +69,7 @@ def test_annotator_class_missing_from_the_ontology_is_reported(tmp_path: Path) -
     kb = KnowledgeBase.load(tmp_path / "user.ttl", files=[*shipped_without("annotators.ttl"), reduced])
     assert "RangeFilter" not in {s.name for s in kb.annotators()}
     problems = check_implementations(kb)
-    assert any("annotators.filters.RangeFilter" in p and "does not declare" in p for p in problems)
+    assert any("annotators.cloud.filters.RangeFilter" in p and "does not declare" in p for p in problems)
 
 
 def test_load_implementation_refuses_modules_outside_annotators() -> None:

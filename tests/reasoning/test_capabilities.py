@@ -7,8 +7,8 @@ from pathlib import Path
 import pytest
 
 from reasoning.errors import OntologyError, UnknownTermError
-from reasoning.knowledge_base import KnowledgeBase
-from reasoning.model import Conditions
+from reasoning.knowledge.knowledge_base import KnowledgeBase
+from reasoning.knowledge.model import Conditions
 from tests.reasoning.helpers import write_ttl
 
 # Test-only annotators layered over the shipped ones (never imported: loading does not import code).
@@ -127,7 +127,7 @@ def test_inputs_of_an_annotator(kb: KnowledgeBase) -> None:
     assert set(spec.inputs) == {"DepthImage", "CameraInfo"}
     assert spec.optional_inputs == ("ColorImage",)
     assert spec.outputs == ("PointCloud",)
-    assert spec.implemented_by == "annotators.point_cloud.PointCloudGenerator"
+    assert spec.implemented_by == "annotators.cloud.point_cloud.PointCloudGenerator"
     assert spec.cost_ms > 0 and 0 < spec.reliability <= 1
 
 

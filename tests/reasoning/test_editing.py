@@ -6,11 +6,11 @@ from pathlib import Path
 
 import pytest
 
-from reasoning import hermit
-from reasoning.editing import OntologyEditor
 from reasoning.errors import EditRejectedError
-from reasoning.knowledge_base import KnowledgeBase
-from reasoning.sources import USER_ONTOLOGY_ENV, default_user_file
+from reasoning.knowledge import hermit
+from reasoning.knowledge.editing import OntologyEditor
+from reasoning.knowledge.knowledge_base import KnowledgeBase
+from reasoning.knowledge.sources import USER_ONTOLOGY_ENV, default_user_file
 
 
 def snapshot(folder: Path) -> dict[str, bytes]:

@@ -4,7 +4,7 @@ from __future__ import annotations
 
 import pytest
 
-from reasoning.knowledge_base import KnowledgeBase
+from reasoning.knowledge.knowledge_base import KnowledgeBase
 
 
 def test_subsumption(kb: KnowledgeBase) -> None:

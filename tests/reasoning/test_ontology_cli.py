@@ -7,7 +7,7 @@ from pathlib import Path
 
 import pytest
 
-from reasoning import ontology_cli
+from robokudo.application.commands import ontology as ontology_cli
 
 
 def run(*argv: str) -> int:
@@ -79,9 +79,9 @@ def test_check_with_hermit_and_code(capsys: pytest.CaptureFixture[str], user_fil
 def test_works_as_a_robokudo_subcommand(
     capsys: pytest.CaptureFixture[str], user_file: Path, monkeypatch: pytest.MonkeyPatch
 ) -> None:
-    from robokudo import cli
+    from robokudo.application import cli
 
-    monkeypatch.setitem(cli._EXTERNAL_COMMANDS, "ontology", ("reasoning.ontology_cli", "the ontology"))
+    monkeypatch.setitem(cli._EXTERNAL_COMMANDS, "ontology", ("robokudo.application.commands.ontology", "the ontology"))
     assert cli.main(["ontology", "--user-file", str(user_file), "show", "cereal boxes"]) == 0
     assert capsys.readouterr().out.startswith("CerealBox  (object class")
     assert cli.main(["ontology", "--user-file", str(user_file), "show", "mlik"]) == 2

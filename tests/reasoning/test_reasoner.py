@@ -7,9 +7,9 @@ from pathlib import Path
 
 import pytest
 
-from reasoning import hermit, knowledge_base, sources
 from reasoning.errors import InconsistentOntologyError
-from reasoning.knowledge_base import KnowledgeBase
+from reasoning.knowledge import hermit, knowledge_base, sources
+from reasoning.knowledge.knowledge_base import KnowledgeBase
 from tests.reasoning.helpers import write_ttl
 
 

@@ -9,7 +9,7 @@ import pytest
 
 from ontology import EXAMPLE_USER_MAP_FILE, ontology_dir
 from reasoning.errors import OntologyError
-from reasoning.knowledge_base import KnowledgeBase
+from reasoning.knowledge.knowledge_base import KnowledgeBase
 from tests.reasoning.helpers import write_ttl
 
 
@@ -36,7 +36,7 @@ def test_milk_is_searched_in_the_fridge_region(kb: KnowledgeBase) -> None:
 
 
 def test_kitchen_map_matches_the_scene(kb: KnowledgeBase) -> None:
-    from annotators.kitchen_scene import kitchen_regions
+    from annotators.simulation.kitchen_scene import kitchen_regions
 
     scene_regions = kitchen_regions()
     assert {r.name for r in scene_regions} == {r.name for r in kb.regions()}
@@ -68,7 +68,7 @@ def test_region_without_pose_is_rejected(tmp_path: Path) -> None:
 
 
 def test_scene_objects_use_ontology_terms(kb: KnowledgeBase) -> None:
-    from annotators.kitchen_scene import kitchen_objects
+    from annotators.simulation.kitchen_scene import kitchen_objects
 
     for obj in kitchen_objects():
         assert kb.kind(obj.object_class) == "class", obj.object_class

@@ -7,8 +7,8 @@ from hypothesis import given, settings
 from hypothesis import strategies as st
 
 from reasoning.errors import UnknownTermError
-from reasoning.knowledge_base import KnowledgeBase
-from reasoning.model import Resolved
+from reasoning.knowledge.knowledge_base import KnowledgeBase
+from reasoning.knowledge.model import Resolved
 
 
 @pytest.mark.parametrize(

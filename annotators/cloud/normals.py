@@ -1,0 +1,110 @@
+"""Surface normals on the organized grid: central differences across ``step`` pixels, smoothed, toward the camera.
+
+For every pixel the horizontal and vertical neighbours ``step`` pixels away span the surface; their cross product is
+the normal, flipped to face the camera. A pixel whose neighbours are missing or lie across a depth discontinuity
+gets NaN. The raw normals are averaged over a ``smoothing`` x ``smoothing`` window (sensor noise), then normalised.
+Only the bounding box of the points of interest is computed, on every ``stride``-th pixel (normals vary slowly;
+each pixel takes the normal of its cell); everything else is NaN.
+"""
+
+from __future__ import annotations
+
+from typing import ClassVar
+
+import cv2
+import numpy as np
+
+from annotators.cloud.point_cloud import cloud_problem
+from annotators.geometry.grid_segmentation import bounding_box, depth_jump
+from robokudo.core.annotator import Annotator
+from robokudo.core.types import CasType, Normals, PointCloud
+
+
+def grid_normals(
+    points: np.ndarray,
+    step: int = 3,
+    smoothing: int = 5,
+    jump_absolute: float = 0.01,
+    jump_relative: float = 0.02,
+) -> np.ndarray:
+    """HxWx3 float32 unit normals (facing the camera at the origin) of an organized HxWx3 cloud; NaN where unknown."""
+    height, width = points.shape[:2]
+    normals = np.full(points.shape, np.nan, dtype=np.float32)
+    if height <= 2 * step or width <= 2 * step:
+        return normals
+    inner = (slice(step, -step), slice(step, -step))
+    x, y, z = (np.ascontiguousarray(points[..., i], dtype=np.float32) for i in range(3))
+    shifts = {
+        "left": (slice(step, -step), slice(0, -2 * step)),
+        "right": (slice(step, -step), slice(2 * step, None)),
+        "up": (slice(0, -2 * step), slice(step, -step)),
+        "down": (slice(2 * step, None), slice(step, -step)),
+    }
+    centre_z = z[inner]
+    with np.errstate(invalid="ignore"):
+        broken = ~np.isfinite(centre_z)
+        for where in shifts.values():
+            broken |= depth_jump(centre_z, z[where], jump_absolute, jump_relative)
+            broken |= ~np.isfinite(z[where])
+    h = [c[shifts["right"]] - c[shifts["left"]] for c in (x, y, z)]
+    v = [c[shifts["down"]] - c[shifts["up"]] for c in (x, y, z)]
+    components = [h[1] * v[2] - h[2] * v[1], h[2] * v[0] - h[0] * v[2], h[0] * v[1] - h[1] * v[0]]
+    with np.errstate(invalid="ignore"):
+        facing = components[0] * x[inner] + components[1] * y[inner] + components[2] * centre_z
+    sign = np.where(broken, np.float32(0.0), np.where(facing > 0, np.float32(-1.0), np.float32(1.0)))
+    sign /= _length(components)
+    n = cv2.merge([np.nan_to_num(c * sign, copy=False) for c in components])
+    if smoothing > 1:
+        n = cv2.boxFilter(n, -1, (smoothing, smoothing), normalize=False, borderType=cv2.BORDER_CONSTANT)
+        channels = cv2.split(n)
+        scale = np.where(broken, np.float32(np.nan), np.float32(1.0)) / _length(channels)
+        n = cv2.merge([c * scale for c in channels])
+    else:
+        n[broken] = np.nan
+    normals[inner] = n
+    return normals
+
+
+def _length(components: list[np.ndarray] | tuple[np.ndarray, ...]) -> np.ndarray:
+    """The per-pixel length of a vector field given as three HxW float32 components (1 where it is 0 or NaN)."""
+    length = cv2.magnitude(np.nan_to_num(components[0]), np.nan_to_num(components[1]))
+    length = cv2.magnitude(length, np.nan_to_num(components[2]))
+    length[length == 0] = 1.0
+    return length
+
+
+class NormalEstimator(Annotator):
+    """Estimates a unit normal (toward the camera) for every point of interest of the organized cloud."""
+
+    inputs: ClassVar[tuple[type[CasType], ...]] = (PointCloud,)
+    outputs: ClassVar[tuple[type[CasType], ...]] = (Normals,)
+
+    def __init__(self, step: int = 2, smoothing: int = 3, stride: int = 2, name: str | None = None) -> None:
+        """``step`` and ``smoothing`` count pixels of the ``stride``-subsampled grid."""
+        super().__init__(name=name)
+        if step < 1 or smoothing < 1 or stride < 1:
+            raise ValueError(f"step, smoothing and stride must be >= 1, got {step}, {smoothing}, {stride}")
+        self.step = step
+        self.smoothing = smoothing
+        self.stride = stride
+
+    def analyse(self) -> None:
+        """Write the Normals view (NaN outside the points of interest' bounding box and where unknown)."""
+        cloud = self.view(PointCloud)
+        problem = cloud_problem(cloud)
+        if problem:
+            self.fail(problem)
+        stride = self.stride
+        x0, y0, x1, y1 = bounding_box(cloud.mask, margin=(self.step + self.smoothing) * stride)
+        coarse = grid_normals(cloud.points[y0:y1:stride, x0:x1:stride], self.step, self.smoothing)
+        if stride > 1:
+            size = (coarse.shape[1] * stride, coarse.shape[0] * stride)
+            coarse = cv2.resize(coarse, size, interpolation=cv2.INTER_NEAREST)[: y1 - y0, : x1 - x0]
+        if coarse.shape == cloud.points.shape:
+            normals = np.ascontiguousarray(coarse)
+        else:
+            normals = np.full(cloud.points.shape, np.nan, dtype=np.float32)
+            normals[y0:y1, x0:x1] = coarse
+        if not np.isfinite(normals[..., 0][cloud.mask]).any():
+            self.fail("no point of interest has enough valid neighbours for a normal")
+        self.write(Normals(normals))

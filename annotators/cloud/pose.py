@@ -1,0 +1,53 @@
+"""Pose estimation: every hypothesis gets the centre and orientation of its oriented bounding box."""
+
+from __future__ import annotations
+
+from typing import ClassVar
+
+import numpy as np
+
+from annotators.cloud.cloud_expert import CloudExpert
+from annotators.geometry.boxes import finite_points, object_box, quaternion_from_matrix
+from robokudo.core.types import CameraInfo, CasType, ObjectHypothesis, PointCloud, Pose
+
+
+def hypothesis_points(cloud: PointCloud, hypothesis: ObjectHypothesis, max_points: int = 2000) -> np.ndarray:
+    """Up to about ``max_points`` finite camera-frame points (Nx3 float64) of the hypothesis, evenly sampled."""
+    indices = np.asarray(hypothesis.point_indices)
+    indices = indices[:: max(1, indices.size // max_points)]
+    indices = indices[(indices >= 0) & (indices < cloud.mask.size)]
+    return finite_points(cloud.points.reshape(-1, 3)[indices])
+
+
+class PoseAnnotator(CloudExpert):
+    """Attaches the oriented-box pose of every hypothesis: upright in the world frame when the camera pose is
+    known, else principal axes in the camera frame."""
+
+    inputs: ClassVar[tuple[type[CasType], ...]] = (ObjectHypothesis, PointCloud)
+    optional_inputs: ClassVar[tuple[type[CasType], ...]] = (CameraInfo,)
+    outputs: ClassVar[tuple[type[CasType], ...]] = (Pose,)
+    purpose: ClassVar[str] = "estimate poses for"
+
+    def __init__(self, max_points: int = 1000, name: str | None = None) -> None:
+        super().__init__(name=name)
+        self.max_points = max_points
+
+    def analyse(self) -> None:
+        """Attach one Pose per hypothesis with points; fail when no hypothesis has any valid point."""
+        cloud = self.usable_cloud()
+        hypotheses = self.hypotheses()
+        camera = self.optional_view(CameraInfo)
+        cam_to_world = camera.cam_to_world if camera is not None else None
+        if cam_to_world is not None and (np.shape(cam_to_world) != (4, 4) or not np.all(np.isfinite(cam_to_world))):
+            self.fail(f"camera pose must be a finite 4x4 matrix, got shape {np.shape(cam_to_world)}")
+        posed = 0
+        for hypothesis in hypotheses:
+            points = hypothesis_points(cloud, hypothesis, self.max_points)
+            if points.shape[0] == 0:
+                continue
+            box, frame = object_box(points, cam_to_world)
+            orientation = quaternion_from_matrix(box.rotation)
+            self.attach(hypothesis, Pose(position=box.centre, orientation=orientation, frame=frame))
+            posed += 1
+        if posed == 0:
+            self.fail("no object hypothesis has a valid 3-D point")

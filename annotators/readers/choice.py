@@ -1,0 +1,138 @@
+"""One entry point for every recorded input: pick the reader annotator from a path (``--input PATH --frame N``).
+
+The rules, tried in this order (the first that matches wins):
+
+=====================================================================  ==========================================
+path                                                                   reader
+=====================================================================  ==========================================
+None                                                                   KitchenSceneReader (the built-in scene)
+folder with ``rgb.txt`` and ``depth.txt``                              TumSequenceReader(folder, frame)
+folder with ``camera_params.json`` and ``NNNNNN-color.png`` files       ColorDepthPairReader(folder, frame)
+folder with ``tiff/`` (and ``pclzf/*.xml``), or that ``tiff/`` folder  TiffSequenceReader(folder, frame)
+folder of ``.pcd`` files                                               PcdReader(the frame-th file, natural order)
+``.pcd`` file                                                          PcdReader(file) (frame must be 0)
+``NNNNNN-color.png`` with ``camera_params.json`` beside it             ColorDepthPairReader(folder, NNNNNN)
+image file named ``*color*`` / ``*rgb*`` / ``*depth*`` with its other  TumPairReader(file) (frame must be 0)
+half beside it (``TUM_color.png`` + ``TUM_depth.png``)
+=====================================================================  ==========================================
+
+Anything else raises ValueError listing these layouts. :func:`reader_name_for` gives the ontology name of the
+reader without constructing it; :func:`reader_choice` also gives the constructor arguments (plain data). Choosing
+looks at the file system only and imports neither the readers nor Open3D.
+"""
+
+from __future__ import annotations
+
+import importlib
+import re
+from collections.abc import Mapping
+from dataclasses import dataclass, field
+from pathlib import Path
+
+from annotators.readers.frame_io import CAMERA_PARAMS_FILE
+from annotators.readers.tiff_io import is_tiff_sequence
+from annotators.readers.tum_io import is_tum_pair, is_tum_sequence
+from robokudo.core.annotator import Annotator
+
+SUPPORTED_LAYOUTS = (
+    "no path: the built-in kitchen scene",
+    "a TUM RGB-D sequence folder (rgb.txt, depth.txt)",
+    "a uoc folder (NNNNNN-color.png, NNNNNN-depth.png, camera_params.json) or one of its NNNNNN-color.png",
+    "a PCL ImageGrabber folder (tiff/ with pclzf/*.xml) or its tiff/ folder",
+    "an organized .pcd file, or a folder of them",
+    "a TUM-style colour/depth pair: a colour file named *color* or *rgb* with the *depth* file beside it",
+)
+
+READER_NAMES: tuple[str, ...] = (
+    "KitchenSceneReader",
+    "TumSequenceReader",
+    "ColorDepthPairReader",
+    "TiffSequenceReader",
+    "PcdReader",
+    "TumPairReader",
+)
+"""Every reader the entry point can choose, by ontology name (classes of :mod:`annotators.readers.frame_readers`)."""
+
+_UOC_COLOR = re.compile(r"^(\d{6})-color\.png$")
+_IMAGE_SUFFIXES = (".png", ".jpg", ".jpeg", ".tif", ".tiff")
+
+
+@dataclass(frozen=True)
+class ReaderChoice:
+    """The reader for a path: its ontology name and its constructor's keyword arguments."""
+
+    name: str
+    parameters: Mapping[str, object] = field(default_factory=dict)
+
+    def create(self) -> Annotator:
+        """A new reader annotator (imports the readers, and so Open3D, only now)."""
+        readers = importlib.import_module("annotators.readers.frame_readers")
+        return getattr(readers, self.name)(**self.parameters)
+
+
+def _natural_key(path: Path) -> list[object]:
+    return [int(part) if part.isdigit() else part for part in re.split(r"(\d+)", path.name)]
+
+
+def _unsupported(path: Path, why: str) -> ValueError:
+    layouts = "\n  - ".join(SUPPORTED_LAYOUTS)
+    return ValueError(f"cannot read {path}: {why}; supported inputs:\n  - {layouts}")
+
+
+def _single_frame(path: Path, frame: int) -> None:
+    if frame != 0:
+        raise ValueError(f"{path} holds a single frame; --frame must be 0, got {frame}")
+
+
+def _folder_choice(folder: Path, frame: int) -> ReaderChoice:
+    if is_tum_sequence(folder):
+        return ReaderChoice("TumSequenceReader", {"folder": str(folder), "frame": frame})
+    if (folder / CAMERA_PARAMS_FILE).is_file() and any(_UOC_COLOR.match(p.name) for p in folder.iterdir()):
+        return ReaderChoice("ColorDepthPairReader", {"folder": str(folder), "frame": frame})
+    if is_tiff_sequence(folder):
+        return ReaderChoice("TiffSequenceReader", {"folder": str(folder), "frame": frame})
+    clouds = sorted((p for p in folder.iterdir() if p.suffix.lower() == ".pcd"), key=_natural_key)
+    if clouds:
+        if not 0 <= frame < len(clouds):
+            raise ValueError(f"{folder} holds {len(clouds)} .pcd files, no frame {frame}")
+        return ReaderChoice("PcdReader", {"path": str(clouds[frame])})
+    raise _unsupported(folder, "the folder matches no known layout")
+
+
+def _file_choice(path: Path, frame: int) -> ReaderChoice:
+    suffix = path.suffix.lower()
+    if suffix == ".pcd":
+        _single_frame(path, frame)
+        return ReaderChoice("PcdReader", {"path": str(path)})
+    uoc = _UOC_COLOR.match(path.name)
+    if uoc and (path.parent / CAMERA_PARAMS_FILE).is_file():
+        _single_frame(path, frame)
+        return ReaderChoice("ColorDepthPairReader", {"folder": str(path.parent), "frame": int(uoc.group(1))})
+    if suffix in _IMAGE_SUFFIXES and is_tum_pair(path):
+        _single_frame(path, frame)
+        return ReaderChoice("TumPairReader", {"path": str(path)})
+    raise _unsupported(path, "the file matches no known layout")
+
+
+def reader_choice(path: str | None, frame: int = 0) -> ReaderChoice:
+    """The reader for ``path`` and frame ``frame`` (see the module docstring); ValueError when none fits."""
+    if frame < 0:
+        raise ValueError(f"frame number must be >= 0, got {frame}")
+    if path is None:
+        return ReaderChoice("KitchenSceneReader")
+    resolved = Path(path).expanduser()
+    if resolved.is_dir():
+        return _folder_choice(resolved, frame)
+    if resolved.is_file():
+        return _file_choice(resolved, frame)
+    raise _unsupported(resolved, "no such file or folder")
+
+
+def reader_for(path: str | None, frame: int = 0) -> Annotator:
+    """A new reader annotator for ``path`` and frame ``frame``; ValueError listing the layouts when none fits."""
+    return reader_choice(path, frame).create()
+
+
+def reader_name_for(path: str | None, frame: int = 0) -> str:
+    """The ontology name of the reader for ``path`` (``KitchenSceneReader`` for None), without constructing it."""
+    return reader_choice(path, frame).name

@@ -1,0 +1,257 @@
+"""Reader annotators: they put a colour image, a depth image and the camera info into the CAS.
+
+* :class:`KitchenSceneReader` renders the project's built-in kitchen scene (with the camera pose).
+* :class:`ColorDepthPairReader` reads a frame of a uoc-layout folder (see :mod:`annotators.readers.frame_io`).
+* :class:`TumSequenceReader` and :class:`TumPairReader` read the TUM RGB-D layouts (:mod:`annotators.readers.tum_io`).
+* :class:`PcdReader` reads an organized PCD file and also writes its point cloud (:mod:`annotators.readers.pcd_io`).
+* :class:`TiffSequenceReader` reads the PCL ImageGrabber TIFF layout (:mod:`annotators.readers.tiff_io`).
+
+:func:`annotators.readers.choice.reader_for` picks the reader from a path. Every reader decodes once and keeps the frame
+on the instance, so repeated ticks of the same frame cost nothing but the CAS writes; the arrays are shared with
+the CAS, never copied, and must not be modified downstream. Recorded frames have no camera pose
+(``cam_to_world`` is None).
+"""
+
+from __future__ import annotations
+
+import time
+from abc import abstractmethod
+from collections.abc import Mapping
+from pathlib import Path
+from typing import ClassVar
+
+import numpy as np
+
+from annotators.readers.frame_io import Frame, FrameError, read_color_depth_pair
+from annotators.readers.pcd_io import read_pcd
+from annotators.readers.tiff_io import read_tiff_frame
+from annotators.readers.tum_io import TUM_DEPTH_SCALE, read_tum_pair, read_tum_sequence
+from annotators.simulation import kitchen_scene
+from robokudo.core.annotator import Annotator
+from robokudo.core.types import CameraInfo, CameraIntrinsics, CasType, ColorImage, DepthImage, PointCloud, QueryView
+
+DEFAULT_KITCHEN_VIEW = "table"
+
+
+def _to_intrinsics(scene_intrinsics: kitchen_scene.CameraIntrinsics) -> CameraIntrinsics:
+    """The runtime's intrinsics type from the scene renderer's."""
+    k = scene_intrinsics
+    return CameraIntrinsics(fx=k.fx, fy=k.fy, cx=k.cx, cy=k.cy, width=k.width, height=k.height)
+
+
+class KitchenSceneReader(Annotator):
+    """Renders the built-in kitchen from a named camera view (``"table"`` when ``view`` is None).
+
+    ``seed`` seeds the sensor noise; ``moved`` moves objects (see ``kitchen_scene.kitchen_objects``). The
+    optional QueryView input is declared for choosing the view from the query's region (not used yet).
+    """
+
+    inputs: ClassVar[tuple[type[CasType], ...]] = ()
+    optional_inputs: ClassVar[tuple[type[CasType], ...]] = (QueryView,)
+    outputs: ClassVar[tuple[type[CasType], ...]] = (ColorImage, DepthImage, CameraInfo)
+
+    def __init__(
+        self,
+        view: str | None = None,
+        seed: int = 0,
+        moved: Mapping[str, np.ndarray] | None = None,
+        name: str | None = None,
+    ) -> None:
+        super().__init__(name=name)
+        self.scene_view = view
+        self.seed = seed
+        self.moved = dict(moved) if moved else None
+        self._rendered: dict[str, kitchen_scene.RenderedScene] = {}
+        self._last: kitchen_scene.RenderedScene | None = None
+
+    @property
+    def last_scene(self) -> kitchen_scene.RenderedScene | None:
+        """The scene (with its ground truth) written by the last successful run, or None before it."""
+        return self._last
+
+    def choose_view(self) -> str:
+        """The camera view to render (the configured one, else the default)."""
+        return self.scene_view or DEFAULT_KITCHEN_VIEW
+
+    def analyse(self) -> None:
+        """Render (once per view) and write the three views."""
+        view = self.choose_view()
+        scene = self._rendered.get(view)
+        if scene is None:
+            try:
+                scene = kitchen_scene.render_kitchen(view, seed=self.seed, moved=self.moved)
+            except ValueError as error:
+                self.fail(f"cannot render the kitchen: {error}")
+            self._rendered[view] = scene
+        self._last = scene
+        self.write(ColorImage(scene.color))
+        self.write(DepthImage(scene.depth))
+        self.write(
+            CameraInfo(
+                intrinsics=_to_intrinsics(scene.intrinsics),
+                cam_to_world=scene.cam_to_world,
+                frame_id=f"kitchen/{view}",
+                timestamp=time.time(),
+            )
+        )
+
+
+class FileFrameReader(Annotator):
+    """Base of the readers of recorded frames: decode once (:meth:`decode`), then write the views on every run.
+
+    ``intrinsics`` given explicitly replace those of the files; readers whose frames hold a point cloud declare
+    PointCloud among their outputs and write it too.
+    """
+
+    inputs: ClassVar[tuple[type[CasType], ...]] = ()
+    outputs: ClassVar[tuple[type[CasType], ...]] = (ColorImage, DepthImage, CameraInfo)
+
+    def __init__(self, name: str | None = None) -> None:
+        super().__init__(name=name)
+        self._decoded: Frame | None = None
+        self._cloud: PointCloud | None = None
+
+    @abstractmethod
+    def decode(self) -> Frame:
+        """Read the frame from disk; raises FrameError with the reason."""
+
+    @property
+    def last_frame(self) -> Frame | None:
+        """The decoded frame (with ground-truth labels when the file has them), None before the first read."""
+        return self._decoded
+
+    def load(self) -> Frame:
+        """The decoded frame (read from disk on first use); raises FrameError."""
+        if self._decoded is None:
+            self._decoded = self.decode()
+        return self._decoded
+
+    def analyse(self) -> None:
+        """Write the frame's colour, depth and camera info (and its cloud when the reader provides one)."""
+        try:
+            frame = self.load()
+        except FrameError as error:
+            self.fail(str(error))
+        except (OSError, ValueError) as error:
+            self.fail(f"cannot read the frame: {type(error).__name__}: {error}")
+        self.write(ColorImage(frame.color))
+        self.write(DepthImage(frame.depth))
+        stamp = frame.timestamp if frame.timestamp is not None else time.time()
+        self.write(CameraInfo(intrinsics=frame.intrinsics, frame_id="camera", timestamp=stamp))
+        if PointCloud in self.outputs:
+            if frame.points is None:
+                self.fail(f"{frame.source} holds no point cloud")
+            if self._cloud is None:
+                mask = np.isfinite(frame.points[..., 2])
+                self._cloud = PointCloud(points=frame.points, mask=mask, colors=frame.color)
+            self.write(self._cloud)
+
+
+class ColorDepthPairReader(FileFrameReader):
+    """Reads frame ``frame`` of a folder in the uoc layout (NNNNNN-color.png, NNNNNN-depth.png, camera_params.json).
+
+    ``depth_scale`` is in sensor units per metre; None takes it from camera_params.json, else 1000 (mm).
+    """
+
+    def __init__(
+        self, folder: str | Path, frame: int = 0, depth_scale: float | None = None, name: str | None = None
+    ) -> None:
+        super().__init__(name=name)
+        self.folder = Path(folder)
+        self.frame = frame
+        self.depth_scale = depth_scale
+
+    def decode(self) -> Frame:
+        """Decode the pair of PNGs with the folder's camera parameters."""
+        return read_color_depth_pair(self.folder, self.frame, self.depth_scale)
+
+
+class TumSequenceReader(FileFrameReader):
+    """Reads frame ``frame`` (time order) of a TUM RGB-D sequence folder (rgb.txt, depth.txt).
+
+    ``depth_scale`` is in units per metre (TUM: 5000); ``intrinsics`` default to the folder's camera_params.json,
+    else the PrimeSense default TUM documents (fx = fy = 525, cx = 319.5, cy = 239.5).
+    """
+
+    def __init__(
+        self,
+        folder: str | Path,
+        frame: int = 0,
+        depth_scale: float = TUM_DEPTH_SCALE,
+        intrinsics: CameraIntrinsics | None = None,
+        name: str | None = None,
+    ) -> None:
+        super().__init__(name=name)
+        self.folder = Path(folder)
+        self.frame = frame
+        self.depth_scale = depth_scale
+        self.intrinsics = intrinsics
+
+    def decode(self) -> Frame:
+        """Associate colour and depth by time stamp and decode the chosen pair."""
+        return read_tum_sequence(self.folder, self.frame, self.depth_scale, self.intrinsics)
+
+
+class TumPairReader(FileFrameReader):
+    """Reads one TUM-style colour/depth pair given by either file (``TUM_color.png`` beside ``TUM_depth.png``).
+
+    ``depth_scale`` is in units per metre (TUM: 5000); ``intrinsics`` default to the PrimeSense default.
+    """
+
+    def __init__(
+        self,
+        path: str | Path,
+        depth_scale: float = TUM_DEPTH_SCALE,
+        intrinsics: CameraIntrinsics | None = None,
+        name: str | None = None,
+    ) -> None:
+        super().__init__(name=name)
+        self.path = Path(path)
+        self.depth_scale = depth_scale
+        self.intrinsics = intrinsics
+
+    def decode(self) -> Frame:
+        """Find the other file of the pair and decode both."""
+        return read_tum_pair(self.path, self.depth_scale, self.intrinsics)
+
+
+class PcdReader(FileFrameReader):
+    """Reads an organized PCD file (x y z rgb/rgba, optional ``label``): colour, depth (z), camera info and the
+    cloud itself, so no PointCloudGenerator is needed. Intrinsics are fitted to the grid unless given; the
+    ``label`` field is kept as ground truth in ``last_frame.labels``."""
+
+    outputs: ClassVar[tuple[type[CasType], ...]] = (ColorImage, DepthImage, CameraInfo, PointCloud)
+
+    def __init__(self, path: str | Path, intrinsics: CameraIntrinsics | None = None, name: str | None = None) -> None:
+        super().__init__(name=name)
+        self.path = Path(path)
+        self.intrinsics = intrinsics
+
+    def decode(self) -> Frame:
+        """Decode the PCD file."""
+        return read_pcd(self.path, self.intrinsics)
+
+
+class TiffSequenceReader(FileFrameReader):
+    """Reads frame ``frame`` of a PCL ImageGrabber TIFF folder (tiff/ with pclzf/*.xml, or the tiff folder).
+
+    ``depth_scale`` (units per metre) and ``intrinsics`` default to the frame's XML file.
+    """
+
+    def __init__(
+        self,
+        folder: str | Path,
+        frame: int = 0,
+        depth_scale: float | None = None,
+        intrinsics: CameraIntrinsics | None = None,
+        name: str | None = None,
+    ) -> None:
+        super().__init__(name=name)
+        self.folder = Path(folder)
+        self.frame = frame
+        self.depth_scale = depth_scale
+        self.intrinsics = intrinsics
+
+    def decode(self) -> Frame:
+        """Decode the frame's TIFFs with the XML intrinsics."""
+        return read_tiff_frame(self.folder, self.frame, self.depth_scale, self.intrinsics)

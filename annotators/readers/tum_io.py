@@ -1,0 +1,161 @@
+"""The TUM RGB-D layouts: a sequence folder (``rgb.txt`` / ``depth.txt``) and a single colour/depth pair.
+
+A sequence folder lists its images in ``rgb.txt`` and ``depth.txt``, one ``timestamp path`` per line (``#`` starts
+a comment, paths are relative to the folder). Frame ``n`` is the ``n``-th colour image, in time order, that has a
+depth image within ``max_time_difference`` seconds (the nearest one; each depth image is used once).
+
+Depth PNGs hold 16-bit values of 1/5000 m (``TUM_DEPTH_SCALE``). TUM ships no intrinsics with the images; the
+default is the PrimeSense default TUM documents for its registered images (fx = fy = 525, cx = 319.5, cy = 239.5,
+640x480). A ``camera_params.json`` (uoc format) in the sequence folder overrides it; an explicit argument wins.
+
+A single pair is a colour file whose name contains ``color`` or ``rgb`` with the depth file beside it, named the
+same with the last ``color``/``rgb`` replaced by ``depth`` (``TUM_color.png`` -> ``TUM_depth.png``); the depth
+file may be given instead of the colour file.
+"""
+
+from __future__ import annotations
+
+import re
+from dataclasses import dataclass
+from pathlib import Path
+
+import numpy as np
+
+from annotators.readers.frame_io import CAMERA_PARAMS_FILE, Frame, FrameError, decode_rgbd, read_camera_params
+from robokudo.core.types import CameraIntrinsics
+
+TUM_DEPTH_SCALE = 5000.0
+"""Sensor units per metre of TUM depth images."""
+
+PRIMESENSE_INTRINSICS = CameraIntrinsics(fx=525.0, fy=525.0, cx=319.5, cy=239.5, width=640, height=480)
+"""The PrimeSense default intrinsics TUM documents for its registered 640x480 images."""
+
+MAX_TIME_DIFFERENCE = 0.02
+"""Largest time gap (seconds) between a colour image and the depth image associated with it."""
+
+_COLOR_WORD = re.compile(r"(color|colour|rgb)", re.IGNORECASE)
+_DEPTH_WORD = re.compile(r"depth", re.IGNORECASE)
+
+
+@dataclass(frozen=True)
+class TimedImage:
+    """One line of rgb.txt or depth.txt: a timestamp (seconds) and the image path."""
+
+    timestamp: float
+    path: Path
+
+
+def read_image_list(path: Path) -> list[TimedImage]:
+    """The entries of an rgb.txt / depth.txt file, in time order; FrameError on a malformed line."""
+    if not path.is_file():
+        raise FrameError(f"missing {path}")
+    entries = []
+    for number, line in enumerate(path.read_text(errors="replace").splitlines(), start=1):
+        text = line.strip()
+        if not text or text.startswith("#"):
+            continue
+        fields = text.split()
+        try:
+            timestamp = float(fields[0])
+            entries.append(TimedImage(timestamp, path.parent / fields[1]))
+        except (ValueError, IndexError):
+            raise FrameError(f"{path}:{number}: expected 'timestamp path', got {text!r}") from None
+    return sorted(entries, key=lambda entry: entry.timestamp)
+
+
+def associate(
+    colors: list[TimedImage], depths: list[TimedImage], max_difference: float = MAX_TIME_DIFFERENCE
+) -> list[tuple[TimedImage, TimedImage]]:
+    """Colour/depth pairs: each colour image with a near unused depth image within ``max_difference`` s.
+
+    Each colour image considers the depth images just before and after it in time; the closest pairs are
+    taken first, so the association does not depend on the order of the lists.
+    """
+    depth_times = np.array([d.timestamp for d in depths], dtype=np.float64)
+    candidates = []
+    for i, color in enumerate(colors):
+        after = int(np.searchsorted(depth_times, color.timestamp))
+        for j in (after - 1, after):
+            if 0 <= j < len(depths) and abs(depth_times[j] - color.timestamp) <= max_difference:
+                candidates.append((abs(depth_times[j] - color.timestamp), i, j))
+    used_colors: set[int] = set()
+    used_depths: set[int] = set()
+    pairs = []
+    for _, i, j in sorted(candidates):
+        if i in used_colors or j in used_depths:
+            continue
+        used_colors.add(i)
+        used_depths.add(j)
+        pairs.append((colors[i], depths[j]))
+    return sorted(pairs, key=lambda pair: pair[0].timestamp)
+
+
+def is_tum_sequence(folder: Path) -> bool:
+    """True when ``folder`` holds rgb.txt and depth.txt."""
+    return (folder / "rgb.txt").is_file() and (folder / "depth.txt").is_file()
+
+
+def sequence_intrinsics(folder: Path, intrinsics: CameraIntrinsics | None) -> CameraIntrinsics:
+    """The explicit intrinsics, else those of the folder's camera_params.json, else the PrimeSense default."""
+    if intrinsics is not None:
+        return intrinsics
+    if (folder / CAMERA_PARAMS_FILE).is_file():
+        return read_camera_params(folder / CAMERA_PARAMS_FILE)[0]
+    return PRIMESENSE_INTRINSICS
+
+
+def read_tum_sequence(
+    folder: str | Path,
+    frame: int = 0,
+    depth_scale: float = TUM_DEPTH_SCALE,
+    intrinsics: CameraIntrinsics | None = None,
+) -> Frame:
+    """Decode frame ``frame`` (0-based, in time order) of a TUM sequence folder."""
+    folder = Path(folder)
+    if not folder.is_dir():
+        raise FrameError(f"no such folder {folder}")
+    if frame < 0:
+        raise FrameError(f"frame number must be >= 0, got {frame}")
+    pairs = associate(read_image_list(folder / "rgb.txt"), read_image_list(folder / "depth.txt"))
+    if frame >= len(pairs):
+        raise FrameError(f"{folder} has {len(pairs)} associated colour/depth frames, no frame {frame}")
+    color, depth = pairs[frame]
+    return decode_rgbd(color.path, depth.path, sequence_intrinsics(folder, intrinsics), depth_scale, color.timestamp)
+
+
+def pair_paths(path: str | Path) -> tuple[Path, Path]:
+    """The colour and depth files of a TUM-style pair from either file's path (see the module docstring)."""
+    path = Path(path)
+    name = path.name
+    if _COLOR_WORD.search(name):
+        start, end = list(_COLOR_WORD.finditer(name))[-1].span()
+        return path, path.with_name(name[:start] + "depth" + name[end:])
+    if _DEPTH_WORD.search(name):
+        start, end = list(_DEPTH_WORD.finditer(name))[-1].span()
+        for word in ("color", "rgb", "colour"):
+            candidate = path.with_name(name[:start] + word + name[end:])
+            if candidate.is_file():
+                return candidate, path
+        return path.with_name(name[:start] + "color" + name[end:]), path
+    raise FrameError(f"{path}: a colour/depth pair file name must contain 'color', 'rgb' or 'depth'")
+
+
+def is_tum_pair(path: Path) -> bool:
+    """True when ``path`` is a file of a pair whose other file exists beside it."""
+    if not path.is_file():
+        return False
+    try:
+        color, depth = pair_paths(path)
+    except FrameError:
+        return False
+    return color.is_file() and depth.is_file() and color != depth
+
+
+def read_tum_pair(
+    path: str | Path,
+    depth_scale: float = TUM_DEPTH_SCALE,
+    intrinsics: CameraIntrinsics | None = None,
+) -> Frame:
+    """Decode a TUM-style colour/depth pair (PrimeSense default intrinsics unless given)."""
+    color, depth = pair_paths(path)
+    return decode_rgbd(color, depth, intrinsics or PRIMESENSE_INTRINSICS, depth_scale)

@@ -1,0 +1,367 @@
+"""Answers to perception queries: object designators with provenance, and the tree step that produces them.
+
+An :class:`ObjectDesignator` is what the robot acts on: id, class (IRI and label), pose (position, quaternion
+x-y-z-w, frame), size, region, attributes with confidence (and the alternatives experts also proposed), the
+image ROI when the object was seen in this frame's image, and the experts that contributed. :class:`Answer` is
+a list of them; both turn into JSON-ready dicts.
+
+:class:`AnswerStep` is the last leaf of a perception tree: it fuses the CAS's object hypotheses
+(:mod:`reasoning.fusion.frame`), integrates them into the :class:`~reasoning.beliefs.store.BeliefStore` (identity,
+confidence, history) and keeps the answer to the query on itself (``step.answer``) for the caller.
+"""
+
+from __future__ import annotations
+
+import json
+import re
+import time
+from collections.abc import Callable
+from dataclasses import dataclass, replace
+from pathlib import Path
+from typing import Any, ClassVar
+
+import numpy as np
+
+from reasoning.beliefs.store import BeliefFilter, BeliefStore
+from reasoning.fusion.association import CameraModel
+from reasoning.fusion.frame import WORLD_FRAME, FrameContext, frame_objects
+from reasoning.fusion.rule import CLASS_ATTRIBUTE, ClassTest
+from reasoning.fusion.tracking import BeliefTracker, ObjectBelief, TrackStep
+from robokudo.core.annotator import Annotator
+from robokudo.core.types import (
+    ONTOLOGY_NAMESPACE,
+    CameraInfo,
+    CasType,
+    Classification,
+    ColorHistogram,
+    DepthImage,
+    Location,
+    ObjectHypothesis,
+    PointCloud,
+    Pose,
+    QueryView,
+    SemanticColor,
+    Shape,
+    Size,
+    Text,
+)
+
+
+def class_iri(class_name: str) -> str:
+    """The ontology IRI of a class name (IRIs are kept as they are)."""
+    return class_name if "://" in class_name or class_name.startswith("urn:") else ONTOLOGY_NAMESPACE + class_name
+
+
+def class_label(class_name: str) -> str:
+    """A readable label: the IRI's local name split at case changes, lower case (``lactose free milk``)."""
+    local = re.split(r"[#/]", class_name)[-1]
+    words = re.findall(r"[A-Z]+(?=[A-Z][a-z])|[A-Z]?[a-z]+|[A-Z]+|\d+", local)
+    return " ".join(words).lower() if words else local
+
+
+@dataclass(frozen=True, slots=True)
+class PoseDesignator:
+    """Position (metres) and unit quaternion (x, y, z, w) in ``frame``."""
+
+    position: tuple[float, float, float]
+    orientation: tuple[float, float, float, float]
+    frame: str
+
+
+@dataclass(frozen=True, slots=True)
+class Alternative:
+    """A value some expert proposed, with its fused probability and who proposed it."""
+
+    value: str
+    confidence: float
+    experts: tuple[str, ...]
+
+
+@dataclass(frozen=True, slots=True)
+class AttributeDesignator:
+    """A fused attribute: value, confidence, supporting experts, and every value proposed (conflicts kept)."""
+
+    value: str
+    confidence: float
+    experts: tuple[str, ...]
+    alternatives: tuple[Alternative, ...] = ()
+    conflict: bool = False
+
+
+@dataclass(frozen=True, slots=True)
+class ObjectDesignator:
+    """One object in an answer (see the module docstring); ``roi`` is ``(x0, y0, x1, y1)`` pixels or None."""
+
+    id: int
+    class_iri: str | None
+    class_label: str | None
+    pose: PoseDesignator
+    size: tuple[float, float, float] | None
+    size_class: str | None
+    region: str | None
+    attributes: dict[str, AttributeDesignator]
+    experts: tuple[str, ...]
+    confidence: float
+    roi: tuple[int, int, int, int] | None = None
+    first_seen: float = 0.0
+    last_seen: float = 0.0
+    status: str = "present"
+
+    def to_dict(self) -> dict[str, Any]:
+        """A JSON-ready dict (numbers rounded to 6 decimals)."""
+        return {
+            "id": self.id,
+            "class": {"iri": self.class_iri, "label": self.class_label},
+            "pose": {
+                "position": _rounded(self.pose.position),
+                "orientation": _rounded(self.pose.orientation),
+                "frame": self.pose.frame,
+            },
+            "size": None if self.size is None else {"dimensions": _rounded(self.size), "class": self.size_class},
+            "region": self.region,
+            "attributes": {
+                name: {
+                    "value": a.value,
+                    "confidence": round(a.confidence, 6),
+                    "experts": list(a.experts),
+                    "conflict": a.conflict,
+                    "alternatives": [
+                        {"value": alt.value, "confidence": round(alt.confidence, 6), "experts": list(alt.experts)}
+                        for alt in a.alternatives
+                    ],
+                }
+                for name, a in self.attributes.items()
+            },
+            "roi": None if self.roi is None else list(self.roi),
+            "experts": list(self.experts),
+            "confidence": round(self.confidence, 6),
+            "first_seen": self.first_seen,
+            "last_seen": self.last_seen,
+            "status": self.status,
+        }
+
+
+def _rounded(values: tuple[float, ...]) -> list[float]:
+    return [round(float(v), 6) for v in values]
+
+
+@dataclass(frozen=True, slots=True)
+class Answer:
+    """The answer to one query: the matching objects, best first."""
+
+    query: str
+    objects: tuple[ObjectDesignator, ...] = ()
+    from_memory: bool = False
+
+    def to_dict(self) -> dict[str, Any]:
+        """A JSON-ready dict."""
+        return {
+            "query": self.query,
+            "from_memory": self.from_memory,
+            "objects": [o.to_dict() for o in self.objects],
+        }
+
+    def to_json(self, indent: int | None = 2) -> str:
+        """The answer as JSON text."""
+        return json.dumps(self.to_dict(), indent=indent)
+
+    def summary(self) -> str:
+        """One line per object, for people."""
+        if not self.objects:
+            return "no matching object"
+        lines = []
+        for o in self.objects:
+            p = o.pose.position
+            colour = o.attributes.get("color")
+            lines.append(
+                f"#{o.id} {o.class_label or 'object'}"
+                + (f" ({colour.value})" if colour else "")
+                + f" at ({p[0]:.3f}, {p[1]:.3f}, {p[2]:.3f}) [{o.pose.frame}]"
+                + (f" in {o.region}" if o.region else "")
+                + f", confidence {o.confidence:.2f}, by {', '.join(o.experts) or 'nobody'}"
+            )
+        return "\n".join(lines)
+
+
+def designator(
+    belief: ObjectBelief,
+    *,
+    class_test: ClassTest | None = None,
+    roi: tuple[int, int, int, int] | None = None,
+    iri_of: Callable[[str], str] = class_iri,
+    label_of: Callable[[str], str] = class_label,
+) -> ObjectDesignator:
+    """The designator of a belief; ``roi`` is given when the object was seen in the current image."""
+    attributes: dict[str, AttributeDesignator] = {}
+    for name, fused in belief.fused(class_test).items():
+        attributes[name] = AttributeDesignator(
+            value=fused.value,
+            confidence=fused.confidence,
+            experts=fused.sources,
+            alternatives=tuple(Alternative(s.value, s.confidence, s.sources) for s in fused.support),
+            conflict=fused.conflict,
+        )
+    class_name = belief.class_name or (attributes[CLASS_ATTRIBUTE].value if CLASS_ATTRIBUTE in attributes else None)
+    size_attribute = attributes.get("size")
+    x, y, z = belief.position.tolist()
+    qx, qy, qz, qw = belief.orientation.tolist()
+    return ObjectDesignator(
+        id=belief.id,
+        class_iri=iri_of(class_name) if class_name else None,
+        class_label=label_of(class_name) if class_name else None,
+        pose=PoseDesignator(position=(x, y, z), orientation=(qx, qy, qz, qw), frame=belief.frame),
+        size=None if belief.dimensions is None else tuple(belief.dimensions.tolist()),  # type: ignore[arg-type]
+        size_class=size_attribute.value if size_attribute else None,
+        region=belief.region or None,
+        attributes=attributes,
+        experts=tuple(sorted(belief.sources)),
+        confidence=belief.confidence,
+        roi=roi,
+        first_seen=belief.first_seen,
+        last_seen=belief.last_seen,
+        status=belief.status,
+    )
+
+
+def answer_from_memory(store: BeliefStore, belief_filter: BeliefFilter, query: str = "", **options: Any) -> Answer:
+    """Answer a query from the store alone (no perception): the matching known objects, most confident first."""
+    beliefs = store.query(belief_filter)
+    beliefs.sort(key=lambda b: (-b.confidence, b.id))
+    designators = tuple(designator(b, class_test=belief_filter.class_test, **options) for b in beliefs)
+    return Answer(query=query, objects=designators, from_memory=True)
+
+
+def camera_model(info: CameraInfo, depth: np.ndarray | None = None) -> CameraModel:
+    """The visibility model of a frame: world frame when the camera pose is known, else the camera frame."""
+    k = info.intrinsics
+    known = info.cam_to_world is not None
+    return CameraModel(
+        fx=k.fx,
+        fy=k.fy,
+        cx=k.cx,
+        cy=k.cy,
+        width=k.width,
+        height=k.height,
+        to_frame=np.asarray(info.cam_to_world, dtype=np.float64) if known else np.eye(4),
+        frame=WORLD_FRAME if known else info.frame_id,
+        depth=depth,
+    )
+
+
+StoreSource = BeliefStore | str | Path | Callable[[], BeliefStore] | None
+
+
+class AnswerStep(Annotator):
+    """Fuse this frame's hypotheses into the belief store and answer the query (kept in :attr:`answer`).
+
+    ``store`` is a store, a path, a factory, or None for :meth:`BeliefStore.default_path`; it is opened on the
+    first run. ``tracker`` (class test, regions, gates) defaults to the store's. The query's filter is
+    ``belief_filter``, or ``filter_for(query)`` of the CAS's QueryView, or everything seen. The answer holds
+    the matching objects seen in this frame, most confident first, with their image ROI; ``label_of`` names
+    classes (e.g. the knowledge base's labels). With ``fail_when_empty`` the step fails when nothing matches.
+    ``timestamp`` 0 in CameraInfo means unknown: ``clock()`` is used instead.
+    """
+
+    inputs: ClassVar[tuple[type[CasType], ...]] = (ObjectHypothesis,)
+    optional_inputs: ClassVar[tuple[type[CasType], ...]] = (
+        CameraInfo,
+        PointCloud,
+        DepthImage,
+        QueryView,
+        Pose,
+        Size,
+        SemanticColor,
+        ColorHistogram,
+        Shape,
+        Classification,
+        Text,
+        Location,
+    )
+    outputs: ClassVar[tuple[type[CasType], ...]] = ()
+
+    def __init__(
+        self,
+        store: StoreSource = None,
+        *,
+        tracker: BeliefTracker | None = None,
+        belief_filter: BeliefFilter | None = None,
+        filter_for: Callable[[object], BeliefFilter] | None = None,
+        min_overlap: float = 0.6,
+        fail_when_empty: bool = False,
+        clock: Callable[[], float] = time.time,
+        label_of: Callable[[str], str] = class_label,
+        name: str | None = None,
+    ) -> None:
+        super().__init__(name=name)
+        self._store_source = store
+        self._store: BeliefStore | None = store if isinstance(store, BeliefStore) else None
+        self.tracker = tracker
+        self.belief_filter = belief_filter
+        self.filter_for = filter_for
+        self.min_overlap = min_overlap
+        self.fail_when_empty = fail_when_empty
+        self.clock = clock
+        self.label_of = label_of
+        self.answer: Answer | None = None
+        self.last_step: TrackStep | None = None
+
+    @property
+    def store(self) -> BeliefStore:
+        """The belief store (opened on first use)."""
+        if self._store is None:
+            source = self._store_source
+            if callable(source) and not isinstance(source, BeliefStore):
+                self._store = source()
+            else:
+                self._store = BeliefStore(BeliefStore.default_path() if source is None else source)
+        return self._store
+
+    def shutdown(self) -> None:
+        """Close the store if this step opened it (py_trees calls this when the tree shuts down)."""
+        if self._store is not None and self._store is not self._store_source:
+            self._store.close()
+            self._store = None
+
+    def analyse(self) -> None:
+        """Fuse, integrate, answer."""
+        hypotheses = self.annotations(ObjectHypothesis)
+        info = self.optional_view(CameraInfo)
+        cloud = self.optional_view(PointCloud)
+        depth = self.optional_view(DepthImage)
+        stamp = info.timestamp if info is not None and info.timestamp > 0 else self.clock()
+        context = FrameContext(
+            points=cloud.points if cloud is not None else None,
+            cam_to_world=info.cam_to_world if info is not None else None,
+            camera_frame=info.frame_id if info is not None else "camera",
+            time=stamp,
+        )
+        objects = frame_objects(hypotheses, context, min_overlap=self.min_overlap, read=self.attached)
+        camera = camera_model(info, depth.depth if depth is not None else None) if info is not None else None
+        store = self.store
+        step = store.integrate(objects, stamp, camera=camera, tracker=self.tracker)
+        self.last_step = step
+        belief_filter = self._filter()
+        seen = dict(zip(step.assigned, objects, strict=True))
+        matching = store.query(replace(belief_filter, ids=tuple(seen), limit=None))
+        matching.sort(key=lambda b: (-b.confidence, b.id))
+        if belief_filter.limit is not None:
+            matching = matching[: belief_filter.limit]
+        query_view = self.optional_view(QueryView)
+        text = getattr(query_view.query, "source", "") if query_view is not None else ""
+        self.answer = Answer(
+            query=str(text or ""),
+            objects=tuple(
+                designator(b, class_test=belief_filter.class_test, roi=seen[b.id].roi, label_of=self.label_of)
+                for b in matching
+            ),
+        )
+        if self.fail_when_empty and not matching:
+            self.fail(f"no object matches the query among {len(objects)} seen")
+
+    def _filter(self) -> BeliefFilter:
+        if self.belief_filter is not None:
+            return self.belief_filter
+        query_view = self.optional_view(QueryView)
+        if self.filter_for is not None and query_view is not None:
+            return self.filter_for(query_view.query)
+        return BeliefFilter(class_test=(self.tracker or self.store.tracker).class_test)

@@ -1,0 +1,808 @@
+"""The persistent belief store: one SQLite file holding object beliefs and their observation history.
+
+* Embedded, one file, WAL journal: readers (other connections, other processes) read a consistent snapshot
+  while the engine writes; every write is one ``BEGIN IMMEDIATE`` ... ``COMMIT`` transaction.
+* ``synchronous=NORMAL`` by default: with WAL, a committed transaction survives a crash of the process
+  (SIGKILL) and the file never corrupts; only a power loss or OS crash may lose the last commits. Pass
+  ``synchronous="FULL"`` to also survive power loss, at the cost of an fsync per commit.
+* A file that is not a valid belief store is never modified: opening it raises :class:`BeliefStoreError`
+  naming the file and how to move it aside.
+
+Tables: ``objects`` (one row per belief: class, pose, size, region, existence, first/last seen, experts and
+the support of every attribute value as JSON), ``objects_place`` (R*Tree over positions), ``attribute_index``
+(the attribute values each belief holds more likely than not, for queries), ``observations`` (every sighting
+with the experts' statements, bounded per object), ``classes`` and ``meta``.
+"""
+
+from __future__ import annotations
+
+import json
+import math
+import operator
+import shlex
+import sqlite3
+import threading
+from collections.abc import Callable, Iterator, Mapping, Sequence
+from contextlib import contextmanager
+from dataclasses import dataclass, field
+from pathlib import Path
+
+import numpy as np
+
+from reasoning.fusion.association import CameraModel, in_view
+from reasoning.fusion.frame import WORLD_FRAME, FrameObject
+from reasoning.fusion.rule import CLASS_ATTRIBUTE, AttributeBelief, ClassTest, ValueSupport, fuse_values, sigmoid
+from reasoning.fusion.tracking import PRESENT, BeliefTracker, ObjectBelief, RegionLike, TrackStep, in_box
+
+SCHEMA_NAME = "robokudo-beliefs"
+SCHEMA_VERSION = 1
+SQLITE_HEADER = b"SQLite format 3\x00"
+SYNCHRONOUS_MODES = ("OFF", "NORMAL", "FULL", "EXTRA")
+_CORRUPT_ERRORS = {"SQLITE_CORRUPT", "SQLITE_NOTADB"}
+RTREE_SLACK = 0.05
+"""Half-width (metres) of a belief's R*Tree entry around its position."""
+WAL_AUTOCHECKPOINT_PAGES = 4000
+"""Checkpoint the WAL into the file every ~16 MB (fewer fsyncs than SQLite's default of 1000 pages)."""
+
+
+class BeliefStoreError(Exception):
+    """The store file cannot be used (corrupt, not a belief store, newer schema, ...)."""
+
+
+@dataclass(frozen=True)
+class BeliefFilter:
+    """Which beliefs a query asks for; every given part must hold.
+
+    ``class_test(a, b)`` tells whether class ``a`` is ``b`` or a subclass of it (default: equal names, case
+    ignored). A belief is in ``region`` when its stored region has that name (case ignored) or when its world
+    position lies in one of ``region_boxes``. ``attributes`` (e.g. ``{"color": "red"}``, case ignored) match the
+    fused value or any value more likely than not. ``ids`` restricts the answer to those beliefs.
+    """
+
+    object_class: str | None = None
+    class_test: ClassTest | None = None
+    region: str | None = None
+    region_boxes: tuple[RegionLike, ...] = ()
+    attributes: Mapping[str, str] = field(default_factory=dict)
+    include_gone: bool = False
+    min_confidence: float = 0.0
+    limit: int | None = None
+    ids: tuple[int, ...] | None = None
+
+
+@dataclass(frozen=True, slots=True)
+class ObservationRecord:
+    """One sighting of an object: when, where, the image box, and every statement the experts made."""
+
+    object_id: int
+    time: float
+    frame: str
+    position: tuple[float, float, float]
+    roi: tuple[int, int, int, int] | None
+    sources: tuple[str, ...]
+    evidence: tuple[tuple[str, str, float, str], ...]
+
+
+def _corrupt_message(path: Path, detail: str) -> str:
+    quoted = shlex.quote(str(path))
+    aside = shlex.quote(f"{path}.corrupt")
+    return (
+        f"belief store {path} is not usable: {detail}. The file was left untouched. "
+        f"Move it aside to start a new store (the old one stays available for inspection): mv {quoted} {aside}"
+    )
+
+
+_OBJECT_COLUMNS = (
+    "id, class_name, frame, px, py, pz, qx, qy, qz, qw, sx, sy, sz, position_variance, appearance, existence, "
+    "status, first_seen, last_seen, misses, observations, region, region_class, roi, sources, attributes, indexed"
+)
+
+_SCHEMA = (
+    "CREATE TABLE IF NOT EXISTS meta (key TEXT PRIMARY KEY, value TEXT NOT NULL) WITHOUT ROWID",
+    """CREATE TABLE IF NOT EXISTS objects (
+        id INTEGER PRIMARY KEY,
+        class_name TEXT,
+        frame TEXT NOT NULL,
+        px REAL NOT NULL, py REAL NOT NULL, pz REAL NOT NULL,
+        qx REAL NOT NULL, qy REAL NOT NULL, qz REAL NOT NULL, qw REAL NOT NULL,
+        sx REAL, sy REAL, sz REAL,
+        position_variance REAL NOT NULL,
+        appearance BLOB,
+        existence REAL NOT NULL,
+        status TEXT NOT NULL,
+        first_seen REAL NOT NULL,
+        last_seen REAL NOT NULL,
+        misses INTEGER NOT NULL,
+        observations INTEGER NOT NULL,
+        region TEXT NOT NULL,
+        region_class TEXT NOT NULL,
+        roi TEXT,
+        sources TEXT NOT NULL,
+        attributes TEXT NOT NULL,
+        indexed TEXT NOT NULL
+    )""",
+    "CREATE INDEX IF NOT EXISTS objects_class ON objects (class_name, region COLLATE NOCASE)",
+    "CREATE INDEX IF NOT EXISTS objects_region ON objects (region COLLATE NOCASE)",
+    "CREATE INDEX IF NOT EXISTS objects_missed ON objects (last_seen) WHERE misses > 0 AND status = 'present'",
+    "CREATE VIRTUAL TABLE IF NOT EXISTS objects_place USING rtree (id, x0, x1, y0, y1, z0, z1)",
+    """CREATE TABLE IF NOT EXISTS attribute_index (
+        name TEXT NOT NULL,
+        value TEXT NOT NULL COLLATE NOCASE,
+        object_id INTEGER NOT NULL,
+        PRIMARY KEY (name, value, object_id)
+    ) WITHOUT ROWID""",
+    """CREATE TABLE IF NOT EXISTS observations (
+        object_id INTEGER NOT NULL,
+        seq INTEGER NOT NULL,
+        time REAL NOT NULL,
+        frame TEXT NOT NULL,
+        px REAL NOT NULL, py REAL NOT NULL, pz REAL NOT NULL,
+        roi TEXT,
+        sources TEXT NOT NULL,
+        evidence TEXT NOT NULL
+    )""",
+    "CREATE UNIQUE INDEX IF NOT EXISTS observations_object ON observations (object_id, seq)",
+    "CREATE INDEX IF NOT EXISTS attribute_index_object ON attribute_index (object_id)",
+    "CREATE TABLE IF NOT EXISTS classes (name TEXT PRIMARY KEY) WITHOUT ROWID",
+)
+
+
+_TABLES = {"meta", "objects", "objects_place", "attribute_index", "observations", "classes"}
+
+
+@dataclass(frozen=True, slots=True)
+class _Loaded:
+    """What a belief looked like in the store when loaded: its R*Tree entry centre and its indexed columns."""
+
+    place: tuple[float, float, float]
+    class_name: str | None
+    region: str
+    region_class: str
+    indexed: str
+
+
+class BeliefStore:
+    """Object beliefs persisted in one SQLite file (see the module docstring).
+
+    One instance holds one connection and may be shared between threads; open another instance (in this or
+    another process) for concurrent reading.
+    """
+
+    def __init__(
+        self,
+        path: str | Path,
+        *,
+        tracker: BeliefTracker | None = None,
+        synchronous: str = "NORMAL",
+        busy_timeout: float = 10.0,
+        check: bool = True,
+        history_limit: int = 100,
+    ) -> None:
+        self.path = Path(path).expanduser()
+        if synchronous.upper() not in SYNCHRONOUS_MODES:
+            raise ValueError(f"synchronous must be one of {', '.join(SYNCHRONOUS_MODES)}, not {synchronous!r}")
+        self.tracker = tracker or BeliefTracker()
+        self.history_limit = history_limit
+        self._lock = threading.RLock()
+        self._conn = self._open(synchronous.upper(), busy_timeout, check)
+
+    # ------------------------------------------------------------------ opening
+
+    def _open(self, synchronous: str, busy_timeout: float, check: bool) -> sqlite3.Connection:
+        path = self.path
+        if path.is_dir():
+            raise BeliefStoreError(f"belief store {path} is a directory, not a file")
+        existed = path.exists() and path.stat().st_size > 0
+        if existed:
+            with path.open("rb") as handle:
+                header = handle.read(len(SQLITE_HEADER))
+            if header != SQLITE_HEADER:
+                raise BeliefStoreError(_corrupt_message(path, "it is not an SQLite database"))
+        else:
+            path.parent.mkdir(parents=True, exist_ok=True)
+        conn = sqlite3.connect(path, timeout=busy_timeout, isolation_level=None, check_same_thread=False)
+        try:
+            conn.execute(f"PRAGMA busy_timeout = {int(busy_timeout * 1000)}")
+            if existed and check:
+                rows = conn.execute("PRAGMA quick_check(20)").fetchall()
+                result = [line for row in rows for line in row[0].splitlines() if not line.startswith("***")]
+                if result != ["ok"]:
+                    detail = f"integrity check failed: {result[0]!r}" + (
+                        f" and {len(result) - 1} more problem(s)" if len(result) > 1 else ""
+                    )
+                    raise BeliefStoreError(_corrupt_message(path, detail))
+            ready = self._check_schema(conn) if existed else False
+            mode = conn.execute("PRAGMA journal_mode = WAL").fetchone()[0]
+            if str(mode).lower() != "wal":
+                raise BeliefStoreError(f"belief store {path}: cannot use WAL journal mode (got {mode})")
+            conn.execute(f"PRAGMA synchronous = {synchronous}")
+            conn.execute(f"PRAGMA wal_autocheckpoint = {WAL_AUTOCHECKPOINT_PAGES}")
+            if not ready:  # a store in use is opened without writing, so readers never wait for the writer
+                conn.execute("BEGIN IMMEDIATE")
+                for statement in _SCHEMA:
+                    conn.execute(statement)
+                conn.execute("INSERT OR IGNORE INTO meta VALUES ('schema', ?)", (SCHEMA_NAME,))
+                conn.execute("INSERT OR IGNORE INTO meta VALUES ('version', ?)", (str(SCHEMA_VERSION),))
+                conn.execute("INSERT OR IGNORE INTO meta VALUES ('next_id', '1')")
+                conn.execute("COMMIT")
+        except BeliefStoreError:
+            conn.close()
+            raise
+        except sqlite3.DatabaseError as error:
+            conn.close()
+            if getattr(error, "sqlite_errorname", "") in _CORRUPT_ERRORS or not isinstance(
+                error, sqlite3.OperationalError
+            ):
+                raise BeliefStoreError(_corrupt_message(path, str(error))) from error
+            raise BeliefStoreError(f"belief store {path}: {error}") from error
+        return conn
+
+    def _check_schema(self, conn: sqlite3.Connection) -> bool:
+        """True when the file holds a complete belief store of this version; raises when it holds another thing."""
+        tables = {row[0] for row in conn.execute("SELECT name FROM sqlite_master WHERE type = 'table'")}
+        if not tables:
+            return False
+        meta = dict(conn.execute("SELECT key, value FROM meta").fetchall()) if "meta" in tables else {}
+        if meta.get("schema") != SCHEMA_NAME:
+            raise BeliefStoreError(_corrupt_message(self.path, "it is an SQLite database but not a belief store"))
+        version = int(meta.get("version", "0"))
+        if version > SCHEMA_VERSION:
+            raise BeliefStoreError(
+                f"belief store {self.path} has schema version {version}, newer than this robokudo "
+                f"({SCHEMA_VERSION}); upgrade robokudo or use another store path"
+            )
+        return version == SCHEMA_VERSION and "next_id" in meta and tables >= _TABLES
+
+    @staticmethod
+    def default_path() -> Path:
+        """``$ROBOKUDO_BELIEF_STORE`` or ``<user data dir>/robokudo/beliefs.sqlite``."""
+        import os
+
+        override = os.environ.get("ROBOKUDO_BELIEF_STORE")
+        if override:
+            return Path(override).expanduser()
+        import platformdirs
+
+        return Path(platformdirs.user_data_dir("robokudo")) / "beliefs.sqlite"
+
+    def close(self) -> None:
+        """Close the connection (idempotent)."""
+        with self._lock:
+            self._conn.close()
+
+    def __enter__(self) -> BeliefStore:
+        return self
+
+    def __exit__(self, *_: object) -> None:
+        self.close()
+
+    # ------------------------------------------------------------------ transactions
+
+    @contextmanager
+    def _guard(self) -> Iterator[sqlite3.Connection]:
+        """Hold the lock and turn corruption found while running into a BeliefStoreError."""
+        with self._lock:
+            try:
+                yield self._conn
+            except sqlite3.DatabaseError as error:
+                if getattr(error, "sqlite_errorname", "") in _CORRUPT_ERRORS:
+                    raise BeliefStoreError(_corrupt_message(self.path, str(error))) from error
+                raise
+
+    @contextmanager
+    def _transaction(self) -> Iterator[sqlite3.Connection]:
+        with self._guard() as conn:
+            conn.execute("BEGIN IMMEDIATE")
+            try:
+                yield conn
+            except BaseException:
+                conn.execute("ROLLBACK")
+                raise
+            conn.execute("COMMIT")
+
+    # ------------------------------------------------------------------ writing
+
+    def integrate(
+        self,
+        objects: Sequence[FrameObject],
+        time: float,
+        *,
+        camera: CameraModel | None = None,
+        tracker: BeliefTracker | None = None,
+    ) -> TrackStep:
+        """Fuse one frame's objects into the store in one transaction and record the observations.
+
+        Beliefs near the observations (and, with ``camera``, in front of it) are loaded, associated and
+        updated by the tracker; new objects get new ids; the changes and the sightings are written. Beliefs
+        missed earlier and not seen for the tracker's ``gone_after`` seconds are marked gone, wherever they are.
+        """
+        tracker = tracker or self.tracker
+        with self._transaction() as conn:
+            beliefs, loaded = self._candidates(conn, objects, camera, tracker.config.association.gate_distance)
+            next_id = int(conn.execute("SELECT value FROM meta WHERE key = 'next_id'").fetchone()[0])
+            allocated = [next_id]
+
+            def new_id() -> int:
+                value = allocated[0]
+                allocated[0] += 1
+                return value
+
+            step = tracker.step(beliefs, objects, time, new_id, camera)
+            self._write_beliefs(conn, step.changed, tracker.class_test, loaded)
+            counts = {b.id: b.observations for b in step.changed}
+            self._write_observations(conn, objects, [(i, counts[i]) for i in step.assigned], time)
+            if allocated[0] != next_id:
+                conn.execute("UPDATE meta SET value = ? WHERE key = 'next_id'", (str(allocated[0]),))
+            seen = set(step.assigned)
+            self._prune_history(conn, [b for b in step.changed if b.id in seen])
+            # beliefs missed earlier and not seen since, wherever they are, are gone after gone_after seconds
+            conn.execute(
+                "UPDATE objects SET status = 'gone' WHERE misses > 0 AND status = 'present' AND last_seen <= ?",
+                (time - tracker.config.gone_after,),
+            )
+        return step
+
+    def put(self, beliefs: Sequence[ObjectBelief], class_test: ClassTest | None = None) -> None:
+        """Write beliefs as they are (insert or replace, attributes included) in one transaction."""
+        with self._transaction() as conn:
+            self._write_beliefs(conn, beliefs, class_test)
+            top = max((b.id for b in beliefs), default=0) + 1
+            conn.execute(
+                "UPDATE meta SET value = CAST(MAX(CAST(value AS INTEGER), ?) AS TEXT) WHERE key = 'next_id'", (top,)
+            )
+
+    def allocate_ids(self, count: int) -> list[int]:
+        """Reserve ``count`` fresh object ids (ids are never reused, not even after :meth:`clear`)."""
+        with self._transaction() as conn:
+            first = int(conn.execute("SELECT value FROM meta WHERE key = 'next_id'").fetchone()[0])
+            conn.execute("UPDATE meta SET value = ? WHERE key = 'next_id'", (str(first + count),))
+        return list(range(first, first + count))
+
+    def clear(self) -> int:
+        """Forget every belief and its history; returns how many beliefs there were."""
+        with self._transaction() as conn:
+            count = int(conn.execute("SELECT COUNT(*) FROM objects").fetchone()[0])
+            for table in ("objects", "objects_place", "attribute_index", "observations", "classes"):
+                conn.execute(f"DELETE FROM {table}")
+        return count
+
+    def _candidates(
+        self,
+        conn: sqlite3.Connection,
+        objects: Sequence[FrameObject],
+        camera: CameraModel | None,
+        gate: float,
+    ) -> tuple[list[ObjectBelief], dict[int, _Loaded]]:
+        """Present beliefs within ``gate`` of an observation or in view of ``camera`` (R*Tree look-ups).
+
+        Also returns how each one was stored, so unchanged R*Tree entries and index columns are not rewritten.
+        """
+        columns = ", ".join(f"o.{c.strip()}" for c in _OBJECT_COLUMNS.split(","))
+        query = (
+            f"SELECT {columns}, r.x0, r.x1, r.y0, r.y1, r.z0, r.z1 FROM objects_place r JOIN objects o ON o.id = r.id "
+            "WHERE r.x0 <= ? AND r.x1 >= ? AND r.y0 <= ? AND r.y1 >= ? AND r.z0 <= ? AND r.z1 >= ? "
+            "AND o.frame = ? AND o.status = ?"
+        )
+        rows: dict[int, tuple] = {}
+        for item in objects:
+            x, y, z = (float(v) for v in item.position)
+            parameters = (x + gate, x - gate, y + gate, y - gate, z + gate, z - gate, item.frame, PRESENT)
+            for row in conn.execute(query, parameters):
+                if row[0] not in rows and _distance(row, item.position) <= gate:
+                    rows[row[0]] = row
+        if camera is not None:
+            low, high = _frustum_bounds(camera)
+            parameters = (high[0], low[0], high[1], low[1], high[2], low[2], camera.frame, PRESENT)
+            in_frustum = [row for row in conn.execute(query, parameters) if row[0] not in rows]
+            if in_frustum:
+                positions = np.array([(row[3], row[4], row[5]) for row in in_frustum], dtype=np.float64)
+                for row, seen in zip(in_frustum, in_view(positions, camera), strict=True):
+                    if seen:
+                        rows[row[0]] = row
+        n = _COLUMN_COUNT
+        loaded = {
+            i: _Loaded(((r[n] + r[n + 1]) / 2, (r[n + 2] + r[n + 3]) / 2, (r[n + 4] + r[n + 5]) / 2), *_labels(r))
+            for i, r in rows.items()
+        }
+        return [_belief_from_row(row) for row in rows.values()], loaded
+
+    def _write_beliefs(
+        self,
+        conn: sqlite3.Connection,
+        beliefs: Sequence[ObjectBelief],
+        class_test: ClassTest | None,
+        loaded: Mapping[int, _Loaded] | None = None,
+    ) -> None:
+        """Write object rows, their R*Tree entries and attribute-index entries.
+
+        Beliefs in ``loaded`` are updated in place; their indexed columns and index entries are touched only
+        when they changed. The R*Tree entry of a belief is a box of half-width ``RTREE_SLACK`` around a recent
+        position; it is rewritten only when the belief has moved more than half of that from the entry's centre,
+        so the true position always lies inside the entry and look-ups by position miss nothing.
+        """
+        if not beliefs:
+            return
+        loaded = loaded or {}
+        cache: dict[frozenset[str], str] = {}
+        rows = {b.id: _object_row(b, class_test, cache) for b in beliefs}
+        fresh = [rows[b.id] for b in beliefs if b.id not in loaded]
+        if fresh:
+            conn.executemany("DELETE FROM attribute_index WHERE object_id = ?", [(row[0],) for row in fresh])
+            conn.executemany(f"INSERT OR REPLACE INTO objects ({_OBJECT_COLUMNS}) VALUES ({_PLACEHOLDERS})", fresh)
+        known = [b for b in beliefs if b.id in loaded]
+        if known:
+            conn.executemany(_UPDATE_VOLATILE, [_volatile(rows[b.id]) for b in known])
+            relabelled = [(*_labels(rows[b.id]), b.id) for b in known if _labels(rows[b.id]) != _state(loaded[b.id])]
+            if relabelled:
+                conn.executemany(
+                    "UPDATE objects SET class_name = ?, region = ?, region_class = ?, indexed = ? WHERE id = ?",
+                    relabelled,
+                )
+        added: list[tuple[str, str, int]] = []
+        removed: list[tuple[str, str, int]] = []
+        for b in beliefs:
+            new = _index_entries(rows[b.id][_INDEXED])
+            old = _index_entries(loaded[b.id].indexed) if b.id in loaded else set()
+            added.extend((name, value, b.id) for name, value in new - old)
+            removed.extend((name, value, b.id) for name, value in old - new)
+        if removed:
+            conn.executemany("DELETE FROM attribute_index WHERE name = ? AND value = ? AND object_id = ?", removed)
+        if added:
+            conn.executemany("INSERT OR IGNORE INTO attribute_index VALUES (?, ?, ?)", added)
+        moved = []
+        for b in beliefs:
+            x, y, z = (float(v) for v in b.position)
+            state = loaded.get(b.id)
+            centre = state.place if state is not None else None
+            if centre is None or max(abs(x - centre[0]), abs(y - centre[1]), abs(z - centre[2])) > RTREE_SLACK / 2:
+                r = RTREE_SLACK
+                moved.append((b.id, x - r, x + r, y - r, y + r, z - r, z + r))
+        if moved:
+            conn.executemany("INSERT OR REPLACE INTO objects_place VALUES (?, ?, ?, ?, ?, ?, ?)", moved)
+        classes = {(b.class_name,) for b in beliefs if b.class_name and b.class_name != _loaded_class(loaded, b.id)}
+        if classes:
+            conn.executemany("INSERT OR IGNORE INTO classes VALUES (?)", classes)
+
+    def _write_observations(
+        self,
+        conn: sqlite3.Connection,
+        objects: Sequence[FrameObject],
+        assigned: Sequence[tuple[int, int]],
+        time: float,
+    ) -> None:
+        """Record each object's sighting under (belief id, its sighting number)."""
+        rows = [
+            (
+                object_id,
+                seq,
+                time,
+                item.frame,
+                float(item.position[0]),
+                float(item.position[1]),
+                float(item.position[2]),
+                _roi_text(item.roi),
+                json.dumps(sorted(item.sources)),
+                json.dumps([[e.attribute, e.value, round(e.confidence, 6), e.source] for e in item.evidence]),
+            )
+            for item, (object_id, seq) in zip(objects, assigned, strict=True)
+        ]
+        if rows:
+            conn.executemany("INSERT OR REPLACE INTO observations VALUES (?, ?, ?, ?, ?, ?, ?, ?, ?, ?)", rows)
+
+    def _prune_history(self, conn: sqlite3.Connection, beliefs: Sequence[ObjectBelief]) -> None:
+        limit = self.history_limit
+        due = [(b.id, b.observations - limit) for b in beliefs if b.observations > limit and b.observations % 16 == 0]
+        if due:
+            conn.executemany("DELETE FROM observations WHERE object_id = ? AND seq <= ?", due)
+
+    # ------------------------------------------------------------------ reading
+
+    def get(self, object_id: int) -> ObjectBelief | None:
+        """One belief by id (gone or not), or None."""
+        with self._guard() as conn:
+            rows = conn.execute(f"SELECT {_OBJECT_COLUMNS} FROM objects WHERE id = ?", (object_id,)).fetchall()
+            found = [_belief_from_row(row) for row in rows]
+        return found[0] if found else None
+
+    def beliefs(self, include_gone: bool = False) -> list[ObjectBelief]:
+        """All beliefs (present ones unless ``include_gone``), by id."""
+        return self.query(BeliefFilter(include_gone=include_gone))
+
+    def count(self, include_gone: bool = True) -> int:
+        """How many beliefs are stored."""
+        with self._guard() as conn:
+            if include_gone:
+                return int(conn.execute("SELECT COUNT(*) FROM objects").fetchone()[0])
+            return int(conn.execute("SELECT COUNT(*) FROM objects WHERE status = ?", (PRESENT,)).fetchone()[0])
+
+    def query(self, belief_filter: BeliefFilter) -> list[ObjectBelief]:
+        """The beliefs matching ``belief_filter`` (class subsumption, region, attributes), by id."""
+        clauses: list[str] = []
+        parameters: list[object] = []
+        f = belief_filter
+        with self._guard() as conn:
+            if not f.include_gone:
+                clauses.append("status = ?")
+                parameters.append(PRESENT)
+            if f.ids is not None:
+                if not f.ids:
+                    return []
+                clauses.append(f"id IN ({', '.join('?' * len(f.ids))})")
+                parameters.extend(f.ids)
+            if f.object_class:
+                classes = self._matching_classes(conn, f.object_class, f.class_test)
+                if not classes:
+                    return []
+                clauses.append(f"class_name IN ({', '.join('?' * len(classes))})")
+                parameters.extend(classes)
+            for name, value in f.attributes.items():
+                # with a class filter, check each candidate; without one, start from the attribute's objects
+                clauses.append(
+                    "EXISTS (SELECT 1 FROM attribute_index a WHERE a.name = ? AND a.value = ? AND a.object_id = id)"
+                    if f.object_class
+                    else "id IN (SELECT object_id FROM attribute_index WHERE name = ? AND value = ?)"
+                )
+                parameters.extend([name, value])
+            # one SELECT per way of being in the region (by stored name, or inside a box), united
+            branches: list[tuple[list[str], list[object]]] = [([], [])]
+            if f.region:
+                names = [f.region, *(box.name for box in f.region_boxes)]
+                branches = [([f"region COLLATE NOCASE IN ({', '.join('?' * len(names))})"], list(names))]
+                for box in f.region_boxes:
+                    low, high = _box_bounds(box.pose, box.size)
+                    branches.append(
+                        (
+                            [
+                                "id IN (SELECT id FROM objects_place "
+                                "WHERE x0 <= ? AND x1 >= ? AND y0 <= ? AND y1 >= ? AND z0 <= ? AND z1 >= ?)"
+                            ],
+                            [high[0], low[0], high[1], low[1], high[2], low[2]],
+                        )
+                    )
+            selects, values = [], []
+            for extra, extra_parameters in branches:
+                where = " AND ".join(clauses + extra)
+                selects.append(f"SELECT {_OBJECT_COLUMNS} FROM objects" + (f" WHERE {where}" if where else ""))
+                values.extend(parameters + extra_parameters)
+            rows = conn.execute(" UNION ".join(selects) + " ORDER BY id", values).fetchall()
+            if f.region and f.region_boxes:
+                rows = [row for row in rows if _in_named_region(row, f)]
+            if f.min_confidence > 0:
+                rows = [row for row in rows if sigmoid(row[15]) >= f.min_confidence]
+            if f.limit is not None:
+                rows = rows[: f.limit]
+            return [_belief_from_row(row) for row in rows]
+
+    def history(self, object_id: int, limit: int | None = None) -> list[ObservationRecord]:
+        """The recorded sightings of one object, oldest first (the newest ``limit`` when given)."""
+        with self._guard() as conn:
+            rows = conn.execute(
+                "SELECT object_id, time, frame, px, py, pz, roi, sources, evidence FROM observations "
+                "WHERE object_id = ? ORDER BY seq DESC LIMIT ?",
+                (object_id, -1 if limit is None else limit),
+            ).fetchall()
+        records = [
+            ObservationRecord(
+                object_id=row[0],
+                time=row[1],
+                frame=row[2],
+                position=(row[3], row[4], row[5]),
+                roi=_roi_from_text(row[6]),
+                sources=tuple(json.loads(row[7])),
+                evidence=tuple((e[0], e[1], float(e[2]), e[3]) for e in json.loads(row[8])),
+            )
+            for row in rows
+        ]
+        records.reverse()
+        return records
+
+    def integrity_check(self) -> str:
+        """SQLite's ``PRAGMA integrity_check`` result (``"ok"`` when sound)."""
+        with self._guard() as conn:
+            return "; ".join(row[0] for row in conn.execute("PRAGMA integrity_check"))
+
+    def _matching_classes(self, conn: sqlite3.Connection, wanted: str, class_test: ClassTest | None) -> list[str]:
+        known = [row[0] for row in conn.execute("SELECT name FROM classes")]
+        canonical = next((name for name in known if name.lower() == wanted.lower()), wanted)
+        test: Callable[[str, str], bool] = class_test or (lambda a, b: a.lower() == b.lower())
+        return [name for name in known if name == canonical or test(name, canonical)]
+
+
+# ---------------------------------------------------------------------------------------- row mapping
+
+
+def _roi_text(roi: tuple[int, int, int, int] | None) -> str | None:
+    return None if roi is None else ",".join(str(int(v)) for v in roi)
+
+
+def _roi_from_text(text: str | None) -> tuple[int, int, int, int] | None:
+    if not text:
+        return None
+    x0, y0, x1, y1 = (int(v) for v in text.split(","))
+    return x0, y0, x1, y1
+
+
+def _object_row(b: ObjectBelief, class_test: ClassTest | None, sources: dict[frozenset[str], str]) -> tuple:
+    """The ``objects`` row of a belief (columns as in ``_OBJECT_COLUMNS``); ``sources`` caches encodings."""
+    dims = b.dimensions if b.dimensions is not None else (None, None, None)
+    appearance = None if b.appearance is None else np.asarray(b.appearance, dtype=np.float32).tobytes()
+    encoded, indexed = _encode_attributes(b.attributes, class_test)
+    return (
+        b.id,
+        b.class_name,
+        b.frame,
+        float(b.position[0]),
+        float(b.position[1]),
+        float(b.position[2]),
+        float(b.orientation[0]),
+        float(b.orientation[1]),
+        float(b.orientation[2]),
+        float(b.orientation[3]),
+        None if dims[0] is None else float(dims[0]),
+        None if dims[1] is None else float(dims[1]),
+        None if dims[2] is None else float(dims[2]),
+        float(b.position_variance),
+        appearance,
+        float(b.existence),
+        b.status,
+        float(b.first_seen),
+        float(b.last_seen),
+        int(b.misses),
+        int(b.observations),
+        b.region,
+        b.region_class,
+        _roi_text(b.roi),
+        _encoded_sources(b.sources, sources),
+        encoded,
+        indexed,
+    )
+
+
+_COLUMN_COUNT = len(_OBJECT_COLUMNS.split(","))
+_INDEXED = _COLUMN_COUNT - 1
+_LABEL_COLUMNS = (1, 21, 22, _INDEXED)
+_VOLATILE_INDEXES = (*(i for i in range(1, _COLUMN_COUNT) if i not in _LABEL_COLUMNS), 0)
+_VOLATILE_COLUMNS = tuple(_OBJECT_COLUMNS.split(",")[i].strip() for i in _VOLATILE_INDEXES[:-1])
+_UPDATE_VOLATILE = f"UPDATE objects SET {', '.join(c + ' = ?' for c in _VOLATILE_COLUMNS)} WHERE id = ?"
+_PLACEHOLDERS = ", ".join("?" * _COLUMN_COUNT)
+_INDEX_SEPARATOR = "\x1f"
+
+_volatile = operator.itemgetter(*_VOLATILE_INDEXES)
+"""The values of ``_VOLATILE_COLUMNS`` of an object row, then its id."""
+
+_labels = operator.itemgetter(*_LABEL_COLUMNS)
+"""The indexed columns of an object row: class, region, region class, attribute-index entries."""
+
+
+def _state(loaded: _Loaded) -> tuple:
+    return loaded.class_name, loaded.region, loaded.region_class, loaded.indexed
+
+
+def _loaded_class(loaded: Mapping[int, _Loaded], belief_id: int) -> str | None:
+    state = loaded.get(belief_id)
+    return state.class_name if state is not None else None
+
+
+def _encoded_sources(experts: set[str], cache: dict[frozenset[str], str]) -> str:
+    key = frozenset(experts)
+    found = cache.get(key)
+    if found is None:
+        found = cache[key] = json.dumps(sorted(key))
+    return found
+
+
+def _encode_attributes(attributes: Mapping[str, AttributeBelief], class_test: ClassTest | None) -> tuple[str, str]:
+    """JSON of every value's support, and the attribute-index entries (values more likely than not, or fused)."""
+    encoded: dict[str, dict[str, list]] = {}
+    entries: list[str] = []
+    for name, attribute in attributes.items():
+        if not attribute.values:
+            continue
+        encoded[name] = {
+            value: [round(s.log_odds, 9), s.count, sorted(s.sources), s.first_seen, s.last_seen]
+            for value, s in attribute.values.items()
+        }
+        if len(attribute.values) == 1:
+            entries.append(f"{name}={next(iter(attribute.values))}")
+            continue
+        fused = fuse_values(name, attribute.values, class_test if name == CLASS_ATTRIBUTE else None)
+        entries.extend(f"{name}={s.value}" for s in fused.support if s.value == fused.value or s.confidence > 0.5)
+    return json.dumps(encoded, separators=(",", ":")), _INDEX_SEPARATOR.join(sorted(entries))
+
+
+def _index_entries(indexed: str) -> set[tuple[str, str]]:
+    if not indexed:
+        return set()
+    return {(name, value) for name, _, value in (entry.partition("=") for entry in indexed.split(_INDEX_SEPARATOR))}
+
+
+def _decode_attributes(text: str) -> dict[str, AttributeBelief]:
+    return {
+        name: AttributeBelief(
+            name, {value: ValueSupport(s[0], s[1], set(s[2]), s[3], s[4]) for value, s in values.items()}
+        )
+        for name, values in json.loads(text).items()
+    }
+
+
+def _belief_from_row(row: tuple) -> ObjectBelief:
+    """The belief of an ``objects`` row (extra trailing columns are ignored)."""
+    (
+        object_id,
+        class_name,
+        frame,
+        px,
+        py,
+        pz,
+        qx,
+        qy,
+        qz,
+        qw,
+        sx,
+        sy,
+        sz,
+        variance,
+        appearance,
+        existence,
+        status,
+        first_seen,
+        last_seen,
+        misses,
+        observations,
+        region,
+        region_class,
+        roi,
+        sources,
+        attributes,
+        _indexed,
+    ) = row[:_COLUMN_COUNT]
+    return ObjectBelief(
+        id=object_id,
+        frame=frame,
+        position=np.array([px, py, pz]),
+        orientation=np.array([qx, qy, qz, qw]),
+        dimensions=None if sx is None else np.array([sx, sy, sz]),
+        appearance=None if appearance is None else np.frombuffer(appearance, dtype=np.float32).astype(np.float64),
+        attributes=_decode_attributes(attributes),
+        position_variance=variance,
+        existence=existence,
+        status=status,
+        first_seen=first_seen,
+        last_seen=last_seen,
+        misses=misses,
+        region=region,
+        region_class=region_class,
+        roi=_roi_from_text(roi),
+        sources=set(json.loads(sources)),
+        observations=observations,
+        class_name=class_name,
+    )
+
+
+def _distance(row: tuple, position: np.ndarray) -> float:
+    return math.dist((row[3], row[4], row[5]), (float(position[0]), float(position[1]), float(position[2])))
+
+
+def _box_bounds(pose: np.ndarray, size: Sequence[float]) -> tuple[np.ndarray, np.ndarray]:
+    pose = np.asarray(pose, dtype=np.float64)
+    half = np.abs(pose[:3, :3]) @ (np.asarray(size, dtype=np.float64) / 2.0)
+    return pose[:3, 3] - half, pose[:3, 3] + half
+
+
+def _in_named_region(row: tuple, f: BeliefFilter) -> bool:
+    names = {n.lower() for n in [f.region or "", *(box.name for box in f.region_boxes)]}
+    if str(row[21]).lower() in names:
+        return True
+    position = np.array([row[3], row[4], row[5]])
+    return any(
+        row[2] == getattr(box, "frame", WORLD_FRAME) and in_box(position, box.pose, box.size) for box in f.region_boxes
+    )
+
+
+def _frustum_bounds(camera: CameraModel) -> tuple[np.ndarray, np.ndarray]:
+    corners = [(0.0, 0.0), (camera.width, 0.0), (0.0, camera.height), (camera.width, camera.height)]
+    rays = [np.array([(u - camera.cx) / camera.fx, (v - camera.cy) / camera.fy, 1.0]) for u, v in corners]
+    points = [np.zeros(3)] + [ray * camera.max_range for ray in rays]
+    transform = np.asarray(camera.to_frame, dtype=np.float64)
+    world = np.stack(points) @ transform[:3, :3].T + transform[:3, 3]
+    return world.min(axis=0), world.max(axis=0)

@@ -1,0 +1,228 @@
+"""Identity across frames: which of this frame's objects is which known belief.
+
+The cost of pairing an observation with a belief is a sum of squared normalised distances, each gated:
+
+* position: ``(d / position_sigma)^2``, gate ``d <= gate_distance`` (metres; both in the same frame);
+* size: ``(log(ratio) / size_sigma)^2`` of the largest extents, gate ``ratio <= size_ratio_gate``;
+* appearance: ``(bhattacharyya_distance / appearance_sigma)^2`` of the colour histograms, gate
+  ``<= appearance_gate``; when a histogram is missing, a mismatch of the stated colours adds ``color_penalty``;
+* class: incompatible classes (neither subsumes the other) are gated out.
+
+The assignment minimising the total cost is found with ``scipy.optimize.linear_sum_assignment`` on the gated
+matrix (infeasible pairs get a prohibitive cost and are rejected afterwards). Observations left over become new
+objects. :func:`visible_from` predicts whether a belief should have been seen (in the image, in range, and not
+hidden behind a nearer surface in the depth image), which is what lets unseen objects lose confidence.
+"""
+
+from __future__ import annotations
+
+import math
+from collections.abc import Callable, Sequence
+from dataclasses import dataclass
+from typing import Protocol
+
+import numpy as np
+
+from reasoning.fusion.rule import ClassTest
+
+
+class Trackable(Protocol):
+    """What association needs of an observation or a belief."""
+
+    @property
+    def position(self) -> np.ndarray: ...
+
+    @property
+    def frame(self) -> str: ...
+
+    @property
+    def dimensions(self) -> np.ndarray | None: ...
+
+    @property
+    def appearance(self) -> np.ndarray | None: ...
+
+
+@dataclass(frozen=True, slots=True)
+class AssociationConfig:
+    """Gates and scales of the association cost (metres, ratios, Bhattacharyya distances)."""
+
+    gate_distance: float = 0.15
+    position_sigma: float = 0.05
+    size_ratio_gate: float = 2.5
+    size_sigma: float = 0.5
+    appearance_gate: float = 0.75
+    appearance_sigma: float = 0.3
+    color_penalty: float = 4.0
+
+
+@dataclass(frozen=True, slots=True)
+class Association:
+    """The result: ``matches`` are (observation index, belief index, cost) pairs."""
+
+    matches: tuple[tuple[int, int, float], ...]
+    new: tuple[int, ...]
+    unmatched: tuple[int, ...]
+
+
+INFEASIBLE = 1e9
+"""Cost standing for a gated-out pair."""
+
+
+def bhattacharyya_distance(a: np.ndarray, b: np.ndarray) -> float:
+    """Hellinger form ``sqrt(1 - Σ sqrt(a_i b_i))`` of two normalised histograms, in [0, 1]."""
+    coefficient = float(np.sum(np.sqrt(np.clip(a, 0.0, None) * np.clip(b, 0.0, None))))
+    return math.sqrt(max(0.0, 1.0 - min(coefficient, 1.0)))
+
+
+def pair_cost(
+    observation: Trackable,
+    belief: Trackable,
+    config: AssociationConfig,
+    *,
+    observation_colors: set[str] | None = None,
+    belief_color: str | None = None,
+    observation_classes: set[str] | None = None,
+    belief_class: str | None = None,
+    class_test: ClassTest | None = None,
+) -> float:
+    """The gated cost of pairing ``observation`` with ``belief`` (:data:`INFEASIBLE` when a gate fails)."""
+    if observation.frame != belief.frame:
+        return INFEASIBLE
+    distance = math.dist(_triple(observation.position), _triple(belief.position))
+    if not distance <= config.gate_distance:
+        return INFEASIBLE
+    cost = (distance / config.position_sigma) ** 2
+    a, b = observation.dimensions, belief.dimensions
+    if a is not None and b is not None and len(a) and len(b):
+        big_a, big_b = float(max(a)), float(max(b))
+        if big_a > 0 and big_b > 0:
+            ratio = max(big_a, big_b) / min(big_a, big_b)
+            if ratio > config.size_ratio_gate:
+                return INFEASIBLE
+            cost += (math.log(ratio) / config.size_sigma) ** 2
+    ha, hb = observation.appearance, belief.appearance
+    if ha is not None and hb is not None and ha.shape == hb.shape:
+        appearance = bhattacharyya_distance(ha, hb)
+        if appearance > config.appearance_gate:
+            return INFEASIBLE
+        cost += (appearance / config.appearance_sigma) ** 2
+    elif observation_colors and belief_color and belief_color not in observation_colors:
+        cost += config.color_penalty
+    if observation_classes and belief_class:
+        test = class_test or (lambda x, y: x == y)
+        if not any(test(c, belief_class) or test(belief_class, c) for c in observation_classes):
+            return INFEASIBLE
+    return cost
+
+
+def _triple(position: np.ndarray) -> tuple[float, float, float]:
+    return float(position[0]), float(position[1]), float(position[2])
+
+
+def assign(cost: np.ndarray) -> Association:
+    """Optimal assignment on a cost matrix (rows: observations, columns: beliefs) honouring the gates."""
+    rows, cols = cost.shape
+    if rows == 0 or cols == 0:
+        return Association((), tuple(range(rows)), tuple(range(cols)))
+    feasible = cost < INFEASIBLE
+    pairs: list[tuple[int, int]]
+    if not feasible.any():
+        pairs = []
+    elif rows == 1 or cols == 1:
+        i, j = np.unravel_index(int(np.argmin(cost)), cost.shape)
+        pairs = [(int(i), int(j))]
+    else:
+        from scipy.optimize import linear_sum_assignment
+
+        row_index, col_index = linear_sum_assignment(np.where(feasible, cost, INFEASIBLE))
+        pairs = [(int(i), int(j)) for i, j in zip(row_index, col_index, strict=True)]
+    matches = tuple((i, j, float(cost[i, j])) for i, j in pairs if feasible[i, j])
+    matched_rows = {i for i, _, _ in matches}
+    matched_cols = {j for _, j, _ in matches}
+    return Association(
+        matches,
+        tuple(i for i in range(rows) if i not in matched_rows),
+        tuple(j for j in range(cols) if j not in matched_cols),
+    )
+
+
+def associate(
+    observations: Sequence[Trackable],
+    beliefs: Sequence[Trackable],
+    config: AssociationConfig | None = None,
+    cost_of: Callable[[Trackable, Trackable], float] | None = None,
+) -> Association:
+    """Match observations to beliefs; ``cost_of`` overrides :func:`pair_cost` (e.g. to add colours, classes)."""
+    config = config or AssociationConfig()
+    cost_fn = cost_of or (lambda o, b: pair_cost(o, b, config))
+    cost = np.full((len(observations), len(beliefs)), INFEASIBLE)
+    for i, j in gated_pairs(observations, beliefs, config.gate_distance):
+        cost[i, j] = cost_fn(observations[i], beliefs[j])
+    return assign(cost)
+
+
+def gated_pairs(observations: Sequence[Trackable], beliefs: Sequence[Trackable], gate: float) -> np.ndarray:
+    """The (observation, belief) index pairs in the same frame within ``gate`` metres (vectorised pre-gate)."""
+    if not observations or not beliefs:
+        return np.empty((0, 2), dtype=np.int64)
+    a = np.stack([np.asarray(o.position, dtype=np.float64) for o in observations])
+    b = np.stack([np.asarray(x.position, dtype=np.float64) for x in beliefs])
+    near = np.linalg.norm(a[:, None, :] - b[None, :, :], axis=2) <= gate
+    frames_a = np.array([o.frame for o in observations], dtype=object)
+    frames_b = np.array([x.frame for x in beliefs], dtype=object)
+    near &= frames_a[:, None] == frames_b[None, :]
+    return np.argwhere(near)
+
+
+@dataclass(frozen=True, slots=True)
+class CameraModel:
+    """A pinhole camera at a pose, with the frame's depth image (metres, 0 or NaN = no data)."""
+
+    fx: float
+    fy: float
+    cx: float
+    cy: float
+    width: int
+    height: int
+    to_frame: np.ndarray
+    """4x4 transform from the optical frame to ``frame``, the frame beliefs are expressed in."""
+    frame: str = "world"
+    depth: np.ndarray | None = None
+    max_range: float = 4.0
+    border: int = 5
+    occlusion_margin: float = 0.05
+
+
+def in_view(positions: np.ndarray, camera: CameraModel) -> np.ndarray:
+    """Which of the Nx3 ``positions`` project inside the image (away from the border) within range."""
+    points = np.asarray(positions, dtype=np.float64).reshape(-1, 3)
+    to_camera = np.linalg.inv(camera.to_frame)
+    p = points @ to_camera[:3, :3].T + to_camera[:3, 3]
+    z = p[:, 2]
+    ahead = (z > 0.05) & (z <= camera.max_range)
+    safe = np.where(ahead, z, 1.0)
+    u = camera.fx * p[:, 0] / safe + camera.cx
+    v = camera.fy * p[:, 1] / safe + camera.cy
+    b = camera.border
+    return ahead & (u >= b) & (u < camera.width - b) & (v >= b) & (v < camera.height - b)
+
+
+def visible_from(position: np.ndarray, camera: CameraModel) -> bool:
+    """True when a belief at ``position`` should have been seen by ``camera``.
+
+    It must project inside the image (away from the border), lie in front within ``max_range``, and the depth
+    image (when given) must have data there that is not nearer than the belief by more than the margin.
+    """
+    if not bool(in_view(position, camera)[0]):
+        return False
+    if camera.depth is None:
+        return True
+    to_camera = np.linalg.inv(camera.to_frame)
+    p = to_camera[:3, :3] @ np.asarray(position, dtype=np.float64) + to_camera[:3, 3]
+    z = float(p[2])
+    r, c = int(camera.fy * p[1] / z + camera.cy), int(camera.fx * p[0] / z + camera.cx)
+    window = np.asarray(camera.depth[max(r - 2, 0) : r + 3, max(c - 2, 0) : c + 3], dtype=np.float64)
+    window = window[np.isfinite(window) & (window > 0)]
+    if window.size == 0:
+        return False
+    return float(np.median(window)) >= z - camera.occlusion_margin

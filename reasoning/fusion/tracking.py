@@ -1,0 +1,293 @@
+"""Object beliefs and their life cycle across frames: match, update, create, lose confidence, mark gone.
+
+A :class:`BeliefTracker` takes the known beliefs near the camera and one frame's
+:class:`~reasoning.fusion.frame.FrameObject` list, associates them (:mod:`reasoning.fusion.association`) and returns
+the changed beliefs. It is pure: loading and saving beliefs is the belief store's job.
+
+Per matched belief: the position is filtered (scalar Kalman gain, measurement noise shrinking with the
+observation's confidence, process noise growing with the time since the last sighting); size and appearance
+are blended; attribute evidence is accumulated with :mod:`reasoning.fusion.rule`; existence log-odds rise.
+A belief that projects into the image in front of the measured surface but was not matched loses existence
+log-odds; once it has been missed and ``gone_after`` seconds have passed since it was last seen, it is gone.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Callable, Sequence
+from dataclasses import dataclass, field
+from typing import Protocol
+
+import numpy as np
+
+from reasoning.fusion.association import (
+    INFEASIBLE,
+    Association,
+    AssociationConfig,
+    CameraModel,
+    assign,
+    gated_pairs,
+    pair_cost,
+    visible_from,
+)
+from reasoning.fusion.frame import WORLD_FRAME, FrameObject
+from reasoning.fusion.rule import (
+    CLASS_ATTRIBUTE,
+    MAX_LOG_ODDS,
+    AttributeBelief,
+    ClassTest,
+    FusedAttribute,
+    accumulate,
+    logit,
+    sigmoid,
+)
+
+PRESENT = "present"
+GONE = "gone"
+
+
+class RegionLike(Protocol):
+    """A named oriented box of the semantic map (``pose``: 4x4 world pose of its centre, ``size``: extents)."""
+
+    @property
+    def name(self) -> str: ...
+
+    @property
+    def pose(self) -> np.ndarray: ...
+
+    @property
+    def size(self) -> tuple[float, float, float]: ...
+
+
+def in_box(position: np.ndarray, pose: np.ndarray, size: Sequence[float], margin: float = 1e-9) -> bool:
+    """True when ``position`` lies inside the oriented box ``pose`` (4x4 centre pose) x ``size``."""
+    pose = np.asarray(pose, dtype=np.float64)
+    local = pose[:3, :3].T @ (np.asarray(position, dtype=np.float64) - pose[:3, 3])
+    return bool(np.all(np.abs(local) <= np.asarray(size, dtype=np.float64) / 2.0 + margin))
+
+
+def region_of(position: np.ndarray, regions: Sequence[RegionLike]) -> RegionLike | None:
+    """The first region whose box contains ``position``."""
+    for region in regions:
+        if in_box(position, region.pose, region.size):
+            return region
+    return None
+
+
+@dataclass(slots=True)
+class ObjectBelief:
+    """What is believed about one object; ``existence`` is log-odds, positions are in ``frame``."""
+
+    id: int
+    frame: str
+    position: np.ndarray
+    orientation: np.ndarray = field(default_factory=lambda: np.array([0.0, 0.0, 0.0, 1.0]))
+    dimensions: np.ndarray | None = None
+    appearance: np.ndarray | None = None
+    attributes: dict[str, AttributeBelief] = field(default_factory=dict)
+    position_variance: float = 0.0004
+    existence: float = 0.0
+    status: str = PRESENT
+    first_seen: float = 0.0
+    last_seen: float = 0.0
+    misses: int = 0
+    region: str = ""
+    region_class: str = ""
+    roi: tuple[int, int, int, int] | None = None
+    sources: set[str] = field(default_factory=set)
+    observations: int = 0
+    class_name: str | None = None
+
+    @property
+    def confidence(self) -> float:
+        """Probability that the object exists as believed."""
+        return sigmoid(self.existence)
+
+    def fused(self, class_test: ClassTest | None = None) -> dict[str, FusedAttribute]:
+        """Every attribute's fused value (subsumption applies to ``class``)."""
+        result: dict[str, FusedAttribute] = {}
+        for name, belief in self.attributes.items():
+            fused = belief.fuse(class_test if name == CLASS_ATTRIBUTE else None)
+            if fused is not None:
+                result[name] = fused
+        return result
+
+    def value(self, attribute: str, class_test: ClassTest | None = None) -> str | None:
+        """The fused value of one attribute, or None."""
+        belief = self.attributes.get(attribute)
+        fused = belief.fuse(class_test if attribute == CLASS_ATTRIBUTE else None) if belief else None
+        return fused.value if fused else None
+
+
+@dataclass(frozen=True, slots=True)
+class TrackerConfig:
+    """Association gates and life-cycle parameters (seconds, metres, log-odds)."""
+
+    association: AssociationConfig = field(default_factory=AssociationConfig)
+    gone_after: float = 10.0
+    hit_log_odds: float = logit(0.8)
+    miss_log_odds: float = logit(0.75)
+    measurement_sigma: float = 0.02
+    motion_sigma: float = 0.01
+    blend_rate: float = 0.3
+
+
+@dataclass(frozen=True, slots=True)
+class TrackStep:
+    """The outcome of one frame: ``assigned[i]`` is the belief id of observation ``i``."""
+
+    changed: tuple[ObjectBelief, ...]
+    assigned: tuple[int, ...]
+    created: tuple[int, ...]
+    missed: tuple[int, ...]
+    gone: tuple[int, ...]
+    association: Association
+
+
+class BeliefTracker:
+    """Associates frames of objects with beliefs and updates them (see the module docstring)."""
+
+    def __init__(
+        self,
+        config: TrackerConfig | None = None,
+        *,
+        class_test: ClassTest | None = None,
+        regions: Sequence[RegionLike] = (),
+    ) -> None:
+        self.config = config or TrackerConfig()
+        self.class_test = class_test
+        self.regions = tuple(regions)
+
+    def step(
+        self,
+        beliefs: Sequence[ObjectBelief],
+        observations: Sequence[FrameObject],
+        time: float,
+        new_id: Callable[[], int],
+        camera: CameraModel | None = None,
+    ) -> TrackStep:
+        """Integrate one frame; ``beliefs`` are the present beliefs that could be involved (changed in place)."""
+        beliefs = [b for b in beliefs if b.status == PRESENT]
+        association = self._associate(observations, beliefs)
+        changed: dict[int, ObjectBelief] = {}
+        assigned = [0] * len(observations)
+        for i, j, _ in association.matches:
+            belief = beliefs[j]
+            self._update(belief, observations[i], time)
+            changed[belief.id] = belief
+            assigned[i] = belief.id
+        created = []
+        for i in association.new:
+            belief = self._create(observations[i], time, new_id())
+            changed[belief.id] = belief
+            assigned[i] = belief.id
+            created.append(belief.id)
+        missed, gone = [], []
+        for j in association.unmatched:
+            belief = beliefs[j]
+            if camera is not None and belief.frame == camera.frame and visible_from(belief.position, camera):
+                belief.existence = max(belief.existence - self.config.miss_log_odds, -MAX_LOG_ODDS)
+                belief.misses += 1
+                missed.append(belief.id)
+                changed[belief.id] = belief
+            if belief.misses > 0 and time - belief.last_seen >= self.config.gone_after:
+                belief.status = GONE
+                gone.append(belief.id)
+                changed[belief.id] = belief
+        return TrackStep(
+            tuple(changed.values()), tuple(assigned), tuple(created), tuple(missed), tuple(gone), association
+        )
+
+    # ------------------------------------------------------------------ internals
+
+    def _associate(self, observations: Sequence[FrameObject], beliefs: Sequence[ObjectBelief]) -> Association:
+        config = self.config.association
+        cost = np.full((len(observations), len(beliefs)), INFEASIBLE)
+        colors: dict[int, str | None] = {}
+        stated: dict[int, tuple[set[str], set[str]]] = {}
+        for i, j in gated_pairs(observations, beliefs, config.gate_distance).tolist():
+            observation, belief = observations[i], beliefs[j]
+            if j not in colors:
+                colors[j] = belief.value("color")
+            if i not in stated:
+                stated[i] = (observation.values("color"), observation.values(CLASS_ATTRIBUTE))
+            cost[i, j] = pair_cost(
+                observation,
+                belief,
+                config,
+                observation_colors=stated[i][0],
+                belief_color=colors[j],
+                observation_classes=stated[i][1],
+                belief_class=belief.class_name,
+                class_test=self.class_test,
+            )
+        return assign(cost)
+
+    def _create(self, observation: FrameObject, time: float, belief_id: int) -> ObjectBelief:
+        belief = ObjectBelief(
+            id=belief_id,
+            frame=observation.frame,
+            position=observation.position.copy(),
+            orientation=observation.orientation.copy(),
+            dimensions=None if observation.dimensions is None else observation.dimensions.copy(),
+            appearance=None if observation.appearance is None else observation.appearance.copy(),
+            attributes=accumulate(observation.evidence, time),
+            position_variance=self._measurement_variance(observation),
+            existence=min(logit(observation.confidence), self.config.hit_log_odds),
+            first_seen=time,
+            last_seen=time,
+            roi=observation.roi,
+            sources=set(observation.sources),
+            observations=1,
+        )
+        self._refresh(belief)
+        return belief
+
+    def _measurement_variance(self, observation: FrameObject) -> float:
+        return self.config.measurement_sigma**2 / max(observation.confidence, 0.1)
+
+    def _update(self, belief: ObjectBelief, observation: FrameObject, time: float) -> None:
+        config = self.config
+        elapsed = max(time - belief.last_seen, 0.0)
+        predicted = belief.position_variance + config.motion_sigma**2 * elapsed
+        measured = self._measurement_variance(observation)
+        gain = predicted / (predicted + measured)
+        belief.position = belief.position + gain * (observation.position - belief.position)
+        belief.position_variance = (1.0 - gain) * predicted
+        belief.orientation = observation.orientation.copy()
+        rate = config.blend_rate
+        if observation.dimensions is not None:
+            if belief.dimensions is None or belief.dimensions.shape != observation.dimensions.shape:
+                belief.dimensions = observation.dimensions.copy()
+            else:
+                belief.dimensions = (1.0 - rate) * belief.dimensions + rate * observation.dimensions
+        if observation.appearance is not None:
+            if belief.appearance is None or belief.appearance.shape != observation.appearance.shape:
+                belief.appearance = observation.appearance.copy()
+            else:
+                blended = (1.0 - rate) * belief.appearance + rate * observation.appearance
+                belief.appearance = blended / max(float(blended.sum()), 1e-12)
+        attributes = belief.attributes
+        for evidence in observation.evidence:
+            known = attributes.get(evidence.attribute)
+            if known is None:
+                known = attributes[evidence.attribute] = AttributeBelief(evidence.attribute)
+            known.add(evidence, time)
+        belief.existence = min(belief.existence + config.hit_log_odds, MAX_LOG_ODDS)
+        belief.misses = 0
+        belief.status = PRESENT
+        belief.last_seen = max(belief.last_seen, time)
+        belief.roi = observation.roi
+        belief.sources.update(observation.sources)
+        belief.observations += 1
+        self._refresh(belief)
+
+    def _refresh(self, belief: ObjectBelief) -> None:
+        """Recompute the cached class and the region after a change."""
+        belief.class_name = belief.value(CLASS_ATTRIBUTE, self.class_test)
+        region = region_of(belief.position, self.regions) if belief.frame == WORLD_FRAME and self.regions else None
+        if region is not None:
+            belief.region = region.name
+            belief.region_class = str(getattr(region, "region_class", ""))
+        else:
+            belief.region = belief.value("region") or ""
+            belief.region_class = ""

@@ -1,0 +1,388 @@
+"""The knowledge base: the ontology loaded once, answering typed questions from in-memory indexes.
+
+Loading parses the Turtle files with rdflib (and, with ``reason=True``, classifies them with HermiT);
+every question afterwards is a dictionary or set lookup on the :class:`~reasoning.knowledge.index.OntologyIndex`:
+no question parses a file or runs the reasoner. :meth:`KnowledgeBase.reload` swaps in a fresh index
+(re-parsing only the files that changed), so a long-running process sees ontology edits.
+"""
+
+from __future__ import annotations
+
+import difflib
+import logging
+from collections.abc import Collection, Sequence
+from pathlib import Path
+
+from rdflib import Graph
+
+from reasoning.errors import AmbiguousTermError, InconsistentOntologyError, UnknownTermError
+from reasoning.knowledge.hermit import ReasonerResult, classify, describe_unsatisfiable
+from reasoning.knowledge.index import OntologyIndex, build_index
+from reasoning.knowledge.model import (
+    KIND_WORDS,
+    KINDS,
+    AnnotatorSpec,
+    Conditions,
+    Kind,
+    ObjectProfile,
+    RegionBox,
+    Resolved,
+)
+from reasoning.knowledge.sources import Sources, Stamp, defined_names, file_stamp, merge_graphs, parse_turtle
+from reasoning.knowledge.words import singular_keys, word_key
+
+log = logging.getLogger(__name__)
+
+_ALL_CONDITIONS = Conditions()
+_CLASS_KINDS: tuple[Kind, ...] = ("class", "region_class", "color", "shape", "size", "material")
+_DOMAIN_FIELDS: dict[Kind, str] = {
+    "class": "classes",
+    "color": "colors",
+    "shape": "shapes",
+    "size": "sizes",
+    "material": "materials",
+}
+
+
+class KnowledgeBase:
+    """Object classes, regions, annotation types and annotator capabilities, indexed for fast questions."""
+
+    def __init__(self, sources: Sources, reason: bool = False) -> None:
+        self._sources = sources
+        self._reason = reason
+        self._parsed: dict[Path, tuple[Stamp | None, Graph]] = {}
+        self._stamps: dict[Path, Stamp | None] = {}
+        self._reasoner: ReasonerResult | None = None
+        self._index: OntologyIndex
+        self.reload()
+
+    @classmethod
+    def load(
+        cls,
+        user_file: Path | None = None,
+        *,
+        reason: bool = False,
+        map_file: Path | None = None,
+        extra_files: Sequence[Path] = (),
+        files: Sequence[Path] | None = None,
+    ) -> KnowledgeBase:
+        """Load the shipped ontology, a semantic map (default: the built-in kitchen), ``extra_files`` and
+        the user file (default: :func:`~reasoning.knowledge.sources.default_user_file`; a missing file is empty).
+
+        ``files`` replaces the shipped files and map. With ``reason=True`` HermiT classifies the ontology
+        (inferred subsumptions join the hierarchy; unsatisfiable classes raise InconsistentOntologyError);
+        without Java it logs why and keeps the asserted hierarchy.
+        """
+        return cls(Sources.default(user_file, map_file, extra_files, files), reason=reason)
+
+    # ------------------------------------------------------------------ loading
+
+    @property
+    def sources(self) -> Sources:
+        """The files this knowledge base reads."""
+        return self._sources
+
+    @property
+    def user_file(self) -> Path:
+        """The user ontology file layered over the shipped ones."""
+        return self._sources.user_file
+
+    @property
+    def index(self) -> OntologyIndex:
+        """The current in-memory index (read-only)."""
+        return self._index
+
+    @property
+    def reasoner_result(self) -> ReasonerResult | None:
+        """The last HermiT run of a ``reason=True`` knowledge base, else None."""
+        return self._reasoner
+
+    def source_graphs(self) -> dict[Path, Graph]:
+        """The parsed graph of every existing source file, the user file last (cached while unchanged)."""
+        return self._read()[0]
+
+    def _read(self) -> tuple[dict[Path, Graph], dict[Path, Stamp | None]]:
+        graphs: dict[Path, Graph] = {}
+        stamps: dict[Path, Stamp | None] = {}
+        for path in (*self._sources.files, self._sources.user_file):
+            stamp = stamps[path] = file_stamp(path)
+            if stamp is None:
+                if path != self._sources.user_file:
+                    parse_turtle(path)  # raises the "no such file" OntologyError
+                continue
+            cached = self._parsed.get(path)
+            if cached is None or cached[0] != stamp:
+                cached = (stamp, parse_turtle(path))
+                self._parsed[path] = cached
+            graphs[path] = cached[1]
+        return graphs, stamps
+
+    def reload(self) -> None:
+        """Re-read the sources (only changed files are parsed again) and swap in a new index."""
+        graphs, stamps = self._read()
+        merged = merge_graphs(graphs.values())
+        defined = defined_names(graphs)
+        result: ReasonerResult | None = None
+        inferred = None
+        if self._reason:
+            result = classify(merged)
+            if result.available and not result.ok:
+                asserted = build_index(merged, defined)
+                raise InconsistentOntologyError(
+                    describe_unsatisfiable(asserted, result), heading="the reasoner rejects the ontology"
+                )
+            inferred = result.inferred
+        self._index = build_index(merged, defined, inferred)
+        self._reasoner = result
+        self._stamps = stamps
+
+    def reload_if_changed(self) -> bool:
+        """Reload when a source file changed since the last load (one ``stat`` per file); True if reloaded."""
+        for path, stamp in self._stamps.items():
+            if file_stamp(path) != stamp:
+                self.reload()
+                return True
+        return False
+
+    # ------------------------------------------------------------------ words
+
+    def resolve(self, word: str, kinds: Collection[Kind] | None = None) -> Resolved:
+        """The term a word names: by label, synonym or name, any case, with spaces, underscores or plurals.
+
+        An exact name wins ("Fridge" is the region class, "fridge" the region of the map); otherwise, when a
+        word names terms of several kinds, the first in :data:`~reasoning.knowledge.model.KINDS` wins (an object class
+        before a region, ...); ``kinds`` restricts the search. Raises UnknownTermError with close
+        matches, or AmbiguousTermError when it names several terms of the same kind.
+        """
+        exact = self._exact(word)
+        if exact is not None and (kinds is None or exact.kind in kinds):
+            return exact
+        found = self._lookup(word, kinds)
+        if not found:
+            raise UnknownTermError(word, self._what(kinds), self._suggestions(word, kinds))
+        same = [r for r in found if r.kind == found[0].kind]
+        if len(same) > 1:
+            raise AmbiguousTermError(word, [r.name for r in same])
+        return same[0]
+
+    def resolve_all(self, word: str) -> tuple[Resolved, ...]:
+        """Every term a word may name, in preference order (empty when none)."""
+        found = self._lookup(word, None)
+        exact = self._exact(word)
+        return found if exact is None else (exact, *(r for r in found if r != exact))
+
+    def _exact(self, word: str) -> Resolved | None:
+        """The term whose exact name ``word`` is (an exact name beats any label)."""
+        index = self._index
+        if word in index.regions:
+            return Resolved("region", word)
+        kind = index.kinds.get(word)
+        return None if kind is None else Resolved(kind, word)
+
+    def _lookup(self, word: str, kinds: Collection[Kind] | None) -> tuple[Resolved, ...]:
+        words = self._index.words
+        key = word_key(word)
+        for candidate in (key, *singular_keys(key)):
+            found = words.get(candidate)
+            if found and kinds is not None:
+                found = tuple(r for r in found if r.kind in kinds)
+            if found:
+                return found
+        return ()
+
+    def _suggestions(self, word: str, kinds: Collection[Kind] | None) -> list[str]:
+        index = self._index
+        keys = [k for k, found in index.words.items() if kinds is None or any(r.kind in kinds for r in found)]
+        close = difflib.get_close_matches(word_key(word), keys, n=3, cutoff=0.6)
+        return [index.word_labels[k] for k in close]
+
+    @staticmethod
+    def _what(kinds: Collection[Kind] | None) -> str:
+        if kinds is None or len(kinds) == 0 or set(kinds) == set(KINDS):
+            return "term"
+        return " or ".join(KIND_WORDS[k] for k in KINDS if k in kinds)
+
+    def _name(self, term: str, kinds: Collection[Kind]) -> str:
+        """``term`` if it is the exact name of a term of one of ``kinds``, else what it resolves to."""
+        kind = self._index.kinds.get(term)
+        if kind is not None and kind in kinds:
+            return term
+        return self.resolve(term, kinds).name
+
+    def _class(self, term: str) -> str:
+        """A class name (any class, CAS types included) for ``term``."""
+        if term in self._index.up:
+            return term
+        return self.resolve(term, _CLASS_KINDS).name
+
+    def kind(self, name: str) -> Kind | None:
+        """The kind of an exact name (None for names of other things, such as CAS types)."""
+        if name in self._index.regions:
+            return "region"
+        return self._index.kinds.get(name)
+
+    def label(self, name: str) -> str:
+        """The label of a term (its lower-case words when it has none); runtime colour names are these."""
+        return self._index.labels.get(name) or name
+
+    def synonyms(self, name: str) -> tuple[str, ...]:
+        """The synonyms (skos:altLabel) of a term."""
+        return self._index.synonyms.get(name, ())
+
+    def names_of_kind(self, kind: Kind) -> list[str]:
+        """All terms of a kind, sorted (e.g. every colour)."""
+        if kind == "region":
+            return sorted(self._index.regions)
+        return self._index.of_kind(kind)
+
+    def defined_in(self, name: str) -> Path | None:
+        """The file that defines a term, or None."""
+        return self._index.defined_in.get(name)
+
+    # ------------------------------------------------------------------ classes
+
+    def is_subclass(self, name: str, ancestor: str) -> bool:
+        """True when ``name`` is ``ancestor`` or one of its (transitive) subclasses."""
+        return self._class(ancestor) in self._index.up[self._class(name)]
+
+    def subclasses(self, name: str, direct: bool = False) -> list[str]:
+        """The (direct or all) proper subclasses of a class, sorted."""
+        cls = self._class(name)
+        if direct:
+            return list(self._index.children.get(cls, ()))
+        return sorted(self._index.down[cls] - {cls})
+
+    def superclasses(self, name: str, direct: bool = False) -> list[str]:
+        """The (direct or all) proper superclasses of a class, sorted."""
+        cls = self._class(name)
+        if direct:
+            return list(self._index.parents.get(cls, ()))
+        return sorted(self._index.up[cls] - {cls})
+
+    def are_disjoint(self, a: str, b: str) -> bool:
+        """True when the ontology declares ``a`` (or a superclass) disjoint with ``b`` (or a superclass)."""
+        index = self._index
+        up_b = index.up[self._class(b)]
+        return any(not index.disjoint.get(x, frozenset()).isdisjoint(up_b) for x in index.up[self._class(a)])
+
+    def object_profile(self, name: str) -> ObjectProfile:
+        """Typical colours, shape, size, material, transparency, storage place, texts and brand of a class."""
+        return self._index.profiles[self._name(name, ("class",))]
+
+    def default_location(self, name: str) -> str | None:
+        """The region class objects of this class are typically kept in (inherited), or None."""
+        return self.object_profile(name).stored_in
+
+    def variants_differ_by_text(self, name: str) -> bool:
+        """True when a sibling class looks the same and only printed text or brand tells them apart."""
+        return self._name(name, ("class",)) in self._index.text_variants
+
+    # ------------------------------------------------------------------ regions
+
+    def regions(self) -> list[RegionBox]:
+        """Every named region of the loaded semantic maps, sorted by name."""
+        return [self._index.regions[name] for name in sorted(self._index.regions)]
+
+    def region(self, name: str) -> RegionBox:
+        """A named region (exact name, label or synonym)."""
+        found = self._index.regions.get(name)
+        return found if found is not None else self._index.regions[self.resolve(name, ("region",)).name]
+
+    def regions_of_class(self, region_class: str) -> list[RegionBox]:
+        """The named regions whose class is ``region_class`` or one of its subclasses."""
+        return list(self._index.regions_by_class[self._name(region_class, ("region_class",))])
+
+    # ------------------------------------------------------------------ perception vocabulary
+
+    def cas_types(self) -> list[str]:
+        """The names of all CAS types (views and annotation types) the ontology declares."""
+        return sorted(self._index.cas_types)
+
+    def annotation_type_for_key(self, key: str) -> str:
+        """The CAS annotation type that answers a query key (``color`` -> ``SemanticColor``)."""
+        found = self._index.query_keys.get(word_key(key))
+        if found is None:
+            keys = sorted(self._index.query_keys)
+            raise UnknownTermError(key, "query key", difflib.get_close_matches(word_key(key), keys, n=3, cutoff=0.6))
+        return found
+
+    def query_keys(self) -> dict[str, str]:
+        """Every query key word (normalised) -> the annotation type that answers it."""
+        return dict(self._index.query_keys)
+
+    # ------------------------------------------------------------------ annotators
+
+    def annotators(self) -> list[AnnotatorSpec]:
+        """Every annotator the ontology declares, sorted by name."""
+        return [self._index.annotators[name] for name in sorted(self._index.annotators)]
+
+    def annotator(self, name: str) -> AnnotatorSpec:
+        """One annotator by its ontology name."""
+        found = self._index.annotators.get(name)
+        if found is None:
+            close = difflib.get_close_matches(name, list(self._index.annotators), n=3, cutoff=0.6)
+            raise UnknownTermError(name, "annotator", close)
+        return found
+
+    def inputs_of(self, name: str) -> tuple[str, ...]:
+        """The required input CAS types of an annotator."""
+        return self.annotator(name).inputs
+
+    def providers(
+        self,
+        annotation_type: str,
+        value: str | None = None,
+        object_class: str | None = None,
+        conditions: Conditions | None = None,
+    ) -> list[AnnotatorSpec]:
+        """Annotators that write ``annotation_type`` (or a subtype), best first (reliability, then cost).
+
+        ``value`` (for types with a value domain: colour, shape, size, class) keeps the annotators whose
+        declared domain holds the value, a subclass of it or a superclass of it (a detector that knows
+        WhiteCeramicBowl serves a query for Bowl); an empty domain means any value. ``object_class`` keeps
+        the annotators whose class domain (if any) is related to it the same way and drops those whose
+        preconditions exclude it (not for transparent objects). ``conditions`` says whether depth and a
+        region are available (default: both) and whether a detector model is configured (default: not).
+        """
+        index = self._index
+        if annotation_type not in index.cas_types:
+            close = difflib.get_close_matches(annotation_type, list(index.cas_types), n=3, cutoff=0.6)
+            raise UnknownTermError(annotation_type, "CAS type", close)
+        candidates = index.providers.get(annotation_type, ())
+        value_kind = index.value_domains.get(annotation_type)
+        value_up = value_down = None
+        if value is not None and value_kind is not None:
+            value_name = self._name(value, (value_kind,))
+            value_up, value_down = index.up[value_name], index.down[value_name]
+            domain_field = _DOMAIN_FIELDS[value_kind]
+        object_up = object_down = None
+        transparent = False
+        if object_class is not None:
+            object_name = self._name(object_class, ("class",))
+            object_up, object_down = index.up[object_name], index.down[object_name]
+            transparent = index.profiles[object_name].transparent is True
+        conditions = conditions or _ALL_CONDITIONS
+        chosen: list[AnnotatorSpec] = []
+        for spec in candidates:
+            if value_up is not None and value_down is not None:
+                domain: frozenset[str] = getattr(spec, domain_field)
+                if domain and domain.isdisjoint(value_up) and domain.isdisjoint(value_down):
+                    continue
+            if (
+                object_up is not None
+                and object_down is not None
+                and spec.classes
+                and spec.classes.isdisjoint(object_up)
+                and spec.classes.isdisjoint(object_down)
+            ):
+                continue
+            needs = index.annotator_conditions[spec.name]
+            if needs and (
+                ("depth" in needs and not conditions.depth)
+                or ("region" in needs and not conditions.region)
+                or ("model" in needs and not conditions.model)
+                or ("opaque" in needs and transparent)
+            ):
+                continue
+            chosen.append(spec)
+        return chosen

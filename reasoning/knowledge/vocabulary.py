@@ -1,0 +1,53 @@
+"""The ontology's namespace and the IRIs of the terms the knowledge base reads."""
+
+from __future__ import annotations
+
+import re
+
+from rdflib import Namespace, URIRef
+from rdflib.namespace import OWL, RDF, RDFS, SKOS, XSD
+
+from robokudo.core.types import ONTOLOGY_NAMESPACE
+
+__all__ = [
+    "ANNOTATORS_PACKAGE",
+    "IMPLEMENTATION_PATTERN",
+    "NAME_PATTERN",
+    "OWL",
+    "RDF",
+    "RDFS",
+    "RK",
+    "SKOS",
+    "XSD",
+    "is_rk",
+    "local_name",
+    "rk",
+]
+
+RK = Namespace(ONTOLOGY_NAMESPACE)
+"""The ``rk:`` namespace of every term the project defines."""
+
+ANNOTATORS_PACKAGE = "annotators"
+"""The only package whose classes ``rk:implementedBy`` may name."""
+
+IMPLEMENTATION_PATTERN = re.compile(r"annotators(?:\.[A-Za-z_][A-Za-z0-9_]*){2,}")
+"""What a valid ``rk:implementedBy`` value looks like: ``annotators.<module>.<Class>``."""
+
+NAME_PATTERN = re.compile(r"[A-Za-z_][A-Za-z0-9_]*")
+"""What the local name of an ``rk:`` term looks like."""
+
+
+def rk(name: str) -> URIRef:
+    """The IRI of the ``rk:`` term ``name``."""
+    return URIRef(ONTOLOGY_NAMESPACE + name)
+
+
+def is_rk(node: object) -> bool:
+    """True when ``node`` is an IRI in the ``rk:`` namespace."""
+    return isinstance(node, URIRef) and str(node).startswith(ONTOLOGY_NAMESPACE)
+
+
+def local_name(node: object) -> str:
+    """The part of an ``rk:`` IRI after the ``#`` (other IRIs are returned whole)."""
+    text = str(node)
+    return text[len(ONTOLOGY_NAMESPACE) :] if text.startswith(ONTOLOGY_NAMESPACE) else text

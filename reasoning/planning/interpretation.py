@@ -1,0 +1,208 @@
+"""Interpret a parsed query against the knowledge base: resolve words, fill gaps, list required types.
+
+``find milk in fridge`` names a class and a region; ``find milk`` names only the class, and the region comes
+from the ontology (Milk is stored in the Fridge); a class whose variants differ only by printed text needs
+text reading. Each requirement carries the sentence that explains it.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+from queries.model import Asked, Block, ListValue, Number, Query, String, Symbol, Value
+from reasoning.errors import TermError
+from reasoning.knowledge.knowledge_base import KnowledgeBase
+from reasoning.knowledge.model import RegionBox
+from reasoning.planning.plan import Constraint, Task
+from reasoning.planning.planner import PlanningError, Requirement
+
+_RELATIONS = ("in", "inside", "on", "at", "near")
+_VALUE_KINDS = {"SemanticColor": "color", "Shape": "shape", "Size": "size"}
+_STRUCTURAL_KEYS = frozenset({"type", "location", "id"})
+_KINDS_WITH_OBJECTS = ("detect", "inspect", "track")
+
+
+@dataclass(frozen=True)
+class Interpretation:
+    """The task, what it requires, and the region box it is restricted to (if any)."""
+
+    task: Task
+    requirements: tuple[Requirement, ...]
+    region_box: RegionBox | None
+
+
+def interpret(query: Query, kb: KnowledgeBase, depth: bool = True) -> Interpretation:
+    """Resolve the query's words and list the annotation types its answer needs.
+
+    ``depth`` says whether the sensor measures depth; without it objects are reported by their image region
+    and no pose is required.
+    """
+    if query.kind == "stop":
+        raise PlanningError("a stop query cancels a running task; there is no perception tree to plan for it")
+    if query.kind == "scan":
+        return _interpret_scan(query, kb)
+    obj = query.get("obj")
+    if not isinstance(obj, Block):
+        raise PlanningError(f"a {query.kind} query needs an obj block describing the object")
+    requirements = [Requirement("ObjectHypothesis", None, f"a {query.kind} query needs object hypotheses")]
+    constraints: list[Constraint] = []
+    inferences: list[str] = []
+    if depth or isinstance(obj.get("pose"), Asked):
+        requirements.append(Requirement("Pose", None, f"a {query.kind} query reports each object's pose"))
+    else:
+        inferences.append("the sensor measures no depth, so objects are reported by image region without a pose")
+    object_class = _object_class(obj.get("type"), kb)
+    if object_class is not None:
+        constraints.append(Constraint("type", "Classification", object_class))
+        requirements.append(Requirement("Classification", object_class, f"query asks type = {object_class}"))
+    for field in obj.fields:
+        if field.key in _STRUCTURAL_KEYS:
+            continue
+        annotation_type = _annotation_type(field.key, kb)
+        for value in _values(field.value):
+            name = _value_name(annotation_type, value, kb)
+            constraints.append(Constraint(field.key, annotation_type, name))
+            asked = f"query asks {field.key} = {name}" if name is not None else f"query asks for {field.key}"
+            requirements.append(Requirement(annotation_type, _domain_value(annotation_type, name), asked))
+    if object_class is not None and not obj.get("text"):
+        why = _why_text_matters(object_class, kb)
+        if why:
+            inferences.append(why)
+            requirements.append(Requirement("Text", None, why))
+    region_box = _region(obj.get("location"), kb)
+    if region_box is None and object_class is not None:
+        region_box, note = _default_region(object_class, kb)
+        if note:
+            inferences.append(note)
+    task = Task(
+        kind=query.kind,
+        object_class=object_class,
+        region=region_box.name if region_box else None,
+        constraints=tuple(constraints),
+        inferences=tuple(inferences),
+        max_results=_whole(query.get("max_results")),
+        object_id=_whole(obj.get("id")),
+    )
+    return Interpretation(task, tuple(requirements), region_box)
+
+
+def _why_text_matters(object_class: str, kb: KnowledgeBase) -> str:
+    """Why text must be read to recognise ``object_class`` ("" when it need not be).
+
+    Text matters when the class's variants differ only by printed text, or when another, unrelated class
+    looks the same (same colours, shape and size) and the class carries printed text that tells them apart.
+    """
+    if kb.variants_differ_by_text(object_class):
+        return f"{object_class} differs from its sibling classes only by printed text, so text must be read"
+    profile = kb.object_profile(object_class)
+    if not profile.texts:
+        return ""
+    looks = (frozenset(profile.colors), profile.shape, profile.size_class)
+    for other in kb.names_of_kind("class"):
+        if kb.is_subclass(other, object_class) or kb.is_subclass(object_class, other):
+            continue
+        seen = kb.object_profile(other)
+        if (frozenset(seen.colors), seen.shape, seen.size_class) == looks:
+            texts = ", ".join(repr(t) for t in profile.texts)
+            return (
+                f"{object_class} looks like {other} (same colour, shape and size); the text printed on it "
+                f"({texts}) tells them apart, so text must be read"
+            )
+    return ""
+
+
+def _interpret_scan(query: Query, kb: KnowledgeBase) -> Interpretation:
+    region_value = query.get("region")
+    region_box = _region(region_value, kb) if region_value is not None else None
+    requirements = (
+        Requirement("Plane", None, "a scan for free space needs the supporting surface"),
+        Requirement("ObjectHypothesis", None, "a scan for free space needs the objects occupying the surface"),
+    )
+    task = Task(kind="scan", region=region_box.name if region_box else None)
+    return Interpretation(task, requirements, region_box)
+
+
+def _word(value: Value, what: str) -> str:
+    if isinstance(value, Symbol):
+        return value.name
+    if isinstance(value, String):
+        return value.text
+    raise PlanningError(f"{what} must be a word, got {type(value).__name__}")
+
+
+def _object_class(value: Value | None, kb: KnowledgeBase) -> str | None:
+    if value is None or isinstance(value, Asked):
+        return None
+    word = _word(value, "type")
+    try:
+        return kb.resolve(word, ("class",)).name
+    except TermError as error:
+        raise PlanningError(str(error)) from None
+
+
+def _annotation_type(key: str, kb: KnowledgeBase) -> str:
+    try:
+        return kb.annotation_type_for_key(key)
+    except TermError as error:
+        raise PlanningError(f"the query key {key!r} is not answered by any annotation type: {error}") from None
+
+
+def _values(value: Value) -> list[Value]:
+    return list(value.items) if isinstance(value, ListValue) else [value]
+
+
+def _value_name(annotation_type: str, value: Value, kb: KnowledgeBase) -> str | None:
+    """The ontology name of a requested value (colour, shape, size class), the text, or None when asked."""
+    if isinstance(value, Asked):
+        return None
+    kind = _VALUE_KINDS.get(annotation_type)
+    if isinstance(value, Number):
+        return f"{value.value:g}{value.unit or ''}"
+    word = _word(value, annotation_type)
+    if kind is None:
+        return word
+    try:
+        return kb.resolve(word, (kind,)).name
+    except TermError as error:
+        raise PlanningError(str(error)) from None
+
+
+def _domain_value(annotation_type: str, name: str | None) -> str | None:
+    """The value the providers' domain must cover (only for types with a value domain)."""
+    return name if annotation_type in _VALUE_KINDS else None
+
+
+def _region(value: Value | None, kb: KnowledgeBase) -> RegionBox | None:
+    if value is None or isinstance(value, Asked):
+        return None
+    if isinstance(value, Block):
+        places = [value.get(relation) for relation in _RELATIONS if value.get(relation) is not None]
+        if not places:
+            raise PlanningError(f"location must say where: one of {', '.join(_RELATIONS)}")
+        value = places[0]
+    word = _word(value, "location")
+    try:
+        found = kb.resolve(word, ("region", "region_class"))
+    except TermError as error:
+        raise PlanningError(str(error)) from None
+    if found.kind == "region":
+        return kb.region(found.name)
+    boxes = kb.regions_of_class(found.name)
+    if not boxes:
+        raise PlanningError(f"the semantic map has no region of class {found.name}")
+    return boxes[0]
+
+
+def _default_region(object_class: str, kb: KnowledgeBase) -> tuple[RegionBox | None, str]:
+    stored_in = kb.default_location(object_class)
+    if stored_in is None:
+        return None, ""
+    boxes = kb.regions_of_class(stored_in)
+    if not boxes:
+        return None, f"{object_class} is stored in a {stored_in}, but the semantic map has none"
+    box = boxes[0]
+    return box, f"{object_class} is typically stored in the {stored_in}, so the search covers region {box.name!r}"
+
+
+def _whole(value: Value | None) -> int | None:
+    return int(value.value) if isinstance(value, Number) else None

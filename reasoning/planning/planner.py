@@ -1,0 +1,801 @@
+"""Plan synthesis: from required annotation types to a staged, minimal set of experts.
+
+The algorithm, polynomial in annotators x types:
+
+1. *Candidates*: the knowledge base ranks the providers of a type - annotators whose outputs include it,
+   whose value domain covers the requested value under class subsumption and whose preconditions hold.
+   An annotator that reads and writes a type (a crop filter) refines it rather than providing it.
+2. *Feasibility* by a forward fixpoint from the sensor types (what some chain of providers can produce).
+   A provider is a valid choice for a type when its inputs can be produced without that type, so choices
+   never depend on themselves. A type with no valid provider is an error naming what was missing and why.
+3. *Assignment*, breadth first from the requirements back to the sensors: each needed type gets one unit
+   - its single valid provider, or all of them as Alternatives (a Fallback, in rank order) - and each
+   annotator belongs to at most one unit. A type that an already planned unit guarantees needs no unit.
+4. *Pruning and cycle breaking*: units nothing needs are dropped; an alternative whose inputs would close a
+   dependency cycle is dropped from its Fallback.
+5. *Refinements* of planned types run after the type's unit and before its readers: every refiner whose
+   preconditions hold and that has some (a region filter when a region is named), plus the cheapest
+   general-purpose one (a crop).
+6. *Grouping*: inputs that only one alternative needs move into that alternative's branch, so a failing
+   branch hands over to the next; units are staged by dependency depth (a stage's units are independent).
+"""
+
+from __future__ import annotations
+
+from collections import deque
+from collections.abc import Callable, Iterable, Mapping, Sequence
+from dataclasses import dataclass
+from typing import Protocol
+
+from reasoning.knowledge.model import AnnotatorSpec, Conditions
+from reasoning.planning.plan import Alternatives, Plan, Step, Task, Unit
+
+
+class PlanningError(Exception):
+    """No tree can satisfy the query; the message says which requirement failed and why."""
+
+
+class _OrderingError(PlanningError):
+    """The chosen alternatives cannot be ordered without a cycle (the planner then chooses more strictly)."""
+
+
+class ProviderIndex(Protocol):
+    """Ranked providers of a type, honouring value domains, subsumption and preconditions (the KnowledgeBase)."""
+
+    def providers(
+        self,
+        annotation_type: str,
+        value: str | None = None,
+        object_class: str | None = None,
+        conditions: Conditions | None = None,
+    ) -> Sequence[AnnotatorSpec]:
+        """Annotators providing ``annotation_type`` that can report ``value`` for ``object_class``, best first."""
+        ...
+
+    def annotators(self) -> Sequence[AnnotatorSpec]:
+        """Every annotator."""
+        ...
+
+    def superclasses(self, name: str, direct: bool = False) -> list[str]:
+        """The proper superclasses of a class (CAS types included)."""
+        ...
+
+
+@dataclass(frozen=True)
+class Requirement:
+    """A type the answer needs, the value asked for and why."""
+
+    annotation_type: str
+    value: str | None = None
+    reason: str = ""
+
+
+@dataclass(frozen=True)
+class SensorSource:
+    """The reader that starts every plan and the types it supplies."""
+
+    step: Step
+
+    @property
+    def types(self) -> frozenset[str]:
+        """The types the reader writes."""
+        return frozenset(self.step.outputs)
+
+
+def plan_requirements(
+    task: Task,
+    requirements: Sequence[Requirement],
+    index: ProviderIndex,
+    source: SensorSource,
+    conditions: Conditions | None = None,
+    parameters: Mapping[str, Mapping[str, object]] | None = None,
+    catalogs: dict[tuple[object, ...], object] | None = None,
+) -> Plan:
+    """Synthesize the staged plan that produces every requirement from the sensor source.
+
+    ``conditions`` say whether depth and a region are available; ``parameters`` are constructor arguments
+    per annotator name (e.g. the region box for a region filter). ``catalogs`` is a cache of the
+    requirement-independent work (providers, fixpoints) that callers planning many queries against one
+    ontology keep; it is keyed by object class, conditions and sensor types.
+    """
+    conditions = conditions or Conditions()
+    key = (task.object_class, conditions, source.types)
+    catalog = catalogs.get(key) if catalogs is not None else None
+    if not isinstance(catalog, _Catalog):
+        catalog = _Catalog(index, source.types, task.object_class, conditions)
+        if catalogs is not None:
+            catalogs[key] = catalog
+    try:
+        assignment = _Assignment(catalog, requirements, by_rounds=False)
+    except _OrderingError:
+        # the greedy choice of alternatives painted itself into a cycle: choose again, allowing only
+        # providers whose inputs are derived in earlier fixpoint rounds (always acyclic, fewer alternatives)
+        assignment = _Assignment(catalog, requirements, by_rounds=True)
+    layout = _Layout(catalog, assignment, source, dict(parameters or {}))
+    return Plan(task=task, stages=layout.stages(), sensor_types=source.types)
+
+
+class _Catalog:
+    """Candidate providers (memoised per type and value) and what can be produced from the sensors."""
+
+    def __init__(
+        self, index: ProviderIndex, sensors: frozenset[str], object_class: str | None, conditions: Conditions
+    ) -> None:
+        self.index = index
+        self._supertypes: dict[str, frozenset[str]] = {}
+        # a type is present when it or a subtype of it is: track each written type together with its supertypes
+        self.sensors = self.with_supertypes(sensors)
+        self.object_class = object_class
+        self.conditions = conditions
+        self._providers: dict[tuple[str, str | None], tuple[AnnotatorSpec, ...]] = {}
+        self._refiners: dict[str, list[AnnotatorSpec]] = {}
+        self._without: dict[frozenset[str], frozenset[str]] = {}
+        outputs = sorted({t for spec in index.annotators() for t in self.with_supertypes(spec.outputs)})
+        self.edges = [(spec, t) for t in outputs for spec in self.providers(t)]
+        self._waiting: dict[str, list[int]] = {}
+        for index, (spec, _) in enumerate(self.edges):
+            for needed in set(spec.inputs) - self.sensors:
+                self._waiting.setdefault(needed, []).append(index)
+        self._missing_at_start = [len(set(spec.inputs) - self.sensors) for spec, _ in self.edges]
+        self._ready_at_start = [i for i, count in enumerate(self._missing_at_start) if count == 0]
+        self.rounds = self._rounds()
+        self.producible = frozenset(self.rounds)
+
+    def _rounds(self) -> dict[str, int]:
+        """The fixpoint round in which each producible type first becomes producible (sensors: 0)."""
+        rounds = dict.fromkeys(self.sensors, 0)
+        current = 0
+        while True:
+            current += 1
+            known = set(rounds)
+            new = {t for spec, t in self.edges if t not in known and known.issuperset(spec.inputs)}
+            if not new:
+                return rounds
+            rounds.update(dict.fromkeys(new, current))
+
+    def with_supertypes(self, types: Iterable[str]) -> frozenset[str]:
+        """The types and all their supertypes."""
+        found: set[str] = set()
+        for type_name in types:
+            if type_name not in self._supertypes:
+                self._supertypes[type_name] = frozenset({type_name, *self.index.superclasses(type_name)})
+            found |= self._supertypes[type_name]
+        return frozenset(found)
+
+    def written(self, spec: AnnotatorSpec) -> frozenset[str]:
+        """What an annotator makes present for others: its outputs and their supertypes, minus what it reads."""
+        return self.with_supertypes(spec.outputs) - self.with_supertypes(spec.inputs)
+
+    def providers(self, type_name: str, value: str | None = None) -> tuple[AnnotatorSpec, ...]:
+        """Ranked providers of ``type_name`` for ``value`` (refiners of the type excluded)."""
+        key = (type_name, value)
+        if key not in self._providers:
+            found = self.index.providers(type_name, value, self.object_class, self.conditions)
+            # annotators without inputs are sensor readers: the plan's source is chosen by its input, not here
+            self._providers[key] = tuple(s for s in found if s.inputs and type_name not in s.inputs)
+        return self._providers[key]
+
+    def refiners(self, type_name: str) -> list[AnnotatorSpec]:
+        """Annotators that read and write ``type_name`` and whose preconditions hold, cheapest first."""
+        if type_name not in self._refiners:
+            found = self.index.providers(type_name, None, self.object_class, self.conditions)
+            self._refiners[type_name] = sorted(
+                (s for s in found if type_name in s.inputs), key=lambda s: (s.cost_ms, s.name)
+            )
+        return self._refiners[type_name]
+
+    def _fixpoint(self, forbidden: frozenset[str]) -> frozenset[str]:
+        """Worklist closure: each provider fires once all its inputs are known (linear in the ports)."""
+        known = set(self.sensors)
+        missing = list(self._missing_at_start)
+        queue = list(self._ready_at_start)
+        while queue:
+            produced = self.edges[queue.pop()][1]
+            if produced in known or produced in forbidden:
+                continue
+            known.add(produced)
+            for index in self._waiting.get(produced, ()):
+                missing[index] -= 1
+                if missing[index] == 0:
+                    queue.append(index)
+        return frozenset(known)
+
+    def producible_without(self, forbidden: frozenset[str]) -> frozenset[str]:
+        """What can be produced when the ``forbidden`` types may not be used."""
+        if forbidden not in self._without:
+            self._without[forbidden] = self._fixpoint(forbidden)
+        return self._without[forbidden]
+
+    def valid(
+        self, type_name: str, value: str | None, above: frozenset[str] = frozenset(), by_rounds: bool = False
+    ) -> list[AnnotatorSpec]:
+        """Providers of ``type_name`` whose inputs can be produced without it and without the types ``above`` it
+        (those that need it), so that choosing them cannot create a cycle; ``by_rounds`` keeps only those whose
+        inputs are derived earliest."""
+        usable = self.producible_without(above | {type_name})
+        found = [s for s in self.providers(type_name, value) if usable.issuperset(s.inputs)]
+        if by_rounds and found:
+            depth = {s.name: max((self.rounds.get(t, 0) for t in s.inputs), default=0) for s in found}
+            limit = min(depth.values())
+            found = [s for s in found if depth[s.name] <= limit]
+        return found
+
+    def why_not(self, type_name: str, value: str | None) -> str:
+        """Why no provider of ``type_name`` is usable, naming each excluded annotator."""
+        asked = f"{type_name} with value {value!r}" if value else type_name
+        usable = {s.name for s in self.providers(type_name, value)}
+        details = [
+            f"{s.name} {_exclusion(s, type_name, value, self.object_class, self.conditions)}"
+            for s in self.index.providers(type_name)
+            if s.name not in usable and type_name not in s.inputs
+        ]
+        producible = self.producible_without(frozenset({type_name}))
+        for spec in self.providers(type_name, value):
+            missing = sorted(set(spec.inputs) - producible)
+            details.append(f"{spec.name} needs {', '.join(missing)}, which cannot be produced")
+        if not details:
+            return f"no annotator in the ontology provides {asked}"
+        return f"no usable annotator provides {asked} ({'; '.join(details)})"
+
+
+class _UnitChoice:
+    """The providers chosen for one needed type (one unit of the plan)."""
+
+    def __init__(
+        self, type_name: str, providers: list[AnnotatorSpec], value: str | None, written: Callable[..., frozenset[str]]
+    ) -> None:
+        self.type_name = type_name
+        self.value = value
+        self._written = written
+        self.providers = providers
+
+    @property
+    def providers(self) -> list[AnnotatorSpec]:
+        """The alternatives, best first."""
+        return self._providers
+
+    @providers.setter
+    def providers(self, providers: list[AnnotatorSpec]) -> None:
+        self._providers = providers
+        self._guaranteed = frozenset.intersection(*(self._written(s) for s in providers))
+
+    def guaranteed(self) -> frozenset[str]:
+        """Types the unit produces for others: outputs every provider writes without having read them."""
+        return self._guaranteed
+
+
+class _Assignment:
+    """Which unit provides each needed type, with each annotator in at most one unit and no cycles.
+
+    Units are keyed by the type they were made for. ``above[T]`` holds the types whose units (transitively)
+    need unit T; a provider for T may not need any of them, which keeps the unit graph acyclic.
+    """
+
+    def __init__(self, catalog: _Catalog, requirements: Sequence[Requirement], by_rounds: bool) -> None:
+        self.catalog = catalog
+        self.by_rounds = by_rounds
+        self.requirements = requirements
+        self.values = {r.annotation_type: r.value for r in requirements}
+        self.reasons: dict[str, list[str]] = {}
+        for requirement in requirements:
+            self._note(requirement.annotation_type, requirement.reason)
+        self.units: dict[str, _UnitChoice] = {}
+        self.above: dict[str, set[str]] = {}
+        self._guaranteed: dict[str, str] | None = None
+        self._dependencies: dict[str, set[str]] | None = None
+        self.pinned: dict[str, str] = {}  # type -> unit chosen for it when several units write it
+        self._check_feasible()
+        self._assign()
+        self._prune()
+
+    def _note(self, type_name: str, reason: str) -> None:
+        reasons = self.reasons.setdefault(type_name, [])
+        if reason and reason not in reasons:
+            reasons.append(reason)
+
+    def _check_feasible(self) -> None:
+        for requirement in self.requirements:
+            type_name, value = requirement.annotation_type, requirement.value
+            if type_name in self.catalog.sensors:
+                continue
+            if type_name not in self.catalog.producible or not self.catalog.valid(type_name, value):
+                raise PlanningError(
+                    f"cannot satisfy '{requirement.reason or type_name}': {self.catalog.why_not(type_name, value)}"
+                )
+
+    def owner(self) -> dict[str, str]:
+        """Annotator name -> the type of the unit it belongs to."""
+        return {s.name: key for key, unit in self.units.items() for s in unit.providers}
+
+    def _invalidate(self) -> None:
+        self._guaranteed = None
+        self._dependencies = None
+
+    def _set_providers(self, key: str, providers: list[AnnotatorSpec]) -> None:
+        self.units[key].providers = providers
+        self._invalidate()
+
+    def guaranteed_by(self) -> dict[str, str]:
+        """Type -> the unit (by its type) that guarantees it (cached until the units change)."""
+        if self._guaranteed is None:
+            self._guaranteed = self._compute_guaranteed()
+        return self._guaranteed
+
+    def _compute_guaranteed(self) -> dict[str, str]:
+        found: dict[str, str] = {}
+        rounds = self.catalog.rounds
+        # by-products come from the unit derived earliest, the one least likely to depend on their readers
+        for key in sorted(self.units, key=lambda k: (rounds.get(k, 0), k)):
+            providers = self.units[key].providers
+            for type_name in sorted(self.units[key].guaranteed()):
+                if self.by_rounds and any(
+                    max((rounds.get(t, 0) for t in s.inputs), default=0) >= rounds.get(type_name, 0) for s in providers
+                ):
+                    continue  # a by-product made from later types could close a cycle in the strict mode
+                found.setdefault(type_name, key)
+        for type_name, key in self.pinned.items():
+            if key in self.units and type_name in self.units[key].guaranteed():
+                found[type_name] = key
+        for key in self.units:  # a unit always guarantees its own type
+            found[key] = key
+        return found
+
+    def dependencies(self) -> dict[str, set[str]]:
+        """Unit -> the units its providers' required inputs come from (cached until the units change)."""
+        if self._dependencies is None:
+            self._dependencies = self._compute_dependencies()
+        return self._dependencies
+
+    def _compute_dependencies(self) -> dict[str, set[str]]:
+        guaranteed = self.guaranteed_by()
+        return {
+            key: {guaranteed[t] for s in unit.providers for t in s.inputs if t in guaranteed} - {key}
+            for key, unit in self.units.items()
+        }
+
+    def _below(self, key: str) -> set[str]:
+        """The unit and every unit it (transitively) needs."""
+        graph = self.dependencies()
+        seen = {key}
+        frontier = [key]
+        while frontier:
+            for dep in graph.get(frontier.pop(), ()):
+                if dep not in seen:
+                    seen.add(dep)
+                    frontier.append(dep)
+        return seen
+
+    def _reuse(self, key: str, above: set[str]) -> bool:
+        """Let the types ``above`` use unit ``key`` when that makes no cycle."""
+        below = self._below(key)
+        if below & above:
+            return False
+        for unit in below:
+            self.above.setdefault(unit, set()).update(above)
+        return True
+
+    def _cut(self, key: str, above: set[str]) -> bool:
+        """Drop the alternatives below unit ``key`` that need a type in ``above``; False when none can remain."""
+        return self._cut_below(key, above, frozenset(), {})
+
+    def _cut_below(self, key: str, above: set[str], path: frozenset[str], memo: dict[str, bool]) -> bool:
+        if key in above or key in path:
+            return False
+        if key in memo:
+            return memo[key]
+        unit = self.units[key]
+        guaranteed = self.guaranteed_by()
+        keep = []
+        for spec in unit.providers:
+            inputs = {guaranteed[t] for t in spec.inputs if t in guaranteed} - {key}
+            if all(self._cut_below(dep, above, path | {key}, memo) for dep in sorted(inputs)):
+                keep.append(spec)
+        memo[key] = bool(keep)
+        if keep and len(keep) < len(unit.providers):
+            self._set_providers(key, keep)
+        return bool(keep)
+
+    def _drop_needing(self, key: str, type_name: str) -> bool:
+        """Drop the alternatives of unit ``key`` that need ``type_name``, if others remain."""
+        unit = self.units[key]
+        keep = [spec for spec in unit.providers if type_name not in spec.inputs]
+        if not keep or len(keep) == len(unit.providers):
+            return False
+        self._set_providers(key, keep)
+        return True
+
+    def _take_over(self, type_name: str, valid: list[AnnotatorSpec], consumer: str | None, above: set[str]) -> bool:
+        """Every valid provider runs as an alternative elsewhere: commit that unit to one of them, or drop the
+        consumer's alternatives that needed the type."""
+        owner = self.owner()
+        for spec in valid:
+            key = owner[spec.name]
+            if consumer is not None and (key == consumer or key in above):
+                if self._drop_needing(consumer, type_name):
+                    return True
+                continue
+            previous = list(self.units[key].providers)
+            self._set_providers(key, [spec])
+            if self._cut(key, above) and self._reuse(key, above):
+                self._note(type_name, f"{spec.name} also provides it")
+                self.pinned[type_name] = key
+                self._invalidate()
+                return True
+            self._set_providers(key, previous)
+        return False
+
+    def _assign(self) -> None:
+        queue: deque[tuple[str, str | None]] = deque((r.annotation_type, None) for r in self.requirements)
+        while queue:
+            type_name, consumer = queue.popleft()
+            if type_name in self.catalog.sensors:
+                continue
+            if consumer is not None and (
+                consumer not in self.units or not any(type_name in s.inputs for s in self.units[consumer].providers)
+            ):
+                continue  # the consumer's alternatives that needed it were dropped
+            above = set() if consumer is None else self.above.get(consumer, set()) | {consumer}
+            existing = self.guaranteed_by().get(type_name)
+            if existing is not None and self._cut(existing, above) and self._reuse(existing, above):
+                continue
+            if existing is not None and consumer is not None and self._drop_needing(consumer, type_name):
+                continue
+            value = self.values.get(type_name)
+            if existing == type_name:
+                # the type's own unit leads back to this consumer: choose its providers again under all constraints
+                combined = above | self.above.get(type_name, set())
+                owner = self.owner()
+                again = [
+                    s
+                    for s in self.catalog.valid(type_name, value, frozenset(combined), self.by_rounds)
+                    if owner.get(s.name) in (None, type_name)
+                ]
+                if not again:
+                    raise _OrderingError(f"cannot order the annotators for {type_name}: its providers need {consumer}")
+                self._set_providers(type_name, again)
+                self.above[type_name] = combined
+                queue.extend((needed, type_name) for spec in again for needed in spec.inputs)
+                continue
+            valid = self.catalog.valid(type_name, value, frozenset(above), self.by_rounds)
+            owner = self.owner()
+            free = [s for s in valid if s.name not in owner]
+            if not free:
+                if not self._take_over(type_name, valid, consumer, above):
+                    raise _OrderingError(f"cannot produce {type_name}: {self.catalog.why_not(type_name, value)}")
+                continue
+            self.units[type_name] = _UnitChoice(type_name, free, value, self.catalog.written)
+            self._invalidate()
+            self.above[type_name] = set(above)
+            for spec in free:
+                for needed in spec.inputs:
+                    self._note(needed, f"needed by {spec.name}")
+                    queue.append((needed, type_name))
+
+    def _prune(self) -> None:
+        """Drop units that no requirement needs any more (after a unit was committed to one provider)."""
+        while True:
+            guaranteed = self.guaranteed_by()
+            needed: set[str] = set()
+            frontier = [r.annotation_type for r in self.requirements]
+            while frontier:
+                type_name = frontier.pop()
+                key = guaranteed.get(type_name)
+                if key is None or key in needed:
+                    continue
+                needed.add(key)
+                frontier.extend(t for s in self.units[key].providers for t in s.inputs)
+            unneeded = set(self.units) - needed
+            if not unneeded:
+                return
+            for key in unneeded:
+                del self.units[key]
+            self._invalidate()
+
+
+def _find_cycle(graph: Mapping[str, set[str]]) -> list[str] | None:
+    """A cycle of the graph (each node followed by a node it depends on), or None."""
+    state: dict[str, int] = {}
+    path: list[str] = []
+
+    def visit(node: str) -> list[str] | None:
+        state[node] = 1
+        path.append(node)
+        for dep in sorted(graph.get(node, ())):
+            if state.get(dep) == 1:
+                return path[path.index(dep) :]
+            if dep not in state:
+                found = visit(dep)
+                if found:
+                    return found
+        state[node] = 2
+        path.pop()
+        return None
+
+    for node in sorted(graph):
+        if node not in state:
+            found = visit(node)
+            if found:
+                return found
+    return None
+
+
+class _Layout:
+    """Units (the reader, provider units, refinements) with their dependencies, staged by depth.
+
+    Unit keys: ``reader``, ``type:<T>`` and ``refine:<annotator>``.
+    """
+
+    def __init__(
+        self,
+        catalog: _Catalog,
+        assignment: _Assignment,
+        source: SensorSource,
+        parameters: dict[str, Mapping[str, object]],
+    ) -> None:
+        self.catalog = catalog
+        self.assignment = assignment
+        self.units = assignment.units
+        self.source = source
+        self.parameters = parameters
+        self.branches = self._branches()
+        absorbed = {t for owned in self.branches.values() for types in owned.values() for t in types}
+        self.final: dict[str, str] = dict.fromkeys(catalog.sensors, "reader")
+        for type_name, key in sorted(assignment.guaranteed_by().items()):
+            if key not in absorbed:
+                self.final[type_name] = f"type:{key}"
+        for owner_type, owned in self.branches.items():
+            for types in owned.values():
+                for type_name in types:
+                    self.final[type_name] = f"type:{owner_type}"
+        self.unrefined = dict(self.final)
+        self.refinements = self._refinements()
+        while True:
+            self._connect()
+            cycle = self._required_cycle()
+            if cycle is None:
+                break
+            # refinements that would close a cycle are left out (refinements are improvements, never required)
+            dropped = {key.split(":", 1)[1] for key in cycle if key.startswith("refine:")}
+            if not dropped:
+                raise PlanningError(f"the annotators for {' -> '.join(cycle)} depend on each other in a cycle")
+            self.refinements = {t: [s for s in specs if s.name not in dropped] for t, specs in self.refinements.items()}
+            self.refinements = {t: specs for t, specs in self.refinements.items() if specs}
+
+    def _connect(self) -> None:
+        """Compute the final producer of each type and every unit's dependencies for the current refinements."""
+        absorbed = {t for owned in self.branches.values() for types in owned.values() for t in types}
+        self.final = dict(self.unrefined)
+        for type_name, specs in self.refinements.items():
+            self.final[type_name] = f"refine:{specs[-1].name}"
+        self.dependencies: dict[str, set[str]] = {"reader": set()}
+        self.optional_edges: set[tuple[str, str]] = set()
+        self.refines_output_of: dict[str, str] = {}
+        for type_name, specs in sorted(self.refinements.items()):
+            previous = self.unrefined[type_name]
+            for spec in specs:
+                key = f"refine:{spec.name}"
+                self.refines_output_of[spec.name] = previous
+                required = {previous} | self._producers([t for t in spec.inputs if t != type_name])
+                optional = self._producers(spec.optional_inputs) - required
+                self.optional_edges |= {(key, dep) for dep in optional}
+                self.dependencies[key] = (required | optional) - {key}
+                previous = key
+        for type_name in sorted(self.units):
+            if type_name in absorbed:
+                continue
+            key = f"type:{type_name}"
+            deps: set[str] = set()
+            optional: set[str] = set()
+            for spec in self.units[type_name].providers:
+                members = self._members(type_name, spec)
+                inside = set(self.branches.get(type_name, {}).get(spec.name, []))
+                deps |= self._producers([t for m in members for t in m.inputs if t not in inside])
+                optional |= self._producers([t for m in members for t in m.optional_inputs if t not in inside])
+            self.optional_edges |= {(key, dep) for dep in optional - deps}
+            self.dependencies[key] = (deps | optional) - {key}
+
+    def _refinements(self) -> dict[str, list[AnnotatorSpec]]:
+        """Refiners of planned types whose other inputs are planned too and that are not otherwise used."""
+        used = set(self.assignment.owner())
+        read = {r.annotation_type for r in self.assignment.requirements}
+        read |= {t for unit in self.units.values() for s in unit.providers for t in s.inputs}
+        found: dict[str, list[AnnotatorSpec]] = {}
+        for type_name in sorted(self.final.keys() & read):
+            usable = [
+                s
+                for s in self.catalog.refiners(type_name)
+                if s.name not in used and all(t == type_name or t in self.final for t in s.inputs)
+            ]
+            # refiners made for a situation (with preconditions, which hold) all apply; of the general-purpose
+            # ones only the cheapest does, so two interchangeable crops are never chained
+            specs = [s for s in usable if s.preconditions]
+            general = [s for s in usable if not s.preconditions]
+            if general:
+                specs.append(min(general, key=lambda s: (s.cost_ms, -s.reliability, s.name)))
+            specs.sort(key=lambda s: (s.cost_ms, s.name))
+            if specs:
+                found[type_name] = specs
+                used |= {s.name for s in specs}
+        return found
+
+    def _producers(self, types: Iterable[str]) -> set[str]:
+        return {self.final[t] for t in types if t in self.final}
+
+    def _members(self, type_name: str, spec: AnnotatorSpec) -> list[AnnotatorSpec]:
+        """The annotators of one branch: absorbed providers in dependency order, then the alternative."""
+        owned = self.branches.get(type_name, {}).get(spec.name, [])
+        return [self.units[t].providers[0] for t in _topological(owned, self.units)] + [spec]
+
+    def _branches(self) -> dict[str, dict[str, list[str]]]:
+        """For each unit with alternatives: the units only one alternative needs, moved into its branch.
+
+        A unit moves when it has a single provider, guarantees nothing else that is used, and is needed
+        only inside that branch.
+        """
+        consumers: dict[str, set[str]] = {}
+        for unit in self.units.values():
+            for spec in unit.providers:
+                for needed in (*spec.inputs, *spec.optional_inputs):
+                    consumers.setdefault(needed, set()).add(spec.name)
+        for type_name in sorted(set(self.units) | set(self.catalog.sensors)):
+            for spec in self.catalog.refiners(type_name):
+                for needed in (*spec.inputs, *spec.optional_inputs):
+                    consumers.setdefault(needed, set()).add(spec.name)
+        guaranteed = self.assignment.guaranteed_by()
+        branches: dict[str, dict[str, list[str]]] = {}
+        for type_name in sorted(self.units):
+            unit = self.units[type_name]
+            if len(unit.providers) < 2:
+                continue
+            branches[type_name] = {}
+            for spec in unit.providers:
+                owned: list[str] = []
+                members = {spec.name}
+                frontier = list(spec.inputs)
+                while frontier:
+                    needed = frontier.pop(0)
+                    key = guaranteed.get(needed)
+                    if key is None or key in owned or key == type_name or len(self.units[key].providers) != 1:
+                        continue
+                    outputs = [t for t, k in guaranteed.items() if k == key]
+                    if any(not consumers.get(t, set()) <= members for t in outputs):
+                        continue
+                    owned.append(key)
+                    inner = self.units[key].providers[0]
+                    members.add(inner.name)
+                    frontier.extend(inner.inputs)
+                branches[type_name][spec.name] = owned
+        return branches
+
+    def _required_cycle(self) -> list[str] | None:
+        """Drop optional ordering edges that close cycles; return a cycle of required edges, if any."""
+        while True:
+            cycle = _find_cycle(self.dependencies)
+            if cycle is None:
+                return None
+            edges = list(zip(cycle, cycle[1:] + cycle[:1], strict=True))
+            optional = [edge for edge in edges if edge in self.optional_edges]
+            if not optional:
+                return cycle
+            consumer, producer = optional[0]
+            self.dependencies[consumer].discard(producer)
+
+    def stages(self) -> tuple[tuple[Unit, ...], ...]:
+        """Units grouped by dependency depth, in a deterministic order."""
+        depth: dict[str, int] = {}
+
+        def level(key: str) -> int:
+            if key not in depth:
+                depth[key] = 1 + max((level(d) for d in self.dependencies.get(key, set())), default=-1)
+            return depth[key]
+
+        by_level: dict[int, list[str]] = {}
+        for key in sorted(self.dependencies):
+            by_level.setdefault(level(key), []).append(key)
+        return tuple(tuple(self._unit(key) for key in sorted(keys)) for _, keys in sorted(by_level.items()))
+
+    def _label(self, key: str) -> str:
+        if key == "reader":
+            return self.source.step.annotator
+        kind, name = key.split(":", 1)
+        if kind == "refine":
+            return name
+        return " / ".join(s.name for s in self.units[name].providers)
+
+    def _step(self, spec: AnnotatorSpec, why: str, provides: str = "", inside: Iterable[str] = ()) -> Step:
+        inside_types = {t for key in inside for t in self.units[key].guaranteed()}
+        guaranteed = self.assignment.guaranteed_by()
+        feeds = []
+        for needed in spec.inputs:
+            if needed in inside_types:
+                feeds.append(f"{needed} from {self.units[guaranteed[needed]].providers[0].name}")
+            elif needed in spec.outputs and spec.name in self.refines_output_of:
+                feeds.append(f"{needed} from {self._label(self.refines_output_of[spec.name])}")
+            elif needed in self.final:
+                feeds.append(f"{needed} from {self._label(self.final[needed])}")
+        reason = f"{spec.name}: {why}"
+        if feeds:
+            reason += f"; needs {', '.join(feeds)}"
+        return Step(
+            annotator=spec.name,
+            implemented_by=spec.implemented_by,
+            inputs=tuple(spec.inputs),
+            outputs=tuple(spec.outputs),
+            parameters=tuple(sorted(self.parameters.get(spec.name, {}).items())),
+            reason=reason,
+            provides=provides,
+        )
+
+    def _why(self, type_name: str) -> str:
+        reasons = self.assignment.reasons.get(type_name, [])
+        consumers = [r.removeprefix("needed by ") for r in reasons if r.startswith("needed by ")]
+        others = [r for r in reasons if not r.startswith("needed by ")]
+        if consumers:
+            others.append(f"{type_name} is needed by {', '.join(consumers)}")
+        return "; ".join(others) if others else f"provides {type_name}"
+
+    def _unit(self, key: str) -> Unit:
+        if key == "reader":
+            return self.source.step
+        kind, name = key.split(":", 1)
+        if kind == "refine":
+            refined, spec = next((t, s) for t, specs in self.refinements.items() for s in specs if s.name == name)
+            return self._step(spec, f"refines {refined} before it is used ({_precondition_note(spec)})")
+        unit = self.units[name]
+        if len(unit.providers) == 1:
+            return self._step(unit.providers[0], self._why(name), provides=name)
+        branches = []
+        for spec in unit.providers:
+            members = self._members(name, spec)
+            owned = self.branches[name][spec.name]
+            inner = tuple(self._step(m, f"needed only by {spec.name}", inside=owned) for m in members[:-1])
+            branches.append((*inner, self._step(spec, self._why(name), provides=name, inside=owned)))
+        ranking = ", ".join(f"{s.name} (reliability {s.reliability:g}, {s.cost_ms:g} ms)" for s in unit.providers)
+        return Alternatives(
+            provides=name,
+            branches=tuple(branches),
+            reason=f"{len(unit.providers)} annotators can provide {name}; tried in rank order: {ranking}",
+        )
+
+
+def _topological(keys: list[str], units: Mapping[str, _UnitChoice]) -> list[str]:
+    """Order units so that each comes after the units of the same list whose types it needs."""
+    ordered: list[str] = []
+    remaining = list(keys)
+    while remaining:
+        for key in sorted(remaining):
+            needs = set(units[key].providers[0].inputs)
+            if not any(units[other].guaranteed() & needs for other in remaining if other != key):
+                ordered.append(key)
+                remaining.remove(key)
+                break
+        else:
+            ordered.extend(sorted(remaining))
+            break
+    return ordered
+
+
+def _precondition_note(spec: AnnotatorSpec) -> str:
+    if spec.preconditions:
+        return "its preconditions hold: " + ", ".join(spec.preconditions)
+    return "the cheapest general-purpose one"
+
+
+def _exclusion(
+    spec: AnnotatorSpec, type_name: str, value: str | None, object_class: str | None, conditions: Conditions
+) -> str:
+    """Why the knowledge base excluded ``spec`` as a provider, in words."""
+    domain_field = _VALUE_DOMAIN_FIELDS.get(type_name)
+    domain: frozenset[str] = getattr(spec, domain_field) if domain_field else frozenset()
+    if value is not None and domain:
+        return f"can report only {', '.join(sorted(domain))}, not {value!r}"
+    if spec.preconditions:
+        facts = f"depth available: {conditions.depth}, region given: {conditions.region}"
+        target = f" for {object_class}" if object_class else ""
+        return f"has preconditions {', '.join(spec.preconditions)} that do not hold{target} ({facts})"
+    if object_class is not None and spec.classes:
+        return f"recognises only {', '.join(sorted(spec.classes))}, not {object_class}"
+    return "was excluded by the knowledge base"
+
+
+_VALUE_DOMAIN_FIELDS = {"SemanticColor": "colors", "Shape": "shapes", "Size": "sizes", "Classification": "classes"}

@@ -1,0 +1,125 @@
+"""From a parsed query to a Plan: interpretation, then synthesis against the sensor source."""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+from queries.model import Query
+from reasoning.knowledge.knowledge_base import KnowledgeBase
+from reasoning.knowledge.model import Conditions, RegionBox
+from reasoning.planning.interpretation import Interpretation, interpret
+from reasoning.planning.plan import Plan
+from reasoning.planning.planner import SensorSource, plan_requirements
+
+DEPTH_TYPES = frozenset({"DepthImage", "PointCloud"})
+REGION_PRECONDITION = "NeedsRegion"
+ROOT_CLASS = "PhysicalObject"
+
+
+@dataclass(frozen=True)
+class QueryPlan:
+    """A plan together with the interpretation it was made from."""
+
+    plan: Plan
+    interpretation: Interpretation
+
+
+def region_parameters(box: RegionBox) -> dict[str, object]:
+    """Constructor arguments that hand a region box to an annotator needing one (plain data, no ontology types)."""
+    return {
+        "region": box.name,
+        "box_pose": tuple(float(v) for v in box.pose.reshape(-1)),
+        "box_size": tuple(float(v) for v in box.size),
+    }
+
+
+def class_profiles(kb: KnowledgeBase) -> tuple[dict[str, object], ...]:
+    """What every object class typically looks like, as plain data for a knowledge-based classifier.
+
+    Colours, shape and size are the ontology's lower-case labels; classes that say nothing visible are left out.
+    """
+    profiles = []
+    for name in kb.names_of_kind("class"):
+        profile = kb.object_profile(name)
+        if not (profile.colors or profile.shape or profile.size_class or profile.texts):
+            continue
+        profiles.append(
+            {
+                "class": name,
+                "colors": tuple(kb.label(c) for c in profile.colors),
+                "shape": kb.label(profile.shape) if profile.shape else None,
+                "size": kb.label(profile.size_class) if profile.size_class else None,
+                "texts": profile.texts,
+                "ancestors": (name, *kb.superclasses(name)),
+            }
+        )
+    return tuple(profiles)
+
+
+def annotator_parameters(
+    kb: KnowledgeBase,
+    box: RegionBox | None,
+    profiles: tuple[dict[str, object], ...] | None = None,
+    expected: str | None = None,
+) -> dict[str, dict[str, object]]:
+    """Constructor arguments the plan hands to annotators, from the ontology.
+
+    An annotator that needs a region gets the region box; one that can report any object class (its class
+    domain is the root class) is a classifier by knowledge and gets the profiles of the classes and the class
+    the query asks for (``expected``).
+    """
+    parameters: dict[str, dict[str, object]] = {}
+    for spec in kb.annotators():
+        if box is not None and REGION_PRECONDITION in spec.preconditions:
+            parameters[spec.name] = region_parameters(box)
+        if "Classification" in spec.outputs and ROOT_CLASS in spec.classes:
+            profiles = profiles if profiles is not None else class_profiles(kb)
+            parameters.setdefault(spec.name, {})["profiles"] = profiles
+            if expected is not None:
+                parameters[spec.name]["expected"] = expected
+    return parameters
+
+
+class QueryPlanner:
+    """Plans queries against one knowledge base, keeping what only changes with the ontology (class profiles)."""
+
+    def __init__(self, kb: KnowledgeBase) -> None:
+        self.kb = kb
+        self._index: object | None = None
+        self._profiles: tuple[dict[str, object], ...] = ()
+        self._catalogs: dict[tuple[object, ...], object] = {}
+
+    def _refresh(self) -> None:
+        """Drop what was derived from an older ontology (after the knowledge base reloaded)."""
+        if self._index is not self.kb.index:
+            self._index = self.kb.index
+            self._profiles = class_profiles(self.kb)
+            self._catalogs = {}
+
+    def profiles(self) -> tuple[dict[str, object], ...]:
+        """The class profiles of the current ontology."""
+        self._refresh()
+        return self._profiles
+
+    def plan(self, query: Query, source: SensorSource) -> QueryPlan:
+        """Interpret ``query`` and synthesize the plan that answers it from ``source``'s sensor types."""
+        depth = bool(source.types & DEPTH_TYPES)
+        interpretation = interpret(query, self.kb, depth=depth)
+        box = interpretation.region_box
+        conditions = Conditions(depth=depth, region=box is not None)
+        parameters = annotator_parameters(self.kb, box, self.profiles(), interpretation.task.object_class)
+        plan = plan_requirements(
+            interpretation.task,
+            interpretation.requirements,
+            self.kb,
+            source,
+            conditions=conditions,
+            parameters=parameters,
+            catalogs=self._catalogs,
+        )
+        return QueryPlan(plan, interpretation)
+
+
+def plan_query(query: Query, kb: KnowledgeBase, source: SensorSource) -> QueryPlan:
+    """Interpret ``query`` and synthesize the plan that answers it (one-off; see QueryPlanner to plan many)."""
+    return QueryPlanner(kb).plan(query, source)

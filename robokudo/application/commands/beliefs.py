@@ -1,0 +1,107 @@
+"""``robokudo beliefs [QUERY] [--json] [--clear] [--store PATH]``: answer from memory, without perception.
+
+Without QUERY every known object is listed; with QUERY (any query form) the known objects matching it are
+listed, using the knowledge base for class subsumption and regions. ``--clear`` forgets everything. The store
+is ``--store``, else ``$ROBOKUDO_BELIEF_STORE``, else ``<user data dir>/robokudo/beliefs.sqlite``.
+"""
+
+from __future__ import annotations
+
+import argparse
+import importlib
+import json
+import sys
+from pathlib import Path
+from typing import Any
+
+from reasoning.beliefs.answer import Answer, answer_from_memory
+from reasoning.beliefs.filters import belief_filter
+from reasoning.beliefs.store import BeliefFilter, BeliefStore, BeliefStoreError
+
+
+def add_arguments(parser: argparse.ArgumentParser) -> None:
+    """Declare the arguments of ``robokudo beliefs``."""
+    parser.add_argument("query", nargs="?", help='a perception query, e.g. "milk in fridge" (default: everything)')
+    parser.add_argument("--json", action="store_true", help="print the answer as JSON")
+    parser.add_argument("--clear", action="store_true", help="forget every stored belief")
+    parser.add_argument("--all", action="store_true", help="include objects marked gone")
+    parser.add_argument("--store", type=Path, default=None, help="belief store file (default: see above)")
+
+
+def run(args: argparse.Namespace) -> int:
+    """Run ``robokudo beliefs``; 0 on success, 2 on a bad store or query."""
+    path = args.store.expanduser() if args.store else BeliefStore.default_path()
+    try:
+        if args.clear:
+            return _clear(path, args)
+        if not path.exists():
+            return _print(Answer(query=args.query or "", from_memory=True), args, f"no beliefs stored yet ({path})")
+        kb = _knowledge_base() if args.query else None
+        query_filter = _filter(args.query, args.all, kb)
+        options = {"label_of": kb.label} if kb is not None and callable(getattr(kb, "label", None)) else {}
+        with BeliefStore(path) as store:
+            answer = answer_from_memory(store, query_filter, args.query or "", **options)
+        return _print(answer, args, None)
+    except BeliefStoreError as error:
+        print(f"robokudo beliefs: {error}", file=sys.stderr)
+        return 2
+    except _QueryProblemError as error:
+        print(f"robokudo beliefs: {error}", file=sys.stderr)
+        return 2
+
+
+class _QueryProblemError(Exception):
+    """The query text could not be parsed."""
+
+
+def _clear(path: Path, args: argparse.Namespace) -> int:
+    count = 0
+    if path.exists():
+        with BeliefStore(path) as store:
+            count = store.clear()
+    if args.json:
+        print(json.dumps({"cleared": count, "store": str(path)}))
+    else:
+        print(f"forgot {count} object(s) in {path}")
+    return 0
+
+
+def _filter(text: str | None, include_gone: bool, kb: Any) -> BeliefFilter:
+    if not text:
+        return BeliefFilter(include_gone=include_gone)
+    parse = _parser()
+    try:
+        query = parse(text)
+    except Exception as error:  # the parser's located QueryError, whatever its class
+        try:  # a memory question may name just the object: "milk in fridge" means "find milk in fridge"
+            query = parse(f"find {text}")
+        except Exception:
+            raise _QueryProblemError(str(error)) from error
+    return belief_filter(query, kb, include_gone=include_gone)
+
+
+def _parser() -> Any:
+    module = importlib.import_module("queries")
+    parse = getattr(module, "parse_query", None)
+    if parse is None:
+        parse = importlib.import_module("queries.dispatch").parse_query
+    return parse
+
+
+def _knowledge_base() -> Any:
+    """The knowledge base when it is available; without it classes and regions match by name only."""
+    try:
+        module = importlib.import_module("reasoning.knowledge.knowledge_base")
+    except ImportError:
+        return None
+    return module.KnowledgeBase.load()
+
+
+def _print(answer: Answer, args: argparse.Namespace, note: str | None) -> int:
+    if args.json:
+        print(answer.to_json())
+    else:
+        if note:
+            print(note, file=sys.stderr)
+        print(answer.summary())
+    return 0

@@ -1,0 +1,278 @@
+"""``robokudo ontology``: show terms, check the ontology, add and remove user object classes.
+
+Wired into ``robokudo/cli.py`` as an external subcommand: this module provides ``add_arguments(parser)``
+and ``run(args) -> int``. A rejected edit or an unknown name exits with status 2 and a message on
+stderr; a failed ``check`` exits with 1.
+"""
+
+from __future__ import annotations
+
+import argparse
+import sys
+from pathlib import Path
+
+from reasoning.errors import EditRejectedError, OntologyError, TermError
+from reasoning.knowledge.editing import CheckReport, EditResult, OntologyEditor
+from reasoning.knowledge.knowledge_base import KnowledgeBase
+from reasoning.knowledge.model import AnnotatorSpec, RegionBox, Resolved
+from reasoning.knowledge.sources import USER_ONTOLOGY_ENV
+
+
+def add_arguments(parser: argparse.ArgumentParser) -> None:
+    """Add the ``ontology`` options and its actions (add-object, show, check, remove-object)."""
+    _common_options(parser, suppress=False)
+    actions = parser.add_subparsers(dest="ontology_action", required=True, metavar="ACTION")
+
+    add = actions.add_parser("add-object", help="add an object class to the user ontology")
+    add.add_argument("name", help="the new class name, CamelCase (e.g. OatMilk)")
+    add.add_argument(
+        "--is-a",
+        dest="is_a",
+        action="append",
+        required=True,
+        metavar="PARENT",
+        help="a parent class (repeat for several)",
+    )
+    add.add_argument(
+        "--color",
+        "--colour",
+        dest="colors",
+        action="extend",
+        nargs="+",
+        default=[],
+        metavar="C",
+        help="typical colour(s)",
+    )
+    add.add_argument("--shape", help="typical shape (box, cylinder, sphere, flat)")
+    add.add_argument("--size", help="size class (small, medium, large)")
+    add.add_argument("--material", help="material (ceramic, plastic, glass, ...)")
+    see_through = add.add_mutually_exclusive_group()
+    see_through.add_argument(
+        "--transparent",
+        dest="transparent",
+        action="store_const",
+        const=True,
+        default=None,
+        help="objects of the class are transparent",
+    )
+    see_through.add_argument(
+        "--opaque",
+        dest="transparent",
+        action="store_const",
+        const=False,
+        help="objects of the class are not transparent",
+    )
+    add.add_argument("--stored-in", dest="stored_in", metavar="REGION", help="region class where it is kept")
+    add.add_argument(
+        "--text", dest="texts", action="extend", nargs="+", default=[], metavar="TEXT", help="text printed on it"
+    )
+    add.add_argument("--brand", help="brand printed on it")
+    add.add_argument("--label", help="the label (default: the name's words, e.g. 'oat milk')")
+    add.add_argument(
+        "--synonym",
+        dest="synonyms",
+        action="append",
+        default=[],
+        metavar="WORD",
+        help="another word for it (repeat for several)",
+    )
+    _common_options(add, suppress=True)
+
+    show = actions.add_parser("show", help="show a class, region, annotator or value")
+    show.add_argument("name", help="a name or a word (label, synonym, plural)")
+    _common_options(show, suppress=True)
+
+    check = actions.add_parser("check", help="check the ontology: loading, HermiT, annotator code agreement")
+    check.add_argument("--no-code", action="store_true", help="do not import and compare the annotator classes")
+    _common_options(check, suppress=True)
+
+    remove = actions.add_parser("remove-object", help="remove an object class from the user ontology")
+    remove.add_argument("name")
+    _common_options(remove, suppress=True)
+
+
+def _common_options(parser: argparse.ArgumentParser, suppress: bool) -> None:
+    """``--user-file`` and ``--no-reasoner``, accepted before or after the action (no default after it)."""
+    parser.add_argument(
+        "--user-file",
+        type=Path,
+        default=argparse.SUPPRESS if suppress else None,
+        metavar="PATH",
+        help=f"the user ontology file (default: ${USER_ONTOLOGY_ENV} or the user data directory)",
+    )
+    parser.add_argument(
+        "--no-reasoner",
+        action="store_true",
+        default=argparse.SUPPRESS if suppress else False,
+        help="skip HermiT; use the asserted hierarchy and disjointness only",
+    )
+
+
+def run(args: argparse.Namespace) -> int:
+    """Carry out the chosen action; returns the exit status."""
+    action = args.ontology_action
+    try:
+        kb = KnowledgeBase.load(args.user_file)
+    except OntologyError as error:
+        print(f"robokudo ontology: {error}", file=sys.stderr)
+        return 1 if action == "check" else 2
+    editor = OntologyEditor(kb, use_reasoner=not args.no_reasoner)
+    try:
+        if action == "show":
+            print(describe(kb, args.name))
+            return 0
+        if action == "check":
+            return _report(editor.check(code=not args.no_code))
+        if action == "add-object":
+            result = editor.add_object(
+                args.name,
+                args.is_a,
+                colors=args.colors,
+                shape=args.shape,
+                size=args.size,
+                material=args.material,
+                transparent=args.transparent,
+                stored_in=args.stored_in,
+                texts=args.texts,
+                brand=args.brand,
+                label=args.label,
+                synonyms=args.synonyms,
+            )
+            _print_result(result)
+            print(describe(kb, result.name))
+            return 0
+        if action == "remove-object":
+            _print_result(editor.remove_object(args.name))
+            return 0
+    except EditRejectedError as error:
+        print(f"robokudo ontology {action}: {error}", file=sys.stderr)
+        return 2
+    except TermError as error:
+        print(f"robokudo ontology {action}: {error}", file=sys.stderr)
+        return 2
+    raise ValueError(f"unknown ontology action {action!r}")
+
+
+def _print_result(result: EditResult) -> None:
+    verb = "added" if result.action == "add-object" else "removed"
+    print(f"{verb} {result.name} ({result.user_file}); checked by: {result.checked_by}")
+    for warning in result.warnings:
+        print(f"warning: {warning}", file=sys.stderr)
+
+
+def _report(report: CheckReport) -> int:
+    print(f"reasoner: {report.reasoner}")
+    for warning in report.warnings:
+        print(f"warning: {warning}")
+    for problem in report.problems:
+        print(f"problem: {problem}")
+    print("ontology OK" if report.ok else f"{len(report.problems)} problem(s)")
+    return 0 if report.ok else 1
+
+
+# ---------------------------------------------------------------------------------------- show
+
+
+def describe(kb: KnowledgeBase, name: str) -> str:
+    """A readable description of the term ``name`` names (annotator, class, region or value)."""
+    if name in kb.index.annotators:
+        return _describe_annotator(kb, kb.annotator(name))
+    if name in kb.index.cas_types:
+        return _describe_class(kb, name, "CAS type")
+    found = kb.resolve_all(name)
+    if not found:
+        kb.resolve(name)  # raises UnknownTermError with suggestions
+    first = kb.resolve(name)
+    text = _describe(kb, first)
+    others = [f"{r.kind.replace('_', ' ')} {r.name}" for r in found if r != first]
+    return text + (f"\n  (the word also names: {', '.join(others)})" if others else "")
+
+
+def _describe(kb: KnowledgeBase, term: Resolved) -> str:
+    if term.kind == "region":
+        return _describe_region(kb, kb.region(term.name))
+    if term.kind == "class":
+        return _describe_object(kb, term.name)
+    text = _describe_class(kb, term.name, term.kind.replace("_", " "))
+    if term.kind == "region_class":
+        regions = ", ".join(r.name for r in kb.regions_of_class(term.name)) or "-"
+        text += f"\n  {'regions':12s} {regions}"
+    return text
+
+
+def _header(kb: KnowledgeBase, name: str, kind: str) -> list[str]:
+    where = kb.defined_in(name)
+    lines = [f"{name}  ({kind}" + (f", defined in {where.name})" if where else ")")]
+    lines.append(f"  {'label':12s} {kb.label(name)}")
+    lines.append(f"  {'synonyms':12s} {', '.join(kb.synonyms(name)) or '-'}")
+    return lines
+
+
+def _describe_class(kb: KnowledgeBase, name: str, kind: str) -> str:
+    lines = _header(kb, name, kind)
+    lines.append(f"  {'is a':12s} {', '.join(kb.superclasses(name, direct=True)) or '-'}")
+    lines.append(f"  {'subclasses':12s} {', '.join(kb.subclasses(name, direct=True)) or '-'}")
+    return "\n".join(lines)
+
+
+def _describe_object(kb: KnowledgeBase, name: str) -> str:
+    profile = kb.object_profile(name)
+    lines = _describe_class(kb, name, "object class").splitlines()
+    lines.append(f"  {'ancestors':12s} {', '.join(kb.superclasses(name)) or '-'}")
+
+    def value(field: str, shown: str) -> None:
+        origin = profile.origin(field)
+        note = f"   (from {origin})" if origin and origin != name else ""
+        lines.append(f"  {field.replace('_', ' '):12s} {shown}{note}")
+
+    value("colors", ", ".join(kb.label(c) for c in profile.colors) or "-")
+    value("shape", kb.label(profile.shape) if profile.shape else "-")
+    value("size_class", kb.label(profile.size_class) if profile.size_class else "-")
+    value("material", kb.label(profile.material) if profile.material else "-")
+    value("transparent", {True: "yes", False: "no", None: "-"}[profile.transparent])
+    stored = "-"
+    if profile.stored_in:
+        regions = ", ".join(r.name for r in kb.regions_of_class(profile.stored_in))
+        stored = profile.stored_in + (f" (regions: {regions})" if regions else "")
+    value("stored_in", stored)
+    value("texts", ", ".join(repr(t) for t in profile.texts) or "-")
+    value("brand", profile.brand or "-")
+    told_apart = "yes" if kb.variants_differ_by_text(name) else "no"
+    lines.append(f"  {'by text':12s} {told_apart}   (only printed text tells it from a look-alike sibling)")
+    return "\n".join(lines)
+
+
+def _describe_region(kb: KnowledgeBase, box: RegionBox) -> str:
+    lines = _header(kb, box.name, "region")
+    lines.append(f"  {'class':12s} {box.region_class}")
+    lines.append(f"  {'map':12s} {box.semantic_map or '-'}")
+    lines.append(f"  {'frame':12s} {box.frame}")
+    lines.append(f"  {'position':12s} {' '.join(f'{v:g}' for v in box.position)}")
+    lines.append(f"  {'orientation':12s} {' '.join(f'{v:g}' for v in box.orientation)}  (x y z w)")
+    lines.append(f"  {'size':12s} {' '.join(f'{v:g}' for v in box.size)}")
+    return "\n".join(lines)
+
+
+def _describe_annotator(kb: KnowledgeBase, spec: AnnotatorSpec) -> str:
+    lines = _header(kb, spec.name, "annotator")
+
+    def names(values: tuple[str, ...] | frozenset[str]) -> str:
+        return ", ".join(sorted(values)) or "-"
+
+    lines.append(f"  {'class':12s} {spec.implemented_by}")
+    lines.append(f"  {'inputs':12s} {names(spec.inputs)}")
+    lines.append(f"  {'optional':12s} {names(spec.optional_inputs)}")
+    lines.append(f"  {'outputs':12s} {names(spec.outputs)}")
+    for field, values in (
+        ("colours", spec.colors),
+        ("shapes", spec.shapes),
+        ("sizes", spec.sizes),
+        ("materials", spec.materials),
+        ("classes", spec.classes),
+    ):
+        if values:
+            lines.append(f"  {field:12s} {names(values)}")
+    lines.append(f"  {'needs':12s} {names(spec.preconditions)}")
+    lines.append(f"  {'cost':12s} {spec.cost_ms:g} ms")
+    lines.append(f"  {'reliability':12s} {spec.reliability:g}")
+    return "\n".join(lines)

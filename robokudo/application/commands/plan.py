@@ -1,0 +1,75 @@
+"""``robokudo plan QUERY``: synthesize the Perception Pipeline Tree for a query and print it."""
+
+from __future__ import annotations
+
+import argparse
+import json
+import sys
+
+from queries import QueryError, format_query, parse_query
+from reasoning.errors import OntologyError
+from reasoning.knowledge.knowledge_base import KnowledgeBase
+from reasoning.planning.planner import PlanningError
+from reasoning.planning.query_planner import QueryPlan, plan_query
+from robokudo.application.sensor_sources import sensor_source
+from robokudo.core.render import tree_to_dict, unicode_tree
+from trees.synthesis import SynthesisError, build_tree
+
+
+def add_arguments(parser: argparse.ArgumentParser) -> None:
+    """Arguments of ``robokudo plan``."""
+    parser.add_argument("query", nargs="+", help="the query: nested, a phrase, or JSON")
+    parser.add_argument("--json", action="store_true", help="print a machine-readable tree")
+    parser.add_argument("--explain", action="store_true", help="print why each node is there")
+    parser.add_argument("--input", help="input the tree will read (default: the built-in kitchen scene)")
+    parser.add_argument("--frame", type=int, default=0)
+
+
+def synthesize(text: str, kb: KnowledgeBase, input_path: str | None, frame: int) -> QueryPlan:
+    """Parse and plan ``text`` for the given input (planning twice only when the reader depends on the region)."""
+    query = parse_query(text)
+    draft = plan_query(query, kb, sensor_source(kb, input_path, frame))
+    region = draft.interpretation.task.region
+    if input_path is None and region is not None:
+        return plan_query(query, kb, sensor_source(kb, input_path, frame, region))
+    return draft
+
+
+def task_summary(query_plan: QueryPlan) -> dict[str, object]:
+    """The interpretation of the query, as plain data."""
+    task = query_plan.interpretation.task
+    return {
+        "kind": task.kind,
+        "object_class": task.object_class,
+        "region": task.region,
+        "constraints": [{"key": c.key, "type": c.annotation_type, "value": c.value} for c in task.constraints],
+        "inferences": list(task.inferences),
+    }
+
+
+def run(args: argparse.Namespace) -> int:
+    """Plan and print; exit 2 with the reason when the query cannot be parsed or planned."""
+    text = " ".join(args.query)
+    try:
+        kb = KnowledgeBase.load()
+        query_plan = synthesize(text, kb, args.input, args.frame)
+        tree = build_tree(query_plan.plan)
+    except QueryError as error:
+        print(error, file=sys.stderr)
+        return 2
+    except (PlanningError, SynthesisError, OntologyError) as error:
+        print(f"robokudo plan: {error}", file=sys.stderr)
+        return 2
+    if args.json:
+        document = {
+            "query": format_query(parse_query(text)),
+            "task": task_summary(query_plan),
+            "tree": tree_to_dict(tree),
+        }
+        print(json.dumps(document, indent=2))
+        return 0
+    print(unicode_tree(tree, show_reasons=args.explain))
+    if args.explain:
+        for inference in query_plan.interpretation.task.inferences:
+            print(f"inferred: {inference}")
+    return 0
