@@ -2,6 +2,9 @@
 
 from pathlib import Path
 
+NAMESPACE = "http://robokudo.org/ontology#"
+"""The namespace of every term the project defines (``rk:``)."""
+
 VOCABULARY_FILES: tuple[str, ...] = ("perception.ttl", "regions.ttl", "objects.ttl", "annotators.ttl")
 """The shipped files every knowledge base loads, in load order."""
 

@@ -14,36 +14,15 @@ from __future__ import annotations
 
 import json
 import re
-import time
 from collections.abc import Callable
-from dataclasses import dataclass, replace
-from pathlib import Path
-from typing import Any, ClassVar
-
-import numpy as np
+from dataclasses import dataclass
+from typing import Any
 
 from reasoning.beliefs.store import BeliefFilter, BeliefStore
-from reasoning.fusion.association import CameraModel
-from reasoning.fusion.frame import WORLD_FRAME, FrameContext, frame_objects
 from reasoning.fusion.rule import CLASS_ATTRIBUTE, ClassTest
-from reasoning.fusion.tracking import BeliefTracker, ObjectBelief, TrackStep
-from robokudo.core.annotator import Annotator
+from reasoning.fusion.tracking import ObjectBelief
 from robokudo.core.types import (
     ONTOLOGY_NAMESPACE,
-    CameraInfo,
-    CasType,
-    Classification,
-    ColorHistogram,
-    DepthImage,
-    Location,
-    ObjectHypothesis,
-    PointCloud,
-    Pose,
-    QueryView,
-    SemanticColor,
-    Shape,
-    Size,
-    Text,
 )
 
 
@@ -229,139 +208,3 @@ def answer_from_memory(store: BeliefStore, belief_filter: BeliefFilter, query: s
     beliefs.sort(key=lambda b: (-b.confidence, b.id))
     designators = tuple(designator(b, class_test=belief_filter.class_test, **options) for b in beliefs)
     return Answer(query=query, objects=designators, from_memory=True)
-
-
-def camera_model(info: CameraInfo, depth: np.ndarray | None = None) -> CameraModel:
-    """The visibility model of a frame: world frame when the camera pose is known, else the camera frame."""
-    k = info.intrinsics
-    known = info.cam_to_world is not None
-    return CameraModel(
-        fx=k.fx,
-        fy=k.fy,
-        cx=k.cx,
-        cy=k.cy,
-        width=k.width,
-        height=k.height,
-        to_frame=np.asarray(info.cam_to_world, dtype=np.float64) if known else np.eye(4),
-        frame=WORLD_FRAME if known else info.frame_id,
-        depth=depth,
-    )
-
-
-StoreSource = BeliefStore | str | Path | Callable[[], BeliefStore] | None
-
-
-class AnswerStep(Annotator):
-    """Fuse this frame's hypotheses into the belief store and answer the query (kept in :attr:`answer`).
-
-    ``store`` is a store, a path, a factory, or None for :meth:`BeliefStore.default_path`; it is opened on the
-    first run. ``tracker`` (class test, regions, gates) defaults to the store's. The query's filter is
-    ``belief_filter``, or ``filter_for(query)`` of the CAS's QueryView, or everything seen. The answer holds
-    the matching objects seen in this frame, most confident first, with their image ROI; ``label_of`` names
-    classes (e.g. the knowledge base's labels). With ``fail_when_empty`` the step fails when nothing matches.
-    ``timestamp`` 0 in CameraInfo means unknown: ``clock()`` is used instead.
-    """
-
-    inputs: ClassVar[tuple[type[CasType], ...]] = (ObjectHypothesis,)
-    optional_inputs: ClassVar[tuple[type[CasType], ...]] = (
-        CameraInfo,
-        PointCloud,
-        DepthImage,
-        QueryView,
-        Pose,
-        Size,
-        SemanticColor,
-        ColorHistogram,
-        Shape,
-        Classification,
-        Text,
-        Location,
-    )
-    outputs: ClassVar[tuple[type[CasType], ...]] = ()
-
-    def __init__(
-        self,
-        store: StoreSource = None,
-        *,
-        tracker: BeliefTracker | None = None,
-        belief_filter: BeliefFilter | None = None,
-        filter_for: Callable[[object], BeliefFilter] | None = None,
-        min_overlap: float = 0.6,
-        fail_when_empty: bool = False,
-        clock: Callable[[], float] = time.time,
-        label_of: Callable[[str], str] = class_label,
-        name: str | None = None,
-    ) -> None:
-        super().__init__(name=name)
-        self._store_source = store
-        self._store: BeliefStore | None = store if isinstance(store, BeliefStore) else None
-        self.tracker = tracker
-        self.belief_filter = belief_filter
-        self.filter_for = filter_for
-        self.min_overlap = min_overlap
-        self.fail_when_empty = fail_when_empty
-        self.clock = clock
-        self.label_of = label_of
-        self.answer: Answer | None = None
-        self.last_step: TrackStep | None = None
-
-    @property
-    def store(self) -> BeliefStore:
-        """The belief store (opened on first use)."""
-        if self._store is None:
-            source = self._store_source
-            if callable(source) and not isinstance(source, BeliefStore):
-                self._store = source()
-            else:
-                self._store = BeliefStore(BeliefStore.default_path() if source is None else source)
-        return self._store
-
-    def shutdown(self) -> None:
-        """Close the store if this step opened it (py_trees calls this when the tree shuts down)."""
-        if self._store is not None and self._store is not self._store_source:
-            self._store.close()
-            self._store = None
-
-    def analyse(self) -> None:
-        """Fuse, integrate, answer."""
-        hypotheses = self.annotations(ObjectHypothesis)
-        info = self.optional_view(CameraInfo)
-        cloud = self.optional_view(PointCloud)
-        depth = self.optional_view(DepthImage)
-        stamp = info.timestamp if info is not None and info.timestamp > 0 else self.clock()
-        context = FrameContext(
-            points=cloud.points if cloud is not None else None,
-            cam_to_world=info.cam_to_world if info is not None else None,
-            camera_frame=info.frame_id if info is not None else "camera",
-            time=stamp,
-        )
-        objects = frame_objects(hypotheses, context, min_overlap=self.min_overlap, read=self.attached)
-        camera = camera_model(info, depth.depth if depth is not None else None) if info is not None else None
-        store = self.store
-        step = store.integrate(objects, stamp, camera=camera, tracker=self.tracker)
-        self.last_step = step
-        belief_filter = self._filter()
-        seen = dict(zip(step.assigned, objects, strict=True))
-        matching = store.query(replace(belief_filter, ids=tuple(seen), limit=None))
-        matching.sort(key=lambda b: (-b.confidence, b.id))
-        if belief_filter.limit is not None:
-            matching = matching[: belief_filter.limit]
-        query_view = self.optional_view(QueryView)
-        text = getattr(query_view.query, "source", "") if query_view is not None else ""
-        self.answer = Answer(
-            query=str(text or ""),
-            objects=tuple(
-                designator(b, class_test=belief_filter.class_test, roi=seen[b.id].roi, label_of=self.label_of)
-                for b in matching
-            ),
-        )
-        if self.fail_when_empty and not matching:
-            self.fail(f"no object matches the query among {len(objects)} seen")
-
-    def _filter(self) -> BeliefFilter:
-        if self.belief_filter is not None:
-            return self.belief_filter
-        query_view = self.optional_view(QueryView)
-        if self.filter_for is not None and query_view is not None:
-            return self.filter_for(query_view.query)
-        return BeliefFilter(class_test=(self.tracker or self.store.tracker).class_test)

@@ -7,7 +7,7 @@ import re
 from rdflib import Namespace, URIRef
 from rdflib.namespace import OWL, RDF, RDFS, SKOS, XSD
 
-from robokudo.core.types import ONTOLOGY_NAMESPACE
+from ontology import NAMESPACE as ONTOLOGY_NAMESPACE
 
 __all__ = [
     "ANNOTATORS_PACKAGE",

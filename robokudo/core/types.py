@@ -16,7 +16,7 @@ from typing import ClassVar, TypeVar
 
 import numpy as np
 
-ONTOLOGY_NAMESPACE = "http://robokudo.org/ontology#"
+from ontology import NAMESPACE as ONTOLOGY_NAMESPACE
 
 A = TypeVar("A", bound="Annotation")
 

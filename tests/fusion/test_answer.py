@@ -12,7 +12,7 @@ import numpy as np
 import pytest
 from py_trees.common import Status
 
-from reasoning.beliefs.answer import AnswerStep, answer_from_memory, class_iri, class_label, designator
+from reasoning.beliefs.answer import answer_from_memory, class_iri, class_label, designator
 from reasoning.beliefs.filters import belief_filter
 from reasoning.beliefs.store import BeliefFilter, BeliefStore
 from reasoning.fusion.frame import FrameObject
@@ -32,6 +32,7 @@ from robokudo.core.types import (
     Pose,
     SemanticColor,
 )
+from trees.answer_step import AnswerStep
 
 SUBCLASSES = {("LactoseFreeMilk", "Milk")}
 

@@ -18,13 +18,13 @@ import numpy as np
 import pytest
 from py_trees.common import Status
 
-from reasoning.beliefs.answer import AnswerStep
 from reasoning.beliefs.store import BeliefStore
 from reasoning.fusion.tracking import GONE, PRESENT, BeliefTracker, TrackerConfig
 from robokudo.core.annotator import Annotator
 from robokudo.core.engine import Engine
 from robokudo.core.pipeline import Pipeline
 from robokudo.core.types import CameraInfo, CameraIntrinsics, CasType, ColorImage, DepthImage, ObjectHypothesis
+from trees.answer_step import AnswerStep
 
 kitchen_scene = pytest.importorskip("annotators.simulation.kitchen_scene")
 tabletop = pytest.importorskip("trees.tabletop")

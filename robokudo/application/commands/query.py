@@ -9,7 +9,7 @@ import py_trees
 from py_trees.common import Status
 
 from queries import QueryError, parse_query
-from reasoning.beliefs.answer import Answer, AnswerStep
+from reasoning.beliefs.answer import Answer
 from reasoning.beliefs.filters import belief_filter, kb_class_test
 from reasoning.beliefs.store import BeliefStore, BeliefStoreError
 from reasoning.errors import OntologyError
@@ -20,6 +20,7 @@ from robokudo.application.commands.plan import synthesize
 from robokudo.core.engine import Engine
 from robokudo.core.render import unicode_tree
 from robokudo.core.slot import TaskSlot
+from trees.answer_step import AnswerStep
 from trees.synthesis import SynthesisError, build_tree
 
 TASK_SLOT = "task"
