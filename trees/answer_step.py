@@ -19,7 +19,7 @@ from reasoning.beliefs.answer import Answer, class_label, designator
 from reasoning.beliefs.store import BeliefFilter, BeliefStore
 from reasoning.fusion.association import CameraModel
 from reasoning.fusion.frame import WORLD_FRAME, FrameContext, frame_objects
-from reasoning.fusion.tracking import BeliefTracker, TrackStep
+from reasoning.fusion.tracking import BeliefTracker
 from robokudo.core.annotator import Annotator
 from robokudo.core.types import (
     CameraInfo,
@@ -31,6 +31,7 @@ from robokudo.core.types import (
     ObjectHypothesis,
     PointCloud,
     Pose,
+    QueryAnswer,
     QueryView,
     SemanticColor,
     Shape,
@@ -60,7 +61,7 @@ StoreSource = BeliefStore | str | Path | Callable[[], BeliefStore] | None
 
 
 class AnswerStep(Annotator):
-    """Fuse this frame's hypotheses into the belief store and answer the query (kept in :attr:`answer`).
+    """Fuse this frame's hypotheses into the belief store and answer the query (a QueryAnswer in the CAS).
 
     ``store`` is a store, a path, a factory, or None for :meth:`BeliefStore.default_path`; it is opened on the
     first run. ``tracker`` (class test, regions, gates) defaults to the store's. The query's filter is
@@ -85,7 +86,7 @@ class AnswerStep(Annotator):
         Text,
         Location,
     )
-    outputs: ClassVar[tuple[type[CasType], ...]] = ()
+    outputs: ClassVar[tuple[type[CasType], ...]] = (QueryAnswer,)
 
     def __init__(
         self,
@@ -110,8 +111,6 @@ class AnswerStep(Annotator):
         self.fail_when_empty = fail_when_empty
         self.clock = clock
         self.label_of = label_of
-        self.answer: Answer | None = None
-        self.last_step: TrackStep | None = None
 
     @property
     def store(self) -> BeliefStore:
@@ -147,7 +146,6 @@ class AnswerStep(Annotator):
         camera = camera_model(info, depth.depth if depth is not None else None) if info is not None else None
         store = self.store
         step = store.integrate(objects, stamp, camera=camera, tracker=self.tracker)
-        self.last_step = step
         belief_filter = self._filter()
         seen = dict(zip(step.assigned, objects, strict=True))
         matching = store.query(replace(belief_filter, ids=tuple(seen), limit=None))
@@ -156,13 +154,15 @@ class AnswerStep(Annotator):
             matching = matching[: belief_filter.limit]
         query_view = self.optional_view(QueryView)
         text = getattr(query_view.query, "source", "") if query_view is not None else ""
-        self.answer = Answer(
+        answer = Answer(
             query=str(text or ""),
             objects=tuple(
                 designator(b, class_test=belief_filter.class_test, roi=seen[b.id].roi, label_of=self.label_of)
                 for b in matching
             ),
+            observed=tuple(step.assigned),
         )
+        self.write(QueryAnswer(answer))
         if self.fail_when_empty and not matching:
             self.fail(f"no object matches the query among {len(objects)} seen")
 

@@ -7,12 +7,16 @@ project's ``annotators`` package can be instantiated.
 from __future__ import annotations
 
 import importlib
-from collections.abc import Callable, Sequence
+from collections.abc import Callable
+from collections.abc import Sequence as Ordered
+from functools import partial
 
 import py_trees
 
+from annotators.catalog import AnnotatorCatalog
 from reasoning.planning.plan import Alternatives, Plan, Step, Unit
 from robokudo.core.annotator import Annotator
+from robokudo.core.composites import Fallback, Sequence
 from robokudo.core.dataflow import validate_data_flow
 from robokudo.core.parallel import ThresholdParallel
 from robokudo.core.pipeline import Pipeline
@@ -45,6 +49,12 @@ def instantiate(step: Step) -> Annotator:
     return node
 
 
+def _from_catalog(catalog: AnnotatorCatalog, step: Step) -> Annotator:
+    node = catalog[step.annotator](name=step.annotator, **dict(step.parameters))
+    node.reason = step.reason
+    return node
+
+
 NodeFactory = Callable[[Step], py_trees.behaviour.Behaviour]
 
 
@@ -54,44 +64,48 @@ def _unit_node(unit: Unit, make: NodeFactory) -> py_trees.behaviour.Behaviour:
     return _fallback(unit, make)
 
 
-def _fallback(alternatives: Alternatives, make: NodeFactory) -> py_trees.composites.Selector:
+def _fallback(alternatives: Alternatives, make: NodeFactory) -> Fallback:
     branches: list[py_trees.behaviour.Behaviour] = []
     for branch in alternatives.branches:
         if len(branch) == 1:
             branches.append(make(branch[0]))
         else:
-            sequence = py_trees.composites.Sequence(
-                f"via {branch[-1].annotator}", memory=True, children=[make(step) for step in branch]
+            branches.append(
+                Sequence(
+                    f"via {branch[-1].annotator}",
+                    [make(step) for step in branch],
+                    reason=f"{branch[-1].annotator} with the steps only it needs",
+                )
             )
-            sequence.reason = f"{branch[-1].annotator} with the steps only it needs"
-            branches.append(sequence)
-    node = py_trees.composites.Selector(f"{alternatives.provides} providers", memory=True, children=branches)
-    node.reason = alternatives.reason
-    return node
+    return Fallback(f"{alternatives.provides} providers", branches, reason=alternatives.reason)
 
 
-def _stage_node(index: int, stage: Sequence[Unit], make: NodeFactory) -> py_trees.behaviour.Behaviour:
+def _stage_node(index: int, stage: Ordered[Unit], make: NodeFactory) -> py_trees.behaviour.Behaviour:
     if len(stage) == 1:
         return _unit_node(stage[0], make)
-    parallel = ThresholdParallel(f"stage {index}", [_unit_node(unit, make) for unit in stage])
-    parallel.reason = "independent experts run side by side; all must succeed"
-    return parallel
+    return ThresholdParallel(
+        f"stage {index}",
+        [_unit_node(unit, make) for unit in stage],
+        reason="independent experts run side by side; all must succeed",
+    )
 
 
 def build_tree(
     plan: Plan,
     name: str = "query",
-    final_steps: Sequence[py_trees.behaviour.Behaviour] = (),
+    final_steps: Ordered[py_trees.behaviour.Behaviour] = (),
     make: NodeFactory = instantiate,
     query: object | None = None,
+    catalog: AnnotatorCatalog | None = None,
 ) -> Pipeline:
     """The Pipeline for ``plan`` (stages in order, then ``final_steps`` such as the answer step), validated.
 
     ``make`` turns a step into a node (default: the annotator class the ontology names); ``query`` is put
     into every new CAS of the pipeline.
     """
+    if catalog is not None:
+        make = partial(_from_catalog, catalog)
     children = [_stage_node(index, stage, make) for index, stage in enumerate(plan.stages, start=1)]
-    pipeline = Pipeline(name, [*children, *final_steps], query=query)
-    pipeline.reason = f"answers the {plan.task.kind} query"
+    pipeline = Pipeline(name, [*children, *final_steps], query=query, reason=f"answers the {plan.task.kind} query")
     validate_data_flow(pipeline)
     return pipeline

@@ -54,8 +54,9 @@ def create_pipeline(reader: Annotator) -> Pipeline:
     color.reason = "names each hypothesis' dominant colour"
     pose = PoseAnnotator()
     pose.reason = "gives each hypothesis the pose of its oriented bounding box"
-    describe = ThresholdParallel("describe", [color, pose])
-    describe.reason = "colour and pose are independent given the hypotheses; both must succeed"
-    root = Pipeline("tabletop", [*front, crop, plane, clusters, describe])
-    root.reason = "the seed's Fig. 2 tabletop perception pipeline"
-    return root
+    describe = ThresholdParallel(
+        "describe", [color, pose], reason="colour and pose are independent given the hypotheses; both must succeed"
+    )
+    return Pipeline(
+        "tabletop", [*front, crop, plane, clusters, describe], reason="the seed's Fig. 2 tabletop perception pipeline"
+    )

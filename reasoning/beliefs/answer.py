@@ -1,13 +1,10 @@
-"""Answers to perception queries: object designators with provenance, and the tree step that produces them.
+"""Answers to perception queries: object designators with provenance, drawn from the belief store.
 
 An :class:`ObjectDesignator` is what the robot acts on: id, class (IRI and label), pose (position, quaternion
 x-y-z-w, frame), size, region, attributes with confidence (and the alternatives experts also proposed), the
 image ROI when the object was seen in this frame's image, and the experts that contributed. :class:`Answer` is
-a list of them; both turn into JSON-ready dicts.
-
-:class:`AnswerStep` is the last leaf of a perception tree: it fuses the CAS's object hypotheses
-(:mod:`reasoning.fusion.frame`), integrates them into the :class:`~reasoning.beliefs.store.BeliefStore` (identity,
-confidence, history) and keeps the answer to the query on itself (``step.answer``) for the caller.
+a list of them; both turn into JSON-ready dicts. The tree leaf that answers from a frame is
+:class:`trees.answer_step.AnswerStep`.
 """
 
 from __future__ import annotations
@@ -131,6 +128,8 @@ class Answer:
     query: str
     objects: tuple[ObjectDesignator, ...] = ()
     from_memory: bool = False
+    observed: tuple[int, ...] = ()
+    """The belief id of each object seen in this frame, in the order perception found them (not in the JSON)."""
 
     def to_dict(self) -> dict[str, Any]:
         """A JSON-ready dict."""

@@ -19,6 +19,7 @@ from __future__ import annotations
 import json
 import math
 import operator
+import os
 import shlex
 import sqlite3
 import threading
@@ -28,6 +29,7 @@ from dataclasses import dataclass, field
 from pathlib import Path
 
 import numpy as np
+import platformdirs
 
 from reasoning.fusion.association import CameraModel, in_view
 from reasoning.fusion.frame import WORLD_FRAME, FrameObject
@@ -256,13 +258,9 @@ class BeliefStore:
     @staticmethod
     def default_path() -> Path:
         """``$ROBOKUDO_BELIEF_STORE`` or ``<user data dir>/robokudo/beliefs.sqlite``."""
-        import os
-
         override = os.environ.get("ROBOKUDO_BELIEF_STORE")
         if override:
             return Path(override).expanduser()
-        import platformdirs
-
         return Path(platformdirs.user_data_dir("robokudo")) / "beliefs.sqlite"
 
     def close(self) -> None:

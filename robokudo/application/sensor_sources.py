@@ -2,6 +2,8 @@
 
 from __future__ import annotations
 
+from annotators.readers.choice import reader_choice
+from annotators.simulation.kitchen_scene import camera_looking_at
 from reasoning.knowledge.knowledge_base import KnowledgeBase
 from reasoning.planning.plan import Step
 from reasoning.planning.planner import SensorSource
@@ -14,8 +16,6 @@ def sensor_source(kb: KnowledgeBase, input_path: str | None, frame: int = 0, reg
     layout raises ValueError listing the supported ones.
     """
     if input_path is None:
-        from annotators.simulation.kitchen_scene import camera_looking_at
-
         view = "table"
         reason = "renders the built-in kitchen from the 'table' camera"
         if region is not None:
@@ -27,8 +27,6 @@ def sensor_source(kb: KnowledgeBase, input_path: str | None, frame: int = 0, reg
         spec = kb.annotator("KitchenSceneReader")
         parameters: tuple[tuple[str, object], ...] = (("view", view),)
     else:
-        from annotators.readers.choice import reader_choice
-
         choice = reader_choice(input_path, frame)
         spec = kb.annotator(choice.name)
         parameters = tuple(sorted(choice.parameters.items()))

@@ -19,6 +19,7 @@ import py_trees
 from py_trees.common import Status
 
 from robokudo.core.cas import CAS, AddAnnotation, AttachAnnotation, CasWrite, SetView
+from robokudo.core.explained import Explained
 from robokudo.core.pipeline import StructureError, enclosing_pipeline, pipeline_named, tree_root
 from robokudo.core.stats import RunStats
 from robokudo.core.types import Annotation, CasType, ObjectHypothesis, View
@@ -51,7 +52,7 @@ class _Run:
         self.cancelled = False  # set once by the tick thread; a plain flag is enough for the worker to poll
 
 
-class Annotator(py_trees.behaviour.Behaviour):
+class Annotator(Explained, py_trees.behaviour.Behaviour):
     """A leaf expert with declared input and output CAS types.
 
     ``inputs`` must be in the CAS before it runs (the data-flow validator checks this); ``optional_inputs``

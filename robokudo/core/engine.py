@@ -147,6 +147,7 @@ class Engine:
         if self._thread is not None:
             self._thread.join()
             self._thread = None
+            self._stop.clear()  # the background run has ended; a later run() or start() may tick again
         if self.root.status is Status.RUNNING:
             self.root.stop(Status.INVALID)
         self.tasks.apply_pending()

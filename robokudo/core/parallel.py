@@ -22,8 +22,10 @@ from collections.abc import Iterator, Sequence
 import py_trees
 from py_trees.common import Status
 
+from robokudo.core.explained import Explained
 
-class ThresholdParallel(py_trees.composites.Composite):
+
+class ThresholdParallel(Explained, py_trees.composites.Composite):
     """Ticks its children side by side and decides by counting successes and failures."""
 
     def __init__(
@@ -32,12 +34,13 @@ class ThresholdParallel(py_trees.composites.Composite):
         children: Sequence[py_trees.behaviour.Behaviour] | None = None,
         n_success: int | None = None,
         n_failure: int = 0,
+        reason: str = "",
     ) -> None:
         """``n_success`` defaults to ``len(children) - 1`` (all must succeed)."""
         super().__init__(name=name, children=list(children or []))
         self._n_success = n_success
         self.n_failure = n_failure
-        self.reason = ""
+        self.reason = reason
 
     @property
     def n_success(self) -> int:

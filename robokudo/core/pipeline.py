@@ -7,10 +7,11 @@ from collections.abc import Iterator, Sequence
 import py_trees
 
 from robokudo.core.cas import CAS
+from robokudo.core.explained import Explained
 from robokudo.core.types import QueryView
 
 
-class Pipeline(py_trees.composites.Sequence):
+class Pipeline(Explained, py_trees.composites.Sequence):
     """A Sequence owning a CAS; every annotator below it (up to a nested Pipeline) works on this CAS.
 
     A fresh CAS is created each time the pipeline starts a new run, so every frame is analysed on a clean
@@ -24,11 +25,12 @@ class Pipeline(py_trees.composites.Sequence):
         children: Sequence[py_trees.behaviour.Behaviour] | None = None,
         memory: bool = True,
         query: object | None = None,
+        reason: str = "",
     ) -> None:
         super().__init__(name=name, memory=memory, children=list(children or []))
         self.query = query
         self.cas = self._new_cas()
-        self.reason = ""
+        self.reason = reason
 
     def _new_cas(self) -> CAS:
         cas = CAS()

@@ -9,6 +9,7 @@ import py_trees
 from py_trees.common import Status
 
 from robokudo.core.annotator import Annotator
+from robokudo.core.explained import reason_of
 from robokudo.core.parallel import ThresholdParallel
 from robokudo.core.pipeline import Pipeline
 from robokudo.core.slot import TaskSlot
@@ -63,7 +64,7 @@ def unicode_tree(
             ins = ", ".join(t.__name__ for t in node.inputs) or "-"
             outs = ", ".join(t.__name__ for t in node.outputs) or "-"
             text += f"  ({ins} → {outs})"
-        reason = getattr(node, "reason", "")
+        reason = reason_of(node)
         if show_reasons and reason:
             text += f"  # {reason}"
         lines.append(prefix + branch + text)
@@ -105,7 +106,7 @@ def dot_tree(root: py_trees.behaviour.Behaviour) -> str:
     for node in root.iterate():
         shape, fill = _DOT_SHAPES[node_kind(node)]
         attributes = f"label={_quote(_label(node))}, shape={shape}, fillcolor={_quote(fill)}"
-        reason = getattr(node, "reason", "")
+        reason = reason_of(node)
         if reason:
             attributes += f", tooltip={_quote(reason)}"
         out.append(f"  {ids[id(node)]} [{attributes}];")
@@ -152,7 +153,7 @@ def tree_to_dict(root: py_trees.behaviour.Behaviour) -> dict[str, object]:
     if isinstance(root, ThresholdParallel):
         node["n_success"] = root.n_success
         node["n_failure"] = root.n_failure
-    node["reason"] = getattr(root, "reason", "")
+    node["reason"] = reason_of(root)
     if root.children:
         node["children"] = [tree_to_dict(child) for child in root.children]
     return node

@@ -7,8 +7,10 @@ from collections.abc import Iterator
 import py_trees
 from py_trees.common import Status
 
+from robokudo.core.explained import Explained
 
-class TaskSlot(py_trees.composites.Composite):
+
+class TaskSlot(Explained, py_trees.composites.Composite):
     """Holds zero or one subtree and passes its status through; an empty slot is idle and succeeds.
 
     Subtrees are put in and taken out by the engine's task interface between ticks, never by the

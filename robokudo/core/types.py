@@ -133,6 +133,13 @@ class QueryView(View):
     query: object
 
 
+@dataclass(eq=False)
+class QueryAnswer(View):
+    """The answer to this CAS's query, written by the step that answers it (e.g. a ``reasoning`` Answer)."""
+
+    answer: object
+
+
 # ----------------------------------------------------------------------------------------- annotations
 
 
@@ -253,7 +260,7 @@ class Location(Annotation):
     region_class: str = ""
 
 
-VIEW_TYPES: tuple[type[View], ...] = (ColorImage, DepthImage, CameraInfo, PointCloud, Normals, QueryView)
+VIEW_TYPES: tuple[type[View], ...] = (ColorImage, DepthImage, CameraInfo, PointCloud, Normals, QueryView, QueryAnswer)
 ANNOTATION_TYPES: tuple[type[Annotation], ...] = (
     Plane,
     ObjectHypothesis,

@@ -30,6 +30,7 @@ from robokudo.core.types import (
     Classification,
     ObjectHypothesis,
     Pose,
+    QueryAnswer,
     SemanticColor,
 )
 from trees.answer_step import AnswerStep
@@ -183,8 +184,7 @@ def test_the_answer_step_fuses_into_the_store_and_answers_with_rois(tmp_path: Pa
         step = AnswerStep(path, belief_filter=BeliefFilter(attributes={"color": "red"}))
         root = Pipeline("perceive", [ScriptedExperts(stamp), step])
         assert Engine(root).tick() is Status.SUCCESS
-        assert step.answer is not None
-        (cup,) = step.answer.objects
+        (cup,) = root.cas.view(QueryAnswer).answer.objects
         assert cup.class_label == "cup" and cup.roi == (10, 10, 20, 20)
         assert cup.pose.frame == "world" and cup.pose.position == pytest.approx((0.0, 0.0, 1.0))
         assert {"ScriptedExperts", "Detector"} <= set(cup.experts)
@@ -312,8 +312,8 @@ def test_the_answer_step_answers_with_what_it_sees_even_under_a_limit(tmp_path: 
         )
         store.integrate([far], 1.0)
     step = AnswerStep(path, belief_filter=BeliefFilter(object_class="Cup", limit=1))
-    assert Engine(Pipeline("perceive", [ScriptedExperts(10.0), step])).tick() is Status.SUCCESS
-    assert step.answer is not None
-    (cup,) = step.answer.objects
+    root = Pipeline("perceive", [ScriptedExperts(10.0), step])
+    assert Engine(root).tick() is Status.SUCCESS
+    (cup,) = root.cas.view(QueryAnswer).answer.objects
     assert cup.id != 1 and cup.roi == (10, 10, 20, 20)
     step.shutdown()

@@ -23,7 +23,15 @@ from reasoning.fusion.tracking import GONE, PRESENT, BeliefTracker, TrackerConfi
 from robokudo.core.annotator import Annotator
 from robokudo.core.engine import Engine
 from robokudo.core.pipeline import Pipeline
-from robokudo.core.types import CameraInfo, CameraIntrinsics, CasType, ColorImage, DepthImage, ObjectHypothesis
+from robokudo.core.types import (
+    CameraInfo,
+    CameraIntrinsics,
+    CasType,
+    ColorImage,
+    DepthImage,
+    ObjectHypothesis,
+    QueryAnswer,
+)
 from trees.answer_step import AnswerStep
 
 kitchen_scene = pytest.importorskip("annotators.simulation.kitchen_scene")
@@ -56,13 +64,13 @@ class FrameReader(Annotator):
         self.write(CameraInfo(intrinsics=intrinsics, cam_to_world=cam_to_world, frame_id="camera", timestamp=stamp))
 
 
-def perceive(reader: FrameReader, store: BeliefStore) -> tuple[Pipeline, AnswerStep]:
+def perceive(reader: FrameReader, store: BeliefStore) -> Pipeline:
     """Run the tabletop experts on one frame and fuse their output into the store."""
     step = AnswerStep(store)
     root = tabletop.create_pipeline(reader)
     root.add_child(step)
     assert Engine(root).tick() is Status.SUCCESS, [(c.name, c.feedback_message) for c in root.children]
-    return root, step
+    return root
 
 
 def render(view: object, stamp: float, moved: dict[str, np.ndarray] | None = None) -> tuple[FrameReader, object]:
@@ -72,11 +80,11 @@ def render(view: object, stamp: float, moved: dict[str, np.ndarray] | None = Non
     return FrameReader(scene.color, scene.depth, intrinsics, stamp, scene.cam_to_world), scene
 
 
-def identities(root: Pipeline, step: AnswerStep, scene: object) -> dict[str, int]:
+def identities(root: Pipeline, scene: object) -> dict[str, int]:
     """Belief id per scene object, naming each expert hypothesis by the object most of its points show."""
-    assert step.last_step is not None
+    observed = root.cas.view(QueryAnswer).answer.observed
     named: dict[str, int] = {}
-    for hypothesis, belief_id in zip(root.cas.annotations(ObjectHypothesis), step.last_step.assigned, strict=True):
+    for hypothesis, belief_id in zip(root.cas.annotations(ObjectHypothesis), observed, strict=True):
         ids = scene.object_ids.ravel()[hypothesis.point_indices]
         ids = ids[ids > 0]
         if ids.size < 0.5 * hypothesis.point_indices.size:
@@ -98,7 +106,7 @@ def test_five_views_give_stable_ids_and_a_far_moved_cup_a_new_belief(store: Beli
     seen: dict[str, set[int]] = {}
     for index, view in enumerate(kitchen_scene.orbit_views(5)):
         reader, scene = render(view, 100.0 + index)
-        for name, belief_id in identities(*perceive(reader, store), scene).items():
+        for name, belief_id in identities(perceive(reader, store), scene).items():
             seen.setdefault(name, set()).add(belief_id)
     assert {"cereal_box", "red_cup", "bowl"} <= set(seen)
     assert all(len(ids) == 1 for ids in seen.values()), seen
@@ -111,7 +119,7 @@ def test_five_views_give_stable_ids_and_a_far_moved_cup_a_new_belief(store: Beli
     far = {"red_cup": np.array([0.0, 0.25, 0.0])}
     for stamp in (105.0, 106.0):
         reader, scene = render(kitchen_scene.orbit_views(5)[2], stamp, far)
-        now = identities(*perceive(reader, store), scene)
+        now = identities(perceive(reader, store), scene)
         assert now["cereal_box"] == ids["cereal_box"] and now["bowl"] == ids["bowl"]
         assert now["red_cup"] != ids["red_cup"]
         new_cup = now["red_cup"]
@@ -127,11 +135,11 @@ def test_five_views_give_stable_ids_and_a_far_moved_cup_a_new_belief(store: Beli
 def test_a_slightly_moved_object_keeps_its_id_and_its_position_follows(store: BeliefStore) -> None:
     view = kitchen_scene.orbit_views(5)[2]
     reader, scene = render(view, 100.0)
-    before = identities(*perceive(reader, store), scene)
+    before = identities(perceive(reader, store), scene)
     nudge = {"bowl": np.array([0.06, 0.0, 0.0])}
     for stamp in (101.0, 102.0, 103.0):
         reader, scene = render(view, stamp, nudge)
-        after = identities(*perceive(reader, store), scene)
+        after = identities(perceive(reader, store), scene)
         assert after == before
     bowl = store.get(before["bowl"])
     assert bowl is not None and bowl.observations == 4 and bowl.status == PRESENT
@@ -168,13 +176,13 @@ def test_box_and_laptop_keep_their_ids_over_three_real_frames(tmp_path: Path) ->
     found: dict[str, list[int]] = {name: [] for name in GRABBER_PIXELS}
     with BeliefStore(tmp_path / "beliefs.sqlite") as store:
         for index, stamp in enumerate(grabber_frames()):
-            root, step = perceive(grabber_reader(stamp, 100.0 + 0.25 * index), store)
-            assert step.last_step is not None
+            root = perceive(grabber_reader(stamp, 100.0 + 0.25 * index), store)
+            observed = root.cas.view(QueryAnswer).answer.observed
             hypotheses = root.cas.annotations(ObjectHypothesis)
             for name, (x, y) in GRABBER_PIXELS.items():
                 at = [i for i, h in enumerate(hypotheses) if h.mask[y, x]]
                 assert len(at) == 1, f"{name} not segmented at {(x, y)} in frame {index}"
-                found[name].append(step.last_step.assigned[at[0]])
+                found[name].append(observed[at[0]])
         for name, ids in found.items():
             assert len(set(ids)) == 1, f"{name} changed identity: {ids}"
             belief = store.get(ids[0])

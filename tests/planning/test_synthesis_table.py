@@ -10,11 +10,13 @@ import pytest
 
 from queries import parse_query
 from reasoning.beliefs.store import BeliefStore
+from reasoning.knowledge.editing import OntologyEditor
 from reasoning.knowledge.knowledge_base import KnowledgeBase
 from reasoning.planning.plan import Alternatives, Plan, Step
 from reasoning.planning.planner import PlanningError, SensorSource
 from reasoning.planning.query_planner import plan_query
 from robokudo.application.sensor_sources import sensor_source
+from robokudo.application.service import AnsweringService
 from robokudo.core.dataflow import validate_data_flow
 from robokudo.core.parallel import ThresholdParallel
 from robokudo.core.render import unicode_tree
@@ -194,9 +196,6 @@ def test_explanations_name_the_query_and_the_producers(kb: KnowledgeBase) -> Non
 
 
 def test_a_new_object_class_plans_and_runs_at_once(tmp_path: Path) -> None:
-    from reasoning.knowledge.editing import OntologyEditor
-    from robokudo.application.commands.query import answer_query
-
     kb = KnowledgeBase.load(tmp_path / "user.ttl")
     with pytest.raises(PlanningError, match="unknown object class 'picnic_cup'"):
         plan_query(parse_query("find the picnic cup"), kb, sensor_source(kb, None))
@@ -204,7 +203,7 @@ def test_a_new_object_class_plans_and_runs_at_once(tmp_path: Path) -> None:
     editor.add_object("PicnicCup", ["Cup"], colors=["red"], shape="cylinder", size="small")
     result = plan_query(parse_query("find the picnic cup"), kb, sensor_source(kb, None))
     assert "KnowledgeClassifier" in order(result.plan)
-    with BeliefStore(tmp_path / "beliefs.sqlite") as store:
-        answer, _ = answer_query("find the picnic cup", kb, store=store)
+    with AnsweringService(kb, BeliefStore(tmp_path / "beliefs.sqlite")) as service:
+        answer = service.answer("find the picnic cup").answer
     assert answer.objects, "the new class was not found in the kitchen"
     assert answer.objects[0].class_iri.endswith("PicnicCup")

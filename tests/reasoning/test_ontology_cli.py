@@ -81,7 +81,6 @@ def test_works_as_a_robokudo_subcommand(
 ) -> None:
     from robokudo.application import cli
 
-    monkeypatch.setitem(cli._EXTERNAL_COMMANDS, "ontology", ("robokudo.application.commands.ontology", "the ontology"))
     assert cli.main(["ontology", "--user-file", str(user_file), "show", "cereal boxes"]) == 0
     assert capsys.readouterr().out.startswith("CerealBox  (object class")
     assert cli.main(["ontology", "--user-file", str(user_file), "show", "mlik"]) == 2

@@ -8,15 +8,18 @@ is ``--store``, else ``$ROBOKUDO_BELIEF_STORE``, else ``<user data dir>/robokudo
 from __future__ import annotations
 
 import argparse
-import importlib
 import json
 import sys
 from pathlib import Path
-from typing import Any
 
+from queries import QueryError, parse_query
 from reasoning.beliefs.answer import Answer, answer_from_memory
 from reasoning.beliefs.filters import belief_filter
 from reasoning.beliefs.store import BeliefFilter, BeliefStore, BeliefStoreError
+from reasoning.knowledge.knowledge_base import KnowledgeBase
+from robokudo.application.knowledge import load_knowledge_base
+
+HELP = "answer from the belief store, without running perception"
 
 
 def add_arguments(parser: argparse.ArgumentParser) -> None:
@@ -36,9 +39,9 @@ def run(args: argparse.Namespace) -> int:
             return _clear(path, args)
         if not path.exists():
             return _print(Answer(query=args.query or "", from_memory=True), args, f"no beliefs stored yet ({path})")
-        kb = _knowledge_base() if args.query else None
+        kb = load_knowledge_base() if args.query else None
         query_filter = _filter(args.query, args.all, kb)
-        options = {"label_of": kb.label} if kb is not None and callable(getattr(kb, "label", None)) else {}
+        options = {"label_of": kb.label} if kb is not None else {}
         with BeliefStore(path) as store:
             answer = answer_from_memory(store, query_filter, args.query or "", **options)
         return _print(answer, args, None)
@@ -66,35 +69,17 @@ def _clear(path: Path, args: argparse.Namespace) -> int:
     return 0
 
 
-def _filter(text: str | None, include_gone: bool, kb: Any) -> BeliefFilter:
+def _filter(text: str | None, include_gone: bool, kb: KnowledgeBase | None) -> BeliefFilter:
     if not text:
         return BeliefFilter(include_gone=include_gone)
-    parse = _parser()
     try:
-        query = parse(text)
-    except Exception as error:  # the parser's located QueryError, whatever its class
+        query = parse_query(text)
+    except QueryError as error:
         try:  # a memory question may name just the object: "milk in fridge" means "find milk in fridge"
-            query = parse(f"find {text}")
-        except Exception:
+            query = parse_query(f"find {text}")
+        except QueryError:
             raise _QueryProblemError(str(error)) from error
     return belief_filter(query, kb, include_gone=include_gone)
-
-
-def _parser() -> Any:
-    module = importlib.import_module("queries")
-    parse = getattr(module, "parse_query", None)
-    if parse is None:
-        parse = importlib.import_module("queries.dispatch").parse_query
-    return parse
-
-
-def _knowledge_base() -> Any:
-    """The knowledge base when it is available; without it classes and regions match by name only."""
-    try:
-        module = importlib.import_module("reasoning.knowledge.knowledge_base")
-    except ImportError:
-        return None
-    return module.KnowledgeBase.load()
 
 
 def _print(answer: Answer, args: argparse.Namespace, note: str | None) -> int:

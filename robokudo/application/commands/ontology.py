@@ -1,7 +1,6 @@
 """``robokudo ontology``: show terms, check the ontology, add and remove user object classes.
 
-Wired into ``robokudo/cli.py`` as an external subcommand: this module provides ``add_arguments(parser)``
-and ``run(args) -> int``. A rejected edit or an unknown name exits with status 2 and a message on
+A rejected edit or an unknown name exits with status 2 and a message on
 stderr; a failed ``check`` exits with 1.
 """
 
@@ -16,6 +15,8 @@ from reasoning.knowledge.editing import CheckReport, EditResult, OntologyEditor
 from reasoning.knowledge.knowledge_base import KnowledgeBase
 from reasoning.knowledge.model import AnnotatorSpec, RegionBox, Resolved
 from reasoning.knowledge.sources import USER_ONTOLOGY_ENV
+
+HELP = "show, check and edit the ontology"
 
 
 def add_arguments(parser: argparse.ArgumentParser) -> None:

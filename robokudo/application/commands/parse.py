@@ -16,6 +16,9 @@ EXIT_BAD_QUERY = 2
 """Exit code for a query that does not parse or validate."""
 
 
+HELP = "parse a perception query and print its canonical form"
+
+
 def add_arguments(parser: argparse.ArgumentParser) -> None:
     """Add the ``parse`` subcommand's arguments to ``parser``."""
     parser.add_argument(

@@ -6,14 +6,17 @@ import argparse
 import json
 import sys
 
+from annotators.catalog import AnnotatorCatalog
 from queries import QueryError, format_query, parse_query
 from reasoning.errors import OntologyError
-from reasoning.knowledge.knowledge_base import KnowledgeBase
 from reasoning.planning.planner import PlanningError
-from reasoning.planning.query_planner import QueryPlan, plan_query
-from robokudo.application.sensor_sources import sensor_source
+from reasoning.planning.query_planner import QueryPlan, QueryPlanner
+from robokudo.application.knowledge import load_knowledge_base
+from robokudo.application.planning import plan_for_input
 from robokudo.core.render import tree_to_dict, unicode_tree
 from trees.synthesis import SynthesisError, build_tree
+
+HELP = "synthesize the perception tree for a query and print it"
 
 
 def add_arguments(parser: argparse.ArgumentParser) -> None:
@@ -23,16 +26,6 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
     parser.add_argument("--explain", action="store_true", help="print why each node is there")
     parser.add_argument("--input", help="input the tree will read (default: the built-in kitchen scene)")
     parser.add_argument("--frame", type=int, default=0)
-
-
-def synthesize(text: str, kb: KnowledgeBase, input_path: str | None, frame: int) -> QueryPlan:
-    """Parse and plan ``text`` for the given input (planning twice only when the reader depends on the region)."""
-    query = parse_query(text)
-    draft = plan_query(query, kb, sensor_source(kb, input_path, frame))
-    region = draft.interpretation.task.region
-    if input_path is None and region is not None:
-        return plan_query(query, kb, sensor_source(kb, input_path, frame, region))
-    return draft
 
 
 def task_summary(query_plan: QueryPlan) -> dict[str, object]:
@@ -51,9 +44,10 @@ def run(args: argparse.Namespace) -> int:
     """Plan and print; exit 2 with the reason when the query cannot be parsed or planned."""
     text = " ".join(args.query)
     try:
-        kb = KnowledgeBase.load()
-        query_plan = synthesize(text, kb, args.input, args.frame)
-        tree = build_tree(query_plan.plan)
+        catalog = AnnotatorCatalog.discover()
+        planner = QueryPlanner(load_knowledge_base(catalog))
+        query_plan = plan_for_input(planner, parse_query(text), args.input, args.frame)
+        tree = build_tree(query_plan.plan, catalog=catalog)
     except QueryError as error:
         print(error, file=sys.stderr)
         return 2

@@ -1,0 +1,42 @@
+"""``robokudo run TREE``: run a hand-authored tree with the engine and print what it found."""
+
+from __future__ import annotations
+
+import argparse
+
+from py_trees.common import Status
+
+from robokudo.application.report import describe_hypotheses, write_annotated_image
+from robokudo.core.engine import Engine
+from robokudo.core.pipeline import pipelines
+from robokudo.core.render import stats_table, unicode_tree
+from trees import load_tree
+
+HELP = "run a tree with the engine"
+
+
+def add_arguments(parser: argparse.ArgumentParser) -> None:
+    """Arguments of ``robokudo run``."""
+    parser.add_argument("name")
+    parser.add_argument("--input", help="input path (default: the built-in kitchen scene)")
+    parser.add_argument("--frame", type=int, default=0, help="frame number in a sequence input")
+    parser.add_argument("--ticks", type=int, default=None, help="tick this many times (default: until it finishes)")
+    parser.add_argument("--hz", type=float, default=30.0, help="tick frequency")
+    parser.add_argument("--annotated-image", metavar="PATH", help="write the colour image with the hypotheses drawn")
+
+
+def run(args: argparse.Namespace) -> int:
+    """Run the tree (once, or ``--ticks`` times); 0 when it succeeded."""
+    root = load_tree(args.name).create(input_path=args.input, frame=args.frame)
+    engine = Engine(root, hz=args.hz)
+    until_finished = (lambda s: s is not Status.RUNNING) if args.ticks is None else None
+    status = engine.run(ticks=args.ticks, until=until_finished)
+    print(unicode_tree(root, show_status=True, show_reasons=False))
+    print()
+    print(stats_table(root))
+    cas = next(pipelines(root)).cas
+    print()
+    print(describe_hypotheses(cas))
+    if args.annotated_image:
+        print(f"annotated image: {write_annotated_image(cas, args.annotated_image)}")
+    return 0 if status is Status.SUCCESS else 1

@@ -1,0 +1,20 @@
+"""Planning a query for an input: the reader the input needs, then the plan (the camera follows the region)."""
+
+from __future__ import annotations
+
+from queries import Query
+from reasoning.planning.query_planner import QueryPlan, QueryPlanner
+from robokudo.application.sensor_sources import sensor_source
+
+
+def plan_for_input(planner: QueryPlanner, query: Query, input_path: str | None, frame: int = 0) -> QueryPlan:
+    """Plan ``query`` to run on ``input_path`` (the built-in kitchen when None).
+
+    For the kitchen the simulated camera is pointed at the region the query names, so the plan is made twice
+    only when the reader depends on that region.
+    """
+    draft = planner.plan(query, sensor_source(planner.kb, input_path, frame))
+    region = draft.interpretation.task.region
+    if input_path is None and region is not None:
+        return planner.plan(query, sensor_source(planner.kb, input_path, frame, region))
+    return draft
