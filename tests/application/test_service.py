@@ -1,0 +1,84 @@
+"""The answering service: one knowledge base, planner, store and engine for many queries; kinds -> modes."""
+
+from __future__ import annotations
+
+from collections.abc import Iterator
+from pathlib import Path
+
+import pytest
+
+from queries import KINDS, parse_query
+from reasoning.knowledge.knowledge_base import KnowledgeBase
+from robokudo.application.service import EXECUTION_MODES, AnsweringService, ExecutionMode
+
+
+@pytest.fixture
+def service(tmp_path: Path, monkeypatch: pytest.MonkeyPatch) -> Iterator[AnsweringService]:
+    monkeypatch.setenv("ROBOKUDO_USER_ONTOLOGY", str(tmp_path / "user.ttl"))
+    with AnsweringService.open(tmp_path / "beliefs.sqlite") as opened:
+        yield opened
+
+
+def test_three_queries_share_one_engine_and_one_knowledge_base_load(
+    tmp_path: Path, monkeypatch: pytest.MonkeyPatch
+) -> None:
+    monkeypatch.setenv("ROBOKUDO_USER_ONTOLOGY", str(tmp_path / "user.ttl"))
+    loads: list[KnowledgeBase] = []
+    original_init = KnowledgeBase.__init__
+
+    def counting_init(self: KnowledgeBase, *args: object, **kwargs: object) -> None:
+        loads.append(self)
+        original_init(self, *args, **kwargs)  # type: ignore[arg-type]
+
+    monkeypatch.setattr(KnowledgeBase, "__init__", counting_init)
+    with AnsweringService.open(tmp_path / "beliefs.sqlite") as service:
+        engine = service.engine
+        milk = service.answer("find milk in fridge").answer
+        ticks_after_first = engine.tick_count
+        cup = service.answer("find the red cup").answer
+        bowl = service.answer("detect { obj: { type: bowl, color: blue } }").answer
+        assert service.engine is engine and engine.tick_count > ticks_after_first
+    assert len(loads) == 1
+    assert len(milk.objects) == 1 and "milk" in (milk.objects[0].class_label or "")
+    assert milk.objects[0].region == "fridge"
+    assert [o.class_label for o in cup.objects] == ["cup"] and cup.objects[0].attributes["color"].value == "red"
+    assert [o.class_label for o in bowl.objects] == ["bowl"]
+    assert len({milk.objects[0].id, cup.objects[0].id, bowl.objects[0].id}) == 3
+
+
+def test_every_query_kind_has_one_execution_mode() -> None:
+    assert set(EXECUTION_MODES) == set(KINDS) - {"stop"}
+    assert EXECUTION_MODES["track"] is ExecutionMode.CONTINUOUS
+    assert {EXECUTION_MODES[k] for k in ("detect", "inspect", "scan")} == {ExecutionMode.ONCE}
+
+
+def test_a_track_query_answers_every_run_until_cancelled(service: AnsweringService) -> None:
+    with pytest.raises(ValueError, match="runs continuously"):
+        service.answer("track the red cup")
+    handle = service.start("track the red cup")
+    first = handle.next_answer(timeout=60)
+    second = handle.next_answer(timeout=60)
+    assert first is not None and second is not None, handle.reason
+    assert [o.class_label for o in first.objects] == ["cup"]
+    assert second.objects[0].id == first.objects[0].id  # the same cup, seen again
+    assert not handle.done
+    handle.cancel()
+    assert handle.done and handle.reason == "cancelled"
+    assert not service.engine.is_running_in_background()
+    assert all(late.objects for late in handle.answers())  # answers() ends once the task ended
+    # the engine answers one-shot queries again after the continuous task
+    assert [o.class_label for o in service.answer("find the red cup").answer.objects] == ["cup"]
+
+
+def test_a_one_shot_query_replaces_a_running_continuous_task(service: AnsweringService) -> None:
+    handle = service.start("track the red cup")
+    assert handle.next_answer(timeout=60) is not None, handle.reason
+    assert service.answer("find milk in fridge").answer.objects
+    assert handle.done and "replaced" in handle.reason
+
+
+def test_kinds_that_do_not_fit_the_call_are_refused(service: AnsweringService) -> None:
+    with pytest.raises(ValueError, match="ends with one answer"):
+        service.start("find the red cup")
+    with pytest.raises(ValueError, match="plans no perception tree"):
+        service.mode_of(parse_query("stop { task: 1 }"))
