@@ -1,17 +1,18 @@
 """From a parsed query and the knowledge base to a :class:`~reasoning.beliefs.store.BeliefFilter`.
 
-The query is read duck-typed (``query.body`` a block with ``get(key)``; the natural front end nests the
-object description under ``obj``); the knowledge base is any object with ``resolve(word)``,
-``is_subclass(a, b)``, ``region(name)`` and ``regions_of_class(name)`` (each may be missing or raise for an
-unknown word, in which case the word is used as it is). Neither package is imported here.
+The object description is the query's body or its ``obj`` block (the natural front end nests it there). Words
+are resolved with the knowledge base (any :class:`Vocabulary`, e.g. the KnowledgeBase); a word it does not
+know is used as it is, so memory can still be searched by name.
 """
 
 from __future__ import annotations
 
-from collections.abc import Callable
-from typing import Any
+from collections.abc import Callable, Collection, Sequence
+from typing import Protocol
 
-from reasoning.beliefs.store import BeliefFilter
+from queries import Block, Number, Query, String, Symbol, Value
+from reasoning.beliefs.store import BeliefFilter, RegionLike
+from reasoning.knowledge.model import Resolved
 
 CLASS_KEYS = ("type", "class", "object")
 REGION_KEYS = ("location", "region")
@@ -19,7 +20,19 @@ REGION_RELATIONS = ("in", "on", "at", "inside", "within")
 ATTRIBUTE_KEYS = {"color": "color", "colour": "color", "shape": "shape", "size": "size", "text": "text"}
 
 
-def belief_filter(query: Any, kb: Any = None, *, include_gone: bool = False) -> BeliefFilter:
+class Vocabulary(Protocol):
+    """What the filter asks the knowledge base; each method raises LookupError for a word it does not know."""
+
+    def resolve(self, word: str, kinds: Collection[str] | None = None) -> Resolved: ...
+
+    def is_subclass(self, name: str, ancestor: str) -> bool: ...
+
+    def region(self, name: str) -> RegionLike: ...
+
+    def regions_of_class(self, region_class: str) -> Sequence[RegionLike]: ...
+
+
+def belief_filter(query: Query, kb: Vocabulary | None = None, *, include_gone: bool = False) -> BeliefFilter:
     """The filter selecting the known objects that answer ``query`` (class subsumption and regions via ``kb``)."""
     blocks = [b for b in (_body(query), _block(_get(_body(query), "obj"))) if b is not None]
     object_class = _first_word(blocks, CLASS_KEYS)
@@ -45,29 +58,28 @@ def belief_filter(query: Any, kb: Any = None, *, include_gone: bool = False) -> 
     )
 
 
-def _body(query: Any) -> Any:
-    return getattr(query, "body", None)
+def _body(query: Query) -> Block:
+    return query.body
 
 
-def _get(block: Any, key: str) -> Any:
-    getter = getattr(block, "get", None)
-    return getter(key) if callable(getter) else None
+def _get(block: Block | None, key: str) -> Value | None:
+    return block.get(key) if block is not None else None
 
 
-def _block(value: Any) -> Any:
-    return value if value is not None and callable(getattr(value, "get", None)) else None
+def _block(value: Value | None) -> Block | None:
+    return value if isinstance(value, Block) else None
 
 
-def _word(value: Any) -> str | None:
+def _word(value: Value | None) -> str | None:
     """The text of a symbol or string value (None for numbers, lists, blocks, ``?``)."""
-    for attribute in ("name", "text"):
-        text = getattr(value, attribute, None)
-        if isinstance(text, str) and text:
-            return text
-    return value if isinstance(value, str) and value else None
+    if isinstance(value, Symbol):
+        return value.name or None
+    if isinstance(value, String):
+        return value.text or None
+    return None
 
 
-def _first_word(blocks: list[Any], keys: tuple[str, ...]) -> str | None:
+def _first_word(blocks: list[Block], keys: tuple[str, ...]) -> str | None:
     for block in blocks:
         for key in keys:
             word = _word(_get(block, key))
@@ -76,15 +88,15 @@ def _first_word(blocks: list[Any], keys: tuple[str, ...]) -> str | None:
     return None
 
 
-def _number(blocks: list[Any], key: str) -> float | None:
+def _number(blocks: list[Block], key: str) -> float | None:
     for block in blocks:
-        value = getattr(_get(block, key), "value", None)
-        if isinstance(value, int | float):
-            return float(value)
+        value = _get(block, key)
+        if isinstance(value, Number):
+            return float(value.value)
     return None
 
 
-def _region_word(blocks: list[Any]) -> str | None:
+def _region_word(blocks: list[Block]) -> str | None:
     for block in blocks:
         for key in REGION_KEYS:
             value = _get(block, key)
@@ -100,65 +112,45 @@ def _region_word(blocks: list[Any]) -> str | None:
     return None
 
 
-def _name_of(found: Any) -> str | None:
-    if isinstance(found, str):
-        return found or None
-    if isinstance(found, tuple | list) and found:
-        return _name_of(found[0])
-    name = getattr(found, "name", None)
-    return name if isinstance(name, str) and name else None
-
-
-def _resolve(kb: Any, word: str, kind: str | None = None) -> str:
-    """The knowledge base's name for ``word`` (restricted to ``kind`` when the KB supports kinds), else ``word``."""
-    resolve = getattr(kb, "resolve", None)
-    if not callable(resolve):
+def _resolve(kb: Vocabulary | None, word: str, kind: str) -> str:
+    """The knowledge base's name for ``word`` as a term of ``kind``, else ``word``."""
+    if kb is None:
         return word
     try:
-        try:
-            found = resolve(word, (kind,)) if kind else resolve(word)
-        except TypeError:
-            found = resolve(word)
-        return _name_of(found) or word
-    except (KeyError, ValueError, LookupError):
+        return kb.resolve(word, (kind,)).name
+    except LookupError:
         return word
 
 
-def _resolve_region(kb: Any, word: str) -> tuple[str, tuple[Any, ...]]:
+def _resolve_region(kb: Vocabulary | None, word: str) -> tuple[str, tuple[RegionLike, ...]]:
     if kb is None:
         return word, ()
     candidates = [word, _resolve(kb, word, "region_class")]
-    region = getattr(kb, "region", None)
-    if callable(region):
-        for name in candidates:
-            try:
-                box = region(name)
-            except (KeyError, ValueError, LookupError):
-                continue
-            if box is not None:
-                return str(getattr(box, "name", name)), (box,)
-    of_class = getattr(kb, "regions_of_class", None)
-    if callable(of_class):
-        for name in candidates:
-            try:
-                boxes = tuple(of_class(name) or ())
-            except (KeyError, ValueError, LookupError):
-                continue
-            if boxes:
-                return name, boxes
+    for name in candidates:
+        try:
+            box = kb.region(name)
+        except LookupError:
+            continue
+        return str(box.name), (box,)
+    for name in candidates:
+        try:
+            boxes = tuple(kb.regions_of_class(name))
+        except LookupError:
+            continue
+        if boxes:
+            return name, boxes
     return candidates[-1], ()
 
 
-def kb_class_test(kb: Any) -> Callable[[str, str], bool] | None:
+def kb_class_test(kb: Vocabulary | None) -> Callable[[str, str], bool] | None:
     """``kb.is_subclass`` as a class test that treats names the KB does not know as equal-or-unrelated."""
-    test = getattr(kb, "is_subclass", None)
-    if not callable(test):
+    if kb is None:
         return None
 
     def class_test(a: str, b: str) -> bool:
         try:
-            return bool(test(a, b))
-        except (KeyError, ValueError, LookupError):
+            return kb.is_subclass(a, b)
+        except LookupError:
             return a == b
 
     return class_test

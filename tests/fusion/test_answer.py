@@ -4,6 +4,7 @@ from __future__ import annotations
 
 import argparse
 import json
+from collections.abc import Collection
 from dataclasses import dataclass
 from pathlib import Path
 from typing import ClassVar
@@ -12,12 +13,14 @@ import numpy as np
 import pytest
 from py_trees.common import Status
 
+from queries import Query, parse_query
 from reasoning.beliefs.answer import answer_from_memory, class_iri, class_label, designator
 from reasoning.beliefs.filters import belief_filter
 from reasoning.beliefs.store import BeliefFilter, BeliefStore
 from reasoning.fusion.frame import FrameObject
 from reasoning.fusion.rule import Evidence
 from reasoning.fusion.tracking import BeliefTracker
+from reasoning.knowledge.model import Resolved
 from robokudo.application.commands import beliefs as beliefs_cli
 from robokudo.core.annotator import Annotator
 from robokudo.core.engine import Engine
@@ -209,14 +212,14 @@ def test_the_answer_step_can_fail_when_nothing_matches(tmp_path: Path) -> None:
 
 
 class FakeKnowledgeBase:
-    """Duck-typed like the KnowledgeBase (resolve, is_subclass, region, regions_of_class)."""
+    """A Vocabulary (what the belief filter asks the KnowledgeBase) over a few words."""
 
     words: ClassVar[dict[str, str]] = {"milk": "Milk", "cup": "Cup", "red": "Red", "fridge": "fridge"}
 
-    def resolve(self, word: str, kinds: tuple[str, ...] | None = None) -> str:
+    def resolve(self, word: str, kinds: Collection[str] | None = None) -> Resolved:
         if word.lower() not in self.words:
             raise KeyError(word)
-        return self.words[word.lower()]
+        return Resolved(kind="class", name=self.words[word.lower()])
 
     def is_subclass(self, name: str, ancestor: str) -> bool:
         return is_subclass(name, ancestor)
@@ -230,9 +233,8 @@ class FakeKnowledgeBase:
         return [FRIDGE] if name == "FridgeInterior" else []
 
 
-def parse(text: str) -> object:
-    queries = pytest.importorskip("queries.dispatch")
-    return queries.parse_query(text)
+def parse(text: str) -> Query:
+    return parse_query(text)
 
 
 def test_query_to_filter_with_a_fake_knowledge_base() -> None:
