@@ -76,9 +76,7 @@ def test_check_with_hermit_and_code(capsys: pytest.CaptureFixture[str], user_fil
     assert code == 0, out
 
 
-def test_works_as_a_robokudo_subcommand(
-    capsys: pytest.CaptureFixture[str], user_file: Path, monkeypatch: pytest.MonkeyPatch
-) -> None:
+def test_works_as_a_robokudo_subcommand(capsys: pytest.CaptureFixture[str], user_file: Path) -> None:
     from robokudo.application import cli
 
     assert cli.main(["ontology", "--user-file", str(user_file), "show", "cereal boxes"]) == 0
