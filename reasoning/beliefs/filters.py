@@ -1,9 +1,14 @@
 """From a parsed query and the knowledge base to a :class:`~reasoning.beliefs.store.BeliefFilter`.
 
-The query is read duck-typed (``query.body`` a block with ``get(key)``; the natural front end nests the
-object description under ``obj``); the knowledge base is any object with ``resolve(word)``,
-``is_subclass(a, b)``, ``region(name)`` and ``regions_of_class(name)`` (each may be missing or raise for an
-unknown word, in which case the word is used as it is). Neither package is imported here.
+The query is read duck-typed (``query.body`` a block with ``get(key)`` and ``fields``; the natural front end
+nests the object description under ``obj``); the knowledge base is any object with ``resolve(word)``,
+``is_subclass(a, b)``, ``region(name)``, ``regions_of_class(name)``, ``annotation_type_for_key(key)`` and
+``value_kind(annotation_type)`` (each may be missing or raise for an unknown word, in which case the word is
+used as it is). Neither package is imported here.
+
+Which key filters which attribute comes from the ontology (the annotation type answering the key, its value
+kind) and the annotation type's ``attribute`` (:mod:`robokudo.core.types`); without a knowledge base a key
+filters the attribute of the same name.
 """
 
 from __future__ import annotations
@@ -12,11 +17,13 @@ from collections.abc import Callable
 from typing import Any
 
 from reasoning.beliefs.store import BeliefFilter
+from robokudo.core.types import ATTRIBUTE_TYPES, Annotation, Classification, Location
 
 CLASS_KEYS = ("type", "class", "object")
 REGION_KEYS = ("location", "region")
 REGION_RELATIONS = ("in", "on", "at", "inside", "within")
-ATTRIBUTE_KEYS = {"color": "color", "colour": "color", "shape": "shape", "size": "size", "text": "text"}
+FILTERED_TYPES: tuple[type[Annotation], ...] = tuple(t for t in ATTRIBUTE_TYPES if t not in (Classification, Location))
+"""The annotation types whose attribute a query key filters on (class and region have their own keys above)."""
 
 
 def belief_filter(query: Any, kb: Any = None, *, include_gone: bool = False) -> BeliefFilter:
@@ -24,11 +31,7 @@ def belief_filter(query: Any, kb: Any = None, *, include_gone: bool = False) -> 
     blocks = [b for b in (_body(query), _block(_get(_body(query), "obj"))) if b is not None]
     object_class = _first_word(blocks, CLASS_KEYS)
     region_word = _region_word(blocks)
-    attributes: dict[str, str] = {}
-    for key, name in ATTRIBUTE_KEYS.items():
-        word = _first_word(blocks, (key,))
-        if word is not None:
-            attributes[name] = word if name == "text" else _resolve(kb, word, name)
+    attributes = _attributes(blocks, kb)
     class_test = kb_class_test(kb)
     if object_class is not None:
         object_class = _resolve(kb, object_class, "class")
@@ -82,6 +85,46 @@ def _number(blocks: list[Any], key: str) -> float | None:
         if isinstance(value, int | float):
             return float(value)
     return None
+
+
+def _attributes(blocks: list[Any], kb: Any) -> dict[str, str]:
+    """Attribute name -> the value asked for, resolved to the knowledge base's name when it has a value kind."""
+    words: dict[type[Annotation], str] = {}
+    for block in blocks:
+        for key in _keys(block):
+            annotation_type = _answering_type(kb, key)
+            word = _word(_get(block, key))
+            if annotation_type is not None and word is not None:
+                words.setdefault(annotation_type, word)
+    found: dict[str, str] = {}
+    for annotation_type in FILTERED_TYPES:
+        word = words.get(annotation_type)
+        if word is not None:
+            kind = _value_kind(kb, annotation_type)
+            found[annotation_type.attribute] = word if kind is None else _resolve(kb, word, kind)
+    return found
+
+
+def _keys(block: Any) -> list[str]:
+    return [key for key in (getattr(f, "key", None) for f in getattr(block, "fields", ())) if isinstance(key, str)]
+
+
+def _answering_type(kb: Any, key: str) -> type[Annotation] | None:
+    """The filtered annotation type answering ``key``: per the ontology, else the type whose attribute it names."""
+    answered_by = getattr(kb, "annotation_type_for_key", None)
+    if not callable(answered_by):
+        return next((t for t in FILTERED_TYPES if t.attribute == key), None)
+    try:
+        name = answered_by(key)
+    except (KeyError, ValueError, LookupError):
+        return None
+    return next((t for t in FILTERED_TYPES if t.type_name() == name), None)
+
+
+def _value_kind(kb: Any, annotation_type: type[Annotation]) -> str | None:
+    """The kind of the ontology values ``annotation_type`` carries (None: free text, or no knowledge base)."""
+    value_kind = getattr(kb, "value_kind", None)
+    return value_kind(annotation_type.type_name()) if callable(value_kind) else None
 
 
 def _region_word(blocks: list[Any]) -> str | None:
