@@ -14,6 +14,21 @@ DEFAULT_MAP_FILE = "kitchen_map.ttl"
 EXAMPLE_USER_MAP_FILE = "example_user_map.ttl"
 """An example of a user's own kitchen map (not loaded by default)."""
 
+REGION_BOX_PROPERTIES: tuple[str, ...] = (
+    "positionX",
+    "positionY",
+    "positionZ",
+    "orientationX",
+    "orientationY",
+    "orientationZ",
+    "orientationW",
+    "sizeX",
+    "sizeY",
+    "sizeZ",
+)
+"""The ``rk:`` data properties that place a region box (regions.ttl): centre position, unit quaternion x-y-z-w
+and size, in this order."""
+
 
 def ontology_dir() -> Path:
     """The folder holding the shipped ``*.ttl`` files."""

@@ -18,39 +18,17 @@ import numpy as np
 from reasoning.beliefs.answer import Answer, class_label, designator
 from reasoning.beliefs.store import BeliefFilter, BeliefStore
 from reasoning.fusion.association import CameraModel
-from reasoning.fusion.frame import WORLD_FRAME, FrameContext, frame_objects
+from reasoning.fusion.frame import FUSED_TYPES, WORLD_FRAME, FrameContext, frame_objects
 from reasoning.fusion.tracking import BeliefTracker
 from robokudo.core.annotator import Annotator
-from robokudo.core.types import (
-    CameraInfo,
-    CasType,
-    Classification,
-    ColorHistogram,
-    DepthImage,
-    Location,
-    ObjectHypothesis,
-    PointCloud,
-    Pose,
-    QueryAnswer,
-    QueryView,
-    SemanticColor,
-    Shape,
-    Size,
-    Text,
-)
+from robokudo.core.types import CameraInfo, CasType, DepthImage, ObjectHypothesis, PointCloud, QueryAnswer, QueryView
 
 
 def camera_model(info: CameraInfo, depth: np.ndarray | None = None) -> CameraModel:
     """The visibility model of a frame: world frame when the camera pose is known, else the camera frame."""
-    k = info.intrinsics
     known = info.cam_to_world is not None
     return CameraModel(
-        fx=k.fx,
-        fy=k.fy,
-        cx=k.cx,
-        cy=k.cy,
-        width=k.width,
-        height=k.height,
+        intrinsics=info.intrinsics,
         to_frame=np.asarray(info.cam_to_world, dtype=np.float64) if known else np.eye(4),
         frame=WORLD_FRAME if known else info.frame_id,
         depth=depth,
@@ -72,20 +50,7 @@ class AnswerStep(Annotator):
     """
 
     inputs: ClassVar[tuple[type[CasType], ...]] = (ObjectHypothesis,)
-    optional_inputs: ClassVar[tuple[type[CasType], ...]] = (
-        CameraInfo,
-        PointCloud,
-        DepthImage,
-        QueryView,
-        Pose,
-        Size,
-        SemanticColor,
-        ColorHistogram,
-        Shape,
-        Classification,
-        Text,
-        Location,
-    )
+    optional_inputs: ClassVar[tuple[type[CasType], ...]] = (CameraInfo, PointCloud, DepthImage, QueryView, *FUSED_TYPES)
     outputs: ClassVar[tuple[type[CasType], ...]] = (QueryAnswer,)
 
     def __init__(

@@ -94,8 +94,9 @@ class Profile:
 
 
 @dataclass(frozen=True)
-class Evidence:
-    """What the experts said about one hypothesis (None: not said), with their confidences."""
+class Cues:
+    """The cues the experts gave about one hypothesis (None: not given): the most confident colour, shape and
+    size class with their confidences, and the text read on it."""
 
     color: tuple[str, float] | None = None
     shape: tuple[str, float] | None = None
@@ -126,23 +127,23 @@ def _size_agreement(observed: str, listed: str | None) -> float:
     return (1.0, 0.25, 0.0)[abs(SIZE_CLASSES.index(observed) - SIZE_CLASSES.index(listed))]
 
 
-def score(profile: Profile, evidence: Evidence) -> Match:
-    """The weighted agreement of a profile with a hypothesis' evidence (see the module docstring)."""
+def score(profile: Profile, cues: Cues) -> Match:
+    """The weighted agreement of a profile with a hypothesis's cues (see the module docstring)."""
     total = weight = 0.0
     found = 0
-    if evidence.color is not None:
-        color, confidence = evidence.color
+    if cues.color is not None:
+        color, confidence = cues.color
         total += WEIGHTS["color"] * _toward_neutral(_value_agreement(color, profile.colors), confidence)
         weight += WEIGHTS["color"]
-    if evidence.shape is not None:
+    if cues.shape is not None:
         shapes = (profile.shape,) if profile.shape else ()
-        total += WEIGHTS["shape"] * _toward_neutral(_value_agreement(evidence.shape[0], shapes), evidence.shape[1])
+        total += WEIGHTS["shape"] * _toward_neutral(_value_agreement(cues.shape[0], shapes), cues.shape[1])
         weight += WEIGHTS["shape"]
-    if evidence.size is not None:
-        total += WEIGHTS["size"] * _toward_neutral(_size_agreement(evidence.size[0], profile.size), evidence.size[1])
+    if cues.size is not None:
+        total += WEIGHTS["size"] * _toward_neutral(_size_agreement(cues.size[0], profile.size), cues.size[1])
         weight += WEIGHTS["size"]
-    if evidence.text:
-        read = compact(evidence.text)
+    if cues.text:
+        read = compact(cues.text)
         found = sum(1 for text in profile.texts if text in read)
         agreement = found / len(profile.texts) if profile.texts else TEXT_NONE
         total += WEIGHTS["text"] * agreement
@@ -202,13 +203,13 @@ class KnowledgeClassifier(Annotator):
         self.margin = margin
         self.expected = expected
 
-    def evidence(self, hypothesis: ObjectHypothesis) -> Evidence:
+    def cues(self, hypothesis: ObjectHypothesis) -> Cues:
         """The most confident colour, shape, size and the text read on the hypothesis."""
         color = max(self.attached(hypothesis, SemanticColor), key=lambda a: a.confidence, default=None)
         shape = max(self.attached(hypothesis, Shape), key=lambda a: a.confidence, default=None)
         size = max(self.attached(hypothesis, Size), key=lambda a: a.confidence, default=None)
         texts = [t.text for t in self.attached(hypothesis, Text) if t.text.strip()]
-        return Evidence(
+        return Cues(
             color=(color.color, color.confidence) if color is not None else None,
             shape=(shape.shape, shape.confidence) if shape is not None else None,
             size=(size.size_class, size.confidence) if size is not None else None,
@@ -225,10 +226,10 @@ class KnowledgeClassifier(Annotator):
         best_seen: Match | None = None
         classified = 0
         for hypothesis in hypotheses:
-            evidence = self.evidence(hypothesis)
-            if evidence == Evidence():
+            cues = self.cues(hypothesis)
+            if cues == Cues():
                 continue
-            matches = [score(profile, evidence) for profile in self.profiles]
+            matches = [score(profile, cues) for profile in self.profiles]
             top = max(matches, key=lambda m: m.score)
             if best_seen is None or top.score > best_seen.score:
                 best_seen = top

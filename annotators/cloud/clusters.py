@@ -57,7 +57,8 @@ class Segment:
 
 @dataclass(frozen=True)
 class ClusterParameters:
-    """Thresholds of :func:`extract_clusters` (metres, pixels or 8-bit gradient units)."""
+    """Thresholds of :func:`extract_clusters` (metres, pixels or 8-bit gradient units); the merge thresholds
+    default to :class:`~annotators.geometry.grid_segmentation.MergeRules`'s."""
 
     min_height: float = 0.01
     max_height: float = 0.5
@@ -70,13 +71,13 @@ class ClusterParameters:
     edge_high: float = 100.0
     min_part_points: int = 40
     grow_distance: float = 6.0
-    footprint_cell: float = 0.005
-    footprint_overlap: float = 0.5
-    inside_tolerance: float = 0.01
-    inside_depth_ratio: float = 1.5
-    continuous_share: float = 0.6
+    footprint_cell: float = MergeRules.cell
+    footprint_overlap: float = MergeRules.overlap
+    inside_tolerance: float = MergeRules.inside_tolerance
+    inside_depth_ratio: float = MergeRules.inside_depth_ratio
+    continuous_share: float = MergeRules.continuous
     smooth_degrees: float = 35.0
-    convexity: float = 0.15
+    convexity: float = MergeRules.convex
     small_part_points: int = 100
     stride: int = 2
 

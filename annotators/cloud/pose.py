@@ -7,7 +7,8 @@ from typing import ClassVar
 import numpy as np
 
 from annotators.cloud.cloud_expert import CloudExpert
-from annotators.geometry.boxes import finite_points, object_box, quaternion_from_matrix
+from annotators.geometry.boxes import finite_points, object_box
+from robokudo.core.geometry import quaternion_from_matrix
 from robokudo.core.types import CameraInfo, CasType, ObjectHypothesis, PointCloud, Pose
 
 

@@ -70,27 +70,6 @@ def principal_box(points: np.ndarray) -> OrientedBox:
     return OrientedBox(centre, rotation, high - low)
 
 
-def quaternion_from_matrix(rotation: np.ndarray) -> np.ndarray:
-    """The unit quaternion (x, y, z, w) of a 3x3 rotation matrix."""
-    m = np.asarray(rotation, dtype=np.float64)
-    trace = m[0, 0] + m[1, 1] + m[2, 2]
-    if trace > 0:
-        s = 2.0 * np.sqrt(trace + 1.0)
-        q = [(m[2, 1] - m[1, 2]) / s, (m[0, 2] - m[2, 0]) / s, (m[1, 0] - m[0, 1]) / s, 0.25 * s]
-    elif m[0, 0] >= m[1, 1] and m[0, 0] >= m[2, 2]:
-        s = 2.0 * np.sqrt(max(1.0 + m[0, 0] - m[1, 1] - m[2, 2], 1e-12))
-        q = [0.25 * s, (m[0, 1] + m[1, 0]) / s, (m[0, 2] + m[2, 0]) / s, (m[2, 1] - m[1, 2]) / s]
-    elif m[1, 1] >= m[2, 2]:
-        s = 2.0 * np.sqrt(max(1.0 + m[1, 1] - m[0, 0] - m[2, 2], 1e-12))
-        q = [(m[0, 1] + m[1, 0]) / s, 0.25 * s, (m[1, 2] + m[2, 1]) / s, (m[0, 2] - m[2, 0]) / s]
-    else:
-        s = 2.0 * np.sqrt(max(1.0 + m[2, 2] - m[0, 0] - m[1, 1], 1e-12))
-        q = [(m[0, 2] + m[2, 0]) / s, (m[1, 2] + m[2, 1]) / s, 0.25 * s, (m[1, 0] - m[0, 1]) / s]
-    quaternion = np.array(q)
-    norm = np.linalg.norm(quaternion)
-    return quaternion / norm if norm > 0 and np.isfinite(norm) else np.array([0.0, 0.0, 0.0, 1.0])
-
-
 def object_box(points_camera: np.ndarray, cam_to_world: np.ndarray | None) -> tuple[OrientedBox, str]:
     """The box of an object's camera-frame points and its frame: upright in "world" when the pose is known."""
     if cam_to_world is not None:

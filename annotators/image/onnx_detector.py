@@ -30,6 +30,7 @@ from typing import Any, ClassVar
 import cv2
 import numpy as np
 
+from annotators.image.pixel_expert import image_and_hypotheses
 from robokudo.core.annotator import Annotator
 from robokudo.core.types import CasType, Classification, ColorImage, ObjectHypothesis
 
@@ -265,12 +266,7 @@ class OnnxDetector(Annotator):
 
     def analyse(self) -> None:
         """Detect, then attach the best overlapping detection's class to each hypothesis."""
-        image = self.view(ColorImage).image
-        if image.ndim != 3 or image.shape[2] != 3 or image.size == 0:
-            self.fail(f"colour image must be HxWx3, got shape {image.shape}")
-        hypotheses = self.annotations(ObjectHypothesis)
-        if not hypotheses:
-            self.fail("no object hypotheses to name")
+        image, hypotheses = image_and_hypotheses(self, "name")
         try:
             detections = self.detect(image)
         except DetectorError as error:

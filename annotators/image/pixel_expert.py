@@ -23,6 +23,18 @@ def hypothesis_pixels(image: np.ndarray, hypothesis: ObjectHypothesis, max_pixel
     return pixels[:: max(1, pixels.shape[0] // max_pixels)]
 
 
+def image_and_hypotheses(annotator: Annotator, purpose: str) -> tuple[np.ndarray, list[ObjectHypothesis]]:
+    """The CAS's RGB image and object hypotheses; fails ``annotator`` when the image is not a non-empty HxWx3
+    array or there is no hypothesis to ``purpose`` (the failure message's verb)."""
+    image = annotator.view(ColorImage).image
+    if image.ndim != 3 or image.shape[2] != 3 or image.size == 0:
+        annotator.fail(f"colour image must be HxWx3, got shape {image.shape}")
+    hypotheses = annotator.annotations(ObjectHypothesis)
+    if not hypotheses:
+        annotator.fail(f"no object hypotheses to {purpose}")
+    return image, hypotheses
+
+
 class PixelExpert(Annotator):
     """Attaches what :meth:`describe` says about the pixels of every hypothesis; fails on unusable input.
 
@@ -42,12 +54,7 @@ class PixelExpert(Annotator):
 
     def analyse(self) -> None:
         """Describe each hypothesis with pixels; fail on missing or inconsistent input."""
-        image = self.view(ColorImage).image
-        if image.ndim != 3 or image.shape[2] != 3 or image.size == 0:
-            self.fail(f"colour image must be HxWx3, got shape {image.shape}")
-        hypotheses = self.annotations(ObjectHypothesis)
-        if not hypotheses:
-            self.fail(f"no object hypotheses to {self.purpose}")
+        image, hypotheses = image_and_hypotheses(self, self.purpose)
         described = 0
         for hypothesis in hypotheses:
             if hypothesis.mask.shape != image.shape[:2]:

@@ -33,12 +33,6 @@ from robokudo.core.types import CameraInfo, CameraIntrinsics, CasType, ColorImag
 DEFAULT_KITCHEN_VIEW = "table"
 
 
-def _to_intrinsics(scene_intrinsics: kitchen_scene.CameraIntrinsics) -> CameraIntrinsics:
-    """The runtime's intrinsics type from the scene renderer's."""
-    k = scene_intrinsics
-    return CameraIntrinsics(fx=k.fx, fy=k.fy, cx=k.cx, cy=k.cy, width=k.width, height=k.height)
-
-
 class KitchenSceneReader(Annotator):
     """Renders the built-in kitchen from a named camera view (``"table"`` when ``view`` is None).
 
@@ -88,7 +82,7 @@ class KitchenSceneReader(Annotator):
         self.write(DepthImage(scene.depth))
         self.write(
             CameraInfo(
-                intrinsics=_to_intrinsics(scene.intrinsics),
+                intrinsics=scene.intrinsics,
                 cam_to_world=scene.cam_to_world,
                 frame_id=f"kitchen/{view}",
                 timestamp=time.time(),

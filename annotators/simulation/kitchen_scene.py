@@ -32,6 +32,8 @@ import open3d as o3d
 from numpy.typing import NDArray
 
 from annotators.cloud.size import SIZE_CLASS_THRESHOLDS, size_class_for
+from annotators.simulation.kitchen_map import map_regions
+from robokudo.core.regions import RegionBox, region_of
 from robokudo.core.types import CameraIntrinsics
 
 __all__ = (
@@ -40,8 +42,6 @@ __all__ = (
     "MAX_DEPTH",
     "SIZE_CLASS_THRESHOLDS",
     "TABLE_TOP_HEIGHT",
-    "CameraIntrinsics",
-    "RegionBox",
     "RenderedScene",
     "SceneObject",
     "camera_looking_at",
@@ -91,24 +91,6 @@ class SceneObject:
     def position(self) -> FloatArray:
         """World position of the object's bounding-box centre."""
         return np.asarray(self.pose[:3, 3], dtype=np.float64).copy()
-
-
-@dataclass(frozen=True, eq=False)
-class RegionBox:
-    """An axis box of the semantic map (pose = world pose of the box centre)."""
-
-    name: str
-    region_class: str
-    pose: FloatArray
-    size: tuple[float, float, float]
-
-    def contains(self, point_world: NDArray[np.floating]) -> bool:
-        """Return True if the world point lies inside the box."""
-        p = np.ones(4)
-        p[:3] = np.asarray(point_world, dtype=np.float64).reshape(3)
-        local = np.linalg.inv(self.pose) @ p
-        half = np.asarray(self.size) / 2.0
-        return bool(np.all(np.abs(local[:3]) <= half + 1e-9))
 
 
 @dataclass(frozen=True, eq=False)
@@ -305,12 +287,6 @@ _OBJECT_SPECS: tuple[_ObjectSpec, ...] = (
     ),
 )  # fmt: skip
 
-_REGION_SPECS: tuple[tuple[str, str, tuple[float, float, float], tuple[float, float, float]], ...] = (
-    # name, region_class, centre, size
-    ("table", "Table", (0.0, 0.0, 0.95), (1.2, 0.8, 0.5)),
-    ("fridge", "Fridge", (1.3, 0.85, 0.8), (0.5, 0.5, 1.5)),
-)
-
 # Surface patterns
 _PLAIN, _CHECKER, _WOOD, _LABEL = 0, 1, 2, 3
 
@@ -320,17 +296,9 @@ _AMBIENT, _KEY, _HEAD = 0.5, 0.35, 0.2
 
 
 def kitchen_regions() -> tuple[RegionBox, ...]:
-    """Semantic-map regions: the table top ("table") and the fridge interior ("fridge")."""
-    return tuple(
-        RegionBox(name=n, region_class=c, pose=_pose(*centre), size=size) for n, c, centre, size in _REGION_SPECS
-    )
-
-
-def _region_of(position: FloatArray, regions: tuple[RegionBox, ...]) -> str:
-    for region in regions:
-        if region.contains(position):
-            return region.name
-    return ""
+    """The semantic-map regions of the kitchen (the table top "table", the fridge interior "fridge"), as the
+    built-in map ``ontology/kitchen_map.ttl`` declares them."""
+    return map_regions()
 
 
 def kitchen_objects(
@@ -370,7 +338,7 @@ def kitchen_objects(
                 size_class=size_class_for(spec.size),
                 pose=pose,
                 text=spec.text,
-                region=_region_of(pose[:3, 3], regions),
+                region=region.name if (region := region_of(pose[:3, 3], regions)) is not None else "",
             )
         )
     return tuple(objects)

@@ -18,6 +18,7 @@ from typing import Any, ClassVar
 import cv2
 import numpy as np
 
+from annotators.image.pixel_expert import image_and_hypotheses
 from robokudo.core.threaded import ThreadedAnnotator
 from robokudo.core.types import CasType, ColorImage, ObjectHypothesis, Text
 
@@ -109,12 +110,7 @@ class TextReader(ThreadedAnnotator):
 
     def analyse(self) -> None:
         """Read every hypothesis' text; fail on broken input (finding no text is a success without Text)."""
-        image = self.view(ColorImage).image
-        if image.ndim != 3 or image.shape[2] != 3 or image.size == 0:
-            self.fail(f"colour image must be HxWx3, got shape {image.shape}")
-        hypotheses = self.annotations(ObjectHypothesis)
-        if not hypotheses:
-            self.fail("no object hypotheses to read text on")
+        image, hypotheses = image_and_hypotheses(self, "read text on")
         usable = 0
         for hypothesis in hypotheses:
             if self.cancelled:

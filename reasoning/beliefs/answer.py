@@ -18,9 +18,7 @@ from typing import Any
 from reasoning.beliefs.store import BeliefFilter, BeliefStore
 from reasoning.fusion.rule import CLASS_ATTRIBUTE, ClassTest
 from reasoning.fusion.tracking import ObjectBelief
-from robokudo.core.types import (
-    ONTOLOGY_NAMESPACE,
-)
+from robokudo.core.types import ONTOLOGY_NAMESPACE, SemanticColor, Size
 
 
 def class_iri(class_name: str) -> str:
@@ -150,7 +148,7 @@ class Answer:
         lines = []
         for o in self.objects:
             p = o.pose.position
-            colour = o.attributes.get("color")
+            colour = o.attributes.get(SemanticColor.attribute)
             lines.append(
                 f"#{o.id} {o.class_label or 'object'}"
                 + (f" ({colour.value})" if colour else "")
@@ -180,7 +178,7 @@ def designator(
             conflict=fused.conflict,
         )
     class_name = belief.class_name or (attributes[CLASS_ATTRIBUTE].value if CLASS_ATTRIBUTE in attributes else None)
-    size_attribute = attributes.get("size")
+    size_attribute = attributes.get(Size.attribute)
     x, y, z = belief.position.tolist()
     qx, qy, qz, qw = belief.orientation.tolist()
     return ObjectDesignator(

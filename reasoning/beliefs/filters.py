@@ -3,6 +3,10 @@
 The object description is the query's body or its ``obj`` block (the natural front end nests it there). Words
 are resolved with the knowledge base (any :class:`Vocabulary`, e.g. the KnowledgeBase); a word it does not
 know is used as it is, so memory can still be searched by name.
+
+Which key filters which attribute comes from the ontology (the annotation type answering the key, its value
+kind) and the annotation type's ``attribute`` (:mod:`robokudo.core.types`); without a knowledge base a key
+filters the attribute of the same name.
 """
 
 from __future__ import annotations
@@ -11,13 +15,16 @@ from collections.abc import Callable, Collection, Sequence
 from typing import Protocol
 
 from queries import Block, Number, Query, String, Symbol, Value
-from reasoning.beliefs.store import BeliefFilter, RegionLike
+from reasoning.beliefs.store import BeliefFilter
 from reasoning.knowledge.model import Resolved
+from robokudo.core.regions import RegionBox
+from robokudo.core.types import ATTRIBUTE_TYPES, Annotation, Classification, Location
 
 CLASS_KEYS = ("type", "class", "object")
 REGION_KEYS = ("location", "region")
 REGION_RELATIONS = ("in", "on", "at", "inside", "within")
-ATTRIBUTE_KEYS = {"color": "color", "colour": "color", "shape": "shape", "size": "size", "text": "text"}
+FILTERED_TYPES: tuple[type[Annotation], ...] = tuple(t for t in ATTRIBUTE_TYPES if t not in (Classification, Location))
+"""The annotation types whose attribute a query key filters on (class and region have their own keys above)."""
 
 
 class Vocabulary(Protocol):
@@ -27,9 +34,13 @@ class Vocabulary(Protocol):
 
     def is_subclass(self, name: str, ancestor: str) -> bool: ...
 
-    def region(self, name: str) -> RegionLike: ...
+    def annotation_type_for_key(self, key: str) -> str: ...
 
-    def regions_of_class(self, region_class: str) -> Sequence[RegionLike]: ...
+    def value_kind(self, annotation_type: str) -> str | None: ...
+
+    def region(self, name: str) -> RegionBox: ...
+
+    def regions_of_class(self, region_class: str) -> Sequence[RegionBox]: ...
 
 
 def belief_filter(query: Query, kb: Vocabulary | None = None, *, include_gone: bool = False) -> BeliefFilter:
@@ -37,11 +48,7 @@ def belief_filter(query: Query, kb: Vocabulary | None = None, *, include_gone: b
     blocks = [b for b in (_body(query), _block(_get(_body(query), "obj"))) if b is not None]
     object_class = _first_word(blocks, CLASS_KEYS)
     region_word = _region_word(blocks)
-    attributes: dict[str, str] = {}
-    for key, name in ATTRIBUTE_KEYS.items():
-        word = _first_word(blocks, (key,))
-        if word is not None:
-            attributes[name] = word if name == "text" else _resolve(kb, word, name)
+    attributes = _attributes(blocks, kb)
     class_test = kb_class_test(kb)
     if object_class is not None:
         object_class = _resolve(kb, object_class, "class")
@@ -96,6 +103,35 @@ def _number(blocks: list[Block], key: str) -> float | None:
     return None
 
 
+def _attributes(blocks: list[Block], kb: Vocabulary | None) -> dict[str, str]:
+    """Attribute name -> the value asked for, resolved to the knowledge base's name when it has a value kind."""
+    words: dict[type[Annotation], str] = {}
+    for block in blocks:
+        for field in block.fields:
+            annotation_type = _answering_type(kb, field.key)
+            word = _word(field.value)
+            if annotation_type is not None and word is not None:
+                words.setdefault(annotation_type, word)
+    found: dict[str, str] = {}
+    for annotation_type in FILTERED_TYPES:
+        word = words.get(annotation_type)
+        if word is not None:
+            kind = None if kb is None else kb.value_kind(annotation_type.type_name())
+            found[annotation_type.attribute] = word if kind is None else _resolve(kb, word, kind)
+    return found
+
+
+def _answering_type(kb: Vocabulary | None, key: str) -> type[Annotation] | None:
+    """The filtered annotation type answering ``key``: per the ontology, else the type whose attribute it names."""
+    if kb is None:
+        return next((t for t in FILTERED_TYPES if t.attribute == key), None)
+    try:
+        name = kb.annotation_type_for_key(key)
+    except LookupError:
+        return None
+    return next((t for t in FILTERED_TYPES if t.type_name() == name), None)
+
+
 def _region_word(blocks: list[Block]) -> str | None:
     for block in blocks:
         for key in REGION_KEYS:
@@ -122,7 +158,7 @@ def _resolve(kb: Vocabulary | None, word: str, kind: str) -> str:
         return word
 
 
-def _resolve_region(kb: Vocabulary | None, word: str) -> tuple[str, tuple[RegionLike, ...]]:
+def _resolve_region(kb: Vocabulary | None, word: str) -> tuple[str, tuple[RegionBox, ...]]:
     if kb is None:
         return word, ()
     candidates = [word, _resolve(kb, word, "region_class")]

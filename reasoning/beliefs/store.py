@@ -32,9 +32,10 @@ import numpy as np
 import platformdirs
 
 from reasoning.fusion.association import CameraModel, in_view
-from reasoning.fusion.frame import WORLD_FRAME, FrameObject
+from reasoning.fusion.frame import FrameObject
 from reasoning.fusion.rule import CLASS_ATTRIBUTE, AttributeBelief, ClassTest, ValueSupport, fuse_values, sigmoid
-from reasoning.fusion.tracking import PRESENT, BeliefTracker, ObjectBelief, RegionLike, TrackStep, in_box
+from reasoning.fusion.tracking import PRESENT, BeliefTracker, ObjectBelief, TrackStep
+from robokudo.core.regions import RegionBox
 
 SCHEMA_NAME = "robokudo-beliefs"
 SCHEMA_VERSION = 1
@@ -64,7 +65,7 @@ class BeliefFilter:
     object_class: str | None = None
     class_test: ClassTest | None = None
     region: str | None = None
-    region_boxes: tuple[RegionLike, ...] = ()
+    region_boxes: tuple[RegionBox, ...] = ()
     attributes: Mapping[str, str] = field(default_factory=dict)
     include_gone: bool = False
     min_confidence: float = 0.0
@@ -792,14 +793,13 @@ def _in_named_region(row: tuple, f: BeliefFilter) -> bool:
     if str(row[21]).lower() in names:
         return True
     position = np.array([row[3], row[4], row[5]])
-    return any(
-        row[2] == getattr(box, "frame", WORLD_FRAME) and in_box(position, box.pose, box.size) for box in f.region_boxes
-    )
+    return any(row[2] == box.frame and box.contains(position) for box in f.region_boxes)
 
 
 def _frustum_bounds(camera: CameraModel) -> tuple[np.ndarray, np.ndarray]:
-    corners = [(0.0, 0.0), (camera.width, 0.0), (0.0, camera.height), (camera.width, camera.height)]
-    rays = [np.array([(u - camera.cx) / camera.fx, (v - camera.cy) / camera.fy, 1.0]) for u, v in corners]
+    k = camera.intrinsics
+    corners = [(0.0, 0.0), (k.width, 0.0), (0.0, k.height), (k.width, k.height)]
+    rays = [k.ray(u, v) for u, v in corners]
     points = [np.zeros(3)] + [ray * camera.max_range for ray in rays]
     transform = np.asarray(camera.to_frame, dtype=np.float64)
     world = np.stack(points) @ transform[:3, :3].T + transform[:3, 3]

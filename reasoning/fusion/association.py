@@ -24,6 +24,7 @@ from typing import Protocol
 import numpy as np
 
 from reasoning.fusion.rule import ClassTest
+from robokudo.core.types import CameraIntrinsics
 
 
 class Trackable(Protocol):
@@ -178,12 +179,7 @@ def gated_pairs(observations: Sequence[Trackable], beliefs: Sequence[Trackable],
 class CameraModel:
     """A pinhole camera at a pose, with the frame's depth image (metres, 0 or NaN = no data)."""
 
-    fx: float
-    fy: float
-    cx: float
-    cy: float
-    width: int
-    height: int
+    intrinsics: CameraIntrinsics
     to_frame: np.ndarray
     """4x4 transform from the optical frame to ``frame``, the frame beliefs are expressed in."""
     frame: str = "world"
@@ -200,11 +196,10 @@ def in_view(positions: np.ndarray, camera: CameraModel) -> np.ndarray:
     p = points @ to_camera[:3, :3].T + to_camera[:3, 3]
     z = p[:, 2]
     ahead = (z > 0.05) & (z <= camera.max_range)
-    safe = np.where(ahead, z, 1.0)
-    u = camera.fx * p[:, 0] / safe + camera.cx
-    v = camera.fy * p[:, 1] / safe + camera.cy
+    k = camera.intrinsics
+    u, v = k.project(np.column_stack((p[:, :2], np.where(ahead, z, 1.0)))).T
     b = camera.border
-    return ahead & (u >= b) & (u < camera.width - b) & (v >= b) & (v < camera.height - b)
+    return ahead & (u >= b) & (u < k.width - b) & (v >= b) & (v < k.height - b)
 
 
 def visible_from(position: np.ndarray, camera: CameraModel) -> bool:
@@ -220,7 +215,8 @@ def visible_from(position: np.ndarray, camera: CameraModel) -> bool:
     to_camera = np.linalg.inv(camera.to_frame)
     p = to_camera[:3, :3] @ np.asarray(position, dtype=np.float64) + to_camera[:3, 3]
     z = float(p[2])
-    r, c = int(camera.fy * p[1] / z + camera.cy), int(camera.fx * p[0] / z + camera.cx)
+    u, v = camera.intrinsics.project(p)[0]
+    r, c = int(v), int(u)
     window = np.asarray(camera.depth[max(r - 2, 0) : r + 3, max(c - 2, 0) : c + 3], dtype=np.float64)
     window = window[np.isfinite(window) & (window > 0)]
     if window.size == 0:

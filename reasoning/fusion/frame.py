@@ -15,18 +15,8 @@ from typing import TypeVar
 import numpy as np
 
 from reasoning.fusion.rule import Evidence
-from robokudo.core.types import (
-    Annotation,
-    Classification,
-    ColorHistogram,
-    Location,
-    ObjectHypothesis,
-    Pose,
-    SemanticColor,
-    Shape,
-    Size,
-    Text,
-)
+from robokudo.core.geometry import IDENTITY_QUATERNION, quaternion_from_matrix
+from robokudo.core.types import ATTRIBUTE_TYPES, Annotation, ColorHistogram, ObjectHypothesis, Pose, Size
 
 A = TypeVar("A", bound=Annotation)
 AttachedReader = Callable[[ObjectHypothesis, type[A]], list[A]]
@@ -38,7 +28,8 @@ WORLD_FRAME = "world"
 DEFAULT_MIN_OVERLAP = 0.6
 """Two hypotheses whose point sets overlap at least this much (of the smaller one) are one object."""
 
-IDENTITY_QUATERNION = np.array([0.0, 0.0, 0.0, 1.0])
+FUSED_TYPES: tuple[type[Annotation], ...] = tuple(dict.fromkeys((Pose, Size, ColorHistogram, *ATTRIBUTE_TYPES)))
+"""The annotation types fusion reads from a hypothesis: pose, extents, appearance and every stated attribute."""
 
 
 @dataclass(slots=True)
@@ -51,7 +42,7 @@ class FrameObject:
 
     position: np.ndarray
     frame: str
-    orientation: np.ndarray = field(default_factory=lambda: IDENTITY_QUATERNION.copy())
+    orientation: np.ndarray = field(default_factory=lambda: np.array(IDENTITY_QUATERNION))
     dimensions: np.ndarray | None = None
     appearance: np.ndarray | None = None
     evidence: list[Evidence] = field(default_factory=list)
@@ -145,27 +136,6 @@ def _groups(hypotheses: Sequence[ObjectHypothesis], sets: Sequence[np.ndarray], 
 # ------------------------------------------------------------------------------------------ geometry
 
 
-def quaternion_from_matrix(rotation: np.ndarray) -> np.ndarray:
-    """Unit quaternion (x, y, z, w) of a 3x3 rotation matrix."""
-    m = np.asarray(rotation, dtype=np.float64)
-    trace = m[0, 0] + m[1, 1] + m[2, 2]
-    if trace > 0:
-        s = 2.0 * np.sqrt(trace + 1.0)
-        q = [(m[2, 1] - m[1, 2]) / s, (m[0, 2] - m[2, 0]) / s, (m[1, 0] - m[0, 1]) / s, 0.25 * s]
-    elif m[0, 0] > m[1, 1] and m[0, 0] > m[2, 2]:
-        s = 2.0 * np.sqrt(1.0 + m[0, 0] - m[1, 1] - m[2, 2])
-        q = [0.25 * s, (m[0, 1] + m[1, 0]) / s, (m[0, 2] + m[2, 0]) / s, (m[2, 1] - m[1, 2]) / s]
-    elif m[1, 1] > m[2, 2]:
-        s = 2.0 * np.sqrt(1.0 + m[1, 1] - m[0, 0] - m[2, 2])
-        q = [(m[0, 1] + m[1, 0]) / s, 0.25 * s, (m[1, 2] + m[2, 1]) / s, (m[0, 2] - m[2, 0]) / s]
-    else:
-        s = 2.0 * np.sqrt(1.0 + m[2, 2] - m[0, 0] - m[1, 1])
-        q = [(m[0, 2] + m[2, 0]) / s, (m[1, 2] + m[2, 1]) / s, 0.25 * s, (m[1, 0] - m[0, 1]) / s]
-    quaternion = np.asarray(q, dtype=np.float64)
-    quaternion /= np.linalg.norm(quaternion)
-    return quaternion if quaternion[3] >= 0 else -quaternion
-
-
 def _pose_in_frame(pose: Pose, context: FrameContext) -> tuple[np.ndarray, np.ndarray, str]:
     position = np.asarray(pose.position, dtype=np.float64).reshape(3)
     orientation = np.asarray(pose.orientation, dtype=np.float64).reshape(4)
@@ -207,27 +177,16 @@ def _union_roi(rois: Sequence[tuple[int, int, int, int]]) -> tuple[int, int, int
 def hypothesis_evidence(
     hypothesis: ObjectHypothesis, time: float = 0.0, read: AttachedReader | None = None
 ) -> list[Evidence]:
-    """The attribute statements attached to one hypothesis (colour, shape, size class, class, text, region)."""
+    """The attribute statements attached to one hypothesis, one per annotation that states an attribute
+    (:data:`~robokudo.core.types.ATTRIBUTE_TYPES`: colour, shape, size class, class, text, region)."""
     reader: AttachedReader = read or _default_reader
     found: list[Evidence] = []
-
-    def add(attribute: str, value: str, annotation: Annotation) -> None:
-        value = value.strip()
-        if value:
-            found.append(Evidence(attribute, value, annotation.confidence, annotation.source or "unknown", time))
-
-    for color in reader(hypothesis, SemanticColor):
-        add("color", color.color.lower(), color)
-    for shape in reader(hypothesis, Shape):
-        add("shape", shape.shape.lower(), shape)
-    for size in reader(hypothesis, Size):
-        add("size", size.size_class.lower(), size)
-    for classification in reader(hypothesis, Classification):
-        add("class", classification.class_name, classification)
-    for text in reader(hypothesis, Text):
-        add("text", " ".join(text.text.split()), text)
-    for location in reader(hypothesis, Location):
-        add("region", location.region.lower(), location)
+    for annotation_type in ATTRIBUTE_TYPES:
+        attribute = annotation_type.attribute
+        for annotation in reader(hypothesis, annotation_type):
+            value = annotation.attribute_value()
+            if value:
+                found.append(Evidence(attribute, value, annotation.confidence, annotation.source or "unknown", time))
     return found
 
 
@@ -270,7 +229,7 @@ def _merge_group(
         (_, orientation, frame), _ = max(placed, key=lambda item: item[1])
     elif points is not None:
         position = points.mean(axis=0)
-        orientation = IDENTITY_QUATERNION.copy()
+        orientation = np.array(IDENTITY_QUATERNION)
         frame = WORLD_FRAME if context.cam_to_world is not None else context.camera_frame
     else:
         return None

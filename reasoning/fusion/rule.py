@@ -20,6 +20,8 @@ import math
 from collections.abc import Callable, Iterable, Mapping
 from dataclasses import dataclass, field
 
+from robokudo.core.types import Classification
+
 ClassTest = Callable[[str, str], bool]
 """``class_test(a, b)`` is True when class ``a`` is ``b`` or a subclass of ``b``."""
 
@@ -29,7 +31,7 @@ CONFIDENCE_CLIP: tuple[float, float] = (0.01, 0.99)
 MAX_LOG_ODDS: float = 6.9
 """Bound of an accumulated log-odds value (about 0.999 probability)."""
 
-CLASS_ATTRIBUTE = "class"
+CLASS_ATTRIBUTE = Classification.attribute
 """The attribute name of the object class (fused with subsumption)."""
 
 

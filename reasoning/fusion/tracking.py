@@ -15,7 +15,6 @@ from __future__ import annotations
 
 from collections.abc import Callable, Sequence
 from dataclasses import dataclass, field
-from typing import Protocol
 
 import numpy as np
 
@@ -40,37 +39,11 @@ from reasoning.fusion.rule import (
     logit,
     sigmoid,
 )
+from robokudo.core.regions import RegionBox, region_of
+from robokudo.core.types import Location, SemanticColor
 
 PRESENT = "present"
 GONE = "gone"
-
-
-class RegionLike(Protocol):
-    """A named oriented box of the semantic map (``pose``: 4x4 world pose of its centre, ``size``: extents)."""
-
-    @property
-    def name(self) -> str: ...
-
-    @property
-    def pose(self) -> np.ndarray: ...
-
-    @property
-    def size(self) -> tuple[float, float, float]: ...
-
-
-def in_box(position: np.ndarray, pose: np.ndarray, size: Sequence[float], margin: float = 1e-9) -> bool:
-    """True when ``position`` lies inside the oriented box ``pose`` (4x4 centre pose) x ``size``."""
-    pose = np.asarray(pose, dtype=np.float64)
-    local = pose[:3, :3].T @ (np.asarray(position, dtype=np.float64) - pose[:3, 3])
-    return bool(np.all(np.abs(local) <= np.asarray(size, dtype=np.float64) / 2.0 + margin))
-
-
-def region_of(position: np.ndarray, regions: Sequence[RegionLike]) -> RegionLike | None:
-    """The first region whose box contains ``position``."""
-    for region in regions:
-        if in_box(position, region.pose, region.size):
-            return region
-    return None
 
 
 @dataclass(slots=True)
@@ -151,7 +124,7 @@ class BeliefTracker:
         config: TrackerConfig | None = None,
         *,
         class_test: ClassTest | None = None,
-        regions: Sequence[RegionLike] = (),
+        regions: Sequence[RegionBox] = (),
     ) -> None:
         self.config = config or TrackerConfig()
         self.class_test = class_test
@@ -207,9 +180,9 @@ class BeliefTracker:
         for i, j in gated_pairs(observations, beliefs, config.gate_distance).tolist():
             observation, belief = observations[i], beliefs[j]
             if j not in colors:
-                colors[j] = belief.value("color")
+                colors[j] = belief.value(SemanticColor.attribute)
             if i not in stated:
-                stated[i] = (observation.values("color"), observation.values(CLASS_ATTRIBUTE))
+                stated[i] = (observation.values(SemanticColor.attribute), observation.values(CLASS_ATTRIBUTE))
             cost[i, j] = pair_cost(
                 observation,
                 belief,
@@ -289,5 +262,5 @@ class BeliefTracker:
             belief.region = region.name
             belief.region_class = str(getattr(region, "region_class", ""))
         else:
-            belief.region = belief.value("region") or ""
+            belief.region = belief.value(Location.attribute) or ""
             belief.region_class = ""

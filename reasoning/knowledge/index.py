@@ -17,10 +17,12 @@ from rdflib import BNode, Graph, Literal, URIRef
 from rdflib.collection import Collection
 from rdflib.term import Node
 
+from ontology import REGION_BOX_PROPERTIES
 from reasoning.errors import OntologyError
-from reasoning.knowledge.model import KINDS, AnnotatorSpec, Kind, ObjectProfile, RegionBox, Resolved
+from reasoning.knowledge.model import KINDS, AnnotatorSpec, Kind, ObjectProfile, Resolved
 from reasoning.knowledge.vocabulary import IMPLEMENTATION_PATTERN, OWL, RDF, RDFS, RK, SKOS, is_rk, local_name
 from reasoning.knowledge.words import camel_words, word_key
+from robokudo.core.regions import RegionBox
 
 ROOTS: Mapping[Kind, str] = {
     "class": "PhysicalObject",
@@ -57,18 +59,6 @@ PRECONDITION_KEYS: frozenset[str] = frozenset({"depth", "region", "opaque", "mod
 """The condition keys the planner knows how to evaluate."""
 
 _SINGLE_FIELDS = ("shape", "size_class", "material", "stored_in", "transparent", "brand")
-_POSE_PROPERTIES = (
-    "positionX",
-    "positionY",
-    "positionZ",
-    "orientationX",
-    "orientationY",
-    "orientationZ",
-    "orientationW",
-    "sizeX",
-    "sizeY",
-    "sizeZ",
-)
 
 
 @dataclass(frozen=True)
@@ -450,7 +440,7 @@ class _Builder:
             if len(specific) != 1:
                 self.problems.append(f"region {name}: needs exactly one most specific region class, has {specific}")
                 continue
-            numbers = [self._number(name, prop) for prop in _POSE_PROPERTIES]
+            numbers = [self._number(name, prop) for prop in REGION_BOX_PROPERTIES]
             frame = self._literal(name, "frame")
             if frame is None:
                 self.problems.append(f"region {name}: rk:frame is missing")

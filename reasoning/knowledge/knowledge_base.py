@@ -25,23 +25,16 @@ from reasoning.knowledge.model import (
     Conditions,
     Kind,
     ObjectProfile,
-    RegionBox,
     Resolved,
 )
 from reasoning.knowledge.sources import Sources, Stamp, defined_names, file_stamp, merge_graphs, parse_turtle
 from reasoning.knowledge.words import singular_keys, word_key
+from robokudo.core.regions import RegionBox
 
 log = logging.getLogger(__name__)
 
 _ALL_CONDITIONS = Conditions()
 _CLASS_KINDS: tuple[Kind, ...] = ("class", "region_class", "color", "shape", "size", "material")
-_DOMAIN_FIELDS: dict[Kind, str] = {
-    "class": "classes",
-    "color": "colors",
-    "shape": "shapes",
-    "size": "sizes",
-    "material": "materials",
-}
 
 
 class KnowledgeBase:
@@ -306,6 +299,11 @@ class KnowledgeBase:
             raise UnknownTermError(key, "query key", difflib.get_close_matches(word_key(key), keys, n=3, cutoff=0.6))
         return found
 
+    def value_kind(self, annotation_type: str) -> Kind | None:
+        """The kind of the values an annotation type carries (``SemanticColor`` -> ``color``), per its
+        ``rk:valueDomain``; None for types without one (free text, poses, ...)."""
+        return self._index.value_domains.get(annotation_type)
+
     def query_keys(self) -> dict[str, str]:
         """Every query key word (normalised) -> the annotation type that answers it."""
         return dict(self._index.query_keys)
@@ -354,7 +352,6 @@ class KnowledgeBase:
         if value is not None and value_kind is not None:
             value_name = self._name(value, (value_kind,))
             value_up, value_down = index.up[value_name], index.down[value_name]
-            domain_field = _DOMAIN_FIELDS[value_kind]
         object_up = object_down = None
         transparent = False
         if object_class is not None:
@@ -365,7 +362,7 @@ class KnowledgeBase:
         chosen: list[AnnotatorSpec] = []
         for spec in candidates:
             if value_up is not None and value_down is not None:
-                domain: frozenset[str] = getattr(spec, domain_field)
+                domain = spec.domain(value_kind)
                 if domain and domain.isdisjoint(value_up) and domain.isdisjoint(value_down):
                     continue
             if (

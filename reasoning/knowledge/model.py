@@ -1,11 +1,11 @@
-"""Typed answers of the knowledge base: resolved words, object profiles, region boxes, annotator specs."""
+"""Typed answers of the knowledge base: resolved words, object profiles, annotator specs (region boxes are
+:class:`robokudo.core.regions.RegionBox`)."""
 
 from __future__ import annotations
 
+from collections.abc import Callable
 from dataclasses import dataclass
 from typing import Literal
-
-import numpy as np
 
 Kind = Literal["class", "region", "region_class", "color", "shape", "size", "material"]
 """What a word can resolve to: an object class, a named region of the semantic map, a region class, or a
@@ -64,39 +64,6 @@ class ObjectProfile:
 
 
 @dataclass(frozen=True, slots=True)
-class RegionBox:
-    """A named region of a semantic map: a box with its centre pose in ``frame`` and its size in metres."""
-
-    name: str
-    region_class: str
-    frame: str
-    position: tuple[float, float, float]
-    orientation: tuple[float, float, float, float]
-    size: tuple[float, float, float]
-    label: str = ""
-    semantic_map: str = ""
-
-    @property
-    def pose(self) -> np.ndarray:
-        """The 4x4 homogeneous transform of the box centre in ``frame``."""
-        x, y, z, w = self.orientation
-        transform = np.eye(4)
-        transform[:3, :3] = [
-            [1 - 2 * (y * y + z * z), 2 * (x * y - z * w), 2 * (x * z + y * w)],
-            [2 * (x * y + z * w), 1 - 2 * (x * x + z * z), 2 * (y * z - x * w)],
-            [2 * (x * z - y * w), 2 * (y * z + x * w), 1 - 2 * (x * x + y * y)],
-        ]
-        transform[:3, 3] = self.position
-        return transform
-
-    def contains(self, point: np.ndarray | tuple[float, float, float]) -> bool:
-        """True when ``point`` (in ``frame``) lies inside the box."""
-        pose = self.pose
-        local = pose[:3, :3].T @ (np.asarray(point, dtype=np.float64).reshape(3) - pose[:3, 3])
-        return bool(np.all(np.abs(local) <= np.asarray(self.size) / 2.0 + 1e-9))
-
-
-@dataclass(frozen=True, slots=True)
 class AnnotatorSpec:
     """An annotator's declared capabilities, as the ontology states them.
 
@@ -118,6 +85,10 @@ class AnnotatorSpec:
     reliability: float
     label: str = ""
 
+    def domain(self, kind: Kind) -> frozenset[str]:
+        """The declared values of one kind this annotator can report (empty: any value, or not that kind)."""
+        return _DOMAINS[kind](self) if kind in _DOMAINS else frozenset()
+
     @property
     def module(self) -> str:
         """The Python module of the implementing class."""
@@ -127,6 +98,16 @@ class AnnotatorSpec:
     def class_name(self) -> str:
         """The name of the implementing class."""
         return self.implemented_by.rpartition(".")[2]
+
+
+_DOMAINS: dict[Kind, Callable[[AnnotatorSpec], frozenset[str]]] = {
+    "class": lambda spec: spec.classes,
+    "color": lambda spec: spec.colors,
+    "shape": lambda spec: spec.shapes,
+    "size": lambda spec: spec.sizes,
+    "material": lambda spec: spec.materials,
+}
+"""Which field of an :class:`AnnotatorSpec` holds its domain of each value kind."""
 
 
 @dataclass(frozen=True, slots=True)

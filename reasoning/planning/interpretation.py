@@ -12,12 +12,11 @@ from dataclasses import dataclass
 from queries.model import Asked, Block, ListValue, Number, Query, String, Symbol, Value
 from reasoning.errors import TermError
 from reasoning.knowledge.knowledge_base import KnowledgeBase
-from reasoning.knowledge.model import RegionBox
 from reasoning.planning.plan import Constraint, Task
 from reasoning.planning.planner import PlanningError, Requirement
+from robokudo.core.regions import RegionBox
 
 _RELATIONS = ("in", "inside", "on", "at", "near")
-_VALUE_KINDS = {"SemanticColor": "color", "Shape": "shape", "Size": "size"}
 _STRUCTURAL_KEYS = frozenset({"type", "location", "id"})
 _KINDS_WITH_OBJECTS = ("detect", "inspect", "track")
 
@@ -63,7 +62,8 @@ def interpret(query: Query, kb: KnowledgeBase, depth: bool = True) -> Interpreta
             name = _value_name(annotation_type, value, kb)
             constraints.append(Constraint(field.key, annotation_type, name))
             asked = f"query asks {field.key} = {name}" if name is not None else f"query asks for {field.key}"
-            requirements.append(Requirement(annotation_type, _domain_value(annotation_type, name), asked))
+            domain_value = name if kb.value_kind(annotation_type) is not None else None
+            requirements.append(Requirement(annotation_type, domain_value, asked))
     if object_class is not None and not obj.get("text"):
         why = _why_text_matters(object_class, kb)
         if why:
@@ -152,10 +152,11 @@ def _values(value: Value) -> list[Value]:
 
 
 def _value_name(annotation_type: str, value: Value, kb: KnowledgeBase) -> str | None:
-    """The ontology name of a requested value (colour, shape, size class), the text, or None when asked."""
+    """The ontology name of a requested value (of the type's value kind: colour, shape, ...), the text, or None
+    when asked."""
     if isinstance(value, Asked):
         return None
-    kind = _VALUE_KINDS.get(annotation_type)
+    kind = kb.value_kind(annotation_type)
     if isinstance(value, Number):
         return f"{value.value:g}{value.unit or ''}"
     word = _word(value, annotation_type)
@@ -165,11 +166,6 @@ def _value_name(annotation_type: str, value: Value, kb: KnowledgeBase) -> str | 
         return kb.resolve(word, (kind,)).name
     except TermError as error:
         raise PlanningError(str(error)) from None
-
-
-def _domain_value(annotation_type: str, name: str | None) -> str | None:
-    """The value the providers' domain must cover (only for types with a value domain)."""
-    return name if annotation_type in _VALUE_KINDS else None
 
 
 def _region(value: Value | None, kb: KnowledgeBase) -> RegionBox | None:

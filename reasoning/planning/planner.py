@@ -25,9 +25,9 @@ from __future__ import annotations
 from collections import deque
 from collections.abc import Callable, Iterable, Mapping, Sequence
 from dataclasses import dataclass
-from typing import Protocol
 
-from reasoning.knowledge.model import AnnotatorSpec, Conditions
+from reasoning.knowledge.knowledge_base import KnowledgeBase
+from reasoning.knowledge.model import AnnotatorSpec, Conditions, Kind
 from reasoning.planning.plan import Alternatives, Plan, Step, Task, Unit
 
 
@@ -37,28 +37,6 @@ class PlanningError(Exception):
 
 class _OrderingError(PlanningError):
     """The chosen alternatives cannot be ordered without a cycle (the planner then chooses more strictly)."""
-
-
-class ProviderIndex(Protocol):
-    """Ranked providers of a type, honouring value domains, subsumption and preconditions (the KnowledgeBase)."""
-
-    def providers(
-        self,
-        annotation_type: str,
-        value: str | None = None,
-        object_class: str | None = None,
-        conditions: Conditions | None = None,
-    ) -> Sequence[AnnotatorSpec]:
-        """Annotators providing ``annotation_type`` that can report ``value`` for ``object_class``, best first."""
-        ...
-
-    def annotators(self) -> Sequence[AnnotatorSpec]:
-        """Every annotator."""
-        ...
-
-    def superclasses(self, name: str, direct: bool = False) -> list[str]:
-        """The proper superclasses of a class (CAS types included)."""
-        ...
 
 
 @dataclass(frozen=True)
@@ -85,7 +63,7 @@ class SensorSource:
 def plan_requirements(
     task: Task,
     requirements: Sequence[Requirement],
-    index: ProviderIndex,
+    index: KnowledgeBase,
     source: SensorSource,
     conditions: Conditions | None = None,
     parameters: Mapping[str, Mapping[str, object]] | None = None,
@@ -119,7 +97,7 @@ class _Catalog:
     """Candidate providers (memoised per type and value) and what can be produced from the sensors."""
 
     def __init__(
-        self, index: ProviderIndex, sensors: frozenset[str], object_class: str | None, conditions: Conditions
+        self, index: KnowledgeBase, sensors: frozenset[str], object_class: str | None, conditions: Conditions
     ) -> None:
         self.index = index
         self._supertypes: dict[str, frozenset[str]] = {}
@@ -225,7 +203,7 @@ class _Catalog:
         asked = f"{type_name} with value {value!r}" if value else type_name
         usable = {s.name for s in self.providers(type_name, value)}
         details = [
-            f"{s.name} {_exclusion(s, type_name, value, self.object_class, self.conditions)}"
+            f"{s.name} {_exclusion(s, self.index.value_kind(type_name), value, self.object_class, self.conditions)}"
             for s in self.index.providers(type_name)
             if s.name not in usable and type_name not in s.inputs
         ]
@@ -782,11 +760,10 @@ def _precondition_note(spec: AnnotatorSpec) -> str:
 
 
 def _exclusion(
-    spec: AnnotatorSpec, type_name: str, value: str | None, object_class: str | None, conditions: Conditions
+    spec: AnnotatorSpec, value_kind: Kind | None, value: str | None, object_class: str | None, conditions: Conditions
 ) -> str:
-    """Why the knowledge base excluded ``spec`` as a provider, in words."""
-    domain_field = _VALUE_DOMAIN_FIELDS.get(type_name)
-    domain: frozenset[str] = getattr(spec, domain_field) if domain_field else frozenset()
+    """Why the knowledge base excluded ``spec`` as a provider of a type whose values are of ``value_kind``."""
+    domain = spec.domain(value_kind) if value_kind is not None else frozenset()
     if value is not None and domain:
         return f"can report only {', '.join(sorted(domain))}, not {value!r}"
     if spec.preconditions:
@@ -796,6 +773,3 @@ def _exclusion(
     if object_class is not None and spec.classes:
         return f"recognises only {', '.join(sorted(spec.classes))}, not {object_class}"
     return "was excluded by the knowledge base"
-
-
-_VALUE_DOMAIN_FIELDS = {"SemanticColor": "colors", "Shape": "shapes", "Size": "sizes", "Classification": "classes"}

@@ -6,10 +6,11 @@ from dataclasses import dataclass
 
 from queries.model import Query
 from reasoning.knowledge.knowledge_base import KnowledgeBase
-from reasoning.knowledge.model import Conditions, RegionBox
+from reasoning.knowledge.model import Conditions
 from reasoning.planning.interpretation import Interpretation, interpret
 from reasoning.planning.plan import Plan
 from reasoning.planning.planner import SensorSource, plan_requirements
+from robokudo.core.regions import RegionBox
 
 DEPTH_TYPES = frozenset({"DepthImage", "PointCloud"})
 REGION_PRECONDITION = "NeedsRegion"

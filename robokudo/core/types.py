@@ -17,8 +17,10 @@ from typing import ClassVar, TypeVar
 import numpy as np
 
 from ontology import NAMESPACE as ONTOLOGY_NAMESPACE
+from robokudo.core.geometry import pose_matrix
 
 A = TypeVar("A", bound="Annotation")
+T = TypeVar("T", bound="CasType")
 
 
 class CasType:
@@ -62,6 +64,15 @@ class CameraIntrinsics:
     def matrix(self) -> np.ndarray:
         """The 3x3 camera matrix K."""
         return np.array([[self.fx, 0.0, self.cx], [0.0, self.fy, self.cy], [0.0, 0.0, 1.0]])
+
+    def project(self, points: np.ndarray) -> np.ndarray:
+        """Pixel coordinates (u, v), Nx2, of Nx3 camera-frame points in front of the camera (z > 0)."""
+        p = np.asarray(points, dtype=np.float64).reshape(-1, 3)
+        return np.column_stack((self.fx * p[:, 0] / p[:, 2] + self.cx, self.fy * p[:, 1] / p[:, 2] + self.cy))
+
+    def ray(self, u: float, v: float) -> np.ndarray:
+        """The camera-frame direction (z = 1) through pixel (u, v)."""
+        return np.array([(u - self.cx) / self.fx, (v - self.cy) / self.fy, 1.0])
 
 
 @dataclass(eq=False)
@@ -145,10 +156,23 @@ class QueryAnswer(View):
 
 @dataclass(eq=False, kw_only=True)
 class Annotation(CasType):
-    """Something an expert says; ``source`` names the annotator, ``confidence`` is in [0, 1]."""
+    """Something an expert says; ``source`` names the annotator, ``confidence`` is in [0, 1].
+
+    A type that states a categorical attribute of an object names it in ``attribute`` (the key of the fused
+    attribute in beliefs, answers and belief filters) and reads its value in :meth:`attribute_value`; this is
+    the one place that says which annotation type becomes which attribute. Which query keys a type answers and
+    which ontology values it carries are said by the ontology (``rk:answeredBy``, ``rk:valueDomain``).
+    """
+
+    attribute: ClassVar[str] = ""
+    """The object attribute this type states (``color``, ``class``, ...), empty when it states none."""
 
     source: str = ""
     confidence: float = 1.0
+
+    def attribute_value(self) -> str:
+        """The stated value of :attr:`attribute`, normalised for fusion (empty when the type states none)."""
+        return ""
 
 
 @dataclass(eq=False, kw_only=True)
@@ -186,8 +210,14 @@ class ObjectHypothesis(Annotation):
 class SemanticColor(Annotation):
     """A colour name (an ontology colour class, lower case) with its share of the object's pixels."""
 
+    attribute: ClassVar[str] = "color"
+
     color: str
     ratio: float = 1.0
+
+    def attribute_value(self) -> str:
+        """The colour name, lower case."""
+        return self.color.strip().lower()
 
 
 @dataclass(eq=False, kw_only=True)
@@ -202,15 +232,27 @@ class ColorHistogram(Annotation):
 class Shape(Annotation):
     """A primitive shape: box, cylinder, sphere or flat."""
 
+    attribute: ClassVar[str] = "shape"
+
     shape: str
+
+    def attribute_value(self) -> str:
+        """The shape name, lower case."""
+        return self.shape.strip().lower()
 
 
 @dataclass(eq=False, kw_only=True)
 class Size(Annotation):
     """Metric extents (metres, sorted largest first) and a size class (small, medium, large)."""
 
+    attribute: ClassVar[str] = "size"
+
     dimensions: tuple[float, float, float]
     size_class: str
+
+    def attribute_value(self) -> str:
+        """The size class, lower case."""
+        return self.size_class.strip().lower()
 
 
 @dataclass(eq=False, kw_only=True)
@@ -223,56 +265,67 @@ class Pose(Annotation):
 
     def matrix(self) -> np.ndarray:
         """The 4x4 homogeneous transform."""
-        x, y, z, w = self.orientation
-        rotation = np.array(
-            [
-                [1 - 2 * (y * y + z * z), 2 * (x * y - z * w), 2 * (x * z + y * w)],
-                [2 * (x * y + z * w), 1 - 2 * (x * x + z * z), 2 * (y * z - x * w)],
-                [2 * (x * z - y * w), 2 * (y * z + x * w), 1 - 2 * (x * x + y * y)],
-            ]
-        )
-        transform = np.eye(4)
-        transform[:3, :3] = rotation
-        transform[:3, 3] = self.position
-        return transform
+        return pose_matrix(self.position, self.orientation)
 
 
 @dataclass(eq=False, kw_only=True)
 class Classification(Annotation):
     """An object class (the ontology class name, e.g. ``Milk``)."""
 
+    attribute: ClassVar[str] = "class"
+
     class_name: str
+
+    def attribute_value(self) -> str:
+        """The class name as the ontology spells it."""
+        return self.class_name.strip()
 
 
 @dataclass(eq=False, kw_only=True)
 class Text(Annotation):
     """Text read on the object, with its image box ``(x0, y0, x1, y1)``."""
 
+    attribute: ClassVar[str] = "text"
+
     text: str
     box: tuple[int, int, int, int] | None = None
+
+    def attribute_value(self) -> str:
+        """The text with its whitespace runs collapsed to single spaces."""
+        return " ".join(self.text.split())
 
 
 @dataclass(eq=False, kw_only=True)
 class Location(Annotation):
     """The named semantic-map region the object is in (e.g. ``fridge``)."""
 
+    attribute: ClassVar[str] = "region"
+
     region: str
     region_class: str = ""
 
+    def attribute_value(self) -> str:
+        """The region name, lower case."""
+        return self.region.strip().lower()
 
-VIEW_TYPES: tuple[type[View], ...] = (ColorImage, DepthImage, CameraInfo, PointCloud, Normals, QueryView, QueryAnswer)
-ANNOTATION_TYPES: tuple[type[Annotation], ...] = (
-    Plane,
-    ObjectHypothesis,
-    SemanticColor,
-    ColorHistogram,
-    Shape,
-    Size,
-    Pose,
-    Classification,
-    Text,
-    Location,
-)
+
+def _declared(root: type[T]) -> tuple[type[T], ...]:
+    """The classes derived from ``root`` in this module, in declaration order."""
+    found: list[type[T]] = []
+    for cls in root.__subclasses__():
+        if cls.__module__ == __name__:
+            found += [cls, *_declared(cls)]
+    return tuple(found)
+
+
+VIEW_TYPES: tuple[type[View], ...] = _declared(View)
+"""Every view type, in declaration order."""
+
+ANNOTATION_TYPES: tuple[type[Annotation], ...] = _declared(Annotation)
+"""Every annotation type, in declaration order."""
+
+ATTRIBUTE_TYPES: tuple[type[Annotation], ...] = tuple(t for t in ANNOTATION_TYPES if t.attribute)
+"""The annotation types that state an object attribute, in declaration order (the order of fused evidence)."""
 
 
 def type_by_name(name: str) -> type[CasType]:
@@ -282,3 +335,12 @@ def type_by_name(name: str) -> type[CasType]:
             return cas_type
     known = ", ".join(t.__name__ for t in VIEW_TYPES + ANNOTATION_TYPES)
     raise KeyError(f"unknown CAS type {name!r}; known: {known}")
+
+
+def attribute_type(attribute: str) -> type[Annotation]:
+    """The annotation type that states ``attribute``; raises KeyError listing the attributes."""
+    for annotation_type in ATTRIBUTE_TYPES:
+        if annotation_type.attribute == attribute:
+            return annotation_type
+    known = ", ".join(t.attribute for t in ATTRIBUTE_TYPES)
+    raise KeyError(f"no annotation type states the attribute {attribute!r}; known: {known}")

@@ -7,7 +7,7 @@ import numpy as np
 import pytest
 from py_trees.common import Status
 
-from annotators.classification.knowledge_classifier import Evidence, KnowledgeClassifier, Profile, choose, score
+from annotators.classification.knowledge_classifier import Cues, KnowledgeClassifier, Profile, choose, score
 from annotators.cloud.filters import CropBoxFilter, RegionFilter
 from annotators.cloud.normals import grid_normals
 from annotators.cloud.point_cloud import PointCloudGenerator
@@ -233,29 +233,29 @@ CUP = {"class": "Cup", "shape": "cylinder", "size": "small", "ancestors": ("Cup"
 PROFILES = [Profile.from_mapping(p) for p in (MILK, LACTOSE_FREE, WHOLE, CEREAL, CUP)]
 
 
-def winner(evidence: Evidence) -> str | None:
+def winner(evidence: Cues) -> str | None:
     match = choose([score(p, evidence) for p in PROFILES], min_score=0.6, margin=0.1)
     return match.profile.class_name if match is not None else None
 
 
 def test_text_picks_the_most_specific_matching_variant() -> None:
-    white_box = Evidence(color=("white", 0.9), shape=("box", 0.8), size=("medium", 1.0))
-    assert winner(Evidence(**{**white_box.__dict__, "text": "MILK lactose free"})) == "LactoseFreeMilk"
-    assert winner(Evidence(**{**white_box.__dict__, "text": "Whole MILK"})) == "WholeMilk"
-    assert winner(Evidence(**{**white_box.__dict__, "text": "MILK"})) == "Milk"
+    white_box = Cues(color=("white", 0.9), shape=("box", 0.8), size=("medium", 1.0))
+    assert winner(Cues(**{**white_box.__dict__, "text": "MILK lactose free"})) == "LactoseFreeMilk"
+    assert winner(Cues(**{**white_box.__dict__, "text": "Whole MILK"})) == "WholeMilk"
+    assert winner(Cues(**{**white_box.__dict__, "text": "MILK"})) == "Milk"
     assert winner(white_box) == "Milk"  # no text: no evidence for a variant, the general class
 
 
 def test_colour_shape_and_size_decide_without_text() -> None:
-    assert winner(Evidence(color=("yellow", 0.9), shape=("box", 0.7), size=("large", 1.0))) == "CerealBox"
-    assert winner(Evidence(color=("red", 0.9), shape=("cylinder", 0.8), size=("small", 1.0))) == "Cup"
-    assert winner(Evidence(color=("green", 0.9), shape=("sphere", 0.9), size=("large", 1.0))) is None
+    assert winner(Cues(color=("yellow", 0.9), shape=("box", 0.7), size=("large", 1.0))) == "CerealBox"
+    assert winner(Cues(color=("red", 0.9), shape=("cylinder", 0.8), size=("small", 1.0))) == "Cup"
+    assert winner(Cues(color=("green", 0.9), shape=("sphere", 0.9), size=("large", 1.0))) is None
 
 
 def test_uncertain_evidence_counts_less() -> None:
     milk = Profile.from_mapping(MILK)
-    sure = score(milk, Evidence(shape=("cylinder", 1.0))).score
-    unsure = score(milk, Evidence(shape=("cylinder", 0.2))).score
+    sure = score(milk, Cues(shape=("cylinder", 1.0))).score
+    unsure = score(milk, Cues(shape=("cylinder", 0.2))).score
     assert sure == 0.0 and unsure == pytest.approx(0.4)
 
 
@@ -300,12 +300,12 @@ def test_image_regions_find_the_table_objects_without_depth() -> None:
 
 
 def test_the_queried_class_decides_between_near_equal_candidates() -> None:
-    from annotators.classification.knowledge_classifier import Evidence, Profile, choose, choose_expected, score
+    from annotators.classification.knowledge_classifier import Cues, Profile, choose, choose_expected, score
 
     cola = Profile.from_mapping({"class": "Cola", "colors": ("red",), "shape": "cylinder", "size": "small"})
     cup = Profile.from_mapping({"class": "Cup", "shape": "cylinder", "size": "small", "ancestors": ("Container",)})
     bowl = Profile.from_mapping({"class": "Bowl", "shape": "sphere", "size": "medium"})
-    evidence = Evidence(color=("red", 0.3), shape=("cylinder", 0.8), size=("small", 1.0))
+    evidence = Cues(color=("red", 0.3), shape=("cylinder", 0.8), size=("small", 1.0))
     matches = [score(p, evidence) for p in (cola, cup, bowl)]
     assert choose(matches, 0.6, 0.1) is None  # Cola and Cup are too close to call without a prior
     assert choose_expected(matches, "Cup", 0.6, 0.1).profile.class_name == "Cup"

@@ -1,4 +1,4 @@
-"""Plane RANSAC, oriented boxes and quaternions on synthetic point sets."""
+"""Plane RANSAC and oriented boxes on synthetic point sets."""
 
 from __future__ import annotations
 
@@ -6,9 +6,9 @@ import numpy as np
 import pytest
 
 from annotators.cloud.plane import ransac_support_plane, up_in_camera
-from annotators.geometry.boxes import object_box, principal_box, quaternion_from_matrix, upright_box
+from annotators.geometry.boxes import object_box, principal_box, upright_box
 from annotators.geometry.grid_segmentation import looks_like_inside
-from robokudo.core.types import CameraInfo, CameraIntrinsics, Pose
+from robokudo.core.types import CameraInfo, CameraIntrinsics
 
 
 def scene_cloud(rows: int = 120, cols: int = 160) -> np.ndarray:
@@ -88,16 +88,6 @@ def test_object_box_reports_world_frame_only_with_a_camera_pose() -> None:
     assert object_box(points, None)[1] == "camera"
     box, frame = object_box(points, np.eye(4))
     assert frame == "world" and np.allclose(box.centre, (points.min(0) + points.max(0)) / 2, atol=0.2)
-
-
-def test_quaternions_round_trip_through_pose_matrix() -> None:
-    rng = np.random.default_rng(3)
-    for _ in range(20):
-        q, _ = np.linalg.qr(rng.normal(size=(3, 3)))
-        rotation = q * np.sign(np.linalg.det(q))
-        quaternion = quaternion_from_matrix(rotation)
-        pose = Pose(position=np.zeros(3), orientation=quaternion)
-        assert np.allclose(pose.matrix()[:3, :3], rotation, atol=1e-9)
 
 
 def test_the_inside_of_a_cup_is_recognised_and_a_neighbour_is_not() -> None:

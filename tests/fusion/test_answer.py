@@ -5,7 +5,6 @@ from __future__ import annotations
 import argparse
 import json
 from collections.abc import Collection
-from dataclasses import dataclass
 from pathlib import Path
 from typing import ClassVar
 
@@ -25,6 +24,7 @@ from robokudo.application.commands import beliefs as beliefs_cli
 from robokudo.core.annotator import Annotator
 from robokudo.core.engine import Engine
 from robokudo.core.pipeline import Pipeline
+from robokudo.core.regions import RegionBox
 from robokudo.core.types import (
     ONTOLOGY_NAMESPACE,
     CameraInfo,
@@ -45,19 +45,9 @@ def is_subclass(a: str, b: str) -> bool:
     return a == b or (a, b) in SUBCLASSES
 
 
-@dataclass(frozen=True)
-class Box:
-    name: str
-    region_class: str
-    pose: np.ndarray
-    size: tuple[float, float, float]
-    frame: str = "world"
-
-
-def box(name: str, centre: tuple[float, float, float], size: tuple[float, float, float]) -> Box:
-    pose = np.eye(4)
-    pose[:3, 3] = centre
-    return Box(name, "FridgeInterior" if name == "fridge" else "TableTop", pose, size)
+def box(name: str, centre: tuple[float, float, float], size: tuple[float, float, float]) -> RegionBox:
+    region_class = "FridgeInterior" if name == "fridge" else "TableTop"
+    return RegionBox(name, region_class, "world", centre, (0.0, 0.0, 0.0, 1.0), size)
 
 
 FRIDGE = box("fridge", (1.3, 0.85, 0.8), (0.5, 0.5, 1.5))
@@ -224,12 +214,21 @@ class FakeKnowledgeBase:
     def is_subclass(self, name: str, ancestor: str) -> bool:
         return is_subclass(name, ancestor)
 
-    def region(self, name: str) -> Box:
+    def annotation_type_for_key(self, key: str) -> str:
+        types = {"color": "SemanticColor", "shape": "Shape", "size": "Size", "text": "Text"}
+        if key not in types:
+            raise KeyError(key)
+        return types[key]
+
+    def value_kind(self, annotation_type: str) -> str | None:
+        return {"SemanticColor": "color", "Shape": "shape", "Size": "size"}.get(annotation_type)
+
+    def region(self, name: str) -> RegionBox:
         if name.lower() != "fridge":
             raise KeyError(name)
         return FRIDGE
 
-    def regions_of_class(self, name: str) -> list[Box]:
+    def regions_of_class(self, name: str) -> list[RegionBox]:
         return [FRIDGE] if name == "FridgeInterior" else []
 
 

@@ -115,7 +115,7 @@ def gt_observations(scene: object, min_pixels: int = 200) -> tuple[list[FrameObj
 
 def camera_of(scene: object) -> CameraModel:
     k = scene.intrinsics
-    return CameraModel(k.fx, k.fy, k.cx, k.cy, k.width, k.height, scene.cam_to_world, depth=scene.depth)
+    return CameraModel(k, scene.cam_to_world, depth=scene.depth)
 
 
 def test_visibility_prediction_in_the_kitchen() -> None:

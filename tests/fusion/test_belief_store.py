@@ -5,7 +5,6 @@ from __future__ import annotations
 import sqlite3
 import threading
 import time
-from dataclasses import dataclass
 from pathlib import Path
 
 import numpy as np
@@ -16,6 +15,8 @@ from reasoning.fusion.association import CameraModel
 from reasoning.fusion.frame import FrameObject
 from reasoning.fusion.rule import Evidence
 from reasoning.fusion.tracking import GONE, PRESENT, BeliefTracker, ObjectBelief, TrackerConfig
+from robokudo.core.regions import RegionBox
+from robokudo.core.types import CameraIntrinsics
 
 SUBCLASSES = {("LactoseFreeMilk", "Milk"), ("Milk", "Drink"), ("LactoseFreeMilk", "Drink")}
 
@@ -24,24 +25,14 @@ def is_subclass(a: str, b: str) -> bool:
     return a == b or (a, b) in SUBCLASSES
 
 
-@dataclass(frozen=True)
-class Box:
-    name: str
-    region_class: str
-    pose: np.ndarray
-    size: tuple[float, float, float]
-
-
-def box(name: str, centre: tuple[float, float, float], size: tuple[float, float, float], yaw: float = 0.0) -> Box:
-    pose = np.eye(4)
-    c, s = np.cos(yaw), np.sin(yaw)
-    pose[:3, :3] = [[c, -s, 0], [s, c, 0], [0, 0, 1]]
-    pose[:3, 3] = centre
-    return Box(name, name.title() + "Region", pose, size)
+def box(name: str, centre: tuple[float, float, float], size: tuple[float, float, float], yaw: float = 0.0) -> RegionBox:
+    orientation = (0.0, 0.0, float(np.sin(yaw / 2)), float(np.cos(yaw / 2)))
+    return RegionBox(name, name.title() + "Region", "world", centre, orientation, size)
 
 
 FRIDGE = box("fridge", (1.3, 0.85, 0.8), (0.5, 0.5, 1.5))
 TABLE = box("table", (0.0, 0.0, 0.95), (1.2, 0.8, 0.5))
+CAMERA = CameraIntrinsics(500.0, 500.0, 320.0, 240.0, 640, 480)
 
 
 def thing(position: tuple[float, float, float], cls: str, color: str, source: str = "Detector") -> FrameObject:
@@ -249,8 +240,8 @@ def test_a_reader_opens_and_reads_while_a_write_transaction_is_open(store_path: 
 
 
 def test_a_missed_object_is_gone_after_the_configured_time_even_out_of_view(store_path: Path) -> None:
-    looking_at_origin = CameraModel(500.0, 500.0, 320.0, 240.0, 640, 480, _camera_at((0.0, -1.0, 0.8)))
-    looking_away = CameraModel(500.0, 500.0, 320.0, 240.0, 640, 480, _camera_at((0.0, 1.0, 0.8)))
+    looking_at_origin = CameraModel(CAMERA, _camera_at((0.0, -1.0, 0.8)))
+    looking_away = CameraModel(CAMERA, _camera_at((0.0, 1.0, 0.8)))
     tracker = BeliefTracker(TrackerConfig(gone_after=5.0))
     with BeliefStore(store_path, tracker=tracker) as store:
         store.integrate([thing((0.0, 0.0, 0.8), "Cup", "red")], 0.0, camera=looking_at_origin)

@@ -7,7 +7,7 @@ import math
 import numpy as np
 import pytest
 
-from reasoning.fusion.frame import FrameContext, duplicate_groups, frame_objects, quaternion_from_matrix
+from reasoning.fusion.frame import FrameContext, duplicate_groups, frame_objects
 from reasoning.fusion.rule import MAX_LOG_ODDS, AttributeBelief, Evidence, accumulate, fuse_evidence, logit
 from robokudo.core.types import Classification, ObjectHypothesis, Pose, SemanticColor, Shape, Size
 
@@ -171,13 +171,3 @@ def test_frame_objects_use_pose_and_size_annotations_in_the_world_frame() -> Non
 def test_hypotheses_without_any_position_are_left_out() -> None:
     shape = (10, 10)
     assert frame_objects([_hypothesis(_block(shape, 2, 5, 2, 5), shape, "Seg")]) == []
-
-
-def test_quaternion_round_trip() -> None:
-    rng = np.random.default_rng(1)
-    for _ in range(20):
-        q = rng.normal(size=4)
-        q /= np.linalg.norm(q)
-        pose = Pose(position=np.zeros(3), orientation=q)
-        recovered = quaternion_from_matrix(pose.matrix()[:3, :3])
-        assert np.allclose(recovered, q, atol=1e-9) or np.allclose(recovered, -q, atol=1e-9)

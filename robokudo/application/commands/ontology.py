@@ -13,8 +13,9 @@ from pathlib import Path
 from reasoning.errors import EditRejectedError, OntologyError, TermError
 from reasoning.knowledge.editing import CheckReport, EditResult, OntologyEditor
 from reasoning.knowledge.knowledge_base import KnowledgeBase
-from reasoning.knowledge.model import AnnotatorSpec, RegionBox, Resolved
+from reasoning.knowledge.model import AnnotatorSpec, Resolved
 from reasoning.knowledge.sources import USER_ONTOLOGY_ENV
+from robokudo.core.regions import RegionBox
 
 HELP = "show, check and edit the ontology"
 

@@ -1,0 +1,62 @@
+"""Rotations as unit quaternions (x, y, z, w) and 3x3 matrices, and rigid 4x4 transforms.
+
+Convention: :func:`quaternion_from_matrix` returns the quaternion with ``w >= 0`` (q and -q are the same
+rotation), so every rotation has one quaternion; a matrix that is not a rotation (NaN, all zero) gives the
+identity.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Sequence
+
+import numpy as np
+
+IDENTITY_QUATERNION: tuple[float, float, float, float] = (0.0, 0.0, 0.0, 1.0)
+"""The quaternion (x, y, z, w) of no rotation."""
+
+
+def rotation_matrix(quaternion: Sequence[float] | np.ndarray) -> np.ndarray:
+    """The 3x3 rotation matrix of a unit quaternion (x, y, z, w)."""
+    x, y, z, w = (float(v) for v in np.asarray(quaternion, dtype=np.float64).reshape(4))
+    return np.array(
+        [
+            [1 - 2 * (y * y + z * z), 2 * (x * y - z * w), 2 * (x * z + y * w)],
+            [2 * (x * y + z * w), 1 - 2 * (x * x + z * z), 2 * (y * z - x * w)],
+            [2 * (x * z - y * w), 2 * (y * z + x * w), 1 - 2 * (x * x + y * y)],
+        ]
+    )
+
+
+def pose_matrix(position: Sequence[float] | np.ndarray, quaternion: Sequence[float] | np.ndarray) -> np.ndarray:
+    """The 4x4 homogeneous transform of a position and a unit quaternion (x, y, z, w)."""
+    transform = np.eye(4)
+    transform[:3, :3] = rotation_matrix(quaternion)
+    transform[:3, 3] = np.asarray(position, dtype=np.float64).reshape(3)
+    return transform
+
+
+def quaternion_from_matrix(rotation: np.ndarray) -> np.ndarray:
+    """The unit quaternion (x, y, z, w), ``w >= 0``, of a 3x3 rotation matrix (identity for a degenerate one).
+
+    The branch on the largest diagonal term keeps the square root away from zero for rotations near 180
+    degrees; the result is normalised, so a slightly non-orthogonal matrix gives the nearest unit quaternion.
+    """
+    m = np.asarray(rotation, dtype=np.float64).reshape(3, 3)
+    if not (np.all(np.isfinite(m)) and np.linalg.det(m) > 1e-6):
+        return np.array(IDENTITY_QUATERNION)
+    trace = m[0, 0] + m[1, 1] + m[2, 2]
+    if trace > 0:
+        s = 2.0 * np.sqrt(trace + 1.0)
+        q = [(m[2, 1] - m[1, 2]) / s, (m[0, 2] - m[2, 0]) / s, (m[1, 0] - m[0, 1]) / s, 0.25 * s]
+    elif m[0, 0] >= m[1, 1] and m[0, 0] >= m[2, 2]:
+        s = 2.0 * np.sqrt(max(1.0 + m[0, 0] - m[1, 1] - m[2, 2], 1e-12))
+        q = [0.25 * s, (m[0, 1] + m[1, 0]) / s, (m[0, 2] + m[2, 0]) / s, (m[2, 1] - m[1, 2]) / s]
+    elif m[1, 1] >= m[2, 2]:
+        s = 2.0 * np.sqrt(max(1.0 + m[1, 1] - m[0, 0] - m[2, 2], 1e-12))
+        q = [(m[0, 1] + m[1, 0]) / s, 0.25 * s, (m[1, 2] + m[2, 1]) / s, (m[0, 2] - m[2, 0]) / s]
+    else:
+        s = 2.0 * np.sqrt(max(1.0 + m[2, 2] - m[0, 0] - m[1, 1], 1e-12))
+        q = [(m[0, 2] + m[2, 0]) / s, (m[1, 2] + m[2, 1]) / s, 0.25 * s, (m[1, 0] - m[0, 1]) / s]
+    quaternion = np.asarray(q, dtype=np.float64)
+    quaternion /= np.linalg.norm(quaternion)
+    return quaternion if quaternion[3] >= 0 else -quaternion
