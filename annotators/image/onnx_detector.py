@@ -31,6 +31,7 @@ import cv2
 import numpy as np
 
 from robokudo.core.annotator import Annotator
+from robokudo.core.capability import Capability
 from robokudo.core.types import CasType, Classification, ColorImage, ObjectHypothesis
 
 DEFAULT_INPUT_SIZE = 640
@@ -171,6 +172,13 @@ class OnnxDetector(Annotator):
 
     inputs: ClassVar[tuple[type[CasType], ...]] = (ColorImage, ObjectHypothesis)
     outputs: ClassVar[tuple[type[CasType], ...]] = (Classification,)
+    capability: ClassVar[Capability] = Capability(
+        label="ONNX object detector",
+        description="Runs a user-supplied YOLO-style ONNX detection model and names the hypotheses its boxes overlap.",
+        preconditions=("NeedsDetectorModel",),
+        cost_ms=80.0,
+        reliability=0.8,
+    )
 
     def __init__(
         self,

@@ -98,9 +98,10 @@ class RegionBox:
 
 @dataclass(frozen=True, slots=True)
 class AnnotatorSpec:
-    """An annotator's declared capabilities, as the ontology states them.
+    """An annotator's capabilities as its class declares them (ports and its Capability), read from the ontology.
 
-    Port and value names are ontology names; an empty value domain means "any value of that kind".
+    ``name`` is the class name and ``implemented_by`` the class's ``<module>.<qualname>``; port and value names
+    are ontology names; an empty value domain means "any value of that kind".
     """
 
     name: str
@@ -117,16 +118,6 @@ class AnnotatorSpec:
     cost_ms: float
     reliability: float
     label: str = ""
-
-    @property
-    def module(self) -> str:
-        """The Python module of the implementing class."""
-        return self.implemented_by.rpartition(".")[0]
-
-    @property
-    def class_name(self) -> str:
-        """The name of the implementing class."""
-        return self.implemented_by.rpartition(".")[2]
 
 
 @dataclass(frozen=True, slots=True)

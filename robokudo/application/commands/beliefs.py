@@ -17,6 +17,7 @@ from typing import Any
 from reasoning.beliefs.answer import Answer, answer_from_memory
 from reasoning.beliefs.filters import belief_filter
 from reasoning.beliefs.store import BeliefFilter, BeliefStore, BeliefStoreError
+from robokudo.application.knowledge import load_knowledge_base
 
 
 def add_arguments(parser: argparse.ArgumentParser) -> None:
@@ -91,10 +92,10 @@ def _parser() -> Any:
 def _knowledge_base() -> Any:
     """The knowledge base when it is available; without it classes and regions match by name only."""
     try:
-        module = importlib.import_module("reasoning.knowledge.knowledge_base")
+        importlib.import_module("reasoning.knowledge.knowledge_base")
     except ImportError:
         return None
-    return module.KnowledgeBase.load()
+    return load_knowledge_base()
 
 
 def _print(answer: Answer, args: argparse.Namespace, note: str | None) -> int:

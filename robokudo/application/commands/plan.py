@@ -11,6 +11,7 @@ from reasoning.errors import OntologyError
 from reasoning.knowledge.knowledge_base import KnowledgeBase
 from reasoning.planning.planner import PlanningError
 from reasoning.planning.query_planner import QueryPlan, plan_query
+from robokudo.application.knowledge import load_knowledge_base
 from robokudo.application.sensor_sources import sensor_source
 from robokudo.core.render import tree_to_dict, unicode_tree
 from trees.synthesis import SynthesisError, build_tree
@@ -51,7 +52,7 @@ def run(args: argparse.Namespace) -> int:
     """Plan and print; exit 2 with the reason when the query cannot be parsed or planned."""
     text = " ".join(args.query)
     try:
-        kb = KnowledgeBase.load()
+        kb = load_knowledge_base()
         query_plan = synthesize(text, kb, args.input, args.frame)
         tree = build_tree(query_plan.plan)
     except QueryError as error:

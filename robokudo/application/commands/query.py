@@ -17,6 +17,7 @@ from reasoning.fusion.tracking import BeliefTracker
 from reasoning.knowledge.knowledge_base import KnowledgeBase
 from reasoning.planning.planner import PlanningError
 from robokudo.application.commands.plan import synthesize
+from robokudo.application.knowledge import load_knowledge_base
 from robokudo.core.engine import Engine
 from robokudo.core.render import unicode_tree
 from robokudo.core.slot import TaskSlot
@@ -68,7 +69,7 @@ def run(args: argparse.Namespace) -> int:
     """Answer the query; exit 2 on a bad query or plan, 1 when perception failed."""
     text = " ".join(args.query)
     try:
-        kb = KnowledgeBase.load()
+        kb = load_knowledge_base()
         store = BeliefStore(args.store) if args.store else None
         answer, tree = answer_query(text, kb, args.input, args.frame, store)
     except QueryError as error:
