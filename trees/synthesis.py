@@ -12,6 +12,7 @@ from functools import partial
 import py_trees
 
 from annotators.catalog import AnnotatorCatalog, CatalogError
+from reasoning.knowledge.capabilities import implementation_path
 from reasoning.planning.plan import Alternatives, Plan, Step, Unit
 from robokudo.core.annotator import Annotator
 from robokudo.core.dataflow import validate_data_flow
@@ -32,7 +33,7 @@ def instantiate(step: Step, catalog: AnnotatorCatalog) -> Annotator:
         cls = catalog[step.annotator]
     except CatalogError as error:
         raise SynthesisError(f"cannot build plan step {step.annotator}: {error}") from None
-    path = f"{cls.__module__}.{cls.__qualname__}"
+    path = implementation_path(cls)
     if step.implemented_by and path != step.implemented_by:
         raise SynthesisError(
             f"cannot build plan step {step.annotator}: the plan was made for {step.implemented_by}, "
