@@ -1,7 +1,9 @@
 """The annotator catalog: every expert and reader class this package defines, found by walking its modules.
 
 The catalog is the one place that turns annotator names into classes: plans name annotators, and trees are
-built only from classes in a catalog (this package's, plus classes a caller registers explicitly).
+built only from classes in a catalog (this package's, plus classes a caller registers explicitly). Each class
+declares its own capability (ports and ``capability``), so the catalog's classes are also what the application
+loads into the knowledge base (``robokudo.application.knowledge.load_knowledge_base``).
 """
 
 from __future__ import annotations

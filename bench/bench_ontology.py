@@ -1,9 +1,10 @@
 """Benchmark of the knowledge base: load time (cold, with and without HermiT) and question latency.
 
-Runs on the shipped ontology and on a generated one (the shipped files plus 1,000 object classes and 200
-annotators). Cold load = a fresh Python process importing the package and loading; warm load = another load
-in the same process. Question latency = median and p99 over 10,000 mixed questions (word resolution,
-subsumption, profiles, default locations, regions, providers, query keys, annotator inputs).
+Runs on the shipped ontology with the catalog's annotator classes and on a generated one (the shipped files plus
+1,000 object classes, and 200 generated annotator classes). Cold load = a fresh Python process importing the
+package, finding the annotator classes and loading; warm load = another load in the same process. Question
+latency = median and p99 over 10,000 mixed questions (word resolution, subsumption, profiles, default locations,
+regions, providers, query keys, annotator inputs).
 
     python bench/bench_ontology.py [--questions N] [--no-reasoner]
 """
@@ -21,10 +22,15 @@ import time
 from collections import defaultdict
 from collections.abc import Callable
 from pathlib import Path
+from typing import Any, TypedDict
 
+from annotators.catalog import AnnotatorCatalog
 from ontology import ontology_dir, shipped_files
 from reasoning.knowledge.knowledge_base import KnowledgeBase
 from reasoning.knowledge.model import Conditions
+from robokudo.core.annotator import Annotator
+from robokudo.core.capability import Capability
+from robokudo.core.types import type_by_name
 
 GENERATED_CLASSES = 1000
 GENERATED_ANNOTATORS = 200
@@ -35,17 +41,46 @@ _COLD_LOAD = """
 import json, sys, time
 start = time.perf_counter()
 from pathlib import Path
+sys.path.insert(0, sys.argv[5])
+from bench_ontology import annotator_classes
 from reasoning.knowledge.knowledge_base import KnowledgeBase
 imported = time.perf_counter()
+classes = annotator_classes(json.loads(Path(sys.argv[4]).read_text()) if sys.argv[4] else None)
+found = time.perf_counter()
 files = [Path(p) for p in json.loads(sys.argv[1])] or None
-KnowledgeBase.load(Path(sys.argv[2]), files=files, reason=sys.argv[3] == "1")
+KnowledgeBase.load(Path(sys.argv[2]), files=files, reason=sys.argv[3] == "1", annotators=classes)
 done = time.perf_counter()
-print(json.dumps({"import": imported - start, "load": done - imported}))
+print(json.dumps({"import": imported - start, "annotators": found - imported, "load": done - found}))
 """
 
 
-def generate(folder: Path, rng: random.Random) -> list[Path]:
-    """Write the generated object classes, regions and annotators; return the full file list."""
+class Declaration(TypedDict):
+    """A generated annotator as plain data (JSON for the cold load): its name, ports and Capability fields."""
+
+    name: str
+    inputs: list[str]
+    outputs: list[str]
+    capability: dict[str, Any]
+
+
+def annotator_classes(declarations: list[Declaration] | None) -> list[type[Annotator]]:
+    """The catalog's annotator classes plus one generated Annotator class per declaration (if any)."""
+    classes = list(AnnotatorCatalog.discover().values())
+    for declared in declarations or ():
+        fields = {k: tuple(v) if isinstance(v, list) else v for k, v in declared["capability"].items()}
+        members = {
+            "__module__": __name__,
+            "__doc__": f"Generated annotator {declared['name']}.",
+            "inputs": tuple(map(type_by_name, declared["inputs"])),
+            "outputs": tuple(map(type_by_name, declared["outputs"])),
+            "capability": Capability(**fields),
+        }
+        classes.append(type(declared["name"], (Annotator,), members))
+    return classes
+
+
+def generate(folder: Path, rng: random.Random) -> tuple[list[Path], list[Declaration]]:
+    """Write the generated object classes and regions; return the full file list and the annotator declarations."""
     base = KnowledgeBase.load(folder / "none.ttl")
     colors = base.names_of_kind("color")
     shapes = base.names_of_kind("shape")
@@ -88,30 +123,38 @@ def generate(folder: Path, rng: random.Random) -> list[Path]:
     types = base.cas_types()
     preconditions = ["NeedsDepth", "NeedsRegion", "NotForTransparentObjects"]
     all_classes = classes + generated
+    declarations: list[Declaration] = []
     for i in range(GENERATED_ANNOTATORS):
-        facts = [
-            f'rk:implementedBy "annotators.generated.GenAnnotator{i:03d}"',
-            "rk:requiresInput " + " , ".join(f"rk:{t}" for t in rng.sample(types, rng.randint(1, 3))),
-            "rk:providesOutput " + " , ".join(f"rk:{t}" for t in rng.sample(types, rng.randint(1, 2))),
-            f"rk:expectedCostMs {rng.uniform(1, 100):.1f}",
-            f"rk:reliability {rng.uniform(0.3, 1.0):.2f}",
-        ]
+        inputs = rng.sample(types, rng.randint(1, 3))
+        outputs = rng.sample(types, rng.randint(1, 2))
+        capability: dict[str, Any] = {
+            "cost_ms": round(rng.uniform(1, 100), 1),
+            "reliability": round(rng.uniform(0.3, 1.0), 2),
+        }
         if rng.random() < 0.4:
-            facts.append("rk:canReportColor " + " , ".join(f"rk:{c}" for c in rng.sample(colors, 4)))
+            capability["colors"] = tuple(rng.sample(colors, 4))
         if rng.random() < 0.4:
-            facts.append("rk:canReportClass " + " , ".join(f"rk:{c}" for c in rng.sample(all_classes, 5)))
+            capability["classes"] = tuple(rng.sample(all_classes, 5))
         if rng.random() < 0.3:
-            facts.append(f"rk:precondition rk:{rng.choice(preconditions)}")
-        lines.append(f"rk:GenAnnotator{i:03d} a owl:NamedIndividual , rk:Annotator ;")
-        lines.append("    " + " ;\n    ".join(facts) + " .")
+            capability["preconditions"] = (rng.choice(preconditions),)
+        declarations.append(
+            {"name": f"GenAnnotator{i:03d}", "inputs": inputs, "outputs": outputs, "capability": capability}
+        )
     extra = folder / "generated.ttl"
     extra.write_text("\n".join(lines) + "\n", encoding="utf-8")
-    return [*shipped_files(), extra]
+    return [*shipped_files(), extra], declarations
 
 
-def cold_load(files: list[Path], user_file: Path, reason: bool) -> dict[str, float]:
-    """Import + load in a fresh interpreter."""
-    argv = [json.dumps([str(f) for f in files]), str(user_file), "1" if reason else "0"]
+def cold_load(
+    files: list[Path], user_file: Path, reason: bool, declarations: list[Declaration] | None
+) -> dict[str, float]:
+    """Import + annotator classes + load in a fresh interpreter (``declarations`` None: the catalog's classes)."""
+    declared = ""
+    if declarations is not None:
+        declared = str(user_file.with_name("annotators.json"))
+        Path(declared).write_text(json.dumps(declarations), encoding="utf-8")
+    argv = [json.dumps([str(f) for f in files]), str(user_file), "1" if reason else "0", declared]
+    argv.append(str(Path(__file__).resolve().parent))
     output = subprocess.run(
         [sys.executable, "-c", _COLD_LOAD, *argv], check=True, capture_output=True, text=True, cwd=ontology_dir().parent
     )
@@ -199,21 +242,29 @@ def p99(values: list[float]) -> float:
     return statistics.quantiles(values, n=100)[98] if len(values) > 1 else values[0]
 
 
-def bench(label: str, files: list[Path], user_file: Path, count: int, reason: bool, rng: random.Random) -> None:
-    """Print load times and question latencies for one ontology."""
+def bench(
+    label: str,
+    files: list[Path],
+    declarations: list[Declaration] | None,
+    user_file: Path,
+    count: int,
+    reason: bool,
+    rng: random.Random,
+) -> None:
+    """Print load times and question latencies for one ontology and its annotator classes."""
     print(f"\n== {label}")
-    cold = cold_load(files, user_file, reason=False)
-    print(f"cold load, no reasoning : import {cold['import'] * 1e3:7.0f} ms + load {cold['load'] * 1e3:7.0f} ms")
-    if reason:
-        cold_reasoned = cold_load(files, user_file, reason=True)
+    runs = [("no reasoning ", False), ("with HermiT  ", True)] if reason else [("no reasoning ", False)]
+    for name, with_hermit in runs:
+        cold = cold_load(files, user_file, with_hermit, declarations)
         print(
-            f"cold load, with HermiT  : import {cold_reasoned['import'] * 1e3:7.0f} ms + "
-            f"load {cold_reasoned['load'] * 1e3:7.0f} ms"
+            f"cold load, {name}: import {cold['import'] * 1e3:7.0f} ms + annotator classes "
+            f"{cold['annotators'] * 1e3:7.0f} ms + load {cold['load'] * 1e3:7.0f} ms"
         )
+    classes = annotator_classes(declarations)
     warm = []
     for _ in range(3):
         start = time.perf_counter()
-        kb = KnowledgeBase.load(user_file, files=files)
+        kb = KnowledgeBase.load(user_file, files=files, annotators=classes)
         warm.append(time.perf_counter() - start)
     print(f"warm load, no reasoning : {min(warm) * 1e3:7.0f} ms (best of 3)")
     start = time.perf_counter()
@@ -239,10 +290,11 @@ def main() -> int:
     rng = random.Random(SEED)
     with tempfile.TemporaryDirectory() as folder:
         user_file = Path(folder) / "user.ttl"
-        bench("shipped ontology", list(shipped_files()), user_file, args.questions, not args.no_reasoner, rng)
-        files = generate(Path(folder), rng)
+        shipped = list(shipped_files())
+        bench("shipped ontology", shipped, None, user_file, args.questions, not args.no_reasoner, rng)
+        files, declarations = generate(Path(folder), rng)
         label = f"generated: shipped + {GENERATED_CLASSES} classes, {GENERATED_ANNOTATORS} annotators"
-        bench(label, files, user_file, args.questions, not args.no_reasoner, rng)
+        bench(label, files, declarations, user_file, args.questions, not args.no_reasoner, rng)
     return 0
 
 

@@ -1,8 +1,8 @@
 """Planning latency (parse -> plan -> tree), median and p99, on the shipped ontology and on a generated one.
 
-The generated ontology (from bench_ontology.generate: ~1,000 extra object classes, ~200 annotators with
-random ports over the real CAS types) has no Python implementations, so its trees are built with plain
-port-declaring nodes; the shipped one instantiates the real annotator classes.
+The generated ontology (from bench_ontology.generate: ~1,000 extra object classes, ~200 generated annotator
+classes with random ports over the real CAS types) has no real implementations, so its trees are built with plain
+port-declaring nodes; the shipped one instantiates the real annotator classes from the catalog.
 """
 
 from __future__ import annotations
@@ -13,18 +13,21 @@ import statistics
 import sys
 import tempfile
 import time
+from functools import partial
 from pathlib import Path
 from types import ModuleType
 
+from annotators.catalog import AnnotatorCatalog
 from queries import parse_query
 from reasoning.knowledge.knowledge_base import KnowledgeBase
 from reasoning.planning.plan import Step
 from reasoning.planning.planner import PlanningError, SensorSource
 from reasoning.planning.query_planner import QueryPlanner
+from robokudo.application.knowledge import load_knowledge_base
 from robokudo.application.sensor_sources import sensor_source
 from robokudo.core.annotator import Annotator
 from robokudo.core.types import type_by_name
-from trees.synthesis import build_tree, instantiate
+from trees.synthesis import NodeFactory, build_tree, instantiate
 
 QUERIES = [
     "detect { obj: { color: red } }",
@@ -52,7 +55,7 @@ def measure(label: str, kb: KnowledgeBase, texts: list[str], source: SensorSourc
     plans: list[float] = []
     planned = failed = 0
     planner = QueryPlanner(kb)
-    make = generic_node if generic else instantiate
+    make: NodeFactory = generic_node if generic else partial(instantiate, catalog=AnnotatorCatalog.discover())
     for _ in range(REPEATS):
         for text in texts:
             start = time.perf_counter()
@@ -84,13 +87,14 @@ def load_generator() -> ModuleType:
 
 
 def main() -> None:
-    kb = KnowledgeBase.load(Path(tempfile.mkdtemp()) / "user.ttl")
+    kb = load_knowledge_base(Path(tempfile.mkdtemp()) / "user.ttl")
     shipped = [q for q in QUERIES]
     measure("shipped ontology, real annotators", kb, shipped, None, generic=False)
     generator = load_generator()
     with tempfile.TemporaryDirectory() as folder:
-        files = generator.generate(Path(folder), random.Random(7))
-        big = KnowledgeBase.load(Path(folder) / "user.ttl", files=files)
+        files, declarations = generator.generate(Path(folder), random.Random(7))
+        classes = generator.annotator_classes(declarations)
+        big = KnowledgeBase.load(Path(folder) / "user.ttl", files=files, annotators=classes)
         print(f"generated ontology: {len(big.names_of_kind('class'))} classes, {len(big.annotators())} annotators")
         rng = random.Random(3)
         classes = [c for c in big.names_of_kind("class") if c.startswith("GenObject")]

@@ -1,19 +1,19 @@
 """Turn a Plan into a Perception Pipeline Tree: Pipeline > stages (Parallel when independent) > Fallbacks.
 
-Annotator classes are looked up by the ``implemented_by`` path the ontology names; only classes of the
-project's ``annotators`` package can be instantiated.
+A plan names annotators; their classes come from an :class:`~annotators.catalog.AnnotatorCatalog` (by default
+the ``annotators`` package's, plus any classes a caller adds), the only place that turns names into classes.
 """
 
 from __future__ import annotations
 
-import importlib
 from collections.abc import Callable
 from collections.abc import Sequence as Ordered
 from functools import partial
 
 import py_trees
 
-from annotators.catalog import AnnotatorCatalog
+from annotators.catalog import AnnotatorCatalog, CatalogError
+from reasoning.knowledge.capabilities import implementation_path
 from reasoning.planning.plan import Alternatives, Plan, Step, Unit
 from robokudo.core.annotator import Annotator
 from robokudo.core.composites import Fallback, Sequence
@@ -21,36 +21,27 @@ from robokudo.core.dataflow import validate_data_flow
 from robokudo.core.parallel import ThresholdParallel
 from robokudo.core.pipeline import Pipeline
 
-ALLOWED_PACKAGE = "annotators"
-
 
 class SynthesisError(Exception):
     """A plan names an annotator class that cannot be used."""
 
 
-def annotator_class(implemented_by: str) -> type[Annotator]:
-    """Import the class ``annotators.module.Class``; anything outside the annotators package is refused."""
-    module_name, _, class_name = implemented_by.rpartition(".")
-    if not module_name.startswith(ALLOWED_PACKAGE + ".") and module_name != ALLOWED_PACKAGE:
-        raise SynthesisError(f"{implemented_by!r} is not in the {ALLOWED_PACKAGE!r} package")
+def instantiate(step: Step, catalog: AnnotatorCatalog) -> Annotator:
+    """A fresh node of the catalog's class for a plan step, with the step's parameters and reason.
+
+    SynthesisError when the catalog has no class of that name, or a different class than the plan was made for.
+    """
     try:
-        cls = getattr(importlib.import_module(module_name), class_name)
-    except (ImportError, AttributeError) as error:
-        raise SynthesisError(f"cannot load annotator class {implemented_by!r}: {error}") from error
-    if not (isinstance(cls, type) and issubclass(cls, Annotator)):
-        raise SynthesisError(f"{implemented_by!r} is not an Annotator")
-    return cls
-
-
-def instantiate(step: Step) -> Annotator:
-    """A fresh annotator node for a plan step, carrying the step's reason."""
-    node = annotator_class(step.implemented_by)(name=step.annotator, **dict(step.parameters))
-    node.reason = step.reason
-    return node
-
-
-def _from_catalog(catalog: AnnotatorCatalog, step: Step) -> Annotator:
-    node = catalog[step.annotator](name=step.annotator, **dict(step.parameters))
+        cls = catalog[step.annotator]
+    except CatalogError as error:
+        raise SynthesisError(f"cannot build plan step {step.annotator}: {error}") from None
+    path = implementation_path(cls)
+    if step.implemented_by and path != step.implemented_by:
+        raise SynthesisError(
+            f"cannot build plan step {step.annotator}: the plan was made for {step.implemented_by}, "
+            f"but the catalog's {step.annotator} is {path}"
+        )
+    node = cls(name=step.annotator, **dict(step.parameters))
     node.reason = step.reason
     return node
 
@@ -94,17 +85,18 @@ def build_tree(
     plan: Plan,
     name: str = "query",
     final_steps: Ordered[py_trees.behaviour.Behaviour] = (),
-    make: NodeFactory = instantiate,
+    make: NodeFactory | None = None,
     query: object | None = None,
     catalog: AnnotatorCatalog | None = None,
 ) -> Pipeline:
     """The Pipeline for ``plan`` (stages in order, then ``final_steps`` such as the answer step), validated.
 
-    ``make`` turns a step into a node (default: the annotator class the ontology names); ``query`` is put
-    into every new CAS of the pipeline.
+    ``make`` turns a step into a node; by default each step becomes an instance of the ``catalog``'s class of
+    that name (default catalog: :meth:`AnnotatorCatalog.discover`). ``query`` is put into every new CAS of
+    the pipeline. SynthesisError when a step names no class of the catalog.
     """
-    if catalog is not None:
-        make = partial(_from_catalog, catalog)
+    if make is None:
+        make = partial(instantiate, catalog=catalog if catalog is not None else AnnotatorCatalog.discover())
     children = [_stage_node(index, stage, make) for index, stage in enumerate(plan.stages, start=1)]
     pipeline = Pipeline(name, [*children, *final_steps], query=query, reason=f"answers the {plan.task.kind} query")
     validate_data_flow(pipeline)

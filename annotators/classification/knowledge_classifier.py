@@ -35,6 +35,7 @@ from typing import ClassVar
 
 from annotators.cloud.size import SIZE_CLASSES
 from robokudo.core.annotator import Annotator
+from robokudo.core.capability import Capability
 from robokudo.core.types import CasType, Classification, ObjectHypothesis, SemanticColor, Shape, Size, Text
 
 WEIGHTS: Mapping[str, float] = MappingProxyType({"color": 1.0, "shape": 1.0, "size": 0.5, "text": 3.0})
@@ -187,6 +188,12 @@ class KnowledgeClassifier(Annotator):
     inputs: ClassVar[tuple[type[CasType], ...]] = (ObjectHypothesis, SemanticColor, Shape, Size)
     optional_inputs: ClassVar[tuple[type[CasType], ...]] = (Text,)
     outputs: ClassVar[tuple[type[CasType], ...]] = (Classification,)
+    capability: ClassVar[Capability] = Capability(
+        label="knowledge classifier",
+        classes=("PhysicalObject",),
+        cost_ms=0.5,
+        reliability=0.7,
+    )
 
     def __init__(
         self,

@@ -43,6 +43,7 @@ from annotators.geometry.grid_segmentation import (
     merge_parts,
 )
 from robokudo.core.annotator import Annotator
+from robokudo.core.capability import Capability
 from robokudo.core.types import CasType, ObjectHypothesis, Plane, PointCloud
 
 
@@ -233,6 +234,12 @@ class ClusterExtractor(Annotator):
 
     inputs: ClassVar[tuple[type[CasType], ...]] = (PointCloud, Plane)
     outputs: ClassVar[tuple[type[CasType], ...]] = (ObjectHypothesis,)
+    capability: ClassVar[Capability] = Capability(
+        label="cluster extractor",
+        preconditions=("NeedsDepth", "NotForTransparentObjects"),
+        cost_ms=30.0,
+        reliability=0.85,
+    )
 
     def __init__(
         self,

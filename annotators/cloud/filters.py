@@ -14,6 +14,7 @@ import numpy as np
 
 from annotators.cloud.point_cloud import cloud_problem
 from robokudo.core.annotator import Annotator
+from robokudo.core.capability import Capability
 from robokudo.core.types import CameraInfo, CasType, PointCloud
 
 
@@ -44,6 +45,11 @@ class RangeFilter(Annotator):
 
     inputs: ClassVar[tuple[type[CasType], ...]] = (PointCloud,)
     outputs: ClassVar[tuple[type[CasType], ...]] = (PointCloud,)
+    capability: ClassVar[Capability] = Capability(
+        label="range filter",
+        cost_ms=2.0,
+        reliability=1.0,
+    )
 
     def __init__(
         self,
@@ -111,6 +117,13 @@ class RegionFilter(Annotator):
 
     inputs: ClassVar[tuple[type[CasType], ...]] = (PointCloud, CameraInfo)
     outputs: ClassVar[tuple[type[CasType], ...]] = (PointCloud,)
+    capability: ClassVar[Capability] = Capability(
+        label="region filter",
+        description="Keeps the points inside a semantic-map region's box (needs the camera pose).",
+        preconditions=("NeedsDepth", "NeedsRegion"),
+        cost_ms=2.0,
+        reliability=1.0,
+    )
 
     def __init__(
         self, region: str, box_pose: Sequence[float], box_size: Sequence[float], name: str | None = None
@@ -154,6 +167,11 @@ class CropBoxFilter(Annotator):
 
     inputs: ClassVar[tuple[type[CasType], ...]] = (PointCloud,)
     outputs: ClassVar[tuple[type[CasType], ...]] = (PointCloud,)
+    capability: ClassVar[Capability] = Capability(
+        label="crop box filter",
+        cost_ms=2.5,
+        reliability=1.0,
+    )
 
     def __init__(
         self,

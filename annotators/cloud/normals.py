@@ -17,6 +17,7 @@ import numpy as np
 from annotators.cloud.point_cloud import cloud_problem
 from annotators.geometry.grid_segmentation import bounding_box, depth_jump
 from robokudo.core.annotator import Annotator
+from robokudo.core.capability import Capability
 from robokudo.core.types import CasType, Normals, PointCloud
 
 
@@ -78,6 +79,13 @@ class NormalEstimator(Annotator):
 
     inputs: ClassVar[tuple[type[CasType], ...]] = (PointCloud,)
     outputs: ClassVar[tuple[type[CasType], ...]] = (Normals,)
+    capability: ClassVar[Capability] = Capability(
+        label="normal estimator",
+        description="Surface normals on the organized grid (central differences, smoothed).",
+        preconditions=("NeedsDepth",),
+        cost_ms=3.0,
+        reliability=0.95,
+    )
 
     def __init__(self, step: int = 2, smoothing: int = 3, stride: int = 2, name: str | None = None) -> None:
         """``step`` and ``smoothing`` count pixels of the ``stride``-subsampled grid."""

@@ -18,6 +18,7 @@ import numpy as np
 
 from annotators.cloud.point_cloud import cloud_problem
 from robokudo.core.annotator import Annotator
+from robokudo.core.capability import Capability
 from robokudo.core.types import CameraInfo, CasType, Plane, PointCloud
 
 MIN_PLANE_POINTS = 50
@@ -213,6 +214,11 @@ class SupportPlaneSegmenter(Annotator):
     inputs: ClassVar[tuple[type[CasType], ...]] = (PointCloud,)
     optional_inputs: ClassVar[tuple[type[CasType], ...]] = (CameraInfo,)
     outputs: ClassVar[tuple[type[CasType], ...]] = (Plane,)
+    capability: ClassVar[Capability] = Capability(
+        label="support plane segmenter",
+        cost_ms=25.0,
+        reliability=0.9,
+    )
 
     def __init__(
         self,

@@ -7,6 +7,7 @@ from typing import ClassVar
 import numpy as np
 
 from robokudo.core.annotator import Annotator
+from robokudo.core.capability import Capability
 from robokudo.core.types import CameraInfo, CameraIntrinsics, CasType, ColorImage, DepthImage, PointCloud
 
 
@@ -63,6 +64,12 @@ class PointCloudGenerator(Annotator):
     inputs: ClassVar[tuple[type[CasType], ...]] = (DepthImage, CameraInfo)
     optional_inputs: ClassVar[tuple[type[CasType], ...]] = (ColorImage,)
     outputs: ClassVar[tuple[type[CasType], ...]] = (PointCloud,)
+    capability: ClassVar[Capability] = Capability(
+        label="point cloud generator",
+        preconditions=("NeedsDepth",),
+        cost_ms=8.0,
+        reliability=1.0,
+    )
 
     def __init__(self, name: str | None = None) -> None:
         super().__init__(name=name)

@@ -8,6 +8,7 @@ import numpy as np
 
 from annotators.cloud.cloud_expert import CloudExpert
 from annotators.geometry.boxes import finite_points, object_box
+from robokudo.core.capability import Capability
 from robokudo.core.geometry import quaternion_from_matrix
 from robokudo.core.types import CameraInfo, CasType, ObjectHypothesis, PointCloud, Pose
 
@@ -28,6 +29,11 @@ class PoseAnnotator(CloudExpert):
     optional_inputs: ClassVar[tuple[type[CasType], ...]] = (CameraInfo,)
     outputs: ClassVar[tuple[type[CasType], ...]] = (Pose,)
     purpose: ClassVar[str] = "estimate poses for"
+    capability: ClassVar[Capability] = Capability(
+        label="pose annotator",
+        cost_ms=2.0,
+        reliability=0.9,
+    )
 
     def __init__(self, max_points: int = 1000, name: str | None = None) -> None:
         super().__init__(name=name)

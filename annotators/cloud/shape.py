@@ -26,6 +26,7 @@ import numpy as np
 
 from annotators.cloud.cloud_expert import CloudExpert
 from annotators.geometry.support_frame import sampled_indices, support_frame, usable_plane
+from robokudo.core.capability import Capability
 from robokudo.core.types import CameraInfo, CasType, Normals, ObjectHypothesis, Plane, PointCloud, Shape
 
 SHAPES: tuple[str, ...] = ("box", "cylinder", "sphere", "flat")
@@ -208,6 +209,13 @@ class ShapeAnnotator(CloudExpert):
     optional_inputs: ClassVar[tuple[type[CasType], ...]] = (CameraInfo, Plane)
     outputs: ClassVar[tuple[type[CasType], ...]] = (Shape,)
     purpose: ClassVar[str] = "fit shapes to"
+    capability: ClassVar[Capability] = Capability(
+        label="shape annotator",
+        shapes=("Box", "Cylinder", "Sphere", "Flat"),
+        preconditions=("NeedsDepth",),
+        cost_ms=12.0,
+        reliability=0.75,
+    )
 
     def __init__(self, max_points: int = 1500, name: str | None = None) -> None:
         super().__init__(name=name)

@@ -16,6 +16,7 @@ import numpy as np
 from annotators.cloud.cloud_expert import CloudExpert
 from annotators.geometry.boxes import principal_box
 from annotators.geometry.support_frame import SupportFrame, sampled_indices, support_frame, usable_plane
+from robokudo.core.capability import Capability
 from robokudo.core.types import CameraInfo, CasType, ObjectHypothesis, Plane, PointCloud, Size
 
 SIZE_CLASS_THRESHOLDS: tuple[float, float] = (0.12, 0.25)
@@ -74,6 +75,13 @@ class SizeAnnotator(CloudExpert):
     optional_inputs: ClassVar[tuple[type[CasType], ...]] = (CameraInfo, Plane)
     outputs: ClassVar[tuple[type[CasType], ...]] = (Size,)
     purpose: ClassVar[str] = "measure"
+    capability: ClassVar[Capability] = Capability(
+        label="size annotator",
+        sizes=("Small", "Medium", "Large"),
+        preconditions=("NeedsDepth",),
+        cost_ms=5.0,
+        reliability=0.9,
+    )
 
     def __init__(self, max_points: int = 3000, name: str | None = None) -> None:
         super().__init__(name=name)

@@ -14,6 +14,7 @@ import cv2
 import numpy as np
 
 from annotators.image.pixel_expert import PixelExpert
+from robokudo.core.capability import Capability
 from robokudo.core.types import CasType, SemanticColor
 
 
@@ -133,6 +134,12 @@ class SemanticColorAnnotator(PixelExpert):
 
     outputs: ClassVar[tuple[type[CasType], ...]] = (SemanticColor,)
     purpose: ClassVar[str] = "name colours for"
+    capability: ClassVar[Capability] = Capability(
+        label="semantic colour annotator",
+        colors=("Red", "Orange", "Yellow", "Green", "Blue", "Purple", "Pink", "Brown", "White", "Grey", "Black"),
+        cost_ms=3.0,
+        reliability=0.8,
+    )
 
     def describe(self, pixels: np.ndarray) -> SemanticColor:
         """The dominant colour name of the pixels."""

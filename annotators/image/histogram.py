@@ -12,6 +12,7 @@ import cv2
 import numpy as np
 
 from annotators.image.pixel_expert import PixelExpert
+from robokudo.core.capability import Capability
 from robokudo.core.types import CasType, ColorHistogram
 
 MIN_VALUE = 30
@@ -33,6 +34,11 @@ class ColorHistogramAnnotator(PixelExpert):
     """Attaches a normalised hue/saturation ColorHistogram to every object hypothesis."""
 
     outputs: ClassVar[tuple[type[CasType], ...]] = (ColorHistogram,)
+    capability: ClassVar[Capability] = Capability(
+        label="colour histogram annotator",
+        cost_ms=2.5,
+        reliability=0.9,
+    )
 
     def __init__(self, bins: tuple[int, int] = (16, 4), max_pixels: int = 4000, name: str | None = None) -> None:
         super().__init__(max_pixels=max_pixels, name=name)

@@ -19,6 +19,7 @@ import numpy as np
 
 from annotators.geometry.grid_segmentation import bounding_box
 from robokudo.core.annotator import Annotator
+from robokudo.core.capability import Capability
 from robokudo.core.types import CasType, ColorImage, ObjectHypothesis
 
 
@@ -39,6 +40,14 @@ class ImageRegionSegmenter(Annotator):
 
     inputs: ClassVar[tuple[type[CasType], ...]] = (ColorImage,)
     outputs: ClassVar[tuple[type[CasType], ...]] = (ObjectHypothesis,)
+    capability: ClassVar[Capability] = Capability(
+        label="image region segmenter",
+        description=(
+            "Regions standing out in colour from the supporting surface become object hypotheses (no depth needed)."
+        ),
+        cost_ms=4.0,
+        reliability=0.5,
+    )
 
     def __init__(
         self,

@@ -32,6 +32,7 @@ import numpy as np
 
 from annotators.image.pixel_expert import image_and_hypotheses
 from robokudo.core.annotator import Annotator
+from robokudo.core.capability import Capability
 from robokudo.core.types import CasType, Classification, ColorImage, ObjectHypothesis
 
 DEFAULT_INPUT_SIZE = 640
@@ -172,6 +173,13 @@ class OnnxDetector(Annotator):
 
     inputs: ClassVar[tuple[type[CasType], ...]] = (ColorImage, ObjectHypothesis)
     outputs: ClassVar[tuple[type[CasType], ...]] = (Classification,)
+    capability: ClassVar[Capability] = Capability(
+        label="ONNX object detector",
+        description="Runs a user-supplied YOLO-style ONNX detection model and names the hypotheses its boxes overlap.",
+        preconditions=("NeedsDetectorModel",),
+        cost_ms=80.0,
+        reliability=0.8,
+    )
 
     def __init__(
         self,

@@ -28,6 +28,7 @@ from annotators.readers.tiff_io import read_tiff_frame
 from annotators.readers.tum_io import TUM_DEPTH_SCALE, read_tum_pair, read_tum_sequence
 from annotators.simulation import kitchen_scene
 from robokudo.core.annotator import Annotator
+from robokudo.core.capability import Capability
 from robokudo.core.types import CameraInfo, CameraIntrinsics, CasType, ColorImage, DepthImage, PointCloud, QueryView
 
 DEFAULT_KITCHEN_VIEW = "table"
@@ -43,6 +44,12 @@ class KitchenSceneReader(Annotator):
     inputs: ClassVar[tuple[type[CasType], ...]] = ()
     optional_inputs: ClassVar[tuple[type[CasType], ...]] = (QueryView,)
     outputs: ClassVar[tuple[type[CasType], ...]] = (ColorImage, DepthImage, CameraInfo)
+    capability: ClassVar[Capability] = Capability(
+        label="kitchen scene reader",
+        description="Renders the built-in synthetic kitchen (colour, depth, camera info).",
+        cost_ms=60.0,
+        reliability=1.0,
+    )
 
     def __init__(
         self,
@@ -147,6 +154,13 @@ class ColorDepthPairReader(FileFrameReader):
     ``depth_scale`` is in sensor units per metre; None takes it from camera_params.json, else 1000 (mm).
     """
 
+    capability: ClassVar[Capability] = Capability(
+        label="colour/depth pair reader",
+        description="Reads a frame of a uoc-layout folder (NNNNNN-color.png, NNNNNN-depth.png, camera_params.json).",
+        cost_ms=15.0,
+        reliability=1.0,
+    )
+
     def __init__(
         self, folder: str | Path, frame: int = 0, depth_scale: float | None = None, name: str | None = None
     ) -> None:
@@ -166,6 +180,13 @@ class TumSequenceReader(FileFrameReader):
     ``depth_scale`` is in units per metre (TUM: 5000); ``intrinsics`` default to the folder's camera_params.json,
     else the PrimeSense default TUM documents (fx = fy = 525, cx = 319.5, cy = 239.5).
     """
+
+    capability: ClassVar[Capability] = Capability(
+        label="TUM sequence reader",
+        description="Reads a frame of a TUM RGB-D sequence folder (rgb.txt, depth.txt; depth scale 5000).",
+        cost_ms=15.0,
+        reliability=1.0,
+    )
 
     def __init__(
         self,
@@ -192,6 +213,13 @@ class TumPairReader(FileFrameReader):
     ``depth_scale`` is in units per metre (TUM: 5000); ``intrinsics`` default to the PrimeSense default.
     """
 
+    capability: ClassVar[Capability] = Capability(
+        label="TUM pair reader",
+        description="Reads one TUM-style colour/depth pair (TUM_color.png beside TUM_depth.png; depth scale 5000).",
+        cost_ms=15.0,
+        reliability=1.0,
+    )
+
     def __init__(
         self,
         path: str | Path,
@@ -215,6 +243,11 @@ class PcdReader(FileFrameReader):
     ``label`` field is kept as ground truth in ``last_frame.labels``."""
 
     outputs: ClassVar[tuple[type[CasType], ...]] = (ColorImage, DepthImage, CameraInfo, PointCloud)
+    capability: ClassVar[Capability] = Capability(
+        label="PCD reader",
+        cost_ms=60.0,
+        reliability=1.0,
+    )
 
     def __init__(self, path: str | Path, intrinsics: CameraIntrinsics | None = None, name: str | None = None) -> None:
         super().__init__(name=name)
@@ -231,6 +264,13 @@ class TiffSequenceReader(FileFrameReader):
 
     ``depth_scale`` (units per metre) and ``intrinsics`` default to the frame's XML file.
     """
+
+    capability: ClassVar[Capability] = Capability(
+        label="TIFF sequence reader",
+        description="Reads a frame of a PCL ImageGrabber folder (16-bit TIFF pairs with XML intrinsics).",
+        cost_ms=20.0,
+        reliability=1.0,
+    )
 
     def __init__(
         self,

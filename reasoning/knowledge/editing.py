@@ -5,7 +5,8 @@ validated completely before anything is written (names, parents, regions and val
 word clash; the result must load and HermiT must find no unsatisfiable class), and the write is atomic
 (temporary file + rename). A rejected edit raises :class:`~reasoning.errors.EditRejectedError` and leaves
 the file byte-identical. After a successful edit the knowledge base is reloaded, so the new class can be
-used at once. The editor rewrites the user file with rdflib, so comments in it are not kept.
+used at once. The editor rewrites the user file with rdflib, so comments in it are not kept. Validation sees the
+ontology as the knowledge base does: the Turtle files plus the triples of its annotator classes.
 """
 
 from __future__ import annotations
@@ -24,9 +25,9 @@ from reasoning.knowledge.hermit import classify, describe_unsatisfiable
 from reasoning.knowledge.index import OntologyIndex, build_index
 from reasoning.knowledge.knowledge_base import KnowledgeBase
 from reasoning.knowledge.model import KIND_WORDS, Kind
-from reasoning.knowledge.sources import defined_names, merge_graphs
 from reasoning.knowledge.vocabulary import OWL, RDF, RDFS, RK, SKOS, XSD, is_rk, local_name, rk
 from reasoning.knowledge.words import camel_case, camel_words, word_key
+from robokudo.core.types import ANNOTATION_TYPES, VIEW_TYPES
 
 USER_ONTOLOGY_IRI = URIRef("http://robokudo.org/ontology/user")
 """The ontology IRI of the user file."""
@@ -75,7 +76,7 @@ class OntologyEditor:
     ) -> None:
         if kb is not None and user_file is not None and Path(user_file) != kb.user_file:
             raise ValueError(f"user_file {user_file} differs from the knowledge base's {kb.user_file}")
-        self.kb = kb if kb is not None else KnowledgeBase.load(user_file)
+        self.kb = kb if kb is not None else KnowledgeBase.load(user_file)  # without annotators unless ``kb`` has them
         self.use_reasoner = use_reasoner
 
     @property
@@ -209,7 +210,7 @@ class OntologyEditor:
                     ]
                 )
             raise EditRejectedError([f"{name} is not a class of the user file {self.user_file}"])
-        merged = merge_graphs(graphs.values())
+        merged, _ = self.kb.combine(graphs)
         users = set()
         for referrer, prop in merged.subject_predicates(subject):
             owner = _owner(merged, referrer)
@@ -227,7 +228,7 @@ class OntologyEditor:
     # ------------------------------------------------------------------ check
 
     def check(self, code: bool = True) -> CheckReport:
-        """Check everything: the files load, HermiT finds no problem, and (``code``) the annotators agree."""
+        """Check everything: the files load, HermiT finds no problem, and (``code``) the CAS types are the runtime's."""
         problems: list[str] = []
         warnings: list[str] = []
         try:
@@ -237,7 +238,7 @@ class OntologyEditor:
         index = self.kb.index
         reasoner = "not run"
         if self.use_reasoner:
-            result = classify(merge_graphs(self.kb.source_graphs().values()))
+            result = classify(self.kb.combine(self.kb.source_graphs())[0])
             reasoner = result.message
             if not result.available:
                 warnings.append(result.message)
@@ -253,10 +254,7 @@ class OntologyEditor:
                     word = index.word_labels[key]
                     warnings.append(f"the word {word!r} names several {kind} terms: {', '.join(same)}")
         if code:
-            from reasoning.knowledge.capabilities import check_cas_types, check_implementations
-
             problems += check_cas_types(self.kb)
-            problems += check_implementations(self.kb)
         return CheckReport(tuple(problems), tuple(warnings), reasoner)
 
     # ------------------------------------------------------------------ validation and writing
@@ -264,9 +262,9 @@ class OntologyEditor:
     def _validate(self, graphs: dict[Path, Graph], user_graph: Graph, name: str | None) -> tuple[str, tuple[str, ...]]:
         """Load and reason over the ontology as it would be after the edit; EditRejectedError when it fails."""
         candidate = {**{p: g for p, g in graphs.items() if p != self.user_file}, self.user_file: user_graph}
-        merged = merge_graphs(candidate.values())
         try:
-            index = build_index(merged, defined_names(candidate))
+            merged, defined = self.kb.combine(candidate)
+            index = build_index(merged, defined)
         except OntologyError as error:
             raise EditRejectedError(error.problems) from None
         if name is None:
@@ -293,6 +291,19 @@ class OntologyEditor:
         data = _HEADER + user_graph.serialize(format="turtle").encode("utf-8")
         write_atomically(self.user_file, data)
         self.kb.reload()
+
+
+def check_cas_types(kb: KnowledgeBase) -> list[str]:
+    """How the ontology's CAS types differ from the runtime's (robokudo.core.types); empty when they agree."""
+    problems = []
+    for root, runtime in (("View", VIEW_TYPES), ("Annotation", ANNOTATION_TYPES)):
+        in_code = {t.__name__ for t in runtime}
+        in_ontology = set(kb.subclasses(root))
+        for name in sorted(in_code - in_ontology):
+            problems.append(f"runtime {root.lower()} type {name} is not a subclass of rk:{root} in the ontology")
+        for name in sorted(in_ontology - in_code):
+            problems.append(f"ontology {root.lower()} type {name} has no runtime class in robokudo.core.types")
+    return problems
 
 
 def _copy(graph: Graph | None) -> Graph:

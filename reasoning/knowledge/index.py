@@ -19,8 +19,9 @@ from rdflib.term import Node
 
 from ontology import REGION_BOX_PROPERTIES
 from reasoning.errors import OntologyError
-from reasoning.knowledge.model import KINDS, AnnotatorSpec, Kind, ObjectProfile, Resolved
-from reasoning.knowledge.vocabulary import IMPLEMENTATION_PATTERN, OWL, RDF, RDFS, RK, SKOS, is_rk, local_name
+from reasoning.knowledge.capabilities import field_of
+from reasoning.knowledge.model import KIND_WORDS, KINDS, AnnotatorSpec, Kind, ObjectProfile, Resolved
+from reasoning.knowledge.vocabulary import OWL, RDF, RDFS, RK, SKOS, is_rk, local_name
 from reasoning.knowledge.words import camel_words, word_key
 from robokudo.core.regions import RegionBox
 
@@ -523,37 +524,31 @@ class _Builder:
             if len(implemented) != 1:
                 self.problems.append(f"annotator {name}: needs exactly one rk:implementedBy, has {len(implemented)}")
                 continue
-            if IMPLEMENTATION_PATTERN.fullmatch(implemented[0]) is None:
-                self.problems.append(
-                    f"annotator {name}: rk:implementedBy {implemented[0]!r} is not a class in the project's "
-                    f"'annotators' package (expected annotators.<module>.<Class>)"
-                )
-                continue
-
-            def names(prop: str, members: Iterable[str], what: str, annotator: str = name) -> list[str]:
-                found = sorted(local_name(v) for v in self.graph.objects(RK[annotator], RK[prop]))
-                allowed = set(members)
-                for value in found:
-                    if value not in allowed:
-                        self.problems.append(f"annotator {annotator}: rk:{prop} {value} is not a {what}")
-                return [v for v in found if v in allowed]
-
-            inputs = names("requiresInput", cas_types, "CAS type")
-            optional = names("optionalInput", cas_types, "CAS type")
-            outputs = names("providesOutput", cas_types, "CAS type")
+            where = f"annotator class {name} ({implemented[0]})"
+            inputs = self._annotator_names(name, where, "requiresInput", cas_types, "CAS type")
+            optional = self._annotator_names(name, where, "optionalInput", cas_types, "CAS type")
+            outputs = self._annotator_names(name, where, "providesOutput", cas_types, "CAS type")
             domains = {
-                kind: frozenset(names(prop, (n for n, k in self.kind_of.items() if k == kind), f"{kind} class"))
+                kind: frozenset(
+                    self._annotator_names(
+                        name,
+                        where,
+                        prop,
+                        [n for n, k in self.kind_of.items() if k == kind],
+                        f"{KIND_WORDS[kind]} of the ontology",
+                    )
+                )
                 for prop, kind in DOMAIN_PROPERTIES.items()
             }
-            conditions = names("precondition", preconditions, "known rk:Precondition")
+            conditions = self._annotator_names(name, where, "precondition", preconditions, "known rk:Precondition")
             cost = self._number(name, "expectedCostMs")
             reliability = self._number(name, "reliability")
             if cost is not None and cost < 0:
-                self.problems.append(f"annotator {name}: rk:expectedCostMs must not be negative")
+                self.problems.append(f"{where}: capability.cost_ms must not be negative")
             if reliability is not None and not 0.0 <= reliability <= 1.0:
-                self.problems.append(f"annotator {name}: rk:reliability must be within 0..1")
+                self.problems.append(f"{where}: capability.reliability must be within 0..1")
             if not outputs:
-                self.problems.append(f"annotator {name}: provides no output")
+                self.problems.append(f"{where}: provides no output")
             specs[name] = AnnotatorSpec(
                 name=name,
                 implemented_by=implemented[0],
@@ -571,6 +566,15 @@ class _Builder:
                 label=self.label_of(name),
             )
         return specs
+
+    def _annotator_names(self, name: str, where: str, prop: str, members: Iterable[str], what: str) -> list[str]:
+        """The sorted names an annotator gives for ``prop`` that are ``members``; the others are problems."""
+        found = sorted(local_name(v) for v in self.graph.objects(RK[name], RK[prop]))
+        allowed = set(members)
+        for value in found:
+            if value not in allowed:
+                self.problems.append(f"{where}: {field_of(prop)} names {value}, which is not a {what}")
+        return [v for v in found if v in allowed]
 
     def _providers(self, annotators: Mapping[str, AnnotatorSpec]) -> dict[str, tuple[AnnotatorSpec, ...]]:
         ranked = sorted(annotators.values(), key=lambda s: (-s.reliability, s.cost_ms, s.name))

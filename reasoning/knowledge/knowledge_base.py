@@ -1,21 +1,25 @@
 """The knowledge base: the ontology loaded once, answering typed questions from in-memory indexes.
 
-Loading parses the Turtle files with rdflib (and, with ``reason=True``, classifies them with HermiT);
-every question afterwards is a dictionary or set lookup on the :class:`~reasoning.knowledge.index.OntologyIndex`:
-no question parses a file or runs the reasoner. :meth:`KnowledgeBase.reload` swaps in a fresh index
-(re-parsing only the files that changed), so a long-running process sees ontology edits.
+Loading parses the Turtle files with rdflib, adds the triples of the annotator classes it is given (an annotator
+is declared by its Python class, never in Turtle: :mod:`reasoning.knowledge.capabilities`) and, with
+``reason=True``, classifies the whole with HermiT; every question afterwards is a dictionary or set lookup on
+the :class:`~reasoning.knowledge.index.OntologyIndex`: no question parses a file or runs the reasoner.
+:meth:`KnowledgeBase.reload` swaps in a fresh index (re-parsing only the files that changed), so a long-running
+process sees ontology edits.
 """
 
 from __future__ import annotations
 
 import difflib
 import logging
-from collections.abc import Collection, Sequence
+from collections.abc import Collection, Iterable, Mapping, Sequence
 from pathlib import Path
+from typing import TYPE_CHECKING
 
 from rdflib import Graph
 
-from reasoning.errors import AmbiguousTermError, InconsistentOntologyError, UnknownTermError
+from reasoning.errors import AmbiguousTermError, InconsistentOntologyError, OntologyError, UnknownTermError
+from reasoning.knowledge.capabilities import annotator_files, capability_graph, turtle_annotators
 from reasoning.knowledge.hermit import ReasonerResult, classify, describe_unsatisfiable
 from reasoning.knowledge.index import OntologyIndex, build_index
 from reasoning.knowledge.model import (
@@ -31,6 +35,9 @@ from reasoning.knowledge.sources import Sources, Stamp, defined_names, file_stam
 from reasoning.knowledge.words import singular_keys, word_key
 from robokudo.core.regions import RegionBox
 
+if TYPE_CHECKING:
+    from robokudo.core.annotator import Annotator
+
 log = logging.getLogger(__name__)
 
 _ALL_CONDITIONS = Conditions()
@@ -40,9 +47,12 @@ _CLASS_KINDS: tuple[Kind, ...] = ("class", "region_class", "color", "shape", "si
 class KnowledgeBase:
     """Object classes, regions, annotation types and annotator capabilities, indexed for fast questions."""
 
-    def __init__(self, sources: Sources, reason: bool = False) -> None:
+    def __init__(self, sources: Sources, reason: bool = False, annotators: Iterable[type[Annotator]] = ()) -> None:
         self._sources = sources
         self._reason = reason
+        self._annotator_classes = tuple(dict.fromkeys(annotators))
+        self._annotator_graph = capability_graph(self._annotator_classes)
+        self._annotator_files = annotator_files(self._annotator_classes)
         self._parsed: dict[Path, tuple[Stamp | None, Graph]] = {}
         self._stamps: dict[Path, Stamp | None] = {}
         self._reasoner: ReasonerResult | None = None
@@ -58,15 +68,19 @@ class KnowledgeBase:
         map_file: Path | None = None,
         extra_files: Sequence[Path] = (),
         files: Sequence[Path] | None = None,
+        annotators: Iterable[type[Annotator]] = (),
     ) -> KnowledgeBase:
-        """Load the shipped ontology, a semantic map (default: the built-in kitchen), ``extra_files`` and
-        the user file (default: :func:`~reasoning.knowledge.sources.default_user_file`; a missing file is empty).
+        """Load the shipped ontology, a semantic map (default: the built-in kitchen), ``extra_files``, the user
+        file (default: :func:`~reasoning.knowledge.sources.default_user_file`; a missing file is empty) and the
+        ``annotators`` (Annotator classes; their declarations become the ontology's annotator individuals).
 
         ``files`` replaces the shipped files and map. With ``reason=True`` HermiT classifies the ontology
         (inferred subsumptions join the hierarchy; unsatisfiable classes raise InconsistentOntologyError);
-        without Java it logs why and keeps the asserted hierarchy.
+        without Java it logs why and keeps the asserted hierarchy. A class whose declaration names something
+        the ontology lacks, or an annotator declared in a Turtle file, raises OntologyError. The application
+        loads with every annotator of the catalog (``robokudo.application.knowledge.load_knowledge_base``).
         """
-        return cls(Sources.default(user_file, map_file, extra_files, files), reason=reason)
+        return cls(Sources.default(user_file, map_file, extra_files, files), reason=reason, annotators=annotators)
 
     # ------------------------------------------------------------------ loading
 
@@ -90,6 +104,28 @@ class KnowledgeBase:
         """The last HermiT run of a ``reason=True`` knowledge base, else None."""
         return self._reasoner
 
+    @property
+    def annotator_classes(self) -> tuple[type[Annotator], ...]:
+        """The annotator classes whose declarations this knowledge base holds (kept across reloads)."""
+        return self._annotator_classes
+
+    @property
+    def annotator_graph(self) -> Graph:
+        """The triples the annotator classes declare (read-only)."""
+        return self._annotator_graph
+
+    def combine(self, graphs: Mapping[Path, Graph]) -> tuple[Graph, dict[str, Path]]:
+        """``graphs`` merged with the annotator classes' triples, and the file each term is defined in.
+
+        An annotator is defined in its class's source file. OntologyError when one of ``graphs`` declares an
+        annotator (annotators are declared by their Python class).
+        """
+        declared_in_turtle = turtle_annotators(graphs)
+        if declared_in_turtle:
+            raise OntologyError(declared_in_turtle)
+        merged = merge_graphs([*graphs.values(), self._annotator_graph])
+        return merged, {**self._annotator_files, **defined_names(graphs)}
+
     def source_graphs(self) -> dict[Path, Graph]:
         """The parsed graph of every existing source file, the user file last (cached while unchanged)."""
         return self._read()[0]
@@ -111,10 +147,12 @@ class KnowledgeBase:
         return graphs, stamps
 
     def reload(self) -> None:
-        """Re-read the sources (only changed files are parsed again) and swap in a new index."""
+        """Re-read the sources (only changed files are parsed again) and swap in a new index.
+
+        The annotator classes' triples are merged in again (the classes are fixed when the knowledge base is made).
+        """
         graphs, stamps = self._read()
-        merged = merge_graphs(graphs.values())
-        defined = defined_names(graphs)
+        merged, defined = self.combine(graphs)
         result: ReasonerResult | None = None
         inferred = None
         if self._reason:
@@ -311,11 +349,11 @@ class KnowledgeBase:
     # ------------------------------------------------------------------ annotators
 
     def annotators(self) -> list[AnnotatorSpec]:
-        """Every annotator the ontology declares, sorted by name."""
+        """Every annotator the knowledge base was loaded with, sorted by name."""
         return [self._index.annotators[name] for name in sorted(self._index.annotators)]
 
     def annotator(self, name: str) -> AnnotatorSpec:
-        """One annotator by its ontology name."""
+        """One annotator by its name (its class name)."""
         found = self._index.annotators.get(name)
         if found is None:
             close = difflib.get_close_matches(name, list(self._index.annotators), n=3, cutoff=0.6)

@@ -65,9 +65,10 @@ class ObjectProfile:
 
 @dataclass(frozen=True, slots=True)
 class AnnotatorSpec:
-    """An annotator's declared capabilities, as the ontology states them.
+    """An annotator's capabilities as its class declares them (ports and its Capability), read from the ontology.
 
-    Port and value names are ontology names; an empty value domain means "any value of that kind".
+    ``name`` is the class name and ``implemented_by`` the class's ``<module>.<qualname>``; port and value names
+    are ontology names; an empty value domain means "any value of that kind".
     """
 
     name: str
@@ -88,16 +89,6 @@ class AnnotatorSpec:
     def domain(self, kind: Kind) -> frozenset[str]:
         """The declared values of one kind this annotator can report (empty: any value, or not that kind)."""
         return _DOMAINS[kind](self) if kind in _DOMAINS else frozenset()
-
-    @property
-    def module(self) -> str:
-        """The Python module of the implementing class."""
-        return self.implemented_by.rpartition(".")[0]
-
-    @property
-    def class_name(self) -> str:
-        """The name of the implementing class."""
-        return self.implemented_by.rpartition(".")[2]
 
 
 _DOMAINS: dict[Kind, Callable[[AnnotatorSpec], frozenset[str]]] = {

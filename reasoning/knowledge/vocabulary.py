@@ -10,8 +10,6 @@ from rdflib.namespace import OWL, RDF, RDFS, SKOS, XSD
 from ontology import NAMESPACE as ONTOLOGY_NAMESPACE
 
 __all__ = [
-    "ANNOTATORS_PACKAGE",
-    "IMPLEMENTATION_PATTERN",
     "NAME_PATTERN",
     "OWL",
     "RDF",
@@ -26,12 +24,6 @@ __all__ = [
 
 RK = Namespace(ONTOLOGY_NAMESPACE)
 """The ``rk:`` namespace of every term the project defines."""
-
-ANNOTATORS_PACKAGE = "annotators"
-"""The only package whose classes ``rk:implementedBy`` may name."""
-
-IMPLEMENTATION_PATTERN = re.compile(r"annotators(?:\.[A-Za-z_][A-Za-z0-9_]*){2,}")
-"""What a valid ``rk:implementedBy`` value looks like: ``annotators.<module>.<Class>``."""
 
 NAME_PATTERN = re.compile(r"[A-Za-z_][A-Za-z0-9_]*")
 """What the local name of an ``rk:`` term looks like."""

@@ -172,7 +172,7 @@ class AnsweringService:
         """A service over the shipped and user ontology and the belief store at ``store_path`` (default store
         when None), with the annotators of ``catalog`` (default: this project's)."""
         catalog = catalog if catalog is not None else AnnotatorCatalog.discover()
-        kb = load_knowledge_base(catalog)
+        kb = load_knowledge_base(catalog=catalog)
         store = BeliefStore(Path(store_path) if store_path is not None else BeliefStore.default_path())
         return cls(kb, store, catalog=catalog, input_path=input_path, frame=frame, hz=hz)
 

@@ -1,11 +1,15 @@
 """Annotator: a behaviour-tree leaf that reads and writes its Pipeline's CAS through declared ports.
 
-An expert subclasses :class:`Annotator`, declares ``inputs`` and ``outputs`` (CAS types) and implements
-:meth:`Annotator.analyse`. The framework's :meth:`Annotator.update` finds the CAS (the nearest Pipeline
-above), runs ``analyse`` and commits its writes only when it succeeds, so a failing expert leaves the CAS
-as it was. ``analyse`` fails by calling :meth:`Annotator.fail`; any other exception also turns into
-FAILURE with the reason in ``feedback_message``, so nothing raises out of a tick. Port violations are
-programming errors and do raise (:class:`PortError`).
+An expert subclasses :class:`Annotator`, declares ``inputs`` and ``outputs`` (CAS types) and its
+:class:`~robokudo.core.capability.Capability` (label, value domains, preconditions, cost, reliability), and
+implements :meth:`Annotator.analyse`. The class is the only declaration of an expert: the knowledge base reads
+these ClassVars when it loads, so the planner knows the expert without any ontology file being edited.
+
+The framework's :meth:`Annotator.update` finds the CAS (the nearest Pipeline above), runs ``analyse`` and
+commits its writes only when it succeeds, so a failing expert leaves the CAS as it was. ``analyse`` fails by
+calling :meth:`Annotator.fail`; any other exception also turns into FAILURE with the reason in
+``feedback_message``, so nothing raises out of a tick. Port violations are programming errors and do raise
+(:class:`PortError`).
 """
 
 from __future__ import annotations
@@ -18,6 +22,7 @@ from typing import ClassVar, NoReturn, TypeVar
 import py_trees
 from py_trees.common import Status
 
+from robokudo.core.capability import Capability
 from robokudo.core.cas import CAS, AddAnnotation, AttachAnnotation, CasWrite, SetView
 from robokudo.core.explained import Explained
 from robokudo.core.pipeline import StructureError, enclosing_pipeline, pipeline_named, tree_root
@@ -53,15 +58,18 @@ class _Run:
 
 
 class Annotator(Explained, py_trees.behaviour.Behaviour):
-    """A leaf expert with declared input and output CAS types.
+    """A leaf expert with declared input and output CAS types and a declared capability.
 
     ``inputs`` must be in the CAS before it runs (the data-flow validator checks this); ``optional_inputs``
-    are used when present; ``outputs`` are what it may write.
+    are used when present; ``outputs`` are what it may write. ``capability`` says which values it can report,
+    what it needs, what it costs and how reliable it is (the defaults: any value, no preconditions, 10 ms,
+    reliability 0.5); the planner chooses experts from these declarations.
     """
 
     inputs: ClassVar[tuple[type[CasType], ...]] = ()
     optional_inputs: ClassVar[tuple[type[CasType], ...]] = ()
     outputs: ClassVar[tuple[type[CasType], ...]] = ()
+    capability: ClassVar[Capability] = Capability()
 
     def __init__(self, name: str | None = None) -> None:
         super().__init__(name=name or type(self).__name__)

@@ -10,8 +10,8 @@ import pytest
 from py_trees.common import Status
 
 from annotators.image.onnx_detector import Detections, OnnxDetector, camel_case, decode_outputs, letterbox
-from reasoning.knowledge.knowledge_base import KnowledgeBase
 from reasoning.knowledge.model import Conditions
+from robokudo.application.knowledge import load_knowledge_base
 from robokudo.core.annotator import Annotator
 from robokudo.core.pipeline import Pipeline
 from robokudo.core.types import Classification, ColorImage, ObjectHypothesis
@@ -107,7 +107,7 @@ def test_a_missing_or_malformed_model_fails_with_the_reason(tmp_path: Path, make
 
 
 def test_plans_include_the_detector_only_when_a_model_is_configured(tmp_path: Path) -> None:
-    kb = KnowledgeBase.load(tmp_path / "user.ttl")
+    kb = load_knowledge_base(tmp_path / "user.ttl")
     assert "NeedsDetectorModel" in kb.annotator("OnnxDetector").preconditions
     default = [spec.name for spec in kb.providers("Classification", value="Milk")]
     configured = [spec.name for spec in kb.providers("Classification", value="Milk", conditions=Conditions(model=True))]

@@ -1,18 +1,22 @@
-"""Random capability ontologies for planner property tests and benchmarks, written as Turtle and loaded by the
-real KnowledgeBase.
+"""Random capability ontologies for planner property tests and benchmarks, loaded by the real KnowledgeBase.
 
-Types ``S0..`` are sensor views (what the reader supplies), ``T0..`` annotation types; each annotator has a
-few required inputs, sometimes an optional input, and one or two outputs.
+Types ``S0..`` are sensor views (what the reader supplies), ``T0..`` annotation types; they are written as Turtle
+(the CAS-type vocabulary). Each annotator is a generated Annotator class, as a real expert would be: a few required
+inputs, sometimes an optional input, one or two outputs, a cost and a reliability; the knowledge base gets the
+classes as ``annotators=`` and turns their declarations into its annotator individuals.
 """
 
 from __future__ import annotations
 
 import random
-from dataclasses import dataclass
+from dataclasses import dataclass, field
 from pathlib import Path
 
 from ontology import shipped_files
 from reasoning.knowledge.knowledge_base import KnowledgeBase
+from robokudo.core.annotator import Annotator
+from robokudo.core.capability import Capability
+from robokudo.core.types import Annotation, CasType, View
 
 PREFIXES = (
     "@prefix rk: <http://robokudo.org/ontology#> .\n"
@@ -40,9 +44,10 @@ class CapabilityOntology:
     sensors: tuple[str, ...]
     types: tuple[str, ...]
     annotators: tuple[RandomAnnotator, ...]
+    _cas_types: dict[str, type[CasType]] = field(default_factory=dict, compare=False, repr=False)
 
     def turtle(self) -> str:
-        """The ontology as Turtle (types as CAS classes, annotators as individuals)."""
+        """The generated CAS types as Turtle (sensor types as views, the others as annotation types)."""
         lines = [PREFIXES]
         for sensor in self.sensors:
             lines.append(f'rk:{sensor} a owl:Class ; rdfs:subClassOf rk:View ; rdfs:label "{sensor.lower()}" .\n')
@@ -50,16 +55,32 @@ class CapabilityOntology:
             lines.append(
                 f'rk:{type_name} a owl:Class ; rdfs:subClassOf rk:Annotation ; rdfs:label "{type_name.lower()}" .\n'
             )
-        for spec in self.annotators:
-            lines.append(f"rk:{spec.name} a owl:NamedIndividual , rk:Annotator ;\n")
-            lines.append(f'    rk:implementedBy "annotators.generated.{spec.name}" ;\n')
-            if spec.inputs:
-                lines.append(f"    rk:requiresInput {' , '.join('rk:' + t for t in spec.inputs)} ;\n")
-            if spec.optional_inputs:
-                lines.append(f"    rk:optionalInput {' , '.join('rk:' + t for t in spec.optional_inputs)} ;\n")
-            lines.append(f"    rk:providesOutput {' , '.join('rk:' + t for t in spec.outputs)} ;\n")
-            lines.append(f"    rk:expectedCostMs {spec.cost_ms:.1f} ;\n    rk:reliability {spec.reliability:.2f} .\n")
         return "".join(lines)
+
+    def cas_type(self, name: str) -> type[CasType]:
+        """The runtime class of a generated type (made once per ontology)."""
+        if name not in self._cas_types:
+            base = View if name in self.sensors else Annotation
+            self._cas_types[name] = type(name, (base,), {"__module__": __name__})
+        return self._cas_types[name]
+
+    def annotator_classes(self) -> list[type[Annotator]]:
+        """One Annotator class per generated annotator, declaring its ports and capability."""
+        return [
+            type(
+                spec.name,
+                (Annotator,),
+                {
+                    "__module__": __name__,
+                    "__doc__": f"Generated annotator {spec.name}.",
+                    "inputs": tuple(map(self.cas_type, spec.inputs)),
+                    "optional_inputs": tuple(map(self.cas_type, spec.optional_inputs)),
+                    "outputs": tuple(map(self.cas_type, spec.outputs)),
+                    "capability": Capability(cost_ms=spec.cost_ms, reliability=spec.reliability),
+                },
+            )
+            for spec in self.annotators
+        ]
 
     def producible(self) -> set[str]:
         """Reference semantics: every type some chain of annotators can produce from the sensors."""
@@ -74,10 +95,12 @@ class CapabilityOntology:
         return known
 
     def load(self, folder: Path) -> KnowledgeBase:
-        """Write the ontology into ``folder`` and load it with the real KnowledgeBase."""
+        """Write the types into ``folder`` and load them with the generated annotator classes."""
         path = folder / "generated.ttl"
         path.write_text(self.turtle(), encoding="utf-8")
-        return KnowledgeBase.load(folder / "user.ttl", files=[*shipped_files(), path])
+        return KnowledgeBase.load(
+            folder / "user.ttl", files=[*shipped_files(), path], annotators=self.annotator_classes()
+        )
 
 
 def random_ontology(

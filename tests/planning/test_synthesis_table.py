@@ -15,6 +15,7 @@ from reasoning.knowledge.knowledge_base import KnowledgeBase
 from reasoning.planning.plan import Alternatives, Plan, Step
 from reasoning.planning.planner import PlanningError, SensorSource
 from reasoning.planning.query_planner import plan_query
+from robokudo.application.knowledge import load_knowledge_base
 from robokudo.application.sensor_sources import sensor_source
 from robokudo.application.service import AnsweringService
 from robokudo.core.dataflow import validate_data_flow
@@ -25,7 +26,7 @@ from trees.synthesis import build_tree
 
 @pytest.fixture(scope="module")
 def kb(tmp_path_factory: pytest.TempPathFactory) -> KnowledgeBase:
-    return KnowledgeBase.load(tmp_path_factory.mktemp("kb") / "user.ttl")
+    return load_knowledge_base(tmp_path_factory.mktemp("kb") / "user.ttl")
 
 
 @dataclass(frozen=True)
@@ -196,7 +197,7 @@ def test_explanations_name_the_query_and_the_producers(kb: KnowledgeBase) -> Non
 
 
 def test_a_new_object_class_plans_and_runs_at_once(tmp_path: Path) -> None:
-    kb = KnowledgeBase.load(tmp_path / "user.ttl")
+    kb = load_knowledge_base(tmp_path / "user.ttl")
     with pytest.raises(PlanningError, match="unknown object class 'picnic_cup'"):
         plan_query(parse_query("find the picnic cup"), kb, sensor_source(kb, None))
     editor = OntologyEditor(kb, user_file=tmp_path / "user.ttl", use_reasoner=False)

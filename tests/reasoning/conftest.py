@@ -9,6 +9,7 @@ import pytest
 
 from reasoning.knowledge.knowledge_base import KnowledgeBase
 from reasoning.knowledge.sources import USER_ONTOLOGY_ENV
+from robokudo.application.knowledge import load_knowledge_base
 
 
 @pytest.fixture(autouse=True)
@@ -20,8 +21,9 @@ def _private_user_ontology(tmp_path: Path, monkeypatch: pytest.MonkeyPatch) -> I
 
 @pytest.fixture(scope="session")
 def kb(tmp_path_factory: pytest.TempPathFactory) -> KnowledgeBase:
-    """The shipped ontology with the built-in kitchen map and an empty user file (shared: do not edit)."""
-    return KnowledgeBase.load(tmp_path_factory.mktemp("kb") / "user.ttl")
+    """The shipped ontology with the built-in kitchen map, every annotator class of the catalog and an empty user
+    file, as the application loads it (shared: do not edit)."""
+    return load_knowledge_base(tmp_path_factory.mktemp("kb") / "user.ttl")
 
 
 @pytest.fixture()

@@ -2,56 +2,56 @@
 
 from __future__ import annotations
 
-from pathlib import Path
-
 import pytest
 
-from reasoning.errors import OntologyError, UnknownTermError
+from reasoning.errors import UnknownTermError
 from reasoning.knowledge.knowledge_base import KnowledgeBase
 from reasoning.knowledge.model import Conditions
-from tests.reasoning.helpers import write_ttl
+from robokudo.application.knowledge import load_knowledge_base
+from robokudo.core.annotator import Annotator
+from robokudo.core.capability import Capability
+from robokudo.core.types import CameraInfo, Classification, ColorImage, ObjectHypothesis, PointCloud, SemanticColor
 
-# Test-only annotators layered over the shipped ones (never imported: loading does not import code).
-TEST_ANNOTATORS = """
-rk:BowlDetector a owl:NamedIndividual , rk:Annotator ;
-    rk:implementedBy "annotators.test_only.BowlDetector" ;
-    rk:requiresInput rk:ColorImage ;
-    rk:providesOutput rk:ObjectHypothesis , rk:Classification ;
-    rk:canReportClass rk:WhiteCeramicBowl ;
-    rk:expectedCostMs 40.0 ;
-    rk:reliability 0.95 .
 
-rk:MilkDetector a owl:NamedIndividual , rk:Annotator ;
-    rk:implementedBy "annotators.test_only.MilkDetector" ;
-    rk:requiresInput rk:ColorImage ;
-    rk:providesOutput rk:ObjectHypothesis , rk:Classification ;
-    rk:canReportClass rk:Milk ;
-    rk:expectedCostMs 40.0 ;
-    rk:reliability 0.7 .
+class BowlDetector(Annotator):
+    """Test-only: detects white ceramic bowls."""
 
-rk:CheapColor a owl:NamedIndividual , rk:Annotator ;
-    rk:implementedBy "annotators.test_only.CheapColor" ;
-    rk:requiresInput rk:ObjectHypothesis ;
-    rk:providesOutput rk:SemanticColor ;
-    rk:canReportColor rk:Red , rk:Teal ;
-    rk:expectedCostMs 1.0 ;
-    rk:reliability 0.8 .
+    inputs = (ColorImage,)
+    outputs = (ObjectHypothesis, Classification)
+    capability = Capability(classes=("WhiteCeramicBowl",), cost_ms=40.0, reliability=0.95)
 
-rk:RegionCropper a owl:NamedIndividual , rk:Annotator ;
-    rk:implementedBy "annotators.test_only.RegionCropper" ;
-    rk:requiresInput rk:PointCloud , rk:CameraInfo ;
-    rk:providesOutput rk:PointCloud ;
-    rk:precondition rk:NeedsRegion ;
-    rk:expectedCostMs 1.0 ;
-    rk:reliability 1.0 .
-"""
+
+class MilkDetector(Annotator):
+    """Test-only: detects milk."""
+
+    inputs = (ColorImage,)
+    outputs = (ObjectHypothesis, Classification)
+    capability = Capability(classes=("Milk",), cost_ms=40.0, reliability=0.7)
+
+
+class CheapColor(Annotator):
+    """Test-only: a cheap colour namer for red and teal."""
+
+    inputs = (ObjectHypothesis,)
+    outputs = (SemanticColor,)
+    capability = Capability(colors=("Red", "Teal"), cost_ms=1.0, reliability=0.8)
+
+
+class RegionCropper(Annotator):
+    """Test-only: crops the cloud to the query's region."""
+
+    inputs = (PointCloud, CameraInfo)
+    outputs = (PointCloud,)
+    capability = Capability(preconditions=("NeedsRegion",), cost_ms=1.0, reliability=1.0)
 
 
 @pytest.fixture(scope="module")
 def test_kb(tmp_path_factory: pytest.TempPathFactory) -> KnowledgeBase:
+    """The application's knowledge base plus the test-only annotators (loading does not run their code)."""
     folder = tmp_path_factory.mktemp("capabilities")
-    extra = write_ttl(folder / "test_annotators.ttl", TEST_ANNOTATORS)
-    return KnowledgeBase.load(folder / "user.ttl", extra_files=[extra])
+    return load_knowledge_base(
+        folder / "user.ttl", extra_annotators=[BowlDetector, MilkDetector, CheapColor, RegionCropper]
+    )
 
 
 def names(specs: list) -> list[str]:
@@ -129,35 +129,3 @@ def test_inputs_of_an_annotator(kb: KnowledgeBase) -> None:
     assert spec.outputs == ("PointCloud",)
     assert spec.implemented_by == "annotators.cloud.point_cloud.PointCloudGenerator"
     assert spec.cost_ms > 0 and 0 < spec.reliability <= 1
-
-
-@pytest.mark.parametrize(
-    "target",
-    ["os.system", "subprocess.Popen", "annotatorsx.evil.Class", "annotators.NoModule", "annotators", "builtins.eval"],
-)
-def test_implementation_outside_the_annotators_package_is_rejected_at_load(tmp_path: Path, target: str) -> None:
-    extra = write_ttl(
-        tmp_path / "evil.ttl",
-        f"""rk:Evil a owl:NamedIndividual , rk:Annotator ;
-    rk:implementedBy "{target}" ;
-    rk:providesOutput rk:Text ;
-    rk:expectedCostMs 1.0 ;
-    rk:reliability 1.0 .
-""",
-    )
-    with pytest.raises(OntologyError, match="annotators"):
-        KnowledgeBase.load(tmp_path / "user.ttl", extra_files=[extra])
-
-
-def test_annotator_with_an_unknown_port_type_is_rejected(tmp_path: Path) -> None:
-    extra = write_ttl(
-        tmp_path / "bad.ttl",
-        """rk:Odd a owl:NamedIndividual , rk:Annotator ;
-    rk:implementedBy "annotators.odd.Odd" ;
-    rk:providesOutput rk:Milk ;
-    rk:expectedCostMs 1.0 ;
-    rk:reliability 1.0 .
-""",
-    )
-    with pytest.raises(OntologyError, match="Milk is not a CAS type"):
-        KnowledgeBase.load(tmp_path / "user.ttl", extra_files=[extra])

@@ -9,7 +9,7 @@ from rdflib import Graph
 
 from ontology import EXAMPLE_USER_MAP_FILE, ontology_dir, shipped_files
 from reasoning.errors import OntologyError
-from reasoning.knowledge.capabilities import check_cas_types
+from reasoning.knowledge.editing import check_cas_types
 from reasoning.knowledge.knowledge_base import KnowledgeBase
 from tests.reasoning.helpers import write_ttl
 

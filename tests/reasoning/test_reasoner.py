@@ -10,6 +10,7 @@ import pytest
 from reasoning.errors import InconsistentOntologyError
 from reasoning.knowledge import hermit, knowledge_base, sources
 from reasoning.knowledge.knowledge_base import KnowledgeBase
+from robokudo.application.knowledge import load_knowledge_base
 from tests.reasoning.helpers import write_ttl
 
 
@@ -54,7 +55,7 @@ def test_without_java_loading_says_so_and_keeps_the_asserted_hierarchy(
 
 
 def test_questions_never_parse_files_or_run_the_reasoner(tmp_path: Path, monkeypatch: pytest.MonkeyPatch) -> None:
-    kb = KnowledgeBase.load(tmp_path / "user.ttl")
+    kb = load_knowledge_base(tmp_path / "user.ttl")
 
     def forbidden(*_: object, **__: object) -> None:
         raise AssertionError("a question parsed a file or ran the reasoner")

@@ -15,6 +15,7 @@ from reasoning.knowledge.editing import CheckReport, EditResult, OntologyEditor
 from reasoning.knowledge.knowledge_base import KnowledgeBase
 from reasoning.knowledge.model import AnnotatorSpec, Resolved
 from reasoning.knowledge.sources import USER_ONTOLOGY_ENV
+from robokudo.application.knowledge import load_knowledge_base
 from robokudo.core.regions import RegionBox
 
 HELP = "show, check and edit the ontology"
@@ -84,8 +85,10 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
     show.add_argument("name", help="a name or a word (label, synonym, plural)")
     _common_options(show, suppress=True)
 
-    check = actions.add_parser("check", help="check the ontology: loading, HermiT, annotator code agreement")
-    check.add_argument("--no-code", action="store_true", help="do not import and compare the annotator classes")
+    check = actions.add_parser(
+        "check", help="check the ontology with the annotator classes: loading, HermiT, CAS types against the runtime"
+    )
+    check.add_argument("--no-code", action="store_true", help="do not compare the CAS types with the runtime's classes")
     _common_options(check, suppress=True)
 
     remove = actions.add_parser("remove-object", help="remove an object class from the user ontology")
@@ -114,7 +117,7 @@ def run(args: argparse.Namespace) -> int:
     """Carry out the chosen action; returns the exit status."""
     action = args.ontology_action
     try:
-        kb = KnowledgeBase.load(args.user_file)
+        kb = load_knowledge_base(args.user_file)
     except OntologyError as error:
         print(f"robokudo ontology: {error}", file=sys.stderr)
         return 1 if action == "check" else 2

@@ -45,7 +45,7 @@ def run(args: argparse.Namespace) -> int:
     text = " ".join(args.query)
     try:
         catalog = AnnotatorCatalog.discover()
-        planner = QueryPlanner(load_knowledge_base(catalog))
+        planner = QueryPlanner(load_knowledge_base(catalog=catalog))
         query_plan = plan_for_input(planner, parse_query(text), args.input, args.frame)
         tree = build_tree(query_plan.plan, catalog=catalog)
     except QueryError as error:
