@@ -18,6 +18,7 @@ from reasoning.knowledge.knowledge_base import KnowledgeBase
 from reasoning.planning.planner import PlanningError
 from reasoning.planning.query_planner import plan_query
 from robokudo.application.sensor_sources import sensor_source
+from robokudo.application.service import AnsweringService
 from robokudo.core.annotator import Annotator
 from robokudo.core.engine import Engine
 from robokudo.core.types import ObjectHypothesis, SemanticColor
@@ -105,3 +106,15 @@ def test_a_plan_naming_a_class_missing_from_the_catalog_is_a_synthesis_error(
     impostor = type("TealSpotter", (Annotator,), {"__module__": __name__, "outputs": (SemanticColor,)})
     with pytest.raises(SynthesisError, match=r"the plan was made for my_teal_expert\.TealSpotter"):
         build_tree(plan, catalog=AnnotatorCatalog.discover(extra=[impostor]))
+
+
+def test_the_answering_service_answers_with_the_new_expert(
+    tmp_path: Path, teal_spotter: type, monkeypatch: pytest.MonkeyPatch
+) -> None:
+    monkeypatch.setenv("ROBOKUDO_USER_ONTOLOGY", str(tmp_path / "user.ttl"))
+    catalog = AnnotatorCatalog.discover(extra=[teal_spotter])
+    with AnsweringService.open(tmp_path / "beliefs.sqlite", catalog=catalog) as service:
+        outcome = service.answer(QUERY)
+    (expert,) = [node for node in outcome.tree.iterate() if isinstance(node, teal_spotter)]
+    assert expert.status is Status.SUCCESS
+    assert "TealSpotter" in outcome.plan.plan.annotator_names()
