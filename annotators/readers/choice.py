@@ -23,13 +23,20 @@ looks at the file system only and imports neither the readers nor Open3D.
 
 from __future__ import annotations
 
-import importlib
 import re
 from collections.abc import Mapping
 from dataclasses import dataclass, field
 from pathlib import Path
 
 from annotators.readers.frame_io import CAMERA_PARAMS_FILE
+from annotators.readers.frame_readers import (
+    ColorDepthPairReader,
+    KitchenSceneReader,
+    PcdReader,
+    TiffSequenceReader,
+    TumPairReader,
+    TumSequenceReader,
+)
 from annotators.readers.tiff_io import is_tiff_sequence
 from annotators.readers.tum_io import is_tum_pair, is_tum_sequence
 from robokudo.core.annotator import Annotator
@@ -59,15 +66,19 @@ _IMAGE_SUFFIXES = (".png", ".jpg", ".jpeg", ".tif", ".tiff")
 
 @dataclass(frozen=True)
 class ReaderChoice:
-    """The reader for a path: its ontology name and its constructor's keyword arguments."""
+    """The reader for a path: its class and its constructor's keyword arguments."""
 
-    name: str
+    reader: type[Annotator]
     parameters: Mapping[str, object] = field(default_factory=dict)
 
+    @property
+    def name(self) -> str:
+        """The reader's name (its class name, which is also its ontology individual)."""
+        return self.reader.__name__
+
     def create(self) -> Annotator:
-        """A new reader annotator (imports the readers, and so Open3D, only now)."""
-        readers = importlib.import_module("annotators.readers.frame_readers")
-        return getattr(readers, self.name)(**self.parameters)
+        """A new reader annotator."""
+        return self.reader(**self.parameters)
 
 
 def _natural_key(path: Path) -> list[object]:
@@ -86,16 +97,16 @@ def _single_frame(path: Path, frame: int) -> None:
 
 def _folder_choice(folder: Path, frame: int) -> ReaderChoice:
     if is_tum_sequence(folder):
-        return ReaderChoice("TumSequenceReader", {"folder": str(folder), "frame": frame})
+        return ReaderChoice(TumSequenceReader, {"folder": str(folder), "frame": frame})
     if (folder / CAMERA_PARAMS_FILE).is_file() and any(_UOC_COLOR.match(p.name) for p in folder.iterdir()):
-        return ReaderChoice("ColorDepthPairReader", {"folder": str(folder), "frame": frame})
+        return ReaderChoice(ColorDepthPairReader, {"folder": str(folder), "frame": frame})
     if is_tiff_sequence(folder):
-        return ReaderChoice("TiffSequenceReader", {"folder": str(folder), "frame": frame})
+        return ReaderChoice(TiffSequenceReader, {"folder": str(folder), "frame": frame})
     clouds = sorted((p for p in folder.iterdir() if p.suffix.lower() == ".pcd"), key=_natural_key)
     if clouds:
         if not 0 <= frame < len(clouds):
             raise ValueError(f"{folder} holds {len(clouds)} .pcd files, no frame {frame}")
-        return ReaderChoice("PcdReader", {"path": str(clouds[frame])})
+        return ReaderChoice(PcdReader, {"path": str(clouds[frame])})
     raise _unsupported(folder, "the folder matches no known layout")
 
 
@@ -103,14 +114,14 @@ def _file_choice(path: Path, frame: int) -> ReaderChoice:
     suffix = path.suffix.lower()
     if suffix == ".pcd":
         _single_frame(path, frame)
-        return ReaderChoice("PcdReader", {"path": str(path)})
+        return ReaderChoice(PcdReader, {"path": str(path)})
     uoc = _UOC_COLOR.match(path.name)
     if uoc and (path.parent / CAMERA_PARAMS_FILE).is_file():
         _single_frame(path, frame)
-        return ReaderChoice("ColorDepthPairReader", {"folder": str(path.parent), "frame": int(uoc.group(1))})
+        return ReaderChoice(ColorDepthPairReader, {"folder": str(path.parent), "frame": int(uoc.group(1))})
     if suffix in _IMAGE_SUFFIXES and is_tum_pair(path):
         _single_frame(path, frame)
-        return ReaderChoice("TumPairReader", {"path": str(path)})
+        return ReaderChoice(TumPairReader, {"path": str(path)})
     raise _unsupported(path, "the file matches no known layout")
 
 
@@ -119,7 +130,7 @@ def reader_choice(path: str | None, frame: int = 0) -> ReaderChoice:
     if frame < 0:
         raise ValueError(f"frame number must be >= 0, got {frame}")
     if path is None:
-        return ReaderChoice("KitchenSceneReader")
+        return ReaderChoice(KitchenSceneReader)
     resolved = Path(path).expanduser()
     if resolved.is_dir():
         return _folder_choice(resolved, frame)
