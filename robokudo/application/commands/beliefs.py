@@ -45,10 +45,7 @@ def run(args: argparse.Namespace) -> int:
         with BeliefStore(path) as store:
             answer = answer_from_memory(store, query_filter, args.query or "", **options)
         return _print(answer, args, None)
-    except BeliefStoreError as error:
-        print(f"robokudo beliefs: {error}", file=sys.stderr)
-        return 2
-    except _QueryProblemError as error:
+    except (BeliefStoreError, _QueryProblemError) as error:
         print(f"robokudo beliefs: {error}", file=sys.stderr)
         return 2
 

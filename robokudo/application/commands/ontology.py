@@ -149,10 +149,7 @@ def run(args: argparse.Namespace) -> int:
         if action == "remove-object":
             _print_result(editor.remove_object(args.name))
             return 0
-    except EditRejectedError as error:
-        print(f"robokudo ontology {action}: {error}", file=sys.stderr)
-        return 2
-    except TermError as error:
+    except (EditRejectedError, TermError) as error:
         print(f"robokudo ontology {action}: {error}", file=sys.stderr)
         return 2
     raise ValueError(f"unknown ontology action {action!r}")
