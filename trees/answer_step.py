@@ -15,6 +15,7 @@ from typing import ClassVar
 
 import numpy as np
 
+from queries import Query
 from reasoning.beliefs.answer import Answer, class_label, designator
 from reasoning.beliefs.store import BeliefFilter, BeliefStore
 from reasoning.fusion.association import CameraModel
@@ -118,7 +119,7 @@ class AnswerStep(Annotator):
         if belief_filter.limit is not None:
             matching = matching[: belief_filter.limit]
         query_view = self.optional_view(QueryView)
-        text = getattr(query_view.query, "source", "") if query_view is not None else ""
+        text = query_view.query.source if query_view is not None and isinstance(query_view.query, Query) else ""
         answer = Answer(
             query=str(text or ""),
             objects=tuple(
