@@ -1,0 +1,1 @@
+"""Object classification from what the other experts said and the ontology's class profiles."""

@@ -1,0 +1,1 @@
+"""Pixel experts: colour naming, colour histograms, colour-only segmentation, the ONNX detector."""

@@ -1,0 +1,1 @@
+"""The built-in kitchen: a deterministic RGB-D renderer with ground truth, its regions read from the map."""

@@ -1,0 +1,1 @@
+"""Text reading (OCR) on object hypotheses."""

@@ -1,0 +1,1 @@
+"""The ``robokudo`` subcommands, one module each (``HELP``, ``add_arguments``, ``run``)."""
