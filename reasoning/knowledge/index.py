@@ -9,7 +9,7 @@ ranked providers per CAS type.
 from __future__ import annotations
 
 from collections import defaultdict, deque
-from collections.abc import Iterable, Mapping
+from collections.abc import Container, Mapping
 from dataclasses import dataclass
 from pathlib import Path
 
@@ -518,6 +518,9 @@ class _Builder:
     def _annotators(self, preconditions: Mapping[str, str]) -> dict[str, AnnotatorSpec]:
         specs: dict[str, AnnotatorSpec] = {}
         cas_types = self.down.get("CasType", frozenset())
+        names_of_kind: dict[Kind, frozenset[str]] = {
+            kind: frozenset(n for n, k in self.kind_of.items() if k == kind) for kind in DOMAIN_PROPERTIES.values()
+        }
         for name in self._individuals_of("Annotator"):
             subject = RK[name]
             implemented = [str(v) for v in self.graph.objects(subject, RK.implementedBy)]
@@ -534,7 +537,7 @@ class _Builder:
                         name,
                         where,
                         prop,
-                        [n for n, k in self.kind_of.items() if k == kind],
+                        names_of_kind[kind],
                         f"{KIND_WORDS[kind]} of the ontology",
                     )
                 )
@@ -567,14 +570,13 @@ class _Builder:
             )
         return specs
 
-    def _annotator_names(self, name: str, where: str, prop: str, members: Iterable[str], what: str) -> list[str]:
+    def _annotator_names(self, name: str, where: str, prop: str, members: Container[str], what: str) -> list[str]:
         """The sorted names an annotator gives for ``prop`` that are ``members``; the others are problems."""
         found = sorted(local_name(v) for v in self.graph.objects(RK[name], RK[prop]))
-        allowed = set(members)
         for value in found:
-            if value not in allowed:
+            if value not in members:
                 self.problems.append(f"{where}: {field_of(prop)} names {value}, which is not a {what}")
-        return [v for v in found if v in allowed]
+        return [v for v in found if v in members]
 
     def _providers(self, annotators: Mapping[str, AnnotatorSpec]) -> dict[str, tuple[AnnotatorSpec, ...]]:
         ranked = sorted(annotators.values(), key=lambda s: (-s.reliability, s.cost_ms, s.name))
