@@ -14,7 +14,7 @@ import cv2
 import numpy as np
 
 from annotators.cloud.cloud_expert import CloudExpert
-from annotators.geometry.boxes import principal_box
+from annotators.geometry.boxes import compact_points, principal_box
 from annotators.geometry.support_frame import SupportFrame, sampled_indices, support_frame, usable_plane
 from robokudo.core.capability import Capability
 from robokudo.core.types import CameraInfo, CasType, ObjectHypothesis, Plane, PointCloud, Size
@@ -61,7 +61,7 @@ def upright_extents(points: np.ndarray, on_plane: bool) -> tuple[float, float, f
 def measure(points_camera: np.ndarray, frame: SupportFrame) -> tuple[float, float, float]:
     """The object's extents (metres, largest first) from its Nx3 camera-frame points."""
     if frame.guessed:
-        extents = principal_box(points_camera).extents
+        extents = principal_box(compact_points(points_camera)).extents
     else:
         extents = np.array(upright_extents(frame.points(points_camera), frame.on_plane))
     ordered = sorted((float(v) for v in extents), reverse=True)

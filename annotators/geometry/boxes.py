@@ -33,6 +33,27 @@ def finite_points(points: np.ndarray) -> np.ndarray:
     return points[np.isfinite(points).all(axis=1)].astype(np.float64)
 
 
+STRAY_FENCE = 3.0
+"""Tukey's far-out fence: a point farther from the median point than Q3 + 3 IQR of all such distances is a stray."""
+
+
+def compact_points(points: np.ndarray) -> np.ndarray:
+    """The finite points of an object's compact body, without strays.
+
+    A segment of a real depth image carries a few points that do not belong to the object's surface: flying pixels
+    at depth edges (between the object and the background behind it) and specks of background. They are few but
+    far away, so they would stretch a box by tens of centimetres. A point is a stray when its distance to the median
+    point is beyond Tukey's far-out fence of those distances; an elongated or hollow object keeps all its points,
+    since its distances spread evenly and the fence lies beyond its far end.
+    """
+    points = finite_points(points)
+    if points.shape[0] < 8:
+        return points
+    distances = np.linalg.norm(points - np.median(points, axis=0), axis=1)
+    q1, q3 = np.percentile(distances, [25.0, 75.0])
+    return points[distances <= q3 + STRAY_FENCE * (q3 - q1)]
+
+
 def _degenerate_box(points: np.ndarray) -> OrientedBox:
     centre = points.mean(axis=0) if points.shape[0] else np.zeros(3)
     extents = np.ptp(points, axis=0) if points.shape[0] else np.zeros(3)
@@ -71,9 +92,11 @@ def principal_box(points: np.ndarray) -> OrientedBox:
 
 
 def object_box(points_camera: np.ndarray, cam_to_world: np.ndarray | None) -> tuple[OrientedBox, str]:
-    """The box of an object's camera-frame points and its frame: upright in "world" when the pose is known."""
+    """The box of an object's camera-frame points (strays dropped) and its frame: upright in "world" when the
+    camera pose is known."""
+    points = compact_points(points_camera)
     if cam_to_world is not None:
         transform = np.asarray(cam_to_world, dtype=np.float64)
-        world = finite_points(points_camera) @ transform[:3, :3].T + transform[:3, 3]
+        world = points @ transform[:3, :3].T + transform[:3, 3]
         return upright_box(world), "world"
-    return principal_box(points_camera), "camera"
+    return principal_box(points), "camera"
