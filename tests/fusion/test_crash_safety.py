@@ -65,7 +65,12 @@ def test_sigkill_at_random_points_keeps_the_store_sound_and_every_commit(tmp_pat
         assert ready == "ready\n", writer.stderr.read() if writer.stderr else ready
         time.sleep(rng.uniform(0.0, 0.25))
         writer.send_signal(signal.SIGKILL)
-        out, _ = writer.communicate(timeout=10)
+        # Read on through the same buffered file object as readline() above: communicate() would read the pipe's
+        # file descriptor directly and lose whatever readline() had already buffered, splitting a line there.
+        out = writer.stdout.read()
+        writer.wait(timeout=10)
+        if writer.stderr is not None:
+            writer.stderr.close()
         assert writer.returncode == -signal.SIGKILL
         for line in out.split("\n")[:-1]:  # the text after the last newline was cut off by the kill
             match = re.fullmatch(r"(\d+) (\d+)", line)
