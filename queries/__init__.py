@@ -9,6 +9,7 @@ from queries.dispatch import QueryForm, detect_form, parse_query
 from queries.errors import QueryError
 from queries.json_form import parse_json, query_from_json, query_to_json
 from queries.model import (
+    ANYWHERE,
     KINDS,
     NO_SPAN,
     Asked,
@@ -29,6 +30,7 @@ from queries.printer import format_query, format_value
 from queries.validation import MAX_DEPTH, MAX_QUERY_LENGTH, validate_query
 
 __all__ = [
+    "ANYWHERE",
     "KINDS",
     "MAX_DEPTH",
     "MAX_QUERY_LENGTH",

@@ -114,11 +114,14 @@ COLORS: MappingProxyType[str, str] = MappingProxyType(
         "magenta": "magenta",
         "beige": "beige",
         "turquoise": "turquoise",
-        "transparent": "transparent",
-        "clear": "transparent",
     }
 )
 """Colour adjectives and the ``color`` value they give."""
+
+TRANSPARENCY: MappingProxyType[str, str] = MappingProxyType(
+    {"transparent": "true", "clear": "true", "translucent": "true", "opaque": "false"}
+)
+"""Adjectives of the ``transparent`` property (a property of the object, not a colour): ``transparent: true``."""
 
 COLOR_MODIFIERS: frozenset[str] = frozenset({"light", "dark", "bright", "pale"})
 """Words joined to a following colour: ``dark red`` -> ``dark_red``."""
@@ -150,10 +153,22 @@ SHAPES: MappingProxyType[str, str] = MappingProxyType(
 )
 """Shape adjectives and the ``shape`` value they give."""
 
+SHAPE_NOUNS: MappingProxyType[str, str] = MappingProxyType(
+    {"box": "box", "cuboid": "box", "cube": "box", "cylinder": "cylinder", "sphere": "sphere"}
+)
+"""Head nouns that name a shape, not a class: ``a small red cylinder`` -> ``shape: cylinder`` and no ``type``
+(a compound such as ``cereal box`` stays a class)."""
+
+INDEFINITE_PRONOUNS: MappingProxyType[str, bool] = MappingProxyType(
+    {"something": True, "anything": False, "everything": False}
+)
+"""Pronouns standing for any object, followed by adjectives (``something blue``); True when they ask for one."""
+
 ADJECTIVE_KEYS: tuple[tuple[str, MappingProxyType[str, str]], ...] = (
     ("color", COLORS),
     ("size", SIZES),
     ("shape", SHAPES),
+    ("transparent", TRANSPARENCY),
 )
 """Which key each adjective table fills, in the order keys are written."""
 
@@ -191,6 +206,9 @@ PREPOSITIONS: MappingProxyType[tuple[str, ...], str] = MappingProxyType(
     }
 )
 """Prepositions and the key they give inside ``location: { ... }``."""
+
+ANYWHERE_WORDS: frozenset[str] = frozenset({"anywhere", "everywhere"})
+"""Words that lift any place restriction: ``find milk anywhere`` -> ``location: anywhere``."""
 
 TEXT_MARKERS: frozenset[tuple[str, ...]] = frozenset(
     {

@@ -140,6 +140,9 @@ class Block:
 Value: TypeAlias = Symbol | String | Number | ListValue | Range | Block | Asked
 """Any typed query value."""
 
+ANYWHERE = "anywhere"
+"""The ``location`` value that restricts the search to no region (``location: anywhere``)."""
+
 KINDS: tuple[str, ...] = ("detect", "inspect", "track", "scan", "stop")
 """The known query kinds, in canonical order."""
 

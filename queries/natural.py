@@ -21,6 +21,10 @@ two ... ten, or a number, before the noun       ``max_results: N`` (detect, trac
 colour adjective (red, dark red, grey...)       ``color: red`` (several: a list)
 size adjective (small, little, big, tiny...)    ``size: small`` / ``large``
 shape adjective (round, cylindrical, boxy...)   ``shape: sphere`` / ``cylinder`` / ``box``
+shape noun (box, cube, cylinder, sphere)        ``shape: box`` and no ``type``
+transparent / clear / opaque                    ``transparent: true`` / ``false`` (a property)
+something / anything / everything + adjectives  no ``type``; ``something`` asks for one
+anywhere / everywhere                           ``location: anywhere`` (no region restriction)
 noun + number (``object 12``, ``cup no 3``)     ``id: 12``; object/item/thing set no type
 in / inside / on / at / near / next to /        ``location: { in: fridge }`` etc.
 under / behind / above / in front of X
@@ -44,6 +48,7 @@ from dataclasses import dataclass, field
 from queries.errors import QueryError, located_error
 from queries.lexicon import (
     ADJECTIVE_KEYS,
+    ANYWHERE_WORDS,
     COLOR_MODIFIERS,
     COLORS,
     CONJUNCTIONS,
@@ -52,6 +57,7 @@ from queries.lexicon import (
     GENERIC_NOUNS,
     ID_MARKERS,
     IGNORED_WORDS,
+    INDEFINITE_PRONOUNS,
     INVARIANT_WORDS,
     IRREGULAR_PLURALS,
     LIMITING_DETERMINERS,
@@ -64,12 +70,14 @@ from queries.lexicon import (
     RELATIVE_CLAUSES,
     SCAN_FOR,
     SCAN_TARGETS,
+    SHAPE_NOUNS,
     STOP_ALL_WORDS,
     STOP_TASK_WORDS,
     TEXT_MARKERS,
     VERBS,
 )
 from queries.model import (
+    ANYWHERE,
     Asked,
     Block,
     Field,
@@ -144,6 +152,7 @@ class _ObjectPhrase:
     extras: list[Field] = field(default_factory=list)
     locations: list[Field] = field(default_factory=list)
     location_span: Span | None = None
+    anywhere: Span | None = None
 
     def add_adjective(self, key: str, value: Value, span: Span) -> None:
         found = self.adjectives.get(key)
@@ -165,10 +174,12 @@ class _ObjectPhrase:
         if self.locations:
             span = self.location_span or self.start
             fields.append(Field("location", Block(tuple(self.locations)), span))
+        elif self.anywhere is not None:
+            fields.append(Field("location", Symbol(ANYWHERE), self.anywhere))
         return Block(tuple(fields))
 
     def is_bare(self) -> bool:
-        return not (self.adjectives or self.extras or self.locations)
+        return not (self.adjectives or self.extras or self.locations or self.anywhere)
 
 
 class _PhraseParser:
@@ -229,7 +240,7 @@ class _PhraseParser:
     def is_boundary(self) -> bool:
         """Whether the current token ends a run of noun words."""
         word = self.word()
-        if word is None or word == "with":
+        if word is None or word == "with" or word in ANYWHERE_WORDS:
             return True
         if word in CONJUNCTIONS:
             return False
@@ -336,6 +347,15 @@ class _PhraseParser:
         elif start.kind == "number":
             phrase.limit = int(self.whole_number(start, "the number of objects").value)
             phrase.limit_span = self.take()[0].span
+        pronoun = self.word()
+        if pronoun in INDEFINITE_PRONOUNS:
+            token = self.take()[0]
+            if INDEFINITE_PRONOUNS[pronoun] and phrase.limit is None:
+                phrase.limit_span = phrase.limit_span or token.span
+            phrase.noun, phrase.generic, phrase.noun_span = "object", True, token.span
+            self.relative_adjectives(phrase, required=False)
+            phrase.end = self.last_span()
+            return phrase
         words: list[PhraseToken] = []
         while not self.is_boundary():
             words.append(self.take()[0])
@@ -381,6 +401,9 @@ class _PhraseParser:
             position += 1
         singular, plural = singularise(head.text)
         phrase.plural = plural
+        if not nouns and singular in SHAPE_NOUNS:
+            phrase.add_adjective("shape", Symbol(SHAPE_NOUNS[singular]), head.span)
+            singular = "object"
         phrase.generic = not nouns and singular in GENERIC_NOUNS
         phrase.noun = "_".join([*nouns, singular])
         first = next((token for token in before if token.text in nouns), head)
@@ -410,6 +433,8 @@ class _PhraseParser:
                 span = _join_span(marker[0].span, quoted.span)
                 phrase.extras.append(Field("text", String(quoted.text), span))
             elif (preposition := self.match(PREPOSITIONS)) is not None:
+                if phrase.anywhere is not None:
+                    raise self.error("expected one place: 'anywhere' lifts the place restriction")
                 taken = self.take(len(preposition))
                 place, place_span = self.place_phrase()
                 span = _join_span(taken[0].span, place_span)
@@ -419,6 +444,10 @@ class _PhraseParser:
             elif (clause := self.match(RELATIVE_CLAUSES)) is not None:
                 self.take(len(clause))
                 self.relative_adjectives(phrase)
+            elif self.word() in ANYWHERE_WORDS:
+                if phrase.locations or phrase.anywhere is not None:
+                    raise self.error("expected one place: 'anywhere' lifts the place restriction")
+                phrase.anywhere = self.take()[0].span
             elif self.word() == "with":
                 taken = self.take()
                 place, place_span = self.place_phrase()
@@ -427,7 +456,8 @@ class _PhraseParser:
                 break
             phrase.end = self.last_span()
 
-    def relative_adjectives(self, phrase: _ObjectPhrase) -> None:
+    def relative_adjectives(self, phrase: _ObjectPhrase, required: bool = True) -> None:
+        """Read colours, sizes, shapes and properties joined by conjunctions (at least one when ``required``)."""
         found = False
         while (word := self.word()) is not None:
             if word in CONJUNCTIONS and found:
@@ -443,7 +473,7 @@ class _PhraseParser:
             else:
                 self.take()
             found = True
-        if not found:
+        if not found and required:
             raise self.error("expected a colour, size or shape")
 
     def place_phrase(self) -> tuple[Symbol, Span]:

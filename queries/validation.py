@@ -5,7 +5,9 @@ key is given twice in one block; ``stop`` names a ``task``; sizes,
 distances, durations, counts and ids are not negative (counts and ids are
 whole numbers, ``max_results`` at least 1) and carry a fitting unit; range
 bounds are scalars of one type, numbers share a unit and ``low <= high``;
-nesting is at most :data:`MAX_DEPTH` deep.  Whether an object class exists
+``confidence`` is a plain number from 0 to 1; ``size`` is a size word (the
+answer is filtered by size class, so a metric size or range is refused here
+rather than ignored later); nesting is at most :data:`MAX_DEPTH` deep.  Whether an object class exists
 is left to the reasoning layer.
 """
 
@@ -36,7 +38,6 @@ MAX_DEPTH = 32
 
 NON_NEGATIVE_KEYS: frozenset[str] = frozenset(
     {
-        "size",
         "min_size",
         "max_size",
         "width",
@@ -60,7 +61,6 @@ WHOLE_NUMBER_KEYS: frozenset[str] = frozenset({"max_results", "task", "id"})
 
 KEY_UNITS: MappingProxyType[str, str] = MappingProxyType(
     {
-        "size": "m",
         "min_size": "m",
         "max_size": "m",
         "width": "m",
@@ -75,6 +75,15 @@ KEY_UNITS: MappingProxyType[str, str] = MappingProxyType(
     }
 )
 """The SI unit a number under these keys must have, if it has one."""
+
+
+WORD_ONLY_KEYS: MappingProxyType[str, str] = MappingProxyType(
+    {"size": "a size word such as tiny, small, medium or large (metric sizes and ranges are not supported)"}
+)
+"""Keys whose value must be words (or a list of words), with what to write instead."""
+
+FRACTION_KEYS: frozenset[str] = frozenset({"confidence"})
+"""Keys whose number is a plain fraction from 0 to 1."""
 
 
 def check_length(text: str, limit: int = MAX_QUERY_LENGTH) -> None:
@@ -127,6 +136,8 @@ def _check_field(query: Query, item: Field, depth: int) -> list[tuple[Block, int
         value, level = pending.pop()
         if level > MAX_DEPTH:
             raise _error(query, item.span, f"'{item.key}' is nested deeper than {MAX_DEPTH} levels")
+        if item.key in WORD_ONLY_KEYS and isinstance(value, Number | Range):
+            raise _error(query, item.span, f"'{item.key}' takes {WORD_ONLY_KEYS[item.key]}")
         if isinstance(value, Block):
             if not value.fields:
                 raise _error(query, item.span, f"'{item.key}' has an empty block")
@@ -150,6 +161,8 @@ def _check_number(query: Query, item: Field, number: Number) -> None:
             raise _error(query, item.span, f"'{key}' must be a whole number without a unit")
         if key == "max_results" and number.value < 1:
             raise _error(query, item.span, "'max_results' must be at least 1")
+    if key in FRACTION_KEYS and (number.unit is not None or not 0.0 <= number.value <= 1.0):
+        raise _error(query, item.span, f"'{key}' must be a number from 0 to 1 without a unit")
     wanted = KEY_UNITS.get(key)
     if wanted is not None and number.unit is not None and number.unit != wanted:
         raise _error(query, item.span, f"'{key}' needs a unit of '{wanted}', not '{number.unit}'")
@@ -173,11 +186,13 @@ def _check_range(query: Query, item: Field, bounds: Range) -> None:
 
 
 __all__ = [
+    "FRACTION_KEYS",
     "KEY_UNITS",
     "MAX_DEPTH",
     "MAX_QUERY_LENGTH",
     "NON_NEGATIVE_KEYS",
     "WHOLE_NUMBER_KEYS",
+    "WORD_ONLY_KEYS",
     "check_length",
     "validate_query",
 ]

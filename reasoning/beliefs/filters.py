@@ -14,7 +14,7 @@ from __future__ import annotations
 from collections.abc import Callable, Collection, Sequence
 from typing import Protocol
 
-from queries import Block, Number, Query, String, Symbol, Value
+from queries import ANYWHERE, Block, Number, Query, String, Symbol, Value
 from reasoning.beliefs.store import BeliefFilter
 from reasoning.knowledge.model import Resolved
 from robokudo.core.regions import RegionBox
@@ -48,12 +48,15 @@ def belief_filter(query: Query, kb: Vocabulary | None = None, *, include_gone: b
     blocks = [b for b in (_body(query), _block(_get(_body(query), "obj"))) if b is not None]
     object_class = _first_word(blocks, CLASS_KEYS)
     region_word = _region_word(blocks)
+    if region_word is not None and region_word.strip().lower() == ANYWHERE:  # ``location: anywhere``: no region
+        region_word = None
     attributes = _attributes(blocks, kb)
     class_test = kb_class_test(kb)
     if object_class is not None:
         object_class = _resolve(kb, object_class, "class")
     region, boxes = (None, ()) if region_word is None else _resolve_region(kb, region_word)
     limit = _number(blocks, "max_results")
+    min_confidence = _number(blocks, "confidence")  # ``confidence: 0.75``: the least belief confidence answered
     return BeliefFilter(
         object_class=object_class,
         class_test=class_test,
@@ -61,6 +64,7 @@ def belief_filter(query: Query, kb: Vocabulary | None = None, *, include_gone: b
         region_boxes=boxes,
         attributes=attributes,
         include_gone=include_gone,
+        min_confidence=0.0 if min_confidence is None else min_confidence,
         limit=None if limit is None else int(limit),
     )
 

@@ -26,7 +26,14 @@ from reasoning.knowledge.index import OntologyIndex, build_index
 from reasoning.knowledge.knowledge_base import KnowledgeBase
 from reasoning.knowledge.model import KIND_WORDS, Kind
 from reasoning.knowledge.vocabulary import OWL, RDF, RDFS, RK, SKOS, XSD, is_rk, local_name, rk
-from reasoning.knowledge.words import camel_case, camel_words, word_key
+from reasoning.knowledge.words import (
+    MAX_LABEL_LENGTH,
+    MAX_NAME_LENGTH,
+    camel_case,
+    camel_words,
+    control_characters,
+    word_key,
+)
 from robokudo.core.types import ANNOTATION_TYPES, VIEW_TYPES
 
 USER_ONTOLOGY_IRI = URIRef("http://robokudo.org/ontology/user")
@@ -126,6 +133,8 @@ class OntologyEditor:
             problems.append("brand must not be empty")
         the_label = (label or camel_words(name)).strip()
         words = [the_label, *synonyms]
+        problems += _text_problems("label", [the_label]) + _text_problems("synonym", synonyms)
+        problems += _text_problems("printed text", texts) + _text_problems("brand", [brand] if brand else [])
         if _CLASS_NAME.fullmatch(name) and word_key(name) not in {word_key(w) for w in words}:
             words.append(name)  # the name is a word too ("Beverage" would clash with the synonym "beverage")
         for word in words:
@@ -168,6 +177,9 @@ class OntologyEditor:
         return EditResult("add-object", name, self.user_file, checked_by, warnings)
 
     def _check_new_name(self, name: str, index: OntologyIndex, problems: list[str]) -> None:
+        if len(name) > MAX_NAME_LENGTH:
+            problems.append(f"the class name is {len(name)} characters long; at most {MAX_NAME_LENGTH} are allowed")
+            return
         if _CLASS_NAME.fullmatch(name) is None:
             suggestion = camel_case(name)
             hint = f", e.g. {suggestion!r}" if suggestion and _CLASS_NAME.fullmatch(suggestion) else ""
@@ -291,6 +303,20 @@ class OntologyEditor:
         data = _HEADER + user_graph.serialize(format="turtle").encode("utf-8")
         write_atomically(self.user_file, data)
         self.kb.reload()
+
+
+def _text_problems(what: str, values: Sequence[str]) -> list[str]:
+    """Why labels, synonyms or texts cannot be written: too long, or with control characters (one line each)."""
+    problems = []
+    for value in values:
+        shown = value if len(value) <= 40 else value[:40] + "..."
+        if len(value) > MAX_LABEL_LENGTH:
+            problems.append(f"{what} {shown!r} is {len(value)} characters long; at most {MAX_LABEL_LENGTH} are allowed")
+        breaking = control_characters(value)
+        if breaking:
+            listed = ", ".join(breaking)
+            problems.append(f"{what} {shown!r} contains control characters ({listed}); write it on one line")
+    return problems
 
 
 def check_cas_types(kb: KnowledgeBase) -> list[str]:

@@ -22,7 +22,7 @@ from reasoning.errors import OntologyError
 from reasoning.knowledge.capabilities import field_of
 from reasoning.knowledge.model import KIND_WORDS, KINDS, AnnotatorSpec, Kind, ObjectProfile, Resolved
 from reasoning.knowledge.vocabulary import OWL, RDF, RDFS, RK, SKOS, is_rk, local_name
-from reasoning.knowledge.words import camel_words, word_key
+from reasoning.knowledge.words import camel_words, one_line, word_key
 from robokudo.core.regions import RegionBox
 
 ROOTS: Mapping[Kind, str] = {
@@ -192,10 +192,10 @@ class _Builder:
             if is_rk(subject) and isinstance(label, Literal) and label.language in (None, "en"):
                 name = local_name(subject)
                 if name not in self.labels or label.language == "en":
-                    self.labels[name] = str(label)
+                    self.labels[name] = one_line(str(label))
         for subject, label in self.graph.subject_objects(SKOS.altLabel):
             if is_rk(subject) and isinstance(label, Literal) and label.language in (None, "en"):
-                self.alt_labels[local_name(subject)].append(str(label))
+                self.alt_labels[local_name(subject)].append(one_line(str(label)))
         for values in self.alt_labels.values():
             values.sort()
         self.all_names = {local_name(node) for triple in self.graph for node in triple if is_rk(node)}

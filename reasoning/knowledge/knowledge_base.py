@@ -397,6 +397,7 @@ class KnowledgeBase:
             object_up, object_down = index.up[object_name], index.down[object_name]
             transparent = index.profiles[object_name].transparent is True
         conditions = conditions or _ALL_CONDITIONS
+        transparent = transparent or conditions.transparent
         chosen: list[AnnotatorSpec] = []
         for spec in candidates:
             if value_up is not None and value_down is not None:

@@ -104,8 +104,10 @@ _DOMAINS: dict[Kind, Callable[[AnnotatorSpec], frozenset[str]]] = {
 @dataclass(frozen=True, slots=True)
 class Conditions:
     """What holds where the planner plans: is a depth image available, is a region known, is a detector model
-    configured (False by default, so plans include model-based detectors only when one is)."""
+    configured (False by default, so plans include model-based detectors only when one is), does the query ask
+    for a transparent object (then experts for opaque objects only are left out, whatever the class)."""
 
     depth: bool = True
     region: bool = True
     model: bool = False
+    transparent: bool = False

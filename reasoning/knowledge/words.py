@@ -3,17 +3,39 @@
 from __future__ import annotations
 
 import re
+import unicodedata
 
-_NOT_ALNUM = re.compile(r"[^0-9a-z]+")
+MAX_NAME_LENGTH = 64
+"""Longest class name accepted by ontology edits, in characters."""
+
+MAX_LABEL_LENGTH = 100
+"""Longest label, synonym, printed text or brand accepted by ontology edits, in characters."""
+
+_BREAKING_CATEGORIES = frozenset({"Cc", "Zl", "Zp"})
 _CAMEL_BOUNDARY = re.compile(r"(?<=[a-z0-9])(?=[A-Z])|(?<=[A-Z])(?=[A-Z][a-z])")
 
 
 def word_key(text: str) -> str:
-    """The lookup key of a word: lower case, letters and digits only ("Cereal_Box" -> "cerealbox")."""
+    """The lookup key of a word: case-folded, letters and digits only ("Cereal_Box" -> "cerealbox").
+
+    Letters and digits of any script count ("コップ" keeps its characters); compatibility forms are unified first
+    (full-width "ＣＵＰ" is "cup").
+    """
     text = text.strip()
     if text.startswith("rk:"):
         text = text[3:]
-    return _NOT_ALNUM.sub("", text.lower())
+    return "".join(ch for ch in unicodedata.normalize("NFKC", text).casefold() if ch.isalnum())
+
+
+def control_characters(text: str) -> list[str]:
+    """The control characters and line or paragraph separators in ``text`` (as escapes, e.g. ``\\n``), in order."""
+    return [repr(ch)[1:-1] for ch in text if unicodedata.category(ch) in _BREAKING_CATEGORIES]
+
+
+def one_line(text: str) -> str:
+    """``text`` with every run of whitespace and control characters made one space, trimmed."""
+    cleaned = "".join(" " if unicodedata.category(ch) in _BREAKING_CATEGORIES else ch for ch in text)
+    return " ".join(cleaned.split())
 
 
 def singular_keys(key: str) -> tuple[str, ...]:

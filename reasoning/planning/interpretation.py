@@ -1,15 +1,18 @@
 """Interpret a parsed query against the knowledge base: resolve words, fill gaps, list required types.
 
 ``find milk in fridge`` names a class and a region; ``find milk`` names only the class, and the region comes
-from the ontology (Milk is stored in the Fridge); a class whose variants differ only by printed text needs
-text reading. Each requirement carries the sentence that explains it.
+from the ontology (Milk is stored in the Fridge) as a hint: it is used only when it can be applied (the input
+carries the camera pose and the semantic map has such a region), otherwise the whole view is searched and the
+inferences say so. ``location: anywhere`` searches the whole view. A region the query names on an input without
+a camera pose is a planning error. A class whose variants differ only by printed text needs text reading. Each
+requirement carries the sentence that explains it.
 """
 
 from __future__ import annotations
 
 from dataclasses import dataclass
 
-from queries.model import Asked, Block, ListValue, Number, Query, String, Symbol, Value
+from queries.model import ANYWHERE, Asked, Block, ListValue, Number, Query, String, Symbol, Value
 from reasoning.errors import TermError
 from reasoning.knowledge.knowledge_base import KnowledgeBase
 from reasoning.planning.plan import Constraint, Task
@@ -17,29 +20,33 @@ from reasoning.planning.planner import PlanningError, Requirement
 from robokudo.core.regions import RegionBox
 
 _RELATIONS = ("in", "inside", "on", "at", "near")
-_STRUCTURAL_KEYS = frozenset({"type", "location", "id"})
+_STRUCTURAL_KEYS = frozenset({"type", "location", "id", "transparent", "confidence"})
+_TRUTH = {"true": True, "yes": True, "false": False, "no": False}
 _KINDS_WITH_OBJECTS = ("detect", "inspect", "track")
 
 
 @dataclass(frozen=True)
 class Interpretation:
-    """The task, what it requires, and the region box it is restricted to (if any)."""
+    """The task, what it requires, the region box it is restricted to (if any) and whether the object asked for
+    is transparent (said by the query or by its class)."""
 
     task: Task
     requirements: tuple[Requirement, ...]
     region_box: RegionBox | None
+    transparent: bool = False
 
 
-def interpret(query: Query, kb: KnowledgeBase, depth: bool = True) -> Interpretation:
+def interpret(query: Query, kb: KnowledgeBase, depth: bool = True, camera_pose: bool = True) -> Interpretation:
     """Resolve the query's words and list the annotation types its answer needs.
 
     ``depth`` says whether the sensor measures depth; without it objects are reported by their image region
-    and no pose is required.
+    and no pose is required. ``camera_pose`` says whether the input's frames carry the camera pose, without
+    which no region of the semantic map can be applied.
     """
     if query.kind == "stop":
         raise PlanningError("a stop query cancels a running task; there is no perception tree to plan for it")
     if query.kind == "scan":
-        return _interpret_scan(query, kb)
+        return _interpret_scan(query, kb, camera_pose)
     obj = query.get("obj")
     if not isinstance(obj, Block):
         raise PlanningError(f"a {query.kind} query needs an obj block describing the object")
@@ -64,14 +71,19 @@ def interpret(query: Query, kb: KnowledgeBase, depth: bool = True) -> Interpreta
             asked = f"query asks {field.key} = {name}" if name is not None else f"query asks for {field.key}"
             domain_value = name if kb.value_kind(annotation_type) is not None else None
             requirements.append(Requirement(annotation_type, domain_value, asked))
+    transparent = _transparency(obj.get("transparent"), object_class, kb, inferences)
+    min_confidence = _confidence(obj.get("confidence"), inferences)
     if object_class is not None and not obj.get("text"):
         why = _why_text_matters(object_class, kb)
         if why:
             inferences.append(why)
             requirements.append(Requirement("Text", None, why))
-    region_box = _region(obj.get("location"), kb)
-    if region_box is None and object_class is not None:
-        region_box, note = _default_region(object_class, kb)
+    location = obj.get("location")
+    region_box = _region(location, kb, camera_pose)
+    if _is_anywhere(location):
+        inferences.append("the query says anywhere, so the search covers the whole view")
+    elif region_box is None and object_class is not None:
+        region_box, note = _default_region(object_class, kb, camera_pose)
         if note:
             inferences.append(note)
     task = Task(
@@ -82,8 +94,36 @@ def interpret(query: Query, kb: KnowledgeBase, depth: bool = True) -> Interpreta
         inferences=tuple(inferences),
         max_results=_whole(query.get("max_results")),
         object_id=_whole(obj.get("id")),
+        min_confidence=min_confidence,
     )
-    return Interpretation(task, tuple(requirements), region_box)
+    return Interpretation(task, tuple(requirements), region_box, transparent)
+
+
+def _transparency(value: Value | None, object_class: str | None, kb: KnowledgeBase, inferences: list[str]) -> bool:
+    """Whether the query asks for a transparent object (``transparent: true``), noting a clash with the class."""
+    if value is None or isinstance(value, Asked):
+        return False
+    word = _word(value, "transparent").strip().lower()
+    if word not in _TRUTH:
+        raise PlanningError(f"transparent must be true or false, not {word!r}")
+    wanted = _TRUTH[word]
+    typical = kb.object_profile(object_class).transparent if object_class is not None else None
+    if typical is not None and typical != wanted:
+        said = "transparent" if typical else "opaque"
+        inferences.append(f"{object_class} is typically {said}, but the query asks for transparent = {word}")
+    if wanted:
+        inferences.append("the query asks for a transparent object, so experts that need opaque objects are left out")
+    return wanted
+
+
+def _confidence(value: Value | None, inferences: list[str]) -> float:
+    """The least confidence an answered object must have (``confidence: 0.75``), 0 when not asked."""
+    if value is None or isinstance(value, Asked):
+        return 0.0
+    if not isinstance(value, Number) or value.unit is not None or not 0.0 <= value.value <= 1.0:
+        raise PlanningError("confidence must be a number between 0 and 1")
+    inferences.append(f"the answer keeps only objects believed with confidence at least {value.value:g}")
+    return value.value
 
 
 def _why_text_matters(object_class: str, kb: KnowledgeBase) -> str:
@@ -111,9 +151,8 @@ def _why_text_matters(object_class: str, kb: KnowledgeBase) -> str:
     return ""
 
 
-def _interpret_scan(query: Query, kb: KnowledgeBase) -> Interpretation:
-    region_value = query.get("region")
-    region_box = _region(region_value, kb) if region_value is not None else None
+def _interpret_scan(query: Query, kb: KnowledgeBase, camera_pose: bool) -> Interpretation:
+    region_box = _region(query.get("region"), kb, camera_pose)
     requirements = (
         Requirement("Plane", None, "a scan for free space needs the supporting surface"),
         Requirement("ObjectHypothesis", None, "a scan for free space needs the objects occupying the surface"),
@@ -168,8 +207,24 @@ def _value_name(annotation_type: str, value: Value, kb: KnowledgeBase) -> str | 
         raise PlanningError(str(error)) from None
 
 
-def _region(value: Value | None, kb: KnowledgeBase) -> RegionBox | None:
-    if value is None or isinstance(value, Asked):
+def _is_anywhere(value: Value | None) -> bool:
+    return isinstance(value, Symbol | String) and _word(value, "location").strip().lower() == ANYWHERE
+
+
+def _region(value: Value | None, kb: KnowledgeBase, camera_pose: bool) -> RegionBox | None:
+    """The region box the query names (None for none or anywhere); PlanningError when it cannot be applied."""
+    box = _named_region(value, kb)
+    if box is not None and not camera_pose:
+        raise PlanningError(
+            f"region {box.name!r} cannot be searched: the input gives no camera pose, so its points cannot be placed "
+            f"in the semantic map; leave the place out (or say 'anywhere', location: anywhere) to search the whole "
+            f"view, or use an input with a camera pose (the built-in kitchen)"
+        )
+    return box
+
+
+def _named_region(value: Value | None, kb: KnowledgeBase) -> RegionBox | None:
+    if value is None or isinstance(value, Asked) or _is_anywhere(value):
         return None
     if isinstance(value, Block):
         places = [value.get(relation) for relation in _RELATIONS if value.get(relation) is not None]
@@ -189,14 +244,23 @@ def _region(value: Value | None, kb: KnowledgeBase) -> RegionBox | None:
     return boxes[0]
 
 
-def _default_region(object_class: str, kb: KnowledgeBase) -> tuple[RegionBox | None, str]:
+def _default_region(object_class: str, kb: KnowledgeBase, camera_pose: bool) -> tuple[RegionBox | None, str]:
+    """Where the class is typically stored, as a hint: the region box when it can be applied, and why (not)."""
     stored_in = kb.default_location(object_class)
     if stored_in is None:
         return None, ""
     boxes = kb.regions_of_class(stored_in)
     if not boxes:
-        return None, f"{object_class} is stored in a {stored_in}, but the semantic map has none"
+        return None, (
+            f"{object_class} is typically stored in a {stored_in}, but the semantic map has none, "
+            f"so the search covers the whole view"
+        )
     box = boxes[0]
+    if not camera_pose:
+        return None, (
+            f"{object_class} is typically stored in the {stored_in} (region {box.name!r}), but the input gives no "
+            f"camera pose to place it, so the search covers the whole view"
+        )
     return box, f"{object_class} is typically stored in the {stored_in}, so the search covers region {box.name!r}"
 
 

@@ -31,6 +31,7 @@ class Task:
     inferences: tuple[str, ...] = ()
     max_results: int | None = None
     object_id: int | None = None
+    min_confidence: float = 0.0
 
     def constraint(self, key: str) -> Constraint | None:
         """The constraint on ``key``, or None."""

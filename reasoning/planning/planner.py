@@ -50,9 +50,13 @@ class Requirement:
 
 @dataclass(frozen=True)
 class SensorSource:
-    """The reader that starts every plan and the types it supplies."""
+    """The reader that starts every plan, the types it supplies and whether its frames carry the camera pose.
+
+    Regions of the semantic map can be applied only with the camera pose (to place the points in the map frame).
+    """
 
     step: Step
+    camera_pose: bool = True
 
     @property
     def types(self) -> frozenset[str]:

@@ -105,9 +105,9 @@ class QueryPlanner:
     def plan(self, query: Query, source: SensorSource) -> QueryPlan:
         """Interpret ``query`` and synthesize the plan that answers it from ``source``'s sensor types."""
         depth = bool(source.types & DEPTH_TYPES)
-        interpretation = interpret(query, self.kb, depth=depth)
+        interpretation = interpret(query, self.kb, depth=depth, camera_pose=source.camera_pose)
         box = interpretation.region_box
-        conditions = Conditions(depth=depth, region=box is not None)
+        conditions = Conditions(depth=depth, region=box is not None, transparent=interpretation.transparent)
         parameters = annotator_parameters(self.kb, box, self.profiles(), interpretation.task.object_class)
         plan = plan_requirements(
             interpretation.task,

@@ -8,11 +8,15 @@ from reasoning.knowledge.knowledge_base import KnowledgeBase
 from reasoning.planning.plan import Step
 from reasoning.planning.planner import SensorSource
 
+READERS_WITH_CAMERA_POSE: frozenset[str] = frozenset({"KitchenSceneReader"})
+"""The readers whose frames carry the camera pose (``CameraInfo.cam_to_world``); recorded inputs have none."""
+
 
 def sensor_source(kb: KnowledgeBase, input_path: str | None, frame: int = 0, region: str | None = None) -> SensorSource:
     """The reader for ``input_path`` (the built-in kitchen when None, looking at ``region`` if given).
 
-    The reader is picked from the path's layout (``annotators.readers.choice.reader_choice``); a path of no known
+    The source says whether the reader's frames carry the camera pose, which regions of the map need. The reader is
+    picked from the path's layout (``annotators.readers.choice.reader_choice``); a path of no known
     layout raises ValueError listing the supported ones.
     """
     if input_path is None:
@@ -39,4 +43,4 @@ def sensor_source(kb: KnowledgeBase, input_path: str | None, frame: int = 0, reg
         parameters=parameters,
         reason=f"{spec.name}: {reason}",
     )
-    return SensorSource(step)
+    return SensorSource(step, camera_pose=spec.name in READERS_WITH_CAMERA_POSE)

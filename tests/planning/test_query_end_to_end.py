@@ -58,7 +58,11 @@ def test_plan_cli_prints_the_tree_with_reasons_and_json(capsys: pytest.CaptureFi
     assert all(node["reason"] for node in _walk(document["tree"]))
 
 
-def test_bad_query_exits_2_with_the_reason(capsys: pytest.CaptureFixture) -> None:
+def test_bad_query_exits_2_with_the_reason(
+    tmp_path: Path, monkeypatch: pytest.MonkeyPatch, capsys: pytest.CaptureFixture
+) -> None:
+    monkeypatch.setenv("ROBOKUDO_BELIEF_STORE", str(tmp_path / "beliefs.sqlite"))
+    monkeypatch.setenv("ROBOKUDO_USER_ONTOLOGY", str(tmp_path / "user.ttl"))
     assert cli.main(["plan", "detect { obj: { color: teal } }"]) == 2
     assert "SemanticColorAnnotator can report only" in capsys.readouterr().err
     assert cli.main(["query", "detect { obj: { type: Milk, } }"]) == 2

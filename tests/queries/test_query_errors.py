@@ -35,8 +35,14 @@ BAD_QUERIES: list[tuple[Parser, str, int, int, str]] = [
     (parse_query, "detect { obj: [{}] }", 1, 10, "'obj' has an empty block"),
     (parse_query, "detect { a: 1, A: 2 }", 1, 16, "key 'a' is given twice (first at line 1, column 10)"),
     (parse_query, "detect { obj: { type: Cup,\n  type: Mug } }", 2, 3, "key 'type' is given twice"),
-    (parse_query, "detect { obj: { size: -1cm } }", 1, 17, "'size' must not be negative"),
-    (parse_query, "detect { obj: { size: -2cm..1cm } }", 1, 17, "'size' must not be negative"),
+    (parse_query, "detect { obj: { width: -1cm } }", 1, 17, "'width' must not be negative"),
+    (parse_query, "detect { obj: { width: -2cm..1cm } }", 1, 17, "'width' must not be negative"),
+    (parse_query, "detect { obj: { size: 5cm..12cm } }", 1, 17, "'size' takes a size word"),
+    (parse_query, "detect { obj: { size: 0.1m } }", 1, 17, "'size' takes a size word"),
+    (parse_query, '{"detect": {"obj": {"size": "10cm..30cm"}}}', 1, 21, "'size' takes a size word"),
+    (parse_query, "detect { obj: { confidence: 1.5 } }", 1, 17, "'confidence' must be a number from 0 to 1"),
+    (parse_query, "detect { obj: { confidence: 0.5s } }", 1, 17, "'confidence' must be a number from 0 to 1"),
+    (parse_query, "find milk anywhere in the fridge", 1, 20, "expected one place"),
     (parse_query, "detect { timeout: -2s }", 1, 10, "'timeout' must not be negative"),
     (parse_query, "detect { timeout: 2m }", 1, 10, "'timeout' needs a unit of 's'"),
     (parse_query, "detect { a: 2m..1m }", 1, 10, "low bound above its high bound"),
@@ -111,10 +117,10 @@ def test_error_lists_what_was_expected() -> None:
 
 def test_caret_points_into_the_right_line_of_a_multiline_query() -> None:
     with pytest.raises(QueryError) as caught:
-        parse_query("detect {\n  obj: { type: Milk, size: -1cm }\n}")
+        parse_query("detect {\n  obj: { type: Milk, width: -1cm }\n}")
     error = caught.value
     assert (error.line, error.column) == (2, 22)
-    assert error.excerpt == "  " + "  obj: { type: Milk, size: -1cm }" + "\n  " + " " * 21 + "^"
+    assert error.excerpt == "  " + "  obj: { type: Milk, width: -1cm }" + "\n  " + " " * 21 + "^"
 
 
 def test_long_lines_are_cut_around_the_caret() -> None:
