@@ -26,8 +26,9 @@ are all small cylinders). The calibration (``calibration.FITTED``, fitted on lab
 match's score, lead and whether its printed text went unread into the probability that it is right. A class is
 asserted only when it fits (score >= ``min_score``) and that probability reaches :data:`ASSERT_PROBABILITY`; its
 Classification confidence is that probability. Otherwise the query's class (``expected``) may break a near-tie:
-a match of that class that fits and scores within ``margin`` of the best, against a fitting match of another
-class, is asserted with its own (low) calibrated probability - the query never lifts a poor fit. Everything
+a match of that class that fits and scores within ``margin`` of the best fitting one is asserted with its own
+(low) calibrated probability - the query never lifts a poor fit (a class named by printed text fits only when its
+text was read; the root class breaks no tie). Everything
 else is classified :data:`UNKNOWN_CLASS` ("unknown object") with confidence 1 - probability (how sure the
 classifier is that naming the best candidate would be wrong).
 """
@@ -192,18 +193,16 @@ def lead(match: Match, matches: Sequence[Match]) -> float:
 
 
 def choose_expected(matches: Sequence[Match], expected: str, min_score: float, margin: float) -> Match | None:
-    """The query's class breaking a near-tie: among the fitting matches (score at least ``min_score``) within
-    ``margin`` of the best score, the best one of the expected class (or a subclass), provided a fitting
-    near-tied match of another class competes with it (else the query decides nothing); None otherwise.
-    A class named by printed text does not fit while its text is unread."""
-    if not matches:
-        return None
-    top = max(m.score for m in matches)
+    """The query's class breaking a near-tie: among the fitting matches within ``margin`` of the best fitting
+    score, the best one of the expected class (or a subclass); None otherwise, and always for the root class
+    (a query for any object prefers none). A match fits when it scores at least ``min_score`` and, for a class
+    named by printed text, its text was read."""
+    fitting = [m for m in matches if m.score >= min_score and not m.unread]
     wanted = expected.lower()
-    near = [m for m in matches if m.score >= min_score and top - m.score < margin]
-    candidates = [m for m in near if wanted in m.profile.ancestors and not m.unread]
-    if all(wanted in m.profile.ancestors for m in near):
+    if not fitting or wanted == UNKNOWN_CLASS.lower():
         return None
+    top = max(m.score for m in fitting)
+    candidates = [m for m in fitting if top - m.score < margin and wanted in m.profile.ancestors]
     return max(candidates, key=lambda m: (m.score, -len(m.profile.ancestors)), default=None)
 
 
