@@ -17,12 +17,20 @@ Text) a profile gets an agreement in [0, 1]:
 
 Colour, shape and size agreements are pulled toward 0.5 by the expert's confidence (``0.5 + (a - 0.5) * c``), so
 uncertain evidence counts less. The score is the weighted mean over the observed cues with :data:`WEIGHTS`
-(text is strong evidence). A hypothesis is classified as the best profile when its score is at least
-``min_score`` and beats every profile not related to it by subsumption by ``margin``. When none is clear and
-the query asked for a class (``expected``), a match of that class within ``margin`` of the best wins: the query
-is a prior, deciding only between near-equal candidates. Among related profiles
-with the same score, the most specific one with the most matched texts wins when text was read and matched
-(lactose-free milk over milk), else the most general one (no evidence for a variant).
+(text is strong evidence). The best match is the top score (among related profiles with that score, the most
+specific one with the most matched texts when text matched, lactose-free milk over milk; else the most general
+one: no evidence for a variant); its lead is how far it scores above the best profile not related to it.
+
+Deciding. The score is not a probability: many classes share colour, shape and size (a cup, a mug and a glass
+are all small cylinders). The calibration (``calibration.FITTED``, fitted on labelled objects) turns the best
+match's score, lead and whether its printed text went unread into the probability that it is right. A class is
+asserted only when it fits (score >= ``min_score``) and that probability reaches :data:`ASSERT_PROBABILITY`; its
+Classification confidence is that probability. Otherwise the query's class (``expected``) may break a near-tie:
+a match of that class that fits and scores within ``margin`` of the best fitting one is asserted with its own
+(low) calibrated probability - the query never lifts a poor fit (a class named by printed text fits only when its
+text was read; the root class breaks no tie). Everything
+else is classified :data:`UNKNOWN_CLASS` ("unknown object") with confidence 1 - probability (how sure the
+classifier is that naming the best candidate would be wrong).
 """
 
 from __future__ import annotations
@@ -33,6 +41,7 @@ from dataclasses import dataclass
 from types import MappingProxyType
 from typing import ClassVar
 
+from annotators.classification.calibration import FITTED, Calibration
 from annotators.cloud.size import SIZE_CLASSES
 from robokudo.core.annotator import Annotator
 from robokudo.core.capability import Capability
@@ -43,6 +52,18 @@ WEIGHTS: Mapping[str, float] = MappingProxyType({"color": 1.0, "shape": 1.0, "si
 
 TEXT_NONE = 0.4
 """Text agreement of a profile without texts when the object has readable text."""
+
+UNKNOWN_CLASS = "PhysicalObject"
+"""The class of a hypothesis no profile fits clearly (the root class: it is some object)."""
+
+MIN_SCORE = 0.6
+"""Default score a profile needs to fit at all."""
+
+TIE_MARGIN = 0.05
+"""Default score difference within which the query's class may decide between fitting candidates."""
+
+ASSERT_PROBABILITY = 0.5
+"""Calibrated probability of being right from which a class is asserted (more likely right than wrong)."""
 
 _NOT_ALPHANUMERIC = re.compile(r"[^0-9a-z]+")
 
@@ -107,11 +128,13 @@ class Cues:
 
 @dataclass(frozen=True)
 class Match:
-    """A profile's score for one hypothesis and how many of its texts were found."""
+    """A profile's score for one hypothesis, how many of its texts were found, and whether the profile names
+    texts that were not looked for (no text was read on the hypothesis)."""
 
     profile: Profile
     score: float
     texts_found: int
+    unread: bool = False
 
 
 def _toward_neutral(agreement: float, confidence: float) -> float:
@@ -149,37 +172,95 @@ def score(profile: Profile, cues: Cues) -> Match:
         agreement = found / len(profile.texts) if profile.texts else TEXT_NONE
         total += WEIGHTS["text"] * agreement
         weight += WEIGHTS["text"]
-    return Match(profile, total / weight if weight else 0.0, found)
+    return Match(profile, total / weight if weight else 0.0, found, unread=bool(profile.texts) and not cues.text)
 
 
-def choose(matches: Sequence[Match], min_score: float, margin: float) -> Match | None:
-    """The clear winner among the matches of one hypothesis, or None (see the module docstring)."""
-    if not matches:
-        return None
+def best_match(matches: Sequence[Match]) -> Match:
+    """The best of the matches of one hypothesis: the highest score; among related profiles with that score the
+    most specific one with the most matched texts when text matched, else the most general one."""
     top = max(m.score for m in matches)
     tied = [m for m in matches if m.score >= top - 1e-9]
     if any(m.texts_found for m in tied):
-        best = max(tied, key=lambda m: (m.texts_found, len(m.profile.ancestors)))
-    else:
-        best = min(tied, key=lambda m: len(m.profile.ancestors))
-    if best.score < min_score:
-        return None
-    rivals = [m.score for m in matches if not m.profile.related(best.profile)]
-    if rivals and best.score - max(rivals) < margin:
-        return None
-    return best
+        return max(tied, key=lambda m: (m.texts_found, len(m.profile.ancestors)))
+    return min(tied, key=lambda m: len(m.profile.ancestors))
+
+
+def lead(match: Match, matches: Sequence[Match]) -> float:
+    """How far ``match`` scores above the best profile not related to it by subsumption (its own score when
+    there is none); negative when an unrelated profile scores higher."""
+    rivals = [m.score for m in matches if not m.profile.related(match.profile)]
+    return match.score - max(rivals, default=0.0)
 
 
 def choose_expected(matches: Sequence[Match], expected: str, min_score: float, margin: float) -> Match | None:
-    """When no match is clear: the best match of the expected class (or a subclass of it) if it scores at least
-    ``min_score`` and lies within ``margin`` of the best score - the query's class acts as a prior."""
-    if not matches:
-        return None
-    top = max(m.score for m in matches)
+    """The query's class breaking a near-tie: among the fitting matches within ``margin`` of the best fitting
+    score, the best one of the expected class (or a subclass); None otherwise, and always for the root class
+    (a query for any object prefers none). A match fits when it scores at least ``min_score`` and, for a class
+    named by printed text, its text was read."""
+    fitting = [m for m in matches if m.score >= min_score and not m.unread]
     wanted = expected.lower()
-    candidates = [m for m in matches if wanted in m.profile.ancestors and m.score >= min_score]
-    candidates = [m for m in candidates if top - m.score < margin]
+    if not fitting or wanted == UNKNOWN_CLASS.lower():
+        return None
+    top = max(m.score for m in fitting)
+    candidates = [m for m in fitting if top - m.score < margin and wanted in m.profile.ancestors]
     return max(candidates, key=lambda m: (m.score, -len(m.profile.ancestors)), default=None)
+
+
+@dataclass(frozen=True)
+class Decision:
+    """What the classifier says about one hypothesis and why.
+
+    ``class_name`` is the asserted class, or :data:`UNKNOWN_CLASS` when no profile fits clearly; ``confidence``
+    is the calibrated probability that the statement is right (for the unknown class: that the best candidate
+    would have been wrong). ``best`` and ``margin`` are the evidence, ``probability`` the calibrated probability
+    that ``best`` is right, ``reason`` says in words why the class was or was not asserted.
+    """
+
+    class_name: str
+    confidence: float
+    best: Match
+    margin: float
+    probability: float
+    reason: str
+
+
+def decide(
+    matches: Sequence[Match],
+    *,
+    min_score: float = MIN_SCORE,
+    margin: float = TIE_MARGIN,
+    expected: str | None = None,
+    calibration: Calibration = FITTED,
+    assert_probability: float = ASSERT_PROBABILITY,
+) -> Decision:
+    """The class of one hypothesis from its matches (see the module docstring); ValueError without matches."""
+    if not matches:
+        raise ValueError("no profile matches to decide from")
+    best = best_match(matches)
+    best_lead = lead(best, matches)
+    p = calibration.probability(best.score, best_lead, best.unread)
+    name = best.profile.class_name
+    if best.score >= min_score and p >= assert_probability:
+        return Decision(name, p, best, best_lead, p, f"fits {name} (score {best.score:.2f}, lead {best_lead:.2f})")
+    if expected:
+        pick = choose_expected(matches, expected, min_score, margin)
+        if pick is not None:
+            pick_lead = lead(pick, matches)
+            return Decision(
+                pick.profile.class_name,
+                calibration.probability(pick.score, pick_lead, pick.unread),
+                best,
+                best_lead,
+                p,
+                f"{pick.profile.class_name} fits (score {pick.score:.2f}) as well as any other class; "
+                f"the query's class decides",
+            )
+    why = (
+        f"no class fits: the closest, {name}, scores {best.score:.2f}"
+        if best.score < min_score
+        else f"{name} fits (score {best.score:.2f}) but leads only by {best_lead:.2f}: right with probability {p:.2f}"
+    )
+    return Decision(UNKNOWN_CLASS, 1.0 - p, best, best_lead, p, why)
 
 
 class KnowledgeClassifier(Annotator):
@@ -190,7 +271,7 @@ class KnowledgeClassifier(Annotator):
     outputs: ClassVar[tuple[type[CasType], ...]] = (Classification,)
     capability: ClassVar[Capability] = Capability(
         label="knowledge classifier",
-        classes=("PhysicalObject",),
+        classes=(UNKNOWN_CLASS,),
         cost_ms=0.5,
         reliability=0.7,
     )
@@ -199,11 +280,11 @@ class KnowledgeClassifier(Annotator):
         self,
         profiles: Sequence[Mapping[str, object]] = (),
         name: str | None = None,
-        min_score: float = 0.6,
-        margin: float = 0.1,
+        min_score: float = MIN_SCORE,
+        margin: float = TIE_MARGIN,
         expected: str | None = None,
     ) -> None:
-        """``expected`` is the class the query asks for; it decides between near-equal candidates."""
+        """``expected`` is the class the query asks for; it only decides between near-equal fitting candidates."""
         super().__init__(name=name)
         self.profiles = tuple(Profile.from_mapping(p) for p in profiles)
         self.min_score = min_score
@@ -223,30 +304,26 @@ class KnowledgeClassifier(Annotator):
             text=" ".join(texts) or None,
         )
 
+    def decide(self, cues: Cues) -> Decision:
+        """The decision for one hypothesis' cues with this classifier's profiles and parameters."""
+        matches = [score(profile, cues) for profile in self.profiles]
+        return decide(matches, min_score=self.min_score, margin=self.margin, expected=self.expected)
+
     def analyse(self) -> None:
-        """Attach a Classification to every hypothesis with a clear best profile (unclear ones stay unclassified)."""
+        """Attach a Classification to every hypothesis that carries cues: its class when one fits clearly, else
+        :data:`UNKNOWN_CLASS` (so the answer can say "unknown object")."""
         if not self.profiles:
             self.fail("no candidate class profiles to compare the hypotheses with")
         hypotheses = self.annotations(ObjectHypothesis)
         if not hypotheses:
             self.fail("no object hypotheses to classify")
-        best_seen: Match | None = None
         classified = 0
         for hypothesis in hypotheses:
             cues = self.cues(hypothesis)
             if cues == Cues():
                 continue
-            matches = [score(profile, cues) for profile in self.profiles]
-            top = max(matches, key=lambda m: m.score)
-            if best_seen is None or top.score > best_seen.score:
-                best_seen = top
-            winner = choose(matches, self.min_score, self.margin)
-            if winner is None and self.expected:
-                winner = choose_expected(matches, self.expected, self.min_score, self.margin)
-            if winner is not None:
-                self.attach(hypothesis, Classification(class_name=winner.profile.class_name, confidence=winner.score))
-                classified += 1
-        if classified == 0 and best_seen is None:
+            decision = self.decide(cues)
+            self.attach(hypothesis, Classification(class_name=decision.class_name, confidence=decision.confidence))
+            classified += 1
+        if classified == 0:
             self.fail("no object hypothesis carries a colour, shape, size or text to classify by")
-        # hypotheses that match no profile clearly stay unclassified: "none of these is a known class" is an
-        # answer, so the tree goes on and the query is answered with the objects that did match (maybe none)

@@ -18,7 +18,11 @@ from typing import Any
 from reasoning.beliefs.store import BeliefFilter, BeliefStore
 from reasoning.fusion.rule import CLASS_ATTRIBUTE, ClassTest
 from reasoning.fusion.tracking import ObjectBelief
+from reasoning.knowledge.index import ROOTS
 from robokudo.core.types import ONTOLOGY_NAMESPACE, SemanticColor, Size
+
+UNKNOWN_LABEL = "unknown object"
+"""The label of an object of no known class: unclassified, or only the root class (no class profile fitted)."""
 
 
 def class_iri(class_name: str) -> str:
@@ -115,6 +119,10 @@ class ObjectDesignator:
         }
 
 
+def _local(class_name: str) -> str:
+    return re.split(r"[#/]", class_name)[-1]
+
+
 def _rounded(values: tuple[float, ...]) -> list[float]:
     return [round(float(v), 6) for v in values]
 
@@ -150,7 +158,7 @@ class Answer:
             p = o.pose.position
             colour = o.attributes.get(SemanticColor.attribute)
             lines.append(
-                f"#{o.id} {o.class_label or 'object'}"
+                f"#{o.id} {o.class_label or UNKNOWN_LABEL}"
                 + (f" ({colour.value})" if colour else "")
                 + f" at ({p[0]:.3f}, {p[1]:.3f}, {p[2]:.3f}) [{o.pose.frame}]"
                 + (f" in {o.region}" if o.region else "")
@@ -184,7 +192,7 @@ def designator(
     return ObjectDesignator(
         id=belief.id,
         class_iri=iri_of(class_name) if class_name else None,
-        class_label=label_of(class_name) if class_name else None,
+        class_label=label_of(class_name) if class_name and _local(class_name) != ROOTS["class"] else UNKNOWN_LABEL,
         pose=PoseDesignator(position=(x, y, z), orientation=(qx, qy, qz, qw), frame=belief.frame),
         size=None if belief.dimensions is None else tuple(belief.dimensions.tolist()),  # type: ignore[arg-type]
         size_class=size_attribute.value if size_attribute else None,

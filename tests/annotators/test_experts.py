@@ -7,7 +7,14 @@ import numpy as np
 import pytest
 from py_trees.common import Status
 
-from annotators.classification.knowledge_classifier import Cues, KnowledgeClassifier, Profile, choose, score
+from annotators.classification.knowledge_classifier import (
+    UNKNOWN_CLASS,
+    Cues,
+    KnowledgeClassifier,
+    Profile,
+    decide,
+    score,
+)
 from annotators.cloud.filters import CropBoxFilter, RegionFilter
 from annotators.cloud.normals import grid_normals
 from annotators.cloud.point_cloud import PointCloudGenerator
@@ -234,8 +241,8 @@ PROFILES = [Profile.from_mapping(p) for p in (MILK, LACTOSE_FREE, WHOLE, CEREAL,
 
 
 def winner(evidence: Cues) -> str | None:
-    match = choose([score(p, evidence) for p in PROFILES], min_score=0.6, margin=0.1)
-    return match.profile.class_name if match is not None else None
+    decision = decide([score(p, evidence) for p in PROFILES])
+    return None if decision.class_name == UNKNOWN_CLASS else decision.class_name
 
 
 def test_text_picks_the_most_specific_matching_variant() -> None:
@@ -243,7 +250,8 @@ def test_text_picks_the_most_specific_matching_variant() -> None:
     assert winner(Cues(**{**white_box.__dict__, "text": "MILK lactose free"})) == "LactoseFreeMilk"
     assert winner(Cues(**{**white_box.__dict__, "text": "Whole MILK"})) == "WholeMilk"
     assert winner(Cues(**{**white_box.__dict__, "text": "MILK"})) == "Milk"
-    assert winner(white_box) == "Milk"  # no text: no evidence for a variant, the general class
+    # no text read: milk is named by its printed text, so a white box alone is not asserted to be milk
+    assert winner(white_box) is None
 
 
 def test_colour_shape_and_size_decide_without_text() -> None:
@@ -300,14 +308,14 @@ def test_image_regions_find_the_table_objects_without_depth() -> None:
 
 
 def test_the_queried_class_decides_between_near_equal_candidates() -> None:
-    from annotators.classification.knowledge_classifier import Cues, Profile, choose, choose_expected, score
+    from annotators.classification.knowledge_classifier import choose_expected
 
     cola = Profile.from_mapping({"class": "Cola", "colors": ("red",), "shape": "cylinder", "size": "small"})
     cup = Profile.from_mapping({"class": "Cup", "shape": "cylinder", "size": "small", "ancestors": ("Container",)})
     bowl = Profile.from_mapping({"class": "Bowl", "shape": "sphere", "size": "medium"})
     evidence = Cues(color=("red", 0.3), shape=("cylinder", 0.8), size=("small", 1.0))
     matches = [score(p, evidence) for p in (cola, cup, bowl)]
-    assert choose(matches, 0.6, 0.1) is None  # Cola and Cup are too close to call without a prior
+    assert decide(matches).class_name == UNKNOWN_CLASS  # Cola and Cup are too close to call without a prior
     assert choose_expected(matches, "Cup", 0.6, 0.1).profile.class_name == "Cup"
     assert choose_expected(matches, "Container", 0.6, 0.1).profile.class_name == "Cup"
     assert choose_expected(matches, "Bowl", 0.6, 0.1) is None  # the prior never overrides clear evidence

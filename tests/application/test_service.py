@@ -36,14 +36,16 @@ def test_three_queries_share_one_engine_and_one_knowledge_base_load(
         milk = service.answer("find milk in fridge").answer
         ticks_after_first = engine.tick_count
         cup = service.answer("find the red cup").answer
-        bowl = service.answer("detect { obj: { type: bowl, color: blue } }").answer
+        # (not the bowl: from the table camera it is a blue sphere, a bowl as much as a fruit, so it is stored as an
+        # unknown object and a later query for bowls does not relabel it)
+        box = service.answer("detect { obj: { type: CerealBox, color: yellow } }").answer
         assert service.engine is engine and engine.tick_count > ticks_after_first
     assert len(loads) == 1
     assert len(milk.objects) == 1 and "milk" in (milk.objects[0].class_label or "")
     assert milk.objects[0].region == "fridge"
     assert [o.class_label for o in cup.objects] == ["cup"] and cup.objects[0].attributes["color"].value == "red"
-    assert [o.class_label for o in bowl.objects] == ["bowl"]
-    assert len({milk.objects[0].id, cup.objects[0].id, bowl.objects[0].id}) == 3
+    assert [o.class_label for o in box.objects] == ["cereal box"]
+    assert len({milk.objects[0].id, cup.objects[0].id, box.objects[0].id}) == 3
 
 
 def test_every_query_kind_has_one_execution_mode() -> None:
