@@ -20,7 +20,9 @@ uncertain evidence counts less. The score is the weighted mean over the observed
 (text is strong evidence). A hypothesis is classified as the best profile when its score is at least
 ``min_score`` and beats every profile not related to it by subsumption by ``margin``. When none is clear and
 the query asked for a class (``expected``), a match of that class within ``margin`` of the best wins: the query
-is a prior, deciding only between near-equal candidates. Among related profiles
+is a prior, deciding only between near-equal candidates, and such a guess is stated with confidence
+:data:`GUESS_CONFIDENCE` (no evidence for the class over its rivals), so the answer may offer the object while
+its belief takes no class from the query. Among related profiles
 with the same score, the most specific one with the most matched texts wins when text was read and matched
 (lactose-free milk over milk), else the most general one (no evidence for a variant).
 """
@@ -40,6 +42,9 @@ from robokudo.core.types import CasType, Classification, ObjectHypothesis, Seman
 
 WEIGHTS: Mapping[str, float] = MappingProxyType({"color": 1.0, "shape": 1.0, "size": 0.5, "text": 3.0})
 """How much each cue counts in the score."""
+
+GUESS_CONFIDENCE = 0.5
+"""Confidence of a class chosen by the query's prior among near-equal candidates: log-odds 0, no evidence."""
 
 TEXT_NONE = 0.4
 """Text agreement of a profile without texts when the object has readable text."""
@@ -241,10 +246,11 @@ class KnowledgeClassifier(Annotator):
             if best_seen is None or top.score > best_seen.score:
                 best_seen = top
             winner = choose(matches, self.min_score, self.margin)
+            confidence = winner.score if winner is not None else GUESS_CONFIDENCE
             if winner is None and self.expected:
                 winner = choose_expected(matches, self.expected, self.min_score, self.margin)
             if winner is not None:
-                self.attach(hypothesis, Classification(class_name=winner.profile.class_name, confidence=winner.score))
+                self.attach(hypothesis, Classification(class_name=winner.profile.class_name, confidence=confidence))
                 classified += 1
         if classified == 0 and best_seen is None:
             self.fail("no object hypothesis carries a colour, shape, size or text to classify by")

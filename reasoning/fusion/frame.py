@@ -4,6 +4,10 @@ Hypotheses that cover the same points (overlap ``|A∩B| / min(|A|, |B|)`` of th
 masks) are merged into one :class:`FrameObject`; the annotations attached to any of them become
 :class:`~reasoning.fusion.rule.Evidence` of that object. Positions are put in the world frame when the camera pose
 is known. Pure numpy: no open3d, no knowledge base.
+
+An object whose geometry its own points do not bear out is marked with a ``doubt`` (:func:`geometry_doubt`): too
+few points, tiny, implausibly large, or a stated position or size the bulk of its points contradicts (the segment
+took in points of other surfaces). Such an object may confirm a known belief but never creates one.
 """
 
 from __future__ import annotations
@@ -24,6 +28,23 @@ AttachedReader = Callable[[ObjectHypothesis, type[A]], list[A]]
 
 WORLD_FRAME = "world"
 """The name of the fixed frame positions are expressed in when the camera pose is known."""
+
+MIN_POINTS = 30
+"""An object with fewer valid 3-D points than this has too little support to become a belief."""
+
+MIN_EXTENT = 0.01
+"""An object whose largest extent (metres) is below this is too tiny to be told from noise."""
+
+MAX_EXTENT = 2.0
+"""An object whose largest extent (metres) is above this is no graspable object but a merge of surfaces."""
+
+ROBUST_PERCENTILES = (2.0, 98.0)
+"""The bulk of an object's points: the percentiles its robust box spans on every axis."""
+
+BULK_TOLERANCE = 1.25
+"""How far a stated size may exceed the diagonal of the bulk's box, and (as a share of that diagonal beyond it)
+how far a stated position may lie outside the box: a box fitted to the points never exceeds them, so only points
+the bulk does not have (another surface) push it further; the tolerance covers the trimmed percentiles."""
 
 DEFAULT_MIN_OVERLAP = 0.6
 """Two hypotheses whose point sets overlap at least this much (of the smaller one) are one object."""
@@ -50,6 +71,10 @@ class FrameObject:
     roi: tuple[int, int, int, int] | None = None
     confidence: float = 1.0
     hypotheses: int = 1
+    recording: str = ""
+    """The recording the frame belongs to (``CameraInfo.recording``)."""
+    doubt: str = ""
+    """Why the object's geometry is not trusted ("" when it is); a doubted object never creates a belief."""
 
     def values(self, attribute: str) -> set[str]:
         """The values stated for ``attribute`` in this frame."""
@@ -64,6 +89,7 @@ class FrameContext:
     cam_to_world: np.ndarray | None = None
     camera_frame: str = "camera"
     time: float = 0.0
+    recording: str = ""
 
 
 def _default_reader(hypothesis: ObjectHypothesis, annotation_type: type[A]) -> list[A]:
@@ -252,6 +278,7 @@ def _merge_group(
         summed = np.sum(same, axis=0).ravel()
         total = summed.sum()
         appearance = summed / total if total > 0 else None
+    doubt = geometry_doubt(position, dimensions, points)
     evidence = [e for h in members for e in hypothesis_evidence(h, context.time, reader)]
     sources = {h.source for h in members if h.source}
     sources.update(e.source for e in evidence)
@@ -268,4 +295,33 @@ def _merge_group(
         roi=_union_roi([h.roi for h in members]),
         confidence=max(h.confidence for h in members),
         hypotheses=len(members),
+        recording=context.recording,
+        doubt=doubt,
     )
+
+
+def geometry_doubt(position: np.ndarray, dimensions: np.ndarray | None, points: np.ndarray | None) -> str:
+    """Why an object's stated position and size are not to be trusted, or "" (see :data:`BULK_TOLERANCE`).
+
+    ``points`` are the object's valid points in the frame of ``position`` (None when the frame has no cloud: then
+    only the stated size is checked).
+    """
+    if points is not None and points.shape[0] < MIN_POINTS:
+        return f"only {points.shape[0]} valid points"
+    if dimensions is not None and len(dimensions):
+        largest = float(np.max(dimensions))
+        if largest < MIN_EXTENT:
+            return f"tiny ({largest * 100:.1f} cm)"
+        if largest > MAX_EXTENT:
+            return f"implausibly large ({largest:.2f} m)"
+    if points is None:
+        return ""
+    low, high = np.percentile(points, ROBUST_PERCENTILES, axis=0)
+    diagonal = float(np.linalg.norm(high - low))
+    if dimensions is not None and len(dimensions) and float(np.max(dimensions)) > BULK_TOLERANCE * diagonal:
+        return f"stated size {float(np.max(dimensions)):.2f} m exceeds its points' extent ({diagonal:.2f} m)"
+    margin = (BULK_TOLERANCE - 1.0) * diagonal
+    outside = float(np.max(np.maximum(low - margin - position, position - high - margin)))
+    if outside > 0:
+        return f"stated position lies {outside:.2f} m outside its points"
+    return ""
