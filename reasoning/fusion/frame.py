@@ -6,8 +6,10 @@ masks) are merged into one :class:`FrameObject`; the annotations attached to any
 is known. Pure numpy: no open3d, no knowledge base.
 
 An object whose geometry its own points do not bear out is marked with a ``doubt`` (:func:`geometry_doubt`): too
-few points, tiny, implausibly large, or a stated position or size the bulk of its points contradicts (the segment
-took in points of other surfaces). Such an object may confirm a known belief but never creates one.
+few points, tiny, flat, implausibly large, or a stated size the bulk of its points contradicts (the segment took
+in points of other surfaces). Such an object may confirm a known belief but never creates one. A stated position
+outside the bulk of the object's points is an expert's error: the object is put at the bulk's centre
+(:func:`placed_on_points`).
 """
 
 from __future__ import annotations
@@ -35,8 +37,16 @@ MIN_POINTS = 30
 MIN_EXTENT = 0.01
 """An object whose largest extent (metres) is below this is too tiny to be told from noise."""
 
+FLAT_EXTENT = 0.005
+"""An object thinner than this (metres, its smallest extent: about a depth sensor's noise) is a patch of a surface,
+not something standing out of it."""
+
 MAX_EXTENT = 2.0
-"""An object whose largest extent (metres) is above this is no graspable object but a merge of surfaces."""
+"""An object whose largest extent (metres) is above this is no object a robot handles but a merge of surfaces."""
+
+MAX_FOOTPRINT = 0.5
+"""An object whose middle extent (metres) is above this is furniture-sized in two directions (a table top, a patch
+of floor or wall): long thin things (a broom) pass, broad ones are no object a robot handles."""
 
 ROBUST_PERCENTILES = (2.0, 98.0)
 """The bulk of an object's points: the percentiles its robust box spans on every axis."""
@@ -44,7 +54,8 @@ ROBUST_PERCENTILES = (2.0, 98.0)
 BULK_TOLERANCE = 1.25
 """How far a stated size may exceed the diagonal of the bulk's box, and (as a share of that diagonal beyond it)
 how far a stated position may lie outside the box: a box fitted to the points never exceeds them, so only points
-the bulk does not have (another surface) push it further; the tolerance covers the trimmed percentiles."""
+the bulk does not have (another surface, stray depth) push it further; the tolerance covers the trimmed
+percentiles."""
 
 DEFAULT_MIN_OVERLAP = 0.6
 """Two hypotheses whose point sets overlap at least this much (of the smaller one) are one object."""
@@ -278,7 +289,8 @@ def _merge_group(
         summed = np.sum(same, axis=0).ravel()
         total = summed.sum()
         appearance = summed / total if total > 0 else None
-    doubt = geometry_doubt(position, dimensions, points)
+    position = placed_on_points(np.asarray(position, dtype=np.float64), points)
+    doubt = geometry_doubt(dimensions, points)
     evidence = [e for h in members for e in hypothesis_evidence(h, context.time, reader)]
     sources = {h.source for h in members if h.source}
     sources.update(e.source for e in evidence)
@@ -300,28 +312,43 @@ def _merge_group(
     )
 
 
-def geometry_doubt(position: np.ndarray, dimensions: np.ndarray | None, points: np.ndarray | None) -> str:
-    """Why an object's stated position and size are not to be trusted, or "" (see :data:`BULK_TOLERANCE`).
+def _bulk(points: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    low, high = np.percentile(points, ROBUST_PERCENTILES, axis=0)
+    return low, high
 
-    ``points`` are the object's valid points in the frame of ``position`` (None when the frame has no cloud: then
-    only the stated size is checked).
+
+def placed_on_points(position: np.ndarray, points: np.ndarray | None) -> np.ndarray:
+    """``position``, or the centre of the bulk of ``points`` when it lies outside their box by more than the
+    tolerance (:data:`BULK_TOLERANCE`); ``points`` are in the frame of ``position``."""
+    if points is None or points.shape[0] < MIN_POINTS:
+        return position
+    low, high = _bulk(points)
+    margin = (BULK_TOLERANCE - 1.0) * float(np.linalg.norm(high - low))
+    if np.all(position >= low - margin) and np.all(position <= high + margin):
+        return position
+    return (low + high) / 2.0
+
+
+def geometry_doubt(dimensions: np.ndarray | None, points: np.ndarray | None) -> str:
+    """Why an object's stated size and support are not to be trusted, or "" (see :data:`BULK_TOLERANCE`).
+
+    ``points`` are the object's valid points (None when the frame has no cloud: then only the size is checked).
     """
     if points is not None and points.shape[0] < MIN_POINTS:
         return f"only {points.shape[0]} valid points"
     if dimensions is not None and len(dimensions):
-        largest = float(np.max(dimensions))
+        extents = np.sort(np.asarray(dimensions, dtype=np.float64))[::-1]
+        largest, middle, smallest = float(extents[0]), float(extents[len(extents) // 2]), float(extents[-1])
         if largest < MIN_EXTENT:
             return f"tiny ({largest * 100:.1f} cm)"
-        if largest > MAX_EXTENT:
-            return f"implausibly large ({largest:.2f} m)"
+        if smallest < FLAT_EXTENT:
+            return f"flat ({smallest * 1000:.0f} mm thick): a patch of a surface"
+        if largest > MAX_EXTENT or middle > MAX_FOOTPRINT:
+            return f"implausibly large ({' x '.join(f'{e:.2f}' for e in extents)} m)"
     if points is None:
         return ""
-    low, high = np.percentile(points, ROBUST_PERCENTILES, axis=0)
+    low, high = _bulk(points)
     diagonal = float(np.linalg.norm(high - low))
     if dimensions is not None and len(dimensions) and float(np.max(dimensions)) > BULK_TOLERANCE * diagonal:
         return f"stated size {float(np.max(dimensions)):.2f} m exceeds its points' extent ({diagonal:.2f} m)"
-    margin = (BULK_TOLERANCE - 1.0) * diagonal
-    outside = float(np.max(np.maximum(low - margin - position, position - high - margin)))
-    if outside > 0:
-        return f"stated position lies {outside:.2f} m outside its points"
     return ""

@@ -115,14 +115,16 @@ def test_a_failed_query_stores_no_phantom_and_bowls_stay_one_belief_each(
 def test_a_doubted_object_confirms_a_belief_but_never_creates_one(tmp_path: Path) -> None:
     grid = np.zeros((10, 10, 3), dtype=np.float32)
     grid[..., 0], grid[..., 1] = np.meshgrid(np.linspace(0, 0.05, 10), np.linspace(0, 0.05, 10))
-    grid[..., 2] = 0.8
+    grid[..., 2] = np.linspace(0.8, 0.83, 10)[:, None]
     mask = np.ones((10, 10), dtype=bool)
     off = ObjectHypothesis(point_indices=np.arange(100), mask=mask, roi=(0, 0, 10, 10))
     off.annotations += [Pose(position=np.array([0.02, 0.02, 1.4]), orientation=np.array([0, 0, 0, 1.0]))]
-    (doubted,) = frame_objects([off], FrameContext(points=grid))
-    assert "outside its points" in doubted.doubt
-    assert "exceeds" in geometry_doubt(np.array([0.02, 0.02, 0.8]), np.array([0.5, 0.05, 0.01]), grid.reshape(-1, 3))
-    assert "valid points" in geometry_doubt(np.zeros(3), None, grid.reshape(-1, 3)[:5])
+    (placed,) = frame_objects([off], FrameContext(points=grid))  # a pose 60 cm behind its points is an error
+    assert placed.doubt == "" and placed.position[2] == pytest.approx(0.815, abs=0.01)
+    assert "exceeds" in geometry_doubt(np.array([0.5, 0.05, 0.02]), grid.reshape(-1, 3))
+    assert "valid points" in geometry_doubt(None, grid.reshape(-1, 3)[:5])
+    assert "flat" in geometry_doubt(np.array([0.3, 0.1, 0.002]), None)
+    assert "implausibly large" in geometry_doubt(np.array([0.8, 0.7, 0.2]), None)
     good = ObjectHypothesis(point_indices=np.arange(100), mask=mask, roi=(0, 0, 10, 10))
     good.annotations += [Size(dimensions=np.array([0.05, 0.05, 0.01]), size_class="small")]
     (trusted,) = frame_objects([good], FrameContext(points=grid))
