@@ -19,8 +19,9 @@ from queries import Query
 from reasoning.beliefs.answer import Answer, class_label, designator
 from reasoning.beliefs.store import BeliefFilter, BeliefStore
 from reasoning.fusion.association import CameraModel
-from reasoning.fusion.frame import FUSED_TYPES, WORLD_FRAME, FrameContext, frame_objects
-from reasoning.fusion.tracking import BeliefTracker
+from reasoning.fusion.frame import FUSED_TYPES, WORLD_FRAME, FrameContext, FrameObject, frame_objects
+from reasoning.fusion.rule import CLASS_ATTRIBUTE
+from reasoning.fusion.tracking import BeliefTracker, ObjectBelief
 from robokudo.core.annotator import Annotator
 from robokudo.core.types import CameraInfo, CasType, DepthImage, ObjectHypothesis, PointCloud, QueryAnswer, QueryView
 
@@ -33,6 +34,7 @@ def camera_model(info: CameraInfo, depth: np.ndarray | None = None) -> CameraMod
         to_frame=np.asarray(info.cam_to_world, dtype=np.float64) if known else np.eye(4),
         frame=WORLD_FRAME if known else info.frame_id,
         depth=depth,
+        recording=info.recording,
     )
 
 
@@ -45,9 +47,11 @@ class AnswerStep(Annotator):
     ``store`` is a store, a path, a factory, or None for :meth:`BeliefStore.default_path`; it is opened on the
     first run. ``tracker`` (class test, regions, gates) defaults to the store's. The query's filter is
     ``belief_filter``, or ``filter_for(query)`` of the CAS's QueryView, or everything seen. The answer holds
-    the matching objects seen in this frame, most confident first, with their image ROI; ``label_of`` names
-    classes (e.g. the knowledge base's labels). With ``fail_when_empty`` the step fails when nothing matches.
-    ``timestamp`` 0 in CameraInfo means unknown: ``clock()`` is used instead.
+    the matching objects seen in this frame, most confident first, with their image ROI (an object an expert only
+    guessed to be of the asked class is a candidate too, see :meth:`_guessed`); ``label_of`` names classes (e.g.
+    the knowledge base's labels). Objects whose geometry is in doubt confirm known beliefs but create none. With
+    ``fail_when_empty`` the step fails when nothing matches. ``timestamp`` 0 in CameraInfo means unknown: ``clock()``
+    is used instead.
     """
 
     inputs: ClassVar[tuple[type[CasType], ...]] = (ObjectHypothesis,)
@@ -107,14 +111,17 @@ class AnswerStep(Annotator):
             cam_to_world=info.cam_to_world if info is not None else None,
             camera_frame=info.frame_id if info is not None else "camera",
             time=stamp,
+            recording=info.recording if info is not None else "",
         )
         objects = frame_objects(hypotheses, context, min_overlap=self.min_overlap, read=self.attached)
         camera = camera_model(info, depth.depth if depth is not None else None) if info is not None else None
         store = self.store
         step = store.integrate(objects, stamp, camera=camera, tracker=self.tracker)
         belief_filter = self._filter()
-        seen = dict(zip(step.assigned, objects, strict=True))
+        seen = {i: o for i, o in zip(step.assigned, objects, strict=True) if i}
         matching = store.query(replace(belief_filter, ids=tuple(seen), limit=None))
+        guesses = self._guessed(store, belief_filter, seen, {b.id for b in matching})
+        matching += guesses.values()
         matching.sort(key=lambda b: (-b.confidence, b.id))
         if belief_filter.limit is not None:
             matching = matching[: belief_filter.limit]
@@ -123,7 +130,13 @@ class AnswerStep(Annotator):
         answer = Answer(
             query=str(text or ""),
             objects=tuple(
-                designator(b, class_test=belief_filter.class_test, roi=seen[b.id].roi, label_of=self.label_of)
+                designator(
+                    b,
+                    class_test=belief_filter.class_test,
+                    roi=seen[b.id].roi,
+                    label_of=self.label_of,
+                    guessed_class=belief_filter.object_class if b.id in guesses else None,
+                )
                 for b in matching
             ),
             observed=tuple(step.assigned),
@@ -131,6 +144,30 @@ class AnswerStep(Annotator):
         self.write(QueryAnswer(answer))
         if self.fail_when_empty and not matching:
             self.fail(f"no object matches the query among {len(objects)} seen")
+
+    @staticmethod
+    def _guessed(
+        store: BeliefStore, belief_filter: BeliefFilter, seen: dict[int, FrameObject], found: set[int]
+    ) -> dict[int, ObjectBelief]:
+        """Objects seen in this frame that an expert named the asked class (or a subclass of it) without evidence
+        to store (confidence 0.5 at most: a guess, e.g. the classifier deciding a tie by the query) and that match
+        the rest of the filter, by id: answered as candidates of the asked class, though their belief keeps no
+        such class."""
+        wanted = belief_filter.object_class
+        if not wanted:
+            return {}
+        test = belief_filter.class_test or (lambda a, b: a.lower() == b.lower())
+        guessed = tuple(
+            i
+            for i, item in seen.items()
+            if i not in found
+            and any(
+                e.attribute == CLASS_ATTRIBUTE and e.confidence <= 0.5 and test(e.value, wanted) for e in item.evidence
+            )
+        )
+        if not guessed:
+            return {}
+        return {b.id: b for b in store.query(replace(belief_filter, object_class=None, ids=guessed, limit=None))}
 
     def _filter(self) -> BeliefFilter:
         if self.belief_filter is not None:

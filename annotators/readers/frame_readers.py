@@ -9,7 +9,9 @@
 :func:`annotators.readers.choice.reader_for` picks the reader from a path. Every reader decodes once and keeps the frame
 on the instance, so repeated ticks of the same frame cost nothing but the CAS writes; the arrays are shared with
 the CAS, never copied, and must not be modified downstream. Recorded frames have no camera pose
-(``cam_to_world`` is None).
+(``cam_to_world`` is None). Every reader names the recording its frame belongs to (``CameraInfo.recording``): a
+sequence folder (TUM, TIFF) is one continuous recording, while each file of a uoc folder, a TUM pair or a PCD file
+is a snapshot of its own; all views of the built-in kitchen show one world (``KITCHEN_RECORDING``).
 """
 
 from __future__ import annotations
@@ -32,6 +34,8 @@ from robokudo.core.capability import Capability
 from robokudo.core.types import CameraInfo, CameraIntrinsics, CasType, ColorImage, DepthImage, PointCloud, QueryView
 
 DEFAULT_KITCHEN_VIEW = "table"
+KITCHEN_RECORDING = "kitchen"
+"""The recording of every view of the built-in kitchen: one simulated world."""
 
 
 class KitchenSceneReader(Annotator):
@@ -93,6 +97,7 @@ class KitchenSceneReader(Annotator):
                 cam_to_world=scene.cam_to_world,
                 frame_id=f"kitchen/{view}",
                 timestamp=time.time(),
+                recording=KITCHEN_RECORDING,
             )
         )
 
@@ -116,6 +121,10 @@ class FileFrameReader(Annotator):
     def decode(self) -> Frame:
         """Read the frame from disk; raises FrameError with the reason."""
 
+    @abstractmethod
+    def recording(self) -> str:
+        """The recording this frame belongs to: the sequence for a continuous recording, else the snapshot."""
+
     @property
     def last_frame(self) -> Frame | None:
         """The decoded frame (with ground-truth labels when the file has them), None before the first read."""
@@ -138,7 +147,9 @@ class FileFrameReader(Annotator):
         self.write(ColorImage(frame.color))
         self.write(DepthImage(frame.depth))
         stamp = frame.timestamp if frame.timestamp is not None else time.time()
-        self.write(CameraInfo(intrinsics=frame.intrinsics, frame_id="camera", timestamp=stamp))
+        self.write(
+            CameraInfo(intrinsics=frame.intrinsics, frame_id="camera", timestamp=stamp, recording=self.recording())
+        )
         if PointCloud in self.outputs:
             if frame.points is None:
                 self.fail(f"{frame.source} holds no point cloud")
@@ -173,6 +184,10 @@ class ColorDepthPairReader(FileFrameReader):
         """Decode the pair of PNGs with the folder's camera parameters."""
         return read_color_depth_pair(self.folder, self.frame, self.depth_scale)
 
+    def recording(self) -> str:
+        """The frame itself: the frames of a uoc folder are separate scenes, not one recording."""
+        return f"{self.folder.resolve()}#{self.frame:06d}"
+
 
 class TumSequenceReader(FileFrameReader):
     """Reads frame ``frame`` (time order) of a TUM RGB-D sequence folder (rgb.txt, depth.txt).
@@ -206,6 +221,10 @@ class TumSequenceReader(FileFrameReader):
         """Associate colour and depth by time stamp and decode the chosen pair."""
         return read_tum_sequence(self.folder, self.frame, self.depth_scale, self.intrinsics)
 
+    def recording(self) -> str:
+        """The sequence folder: one continuous recording."""
+        return str(self.folder.resolve())
+
 
 class TumPairReader(FileFrameReader):
     """Reads one TUM-style colour/depth pair given by either file (``TUM_color.png`` beside ``TUM_depth.png``).
@@ -236,6 +255,10 @@ class TumPairReader(FileFrameReader):
         """Find the other file of the pair and decode both."""
         return read_tum_pair(self.path, self.depth_scale, self.intrinsics)
 
+    def recording(self) -> str:
+        """The pair's file: a snapshot of its own."""
+        return str(self.path.resolve())
+
 
 class PcdReader(FileFrameReader):
     """Reads an organized PCD file (x y z rgb/rgba, optional ``label``): colour, depth (z), camera info and the
@@ -257,6 +280,10 @@ class PcdReader(FileFrameReader):
     def decode(self) -> Frame:
         """Decode the PCD file."""
         return read_pcd(self.path, self.intrinsics)
+
+    def recording(self) -> str:
+        """The PCD file: a snapshot of its own."""
+        return str(self.path.resolve())
 
 
 class TiffSequenceReader(FileFrameReader):
@@ -289,3 +316,7 @@ class TiffSequenceReader(FileFrameReader):
     def decode(self) -> Frame:
         """Decode the frame's TIFFs with the XML intrinsics."""
         return read_tiff_frame(self.folder, self.frame, self.depth_scale, self.intrinsics)
+
+    def recording(self) -> str:
+        """The grabber folder: one continuous recording."""
+        return str(self.folder.resolve())

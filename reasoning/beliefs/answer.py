@@ -174,10 +174,16 @@ def designator(
     roi: tuple[int, int, int, int] | None = None,
     iri_of: Callable[[str], str] = class_iri,
     label_of: Callable[[str], str] = class_label,
+    guessed_class: str | None = None,
 ) -> ObjectDesignator:
-    """The designator of a belief; ``roi`` is given when the object was seen in the current image."""
+    """The designator of a belief; ``roi`` is given when the object was seen in the current image.
+
+    ``guessed_class`` names the object when this answer offers it as a candidate of that class without evidence
+    the belief keeps (its class attribute still shows what the evidence says).
+    """
     attributes: dict[str, AttributeDesignator] = {}
-    for name, fused in belief.fused(class_test).items():
+    every = belief.fused(class_test)
+    for name, fused in every.items():
         attributes[name] = AttributeDesignator(
             value=fused.value,
             confidence=fused.confidence,
@@ -185,7 +191,10 @@ def designator(
             alternatives=tuple(Alternative(s.value, s.confidence, s.sources) for s in fused.support),
             conflict=fused.conflict,
         )
-    class_name = belief.class_name or (attributes[CLASS_ATTRIBUTE].value if CLASS_ATTRIBUTE in attributes else None)
+    fused_class = every.get(CLASS_ATTRIBUTE)
+    class_name = guessed_class or belief.class_name
+    if class_name is None and fused_class is not None and fused_class.supported:
+        class_name = fused_class.value
     size_attribute = attributes.get(Size.attribute)
     x, y, z = belief.position.tolist()
     qx, qy, qz, qw = belief.orientation.tolist()

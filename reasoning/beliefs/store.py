@@ -6,12 +6,15 @@
   (SIGKILL) and the file never corrupts; only a power loss or OS crash may lose the last commits. Pass
   ``synchronous="FULL"`` to also survive power loss, at the cost of an fsync per commit.
 * A file that is not a valid belief store is never modified: opening it raises :class:`BeliefStoreError`
-  naming the file and how to move it aside.
+  naming the file and how to move it aside. A store of schema version 1 (before recordings were stored) is
+  migrated in one transaction: its beliefs and sightings get an empty recording, so its camera-frame beliefs are
+  never confused with new observations, while its world-frame beliefs go on being updated.
 
-Tables: ``objects`` (one row per belief: class, pose, size, region, existence, first/last seen, experts and
-the support of every attribute value as JSON), ``objects_place`` (R*Tree over positions), ``attribute_index``
-(the attribute values each belief holds more likely than not, for queries), ``observations`` (every sighting
-with the experts' statements, bounded per object), ``classes`` and ``meta``.
+Tables: ``objects`` (one row per belief: class, pose, size, region, recording, existence, first/last seen,
+experts and the support of every attribute value as JSON), ``objects_place`` (R*Tree over positions),
+``attribute_index`` (the attribute values each belief holds more likely than not, for queries),
+``observations`` (every sighting
+with its recording and the experts' statements, bounded per object), ``classes`` and ``meta``.
 """
 
 from __future__ import annotations
@@ -32,13 +35,22 @@ import numpy as np
 import platformdirs
 
 from reasoning.fusion.association import CameraModel, in_view
-from reasoning.fusion.frame import FrameObject
+from reasoning.fusion.frame import WORLD_FRAME, FrameObject
 from reasoning.fusion.rule import CLASS_ATTRIBUTE, AttributeBelief, ClassTest, ValueSupport, fuse_values, sigmoid
+from reasoning.fusion.text import text_matches
 from reasoning.fusion.tracking import PRESENT, BeliefTracker, ObjectBelief, TrackStep
 from robokudo.core.regions import RegionBox
+from robokudo.core.types import Text
 
 SCHEMA_NAME = "robokudo-beliefs"
-SCHEMA_VERSION = 1
+SCHEMA_VERSION = 2
+MIGRATIONS = {
+    1: (
+        "ALTER TABLE objects ADD COLUMN recording TEXT NOT NULL DEFAULT ''",
+        "ALTER TABLE observations ADD COLUMN recording TEXT NOT NULL DEFAULT ''",
+    ),
+}
+"""Version -> the statements that bring a store of that version to the next one."""
 SQLITE_HEADER = b"SQLite format 3\x00"
 SYNCHRONOUS_MODES = ("OFF", "NORMAL", "FULL", "EXTRA")
 _CORRUPT_ERRORS = {"SQLITE_CORRUPT", "SQLITE_NOTADB"}
@@ -59,7 +71,9 @@ class BeliefFilter:
     ``class_test(a, b)`` tells whether class ``a`` is ``b`` or a subclass of it (default: equal names, case
     ignored). A belief is in ``region`` when its stored region has that name (case ignored) or when its world
     position lies in one of ``region_boxes``. ``attributes`` (e.g. ``{"color": "red"}``, case ignored) match the
-    fused value or any value more likely than not. ``ids`` restricts the answer to those beliefs.
+    fused value or any value more likely than not; ``text`` matches when each of its words is read in such a
+    value, tolerating OCR errors (:func:`~reasoning.fusion.text.text_matches`). ``ids`` restricts the answer to
+    those beliefs.
     """
 
     object_class: str | None = None
@@ -84,6 +98,7 @@ class ObservationRecord:
     roi: tuple[int, int, int, int] | None
     sources: tuple[str, ...]
     evidence: tuple[tuple[str, str, float, str], ...]
+    recording: str = ""
 
 
 def _corrupt_message(path: Path, detail: str) -> str:
@@ -97,7 +112,8 @@ def _corrupt_message(path: Path, detail: str) -> str:
 
 _OBJECT_COLUMNS = (
     "id, class_name, frame, px, py, pz, qx, qy, qz, qw, sx, sy, sz, position_variance, appearance, existence, "
-    "status, first_seen, last_seen, misses, observations, region, region_class, roi, sources, attributes, indexed"
+    "status, first_seen, last_seen, misses, observations, region, region_class, recording, roi, sources, attributes, "
+    "indexed"
 )
 
 _SCHEMA = (
@@ -119,6 +135,7 @@ _SCHEMA = (
         observations INTEGER NOT NULL,
         region TEXT NOT NULL,
         region_class TEXT NOT NULL,
+        recording TEXT NOT NULL DEFAULT '',
         roi TEXT,
         sources TEXT NOT NULL,
         attributes TEXT NOT NULL,
@@ -142,7 +159,8 @@ _SCHEMA = (
         px REAL NOT NULL, py REAL NOT NULL, pz REAL NOT NULL,
         roi TEXT,
         sources TEXT NOT NULL,
-        evidence TEXT NOT NULL
+        evidence TEXT NOT NULL,
+        recording TEXT NOT NULL DEFAULT ''
     )""",
     "CREATE UNIQUE INDEX IF NOT EXISTS observations_object ON observations (object_id, seq)",
     "CREATE INDEX IF NOT EXISTS attribute_index_object ON attribute_index (object_id)",
@@ -214,7 +232,8 @@ class BeliefStore:
                         f" and {len(result) - 1} more problem(s)" if len(result) > 1 else ""
                     )
                     raise BeliefStoreError(_corrupt_message(path, detail))
-            ready = self._check_schema(conn) if existed else False
+            version = self._check_schema(conn) if existed else None
+            ready = version == SCHEMA_VERSION
             mode = conn.execute("PRAGMA journal_mode = WAL").fetchone()[0]
             if str(mode).lower() != "wal":
                 raise BeliefStoreError(f"belief store {path}: cannot use WAL journal mode (got {mode})")
@@ -222,10 +241,11 @@ class BeliefStore:
             conn.execute(f"PRAGMA wal_autocheckpoint = {WAL_AUTOCHECKPOINT_PAGES}")
             if not ready:  # a store in use is opened without writing, so readers never wait for the writer
                 conn.execute("BEGIN IMMEDIATE")
+                self._migrate(conn)
                 for statement in _SCHEMA:
                     conn.execute(statement)
                 conn.execute("INSERT OR IGNORE INTO meta VALUES ('schema', ?)", (SCHEMA_NAME,))
-                conn.execute("INSERT OR IGNORE INTO meta VALUES ('version', ?)", (str(SCHEMA_VERSION),))
+                conn.execute("INSERT OR REPLACE INTO meta VALUES ('version', ?)", (str(SCHEMA_VERSION),))
                 conn.execute("INSERT OR IGNORE INTO meta VALUES ('next_id', '1')")
                 conn.execute("COMMIT")
         except BeliefStoreError:
@@ -240,11 +260,12 @@ class BeliefStore:
             raise BeliefStoreError(f"belief store {path}: {error}") from error
         return conn
 
-    def _check_schema(self, conn: sqlite3.Connection) -> bool:
-        """True when the file holds a complete belief store of this version; raises when it holds another thing."""
+    def _check_schema(self, conn: sqlite3.Connection) -> int | None:
+        """The version of the complete belief store the file holds (None when empty or incomplete); raises when
+        it holds another thing or a newer version."""
         tables = {row[0] for row in conn.execute("SELECT name FROM sqlite_master WHERE type = 'table'")}
         if not tables:
-            return False
+            return None
         meta = dict(conn.execute("SELECT key, value FROM meta").fetchall()) if "meta" in tables else {}
         if meta.get("schema") != SCHEMA_NAME:
             raise BeliefStoreError(_corrupt_message(self.path, "it is an SQLite database but not a belief store"))
@@ -254,7 +275,23 @@ class BeliefStore:
                 f"belief store {self.path} has schema version {version}, newer than this robokudo "
                 f"({SCHEMA_VERSION}); upgrade robokudo or use another store path"
             )
-        return version == SCHEMA_VERSION and "next_id" in meta and tables >= _TABLES
+        return version if "next_id" in meta and tables >= _TABLES else None
+
+    @staticmethod
+    def _migrate(conn: sqlite3.Connection) -> None:
+        """Bring the tables of an older store up to :data:`SCHEMA_VERSION` (inside the caller's transaction)."""
+        tables = {row[0] for row in conn.execute("SELECT name FROM sqlite_master WHERE type = 'table'")}
+        if "meta" not in tables:
+            return
+        found = conn.execute("SELECT value FROM meta WHERE key = 'version'").fetchone()
+        version = int(found[0]) if found is not None else SCHEMA_VERSION
+        for step in range(version, SCHEMA_VERSION):
+            for statement in MIGRATIONS[step]:
+                table = statement.split()[2]
+                column = statement.split()[5]
+                present = {row[1] for row in conn.execute(f"PRAGMA table_info({table})")}
+                if table in tables and column not in present:
+                    conn.execute(statement)
 
     @staticmethod
     def default_path() -> Path:
@@ -329,7 +366,7 @@ class BeliefStore:
             step = tracker.step(beliefs, objects, time, new_id, camera)
             self._write_beliefs(conn, step.changed, tracker.class_test, loaded)
             counts = {b.id: b.observations for b in step.changed}
-            self._write_observations(conn, objects, [(i, counts[i]) for i in step.assigned], time)
+            self._write_observations(conn, objects, [(i, counts.get(i, 0)) for i in step.assigned], time)
             if allocated[0] != next_id:
                 conn.execute("UPDATE meta SET value = ? WHERE key = 'next_id'", (str(allocated[0]),))
             seen = set(step.assigned)
@@ -380,18 +417,20 @@ class BeliefStore:
         query = (
             f"SELECT {columns}, r.x0, r.x1, r.y0, r.y1, r.z0, r.z1 FROM objects_place r JOIN objects o ON o.id = r.id "
             "WHERE r.x0 <= ? AND r.x1 >= ? AND r.y0 <= ? AND r.y1 >= ? AND r.z0 <= ? AND r.z1 >= ? "
-            "AND o.frame = ? AND o.status = ?"
+            "AND o.frame = ? AND (o.frame = ? OR o.recording = ?) AND o.status = ?"
         )
         rows: dict[int, tuple] = {}
         for item in objects:
             x, y, z = (float(v) for v in item.position)
-            parameters = (x + gate, x - gate, y + gate, y - gate, z + gate, z - gate, item.frame, PRESENT)
+            world = (item.frame, WORLD_FRAME, item.recording)
+            parameters = (x + gate, x - gate, y + gate, y - gate, z + gate, z - gate, *world, PRESENT)
             for row in conn.execute(query, parameters):
                 if row[0] not in rows and _distance(row, item.position) <= gate:
                     rows[row[0]] = row
         if camera is not None:
             low, high = _frustum_bounds(camera)
-            parameters = (high[0], low[0], high[1], low[1], high[2], low[2], camera.frame, PRESENT)
+            world = (camera.frame, WORLD_FRAME, camera.recording)
+            parameters = (high[0], low[0], high[1], low[1], high[2], low[2], *world, PRESENT)
             in_frustum = [row for row in conn.execute(query, parameters) if row[0] not in rows]
             if in_frustum:
                 positions = np.array([(row[3], row[4], row[5]) for row in in_frustum], dtype=np.float64)
@@ -482,11 +521,17 @@ class BeliefStore:
                 _roi_text(item.roi),
                 json.dumps(sorted(item.sources)),
                 json.dumps([[e.attribute, e.value, round(e.confidence, 6), e.source] for e in item.evidence]),
+                item.recording,
             )
             for item, (object_id, seq) in zip(objects, assigned, strict=True)
+            if object_id
         ]
         if rows:
-            conn.executemany("INSERT OR REPLACE INTO observations VALUES (?, ?, ?, ?, ?, ?, ?, ?, ?, ?)", rows)
+            conn.executemany(
+                "INSERT OR REPLACE INTO observations (object_id, seq, time, frame, px, py, pz, roi, sources, evidence, "
+                "recording) VALUES (?, ?, ?, ?, ?, ?, ?, ?, ?, ?, ?)",
+                rows,
+            )
 
     def _prune_history(self, conn: sqlite3.Connection, beliefs: Sequence[ObjectBelief]) -> None:
         limit = self.history_limit
@@ -534,7 +579,10 @@ class BeliefStore:
                     return []
                 clauses.append(f"class_name IN ({', '.join('?' * len(classes))})")
                 parameters.extend(classes)
+            texts = {name: value for name, value in f.attributes.items() if name == Text.attribute}
             for name, value in f.attributes.items():
+                if name in texts:
+                    continue  # read text is matched word by word below, tolerating OCR errors
                 # with a class filter, check each candidate; without one, start from the attribute's objects
                 clauses.append(
                     "EXISTS (SELECT 1 FROM attribute_index a WHERE a.name = ? AND a.value = ? AND a.object_id = id)"
@@ -566,6 +614,8 @@ class BeliefStore:
             rows = conn.execute(" UNION ".join(selects) + " ORDER BY id", values).fetchall()
             if f.region and f.region_boxes:
                 rows = [row for row in rows if _in_named_region(row, f)]
+            for name, wanted in texts.items():
+                rows = [row for row in rows if _reads(row, name, wanted)]
             if f.min_confidence > 0:
                 rows = [row for row in rows if sigmoid(row[15]) >= f.min_confidence]
             if f.limit is not None:
@@ -576,7 +626,7 @@ class BeliefStore:
         """The recorded sightings of one object, oldest first (the newest ``limit`` when given)."""
         with self._guard() as conn:
             rows = conn.execute(
-                "SELECT object_id, time, frame, px, py, pz, roi, sources, evidence FROM observations "
+                "SELECT object_id, time, frame, px, py, pz, roi, sources, evidence, recording FROM observations "
                 "WHERE object_id = ? ORDER BY seq DESC LIMIT ?",
                 (object_id, -1 if limit is None else limit),
             ).fetchall()
@@ -589,6 +639,7 @@ class BeliefStore:
                 roi=_roi_from_text(row[6]),
                 sources=tuple(json.loads(row[7])),
                 evidence=tuple((e[0], e[1], float(e[2]), e[3]) for e in json.loads(row[8])),
+                recording=row[9],
             )
             for row in rows
         ]
@@ -650,6 +701,7 @@ def _object_row(b: ObjectBelief, class_test: ClassTest | None, sources: dict[fro
         int(b.observations),
         b.region,
         b.region_class,
+        b.recording,
         _roi_text(b.roi),
         _encoded_sources(b.sources, sources),
         encoded,
@@ -750,6 +802,7 @@ def _belief_from_row(row: tuple) -> ObjectBelief:
         observations,
         region,
         region_class,
+        recording,
         roi,
         sources,
         attributes,
@@ -775,6 +828,7 @@ def _belief_from_row(row: tuple) -> ObjectBelief:
         sources=set(json.loads(sources)),
         observations=observations,
         class_name=class_name,
+        recording=recording,
     )
 
 
@@ -786,6 +840,11 @@ def _box_bounds(pose: np.ndarray, size: Sequence[float]) -> tuple[np.ndarray, np
     pose = np.asarray(pose, dtype=np.float64)
     half = np.abs(pose[:3, :3]) @ (np.asarray(size, dtype=np.float64) / 2.0)
     return pose[:3, 3] - half, pose[:3, 3] + half
+
+
+def _reads(row: tuple, name: str, wanted: str) -> bool:
+    """True when one of the belief's indexed ``name`` values (more likely than not, or fused) reads ``wanted``."""
+    return any(entry == name and text_matches(wanted, value) for entry, value in _index_entries(row[_INDEXED]))
 
 
 def _in_named_region(row: tuple, f: BeliefFilter) -> bool:

@@ -3,10 +3,17 @@
 The cost of pairing an observation with a belief is a sum of squared normalised distances, each gated:
 
 * position: ``(d / position_sigma)^2``, gate ``d <= gate_distance`` (metres; both in the same frame);
-* size: ``(log(ratio) / size_sigma)^2`` of the largest extents, gate ``ratio <= size_ratio_gate``;
+* size: ``(log(ratio) / size_sigma)^2`` of the typical sizes (geometric mean of the extents, the cube root of the
+  box volume: less swayed than the largest extent by one axis a partial view or stray points of the supporting
+  surface stretch), gate ``ratio <= size_ratio_gate``;
 * appearance: ``(bhattacharyya_distance / appearance_sigma)^2`` of the colour histograms, gate
   ``<= appearance_gate``; when a histogram is missing, a mismatch of the stated colours adds ``color_penalty``;
-* class: incompatible classes (neither subsumes the other) are gated out.
+* class: incompatible classes (neither subsumes the other) add ``class_penalty``; they are not gated out, since
+  one object classified differently in two frames is still one object (the conflict is kept in its class
+  alternatives).
+
+Only positions of one world are compared (:func:`same_world`): the same fixed frame (``world``, known when the
+camera pose is), or the same camera frame of the same recording.
 
 The assignment minimising the total cost is found with ``scipy.optimize.linear_sum_assignment`` on the gated
 matrix (infeasible pairs get a prohibitive cost and are rejected afterwards). Observations left over become new
@@ -23,6 +30,7 @@ from typing import Protocol
 
 import numpy as np
 
+from reasoning.fusion.frame import WORLD_FRAME
 from reasoning.fusion.rule import ClassTest
 from robokudo.core.types import CameraIntrinsics
 
@@ -35,6 +43,9 @@ class Trackable(Protocol):
 
     @property
     def frame(self) -> str: ...
+
+    @property
+    def recording(self) -> str: ...
 
     @property
     def dimensions(self) -> np.ndarray | None: ...
@@ -54,6 +65,7 @@ class AssociationConfig:
     appearance_gate: float = 0.75
     appearance_sigma: float = 0.3
     color_penalty: float = 4.0
+    class_penalty: float = 4.0
 
 
 @dataclass(frozen=True, slots=True)
@@ -67,6 +79,16 @@ class Association:
 
 INFEASIBLE = 1e9
 """Cost standing for a gated-out pair."""
+
+
+def world_key(frame: str, recording: str) -> str:
+    """What must be equal for two positions to be comparable: the fixed frame, or the camera frame of a recording."""
+    return frame if frame == WORLD_FRAME else f"{frame}@{recording}"
+
+
+def same_world(a: Trackable, b: Trackable) -> bool:
+    """True when the positions of ``a`` and ``b`` can be compared (see :func:`world_key`)."""
+    return world_key(a.frame, a.recording) == world_key(b.frame, b.recording)
 
 
 def bhattacharyya_distance(a: np.ndarray, b: np.ndarray) -> float:
@@ -87,7 +109,7 @@ def pair_cost(
     class_test: ClassTest | None = None,
 ) -> float:
     """The gated cost of pairing ``observation`` with ``belief`` (:data:`INFEASIBLE` when a gate fails)."""
-    if observation.frame != belief.frame:
+    if not same_world(observation, belief):
         return INFEASIBLE
     distance = math.dist(_triple(observation.position), _triple(belief.position))
     if not distance <= config.gate_distance:
@@ -95,7 +117,7 @@ def pair_cost(
     cost = (distance / config.position_sigma) ** 2
     a, b = observation.dimensions, belief.dimensions
     if a is not None and b is not None and len(a) and len(b):
-        big_a, big_b = float(max(a)), float(max(b))
+        big_a, big_b = typical_size(a), typical_size(b)
         if big_a > 0 and big_b > 0:
             ratio = max(big_a, big_b) / min(big_a, big_b)
             if ratio > config.size_ratio_gate:
@@ -112,8 +134,15 @@ def pair_cost(
     if observation_classes and belief_class:
         test = class_test or (lambda x, y: x == y)
         if not any(test(c, belief_class) or test(belief_class, c) for c in observation_classes):
-            return INFEASIBLE
+            cost += config.class_penalty
     return cost
+
+
+def typical_size(dimensions: np.ndarray) -> float:
+    """The geometric mean of the positive extents (0 when there is none)."""
+    extents = np.asarray(dimensions, dtype=np.float64)
+    extents = extents[extents > 0]
+    return float(np.exp(np.mean(np.log(extents)))) if extents.size else 0.0
 
 
 def _triple(position: np.ndarray) -> tuple[float, float, float]:
@@ -163,14 +192,14 @@ def associate(
 
 
 def gated_pairs(observations: Sequence[Trackable], beliefs: Sequence[Trackable], gate: float) -> np.ndarray:
-    """The (observation, belief) index pairs in the same frame within ``gate`` metres (vectorised pre-gate)."""
+    """The (observation, belief) index pairs of one world within ``gate`` metres (vectorised pre-gate)."""
     if not observations or not beliefs:
         return np.empty((0, 2), dtype=np.int64)
     a = np.stack([np.asarray(o.position, dtype=np.float64) for o in observations])
     b = np.stack([np.asarray(x.position, dtype=np.float64) for x in beliefs])
     near = np.linalg.norm(a[:, None, :] - b[None, :, :], axis=2) <= gate
-    frames_a = np.array([o.frame for o in observations], dtype=object)
-    frames_b = np.array([x.frame for x in beliefs], dtype=object)
+    frames_a = np.array([world_key(o.frame, o.recording) for o in observations], dtype=object)
+    frames_b = np.array([world_key(x.frame, x.recording) for x in beliefs], dtype=object)
     near &= frames_a[:, None] == frames_b[None, :]
     return np.argwhere(near)
 
@@ -184,6 +213,8 @@ class CameraModel:
     """4x4 transform from the optical frame to ``frame``, the frame beliefs are expressed in."""
     frame: str = "world"
     depth: np.ndarray | None = None
+    recording: str = ""
+    """The recording of the frame; beliefs of another recording are not in view unless ``frame`` is fixed."""
     max_range: float = 4.0
     border: int = 5
     occlusion_margin: float = 0.05

@@ -4,6 +4,12 @@ Hypotheses that cover the same points (overlap ``|A∩B| / min(|A|, |B|)`` of th
 masks) are merged into one :class:`FrameObject`; the annotations attached to any of them become
 :class:`~reasoning.fusion.rule.Evidence` of that object. Positions are put in the world frame when the camera pose
 is known. Pure numpy: no open3d, no knowledge base.
+
+An object whose geometry its own points do not bear out is marked with a ``doubt`` (:func:`geometry_doubt`): too
+few points, tiny, flat, implausibly large, or a stated size the bulk of its points contradicts (the segment took
+in points of other surfaces). Such an object may confirm a known belief but never creates one. A stated position
+outside the bulk of the object's points is an expert's error: the object is put at the bulk's centre
+(:func:`placed_on_points`).
 """
 
 from __future__ import annotations
@@ -24,6 +30,32 @@ AttachedReader = Callable[[ObjectHypothesis, type[A]], list[A]]
 
 WORLD_FRAME = "world"
 """The name of the fixed frame positions are expressed in when the camera pose is known."""
+
+MIN_POINTS = 30
+"""An object with fewer valid 3-D points than this has too little support to become a belief."""
+
+MIN_EXTENT = 0.01
+"""An object whose largest extent (metres) is below this is too tiny to be told from noise."""
+
+FLAT_EXTENT = 0.005
+"""An object thinner than this (metres, its smallest extent: about a depth sensor's noise) is a patch of a surface,
+not something standing out of it."""
+
+MAX_EXTENT = 2.0
+"""An object whose largest extent (metres) is above this is no object a robot handles but a merge of surfaces."""
+
+MAX_FOOTPRINT = 0.5
+"""An object whose middle extent (metres) is above this is furniture-sized in two directions (a table top, a patch
+of floor or wall): long thin things (a broom) pass, broad ones are no object a robot handles."""
+
+ROBUST_PERCENTILES = (2.0, 98.0)
+"""The bulk of an object's points: the percentiles its robust box spans on every axis."""
+
+BULK_TOLERANCE = 1.25
+"""How far a stated size may exceed the diagonal of the bulk's box, and (as a share of that diagonal beyond it)
+how far a stated position may lie outside the box: a box fitted to the points never exceeds them, so only points
+the bulk does not have (another surface, stray depth) push it further; the tolerance covers the trimmed
+percentiles."""
 
 DEFAULT_MIN_OVERLAP = 0.6
 """Two hypotheses whose point sets overlap at least this much (of the smaller one) are one object."""
@@ -50,6 +82,10 @@ class FrameObject:
     roi: tuple[int, int, int, int] | None = None
     confidence: float = 1.0
     hypotheses: int = 1
+    recording: str = ""
+    """The recording the frame belongs to (``CameraInfo.recording``)."""
+    doubt: str = ""
+    """Why the object's geometry is not trusted ("" when it is); a doubted object never creates a belief."""
 
     def values(self, attribute: str) -> set[str]:
         """The values stated for ``attribute`` in this frame."""
@@ -64,6 +100,7 @@ class FrameContext:
     cam_to_world: np.ndarray | None = None
     camera_frame: str = "camera"
     time: float = 0.0
+    recording: str = ""
 
 
 def _default_reader(hypothesis: ObjectHypothesis, annotation_type: type[A]) -> list[A]:
@@ -252,6 +289,8 @@ def _merge_group(
         summed = np.sum(same, axis=0).ravel()
         total = summed.sum()
         appearance = summed / total if total > 0 else None
+    position = placed_on_points(np.asarray(position, dtype=np.float64), points)
+    doubt = geometry_doubt(dimensions, points)
     evidence = [e for h in members for e in hypothesis_evidence(h, context.time, reader)]
     sources = {h.source for h in members if h.source}
     sources.update(e.source for e in evidence)
@@ -268,4 +307,48 @@ def _merge_group(
         roi=_union_roi([h.roi for h in members]),
         confidence=max(h.confidence for h in members),
         hypotheses=len(members),
+        recording=context.recording,
+        doubt=doubt,
     )
+
+
+def _bulk(points: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    low, high = np.percentile(points, ROBUST_PERCENTILES, axis=0)
+    return low, high
+
+
+def placed_on_points(position: np.ndarray, points: np.ndarray | None) -> np.ndarray:
+    """``position``, or the centre of the bulk of ``points`` when it lies outside their box by more than the
+    tolerance (:data:`BULK_TOLERANCE`); ``points`` are in the frame of ``position``."""
+    if points is None or points.shape[0] < MIN_POINTS:
+        return position
+    low, high = _bulk(points)
+    margin = (BULK_TOLERANCE - 1.0) * float(np.linalg.norm(high - low))
+    if np.all(position >= low - margin) and np.all(position <= high + margin):
+        return position
+    return (low + high) / 2.0
+
+
+def geometry_doubt(dimensions: np.ndarray | None, points: np.ndarray | None) -> str:
+    """Why an object's stated size and support are not to be trusted, or "" (see :data:`BULK_TOLERANCE`).
+
+    ``points`` are the object's valid points (None when the frame has no cloud: then only the size is checked).
+    """
+    if points is not None and points.shape[0] < MIN_POINTS:
+        return f"only {points.shape[0]} valid points"
+    if dimensions is not None and len(dimensions):
+        extents = np.sort(np.asarray(dimensions, dtype=np.float64))[::-1]
+        largest, middle, smallest = float(extents[0]), float(extents[len(extents) // 2]), float(extents[-1])
+        if largest < MIN_EXTENT:
+            return f"tiny ({largest * 100:.1f} cm)"
+        if smallest < FLAT_EXTENT:
+            return f"flat ({smallest * 1000:.0f} mm thick): a patch of a surface"
+        if largest > MAX_EXTENT or middle > MAX_FOOTPRINT:
+            return f"implausibly large ({' x '.join(f'{e:.2f}' for e in extents)} m)"
+    if points is None:
+        return ""
+    low, high = _bulk(points)
+    diagonal = float(np.linalg.norm(high - low))
+    if dimensions is not None and len(dimensions) and float(np.max(dimensions)) > BULK_TOLERANCE * diagonal:
+        return f"stated size {float(np.max(dimensions)):.2f} m exceeds its points' extent ({diagonal:.2f} m)"
+    return ""

@@ -11,7 +11,8 @@ Rule (log-odds accumulation over a categorical domain with an implicit "somethin
   ``p(v) = e^S(v) / (e^S(v) + 1 + Σ_w e^S(w))`` over the most general conflicting values ``w``.
   One statement with confidence ``c`` thus gives back exactly ``c``; agreement raises it, conflicts lower it;
 * the fused value is the most probable one, refined to its most specific subclass that is itself more likely
-  than not; every value is kept with its support (log-odds, count, experts), so conflicts are never dropped.
+  than not; every value is kept with its support (log-odds, count, experts), so conflicts are never dropped;
+  it is ``supported`` when its score is positive (a value stated with confidence 0.5 only is no evidence).
 """
 
 from __future__ import annotations
@@ -103,7 +104,8 @@ class FusedAttribute:
     """The fused value of an attribute, its confidence, its experts, and the support of every value seen.
 
     ``sources`` are the experts that agree with the fused value (they said it, a subclass or a superclass);
-    ``conflict`` is True when a value incompatible with the fused one has support of its own.
+    ``conflict`` is True when a value incompatible with the fused one has support of its own; ``supported`` is
+    False when nothing but zero-evidence statements (confidence 0.5 or less) back the fused value.
     """
 
     name: str
@@ -112,6 +114,7 @@ class FusedAttribute:
     sources: tuple[str, ...]
     support: tuple[SupportSummary, ...]
     conflict: bool
+    supported: bool = True
 
     def confidence_of(self, value: str) -> float:
         """The probability of ``value`` (0 when nobody said it)."""
@@ -158,7 +161,13 @@ def fuse_values(name: str, values: Mapping[str, ValueSupport], class_test: Class
         p = sigmoid(support.log_odds)
         experts = tuple(sorted(support.sources))
         return FusedAttribute(
-            name, only, p, experts, (SupportSummary(only, p, support.log_odds, support.count, experts),), False
+            name,
+            only,
+            p,
+            experts,
+            (SupportSummary(only, p, support.log_odds, support.count, experts),),
+            False,
+            support.log_odds > 0,
         )
     names = list(values)
 
@@ -200,7 +209,7 @@ def fuse_values(name: str, values: Mapping[str, ValueSupport], class_test: Class
             key=lambda s: (-s.confidence, s.value),
         )
     )
-    return FusedAttribute(name, best, probability[best], tuple(sorted(supporters)), summary, conflict)
+    return FusedAttribute(name, best, probability[best], tuple(sorted(supporters)), summary, conflict, score[best] > 0)
 
 
 def fuse_evidence(evidence: Iterable[Evidence], class_test: ClassTest | None = None) -> dict[str, FusedAttribute]:

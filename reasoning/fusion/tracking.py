@@ -9,6 +9,10 @@ observation's confidence, process noise growing with the time since the last sig
 are blended; attribute evidence is accumulated with :mod:`reasoning.fusion.rule`; existence log-odds rise.
 A belief that projects into the image in front of the measured surface but was not matched loses existence
 log-odds; once it has been missed and ``gone_after`` seconds have passed since it was last seen, it is gone.
+Beliefs of another world (another recording seen without a camera pose) are never matched nor missed. An
+observation whose geometry is in doubt (:func:`reasoning.fusion.frame.geometry_doubt`) may confirm a belief but
+creates none. A belief's class is the fused class only when evidence supports it (positive log-odds): a class
+stated without evidence (e.g. only the query's guess) is kept among the alternatives but names nothing.
 """
 
 from __future__ import annotations
@@ -26,6 +30,7 @@ from reasoning.fusion.association import (
     assign,
     gated_pairs,
     pair_cost,
+    same_world,
     visible_from,
 )
 from reasoning.fusion.frame import WORLD_FRAME, FrameObject
@@ -69,6 +74,8 @@ class ObjectBelief:
     sources: set[str] = field(default_factory=set)
     observations: int = 0
     class_name: str | None = None
+    recording: str = ""
+    """The recording the belief was first seen in (what its position is relative to without a fixed frame)."""
 
     @property
     def confidence(self) -> float:
@@ -106,7 +113,8 @@ class TrackerConfig:
 
 @dataclass(frozen=True, slots=True)
 class TrackStep:
-    """The outcome of one frame: ``assigned[i]`` is the belief id of observation ``i``."""
+    """The outcome of one frame: ``assigned[i]`` is the belief id of observation ``i`` (0 when a doubted
+    observation matched no belief and was dropped)."""
 
     changed: tuple[ObjectBelief, ...]
     assigned: tuple[int, ...]
@@ -150,6 +158,8 @@ class BeliefTracker:
             assigned[i] = belief.id
         created = []
         for i in association.new:
+            if observations[i].doubt:
+                continue
             belief = self._create(observations[i], time, new_id())
             changed[belief.id] = belief
             assigned[i] = belief.id
@@ -157,7 +167,7 @@ class BeliefTracker:
         missed, gone = [], []
         for j in association.unmatched:
             belief = beliefs[j]
-            if camera is not None and belief.frame == camera.frame and visible_from(belief.position, camera):
+            if camera is not None and same_world(belief, camera) and visible_from(belief.position, camera):
                 belief.existence = max(belief.existence - self.config.miss_log_odds, -MAX_LOG_ODDS)
                 belief.misses += 1
                 missed.append(belief.id)
@@ -211,6 +221,7 @@ class BeliefTracker:
             roi=observation.roi,
             sources=set(observation.sources),
             observations=1,
+            recording=observation.recording,
         )
         self._refresh(belief)
         return belief
@@ -256,7 +267,9 @@ class BeliefTracker:
 
     def _refresh(self, belief: ObjectBelief) -> None:
         """Recompute the cached class and the region after a change."""
-        belief.class_name = belief.value(CLASS_ATTRIBUTE, self.class_test)
+        known = belief.attributes.get(CLASS_ATTRIBUTE)
+        fused = known.fuse(self.class_test) if known is not None else None
+        belief.class_name = fused.value if fused is not None and fused.supported else None
         region = region_of(belief.position, self.regions) if belief.frame == WORLD_FRAME and self.regions else None
         if region is not None:
             belief.region = region.name

@@ -91,12 +91,18 @@ class DepthImage(View):
 
 @dataclass(eq=False)
 class CameraInfo(View):
-    """Intrinsics, the camera pose in the world (None when unknown), the frame id and the timestamp."""
+    """Intrinsics, the camera pose in the world (None when unknown), the frame id, the timestamp and the recording.
+
+    ``recording`` names the world the frame shows: the frames of one continuous recording (a sequence, the
+    simulated kitchen) share it, an unrelated snapshot has its own ("" when the reader cannot tell). Without a
+    camera pose, positions of frames of different recordings are never compared.
+    """
 
     intrinsics: CameraIntrinsics
     cam_to_world: np.ndarray | None = None
     frame_id: str = "camera"
     timestamp: float = 0.0
+    recording: str = ""
 
 
 @dataclass(eq=False)

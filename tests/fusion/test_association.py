@@ -48,7 +48,7 @@ def test_optimal_assignment_beats_greedy_nearest_neighbour() -> None:
     assert result.new == () and result.unmatched == ()
 
 
-def test_gates_reject_far_other_frame_other_size_other_class_other_appearance() -> None:
+def test_gates_reject_far_other_frame_other_size_other_appearance_and_penalise_other_class() -> None:
     config = AssociationConfig()
     base = obs(0.0, dimensions=np.array([0.2, 0.1, 0.1]))
     assert pair_cost(obs(0.3), base, config) == INFEASIBLE
@@ -56,7 +56,9 @@ def test_gates_reject_far_other_frame_other_size_other_class_other_appearance() 
     assert pair_cost(camera_frame, base, config) == INFEASIBLE
     assert pair_cost(obs(0.01, dimensions=np.array([0.9, 0.5, 0.1])), base, config) == INFEASIBLE
     assert pair_cost(obs(0.01, dimensions=np.array([0.21, 0.1, 0.1])), base, config) < 1.0
-    assert pair_cost(obs(0.0), base, config, observation_classes={"Cup"}, belief_class="Milk") == INFEASIBLE
+    # issue 13: a disjoint class is no gate (one object classified two ways stays one belief), only a penalty
+    other_class = pair_cost(obs(0.0), base, config, observation_classes={"Cup"}, belief_class="Milk")
+    assert other_class == pytest.approx(config.class_penalty)
     subclass = {("LactoseFreeMilk", "Milk")}
     assert pair_cost(
         obs(0.0),
