@@ -75,6 +75,15 @@ class ThreadedAnnotator(Annotator):
             run.cancelled = True
         self._active_run = None
 
+    def stop_worker(self, timeout: float | None = None) -> bool:
+        """Cancel a run in progress and wait up to ``timeout`` s (None: as long as it takes) for the worker thread
+        to end; True when no worker of this node is left running."""
+        self._cancel()
+        worker = self._worker
+        if worker is not None and worker is not threading.current_thread():
+            worker.join(timeout)
+        return not self.is_working()
+
     def is_working(self) -> bool:
         """True while a worker thread of this node is alive (a cancelled one may still be finishing)."""
         return self._worker is not None and self._worker.is_alive()
