@@ -47,6 +47,7 @@ from robokudo.core.composites import Sequence
 from robokudo.core.engine import Engine
 from robokudo.core.pipeline import Pipeline
 from robokudo.core.slot import TaskSlot
+from robokudo.core.threaded import has_workers, stop_workers
 from robokudo.core.types import QueryAnswer
 from trees.answer_step import AnswerStep
 from trees.synthesis import build_tree
@@ -198,6 +199,7 @@ class AnsweringService:
         self.engine.tree.add_post_tick_handler(self._after_tick)
         self._lock = threading.Lock()
         self._continuous: TaskHandle | None = None
+        self._retired: list[py_trees.behaviour.Behaviour] = []
 
     @classmethod
     def open(
@@ -286,11 +288,11 @@ class AnsweringService:
             return deadline is not None and time.monotonic() >= deadline
 
         # The finished tree stays in the slot (with its statuses, for explanations) until the next task.
-        self.engine.tasks.replace(TASK_SLOT, pipeline)
+        self._retire(self.engine.tasks.replace(TASK_SLOT, pipeline))
         if not expired():
             self.engine.run(until=lambda _: finished() or expired())
         if not finished():
-            self.engine.tasks.remove(TASK_SLOT)  # stops the tree: running experts are interrupted
+            self._retire(self.engine.tasks.remove(TASK_SLOT))  # stops the tree: running experts are interrupted
             return Outcome(self._remembered(parsed, timed_out=True), pipeline, query_plan)
         found = pipeline.cas.view(QueryAnswer) if pipeline.status is Status.SUCCESS else None
         if found is None or not isinstance(found.answer, Answer):
@@ -319,7 +321,7 @@ class AnsweringService:
         self._end_continuous("replaced by another task")
         with self._lock:
             self._continuous = handle
-        self.engine.tasks.replace(TASK_SLOT, repeat)
+        self._retire(self.engine.tasks.replace(TASK_SLOT, repeat))
         if not self.engine.is_running_in_background():
             self.engine.start()
         return handle
@@ -333,7 +335,7 @@ class AnsweringService:
         self._end_continuous("cancelled")
         if self.engine.is_running_in_background():
             self.engine.stop()
-        self.engine.tasks.remove(TASK_SLOT)
+        self._retire(self.engine.tasks.remove(TASK_SLOT))
 
     @staticmethod
     def mode_of(query: Query) -> ExecutionMode:
@@ -348,7 +350,10 @@ class AnsweringService:
         (up to :data:`WORKER_WAIT` s) and close the belief store."""
         self._end_continuous("the service closed")
         try:
-            self.engine.shutdown(WORKER_WAIT)
+            self.engine.stop()
+            with self._lock:
+                retired, self._retired = self._retired, []
+            stop_workers([self.engine.root, *retired], WORKER_WAIT)
         finally:
             self.store.close()
 
@@ -380,7 +385,16 @@ class AnsweringService:
             with self._lock:
                 self._continuous = None
             # Between two ticks on the engine thread, the slot may be emptied directly (as the engine does).
-            self.engine.tasks.slot(TASK_SLOT).set_subtree(None)
+            self._retire(self.engine.tasks.slot(TASK_SLOT).set_subtree(None))
+
+    def _retire(self, tree: py_trees.behaviour.Behaviour | None) -> None:
+        """Remember a tree taken out of the slot while its experts' worker threads finish (:meth:`close` waits)."""
+        if tree is None:
+            return
+        with self._lock:
+            self._retired = [t for t in self._retired if has_workers(t)]
+            if has_workers(tree):
+                self._retired.append(tree)
 
     def _end_continuous(self, reason: str) -> None:
         with self._lock:
