@@ -16,7 +16,6 @@ from robokudo.core.dataflow import validate_data_flow
 from robokudo.core.slot import TaskSlot
 from robokudo.core.stats import RunStats
 from robokudo.core.structure import check_structure
-from robokudo.core.threaded import ThreadedAnnotator
 
 
 @dataclass
@@ -152,20 +151,6 @@ class Engine:
         if self.root.status is Status.RUNNING:
             self.root.stop(Status.INVALID)
         self.tasks.apply_pending()
-
-    def shutdown(self, timeout: float = 10.0) -> list[str]:
-        """Stop ticking, interrupt the tree and wait (up to ``timeout`` s in all) until the worker threads of its
-        threaded annotators have ended; returns the names of those still working.
-
-        A process should not exit while a worker runs native code (e.g. an ONNX session): the runtime may abort.
-        """
-        self.stop()
-        deadline = time.monotonic() + timeout
-        left = []
-        for node in self.root.iterate():
-            if isinstance(node, ThreadedAnnotator) and not node.stop_worker(max(0.0, deadline - time.monotonic())):
-                left.append(node.name)
-        return left
 
     def is_running_in_background(self) -> bool:
         """True while the background tick thread is alive."""
