@@ -10,6 +10,8 @@ folder with ``rgb.txt`` and ``depth.txt``                              TumSequen
 folder with ``camera_params.json`` and ``NNNNNN-color.png`` files       ColorDepthPairReader(folder, frame)
 folder with ``tiff/`` (and ``pclzf/*.xml``), or that ``tiff/`` folder  TiffSequenceReader(folder, frame)
 folder of ``.pcd`` files                                               PcdReader(the frame-th file, natural order)
+folder of TUM-style colour/depth pairs (``TUM_color.png`` +           TumPairReader(the frame-th pair's colour
+``TUM_depth.png``, ...)                                                 file, natural order)
 ``.pcd`` file                                                          PcdReader(file) (frame must be 0)
 ``NNNNNN-color.png`` with ``camera_params.json`` beside it             ColorDepthPairReader(folder, NNNNNN)
 image file named ``*color*`` / ``*rgb*`` / ``*depth*`` with its other  TumPairReader(file) (frame must be 0)
@@ -38,7 +40,7 @@ from annotators.readers.frame_readers import (
     TumSequenceReader,
 )
 from annotators.readers.tiff_io import is_tiff_sequence
-from annotators.readers.tum_io import is_tum_pair, is_tum_sequence
+from annotators.readers.tum_io import is_tum_pair, is_tum_sequence, pair_color_files
 from robokudo.core.annotator import Annotator
 
 SUPPORTED_LAYOUTS = (
@@ -47,7 +49,8 @@ SUPPORTED_LAYOUTS = (
     "a uoc folder (NNNNNN-color.png, NNNNNN-depth.png, camera_params.json) or one of its NNNNNN-color.png",
     "a PCL ImageGrabber folder (tiff/ with pclzf/*.xml) or its tiff/ folder",
     "an organized .pcd file, or a folder of them",
-    "a TUM-style colour/depth pair: a colour file named *color* or *rgb* with the *depth* file beside it",
+    "a TUM-style colour/depth pair: a colour file named *color* or *rgb* with the *depth* file beside it, "
+    "or a folder of such pairs",
 )
 
 READER_NAMES: tuple[str, ...] = (
@@ -107,6 +110,14 @@ def _folder_choice(folder: Path, frame: int) -> ReaderChoice:
         if not 0 <= frame < len(clouds):
             raise ValueError(f"{folder} holds {len(clouds)} .pcd files, no frame {frame}")
         return ReaderChoice(PcdReader, {"path": str(clouds[frame])})
+    # uoc-named files without camera_params.json are not pairs: their intrinsics would be guessed
+    pairs = sorted(
+        (p for p in pair_color_files(folder, _IMAGE_SUFFIXES) if not _UOC_COLOR.match(p.name)), key=_natural_key
+    )
+    if pairs:
+        if not 0 <= frame < len(pairs):
+            raise ValueError(f"{folder} holds {len(pairs)} colour/depth pair(s), no frame {frame}")
+        return ReaderChoice(TumPairReader, {"path": str(pairs[frame])})
     raise _unsupported(folder, "the folder matches no known layout")
 
 

@@ -8,12 +8,17 @@ size, the depth scale is a positive finite number.
 The uoc layout is ``NNNNNN-color.png`` (8-bit RGB), ``NNNNNN-depth.png`` (16-bit depth in sensor units) and
 ``camera_params.json`` with ``fx``, ``fy``, ``x_offset`` (cx), ``y_offset`` (cy), ``img_width``, ``img_height``
 and optionally ``depth_scale``. Problems raise :class:`FrameError` with a reason.
+
+A PNG file's chunk structure and checksums are checked (:func:`png_problem`) before OpenCV decodes it: libpng
+reports a broken file by printing to the process's stderr, so a truncated or damaged PNG is refused here, with
+the reason in the FrameError, and never reaches the decoder.
 """
 
 from __future__ import annotations
 
 import json
 import math
+import zlib
 from dataclasses import dataclass
 from pathlib import Path
 
@@ -26,6 +31,8 @@ DEFAULT_DEPTH_SCALE = 1000.0
 """Sensor units per metre when camera_params.json does not say (millimetres)."""
 
 CAMERA_PARAMS_FILE = "camera_params.json"
+
+PNG_SIGNATURE = b"\x89PNG\r\n\x1a\n"
 
 
 class FrameError(Exception):
@@ -75,20 +82,66 @@ def require_file(path: Path) -> Path:
     return path
 
 
+def png_problem(data: bytes) -> str | None:
+    """Why ``data`` (a file starting with the PNG signature) is not a complete, intact PNG; None when it is.
+
+    Checks the chunk layout (IHDR first, image data present, IEND last, no chunk past the end of the file) and
+    every chunk's CRC; the compressed image data itself is left to the decoder.
+    """
+    view = memoryview(data)
+    position = len(PNG_SIGNATURE)
+    kinds: list[bytes] = []
+    while position < len(data):
+        if position + 12 > len(data):
+            return f"truncated: the file ends inside a chunk header at byte {position}"
+        length = int.from_bytes(view[position : position + 4], "big")
+        kind = bytes(view[position + 4 : position + 8])
+        name = kind.decode("latin-1")
+        if not kind.isalpha():
+            return f"damaged: no valid chunk at byte {position}"
+        if not kinds and kind != b"IHDR":
+            return "damaged: the first chunk is not IHDR"
+        end = position + 12 + length
+        if end > len(data):
+            return f"truncated: chunk {name} at byte {position} needs {length} bytes, the file ends first"
+        stored = int.from_bytes(view[end - 4 : end], "big")
+        if zlib.crc32(view[position + 4 : end - 4]) != stored:
+            return f"damaged: checksum mismatch in chunk {name} at byte {position}"
+        kinds.append(kind)
+        position = end
+        if kind == b"IEND":
+            break
+    if not kinds:
+        return "truncated: the file ends after its signature"
+    if b"IDAT" not in kinds:
+        return "no image data (IDAT chunk)"
+    if kinds[-1] != b"IEND":
+        return "truncated: the file ends before its IEND chunk"
+    return None
+
+
+def _decode_image(path: Path, flags: int) -> np.ndarray:
+    """The image of ``path`` decoded by OpenCV with ``flags``; FrameError with the reason when it cannot be."""
+    data = require_file(path).read_bytes()
+    if data.startswith(PNG_SIGNATURE):
+        problem = png_problem(data)
+        if problem is not None:
+            raise FrameError(f"cannot decode {path}: {problem}")
+    image = cv2.imdecode(np.frombuffer(data, dtype=np.uint8), flags)
+    if image is None or image.size == 0:
+        raise FrameError(f"cannot decode {path}: not an image OpenCV can read")
+    return image
+
+
 def decode_color(path: Path) -> np.ndarray:
     """An RGB uint8 image from an 8-bit colour file (PNG, JPEG, TIFF); FrameError when it cannot be decoded."""
-    bgr = cv2.imread(str(require_file(path)), cv2.IMREAD_COLOR)
-    if bgr is None or bgr.size == 0:
-        raise FrameError(f"cannot decode {path}")
-    return cv2.cvtColor(bgr, cv2.COLOR_BGR2RGB)
+    return cv2.cvtColor(_decode_image(path, cv2.IMREAD_COLOR), cv2.COLOR_BGR2RGB)
 
 
 def decode_depth(path: Path, depth_scale: float) -> np.ndarray:
     """Depth in metres (float32, 0 = no data) from a one-channel 16-bit file in units of 1/``depth_scale`` m."""
     scale = check_depth_scale(depth_scale)
-    raw = cv2.imread(str(require_file(path)), cv2.IMREAD_UNCHANGED)
-    if raw is None or raw.size == 0:
-        raise FrameError(f"cannot decode {path}")
+    raw = _decode_image(path, cv2.IMREAD_UNCHANGED)
     if raw.ndim != 2:
         raise FrameError(f"depth image {path} has {raw.shape[2]} channels, expected one")
     if raw.dtype != np.uint16:

@@ -10,7 +10,8 @@ default is the PrimeSense default TUM documents for its registered images (fx = 
 
 A single pair is a colour file whose name contains ``color`` or ``rgb`` with the depth file beside it, named the
 same with the last ``color``/``rgb`` replaced by ``depth`` (``TUM_color.png`` -> ``TUM_depth.png``); the depth
-file may be given instead of the colour file.
+file may be given instead of the colour file. A folder holding such pairs (and no other layout) is read pair by
+pair: :func:`pair_color_files` lists their colour files.
 """
 
 from __future__ import annotations
@@ -149,6 +150,15 @@ def is_tum_pair(path: Path) -> bool:
     except FrameError:
         return False
     return color.is_file() and depth.is_file() and color != depth
+
+
+def pair_color_files(folder: Path, suffixes: tuple[str, ...]) -> list[Path]:
+    """The colour files in ``folder`` (with one of ``suffixes``) whose depth file is beside them, unsorted."""
+    return [
+        path
+        for path in folder.iterdir()
+        if path.suffix.lower() in suffixes and _COLOR_WORD.search(path.name) and is_tum_pair(path)
+    ]
 
 
 def read_tum_pair(

@@ -136,12 +136,15 @@ class Answer:
     from_memory: bool = False
     observed: tuple[int, ...] = ()
     """The belief id of each object seen in this frame, in the order perception found them (not in the JSON)."""
+    timed_out: bool = False
+    """True when the query's timeout passed before perception finished (the objects then come from memory)."""
 
     def to_dict(self) -> dict[str, Any]:
         """A JSON-ready dict."""
         return {
             "query": self.query,
             "from_memory": self.from_memory,
+            "timed_out": self.timed_out,
             "objects": [o.to_dict() for o in self.objects],
         }
 

@@ -2,7 +2,9 @@
 
 The object description is the query's body or its ``obj`` block (the natural front end nests it there). Words
 are resolved with the knowledge base (any :class:`Vocabulary`, e.g. the KnowledgeBase); a word it does not
-know is used as it is, so memory can still be searched by name.
+know is used as it is, so memory can still be searched by name, unless the filter is ``strict``: then the
+knowledge base's LookupError (e.g. ``unknown object class 'unicorn'``) is raised, as planning the query would.
+An ``id`` (``inspect object 3``, ``inspect {obj: {id: 3}}``) selects that stored belief.
 
 Which key filters which attribute comes from the ontology (the annotation type answering the key, its value
 kind) and the annotation type's ``attribute`` (:mod:`robokudo.core.types`); without a knowledge base a key
@@ -23,6 +25,8 @@ from robokudo.core.types import ATTRIBUTE_TYPES, Annotation, Classification, Loc
 CLASS_KEYS = ("type", "class", "object")
 REGION_KEYS = ("location", "region")
 REGION_RELATIONS = ("in", "on", "at", "inside", "within")
+ID_KEY = "id"
+"""The key naming one stored belief by its id."""
 FILTERED_TYPES: tuple[type[Annotation], ...] = tuple(t for t in ATTRIBUTE_TYPES if t not in (Classification, Location))
 """The annotation types whose attribute a query key filters on (class and region have their own keys above)."""
 
@@ -43,20 +47,27 @@ class Vocabulary(Protocol):
     def regions_of_class(self, region_class: str) -> Sequence[RegionBox]: ...
 
 
-def belief_filter(query: Query, kb: Vocabulary | None = None, *, include_gone: bool = False) -> BeliefFilter:
-    """The filter selecting the known objects that answer ``query`` (class subsumption and regions via ``kb``)."""
+def belief_filter(
+    query: Query, kb: Vocabulary | None = None, *, include_gone: bool = False, strict: bool = False
+) -> BeliefFilter:
+    """The filter selecting the known objects that answer ``query`` (class subsumption and regions via ``kb``).
+
+    With ``strict`` (and a ``kb``), a class, value or region word the knowledge base does not know raises its
+    LookupError instead of being searched by name.
+    """
     blocks = [b for b in (_body(query), _block(_get(_body(query), "obj"))) if b is not None]
     object_class = _first_word(blocks, CLASS_KEYS)
     region_word = _region_word(blocks)
     if region_word is not None and region_word.strip().lower() == ANYWHERE:  # ``location: anywhere``: no region
         region_word = None
-    attributes = _attributes(blocks, kb)
+    attributes = _attributes(blocks, kb, strict)
     class_test = kb_class_test(kb)
     if object_class is not None:
-        object_class = _resolve(kb, object_class, "class")
-    region, boxes = (None, ()) if region_word is None else _resolve_region(kb, region_word)
+        object_class = _resolve(kb, object_class, "class", strict)
+    region, boxes = (None, ()) if region_word is None else _resolve_region(kb, region_word, strict)
     limit = _number(blocks, "max_results")
     min_confidence = _number(blocks, "confidence")  # ``confidence: 0.75``: the least belief confidence answered
+    object_id = _number(blocks, ID_KEY)
     return BeliefFilter(
         object_class=object_class,
         class_test=class_test,
@@ -66,6 +77,7 @@ def belief_filter(query: Query, kb: Vocabulary | None = None, *, include_gone: b
         include_gone=include_gone,
         min_confidence=0.0 if min_confidence is None else min_confidence,
         limit=None if limit is None else int(limit),
+        ids=None if object_id is None else (int(object_id),),
     )
 
 
@@ -107,7 +119,7 @@ def _number(blocks: list[Block], key: str) -> float | None:
     return None
 
 
-def _attributes(blocks: list[Block], kb: Vocabulary | None) -> dict[str, str]:
+def _attributes(blocks: list[Block], kb: Vocabulary | None, strict: bool) -> dict[str, str]:
     """Attribute name -> the value asked for, resolved to the knowledge base's name when it has a value kind."""
     words: dict[type[Annotation], str] = {}
     for block in blocks:
@@ -121,7 +133,7 @@ def _attributes(blocks: list[Block], kb: Vocabulary | None) -> dict[str, str]:
         word = words.get(annotation_type)
         if word is not None:
             kind = None if kb is None else kb.value_kind(annotation_type.type_name())
-            found[annotation_type.attribute] = word if kind is None else _resolve(kb, word, kind)
+            found[annotation_type.attribute] = word if kind is None else _resolve(kb, word, kind, strict)
     return found
 
 
@@ -152,19 +164,23 @@ def _region_word(blocks: list[Block]) -> str | None:
     return None
 
 
-def _resolve(kb: Vocabulary | None, word: str, kind: str) -> str:
-    """The knowledge base's name for ``word`` as a term of ``kind``, else ``word``."""
+def _resolve(kb: Vocabulary | None, word: str, kind: str, strict: bool = False) -> str:
+    """The knowledge base's name for ``word`` as a term of ``kind``, else ``word`` (LookupError when ``strict``)."""
     if kb is None:
         return word
+    if strict:
+        return kb.resolve(word, (kind,)).name
     try:
         return kb.resolve(word, (kind,)).name
     except LookupError:
         return word
 
 
-def _resolve_region(kb: Vocabulary | None, word: str) -> tuple[str, tuple[RegionBox, ...]]:
+def _resolve_region(kb: Vocabulary | None, word: str, strict: bool) -> tuple[str, tuple[RegionBox, ...]]:
     if kb is None:
         return word, ()
+    if strict:
+        kb.resolve(word, ("region", "region_class"))  # raises for a word naming no region
     candidates = [word, _resolve(kb, word, "region_class")]
     for name in candidates:
         try:

@@ -402,6 +402,16 @@ class BeliefStore:
                 conn.execute(f"DELETE FROM {table}")
         return count
 
+    def forget(self, ids: Sequence[int]) -> int:
+        """Forget the beliefs ``ids`` and their history (unknown ids are skipped); returns how many were forgotten."""
+        rows = [(int(i),) for i in set(ids)]
+        with self._transaction() as conn:
+            count = conn.executemany("DELETE FROM objects WHERE id = ?", rows).rowcount
+            conn.executemany("DELETE FROM objects_place WHERE id = ?", rows)
+            conn.executemany("DELETE FROM attribute_index WHERE object_id = ?", rows)
+            conn.executemany("DELETE FROM observations WHERE object_id = ?", rows)
+        return count
+
     def _candidates(
         self,
         conn: sqlite3.Connection,

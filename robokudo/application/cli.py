@@ -1,34 +1,42 @@
 """The ``robokudo`` command line: one subcommand per module of :mod:`robokudo.application.commands`.
 
-Each command module provides ``HELP``, ``add_arguments(parser)`` and ``run(args) -> int``.
+Each command module provides ``HELP``, ``add_arguments(parser)`` and ``run(args) -> int``. Exit status: 0 on
+success, 1 when the work itself failed (e.g. perception), 2 for bad input (query, option, path, store), and
+130 when interrupted (SIGINT or SIGTERM: the command prints one line ``interrupted`` on stderr after stopping
+the engine and closing the belief store, and ends the process; :mod:`robokudo.application.interrupts`).
 """
 
 from __future__ import annotations
 
 import argparse
+import importlib
 import sys
-from collections.abc import Sequence
-from types import ModuleType
+from collections.abc import Mapping, Sequence
+from types import MappingProxyType
 
-from robokudo.application.commands import beliefs, ontology, parse, plan, query, run, tree
+from robokudo.application.interrupts import InterruptHandling
 
-COMMANDS: dict[str, ModuleType] = {
-    "tree": tree,
-    "run": run,
-    "parse": parse,
-    "plan": plan,
-    "query": query,
-    "beliefs": beliefs,
-    "ontology": ontology,
-}
-"""Subcommand name -> the module implementing it."""
+COMMANDS: Mapping[str, str] = MappingProxyType(
+    {
+        "tree": "robokudo.application.commands.tree",
+        "run": "robokudo.application.commands.run",
+        "parse": "robokudo.application.commands.parse",
+        "plan": "robokudo.application.commands.plan",
+        "query": "robokudo.application.commands.query",
+        "beliefs": "robokudo.application.commands.beliefs",
+        "ontology": "robokudo.application.commands.ontology",
+    }
+)
+"""Subcommand name -> the module implementing it. :func:`build_parser` imports them: loading them loads
+Open3D and OpenCV (a second or more), which :func:`main` does with interrupts already handled."""
 
 
 def build_parser() -> argparse.ArgumentParser:
     """The argument parser of the ``robokudo`` command."""
     parser = argparse.ArgumentParser(prog="robokudo", description="Knowledge-enabled robot perception.")
     commands = parser.add_subparsers(dest="command", required=True, metavar="COMMAND")
-    for name, module in COMMANDS.items():
+    for name, module_name in COMMANDS.items():
+        module = importlib.import_module(module_name)
         sub = commands.add_parser(name, help=module.HELP, description=module.HELP)
         module.add_arguments(sub)
         sub.set_defaults(handler=module.run)
@@ -36,7 +44,23 @@ def build_parser() -> argparse.ArgumentParser:
 
 
 def main(argv: Sequence[str] | None = None) -> int:
-    """Entry point of the console script."""
+    """Entry point of the console script; an interrupted command ends the process (exit status 130)."""
+    with InterruptHandling() as interrupts:
+        try:
+            status = _run(argv)
+        except SystemExit:
+            raise
+        except BaseException:
+            if interrupts.received is None:
+                raise
+        # The interrupt may arrive wrapped (a C extension turns it into ImportError, an expert's failure, ...):
+        # once one was received, the command was interrupted whatever it returned.
+        if interrupts.received is not None:
+            interrupts.exit()
+    return status
+
+
+def _run(argv: Sequence[str] | None) -> int:
     args = build_parser().parse_args(list(sys.argv[1:] if argv is None else argv))
     try:
         return int(args.handler(args))

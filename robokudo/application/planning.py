@@ -7,14 +7,17 @@ from reasoning.planning.query_planner import QueryPlan, QueryPlanner
 from robokudo.application.sensor_sources import sensor_source
 
 
-def plan_for_input(planner: QueryPlanner, query: Query, input_path: str | None, frame: int = 0) -> QueryPlan:
+def plan_for_input(
+    planner: QueryPlanner, query: Query, input_path: str | None, frame: int = 0, *, look_at: str | None = None
+) -> QueryPlan:
     """Plan ``query`` to run on ``input_path`` (the built-in kitchen when None).
 
-    For the kitchen the simulated camera is pointed at the region the query names, so the plan is made twice
-    only when the reader depends on that region.
+    For the kitchen the simulated camera is pointed at the region the query names, else at ``look_at`` (e.g.
+    where the object a query names by id was last seen), so the plan is made twice only when the reader
+    depends on that region.
     """
     draft = planner.plan(query, sensor_source(planner.kb, input_path, frame))
-    region = draft.interpretation.task.region
+    region = draft.interpretation.task.region or look_at
     if input_path is None and region is not None:
         return planner.plan(query, sensor_source(planner.kb, input_path, frame, region))
     return draft

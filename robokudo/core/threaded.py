@@ -4,7 +4,9 @@ from __future__ import annotations
 
 import threading
 import time
+from collections.abc import Iterable
 
+import py_trees
 from py_trees.common import Status
 
 from robokudo.core.annotator import Annotator, _Run
@@ -75,6 +77,35 @@ class ThreadedAnnotator(Annotator):
             run.cancelled = True
         self._active_run = None
 
+    def stop_worker(self, timeout: float | None = None) -> bool:
+        """Cancel a run in progress and wait up to ``timeout`` s (None: as long as it takes) for the worker thread
+        to end; True when no worker of this node is left running."""
+        self._cancel()
+        worker = self._worker
+        if worker is not None and worker is not threading.current_thread():
+            worker.join(timeout)
+        return not self.is_working()
+
     def is_working(self) -> bool:
         """True while a worker thread of this node is alive (a cancelled one may still be finishing)."""
         return self._worker is not None and self._worker.is_alive()
+
+
+def stop_workers(trees: Iterable[py_trees.behaviour.Behaviour], timeout: float) -> list[str]:
+    """Cancel the runs of the threaded annotators in ``trees`` and wait (up to ``timeout`` s in all) for their
+    worker threads to end; returns the names of those still working.
+
+    A process should not exit while a worker runs native code (e.g. an ONNX session): the runtime may abort it.
+    """
+    deadline = time.monotonic() + timeout
+    left = []
+    for tree in trees:
+        for node in tree.iterate():
+            if isinstance(node, ThreadedAnnotator) and not node.stop_worker(max(0.0, deadline - time.monotonic())):
+                left.append(node.name)
+    return left
+
+
+def has_workers(tree: py_trees.behaviour.Behaviour) -> bool:
+    """True while a worker thread of a threaded annotator in ``tree`` is alive."""
+    return any(isinstance(node, ThreadedAnnotator) and node.is_working() for node in tree.iterate())

@@ -262,7 +262,7 @@ def test_query_to_filter_with_the_real_knowledge_base(filled: Path) -> None:
 def cli(store: Path, query: str | None = None, *, as_json: bool = False, clear: bool = False) -> argparse.Namespace:
     parser = argparse.ArgumentParser()
     beliefs_cli.add_arguments(parser)
-    argv = ([query] if query else []) + (["--json"] if as_json else []) + (["--clear"] if clear else [])
+    argv = ([query] if query else []) + (["--json"] if as_json else []) + (["--clear", "--yes"] if clear else [])
     return parser.parse_args([*argv, "--store", str(store)])
 
 

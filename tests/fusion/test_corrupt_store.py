@@ -83,7 +83,7 @@ def test_the_cli_reports_a_corrupt_store_without_touching_it(tmp_path: Path, cap
     path.write_bytes(b"\x00garbage" * 100)
     before = digest(path)
     for clear in (False, True):
-        args = argparse.Namespace(query=None, json=False, clear=clear, all=False, store=path)
+        args = argparse.Namespace(query=None, json=False, clear=clear, yes=clear, all=False, store=path)
         assert beliefs_cli.run(args) == 2
         err = capsys.readouterr().err
         assert str(path) in err and "mv " in err

@@ -14,8 +14,9 @@ from robokudo.application.knowledge import load_knowledge_base
 
 @pytest.fixture(autouse=True)
 def _private_user_ontology(tmp_path: Path, monkeypatch: pytest.MonkeyPatch) -> Iterator[None]:
-    """Never read or write the real user data directory: the default user file is a temporary one."""
+    """Never read or write the real user data directory: the default user file and belief store are temporary."""
     monkeypatch.setenv(USER_ONTOLOGY_ENV, str(tmp_path / "default-user.ttl"))
+    monkeypatch.setenv("ROBOKUDO_BELIEF_STORE", str(tmp_path / "default-beliefs.sqlite"))
     yield
 
 

@@ -1,8 +1,14 @@
-"""``robokudo beliefs [QUERY] [--json] [--clear] [--store PATH]``: answer from memory, without perception.
+"""``robokudo beliefs [QUERY] [--json] [--all] [--clear [--yes]] [--store PATH]``: answer from memory.
 
 Without QUERY every known object is listed; with QUERY (any query form) the known objects matching it are
-listed, using the knowledge base for class subsumption and regions. ``--clear`` forgets everything. The store
-is ``--store``, else ``$ROBOKUDO_BELIEF_STORE``, else ``<user data dir>/robokudo/beliefs.sqlite``.
+listed, using the knowledge base for class subsumption and regions. A class, value or region word the knowledge
+base does not know is an error (exit 2), as it is for ``robokudo query``; ``inspect object 3`` lists belief 3,
+or says ``no object 3`` (exit 2) when the store holds no such belief.
+
+``QUERY --clear`` forgets exactly the objects the same command without ``--clear`` lists (with their history)
+and prints how many. ``--clear`` without QUERY forgets every belief, gone ones and history included, and needs
+``--yes`` to confirm; ``--clear --yes QUERY`` is refused as ambiguous. A refused or failed command forgets
+nothing. The store is ``--store``, else ``$ROBOKUDO_BELIEF_STORE``, else ``<user data dir>/robokudo/beliefs.sqlite``.
 """
 
 from __future__ import annotations
@@ -16,6 +22,7 @@ from queries import QueryError, parse_query
 from reasoning.beliefs.answer import Answer, answer_from_memory
 from reasoning.beliefs.filters import belief_filter
 from reasoning.beliefs.store import BeliefFilter, BeliefStore, BeliefStoreError
+from reasoning.errors import TermError
 from reasoning.knowledge.knowledge_base import KnowledgeBase
 from robokudo.application.knowledge import load_knowledge_base
 
@@ -24,46 +31,97 @@ HELP = "answer from the belief store, without running perception"
 
 def add_arguments(parser: argparse.ArgumentParser) -> None:
     """Declare the arguments of ``robokudo beliefs``."""
-    parser.add_argument("query", nargs="?", help='a perception query, e.g. "milk in fridge" (default: everything)')
+    parser.add_argument(
+        "query", nargs="*", help='a perception query, e.g. "milk in fridge" (words are joined; default: everything)'
+    )
     parser.add_argument("--json", action="store_true", help="print the answer as JSON")
-    parser.add_argument("--clear", action="store_true", help="forget every stored belief")
+    parser.add_argument(
+        "--clear",
+        action="store_true",
+        help="forget the objects QUERY matches (what the command lists without --clear); "
+        "without QUERY, forget every belief (needs --yes)",
+    )
+    parser.add_argument(
+        "--yes", action="store_true", help="confirm --clear without QUERY: forget every belief and its history"
+    )
     parser.add_argument("--all", action="store_true", help="include objects marked gone")
     parser.add_argument("--store", type=Path, default=None, help="belief store file (default: see above)")
 
 
+class _RefusedError(Exception):
+    """The command cannot be carried out as given; nothing was changed."""
+
+
 def run(args: argparse.Namespace) -> int:
-    """Run ``robokudo beliefs``; 0 on success, 2 on a bad store or query."""
+    """Run ``robokudo beliefs``; 0 on success, 2 on a bad store, query, option combination or object id."""
     path = args.store.expanduser() if args.store else BeliefStore.default_path()
+    words = args.query if isinstance(args.query, list) else [args.query or ""]
+    args.query = " ".join(words).strip()
     try:
-        if args.clear:
-            return _clear(path, args)
-        if not path.exists():
-            return _print(Answer(query=args.query or "", from_memory=True), args, f"no beliefs stored yet ({path})")
+        _check_options(args)
+        if args.clear and not args.query:
+            return _clear_everything(path, args)
         kb = load_knowledge_base() if args.query else None
         query_filter = _filter(args.query, args.all, kb)
-        options = {"label_of": kb.label} if kb is not None else {}
+        if not path.exists():  # reading never creates the store
+            _check_ids(query_filter, None)
+            if args.clear:
+                return _print_cleared(0, (), path, args)
+            return _print(Answer(query=args.query or "", from_memory=True), args, f"no beliefs stored yet ({path})")
         with BeliefStore(path) as store:
+            _check_ids(query_filter, store)
+            if args.clear:
+                ids = tuple(b.id for b in store.query(query_filter))
+                return _print_cleared(store.forget(ids), ids, path, args)
+            options = {"label_of": kb.label} if kb is not None else {}
             answer = answer_from_memory(store, query_filter, args.query or "", **options)
         return _print(answer, args, None)
-    except (BeliefStoreError, _QueryProblemError) as error:
+    except (BeliefStoreError, _RefusedError) as error:
         print(f"robokudo beliefs: {error}", file=sys.stderr)
         return 2
 
 
-class _QueryProblemError(Exception):
-    """The query text could not be parsed."""
+def _check_options(args: argparse.Namespace) -> None:
+    if args.yes and not args.clear:
+        raise _RefusedError("--yes only confirms --clear; nothing was forgotten")
+    if args.clear and args.yes and args.query:
+        raise _RefusedError(
+            "--clear with both a QUERY and --yes is ambiguous: give QUERY to forget what it matches, or --yes "
+            "(without QUERY) to forget every belief; nothing was forgotten"
+        )
+    if args.clear and not args.query and not args.yes:
+        raise _RefusedError(
+            "--clear without a QUERY would forget every belief; add --yes to confirm, or give a QUERY to forget "
+            "only what it matches; nothing was forgotten"
+        )
 
 
-def _clear(path: Path, args: argparse.Namespace) -> int:
+def _clear_everything(path: Path, args: argparse.Namespace) -> int:
     count = 0
     if path.exists():
         with BeliefStore(path) as store:
             count = store.clear()
+    return _print_cleared(count, None, path, args)
+
+
+def _print_cleared(count: int, ids: tuple[int, ...] | None, path: Path, args: argparse.Namespace) -> int:
     if args.json:
-        print(json.dumps({"cleared": count, "store": str(path)}))
+        document: dict[str, object] = {"cleared": count, "store": str(path)}
+        if ids is not None:
+            document["ids"] = sorted(ids)
+        print(json.dumps(document))
+    elif ids is None:
+        print(f"forgot {count} object(s) in {path} (every belief, with its history)")
     else:
-        print(f"forgot {count} object(s) in {path}")
+        print(f"forgot {count} object(s) matching {args.query!r} in {path}")
     return 0
+
+
+def _check_ids(query_filter: BeliefFilter, store: BeliefStore | None) -> None:
+    """Refuse a query naming an object id the store does not hold."""
+    for object_id in query_filter.ids or ():
+        if store is None or store.get(object_id) is None:
+            raise _RefusedError(f"no object {object_id}")
 
 
 def _filter(text: str | None, include_gone: bool, kb: KnowledgeBase | None) -> BeliefFilter:
@@ -75,8 +133,11 @@ def _filter(text: str | None, include_gone: bool, kb: KnowledgeBase | None) -> B
         try:  # a memory question may name just the object: "milk in fridge" means "find milk in fridge"
             query = parse_query(f"find {text}")
         except QueryError:
-            raise _QueryProblemError(str(error)) from error
-    return belief_filter(query, kb, include_gone=include_gone)
+            raise _RefusedError(str(error)) from error
+    try:
+        return belief_filter(query, kb, include_gone=include_gone, strict=True)
+    except TermError as error:
+        raise _RefusedError(str(error)) from error
 
 
 def _print(answer: Answer, args: argparse.Namespace, note: str | None) -> int:

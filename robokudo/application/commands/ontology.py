@@ -2,6 +2,11 @@
 
 A rejected edit or an unknown name exits with status 2 and a message on
 stderr; a failed ``check`` exits with 1.
+
+``remove-object NAME`` also updates the belief store (``--store``, else ``$ROBOKUDO_BELIEF_STORE``, else the
+user data dir; a store that does not exist is left alone): after the class is removed, the stored beliefs of
+that class are reclassified as its parent class, keeping their other class alternatives
+(:mod:`robokudo.application.reclassify`). An unusable store is reported before anything is removed.
 """
 
 from __future__ import annotations
@@ -10,12 +15,15 @@ import argparse
 import sys
 from pathlib import Path
 
+from reasoning.beliefs.filters import kb_class_test
+from reasoning.beliefs.store import BeliefStore, BeliefStoreError
 from reasoning.errors import EditRejectedError, OntologyError, TermError
 from reasoning.knowledge.editing import CheckReport, EditResult, OntologyEditor
 from reasoning.knowledge.knowledge_base import KnowledgeBase
 from reasoning.knowledge.model import AnnotatorSpec, Resolved
 from reasoning.knowledge.sources import USER_ONTOLOGY_ENV
 from robokudo.application.knowledge import load_knowledge_base
+from robokudo.application.reclassify import reclassify
 from robokudo.core.regions import RegionBox
 
 HELP = "show, check and edit the ontology"
@@ -91,8 +99,17 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
     check.add_argument("--no-code", action="store_true", help="do not compare the CAS types with the runtime's classes")
     _common_options(check, suppress=True)
 
-    remove = actions.add_parser("remove-object", help="remove an object class from the user ontology")
+    remove = actions.add_parser(
+        "remove-object",
+        help="remove an object class from the user ontology; stored beliefs of it move to its parent class",
+    )
     remove.add_argument("name")
+    remove.add_argument(
+        "--store",
+        type=Path,
+        default=None,
+        help="belief store file (default: $ROBOKUDO_BELIEF_STORE or the user data dir)",
+    )
     _common_options(remove, suppress=True)
 
 
@@ -147,12 +164,34 @@ def run(args: argparse.Namespace) -> int:
             print(describe(kb, result.name))
             return 0
         if action == "remove-object":
-            _print_result(editor.remove_object(args.name))
-            return 0
-    except (EditRejectedError, TermError) as error:
+            return _remove_object(kb, editor, args.name, args.store)
+    except (EditRejectedError, TermError, BeliefStoreError) as error:
         print(f"robokudo ontology {action}: {error}", file=sys.stderr)
         return 2
     raise ValueError(f"unknown ontology action {action!r}")
+
+
+def _remove_object(kb: KnowledgeBase, editor: OntologyEditor, name: str, store_path: Path | None) -> int:
+    """Remove the class, then move the stored beliefs of it to its parent class."""
+    path = (store_path or BeliefStore.default_path()).expanduser()
+    store = BeliefStore(path) if path.exists() else None  # an unusable store fails here, before the removal
+    try:
+        try:
+            parents = sorted(kb.superclasses(name, direct=True))  # read before the class is gone
+        except LookupError:
+            parents = []  # remove_object says what is wrong with the name
+        result = editor.remove_object(name)
+        _print_result(result)
+        if store is not None:
+            parent = parents[0] if parents else None
+            moved = reclassify(store, result.name, parent, kb_class_test(kb))
+            if moved:
+                target = f"as {parent}" if parent else "with no class"
+                print(f"reclassified {len(moved)} stored belief(s) of {result.name} {target} ({path})")
+    finally:
+        if store is not None:
+            store.close()
+    return 0
 
 
 def _print_result(result: EditResult) -> None:

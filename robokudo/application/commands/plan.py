@@ -11,6 +11,7 @@ from queries import QueryError, format_query, parse_query
 from reasoning.errors import OntologyError
 from reasoning.planning.planner import PlanningError
 from reasoning.planning.query_planner import QueryPlan, QueryPlanner
+from robokudo.application.commands.input_options import add_input_arguments, frame_number, input_problem
 from robokudo.application.knowledge import load_knowledge_base
 from robokudo.application.planning import plan_for_input
 from robokudo.core.render import tree_to_dict, unicode_tree
@@ -24,8 +25,7 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
     parser.add_argument("query", nargs="+", help="the query: nested, a phrase, or JSON")
     parser.add_argument("--json", action="store_true", help="print a machine-readable tree")
     parser.add_argument("--explain", action="store_true", help="print why each node is there")
-    parser.add_argument("--input", help="input the tree will read (default: the built-in kitchen scene)")
-    parser.add_argument("--frame", type=int, default=0)
+    add_input_arguments(parser, "input the tree will read")
 
 
 def task_summary(query_plan: QueryPlan) -> dict[str, object]:
@@ -43,10 +43,14 @@ def task_summary(query_plan: QueryPlan) -> dict[str, object]:
 def run(args: argparse.Namespace) -> int:
     """Plan and print; exit 2 with the reason when the query cannot be parsed or planned."""
     text = " ".join(args.query)
+    problem = input_problem(args)
+    if problem is not None:
+        print(f"robokudo plan: {problem}", file=sys.stderr)
+        return 2
     try:
         catalog = AnnotatorCatalog.discover()
         planner = QueryPlanner(load_knowledge_base(catalog=catalog))
-        query_plan = plan_for_input(planner, parse_query(text), args.input, args.frame)
+        query_plan = plan_for_input(planner, parse_query(text), args.input, frame_number(args))
         tree = build_tree(query_plan.plan, catalog=catalog)
     except QueryError as error:
         print(error, file=sys.stderr)

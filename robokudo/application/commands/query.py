@@ -1,26 +1,34 @@
-"""``robokudo query QUERY``: plan, run on an input, fuse into the belief store and print the answer."""
+"""``robokudo query QUERY``: plan, run on an input, fuse into the belief store and print the answer.
+
+Exit status: 0 with an answer (also when the query's ``timeout`` passed first: the answer then holds the stored
+beliefs matching the query, ``"timed_out": true`` in the JSON and a note on stderr), 1 when perception failed,
+2 for a bad query, plan, option, input, belief store or an object id the store does not hold (``no object 3``).
+The query is parsed first, then the belief store is checked, before anything else is loaded.
+"""
 
 from __future__ import annotations
 
 import argparse
 import sys
 
-from queries import QueryError
+from queries import QueryError, parse_query
 from reasoning.beliefs.store import BeliefStoreError
 from reasoning.errors import OntologyError
 from reasoning.planning.planner import PlanningError
-from robokudo.application.service import AnsweringService, PerceptionFailedError
+from robokudo.application.commands.input_options import add_input_arguments, frame_number, input_problem
+from robokudo.application.service import AnsweringService, PerceptionFailedError, UnknownObjectError
 from robokudo.core.render import unicode_tree
 from trees.synthesis import SynthesisError
 
 HELP = "plan and run a query on an input and print the answer"
 
+TIMED_OUT_NOTE = "the query's timeout passed before perception finished; the answer holds the stored beliefs that match"
+
 
 def add_arguments(parser: argparse.ArgumentParser) -> None:
     """Arguments of ``robokudo query``."""
     parser.add_argument("query", nargs="+", help="the query: nested, a phrase, or JSON")
-    parser.add_argument("--input", help="input to perceive (default: the built-in kitchen scene)")
-    parser.add_argument("--frame", type=int, default=0, help="frame number in a sequence input")
+    add_input_arguments(parser)
     parser.add_argument("--json", action="store_true", help="print the answer as JSON")
     parser.add_argument("--explain", action="store_true", help="print the synthesized tree with its reasons")
     parser.add_argument("--store", help="belief store file (default: $ROBOKUDO_BELIEF_STORE or the user data dir)")
@@ -29,13 +37,18 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
 def run(args: argparse.Namespace) -> int:
     """Answer the query; exit 2 on a bad query or plan, 1 when perception failed."""
     text = " ".join(args.query)
+    problem = input_problem(args)
+    if problem is not None:
+        print(f"robokudo query: {problem}", file=sys.stderr)
+        return 2
     try:
-        with AnsweringService.open(args.store, input_path=args.input, frame=args.frame) as service:
-            outcome = service.answer(text)
+        query = parse_query(text)  # the cheapest check first: a bad query touches nothing
+        with AnsweringService.open(args.store, input_path=args.input, frame=frame_number(args)) as service:
+            outcome = service.answer(query)
     except QueryError as error:
         print(error, file=sys.stderr)
         return 2
-    except (PlanningError, SynthesisError, OntologyError, BeliefStoreError, ValueError) as error:
+    except (PlanningError, SynthesisError, OntologyError, BeliefStoreError, UnknownObjectError, ValueError) as error:
         print(f"robokudo query: {error}", file=sys.stderr)
         return 2
     except PerceptionFailedError as error:
@@ -44,5 +57,7 @@ def run(args: argparse.Namespace) -> int:
     if args.explain:
         print(unicode_tree(outcome.tree, show_status=True, show_reasons=True))
         print()
+    if outcome.answer.timed_out:
+        print(f"robokudo query: {TIMED_OUT_NOTE}", file=sys.stderr)
     print(outcome.answer.to_json() if args.json else outcome.answer.summary())
     return 0

@@ -3,9 +3,11 @@
 from __future__ import annotations
 
 import argparse
+import sys
 
 from py_trees.common import Status
 
+from robokudo.application.commands.input_options import add_input_arguments, frame_number, input_problem
 from robokudo.application.report import describe_hypotheses, write_annotated_image
 from robokudo.core.engine import Engine
 from robokudo.core.pipeline import pipelines
@@ -18,16 +20,19 @@ HELP = "run a tree with the engine"
 def add_arguments(parser: argparse.ArgumentParser) -> None:
     """Arguments of ``robokudo run``."""
     parser.add_argument("name")
-    parser.add_argument("--input", help="input path (default: the built-in kitchen scene)")
-    parser.add_argument("--frame", type=int, default=0, help="frame number in a sequence input")
+    add_input_arguments(parser, "input path")
     parser.add_argument("--ticks", type=int, default=None, help="tick this many times (default: until it finishes)")
     parser.add_argument("--hz", type=float, default=30.0, help="tick frequency")
     parser.add_argument("--annotated-image", metavar="PATH", help="write the colour image with the hypotheses drawn")
 
 
 def run(args: argparse.Namespace) -> int:
-    """Run the tree (once, or ``--ticks`` times); 0 when it succeeded."""
-    root = load_tree(args.name).create(input_path=args.input, frame=args.frame)
+    """Run the tree (once, or ``--ticks`` times); 0 when it succeeded, 2 for bad options."""
+    problem = input_problem(args)
+    if problem is not None:
+        print(f"robokudo run: {problem}", file=sys.stderr)
+        return 2
+    root = load_tree(args.name).create(input_path=args.input, frame=frame_number(args))
     engine = Engine(root, hz=args.hz)
     until_finished = (lambda s: s is not Status.RUNNING) if args.ticks is None else None
     status = engine.run(ticks=args.ticks, until=until_finished)
