@@ -153,19 +153,23 @@ class Answer:
         return json.dumps(self.to_dict(), indent=indent)
 
     def summary(self) -> str:
-        """One line per object, for people."""
+        """One line per object, for people: a class more likely wrong than right is marked ``?``; ``class`` is the
+        probability that the class is right, ``exists`` the confidence that the object is there."""
         if not self.objects:
             return "no matching object"
         lines = []
         for o in self.objects:
             p = o.pose.position
             colour = o.attributes.get(SemanticColor.attribute)
+            stated = o.attributes.get(CLASS_ATTRIBUTE)
+            doubtful = o.class_label is not None and stated is not None and stated.confidence < 0.5
             lines.append(
-                f"#{o.id} {o.class_label or UNKNOWN_LABEL}"
+                f"#{o.id} {o.class_label or UNKNOWN_LABEL}{'?' if doubtful else ''}"
                 + (f" ({colour.value})" if colour else "")
                 + f" at ({p[0]:.3f}, {p[1]:.3f}, {p[2]:.3f}) [{o.pose.frame}]"
                 + (f" in {o.region}" if o.region else "")
-                + f", confidence {o.confidence:.2f}, by {', '.join(o.experts) or 'nobody'}"
+                + (f", class {stated.confidence:.2f}" if stated is not None and o.class_label else "")
+                + f", exists {o.confidence:.2f}, by {', '.join(o.experts) or 'nobody'}"
             )
         return "\n".join(lines)
 

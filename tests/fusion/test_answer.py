@@ -13,7 +13,16 @@ import pytest
 from py_trees.common import Status
 
 from queries import Query, parse_query
-from reasoning.beliefs.answer import answer_from_memory, class_iri, class_label, designator
+from reasoning.beliefs.answer import (
+    Answer,
+    AttributeDesignator,
+    ObjectDesignator,
+    PoseDesignator,
+    answer_from_memory,
+    class_iri,
+    class_label,
+    designator,
+)
 from reasoning.beliefs.filters import belief_filter
 from reasoning.beliefs.store import BeliefFilter, BeliefStore
 from reasoning.fusion.frame import FrameObject
@@ -318,3 +327,24 @@ def test_the_answer_step_answers_with_what_it_sees_even_under_a_limit(tmp_path: 
     (cup,) = root.cas.view(QueryAnswer).answer.objects
     assert cup.id != 1 and cup.roi == (10, 10, 20, 20)
     step.shutdown()
+
+
+def test_the_summary_marks_a_doubtful_class_and_shows_both_confidences() -> None:
+    def one(class_confidence: float) -> str:
+        guessed = AttributeDesignator(value="Cup", confidence=class_confidence, experts=("KnowledgeClassifier",))
+        cup = ObjectDesignator(
+            id=7,
+            class_iri=class_iri("Cup"),
+            class_label="cup",
+            pose=PoseDesignator(position=(0.1, 0.2, 0.3), orientation=(0.0, 0.0, 0.0, 1.0), frame="camera"),
+            size=None,
+            size_class=None,
+            region=None,
+            attributes={"class": guessed},
+            experts=("KnowledgeClassifier",),
+            confidence=0.9,
+        )
+        return Answer(query="find the cup", objects=(cup,)).summary()
+
+    assert one(0.3).startswith("#7 cup? at") and ", class 0.30, exists 0.90" in one(0.3)
+    assert one(0.8).startswith("#7 cup at") and ", class 0.80, exists 0.90" in one(0.8)
