@@ -2,6 +2,6 @@
 
 import sys
 
-from robokudo.application.cli import main
+from robokudo.application.console import main
 
 sys.exit(main())

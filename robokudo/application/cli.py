@@ -9,34 +9,32 @@ the engine and closing the belief store, and ends the process; :mod:`robokudo.ap
 from __future__ import annotations
 
 import argparse
-import importlib
 import sys
 from collections.abc import Mapping, Sequence
-from types import MappingProxyType
+from types import MappingProxyType, ModuleType
 
+from robokudo.application.commands import beliefs, ontology, parse, plan, query, run, tree
 from robokudo.application.interrupts import InterruptHandling
 
-COMMANDS: Mapping[str, str] = MappingProxyType(
+COMMANDS: Mapping[str, ModuleType] = MappingProxyType(
     {
-        "tree": "robokudo.application.commands.tree",
-        "run": "robokudo.application.commands.run",
-        "parse": "robokudo.application.commands.parse",
-        "plan": "robokudo.application.commands.plan",
-        "query": "robokudo.application.commands.query",
-        "beliefs": "robokudo.application.commands.beliefs",
-        "ontology": "robokudo.application.commands.ontology",
+        "tree": tree,
+        "run": run,
+        "parse": parse,
+        "plan": plan,
+        "query": query,
+        "beliefs": beliefs,
+        "ontology": ontology,
     }
 )
-"""Subcommand name -> the module implementing it. :func:`build_parser` imports them: loading them loads
-Open3D and OpenCV (a second or more), which :func:`main` does with interrupts already handled."""
+"""Subcommand name -> the module implementing it."""
 
 
 def build_parser() -> argparse.ArgumentParser:
     """The argument parser of the ``robokudo`` command."""
     parser = argparse.ArgumentParser(prog="robokudo", description="Knowledge-enabled robot perception.")
     commands = parser.add_subparsers(dest="command", required=True, metavar="COMMAND")
-    for name, module_name in COMMANDS.items():
-        module = importlib.import_module(module_name)
+    for name, module in COMMANDS.items():
         sub = commands.add_parser(name, help=module.HELP, description=module.HELP)
         module.add_arguments(sub)
         sub.set_defaults(handler=module.run)
