@@ -9,7 +9,8 @@ import pytest
 
 @pytest.fixture(autouse=True)
 def private_user_data(tmp_path_factory: pytest.TempPathFactory, monkeypatch: pytest.MonkeyPatch) -> None:
-    """Point the default user ontology and belief store at a fresh folder (tests may set their own on top)."""
+    """Point the user ontology, belief store and data dir at a fresh folder (tests may set their own on top)."""
     folder: Path = tmp_path_factory.mktemp("user-data")
     monkeypatch.setenv("ROBOKUDO_USER_ONTOLOGY", str(folder / "user.ttl"))
     monkeypatch.setenv("ROBOKUDO_BELIEF_STORE", str(folder / "beliefs.sqlite"))
+    monkeypatch.setenv("XDG_DATA_HOME", str(folder / "data"))

@@ -3,7 +3,6 @@
 from __future__ import annotations
 
 import json
-import shutil
 from pathlib import Path
 
 import cv2
@@ -18,25 +17,6 @@ from robokudo.application.service import AnsweringService
 from robokudo.core.threaded import has_workers
 
 TUM_SAMPLE = Path("../shared/data/tum_rgbd_sample_open3d")
-
-
-@pytest.fixture(scope="module")
-def perceived(tmp_path_factory: pytest.TempPathFactory) -> Path:
-    """A store filled by two kitchen queries: the milk in the fridge (#1) and three table objects (#2..#4)."""
-    folder = tmp_path_factory.mktemp("perceived")
-    path = folder / "beliefs.sqlite"
-    with pytest.MonkeyPatch.context() as env:
-        env.setenv("ROBOKUDO_USER_ONTOLOGY", str(folder / "user.ttl"))
-        env.setenv("ROBOKUDO_BELIEF_STORE", str(folder / "unused.sqlite"))
-        assert cli.main(["query", "find milk in fridge", "--store", str(path)]) == 0
-        assert cli.main(["query", "scan the table", "--store", str(path)]) == 0
-    return path
-
-
-@pytest.fixture
-def store(perceived: Path, tmp_path: Path) -> Path:
-    """A private copy of the perceived store."""
-    return Path(shutil.copy(perceived, tmp_path / "perceived.sqlite"))
 
 
 def query(capsys: pytest.CaptureFixture[str], *argv: str) -> tuple[int, str, str]:
