@@ -6,6 +6,8 @@ The rules, tried in this order (the first that matches wins):
 path                                                                   reader
 =====================================================================  ==========================================
 None                                                                   KitchenSceneReader (the built-in scene)
+ROS 1 ``.bag`` file, ROS 2 bag folder (``metadata.yaml``) or its       BagReader(path, frame) (BagCloudReader
+``.mcap`` / ``.db3`` file                                               when it holds only PointCloud2 topics)
 folder with ``rgb.txt`` and ``depth.txt``                              TumSequenceReader(folder, frame)
 folder with ``camera_params.json`` and ``NNNNNN-color.png`` files       ColorDepthPairReader(folder, frame)
 folder with ``tiff/`` (and ``pclzf/*.xml``), or that ``tiff/`` folder  TiffSequenceReader(folder, frame)
@@ -20,7 +22,7 @@ half beside it (``TUM_color.png`` + ``TUM_depth.png``)
 
 Anything else raises ValueError listing these layouts. :func:`reader_name_for` gives the ontology name of the
 reader without constructing it; :func:`reader_choice` also gives the constructor arguments (plain data). Choosing
-looks at the file system only and imports neither the readers nor Open3D.
+looks at the file system only (for a bag, at its index of topics) and decodes no frame.
 """
 
 from __future__ import annotations
@@ -30,8 +32,11 @@ from collections.abc import Mapping
 from dataclasses import dataclass, field
 from pathlib import Path
 
-from annotators.readers.frame_io import CAMERA_PARAMS_FILE
+from annotators.readers.bag_io import IMAGE, bag_message_types, is_bag
+from annotators.readers.frame_io import CAMERA_PARAMS_FILE, FrameError
 from annotators.readers.frame_readers import (
+    BagCloudReader,
+    BagReader,
     ColorDepthPairReader,
     KitchenSceneReader,
     PcdReader,
@@ -45,6 +50,7 @@ from robokudo.core.annotator import Annotator
 
 SUPPORTED_LAYOUTS = (
     "no path: the built-in kitchen scene",
+    "a ROS 1 .bag file, or a ROS 2 bag (folder with metadata.yaml, .mcap or .db3 file)",
     "a TUM RGB-D sequence folder (rgb.txt, depth.txt)",
     "a uoc folder (NNNNNN-color.png, NNNNNN-depth.png, camera_params.json) or one of its NNNNNN-color.png",
     "a PCL ImageGrabber folder (tiff/ with pclzf/*.xml) or its tiff/ folder",
@@ -60,6 +66,8 @@ READER_NAMES: tuple[str, ...] = (
     "TiffSequenceReader",
     "PcdReader",
     "TumPairReader",
+    "BagReader",
+    "BagCloudReader",
 )
 """Every reader the entry point can choose, by ontology name (classes of :mod:`annotators.readers.frame_readers`)."""
 
@@ -96,6 +104,15 @@ def _unsupported(path: Path, why: str) -> ValueError:
 def _single_frame(path: Path, frame: int) -> None:
     if frame != 0:
         raise ValueError(f"{path} holds a single frame; --frame must be 0, got {frame}")
+
+
+def _bag_choice(path: Path, frame: int) -> ReaderChoice:
+    try:
+        types = bag_message_types(path)
+    except FrameError as error:
+        raise _unsupported(path, str(error)) from None
+    reader = BagReader if IMAGE in types else BagCloudReader
+    return ReaderChoice(reader, {"path": str(path), "frame": frame})
 
 
 def _folder_choice(folder: Path, frame: int) -> ReaderChoice:
@@ -143,6 +160,8 @@ def reader_choice(path: str | None, frame: int = 0) -> ReaderChoice:
     if path is None:
         return ReaderChoice(KitchenSceneReader)
     resolved = Path(path).expanduser()
+    if is_bag(resolved):
+        return _bag_choice(resolved, frame)
     if resolved.is_dir():
         return _folder_choice(resolved, frame)
     if resolved.is_file():

@@ -5,6 +5,7 @@
 * :class:`TumSequenceReader` and :class:`TumPairReader` read the TUM RGB-D layouts (:mod:`annotators.readers.tum_io`).
 * :class:`PcdReader` reads an organized PCD file and also writes its point cloud (:mod:`annotators.readers.pcd_io`).
 * :class:`TiffSequenceReader` reads the PCL ImageGrabber TIFF layout (:mod:`annotators.readers.tiff_io`).
+* :class:`BagReader` reads a frame of a ROS 1 or ROS 2 bag (:mod:`annotators.readers.bag_io`).
 
 :func:`annotators.readers.choice.reader_for` picks the reader from a path. Every reader decodes once and keeps the frame
 on the instance, so repeated ticks of the same frame cost nothing but the CAS writes; the arrays are shared with
@@ -24,6 +25,7 @@ from typing import ClassVar
 
 import numpy as np
 
+from annotators.readers.bag_io import MILLIMETRES, BagTopics, read_bag_frame
 from annotators.readers.frame_io import Frame, FrameError, read_color_depth_pair
 from annotators.readers.pcd_io import read_pcd
 from annotators.readers.tiff_io import read_tiff_frame
@@ -320,3 +322,57 @@ class TiffSequenceReader(FileFrameReader):
     def recording(self) -> str:
         """The grabber folder: one continuous recording."""
         return str(self.folder.resolve())
+
+
+class BagReader(FileFrameReader):
+    """Reads frame ``frame`` (recording order) of a ROS 1 ``.bag`` or a ROS 2 bag (folder, ``.mcap``, ``.db3``).
+
+    Colour + depth ``sensor_msgs/Image`` paired by stamp with the ``CameraInfo`` intrinsics; topics are picked by
+    type unless named. ``depth_scale`` is in units per metre of 16-bit depth (ROS: millimetres).
+    :class:`BagCloudReader` reads bags of organized ``PointCloud2`` messages.
+    """
+
+    capability: ClassVar[Capability] = Capability(
+        label="bag reader",
+        description="Reads a frame of a ROS 1 or ROS 2 bag (sensor_msgs/Image colour + depth with CameraInfo).",
+        cost_ms=40.0,
+        reliability=1.0,
+    )
+
+    def __init__(
+        self,
+        path: str | Path,
+        frame: int = 0,
+        color_topic: str | None = None,
+        depth_topic: str | None = None,
+        info_topic: str | None = None,
+        cloud_topic: str | None = None,
+        depth_scale: float = MILLIMETRES,
+        name: str | None = None,
+    ) -> None:
+        super().__init__(name=name)
+        self.path = Path(path)
+        self.frame = frame
+        self.topics = BagTopics(color=color_topic, depth=depth_topic, info=info_topic, cloud=cloud_topic)
+        self.depth_scale = depth_scale
+
+    def decode(self) -> Frame:
+        """Read the bag up to the frame and decode it."""
+        return read_bag_frame(self.path, self.frame, self.topics, self.depth_scale)
+
+    def recording(self) -> str:
+        """The bag: one continuous recording."""
+        return str(self.path.resolve())
+
+
+class BagCloudReader(BagReader):
+    """Reads frame ``frame`` of a bag of organized ``sensor_msgs/PointCloud2`` messages: colour, depth (z), camera
+    info (fitted to the grid) and the cloud itself. A colour + depth image bag gives no cloud (use BagReader)."""
+
+    outputs: ClassVar[tuple[type[CasType], ...]] = (ColorImage, DepthImage, CameraInfo, PointCloud)
+    capability: ClassVar[Capability] = Capability(
+        label="bag cloud reader",
+        description="Reads a frame of a ROS 1 or ROS 2 bag of organized sensor_msgs/PointCloud2 messages.",
+        cost_ms=60.0,
+        reliability=1.0,
+    )

@@ -32,7 +32,10 @@ from annotators.image.color import SemanticColorAnnotator
 from annotators.image.histogram import ColorHistogramAnnotator
 from annotators.image.image_regions import ImageRegionSegmenter
 from annotators.image.onnx_detector import OnnxDetector
+from annotators.readers.frame_io import Frame
 from annotators.readers.frame_readers import (
+    BagCloudReader,
+    BagReader,
     ColorDepthPairReader,
     KitchenSceneReader,
     PcdReader,
@@ -60,6 +63,7 @@ from robokudo.core.types import (
     Size,
     View,
 )
+from tests.annotators.bag_writing import INFO_TOPIC, write_bag
 from tests.annotators.onnx_models import detection_model, one_box_model
 
 H, W = 48, 64
@@ -418,6 +422,16 @@ BROKEN_READERS: dict[type[Annotator], dict[str, Callable[[Path], Annotator]]] = 
             write_pcd(tmp / "a.pcd"), intrinsics=CameraIntrinsics(0, 0, 0, 0, 0, 0)
         ),
     },
+    BagReader: {
+        "missing bag": lambda tmp: BagReader(tmp / "nowhere.bag"),
+        "not a bag file": lambda tmp: BagReader((tmp / "junk.bag", (tmp / "junk.bag").write_text("hello"))[0]),
+        "missing frame": lambda tmp: BagReader(write_small_bag(tmp / "a.bag"), frame=1),
+        "named topic of another type": lambda tmp: BagReader(write_small_bag(tmp / "b"), color_topic=INFO_TOPIC),
+    },
+    BagCloudReader: {
+        "missing bag": lambda tmp: BagCloudReader(tmp / "nowhere"),
+        "image bag": lambda tmp: BagCloudReader(write_small_bag(tmp / "c.bag")),
+    },
     TiffSequenceReader: {
         "missing folder": lambda tmp: TiffSequenceReader(tmp / "nowhere"),
         "missing frame": lambda tmp: TiffSequenceReader(write_tiff(tmp), frame=1),
@@ -427,6 +441,12 @@ BROKEN_READERS: dict[type[Annotator], dict[str, Callable[[Path], Annotator]]] = 
         "truncated depth file": lambda tmp: TiffSequenceReader(write_tiff(tmp, truncate=True)),
     },
 }
+
+
+def write_small_bag(path: Path) -> Path:
+    """A bag (ROS 1 for a .bag path, else ROS 2) of one small colour + depth frame."""
+    frame = Frame(np.full((H, W, 3), 90, np.uint8), np.full((H, W), 0.8, np.float32), K)
+    return write_bag(path, [frame], ros1=path.suffix == ".bag")
 
 
 class Seed(Annotator):
