@@ -67,6 +67,10 @@ class BagTopics:
         return self.cloud is not None
 
 
+ANY_TOPICS = BagTopics()
+"""No topic named: every topic is picked by message type."""
+
+
 def open_bag(path: str | Path) -> AnyReader:
     """An opened reader of the bag at ``path`` (close it); FrameError when it is no bag rosbags can read."""
     path = Path(path)
@@ -114,7 +118,7 @@ def _one(candidates: list[str], what: str, hint: str) -> str:
     raise FrameError(f"the bag has several {what}s ({', '.join(candidates)}); name one with {hint}")
 
 
-def pick_topics(reader: AnyReader, requested: BagTopics = BagTopics()) -> BagTopics:
+def pick_topics(reader: AnyReader, requested: BagTopics = ANY_TOPICS) -> BagTopics:
     """The topics to read: those ``requested`` (checked), the others picked by message type and encoding."""
     if requested.cloud is not None:
         return BagTopics(cloud=_require(reader, requested.cloud, POINT_CLOUD))
@@ -282,7 +286,7 @@ def _cloud_frames(reader: AnyReader, topics: BagTopics, source: str) -> Iterator
 
 def bag_frames(
     path: str | Path,
-    topics: BagTopics = BagTopics(),
+    topics: BagTopics = ANY_TOPICS,
     depth_scale: float = MILLIMETRES,
     max_difference: float = MAX_STAMP_DIFFERENCE,
 ) -> Iterator[Frame]:
@@ -301,7 +305,7 @@ def bag_frames(
 
 
 def read_bag_frame(
-    path: str | Path, frame: int = 0, topics: BagTopics = BagTopics(), depth_scale: float = MILLIMETRES
+    path: str | Path, frame: int = 0, topics: BagTopics = ANY_TOPICS, depth_scale: float = MILLIMETRES
 ) -> Frame:
     """Frame number ``frame`` (0-based, recording order) of the bag; FrameError when the bag has fewer."""
     if frame < 0:

@@ -44,8 +44,8 @@ from annotators.readers.frame_readers import (
     TumPairReader,
     TumSequenceReader,
 )
-from annotators.readers.tiff_io import is_tiff_sequence
-from annotators.readers.tum_io import is_tum_pair, is_tum_sequence, pair_color_files
+from annotators.readers.tiff_io import frame_stamps, is_tiff_sequence, tiff_folder
+from annotators.readers.tum_io import associate, is_tum_pair, is_tum_sequence, pair_color_files, read_image_list
 from robokudo.core.annotator import Annotator
 
 SUPPORTED_LAYOUTS = (
@@ -177,3 +177,33 @@ def reader_for(path: str | None, frame: int = 0) -> Annotator:
 def reader_name_for(path: str | None, frame: int = 0) -> str:
     """The ontology name of the reader for ``path`` (``KitchenSceneReader`` for None), without constructing it."""
     return reader_choice(path, frame).name
+
+
+def _folder_frame_count(folder: Path) -> int:
+    if is_tum_sequence(folder):
+        return len(associate(read_image_list(folder / "rgb.txt"), read_image_list(folder / "depth.txt")))
+    if is_tiff_sequence(folder):
+        return len(frame_stamps(tiff_folder(folder)))
+    clouds = [p for p in folder.iterdir() if p.suffix.lower() == ".pcd"]
+    if clouds:
+        return len(clouds)
+    return len([p for p in pair_color_files(folder, _IMAGE_SUFFIXES) if not _UOC_COLOR.match(p.name)])
+
+
+def recorded_frames(path: str) -> tuple[ReaderChoice, ...]:
+    """The reader of every frame of the recorded input at ``path`` (not a bag), in recording order.
+
+    A uoc folder gives its NNNNNN frames in number order, a sequence or a folder of files each of its frames, a
+    single file its one frame. ValueError as :func:`reader_choice` for a path of no known layout or a bag (bags are
+    read in order by :func:`annotators.readers.bag_io.bag_frames`); FrameError for an unreadable frame list.
+    """
+    resolved = Path(path).expanduser()
+    if is_bag(resolved):
+        raise ValueError(f"{resolved} is a bag: read its frames with bag_frames")
+    first = reader_choice(path, 0)
+    if not resolved.is_dir():
+        return (first,)
+    if first.reader is ColorDepthPairReader:
+        numbers = sorted(int(m.group(1)) for p in resolved.iterdir() if (m := _UOC_COLOR.match(p.name)))
+        return tuple(ReaderChoice(ColorDepthPairReader, {"folder": str(resolved), "frame": n}) for n in numbers)
+    return tuple(_folder_choice(resolved, frame) for frame in range(_folder_frame_count(resolved)))

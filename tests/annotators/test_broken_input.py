@@ -43,6 +43,7 @@ from annotators.readers.frame_readers import (
     TumPairReader,
     TumSequenceReader,
 )
+from annotators.readers.streams import FrameStream, StreamReader, recorded_stream
 from annotators.text.reader import TextReader
 from robokudo.core.annotator import Annotator
 from robokudo.core.pipeline import Pipeline
@@ -432,6 +433,11 @@ BROKEN_READERS: dict[type[Annotator], dict[str, Callable[[Path], Annotator]]] = 
         "missing bag": lambda tmp: BagCloudReader(tmp / "nowhere"),
         "image bag": lambda tmp: BagCloudReader(write_small_bag(tmp / "c.bag")),
     },
+    StreamReader: {
+        "source ended": lambda tmp: StreamReader(played_once(recorded_stream(str(write_uoc(tmp / "a")), loop=False))),
+        "unreadable frame": lambda tmp: StreamReader(recorded_stream(str(truncated_uoc(tmp / "b")))),
+        "closed stream": lambda tmp: StreamReader(closed(recorded_stream(str(write_uoc(tmp / "c"))))),
+    },
     TiffSequenceReader: {
         "missing folder": lambda tmp: TiffSequenceReader(tmp / "nowhere"),
         "missing frame": lambda tmp: TiffSequenceReader(write_tiff(tmp), frame=1),
@@ -447,6 +453,17 @@ def write_small_bag(path: Path) -> Path:
     """A bag (ROS 1 for a .bag path, else ROS 2) of one small colour + depth frame."""
     frame = Frame(np.full((H, W, 3), 90, np.uint8), np.full((H, W), 0.8, np.float32), K)
     return write_bag(path, [frame], ros1=path.suffix == ".bag")
+
+
+def played_once(stream: FrameStream) -> FrameStream:
+    """``stream`` after its first frame was taken (a one-frame recording played once has then ended)."""
+    stream.next_frame()
+    return stream
+
+
+def closed(stream: FrameStream) -> FrameStream:
+    stream.close()
+    return stream
 
 
 class Seed(Annotator):

@@ -1,0 +1,389 @@
+"""Frame streams: live sources that give the next frame each time they are asked, paced at a sensor rate.
+
+* :class:`KitchenCameraStream` is the built-in kitchen as a simulated camera: a frame every ``1 / rate_hz`` s from
+  the current view, which can be changed while it runs (:meth:`~KitchenCameraStream.look_at` a region, as
+  ``robokudo query`` points the camera). A consumer slower than the camera gets the newest frame; frames it missed
+  are skipped, as with a real sensor.
+* :class:`PlaybackStream` plays a recorded source (:func:`recorded_stream`: anything ``--input`` reads, or a ROS
+  bag) frame after frame, never skipping one: at the recorded rate (from the frames' time stamps where the layout
+  has them: TUM sequences, TIFF grabber folders, bags) or at ``rate_hz``; ``loop`` starts over at the end, else
+  the stream ends and every later request raises :class:`SourceEndedError`.
+
+:meth:`FrameStream.next_frame` blocks until the next frame is due (or returns None at once with ``block=False``);
+:meth:`FrameStream.close` wakes a blocked caller, which then gets SourceEndedError. :class:`StreamReader` is the reader
+annotator over a stream: each run writes the stream's next frame into the CAS, and fails with the reason when the
+source ended (``StreamReader.ended``) or a frame cannot be read. A server builds its perceive node from
+:func:`stream_for` (``--input``, ``--rate``, loop or once) and turns SourceEndedError into "source ended" aborts.
+Streams are thread-safe: a view change or close may come from another thread than the reading one.
+"""
+
+from __future__ import annotations
+
+import math
+import threading
+import time
+from abc import ABC, abstractmethod
+from collections.abc import Callable, Iterator
+from dataclasses import dataclass
+from pathlib import Path
+from types import TracebackType
+from typing import ClassVar, Self
+
+from annotators.readers.bag_io import ANY_TOPICS, BagTopics, bag_frames, is_bag
+from annotators.readers.choice import recorded_frames
+from annotators.readers.frame_io import Frame, FrameError
+from annotators.readers.frame_readers import DEFAULT_KITCHEN_VIEW, KITCHEN_RECORDING, FileFrameReader
+from annotators.simulation import kitchen_scene
+from robokudo.core.annotator import Annotator
+from robokudo.core.capability import Capability
+from robokudo.core.types import CameraInfo, CasType, ColorImage, DepthImage
+
+DEFAULT_RATE_HZ = 30.0
+"""The kitchen camera's rate, and the playback rate of recordings without time stamps unless one is given."""
+MAX_RECORDED_GAP_S = 5.0
+"""A time-stamp gap above this (or not positive) is not a sensor period: such a step is played at the default rate."""
+MAX_LAG_S = 1.0
+"""A playback consumer more than this behind the schedule gets frames at once and the schedule restarts from now."""
+
+
+class SourceEndedError(Exception):
+    """The stream has no more frames: a recording played once reached its end, or the stream was closed."""
+
+
+@dataclass(frozen=True, eq=False)
+class StreamFrame:
+    """A frame delivered by a stream: the frame, its camera info, its position in the source and in the stream."""
+
+    frame: Frame
+    camera: CameraInfo
+    index: int
+    """The frame's position in its source (the sensor's frame count for a live camera)."""
+    sequence: int
+    """How many frames the stream delivered before this one."""
+
+
+class FrameStream(ABC):
+    """Frames one after another at the source's pace (see the module docstring)."""
+
+    def __init__(self, name: str) -> None:
+        self.name = name
+        self._lock = threading.Lock()
+        self._reading = threading.Lock()
+        self._closed = threading.Event()
+        self._delivered = 0
+
+    def next_frame(self, block: bool = True) -> StreamFrame | None:
+        """The next frame, waiting until it is due; None when ``block`` is False and none is due yet.
+
+        Raises SourceEndedError when the source has no more frames (or the stream was closed), FrameError when the frame
+        cannot be read. Callers on several threads take turns.
+        """
+        with self._reading:
+            self._check_open()
+            return self._next(block)
+
+    @abstractmethod
+    def _next(self, block: bool) -> StreamFrame | None:
+        """:meth:`next_frame` for one caller at a time."""
+
+    @property
+    def delivered(self) -> int:
+        """How many frames the stream has delivered."""
+        return self._delivered
+
+    def close(self) -> None:
+        """Stop the stream; a caller waiting in :meth:`next_frame` wakes up with SourceEndedError."""
+        self._closed.set()
+
+    @property
+    def closed(self) -> bool:
+        """True once :meth:`close` was called."""
+        return self._closed.is_set()
+
+    def _wait_until(self, due: float) -> None:
+        """Sleep until monotonic time ``due``; SourceEndedError when the stream is closed meanwhile."""
+        while not self._closed.is_set():
+            delay = due - time.monotonic()
+            if delay <= 0:
+                return
+            self._closed.wait(delay)
+        raise SourceEndedError(f"{self.name}: the stream was closed")
+
+    def _check_open(self) -> None:
+        if self._closed.is_set():
+            raise SourceEndedError(f"{self.name}: the stream was closed")
+
+    def __enter__(self) -> Self:
+        return self
+
+    def __exit__(
+        self, kind: type[BaseException] | None, error: BaseException | None, trace: TracebackType | None
+    ) -> None:
+        self.close()
+
+
+def _check_rate(rate_hz: float) -> float:
+    if not math.isfinite(rate_hz) or rate_hz <= 0:
+        raise ValueError(f"the stream rate must be a positive number of frames per second, got {rate_hz}")
+    return float(rate_hz)
+
+
+class KitchenCameraStream(FrameStream):
+    """The built-in kitchen as a simulated camera producing a frame every ``1 / rate_hz`` seconds.
+
+    Each view is rendered once (``seed`` seeds its sensor noise) and delivered with a fresh time stamp; the view
+    can be changed while the stream runs (:meth:`set_view`, :meth:`look_at`).
+    """
+
+    def __init__(self, rate_hz: float = DEFAULT_RATE_HZ, view: str = DEFAULT_KITCHEN_VIEW, seed: int = 0) -> None:
+        super().__init__(name="kitchen camera")
+        self.rate_hz = _check_rate(rate_hz)
+        self.seed = seed
+        self._view = self._checked_view(view)
+        self._rendered: dict[str, kitchen_scene.RenderedScene] = {}
+        self._start = time.monotonic()
+        self._last_slot = -1
+
+    @staticmethod
+    def _checked_view(view: str) -> str:
+        views = kitchen_scene.camera_views()
+        if view not in views:
+            raise ValueError(f"unknown kitchen camera view {view!r}; known: {', '.join(views)}")
+        return view
+
+    @property
+    def view(self) -> str:
+        """The camera view frames are rendered from."""
+        with self._lock:
+            return self._view
+
+    def set_view(self, view: str) -> None:
+        """Render the next frames from the named view (ValueError for an unknown one)."""
+        checked = self._checked_view(view)
+        with self._lock:
+            self._view = checked
+
+    def look_at(self, region: str) -> str:
+        """Point the camera at ``region`` (as ``robokudo query`` does); the chosen view. ValueError when no view
+        looks at it."""
+        view = kitchen_scene.camera_looking_at(region)
+        self.set_view(view)
+        return view
+
+    @property
+    def last_scene(self) -> kitchen_scene.RenderedScene | None:
+        """The scene (with its ground truth) of the current view, None before it was first rendered."""
+        with self._lock:
+            return self._rendered.get(self._view)
+
+    def _next(self, block: bool) -> StreamFrame | None:
+        """The camera's newest frame after the last one delivered (frames a slow caller missed are skipped)."""
+        period = 1.0 / self.rate_hz
+        slot = math.floor((time.monotonic() - self._start) / period)
+        if slot <= self._last_slot:
+            if not block:
+                return None
+            slot = self._last_slot + 1
+            self._wait_until(self._start + slot * period)
+        with self._lock:
+            view = self._view
+            scene = self._rendered.get(view)
+        if scene is None:
+            scene = kitchen_scene.render_kitchen(view, seed=self.seed)
+            with self._lock:
+                self._rendered.setdefault(view, scene)
+        camera = CameraInfo(
+            intrinsics=scene.intrinsics,
+            cam_to_world=scene.cam_to_world,
+            frame_id=f"kitchen/{view}",
+            timestamp=time.time(),
+            recording=KITCHEN_RECORDING,
+        )
+        frame = Frame(scene.color, scene.depth, scene.intrinsics, source=f"kitchen/{view}", timestamp=camera.timestamp)
+        self._last_slot = slot
+        delivered = StreamFrame(frame, camera, index=slot, sequence=self._delivered)
+        self._delivered += 1
+        return delivered
+
+
+RecordedFrames = Callable[[], Iterator[tuple[Frame, str]]]
+"""Opens a recording from its start: an iterator of its frames in order, each with the recording it belongs to."""
+
+
+class PlaybackStream(FrameStream):
+    """Plays a recording frame after frame (see the module docstring); ``rate_hz`` None plays at the recorded rate."""
+
+    def __init__(self, frames: RecordedFrames, name: str, rate_hz: float | None = None, loop: bool = True) -> None:
+        super().__init__(name=name)
+        self.rate_hz = None if rate_hz is None else _check_rate(rate_hz)
+        self.loop = loop
+        self._open = frames
+        self._frames: Iterator[tuple[Frame, str]] | None = None
+        self._pending: tuple[Frame, str, int] | None = None
+        self._previous_stamp: float | None = None
+        self._due: float | None = None
+        self._index = 0
+        self._error: Exception | None = None
+        self._ended: str | None = None
+        self.loops = 0
+        """How many times the recording started over."""
+
+    @property
+    def ended(self) -> bool:
+        """True once a recording played once delivered its last frame."""
+        return self._ended is not None
+
+    def _gap(self, stamp: float | None) -> float:
+        if self.rate_hz is not None:
+            return 1.0 / self.rate_hz
+        previous = self._previous_stamp
+        if stamp is not None and previous is not None and 0 < stamp - previous <= MAX_RECORDED_GAP_S:
+            return stamp - previous
+        return 1.0 / DEFAULT_RATE_HZ
+
+    def _advance(self) -> tuple[Frame, str, int]:
+        """The next frame of the recording (starting over when looping); SourceEndedError after a single play."""
+        for attempt in range(2):
+            if self._frames is None:
+                self._frames = self._open()
+            try:
+                frame, recording = next(self._frames)
+            except StopIteration:
+                self._frames = None
+                if self._index == 0:
+                    raise SourceEndedError(f"{self.name}: the recording holds no frame") from None
+                if not self.loop or attempt == 1:
+                    self._ended = f"{self.name}: all {self._index} frames played"
+                    raise SourceEndedError(self._ended) from None
+                self.loops += 1
+                self._index = 0
+                self._previous_stamp = None
+                continue
+            self._index += 1
+            return frame, recording, self._index - 1
+        raise SourceEndedError(f"{self.name}: the recording holds no frame")
+
+    def _next(self, block: bool) -> StreamFrame | None:
+        """The recording's next frame once it is due (frames are never skipped)."""
+        if self._ended is not None:
+            raise SourceEndedError(self._ended)
+        if self._error is not None:
+            raise self._error
+        if self._pending is None:
+            try:
+                self._pending = self._advance()
+            except FrameError as error:
+                self._error = error
+                raise
+            stamp = self._pending[0].timestamp
+            now = time.monotonic()
+            self._due = now if self._due is None else max(self._due + self._gap(stamp), now - MAX_LAG_S)
+            self._previous_stamp = stamp
+        assert self._due is not None
+        if not block and time.monotonic() < self._due:
+            return None
+        self._wait_until(self._due)
+        frame, recording, index = self._pending
+        self._pending = None
+        stamp = frame.timestamp if frame.timestamp is not None else time.time()
+        camera = CameraInfo(intrinsics=frame.intrinsics, frame_id="camera", timestamp=stamp, recording=recording)
+        delivered = StreamFrame(frame, camera, index=index, sequence=self._delivered)
+        self._delivered += 1
+        return delivered
+
+
+def _folder_frames(path: str) -> RecordedFrames:
+    choices = recorded_frames(path)
+
+    def frames() -> Iterator[tuple[Frame, str]]:
+        for choice in choices:
+            reader = choice.create()
+            assert isinstance(reader, FileFrameReader)
+            yield reader.load(), reader.recording()
+
+    return frames
+
+
+def _bag_frames(path: Path, topics: BagTopics) -> RecordedFrames:
+    recording = str(path.resolve())
+
+    def frames() -> Iterator[tuple[Frame, str]]:
+        for frame in bag_frames(path, topics):
+            yield frame, recording
+
+    return frames
+
+
+def recorded_stream(
+    path: str, rate_hz: float | None = None, loop: bool = True, topics: BagTopics = ANY_TOPICS
+) -> PlaybackStream:
+    """A playback stream of the recording at ``path``: any layout ``--input`` reads, or a ROS 1 / ROS 2 bag
+    (``topics`` names the bag's topics; unnamed ones are picked by type). ValueError for a path of no known
+    layout."""
+    if rate_hz is not None:
+        _check_rate(rate_hz)
+    resolved = Path(path).expanduser()
+    if is_bag(resolved):
+        return PlaybackStream(_bag_frames(resolved, topics), name=str(resolved), rate_hz=rate_hz, loop=loop)
+    return PlaybackStream(_folder_frames(path), name=str(resolved), rate_hz=rate_hz, loop=loop)
+
+
+def stream_for(
+    path: str | None,
+    rate_hz: float | None = None,
+    loop: bool = True,
+    view: str = DEFAULT_KITCHEN_VIEW,
+    topics: BagTopics = ANY_TOPICS,
+) -> FrameStream:
+    """The stream of ``--input``: the kitchen camera (at ``rate_hz`` or the default, from ``view``) for None, else
+    :func:`recorded_stream`."""
+    if path is None:
+        return KitchenCameraStream(rate_hz if rate_hz is not None else DEFAULT_RATE_HZ, view=view)
+    return recorded_stream(path, rate_hz, loop, topics)
+
+
+class StreamReader(Annotator):
+    """Writes the stream's next frame (colour, depth, camera info) each time it runs.
+
+    ``wait`` False takes only a frame that is already due and otherwise writes the last one again. Fails with the
+    reason when the source ended (then :attr:`ended` is True) or a frame cannot be read.
+    """
+
+    inputs: ClassVar[tuple[type[CasType], ...]] = ()
+    outputs: ClassVar[tuple[type[CasType], ...]] = (ColorImage, DepthImage, CameraInfo)
+    capability: ClassVar[Capability] = Capability(
+        label="stream reader",
+        description="Reads the next frame of a live source (the kitchen camera, a recording or a bag played back).",
+        cost_ms=5.0,
+        reliability=1.0,
+    )
+
+    def __init__(self, stream: FrameStream, wait: bool = True, name: str | None = None) -> None:
+        super().__init__(name=name)
+        self.stream = stream
+        self.wait = wait
+        self.ended = False
+        self._last: StreamFrame | None = None
+
+    @property
+    def last_frame(self) -> StreamFrame | None:
+        """The frame written by the last successful run, None before it."""
+        return self._last
+
+    def analyse(self) -> None:
+        """Take the next frame (or keep the last one when not waiting and none is due) and write it."""
+        try:
+            delivered = self.stream.next_frame(block=self.wait or self._last is None)
+        except SourceEndedError as error:
+            self.ended = True
+            self.fail(f"source ended: {error}")
+        except FrameError as error:
+            self.fail(f"cannot read the next frame of {self.stream.name}: {error}")
+        except (OSError, ValueError) as error:
+            self.fail(f"cannot read the next frame of {self.stream.name}: {type(error).__name__}: {error}")
+        if delivered is not None:
+            self._last = delivered
+        assert self._last is not None
+        self.write(ColorImage(self._last.frame.color))
+        self.write(DepthImage(self._last.frame.depth))
+        self.write(self._last.camera)
