@@ -254,20 +254,21 @@ def _rgbd_frames(
     intrinsics: CameraIntrinsics | None = None
     colors: deque[Any] = deque()
     depths: deque[Any] = deque()
+    paired: deque[tuple[Any, Any]] = deque()  # pairs waiting for the first camera info
     for connection, _, raw in reader.messages(connections=connections):
         message = reader.deserialize(raw, connection.msgtype)
         if connection.topic == topics.info:
             intrinsics = camera_intrinsics(message)
-            continue
-        (colors if connection.topic == topics.color else depths).append(message)
+        else:
+            (colors if connection.topic == topics.color else depths).append(message)
         while colors and depths:
             gap = _stamp(colors[0]) - _stamp(depths[0])
             if abs(gap) > max_difference:
                 (depths if gap > 0 else colors).popleft()  # the older one has no partner any more
                 continue
-            color, depth = colors.popleft(), depths.popleft()
-            if intrinsics is None:
-                raise FrameError(f"{source}: no camera info on {topics.info} before the first image pair")
+            paired.append((colors.popleft(), depths.popleft()))
+        while paired and intrinsics is not None:
+            color, depth = paired.popleft()
             yield assemble_frame(
                 decode_color_image(color),
                 decode_depth_image(depth, depth_scale),
@@ -275,6 +276,8 @@ def _rgbd_frames(
                 f"{source}#{topics.color}@{_stamp(color):.6f}",
                 timestamp=_stamp(color),
             )
+    if paired:
+        raise FrameError(f"{source}: no camera info on {topics.info}, so the images have no intrinsics")
 
 
 def _cloud_frames(reader: AnyReader, topics: BagTopics, source: str) -> Iterator[Frame]:

@@ -100,16 +100,29 @@ def _cloud(store: Any, ros1: bool, stamp_ns: int, frame: Frame) -> Any:
     )
 
 
-def _depth_mm(frame: Frame) -> np.ndarray:
-    return np.rint(frame.depth * 1000.0).astype(np.uint16)
+def _depth_pixels(frame: Frame, encoding: str) -> np.ndarray:
+    if encoding == "32FC1":
+        return frame.depth.astype("<f4")
+    return np.rint(frame.depth * 1000.0).astype("<u2")
 
 
 def write_bag(
-    path: Path, frames: Sequence[Frame], *, ros1: bool, period_ns: int = 100_000_000, cloud: bool = False
+    path: Path,
+    frames: Sequence[Frame],
+    *,
+    ros1: bool,
+    period_ns: int = 100_000_000,
+    cloud: bool = False,
+    color_encoding: str = "rgb8",
+    depth_encoding: str = "16UC1",
+    depth_offset_ns: int = 3_000_000,
+    info_offset_ns: int = 0,
 ) -> Path:
     """Write ``frames`` (colour + depth + camera info, or organized clouds) to a new bag at ``path``; ``path``.
 
-    Frame ``i`` is stamped at ``1.7e9 s + i * period_ns``; depth is stamped 3 ms after colour, as real cameras do.
+    Frame ``i`` is stamped at ``1.7e9 s + i * period_ns``; depth ``depth_offset_ns`` later (real cameras are a few
+    ms apart), camera info ``info_offset_ns`` later. Colour is ``rgb8`` or ``bgr8``, depth ``16UC1``/``mono16``
+    (mm) or ``32FC1`` (m).
     """
     store = _typestore(ros1)
     serialize = store.serialize_ros1 if ros1 else store.serialize_cdr
@@ -130,12 +143,15 @@ def write_bag(
             if cloud:
                 messages = [(CLOUD_TOPIC, stamp, _cloud(store, ros1, stamp, frame))]
             else:
+                color = frame.color[..., ::-1] if color_encoding == "bgr8" else frame.color
+                depth_stamp, info_stamp = stamp + depth_offset_ns, stamp + info_offset_ns
+                depth = _depth_pixels(frame, depth_encoding)
                 messages = [
-                    (INFO_TOPIC, stamp, _camera_info(store, ros1, stamp, frame)),
-                    (COLOR_TOPIC, stamp, _image(store, ros1, stamp, frame.color, "rgb8")),
-                    (DEPTH_TOPIC, stamp + 3_000_000, _image(store, ros1, stamp + 3_000_000, _depth_mm(frame), "16UC1")),
+                    (INFO_TOPIC, info_stamp, _camera_info(store, ros1, info_stamp, frame)),
+                    (COLOR_TOPIC, stamp, _image(store, ros1, stamp, color, color_encoding)),
+                    (DEPTH_TOPIC, depth_stamp, _image(store, ros1, depth_stamp, depth, depth_encoding)),
                 ]
-            for topic, time_ns, message in messages:
+            for topic, time_ns, message in sorted(messages, key=lambda item: item[1]):
                 connection = connections[topic]
                 writer.write(connection, time_ns, serialize(message, connection.msgtype))
     return path

@@ -28,6 +28,7 @@ from annotators.readers.streams import (
 from robokudo.core.pipeline import Pipeline
 from robokudo.core.types import CameraInfo, PointCloud
 from tests.annotators.bag_writing import write_bag
+from tests.annotators.conftest import require_folder
 
 
 def frames_within(stream: FrameStream, seconds: float) -> int:
@@ -168,3 +169,18 @@ def test_bad_rates_and_paths_are_refused(tmp_path: Path) -> None:
         stream_for(str(tmp_path), rate_hz=float("nan"))
     with pytest.raises(ValueError, match="no known layout"):
         stream_for(str(tmp_path))
+
+
+@pytest.mark.real_data
+def test_a_grabber_sequence_plays_in_time_order_at_its_recorded_rate(shared_data: Path) -> None:
+    folder = require_folder(shared_data / "pcl_grabber_sequences")
+    stream = recorded_stream(str(folder), loop=False)
+    start = time.monotonic()
+    played = [stream.next_frame() for _ in range(3)]
+    elapsed = time.monotonic() - start
+    stamps = [f.camera.timestamp for f in played if f]
+    assert stamps == sorted(stamps) and len(set(stamps)) == 3
+    assert elapsed >= 0.95 * (stamps[-1] - stamps[0])  # the recorded gaps (about 0.25 s each); a lower bound only
+    assert {f.camera.recording for f in played if f} == {str(folder.resolve())}
+    with pytest.raises(SourceEndedError, match="all 3 frames played"):
+        stream.next_frame()
