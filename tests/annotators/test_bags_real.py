@@ -7,6 +7,7 @@ tabletop tree must run on the bag as on any other input.
 
 from __future__ import annotations
 
+import json
 from pathlib import Path
 
 import numpy as np
@@ -18,6 +19,7 @@ from annotators.readers.choice import reader_choice, reader_name_for
 from annotators.readers.frame_io import Frame, read_color_depth_pair
 from annotators.readers.frame_readers import BagCloudReader, BagReader, ColorDepthPairReader, PcdReader
 from annotators.readers.pcd_io import read_pcd
+from robokudo.application import cli
 from robokudo.core.pipeline import Pipeline
 from robokudo.core.types import CameraInfo, ObjectHypothesis
 from tests.annotators.bag_writing import COLOR_TOPIC, DEPTH_TOPIC, INFO_TOPIC, write_bag
@@ -101,3 +103,19 @@ def _run(reader: BagReader) -> Status:
     pipeline = Pipeline("read", [reader])
     pipeline.tick_once()
     return reader.status
+
+
+def test_robokudo_query_on_the_bag_answers_as_on_the_uoc_folder(
+    bag: Path, uoc_folder: Path, tmp_path: Path, monkeypatch: pytest.MonkeyPatch, capsys: pytest.CaptureFixture
+) -> None:
+    answers = []
+    for name, source in (("bag", bag), ("uoc", uoc_folder)):
+        monkeypatch.setenv("ROBOKUDO_BELIEF_STORE", str(tmp_path / f"{name}.sqlite"))
+        monkeypatch.setenv("ROBOKUDO_USER_ONTOLOGY", str(tmp_path / f"{name}.ttl"))
+        query = ["query", "detect { obj: { type: Cup } }", "--input", str(source), "--frame", "1", "--json"]
+        assert cli.main(query) == 0
+        answers.append(json.loads(capsys.readouterr().out)["objects"])
+    from_bag, from_uoc = ([np.asarray(o["pose"]["position"]) for o in objects] for objects in answers)
+    assert len(from_bag) == len(from_uoc) > 0
+    for position, expected in zip(sorted(from_bag, key=tuple), sorted(from_uoc, key=tuple), strict=True):
+        assert np.linalg.norm(position - expected) < 0.001
