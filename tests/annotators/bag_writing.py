@@ -13,6 +13,7 @@ from typing import Any
 
 import numpy as np
 from rosbags.rosbag1 import Writer as Writer1
+from rosbags.rosbag2 import StoragePlugin
 from rosbags.rosbag2 import Writer as Writer2
 from rosbags.typesys import Stores, get_typestore
 
@@ -117,16 +118,18 @@ def write_bag(
     depth_encoding: str = "16UC1",
     depth_offset_ns: int = 3_000_000,
     info_offset_ns: int = 0,
+    mcap: bool = False,
 ) -> Path:
     """Write ``frames`` (colour + depth + camera info, or organized clouds) to a new bag at ``path``; ``path``.
 
     Frame ``i`` is stamped at ``1.7e9 s + i * period_ns``; depth ``depth_offset_ns`` later (real cameras are a few
     ms apart), camera info ``info_offset_ns`` later. Colour is ``rgb8`` or ``bgr8``, depth ``16UC1``/``mono16``
-    (mm) or ``32FC1`` (m).
+    (mm) or ``32FC1`` (m). A ROS 2 bag is stored in SQLite, or in MCAP when ``mcap``.
     """
     store = _typestore(ros1)
     serialize = store.serialize_ros1 if ros1 else store.serialize_cdr
-    writer = Writer1(path) if ros1 else Writer2(path, version=9)
+    plugin = StoragePlugin.MCAP if mcap else StoragePlugin.SQLITE3
+    writer = Writer1(path) if ros1 else Writer2(path, version=9, storage_plugin=plugin)
     start = 1_700_000_000 * 10**9
     with writer:
         if cloud:

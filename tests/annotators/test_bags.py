@@ -9,6 +9,7 @@ import numpy as np
 import pytest
 
 from annotators.readers.bag_io import bag_frames, read_bag_frame
+from annotators.readers.choice import reader_name_for
 from annotators.readers.frame_io import Frame, FrameError
 from robokudo.core.types import CameraIntrinsics
 from tests.annotators.bag_writing import write_bag
@@ -66,3 +67,21 @@ def test_colour_and_depth_too_far_apart_are_not_paired(tmp_path: Path) -> None:
 def test_the_frame_stamp_is_the_colour_stamp(tmp_path: Path) -> None:
     bag = write_bag(tmp_path / "s", frames(), ros1=False, period_ns=250_000_000)
     assert [f.timestamp for f in bag_frames(bag)] == pytest.approx([1.7e9, 1.7e9 + 0.25, 1.7e9 + 0.5])
+
+
+def test_a_ros2_bag_reads_from_its_folder_or_its_storage_file(tmp_path: Path) -> None:
+    written = frames(2)
+    for mcap, suffix in ((True, ".mcap"), (False, ".db3")):
+        folder = write_bag(tmp_path / f"bag{suffix}-folder", written, ros1=False, mcap=mcap)
+        (storage,) = folder.glob(f"*{suffix}")
+        for path in (folder, storage):
+            assert reader_name_for(str(path)) == "BagReader"
+            assert np.array_equal(read_bag_frame(path, 1).color, written[1].color)
+
+
+def test_a_file_that_is_no_bag_is_refused_with_the_layouts(tmp_path: Path) -> None:
+    junk = tmp_path / "junk.bag"
+    junk.write_bytes(b"not a bag at all")
+    with pytest.raises(ValueError, match="cannot open the bag") as caught:
+        reader_name_for(str(junk))
+    assert "supported inputs" in str(caught.value) and junk.read_bytes() == b"not a bag at all"
