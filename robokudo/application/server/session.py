@@ -78,7 +78,7 @@ class Session:
         finally:
             self.subscribers.discard(self)
             self.goals.cancel_owner(self, "the client disconnected")
-            self._outbox.put_nowait(None)
+            self._loop.call_soon(self._outbox.put_nowait, None)  # after the replies already handed over
             await writer
 
     async def flush(self) -> None:

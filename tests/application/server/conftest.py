@@ -59,17 +59,22 @@ def start_server(folder: Path, *extra: str, host: str = "127.0.0.1", env: dict[s
     process = subprocess.Popen(
         command, cwd=REPO, env=environment, stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True
     )
-    ready = threading.Event()
+    listening = threading.Event()
+    settled = threading.Event()
 
     def watch() -> None:
         assert process.stdout is not None
         for line in process.stdout:
             if line.startswith("serving on"):
-                ready.set()
+                listening.set()
+                settled.set()
+        settled.set()  # the output ended: the process exited
 
     threading.Thread(target=watch, daemon=True).start()
-    if not ready.wait(START_LIMIT):
+    settled.wait(START_LIMIT)
+    if not listening.is_set():
         process.kill()
+        process.wait()
         raise RuntimeError(f"robokudo serve did not start: {process.stderr.read() if process.stderr else ''}")
     return Served(process, host, port)
 
