@@ -4,6 +4,8 @@ working, authentication on a non-loopback bind, a client vanishing mid-goal, SIG
 from __future__ import annotations
 
 import json
+import time
+from concurrent.futures import ThreadPoolExecutor
 from pathlib import Path
 from typing import Any
 
@@ -15,6 +17,10 @@ from tests.application.server.conftest import Served, start_server
 
 ACTION = "/robokudo/query"
 WAIT = 60.0
+QUIET = 2.0
+"""Seconds without a message after which the server is taken to be idle."""
+CLIENTS = 8
+GOALS_PER_CLIENT = 50
 
 
 def receive(connection: ClientConnection, op: str, goal_id: str | None = None) -> dict[str, Any]:
@@ -25,12 +31,24 @@ def receive(connection: ClientConnection, op: str, goal_id: str | None = None) -
             return message
 
 
+def went_quiet(connection: ClientConnection) -> bool:
+    """True once nothing arrived for :data:`QUIET` seconds (within :data:`WAIT`)."""
+    deadline = time.monotonic() + WAIT
+    while time.monotonic() < deadline:
+        try:
+            connection.recv(timeout=QUIET)
+        except TimeoutError:
+            return True
+    return False
+
+
 def goal(goal_id: str, query: str = "find milk in fridge") -> str:
     return json.dumps({"op": "send_action_goal", "id": goal_id, "action": ACTION, "args": {"query": query}})
 
 
-def plan_call(call_id: str) -> str:
-    return json.dumps({"op": "call_service", "id": call_id, "service": "/robokudo/beliefs", "args": {"query": "find milk"}})
+def beliefs_call(call_id: str) -> str:
+    request = {"op": "call_service", "id": call_id, "service": "/robokudo/beliefs", "args": {"query": "find milk"}}
+    return json.dumps(request)
 
 
 @pytest.mark.parametrize(
@@ -52,7 +70,7 @@ def test_a_bad_message_gets_a_status_error_and_the_connection_keeps_working(
         connection.send(message)
         error = receive(connection, "status")
         assert error["level"] == "error" and problem in error["msg"]
-        connection.send(plan_call("after"))
+        connection.send(beliefs_call("after"))
         response = receive(connection, "service_response")
         assert response["id"] == "after" and response["result"] is True
 
@@ -66,9 +84,15 @@ def test_a_goal_without_query_text_is_refused(kitchen_server: Served) -> None:
 
 def test_a_client_vanishing_mid_goal_has_its_goal_canceled_and_others_are_served(kitchen_server: Served) -> None:
     with connect(kitchen_server.url) as watcher, connect(kitchen_server.url) as leaving:
-        leaving.send(goal("vanishing"))
-        assert receive(leaving, "action_feedback", "vanishing")["values"]["phase"] == "planning"
+        leaving.send(goal("vanishing", "track milk in fridge"))  # runs until cancelled
+        feedback = receive(leaving, "action_feedback", "vanishing")
+        while feedback["values"]["phase"] != "answer":
+            feedback = receive(leaving, "action_feedback", "vanishing")
+        watcher.send(json.dumps({"op": "subscribe", "topic": "/robokudo/tree_status"}))
+        receive(watcher, "publish")
         leaving.close()
+        assert went_quiet(watcher), "the vanished client's task kept running"  # its cancelled task stops ticking
+        watcher.send(json.dumps({"op": "unsubscribe", "topic": "/robokudo/tree_status"}))
         watcher.send(goal("next"))
         result = receive(watcher, "action_result", "next")
         assert result["status"] == 4 and result["values"]["objects"]
@@ -78,7 +102,7 @@ def test_the_beliefs_service_answers_from_memory(kitchen_server: Served) -> None
     with connect(kitchen_server.url) as connection:
         connection.send(goal("fill"))
         assert receive(connection, "action_result", "fill")["status"] == 4
-        connection.send(plan_call("memory"))
+        connection.send(beliefs_call("memory"))
         response = receive(connection, "service_response")
         assert response["values"]["from_memory"] is True
         assert any(o["region"] == "fridge" for o in response["values"]["objects"])
@@ -93,7 +117,7 @@ def guarded(tmp_path_factory: pytest.TempPathFactory) -> Any:
 
 def test_a_client_without_the_token_is_refused_on_a_non_loopback_bind(guarded: Served) -> None:
     with connect(guarded.url) as connection:
-        connection.send(plan_call("early"))
+        connection.send(beliefs_call("early"))
         error = receive(connection, "status")
         assert "authenticate first" in error["msg"]
         with pytest.raises(ConnectionClosed):
@@ -108,7 +132,7 @@ def test_a_client_without_the_token_is_refused_on_a_non_loopback_bind(guarded: S
 def test_a_client_with_the_token_is_served(guarded: Served) -> None:
     with connect(guarded.url) as connection:
         connection.send(json.dumps({"op": "auth", "mac": "s3cret"}))
-        connection.send(plan_call("late"))
+        connection.send(beliefs_call("late"))
         assert receive(connection, "service_response")["result"] is True
 
 
@@ -132,3 +156,30 @@ def test_sigterm_aborts_the_running_goal_with_the_reason_and_exits_0(tmp_path: P
         status = served.stop()
     assert status == 0
     assert (tmp_path / "beliefs.sqlite").exists()
+
+
+def test_eight_clients_sending_fifty_goals_each_get_exactly_one_result_per_goal(kitchen_server: Served) -> None:
+    def client(number: int) -> list[dict[str, Any]]:
+        ids = [f"c{number}-g{i}" for i in range(GOALS_PER_CLIENT)]
+        with connect(kitchen_server.url) as connection:
+            for goal_id in ids:
+                connection.send(goal(goal_id))
+            results: list[dict[str, Any]] = []
+            while len(results) < len(ids):
+                results.append(receive(connection, "action_result"))
+            while True:
+                try:
+                    message = json.loads(connection.recv(timeout=QUIET))
+                except TimeoutError:
+                    break
+                if message["op"] == "action_result":
+                    results.append(message)
+        return results
+
+    with ThreadPoolExecutor(CLIENTS) as pool:
+        per_client = list(pool.map(client, range(CLIENTS)))
+    results = [r for rs in per_client for r in rs]
+    ids = [r["id"] for r in results]
+    assert len(ids) == CLIENTS * GOALS_PER_CLIENT and len(set(ids)) == len(ids)
+    assert {r["status"] for r in results} <= {4, 5}
+    assert sum(r["status"] == 4 for r in results) >= 1
