@@ -20,7 +20,7 @@ from typing import Any
 import py_trees
 from py_trees.common import Status
 
-from queries import parse_query
+from queries import Query, parse_query
 from robokudo.application.server.protocol import GoalStatus, action_feedback, action_result
 from robokudo.application.service import AnsweringService, ExecutionMode, QueryCancelledError
 
@@ -33,7 +33,7 @@ POLL_SECONDS = 0.05
 class Goal:
     """One goal of the query action: its id, query text, owner (the session that sent it) and terminal state."""
 
-    def __init__(self, goal_id: str, query: str, owner: object, send: Send) -> None:
+    def __init__(self, goal_id: str, query: str | Query, owner: object, send: Send) -> None:
         self.id = goal_id
         self.query = query
         self.owner = owner
@@ -205,7 +205,7 @@ class GoalManager:
             return
         goal.feedback({"phase": "planning", "running": []})
         try:
-            mode = self.service.mode_of(parse_query(goal.query))
+            mode = self.service.mode_of(parse_query(goal.query) if isinstance(goal.query, str) else goal.query)
             if mode is ExecutionMode.CONTINUOUS:
                 self._run_continuous(goal)
                 return

@@ -19,11 +19,13 @@ from typing import Any
 from websockets.asyncio.server import ServerConnection
 from websockets.exceptions import ConnectionClosed
 
+from robokudo.application.server.designator import GoalError, MissingQueryError, goal_query
 from robokudo.application.server.goals import Goal, GoalManager
 from robokudo.application.server.protocol import (
     GOAL_QUERY_FIELD,
     QUERY_ACTION,
     TREE_STATUS_TOPIC,
+    GoalStatus,
     ProtocolError,
     action_result,
     parse_message,
@@ -139,11 +141,14 @@ class Session:
         if message["action"] != QUERY_ACTION:
             self.send(action_result(goal_id, 0, {"error": f"no action {message['action']!r}"}, result=False))
             raise ProtocolError(f"unknown action {message['action']!r}; this server has {QUERY_ACTION!r}", goal_id)
-        query = message["args"].get(GOAL_QUERY_FIELD)
-        if not isinstance(query, str) or not query.strip():
-            error = f"the goal needs the field {GOAL_QUERY_FIELD!r}: the query text"
-            self.send(action_result(goal_id, 0, {"error": error}, result=False))
-            raise ProtocolError(error, goal_id)
+        try:
+            query = goal_query(message["args"])
+        except MissingQueryError as error:
+            self.send(action_result(goal_id, 0, {"error": str(error)}, result=False))
+            raise ProtocolError(str(error), goal_id) from None
+        except GoalError as error:  # a designator that makes no query: the goal is aborted with the reason
+            self.send(action_result(goal_id, GoalStatus.ABORTED, {"reason": str(error)}))
+            return
         if self.goals.open_goals(self) >= MAX_OPEN_GOALS:
             error = f"too many open goals (at most {MAX_OPEN_GOALS} per client)"
             self.send(action_result(goal_id, 0, {"error": error}, result=False))

@@ -79,7 +79,38 @@ def test_a_goal_without_query_text_is_refused(kitchen_server: Served) -> None:
     with connect(kitchen_server.url) as connection:
         connection.send(json.dumps({"op": "send_action_goal", "id": "g", "action": ACTION, "args": {}}))
         result = receive(connection, "action_result", "g")
-        assert result["result"] is False and "'query'" in result["values"]["error"]
+        assert result["result"] is False and "'query' (the query text) or 'obj'" in result["values"]["error"]
+
+
+def test_a_structured_designator_goal_finds_the_milk_in_the_fridge(kitchen_server: Served) -> None:
+    with connect(kitchen_server.url) as connection:
+        args = {"type": "detect", "obj": {"type": "Milk", "location": ["fridge"], "pose": []}}
+        connection.send(json.dumps({"op": "send_action_goal", "id": "d", "action": ACTION, "args": args}))
+        result = receive(connection, "action_result", "d")
+    assert result["status"] == 4
+    objects = result["values"]["objects"]
+    assert objects and all(o["region"] == "fridge" for o in objects)
+    assert any("milk" in o["class"]["label"].lower() for o in objects)
+
+
+@pytest.mark.parametrize(
+    ("designator", "problem"),
+    [
+        ({"type": "lactose free"}, "expected an identifier"),
+        ({"type": "Milk", "pose": [{"x": 1}]}, "'pose' is not mapped onto a query yet"),
+        ({"color": ["red", "white"]}, "several: not yet"),
+        ({"weight": "1kg"}, "unknown designator field 'weight'"),
+    ],
+    ids=["not-a-name", "pose", "several-colors", "unknown-field"],
+)
+def test_a_designator_that_makes_no_query_is_aborted_with_the_reason(
+    kitchen_server: Served, designator: dict[str, Any], problem: str
+) -> None:
+    with connect(kitchen_server.url) as connection:
+        args = {"obj": designator}
+        connection.send(json.dumps({"op": "send_action_goal", "id": "bad", "action": ACTION, "args": args}))
+        result = receive(connection, "action_result", "bad")
+    assert result["status"] == 6 and problem in result["values"]["reason"]
 
 
 def test_a_client_vanishing_mid_goal_has_its_goal_canceled_and_others_are_served(kitchen_server: Served) -> None:
