@@ -54,7 +54,7 @@ def run(args: argparse.Namespace) -> int:
                 result = _wait(connection)
             except KeyboardInterrupt:
                 connection.send(json.dumps({"op": "cancel_action_goal", "id": GOAL_ID, "action": QUERY_ACTION}))
-                _wait(connection)
+                _report(_wait(connection), args.json)
                 raise
     except (OSError, InvalidURI, ConnectionClosed) as error:
         print(f"robokudo ask: cannot talk to {args.server}: {error}", file=sys.stderr)

@@ -85,3 +85,14 @@ def kitchen_server(tmp_path_factory: pytest.TempPathFactory) -> Iterator[Served]
     served = start_server(tmp_path_factory.mktemp("served"))
     yield served
     served.stop()
+
+
+TOKEN = "s3cret"
+
+
+@pytest.fixture(scope="session")
+def guarded_server(tmp_path_factory: pytest.TempPathFactory) -> Iterator[Served]:
+    """A server bound to a non-loopback-default address (127.0.0.2) that requires the token :data:`TOKEN`."""
+    served = start_server(tmp_path_factory.mktemp("guarded"), host="127.0.0.2", env={"ROBOKUDO_TOKEN": TOKEN})
+    yield served
+    served.stop()

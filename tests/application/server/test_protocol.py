@@ -13,7 +13,7 @@ import pytest
 from websockets.exceptions import ConnectionClosed
 from websockets.sync.client import ClientConnection, connect
 
-from tests.application.server.conftest import Served, start_server
+from tests.application.server.conftest import TOKEN, Served, start_server
 
 ACTION = "/robokudo/query"
 WAIT = 60.0
@@ -139,30 +139,23 @@ def test_the_beliefs_service_answers_from_memory(kitchen_server: Served) -> None
         assert any(o["region"] == "fridge" for o in response["values"]["objects"])
 
 
-@pytest.fixture(scope="module")
-def guarded(tmp_path_factory: pytest.TempPathFactory) -> Any:
-    served = start_server(tmp_path_factory.mktemp("guarded"), host="127.0.0.2", env={"ROBOKUDO_TOKEN": "s3cret"})
-    yield served
-    served.stop()
-
-
-def test_a_client_without_the_token_is_refused_on_a_non_loopback_bind(guarded: Served) -> None:
-    with connect(guarded.url) as connection:
+def test_a_client_without_the_token_is_refused_on_a_non_loopback_bind(guarded_server: Served) -> None:
+    with connect(guarded_server.url) as connection:
         connection.send(beliefs_call("early"))
         error = receive(connection, "status")
         assert "authenticate first" in error["msg"]
         with pytest.raises(ConnectionClosed):
             receive(connection, "service_response")
-    with connect(guarded.url) as connection:
+    with connect(guarded_server.url) as connection:
         connection.send(json.dumps({"op": "auth", "mac": "wrong"}))
         assert "wrong token" in receive(connection, "status")["msg"]
         with pytest.raises(ConnectionClosed):
             connection.recv(timeout=WAIT)
 
 
-def test_a_client_with_the_token_is_served(guarded: Served) -> None:
-    with connect(guarded.url) as connection:
-        connection.send(json.dumps({"op": "auth", "mac": "s3cret"}))
+def test_a_client_with_the_token_is_served(guarded_server: Served) -> None:
+    with connect(guarded_server.url) as connection:
+        connection.send(json.dumps({"op": "auth", "mac": TOKEN}))
         connection.send(beliefs_call("late"))
         assert receive(connection, "service_response")["result"] is True
 

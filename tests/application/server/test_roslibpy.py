@@ -10,7 +10,7 @@ from typing import Any
 import pytest
 import roslibpy
 
-from tests.application.server.conftest import Served
+from tests.application.server.conftest import TOKEN, Served
 
 ACTION = "/robokudo/query"
 ACTION_TYPE = "robokudo_msgs/action/Query"
@@ -133,3 +133,15 @@ def test_the_tree_status_topic_publishes_ticks(ros: roslibpy.Ros) -> None:
     ticks = [s["tick"] for s in statuses]
     assert ticks == sorted(ticks) and len(set(ticks)) == len(ticks)
     assert statuses[0]["tree"]["name"] == "robot"
+
+
+def test_roslibpy_authenticates_with_the_token_on_a_guarded_server(guarded_server: Served) -> None:
+    client = roslibpy.Ros(host=guarded_server.host, port=guarded_server.port)
+    client.authenticate(mac=TOKEN, client="", dest="", rand="", t=0, level="", end=0)
+    client.run()
+    try:
+        service = roslibpy.Service(client, "/robokudo/plan", "robokudo_msgs/srv/Plan")
+        response = service.call(roslibpy.ServiceRequest({"query": "find milk in fridge"}), timeout=WAIT)
+        assert response["task"]["region"] == "fridge"
+    finally:
+        client.close()
