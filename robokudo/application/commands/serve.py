@@ -62,5 +62,8 @@ def run(args: argparse.Namespace) -> int:
     except OSError as error:  # the address is in use or cannot be bound
         print(f"robokudo serve: {error}", file=sys.stderr)
         return 2
+    except BaseException:  # interrupted before the server took over the signals: still close the store
+        service.close()
+        raise
     print(f"robokudo serve: stopped: {reason}", file=sys.stderr, flush=True)
     return 0

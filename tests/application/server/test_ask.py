@@ -67,3 +67,8 @@ def test_serve_refuses_bad_options(
     monkeypatch.delenv("ROBOKUDO_TOKEN", raising=False)
     assert cli.main(["serve", *options]) == 2
     assert problem in capsys.readouterr().err
+
+
+def test_serve_reports_a_port_in_use(kitchen_server: Served, capsys: pytest.CaptureFixture) -> None:
+    assert cli.main(["serve", "--port", str(kitchen_server.port)]) == 2
+    assert "address already in use" in capsys.readouterr().err.lower()
