@@ -20,11 +20,14 @@ from typing import Any
 import py_trees
 from py_trees.common import Status
 
-from queries import Query, parse_query
+from queries import Query, format_query, parse_query
 from robokudo.application.server.protocol import GoalStatus, action_feedback, action_result
 from robokudo.application.service import AnsweringService, ExecutionMode, QueryCancelledError
 
 Send = Callable[[dict[str, Any]], None]
+
+STOP_KIND = "stop"
+"""The query kind that plans nothing: a ``stop`` goal ends every goal submitted before it and succeeds."""
 
 POLL_SECONDS = 0.05
 """How often a continuous goal's worker looks for cancellation and jobs between answers."""
@@ -205,7 +208,11 @@ class GoalManager:
             return
         goal.feedback({"phase": "planning", "running": []})
         try:
-            mode = self.service.mode_of(parse_query(goal.query) if isinstance(goal.query, str) else goal.query)
+            query = parse_query(goal.query) if isinstance(goal.query, str) else goal.query
+            if query.kind == STOP_KIND:  # submitting it already preempted every earlier goal
+                goal.finish(GoalStatus.SUCCEEDED, {"query": format_query(query), "objects": []})
+                return
+            mode = self.service.mode_of(query)
             if mode is ExecutionMode.CONTINUOUS:
                 self._run_continuous(goal)
                 return

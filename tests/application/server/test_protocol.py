@@ -129,6 +129,19 @@ def test_a_client_vanishing_mid_goal_has_its_goal_canceled_and_others_are_served
         assert result["status"] == 4 and result["values"]["objects"]
 
 
+def test_a_stop_goal_ends_the_running_track_goal_and_succeeds(kitchen_server: Served) -> None:
+    with connect(kitchen_server.url) as connection:
+        connection.send(goal("tracking", "track milk in fridge"))
+        feedback = receive(connection, "action_feedback", "tracking")
+        while feedback["values"]["phase"] != "answer":
+            feedback = receive(connection, "action_feedback", "tracking")
+        connection.send(goal("stopper", "stop all"))
+        tracking = receive(connection, "action_result", "tracking")
+        stopper = receive(connection, "action_result", "stopper")
+    assert tracking["status"] == 5 and tracking["values"]["reason"] == "preempted by goal stopper"
+    assert stopper["status"] == 4
+
+
 def test_the_beliefs_service_answers_from_memory(kitchen_server: Served) -> None:
     with connect(kitchen_server.url) as connection:
         connection.send(goal("fill"))
