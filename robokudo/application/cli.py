@@ -13,7 +13,7 @@ import sys
 from collections.abc import Mapping, Sequence
 from types import MappingProxyType, ModuleType
 
-from robokudo.application.commands import beliefs, ontology, parse, plan, query, run, tree
+from robokudo.application.commands import ask, beliefs, ontology, parse, plan, query, run, serve, tree
 from robokudo.application.interrupts import InterruptHandling
 
 COMMANDS: Mapping[str, ModuleType] = MappingProxyType(
@@ -25,6 +25,8 @@ COMMANDS: Mapping[str, ModuleType] = MappingProxyType(
         "query": query,
         "beliefs": beliefs,
         "ontology": ontology,
+        "serve": serve,
+        "ask": ask,
     }
 )
 """Subcommand name -> the module implementing it."""

@@ -24,7 +24,7 @@ from __future__ import annotations
 import queue
 import threading
 import time
-from collections.abc import Iterator, Mapping
+from collections.abc import Callable, Iterator, Mapping
 from dataclasses import dataclass, replace
 from enum import Enum
 from pathlib import Path
@@ -88,6 +88,10 @@ WORKER_WAIT = 10.0
 
 class PerceptionFailedError(Exception):
     """The tree ran but did not answer; the message names the experts that failed and why."""
+
+
+class QueryCancelledError(Exception):
+    """A one-shot query was stopped (its ``stop`` condition held) before its tree finished; nothing was fused."""
 
 
 class UnknownObjectError(LookupError):
@@ -259,8 +263,11 @@ class AnsweringService:
 
     # ------------------------------------------------------------------ running
 
-    def answer(self, query: str | Query) -> Outcome:
+    def answer(self, query: str | Query, *, stop: Callable[[], bool] | None = None) -> Outcome:
         """Answer a one-shot query (detect, inspect, scan): plan, run once in the task slot, fuse, answer.
+
+        ``stop`` is asked after every tick (on the calling thread); when it holds before the tree finished, the
+        tree is stopped (running experts are interrupted, nothing is fused) and QueryCancelledError is raised.
 
         Raises QueryError / PlanningError / SynthesisError for a query that cannot be answered by any tree,
         ValueError for a continuous kind (use :meth:`start`), UnknownObjectError for an object id the store does
@@ -287,17 +294,26 @@ class AnsweringService:
         def expired() -> bool:
             return deadline is not None and time.monotonic() >= deadline
 
+        def stopped() -> bool:
+            return stop is not None and stop()
+
         # The finished tree stays in the slot (with its statuses, for explanations) until the next task.
         self._retire(self.engine.tasks.replace(TASK_SLOT, pipeline))
         if not expired():
-            self.engine.run(until=lambda _: finished() or expired())
+            self.engine.run(until=lambda _: finished() or expired() or stopped())
         if not finished():
             self._retire(self.engine.tasks.remove(TASK_SLOT))  # stops the tree: running experts are interrupted
+            if stopped():
+                raise QueryCancelledError("stopped before the tree finished")
             return Outcome(self._remembered(parsed, timed_out=True), pipeline, query_plan)
         found = pipeline.cas.view(QueryAnswer) if pipeline.status is Status.SUCCESS else None
         if found is None or not isinstance(found.answer, Answer):
             raise PerceptionFailedError(f"perception failed: {failure_reason(pipeline)}")
         return Outcome(only(found.answer, ids), pipeline, query_plan)
+
+    def recall(self, query: str | Query) -> Answer:
+        """The stored beliefs matching ``query``, answered from memory (nothing runs)."""
+        return self._remembered(parse_query(query) if isinstance(query, str) else query)
 
     def _remembered(self, query: Query, *, timed_out: bool = False) -> Answer:
         """The stored beliefs matching ``query``, as an answer from memory."""

@@ -1,0 +1,135 @@
+"""The server: a websockets (asyncio) server on the main thread's event loop in front of one answering service.
+
+Goals and service calls run on the goal manager's worker thread (:mod:`.goals`), never on the event loop. After
+every engine tick the tree's statuses are handed to the loop (``call_soon_threadsafe``) and published to the
+``/robokudo/tree_status`` subscribers. SIGINT or SIGTERM stops the server: open goals are aborted with the
+reason, their results are sent, the belief store is closed and :func:`serve` returns.
+"""
+
+from __future__ import annotations
+
+import asyncio
+import contextlib
+import ipaddress
+import signal
+from collections.abc import Callable
+from dataclasses import dataclass
+from typing import Any
+
+import py_trees
+from websockets.asyncio.server import ServerConnection
+from websockets.asyncio.server import serve as websocket_server
+
+from queries import format_query, parse_query
+from robokudo.application.commands.plan import task_summary
+from robokudo.application.server.goals import GoalManager
+from robokudo.application.server.protocol import (
+    BELIEFS_SERVICE,
+    MAX_MESSAGE_BYTES,
+    PLAN_SERVICE,
+    TREE_STATUS_TOPIC,
+    publish,
+)
+from robokudo.application.server.session import Services, Session
+from robokudo.application.server.tree_status import tree_status
+from robokudo.application.service import AnsweringService
+from robokudo.core.render import tree_to_dict, unicode_tree
+
+FRAME_LIMIT = 8 * MAX_MESSAGE_BYTES
+"""Frames above this are refused by the WebSocket layer (connection closed); up to it, a message over
+:data:`MAX_MESSAGE_BYTES` gets a status error and the connection stays open."""
+
+FLUSH_SECONDS = 2.0
+"""How long the shutdown waits for the last results to be written to each client."""
+
+
+@dataclass(frozen=True)
+class ServerConfig:
+    """Where the server listens and the token clients must send (None: no authentication)."""
+
+    host: str = "127.0.0.1"
+    port: int = 9090
+    token: str | None = None
+
+
+def is_loopback(host: str) -> bool:
+    """True for ``localhost`` and loopback addresses (127.0.0.0/8, ::1)."""
+    if host == "localhost":
+        return True
+    try:
+        return ipaddress.ip_address(host).is_loopback
+    except ValueError:
+        return False
+
+
+def plan_service(service: AnsweringService, text: str) -> dict[str, Any]:
+    """``/robokudo/plan``: the interpretation, the synthesized tree and its explanation (nothing runs)."""
+    query = parse_query(text)
+    query_plan = service.plan(query)
+    tree = service.tree(query, query_plan)
+    return {
+        "query": format_query(query),
+        "task": task_summary(query_plan),
+        "tree": tree_to_dict(tree),
+        "explanation": unicode_tree(tree, show_reasons=True),
+    }
+
+
+def beliefs_service(service: AnsweringService, text: str) -> dict[str, Any]:
+    """``/robokudo/beliefs``: the stored beliefs matching the query (nothing runs)."""
+    return service.recall(text).to_dict()
+
+
+SERVICES: Services = {PLAN_SERVICE: plan_service, BELIEFS_SERVICE: beliefs_service}
+
+
+async def serve(
+    service: AnsweringService, config: ServerConfig, *, on_ready: Callable[[str], None] | None = None
+) -> str:
+    """Serve until SIGINT or SIGTERM; returns the reason it stopped. Closes ``service``."""
+    loop = asyncio.get_running_loop()
+    stopping: asyncio.Future[str] = loop.create_future()
+    for signum in (signal.SIGINT, signal.SIGTERM):
+        reason = f"the server is shutting down ({signal.Signals(signum).name})"
+        loop.add_signal_handler(signum, lambda r=reason: stopping.done() or stopping.set_result(r))
+    goals = GoalManager(service)
+    sessions: set[Session] = set()
+    subscribers: set[Session] = set()
+
+    def broadcast(message: dict[str, Any]) -> None:
+        for session in list(subscribers):
+            session.send(message)
+
+    def after_tick(tree: py_trees.trees.BehaviourTree) -> None:
+        if subscribers:  # engine thread: a stale read only delays or skips one message
+            status = tree_status(tree.root, service.engine.tick_count)
+            loop.call_soon_threadsafe(broadcast, publish(TREE_STATUS_TOPIC, status))
+
+    service.engine.tree.add_post_tick_handler(after_tick)
+
+    async def connect(connection: ServerConnection) -> None:
+        session = Session(connection, goals, SERVICES, subscribers, config.token)
+        sessions.add(session)
+        try:
+            await session.serve()
+        finally:
+            sessions.discard(session)
+
+    closed = False
+    try:
+        async with websocket_server(connect, config.host, config.port, max_size=FRAME_LIMIT) as server:
+            if on_ready is not None:
+                on_ready(f"ws://{config.host}:{config.port}")
+            reason = await stopping
+            closed = True
+            await loop.run_in_executor(None, goals.close, reason)
+            for session in list(sessions):
+                with contextlib.suppress(TimeoutError):
+                    await asyncio.wait_for(session.flush(), FLUSH_SECONDS)
+            server.close()
+    finally:
+        if not closed:  # the server could not start (address in use, ...): still close the store
+            await loop.run_in_executor(None, goals.close, "the server stopped")
+        for signum in (signal.SIGINT, signal.SIGTERM):
+            loop.remove_signal_handler(signum)
+    return reason

@@ -1,0 +1,188 @@
+"""One client connection: authentication, dispatch of the rosbridge ops, its goals and subscriptions.
+
+Replies go through an outbox drained by one writer task, so the worker thread hands messages over with
+``loop.call_soon_threadsafe`` and never touches the socket. A message that fails validation gets a ``status``
+error and the connection keeps working; a client that must authenticate (the server has a token) and sends any
+other op first, or a wrong token, gets a ``status`` error and is disconnected. When the connection closes, the
+client's open goals are cancelled.
+"""
+
+from __future__ import annotations
+
+import asyncio
+import hmac
+import json
+from collections.abc import Callable
+from concurrent.futures import Future
+from typing import Any
+
+from websockets.asyncio.server import ServerConnection
+from websockets.exceptions import ConnectionClosed
+
+from robokudo.application.server.designator import GoalError, MissingQueryError, goal_query
+from robokudo.application.server.goals import Goal, GoalManager
+from robokudo.application.server.protocol import (
+    GOAL_QUERY_FIELD,
+    QUERY_ACTION,
+    TREE_STATUS_TOPIC,
+    GoalStatus,
+    ProtocolError,
+    action_result,
+    parse_message,
+    service_response,
+    status,
+)
+from robokudo.application.service import AnsweringService
+
+MAX_OPEN_GOALS = 64
+"""Goals one client may have open (queued or running) at a time."""
+
+TOPICS = (TREE_STATUS_TOPIC,)
+
+Services = dict[str, Callable[[AnsweringService, str], dict[str, Any]]]
+
+
+class Session:
+    """Serves one WebSocket connection (see the module)."""
+
+    def __init__(
+        self,
+        connection: ServerConnection,
+        goals: GoalManager,
+        services: Services,
+        subscribers: set[Session],
+        token: str | None,
+    ) -> None:
+        self.connection = connection
+        self.goals = goals
+        self.services = services
+        self.subscribers = subscribers
+        self.token = token
+        self.authenticated = token is None
+        self.topics: set[str] = set()
+        self._loop = asyncio.get_running_loop()
+        self._outbox: asyncio.Queue[dict[str, Any] | None] = asyncio.Queue()
+        self._calls: set[asyncio.Task[None]] = set()
+
+    def send(self, message: dict[str, Any]) -> None:
+        """Queue ``message`` for this client; callable from any thread."""
+        self._loop.call_soon_threadsafe(self._outbox.put_nowait, message)
+
+    async def serve(self) -> None:
+        """Read and answer messages until the connection closes; then cancel this client's goals."""
+        writer = asyncio.create_task(self._write())
+        try:
+            async for raw in self.connection:
+                if not await self._handle(raw):
+                    break
+        except ConnectionClosed:
+            pass
+        finally:
+            self.subscribers.discard(self)
+            self.goals.cancel_owner(self, "the client disconnected")
+            self._loop.call_soon(self._outbox.put_nowait, None)  # after the replies already handed over
+            await writer
+
+    async def flush(self) -> None:
+        """Wait until everything queued so far was written."""
+        await self._outbox.join()
+
+    async def _write(self) -> None:
+        while (message := await self._outbox.get()) is not None:
+            try:
+                await self.connection.send(json.dumps(message))
+            except ConnectionClosed:
+                pass
+            finally:
+                self._outbox.task_done()
+        self._outbox.task_done()
+
+    async def _handle(self, raw: str | bytes) -> bool:
+        """Act on one message; False when the connection is to be closed."""
+        try:
+            message = parse_message(raw)
+        except ProtocolError as error:
+            self.send(status("error", str(error), error.id))
+            return self.authenticated
+        op = message["op"]
+        if op == "auth":
+            return self._auth(message)
+        if not self.authenticated:
+            self.send(status("error", f"authenticate first (op 'auth' with the server's token) before {op!r}"))
+            return False
+        try:
+            if op == "send_action_goal":
+                self._send_goal(message)
+            elif op == "cancel_action_goal":
+                self._cancel_goal(message)
+            elif op == "call_service":
+                self._call_service(message)
+            elif op == "subscribe":
+                self._subscribe(message)
+            elif op == "unsubscribe":
+                self.topics.discard(message["topic"])
+                if not self.topics:
+                    self.subscribers.discard(self)
+        except ProtocolError as error:
+            self.send(status("error", str(error), message.get("id")))
+        return True
+
+    def _auth(self, message: dict[str, Any]) -> bool:
+        if self.token is None:
+            return True
+        if hmac.compare_digest(message["mac"].encode(), self.token.encode()):
+            self.authenticated = True
+            return True
+        self.send(status("error", "authentication failed: wrong token"))
+        return False
+
+    def _send_goal(self, message: dict[str, Any]) -> None:
+        goal_id = message["id"]
+        if message["action"] != QUERY_ACTION:
+            self.send(action_result(goal_id, 0, {"error": f"no action {message['action']!r}"}, result=False))
+            raise ProtocolError(f"unknown action {message['action']!r}; this server has {QUERY_ACTION!r}", goal_id)
+        try:
+            query = goal_query(message["args"])
+        except MissingQueryError as error:
+            self.send(action_result(goal_id, 0, {"error": str(error)}, result=False))
+            raise ProtocolError(str(error), goal_id) from None
+        except GoalError as error:  # a designator that makes no query: the goal is aborted with the reason
+            self.send(action_result(goal_id, GoalStatus.ABORTED, {"reason": str(error)}))
+            return
+        if self.goals.open_goals(self) >= MAX_OPEN_GOALS:
+            error = f"too many open goals (at most {MAX_OPEN_GOALS} per client)"
+            self.send(action_result(goal_id, 0, {"error": error}, result=False))
+            raise ProtocolError(error, goal_id)
+        self.goals.submit(Goal(goal_id, query, self, self.send))
+
+    def _cancel_goal(self, message: dict[str, Any]) -> None:
+        if not self.goals.cancel(message["id"], self):
+            raise ProtocolError(f"no open goal {message['id']!r} of this client", message["id"])
+
+    def _call_service(self, message: dict[str, Any]) -> None:
+        name = message["service"]
+        handler = self.services.get(name)
+        if handler is None:
+            raise ProtocolError(f"unknown service {name!r}; this server has {', '.join(self.services)}")
+        query = message.get("args", {}).get(GOAL_QUERY_FIELD)
+        if not isinstance(query, str):
+            raise ProtocolError(f"service {name!r} needs the argument {GOAL_QUERY_FIELD!r}: the query text")
+        future = self.goals.call(lambda service: handler(service, query))
+        call = asyncio.create_task(self._respond(name, message.get("id"), future))
+        self._calls.add(call)  # the loop keeps only weak references to tasks
+        call.add_done_callback(self._calls.discard)
+
+    async def _respond(self, name: str, request_id: str | None, future: Future[dict[str, Any]]) -> None:
+        try:
+            values = await asyncio.wrap_future(future)
+        except Exception as error:  # the request failed (bad query, plan): the client gets the reason
+            self.send(service_response(name, request_id, {"error": str(error)}, result=False))
+            return
+        self.send(service_response(name, request_id, values, result=True))
+
+    def _subscribe(self, message: dict[str, Any]) -> None:
+        topic = message["topic"]
+        if topic not in TOPICS:
+            raise ProtocolError(f"unknown topic {topic!r}; this server publishes {', '.join(TOPICS)}")
+        self.topics.add(topic)
+        self.subscribers.add(self)

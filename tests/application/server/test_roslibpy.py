@@ -1,0 +1,147 @@
+"""An independent client, roslibpy, uses the served kitchen: the query action, cancel, preemption, the plan
+service and the tree status topic."""
+
+from __future__ import annotations
+
+import threading
+from collections.abc import Iterator
+from typing import Any
+
+import pytest
+import roslibpy
+
+from tests.application.server.conftest import TOKEN, Served
+
+ACTION = "/robokudo/query"
+ACTION_TYPE = "robokudo_msgs/action/Query"
+WAIT = 60.0
+
+
+class GoalRecord:
+    """What roslibpy reported for one goal."""
+
+    def __init__(self) -> None:
+        self.feedback: list[dict[str, Any]] = []
+        self.result: dict[str, Any] | None = None
+        self.error: Any = None
+        self.running = threading.Event()
+        self.ended = threading.Event()
+
+    def on_feedback(self, feedback: Any) -> None:
+        self.feedback.append(dict(feedback))
+        if feedback.get("phase") == "running":
+            self.running.set()
+
+    def on_result(self, result: Any) -> None:
+        self.result = dict(result)
+        self.ended.set()
+
+    def on_error(self, error: Any) -> None:
+        self.error = error
+        self.ended.set()
+
+
+@pytest.fixture(scope="module")
+def ros(kitchen_server: Served) -> Iterator[roslibpy.Ros]:
+    client = roslibpy.Ros(host=kitchen_server.host, port=kitchen_server.port)
+    client.run()
+    yield client
+    client.close()
+
+
+def send(action: roslibpy.ActionClient, query: str) -> tuple[str, GoalRecord]:
+    record = GoalRecord()
+    goal_id = action.send_goal(roslibpy.Goal({"query": query}), record.on_result, record.on_feedback, record.on_error)
+    return goal_id, record
+
+
+def ended(record: GoalRecord) -> dict[str, Any]:
+    assert record.ended.wait(WAIT), "no result"
+    assert record.error is None, record.error
+    assert record.result is not None
+    return record.result
+
+
+def test_find_milk_in_fridge_gives_feedback_then_the_milk(ros: roslibpy.Ros) -> None:
+    action = roslibpy.ActionClient(ros, ACTION, ACTION_TYPE)
+    _, record = send(action, "find milk in fridge")
+    result = ended(record)
+    assert result["status"] is roslibpy.GoalStatus.SUCCEEDED
+    assert [f["phase"] for f in record.feedback][:2] == ["planning", "running"]
+    objects = result["values"]["objects"]
+    assert objects and all(o["region"] == "fridge" for o in objects)
+    assert any("milk" in o["class"]["label"].lower() for o in objects)
+
+
+def test_a_cancelled_goal_ends_canceled_and_the_server_still_answers(ros: roslibpy.Ros) -> None:
+    action = roslibpy.ActionClient(ros, ACTION, ACTION_TYPE)
+    goal_id, record = send(action, "find milk in fridge")
+    assert record.running.wait(WAIT)
+    action.cancel_goal(goal_id)
+    result = ended(record)
+    assert result["status"] is roslibpy.GoalStatus.CANCELED
+    assert "cancel" in result["values"]["reason"]
+    _, again = send(action, "find milk in fridge")
+    assert ended(again)["status"] is roslibpy.GoalStatus.SUCCEEDED
+
+
+def test_a_second_goal_preempts_the_running_one(ros: roslibpy.Ros) -> None:
+    action = roslibpy.ActionClient(ros, ACTION, ACTION_TYPE)
+    _, first = send(action, "find milk in fridge")
+    assert first.running.wait(WAIT)
+    second_id, second = send(action, "find milk in fridge")
+    preempted = ended(first)
+    assert preempted["status"] is roslibpy.GoalStatus.CANCELED
+    assert preempted["values"]["reason"] == f"preempted by goal {second_id}"
+    assert ended(second)["status"] is roslibpy.GoalStatus.SUCCEEDED
+
+
+def test_an_unplannable_goal_is_aborted_with_the_located_error(ros: roslibpy.Ros) -> None:
+    action = roslibpy.ActionClient(ros, ACTION, ACTION_TYPE)
+    _, record = send(action, "detect {obj: {type: Milk")
+    result = ended(record)
+    assert result["status"] is roslibpy.GoalStatus.ABORTED
+    assert "line 1, column" in result["values"]["reason"]
+
+
+def test_the_plan_service_returns_the_tree_and_its_explanation(ros: roslibpy.Ros) -> None:
+    service = roslibpy.Service(ros, "/robokudo/plan", "robokudo_msgs/srv/Plan")
+    response = service.call(roslibpy.ServiceRequest({"query": "find milk in fridge"}), timeout=WAIT)
+    assert response["task"]["region"] == "fridge"
+    names = str(response["tree"])
+    assert "TextReader" in names and "TextReader" in response["explanation"]
+
+
+def test_the_tree_status_topic_publishes_ticks(ros: roslibpy.Ros) -> None:
+    statuses: list[dict[str, Any]] = []
+    seen = threading.Event()
+
+    def on_status(message: dict[str, Any]) -> None:
+        statuses.append(message)
+        if len(statuses) >= 3:
+            seen.set()
+
+    topic = roslibpy.Topic(ros, "/robokudo/tree_status", "std_msgs/String")
+    topic.subscribe(on_status)
+    try:
+        action = roslibpy.ActionClient(ros, ACTION, ACTION_TYPE)
+        _, record = send(action, "find milk in fridge")
+        assert seen.wait(WAIT)
+        ended(record)
+    finally:
+        topic.unsubscribe()
+    ticks = [s["tick"] for s in statuses]
+    assert ticks == sorted(ticks) and len(set(ticks)) == len(ticks)
+    assert statuses[0]["tree"]["name"] == "robot"
+
+
+def test_roslibpy_authenticates_with_the_token_on_a_guarded_server(guarded_server: Served) -> None:
+    client = roslibpy.Ros(host=guarded_server.host, port=guarded_server.port)
+    client.authenticate(mac=TOKEN, client="", dest="", rand="", t=0, level="", end=0)
+    client.run()
+    try:
+        service = roslibpy.Service(client, "/robokudo/plan", "robokudo_msgs/srv/Plan")
+        response = service.call(roslibpy.ServiceRequest({"query": "find milk in fridge"}), timeout=WAIT)
+        assert response["task"]["region"] == "fridge"
+    finally:
+        client.close()
