@@ -119,6 +119,8 @@ class AnswerStep(Annotator):
         step = store.integrate(objects, stamp, camera=camera, tracker=self.tracker)
         belief_filter = self._filter()
         seen = {i: o for i, o in zip(step.assigned, objects, strict=True) if i}
+        if belief_filter.ids is not None:  # the query names objects (``id:``): answer only those of them seen here
+            seen = {i: o for i, o in seen.items() if i in belief_filter.ids}
         matching = store.query(replace(belief_filter, ids=tuple(seen), limit=None))
         guesses = self._guessed(store, belief_filter, seen, {b.id for b in matching})
         matching += guesses.values()

@@ -124,15 +124,12 @@ class TaskHandle:
         plan: QueryPlan,
         service: AnsweringService,
         *,
-        ids: tuple[int, ...] | None = None,
         timeout: float | None = None,
         started: float = 0.0,
     ) -> None:
         self.kind = kind
         self.tree = tree
         self.plan = plan
-        self.ids = ids
-        """The object ids the answers are restricted to (None: every matching object)."""
         self.timeout = timeout
         self._deadline = None if timeout is None else started + timeout
         self._service = service
@@ -167,7 +164,7 @@ class TaskHandle:
         self._service.cancel(self)
 
     def _publish(self, answer: Answer) -> None:
-        self._answers.put(only(answer, self.ids))
+        self._answers.put(answer)
 
     def _expired(self) -> bool:
         return self._deadline is not None and time.monotonic() >= self._deadline
@@ -281,7 +278,7 @@ class AnsweringService:
             raise ValueError(f"a {parsed.kind} query runs continuously; start it with start() and read its answers")
         timeout = query_timeout(parsed)
         deadline = None if timeout is None else started + timeout
-        ids = self.object_ids(parsed)
+        self.object_ids(parsed)  # an id that is not stored is refused before anything runs
         query_plan = self.plan(parsed)
         pipeline = self.tree(parsed, query_plan)
         if self.engine.is_running_in_background():
@@ -309,7 +306,7 @@ class AnsweringService:
         found = pipeline.cas.view(QueryAnswer) if pipeline.status is Status.SUCCESS else None
         if found is None or not isinstance(found.answer, Answer):
             raise PerceptionFailedError(f"perception failed: {failure_reason(pipeline)}")
-        return Outcome(only(found.answer, ids), pipeline, query_plan)
+        return Outcome(found.answer, pipeline, query_plan)
 
     def recall(self, query: str | Query) -> Answer:
         """The stored beliefs matching ``query``, answered from memory (nothing runs)."""
@@ -327,12 +324,10 @@ class AnsweringService:
         parsed = parse_query(query) if isinstance(query, str) else query
         if self.mode_of(parsed) is not ExecutionMode.CONTINUOUS:
             raise ValueError(f"a {parsed.kind} query ends with one answer; ask it with answer()")
-        ids = self.object_ids(parsed)
+        self.object_ids(parsed)  # an id that is not stored is refused before anything runs
         query_plan = self.plan(parsed)
         pipeline = self.tree(parsed, query_plan)
-        handle = TaskHandle(
-            parsed.kind, pipeline, query_plan, self, ids=ids, timeout=query_timeout(parsed), started=started
-        )
+        handle = TaskHandle(parsed.kind, pipeline, query_plan, self, timeout=query_timeout(parsed), started=started)
         repeat = py_trees.decorators.Repeat(f"every run of {pipeline.name}", pipeline, num_success=-1)
         self._end_continuous("replaced by another task")
         with self._lock:
@@ -423,13 +418,6 @@ def query_timeout(query: Query) -> float | None:
     """The query's ``timeout`` in seconds (None when it sets none)."""
     value = query.get(TIMEOUT_KEY)
     return float(value.value) if isinstance(value, Number) else None
-
-
-def only(answer: Answer, ids: tuple[int, ...] | None) -> Answer:
-    """``answer`` restricted to the objects ``ids`` (unchanged when None)."""
-    if ids is None:
-        return answer
-    return replace(answer, objects=tuple(o for o in answer.objects if o.id in ids))
 
 
 def failure_reason(tree: py_trees.behaviour.Behaviour) -> str:
