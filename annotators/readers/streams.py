@@ -36,7 +36,12 @@ from annotators.readers.frame_readers import DEFAULT_KITCHEN_VIEW, KITCHEN_RECOR
 from annotators.simulation import kitchen_scene
 from robokudo.core.annotator import Annotator
 from robokudo.core.capability import Capability
+from robokudo.core.pipeline import StructureError
 from robokudo.core.types import CameraInfo, CasType, ColorImage, DepthImage
+
+PERCEPTION_PIPELINE = "perception"
+"""The name of a served root's perceive pipeline (the paper's Fig. 4): its CAS holds the frame read this run, which
+:class:`PerceivedFrameReader` hands to the task's pipeline."""
 
 DEFAULT_RATE_HZ = 30.0
 """The kitchen camera's rate, and the playback rate of recordings without time stamps unless one is given."""
@@ -143,6 +148,7 @@ class KitchenCameraStream(FrameStream):
         self._rendered: dict[str, kitchen_scene.RenderedScene] = {}
         self._start = time.monotonic()
         self._last_slot = -1
+        self._last_view: str | None = None
 
     @staticmethod
     def _checked_view(view: str) -> str:
@@ -170,6 +176,20 @@ class KitchenCameraStream(FrameStream):
         self.set_view(view)
         return view
 
+    def prepare(self) -> None:
+        """Render every view now, so that pointing the camera later costs no rendering on the reading thread."""
+        for view in kitchen_scene.camera_views():
+            self._scene(view)
+
+    def _scene(self, view: str) -> kitchen_scene.RenderedScene:
+        with self._lock:
+            scene = self._rendered.get(view)
+        if scene is None:
+            scene = kitchen_scene.render_kitchen(view, seed=self.seed)
+            with self._lock:
+                scene = self._rendered.setdefault(view, scene)
+        return scene
+
     @property
     def last_scene(self) -> kitchen_scene.RenderedScene | None:
         """The scene (with its ground truth) of the current view, None before it was first rendered."""
@@ -177,21 +197,18 @@ class KitchenCameraStream(FrameStream):
             return self._rendered.get(self._view)
 
     def _next(self, block: bool) -> StreamFrame | None:
-        """The camera's newest frame after the last one delivered (frames a slow caller missed are skipped)."""
+        """The camera's newest frame after the last one delivered (frames a slow caller missed are skipped); after
+        the view changed, a frame from the new view at once."""
         period = 1.0 / self.rate_hz
         slot = math.floor((time.monotonic() - self._start) / period)
-        if slot <= self._last_slot:
+        view = self.view
+        if slot <= self._last_slot and view == self._last_view:
             if not block:
                 return None
             slot = self._last_slot + 1
             self._wait_until(self._start + slot * period)
-        with self._lock:
-            view = self._view
-            scene = self._rendered.get(view)
-        if scene is None:
-            scene = kitchen_scene.render_kitchen(view, seed=self.seed)
-            with self._lock:
-                self._rendered.setdefault(view, scene)
+        slot = max(slot, self._last_slot + 1)
+        scene = self._scene(view)
         camera = CameraInfo(
             intrinsics=scene.intrinsics,
             cam_to_world=scene.cam_to_world,
@@ -201,6 +218,7 @@ class KitchenCameraStream(FrameStream):
         )
         frame = Frame(scene.color, scene.depth, scene.intrinsics, source=f"kitchen/{view}", timestamp=camera.timestamp)
         self._last_slot = slot
+        self._last_view = view
         delivered = StreamFrame(frame, camera, index=slot, sequence=self._delivered)
         self._delivered += 1
         return delivered
@@ -387,3 +405,37 @@ class StreamReader(Annotator):
         self.write(ColorImage(self._last.frame.color))
         self.write(DepthImage(self._last.frame.depth))
         self.write(self._last.camera)
+
+
+class PerceivedFrameReader(Annotator):
+    """The first step of a task in a served tree: takes the frame the root's perceive pipeline read this run.
+
+    The views are shared by reference (no copy). Fails with the reason when the tree has no such pipeline or it
+    holds no frame.
+    """
+
+    inputs: ClassVar[tuple[type[CasType], ...]] = ()
+    outputs: ClassVar[tuple[type[CasType], ...]] = (ColorImage, DepthImage, CameraInfo)
+    capability: ClassVar[Capability] = Capability(
+        label="perceived frame",
+        description="Takes the frame the running engine perceived this run (colour, depth, camera info).",
+        cost_ms=0.1,
+        reliability=1.0,
+    )
+
+    def __init__(self, pipeline: str = PERCEPTION_PIPELINE, name: str | None = None) -> None:
+        super().__init__(name=name)
+        self.pipeline = pipeline
+
+    def analyse(self) -> None:
+        """Write the perceived colour, depth and camera info into this task's CAS."""
+        try:
+            perceived = self.cas_of(self.pipeline)
+        except StructureError as error:
+            self.fail(str(error))
+        views = (perceived.view(ColorImage), perceived.view(DepthImage), perceived.view(CameraInfo))
+        if any(view is None for view in views):
+            self.fail(f"no frame was perceived: the {self.pipeline!r} pipeline holds none")
+        for view in views:
+            assert view is not None
+            self.write(view)

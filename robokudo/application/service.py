@@ -4,9 +4,18 @@ Everything that only changes with the ontology or the mission is made once and k
 reload picks up ontology edits), the QueryPlanner with its caches, the BeliefStore, and one Engine whose root
 holds a task slot. Each query is parsed, planned and synthesized into a Pipeline that ends in the answer step;
 the Pipeline goes into the task slot between ticks, and how it runs follows from the query's kind
-(:data:`EXECUTION_MODES`): one-shot kinds run until the tree finishes and return one Answer; continuous kinds
-run again and again, one Answer per run, until cancelled or until a run fails. One task runs at a time: a new
-task replaces the one in the slot.
+(:data:`EXECUTION_MODES`): a one-shot task runs until its tree finishes and has one Answer; a continuous task runs
+again on every run of the root, one Answer per run, until cancelled or until a run fails. One task runs at a
+time: a new task replaces the one in the slot. Without a task the slot holds an idle subtree.
+
+Over a live stream (``stream=``, as ``robokudo serve`` runs it) the root is the paper's Fig. 4 shape: a perceive
+pipeline reads the stream's newest frame, then the task slot; the engine ticks at its fixed rate in the
+background for the service's lifetime (:meth:`AnsweringService.run_in_background`), every task starts on a freshly
+perceived frame (:class:`~annotators.readers.streams.PerceivedFrameReader` is its first step), and the kitchen
+camera is pointed at the task's region. When perception fails (the source ended, a frame cannot be read) the
+running task ends with that reason; once the source ended, new tasks are refused with it
+(:class:`SourceEndedError`). Without a stream (``robokudo query``), each task's tree reads its own frame and the
+engine ticks on the calling thread while :meth:`AnsweringService.answer` waits.
 
 A query's ``timeout`` (``detect {obj: {type: Milk}, timeout: 2s}``) is a deadline counted from when the query
 is received: when it passes before the tree finished, the tree is stopped (running experts are interrupted,
@@ -34,6 +43,7 @@ import py_trees
 from py_trees.common import Status
 
 from annotators.catalog import AnnotatorCatalog
+from annotators.readers.streams import PERCEPTION_PIPELINE, FrameStream, KitchenCameraStream, StreamReader
 from queries import Number, Query, parse_query
 from reasoning.beliefs.answer import Answer, answer_from_memory
 from reasoning.beliefs.filters import belief_filter, kb_class_test
@@ -43,10 +53,11 @@ from reasoning.knowledge.knowledge_base import KnowledgeBase
 from reasoning.planning.query_planner import QueryPlan, QueryPlanner
 from robokudo.application.knowledge import load_knowledge_base
 from robokudo.application.planning import plan_for_input
+from robokudo.application.sensor_sources import kitchen_view_for, served_source
 from robokudo.core.composites import Sequence
 from robokudo.core.engine import Engine
 from robokudo.core.pipeline import Pipeline
-from robokudo.core.slot import TaskSlot
+from robokudo.core.slot import Idle, TaskSlot
 from robokudo.core.threaded import has_workers, stop_workers
 from robokudo.core.types import QueryAnswer
 from trees.answer_step import AnswerStep
@@ -111,15 +122,17 @@ class Outcome:
 
 
 class TaskHandle:
-    """A continuous task in the engine: its answers as they come, and a way to cancel it.
+    """A task in the engine: its answers as they come (continuous) or its one answer (one-shot), and a way to
+    cancel it.
 
     ``next_answer`` and ``answers`` block until the engine produced the next answer or the task ended;
-    ``reason`` says why it ended (cancelled, replaced by another task, or the failure of a run).
+    ``reason`` says why it ended (finished, cancelled, replaced by another task, timed out, or a failure).
     """
 
     def __init__(
         self,
-        kind: str,
+        query: Query,
+        mode: ExecutionMode,
         tree: Pipeline,
         plan: QueryPlan,
         service: AnsweringService,
@@ -127,7 +140,9 @@ class TaskHandle:
         timeout: float | None = None,
         started: float = 0.0,
     ) -> None:
-        self.kind = kind
+        self.query = query
+        self.kind = query.kind
+        self.mode = mode
         self.tree = tree
         self.plan = plan
         self.timeout = timeout
@@ -136,6 +151,8 @@ class TaskHandle:
         self._answers: queue.SimpleQueue[Answer | None] = queue.SimpleQueue()
         self._ended = threading.Event()
         self._reason = ""
+        self._result: Answer | None = None
+        self._timed_out = False
 
     @property
     def done(self) -> bool:
@@ -146,6 +163,20 @@ class TaskHandle:
     def reason(self) -> str:
         """Why the task ended ("" while it runs)."""
         return self._reason
+
+    @property
+    def result(self) -> Answer | None:
+        """A one-shot task's answer once its tree succeeded (None before, and when it did not)."""
+        return self._result
+
+    @property
+    def timed_out(self) -> bool:
+        """True when the task ended because its timeout passed."""
+        return self._timed_out
+
+    def wait(self, timeout: float | None = None) -> bool:
+        """Wait until the task ended (at most ``timeout`` seconds); True when it has."""
+        return self._ended.wait(timeout)
 
     def next_answer(self, timeout: float | None = None) -> Answer | None:
         """The next answer; None when the task ended (or nothing came within ``timeout`` seconds)."""
@@ -169,11 +200,20 @@ class TaskHandle:
     def _expired(self) -> bool:
         return self._deadline is not None and time.monotonic() >= self._deadline
 
-    def _end(self, reason: str) -> None:
-        if not self._ended.is_set():
-            self._reason = reason
-            self._ended.set()
-            self._answers.put(None)
+    def _end(self, reason: str, *, result: Answer | None = None, timed_out: bool = False) -> bool:
+        """End the task once (False when it had ended already)."""
+        if self._ended.is_set():
+            return False
+        self._reason = reason
+        self._result = result
+        self._timed_out = timed_out
+        self._ended.set()
+        self._answers.put(None)
+        return True
+
+
+class SourceEndedError(Exception):
+    """The live source ended (a recording played once reached its end): no task can perceive any more."""
 
 
 class AnsweringService:
@@ -188,19 +228,33 @@ class AnsweringService:
         input_path: str | None = None,
         frame: int = 0,
         hz: float = 100.0,
+        stream: FrameStream | None = None,
     ) -> None:
         self.kb = kb
         self.store = store
         self.catalog = catalog if catalog is not None else AnnotatorCatalog.discover()
         self.input_path = input_path
         self.frame = frame
+        self.stream = stream
         self.planner = QueryPlanner(kb)
-        root = Sequence("robot", [TaskSlot(TASK_SLOT)], reason="the robot's perception: the current task")
+        self._idle = Idle(reason="no task: the engine keeps perceiving until the next one")
+        self._slot = TaskSlot(TASK_SLOT)
+        self._slot.set_subtree(self._idle)
+        self._reader: StreamReader | None = None
+        self._perception: Pipeline | None = None
+        if stream is None:
+            root = Sequence("robot", [self._slot], reason="the robot's perception: the current task")
+        else:
+            self._reader = StreamReader(stream, wait=False, name="read frame")
+            self._reader.reason = f"reads the newest frame of {stream.name}"
+            self._perception = Pipeline(PERCEPTION_PIPELINE, [self._reader], reason="perceives: the newest frame")
+            root = Sequence("robot", [self._perception, self._slot], reason="perceive, then the current task")
         self.engine = Engine(root, hz=hz)
         self.engine.tree.add_post_tick_handler(self._after_tick)
         self._lock = threading.Lock()
-        self._continuous: TaskHandle | None = None
+        self._current: TaskHandle | None = None
         self._retired: list[py_trees.behaviour.Behaviour] = []
+        self._source_ended: str | None = None
 
     @classmethod
     def open(
@@ -211,6 +265,7 @@ class AnsweringService:
         frame: int = 0,
         hz: float = 100.0,
         catalog: AnnotatorCatalog | None = None,
+        stream: FrameStream | None = None,
     ) -> AnsweringService:
         """A service over the shipped and user ontology and the belief store at ``store_path`` (default store
         when None), with the annotators of ``catalog`` (default: this project's).
@@ -225,7 +280,7 @@ class AnsweringService:
         except BaseException:
             store.close()
             raise
-        return cls(kb, store, catalog=catalog, input_path=input_path, frame=frame, hz=hz)
+        return cls(kb, store, catalog=catalog, input_path=input_path, frame=frame, hz=hz, stream=stream)
 
     # ------------------------------------------------------------------ planning
 
@@ -233,11 +288,19 @@ class AnsweringService:
         """Interpret and plan ``query`` for this service's input (the kitchen camera looks at the query's region,
         else at the region of the object the query names by id)."""
         parsed = parse_query(query) if isinstance(query, str) else query
-        look_at = None
-        for object_id in self.object_ids(parsed) or ():
+        if self.stream is not None:
+            return self.planner.plan(parsed, served_source(self.kb, self.stream))
+        return plan_for_input(
+            self.planner, parsed, self.input_path, self.frame, look_at=self._remembered_region(parsed)
+        )
+
+    def _remembered_region(self, query: Query) -> str | None:
+        """Where the last object the query names by id was last seen (None when it names none, or no region)."""
+        region = None
+        for object_id in self.object_ids(query) or ():
             known = self.store.get(object_id)
-            look_at = known.region if known is not None and known.region else look_at
-        return plan_for_input(self.planner, parsed, self.input_path, self.frame, look_at=look_at)
+            region = known.region if known is not None and known.region else region
+        return region
 
     def object_ids(self, query: Query) -> tuple[int, ...] | None:
         """The object ids ``query`` names (None when it names none); UnknownObjectError for an id not stored."""
@@ -260,53 +323,71 @@ class AnsweringService:
 
     # ------------------------------------------------------------------ running
 
-    def answer(self, query: str | Query, *, stop: Callable[[], bool] | None = None) -> Outcome:
-        """Answer a one-shot query (detect, inspect, scan): plan, run once in the task slot, fuse, answer.
+    def submit(self, query: str | Query) -> TaskHandle:
+        """Plan ``query`` and put its tree into the task slot (replacing the running task); its handle.
 
-        ``stop`` is asked after every tick (on the calling thread); when it holds before the tree finished, the
-        tree is stopped (running experts are interrupted, nothing is fused) and QueryCancelledError is raised.
-
-        Raises QueryError / PlanningError / SynthesisError for a query that cannot be answered by any tree,
-        ValueError for a continuous kind (use :meth:`start`), UnknownObjectError for an object id the store does
-        not hold, PerceptionFailedError when the tree failed. When the query's timeout passes first, the answer
-        is the stored beliefs matching the query, with ``timed_out`` set (see the module).
+        Raises QueryError / PlanningError / SynthesisError for a query no tree can answer, ValueError for a
+        ``stop`` query, UnknownObjectError for an object id the store does not hold, SourceEndedError once the
+        live source ended. Nothing changes in the engine when it raises.
         """
         started = time.monotonic()
         parsed = parse_query(query) if isinstance(query, str) else query
         mode = self.mode_of(parsed)
-        if mode is not ExecutionMode.ONCE:
-            raise ValueError(f"a {parsed.kind} query runs continuously; start it with start() and read its answers")
-        timeout = query_timeout(parsed)
-        deadline = None if timeout is None else started + timeout
+        if self._source_ended is not None:
+            raise SourceEndedError(self._source_ended)
         self.object_ids(parsed)  # an id that is not stored is refused before anything runs
         query_plan = self.plan(parsed)
         pipeline = self.tree(parsed, query_plan)
-        if self.engine.is_running_in_background():
-            self._end_continuous("replaced by a one-shot query")
-            self.engine.stop()
+        handle = TaskHandle(parsed, mode, pipeline, query_plan, self, timeout=query_timeout(parsed), started=started)
+        if isinstance(self.stream, KitchenCameraStream):
+            region = query_plan.interpretation.task.region or self._remembered_region(parsed)
+            self.stream.set_view(kitchen_view_for(region))
+        with self._lock:
+            previous, self._current = self._current, handle
+        if previous is not None:
+            previous._end("replaced by another task")
+        self._retire(self.engine.tasks.replace(TASK_SLOT, pipeline, restart=True))
+        return handle
 
-        def finished() -> bool:
-            return pipeline.status in (Status.SUCCESS, Status.FAILURE)
+    def answer(self, query: str | Query, *, stop: Callable[[], bool] | None = None) -> Outcome:
+        """Answer a one-shot query (detect, inspect, scan): plan, run once in the task slot, fuse, answer.
 
-        def expired() -> bool:
-            return deadline is not None and time.monotonic() >= deadline
+        ``stop`` is asked after every tick period (on the calling thread); when it holds before the tree finished,
+        the tree is stopped (running experts are interrupted, nothing is fused) and QueryCancelledError is raised.
+        When the engine ticks in the background (a served instance) this waits for the task; otherwise the engine
+        ticks on the calling thread until the task ended.
+
+        Raises what :meth:`submit` raises, ValueError for a continuous kind (use :meth:`start`),
+        PerceptionFailedError when the tree failed. When the query's timeout passes first, the answer is the
+        stored beliefs matching the query, with ``timed_out`` set (see the module).
+        """
+        started = time.monotonic()
+        parsed = parse_query(query) if isinstance(query, str) else query
+        if self.mode_of(parsed) is not ExecutionMode.ONCE:
+            raise ValueError(f"a {parsed.kind} query runs continuously; start it with start() and read its answers")
+        timeout = query_timeout(parsed)
+        handle = self.submit(parsed)
+        if timeout is not None and time.monotonic() - started >= timeout:
+            self.cancel(handle)  # the deadline passed while planning: answer from memory without running
+            return Outcome(self._remembered(parsed, timed_out=True), handle.tree, handle.plan)
 
         def stopped() -> bool:
             return stop is not None and stop()
 
-        # The finished tree stays in the slot (with its statuses, for explanations) until the next task.
-        self._retire(self.engine.tasks.replace(TASK_SLOT, pipeline))
-        if not expired():
-            self.engine.run(until=lambda _: finished() or expired() or stopped())
-        if not finished():
-            self._retire(self.engine.tasks.remove(TASK_SLOT))  # stops the tree: running experts are interrupted
-            if stopped():
-                raise QueryCancelledError("stopped before the tree finished")
-            return Outcome(self._remembered(parsed, timed_out=True), pipeline, query_plan)
-        found = pipeline.cas.view(QueryAnswer) if pipeline.status is Status.SUCCESS else None
-        if found is None or not isinstance(found.answer, Answer):
-            raise PerceptionFailedError(f"perception failed: {failure_reason(pipeline)}")
-        return Outcome(found.answer, pipeline, query_plan)
+        if self.engine.is_running_in_background():
+            while not handle.wait(1.0 / self.engine.hz):
+                if stopped():
+                    break
+        else:
+            self.engine.run(until=lambda _: handle.done or stopped())
+        if not handle.done:
+            self.cancel(handle)
+            raise QueryCancelledError("stopped before the tree finished")
+        if handle.timed_out:
+            return Outcome(self._remembered(parsed, timed_out=True), handle.tree, handle.plan)
+        if handle.result is None:
+            raise PerceptionFailedError(f"perception failed: {handle.reason}")
+        return Outcome(handle.result, handle.tree, handle.plan)
 
     def recall(self, query: str | Query) -> Answer:
         """The stored beliefs matching ``query``, answered from memory (nothing runs)."""
@@ -320,33 +401,33 @@ class AnsweringService:
     def start(self, query: str | Query) -> TaskHandle:
         """Start a continuous query (track): the engine ticks in the background and every run of the tree
         yields an answer on the returned handle until it is cancelled or a run fails."""
-        started = time.monotonic()
         parsed = parse_query(query) if isinstance(query, str) else query
         if self.mode_of(parsed) is not ExecutionMode.CONTINUOUS:
             raise ValueError(f"a {parsed.kind} query ends with one answer; ask it with answer()")
-        self.object_ids(parsed)  # an id that is not stored is refused before anything runs
-        query_plan = self.plan(parsed)
-        pipeline = self.tree(parsed, query_plan)
-        handle = TaskHandle(parsed.kind, pipeline, query_plan, self, timeout=query_timeout(parsed), started=started)
-        repeat = py_trees.decorators.Repeat(f"every run of {pipeline.name}", pipeline, num_success=-1)
-        self._end_continuous("replaced by another task")
-        with self._lock:
-            self._continuous = handle
-        self._retire(self.engine.tasks.replace(TASK_SLOT, repeat))
-        if not self.engine.is_running_in_background():
-            self.engine.start()
+        handle = self.submit(parsed)
+        self.run_in_background()
         return handle
 
+    def run_in_background(self) -> None:
+        """Tick the engine at its rate on its own thread until :meth:`close` (no-op when it already does)."""
+        if not self.engine.is_running_in_background():
+            self.engine.start()
+
     def cancel(self, handle: TaskHandle | None = None) -> None:
-        """Cancel the running continuous task (``handle``, or whichever runs); its experts are interrupted."""
+        """Cancel the running task (``handle``, or whichever runs); its experts are interrupted and the slot
+        becomes idle."""
         with self._lock:
-            current = self._continuous
-        if current is None or (handle is not None and handle is not current):
-            return
-        self._end_continuous("cancelled")
-        if self.engine.is_running_in_background():
-            self.engine.stop()
-        self._retire(self.engine.tasks.remove(TASK_SLOT))
+            current = self._current
+            if current is None or (handle is not None and handle is not current):
+                return
+            self._current = None
+        current._end("cancelled")
+        self._retire(self.engine.tasks.replace(TASK_SLOT, self._idle))
+
+    @property
+    def source_ended(self) -> str | None:
+        """Why the live source ended (None while it has frames, and without a stream)."""
+        return self._source_ended
 
     @staticmethod
     def mode_of(query: Query) -> ExecutionMode:
@@ -357,10 +438,15 @@ class AnsweringService:
             raise ValueError(f"a {query.kind} query plans no perception tree") from None
 
     def close(self) -> None:
-        """Stop the engine (ending any continuous task), wait for interrupted experts' worker threads to end
-        (up to :data:`WORKER_WAIT` s) and close the belief store."""
-        self._end_continuous("the service closed")
+        """Stop the engine (ending the running task), close the stream, wait for interrupted experts' worker
+        threads to end (up to :data:`WORKER_WAIT` s) and close the belief store."""
+        with self._lock:
+            current, self._current = self._current, None
+        if current is not None:
+            current._end("the service closed")
         try:
+            if self.stream is not None:
+                self.stream.close()
             self.engine.stop()
             with self._lock:
                 retired, self._retired = self._retired, []
@@ -379,24 +465,42 @@ class AnsweringService:
     # ------------------------------------------------------------------ engine side
 
     def _after_tick(self, _: py_trees.trees.BehaviourTree) -> None:
-        """After every tick (engine thread): hand a finished run's answer to the continuous task's handle."""
+        """After every tick (engine thread): end a finished one-shot task or hand a continuous task's answer to
+        its handle; end the task when perception failed, its run failed or its deadline passed."""
+        perception_failure = None
+        if self._perception is not None and self._perception.status is Status.FAILURE:
+            perception_failure = failure_reason(self._perception)
+            if self._reader is not None and self._reader.ended:
+                self._source_ended = perception_failure
         with self._lock:
-            handle = self._continuous
-        if handle is None or handle.done:
-            return
+            handle = self._current
+        if handle is None or handle.done or self._slot.subtree is not handle.tree:
+            return  # no task, or its tree is not in the slot yet (the swap is applied at the next tick)
         pipeline = handle.tree
-        if pipeline.status is Status.SUCCESS:
+        if perception_failure is not None:
+            self._finish(handle, f"perception failed: {perception_failure}")
+        elif pipeline.status is Status.SUCCESS:
             found = pipeline.cas.view(QueryAnswer)
-            if found is not None and isinstance(found.answer, Answer):
-                handle._publish(found.answer)
-        failed = pipeline.status is Status.FAILURE
-        if failed or handle._expired():
-            why = f"a run failed: {failure_reason(pipeline)}" if failed else f"timed out after {handle.timeout:g} s"
-            handle._end(why)
-            with self._lock:
-                self._continuous = None
-            # Between two ticks on the engine thread, the slot may be emptied directly (as the engine does).
-            self._retire(self.engine.tasks.slot(TASK_SLOT).set_subtree(None))
+            answer = found.answer if found is not None and isinstance(found.answer, Answer) else None
+            if handle.mode is ExecutionMode.ONCE:
+                self._finish(handle, "answered", result=answer)
+            elif answer is not None:
+                handle._publish(answer)
+        elif pipeline.status is Status.FAILURE:
+            reason = failure_reason(pipeline)
+            self._finish(handle, reason if handle.mode is ExecutionMode.ONCE else f"a run failed: {reason}")
+        if not handle.done and handle._expired():
+            self._finish(handle, f"timed out after {handle.timeout:g} s", timed_out=True)
+
+    def _finish(
+        self, handle: TaskHandle, reason: str, *, result: Answer | None = None, timed_out: bool = False
+    ) -> None:
+        """End ``handle`` (engine thread, between two ticks) and put the idle subtree into the slot."""
+        with self._lock:
+            if self._current is handle:
+                self._current = None
+        handle._end(reason, result=result, timed_out=timed_out)
+        self._retire(self._slot.set_subtree(self._idle))
 
     def _retire(self, tree: py_trees.behaviour.Behaviour | None) -> None:
         """Remember a tree taken out of the slot while its experts' worker threads finish (:meth:`close` waits)."""
@@ -406,12 +510,6 @@ class AnsweringService:
             self._retired = [t for t in self._retired if has_workers(t)]
             if has_workers(tree):
                 self._retired.append(tree)
-
-    def _end_continuous(self, reason: str) -> None:
-        with self._lock:
-            handle, self._continuous = self._continuous, None
-        if handle is not None:
-            handle._end(reason)
 
 
 def query_timeout(query: Query) -> float | None:

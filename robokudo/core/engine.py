@@ -22,6 +22,7 @@ from robokudo.core.structure import check_structure
 class _SlotChange:
     slot: TaskSlot
     subtree: py_trees.behaviour.Behaviour | None
+    restart: bool = False
     applied: threading.Event = field(default_factory=threading.Event)
     previous: py_trees.behaviour.Behaviour | None = None
 
@@ -46,18 +47,25 @@ class TaskInterface:
         raise KeyError(f"no TaskSlot named {name!r} (slots: {', '.join(s.name for s in slots) or 'none'})")
 
     def replace(
-        self, slot_name: str, subtree: py_trees.behaviour.Behaviour | None, timeout: float = 5.0
+        self,
+        slot_name: str,
+        subtree: py_trees.behaviour.Behaviour | None,
+        timeout: float = 5.0,
+        *,
+        restart: bool = False,
     ) -> py_trees.behaviour.Behaviour | None:
         """Put ``subtree`` into the slot (None removes); returns the subtree taken out.
 
         The tree structure is checked first, so a bad subtree is rejected before anything changes. When the
         engine ticks in a background thread this waits (up to ``timeout`` s) until the change is applied.
+        ``restart`` also ends the root's current run, so the next tick starts the root from its first child (in
+        the Fig. 4 shape: the new task starts on a freshly perceived frame).
         """
         slot = self.slot(slot_name)
         if subtree is not None:
             check_structure(subtree, attach_to=slot)
             validate_data_flow(self._engine.root, substitute={slot: subtree})
-        change = _SlotChange(slot, subtree)
+        change = _SlotChange(slot, subtree, restart)
         self._changes.put(change)
         if self._engine.is_running_in_background():
             if not change.applied.wait(timeout):
@@ -84,6 +92,8 @@ class TaskInterface:
             except queue.Empty:
                 return
             change.previous = change.slot.set_subtree(change.subtree)
+            if change.restart and self._engine.root.status is Status.RUNNING:
+                self._engine.root.stop(Status.INVALID)
             change.applied.set()
 
 

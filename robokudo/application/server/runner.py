@@ -106,6 +106,7 @@ async def serve(
             loop.call_soon_threadsafe(broadcast, publish(TREE_STATUS_TOPIC, status))
 
     service.engine.tree.add_post_tick_handler(after_tick)
+    service.run_in_background()
 
     async def connect(connection: ServerConnection) -> None:
         session = Session(connection, goals, SERVICES, subscribers, config.token)
