@@ -29,6 +29,8 @@ from pathlib import Path
 from types import TracebackType
 from typing import ClassVar, Self
 
+from py_trees.common import Status
+
 from annotators.readers.bag_io import ANY_TOPICS, BagTopics, bag_frames, is_bag
 from annotators.readers.choice import recorded_frames
 from annotators.readers.frame_io import Frame, FrameError
@@ -361,10 +363,12 @@ def stream_for(
 
 
 class StreamReader(Annotator):
-    """Writes the stream's next frame (colour, depth, camera info) each time it runs.
+    """Writes the stream's next frame (colour, depth, camera info) each time it runs; never the same frame twice.
 
-    ``wait`` False takes only a frame that is already due and otherwise writes the last one again. Fails with the
-    reason when the source ended (then :attr:`ended` is True) or a frame cannot be read.
+    ``wait`` True blocks the tick until the next frame is due. ``wait`` False never blocks: while no new frame is
+    due the reader stays RUNNING (feedback "waiting for the next frame"), so the engine keeps its tick rate and the
+    rest of the tree runs once per new frame. Fails with the reason when the source ended (then :attr:`ended` is
+    True) or a frame cannot be read.
     """
 
     inputs: ClassVar[tuple[type[CasType], ...]] = ()
@@ -376,22 +380,42 @@ class StreamReader(Annotator):
         reliability=1.0,
     )
 
+    WAITING = "waiting for the next frame"
+
     def __init__(self, stream: FrameStream, wait: bool = True, name: str | None = None) -> None:
         super().__init__(name=name)
         self.stream = stream
         self.wait = wait
         self.ended = False
         self._last: StreamFrame | None = None
+        self._due: StreamFrame | None = None
+        self._problem: Exception | None = None
 
     @property
     def last_frame(self) -> StreamFrame | None:
         """The frame written by the last successful run, None before it."""
         return self._last
 
+    def update(self) -> Status:
+        """Without waiting: RUNNING until a new frame is due, then write it (see the class)."""
+        if not self.wait:
+            try:
+                self._due = self.stream.next_frame(block=False)
+            except (SourceEndedError, FrameError, OSError, ValueError) as error:
+                self._problem = error  # analyse reports it as the run's failure
+            if self._due is None and self._problem is None:
+                self.feedback_message = self.WAITING
+                return Status.RUNNING
+        return super().update()
+
     def analyse(self) -> None:
-        """Take the next frame (or keep the last one when not waiting and none is due) and write it."""
+        """Take the next frame and write it."""
+        due, problem = self._due, self._problem
+        self._due = self._problem = None
         try:
-            delivered = self.stream.next_frame(block=self.wait or self._last is None)
+            if problem is not None:
+                raise problem
+            delivered = due if due is not None else self.stream.next_frame(block=True)
         except SourceEndedError as error:
             self.ended = True
             self.fail(f"source ended: {error}")
@@ -399,12 +423,11 @@ class StreamReader(Annotator):
             self.fail(f"cannot read the next frame of {self.stream.name}: {error}")
         except (OSError, ValueError) as error:
             self.fail(f"cannot read the next frame of {self.stream.name}: {type(error).__name__}: {error}")
-        if delivered is not None:
-            self._last = delivered
-        assert self._last is not None
-        self.write(ColorImage(self._last.frame.color))
-        self.write(DepthImage(self._last.frame.depth))
-        self.write(self._last.camera)
+        assert delivered is not None
+        self._last = delivered
+        self.write(ColorImage(delivered.frame.color))
+        self.write(DepthImage(delivered.frame.depth))
+        self.write(delivered.camera)
 
 
 class PerceivedFrameReader(Annotator):
