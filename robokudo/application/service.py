@@ -48,7 +48,7 @@ from queries import Number, Query, parse_query
 from reasoning.beliefs.answer import Answer, answer_from_memory
 from reasoning.beliefs.filters import belief_filter, kb_class_test
 from reasoning.beliefs.store import BeliefStore
-from reasoning.fusion.tracking import BeliefTracker
+from reasoning.fusion.tracking import BeliefTracker, TrackStep
 from reasoning.knowledge.knowledge_base import KnowledgeBase
 from reasoning.planning.query_planner import QueryPlan, QueryPlanner
 from robokudo.application.knowledge import load_knowledge_base
@@ -255,6 +255,7 @@ class AnsweringService:
         self._current: TaskHandle | None = None
         self._retired: list[py_trees.behaviour.Behaviour] = []
         self._source_ended: str | None = None
+        self._belief_listeners: list[Callable[[TrackStep], None]] = []
 
     @classmethod
     def open(
@@ -317,6 +318,7 @@ class AnsweringService:
             tracker=BeliefTracker(class_test=kb_class_test(self.kb), regions=self.kb.regions()),
             filter_for=lambda q: belief_filter(q, self.kb),
             label_of=self.kb.label,
+            on_integrated=self._beliefs_changed,
         )
         step.reason = ANSWER_REASON
         return build_tree(query_plan.plan, final_steps=[step], query=query, catalog=self.catalog)
@@ -462,7 +464,16 @@ class AnsweringService:
     ) -> None:
         self.close()
 
+    def add_belief_listener(self, listener: Callable[[TrackStep], None]) -> None:
+        """Call ``listener`` with every frame's changes to the belief store (on the engine's thread, right after
+        they are written; keep it short)."""
+        self._belief_listeners.append(listener)
+
     # ------------------------------------------------------------------ engine side
+
+    def _beliefs_changed(self, step: TrackStep) -> None:
+        for listener in self._belief_listeners:
+            listener(step)
 
     def _after_tick(self, _: py_trees.trees.BehaviourTree) -> None:
         """After every tick (engine thread): end a finished one-shot task or hand a continuous task's answer to

@@ -2,7 +2,8 @@
 
 Goals and service calls run on the goal manager's worker thread (:mod:`.goals`), never on the event loop. After
 every engine tick the tree's statuses are handed to the loop (``call_soon_threadsafe``) and published to the
-``/robokudo/tree_status`` subscribers. SIGINT or SIGTERM stops the server: open goals are aborted with the
+``/robokudo/tree_status`` subscribers, and every frame's belief changes to the ``/robokudo/beliefs`` subscribers.
+SIGINT or SIGTERM stops the server: open goals are aborted with the
 reason, their results are sent, the belief store is closed and :func:`serve` returns.
 """
 
@@ -21,10 +22,13 @@ from websockets.asyncio.server import ServerConnection
 from websockets.asyncio.server import serve as websocket_server
 
 from queries import format_query, parse_query
+from reasoning.fusion.tracking import TrackStep
 from robokudo.application.commands.plan import task_summary
+from robokudo.application.server.belief_changes import belief_changes
 from robokudo.application.server.goals import GoalManager
 from robokudo.application.server.protocol import (
     BELIEFS_SERVICE,
+    BELIEFS_TOPIC,
     MAX_MESSAGE_BYTES,
     PLAN_SERVICE,
     TREE_STATUS_TOPIC,
@@ -96,16 +100,26 @@ async def serve(
     sessions: set[Session] = set()
     subscribers: set[Session] = set()
 
-    def broadcast(message: dict[str, Any]) -> None:
+    def broadcast(topic: str, message: dict[str, Any]) -> None:
         for session in list(subscribers):
-            session.send(message)
+            if topic in session.topics:
+                session.send(publish(topic, message))
+
+    def subscribed(topic: str) -> bool:  # engine thread: a stale read only delays or skips one message
+        return any(topic in session.topics for session in list(subscribers))
 
     def after_tick(tree: py_trees.trees.BehaviourTree) -> None:
-        if subscribers:  # engine thread: a stale read only delays or skips one message
+        if subscribed(TREE_STATUS_TOPIC):
             status = tree_status(tree.root, service.engine.tick_count)
-            loop.call_soon_threadsafe(broadcast, publish(TREE_STATUS_TOPIC, status))
+            loop.call_soon_threadsafe(broadcast, TREE_STATUS_TOPIC, status)
+
+    def beliefs_changed(step: TrackStep) -> None:
+        if subscribed(BELIEFS_TOPIC):
+            changes = belief_changes(step, service.engine.tick_count, service.kb.label)
+            loop.call_soon_threadsafe(broadcast, BELIEFS_TOPIC, changes)
 
     service.engine.tree.add_post_tick_handler(after_tick)
+    service.add_belief_listener(beliefs_changed)
     service.run_in_background()
 
     async def connect(connection: ServerConnection) -> None:

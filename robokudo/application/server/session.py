@@ -22,6 +22,7 @@ from websockets.exceptions import ConnectionClosed
 from robokudo.application.server.designator import GoalError, MissingQueryError, goal_query
 from robokudo.application.server.goals import Goal, GoalManager
 from robokudo.application.server.protocol import (
+    BELIEFS_TOPIC,
     GOAL_QUERY_FIELD,
     QUERY_ACTION,
     TREE_STATUS_TOPIC,
@@ -37,7 +38,7 @@ from robokudo.application.service import AnsweringService
 MAX_OPEN_GOALS = 64
 """Goals one client may have open (queued or running) at a time."""
 
-TOPICS = (TREE_STATUS_TOPIC,)
+TOPICS = (TREE_STATUS_TOPIC, BELIEFS_TOPIC)
 
 Services = dict[str, Callable[[AnsweringService, str], dict[str, Any]]]
 

@@ -135,6 +135,30 @@ def test_the_tree_status_topic_publishes_ticks(ros: roslibpy.Ros) -> None:
     assert statuses[0]["tree"]["name"] == "robot"
 
 
+def test_the_beliefs_topic_publishes_what_a_goal_changed_in_the_store(ros: roslibpy.Ros) -> None:
+    changes: list[dict[str, Any]] = []
+    arrived = threading.Event()
+
+    def on_changes(message: dict[str, Any]) -> None:
+        changes.append(message)
+        arrived.set()
+
+    topic = roslibpy.Topic(ros, "/robokudo/beliefs", "std_msgs/String")
+    topic.subscribe(on_changes)
+    try:
+        action = roslibpy.ActionClient(ros, ACTION, ACTION_TYPE)
+        _, record = send(action, "find milk in fridge")
+        result = ended(record)
+        assert arrived.wait(WAIT)
+    finally:
+        topic.unsubscribe()
+    milk = result["values"]["objects"][0]
+    changed = {belief["id"]: belief for message in changes for belief in message["changed"]}
+    assert milk["id"] in changed  # the milk the goal saw was published as a changed belief
+    assert changed[milk["id"]]["region"] == "fridge"
+    assert changed[milk["id"]]["class"] == milk["class"]
+
+
 def test_roslibpy_authenticates_with_the_token_on_a_guarded_server(guarded_server: Served) -> None:
     client = roslibpy.Ros(host=guarded_server.host, port=guarded_server.port)
     client.authenticate(mac=TOKEN, client="", dest="", rand="", t=0, level="", end=0)
