@@ -43,7 +43,7 @@ from annotators.readers.frame_readers import (
     TumPairReader,
     TumSequenceReader,
 )
-from annotators.readers.streams import FrameStream, StreamReader, recorded_stream
+from annotators.readers.streams import FrameStream, PerceivedFrameReader, StreamReader, recorded_stream
 from annotators.text.reader import TextReader
 from robokudo.core.annotator import Annotator
 from robokudo.core.pipeline import Pipeline
@@ -437,6 +437,10 @@ BROKEN_READERS: dict[type[Annotator], dict[str, Callable[[Path], Annotator]]] = 
         "source ended": lambda tmp: StreamReader(played_once(recorded_stream(str(write_uoc(tmp / "a")), loop=False))),
         "unreadable frame": lambda tmp: StreamReader(recorded_stream(str(truncated_uoc(tmp / "b")))),
         "closed stream": lambda tmp: StreamReader(closed(recorded_stream(str(write_uoc(tmp / "c"))))),
+    },
+    PerceivedFrameReader: {
+        "no perception pipeline in the tree": lambda tmp: PerceivedFrameReader(),
+        "a perception pipeline without a frame": lambda tmp: PerceivedFrameReader(pipeline="broken"),
     },
     TiffSequenceReader: {
         "missing folder": lambda tmp: TiffSequenceReader(tmp / "nowhere"),

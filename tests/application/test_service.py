@@ -91,3 +91,12 @@ def test_kinds_that_do_not_fit_the_call_are_refused(service: AnsweringService) -
         service.start("find the red cup")
     with pytest.raises(ValueError, match="plans no perception tree"):
         service.mode_of(parse_query("stop { task: 1 }"))
+
+
+def test_the_trees_of_one_service_share_the_loaded_ocr_model(service: AnsweringService) -> None:
+    readers = []
+    for _ in range(2):
+        tree = service.answer("find milk in fridge").tree
+        readers += [node for node in tree.iterate() if node.name == "TextReader"]
+    assert len(readers) == 2 and readers[0] is not readers[1]
+    assert readers[0].engine() is readers[1].engine()  # the second tree did not load the OCR models again
