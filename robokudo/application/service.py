@@ -57,6 +57,7 @@ from robokudo.application.sensor_sources import kitchen_view_for, served_source
 from robokudo.core.composites import Sequence
 from robokudo.core.engine import Engine
 from robokudo.core.pipeline import Pipeline
+from robokudo.core.resources import SharedResources
 from robokudo.core.slot import Idle, TaskSlot
 from robokudo.core.threaded import has_workers, stop_workers
 from robokudo.core.types import QueryAnswer
@@ -237,6 +238,8 @@ class AnsweringService:
         self.frame = frame
         self.stream = stream
         self.planner = QueryPlanner(kb)
+        self.resources = SharedResources()
+        """Loaded models shared by every task's tree (the first task loads them)."""
         self._idle = Idle(reason="no task: the engine keeps perceiving until the next one")
         self._slot = TaskSlot(TASK_SLOT)
         self._slot.set_subtree(self._idle)
@@ -321,7 +324,9 @@ class AnsweringService:
             on_integrated=self._beliefs_changed,
         )
         step.reason = ANSWER_REASON
-        return build_tree(query_plan.plan, final_steps=[step], query=query, catalog=self.catalog)
+        return build_tree(
+            query_plan.plan, final_steps=[step], query=query, catalog=self.catalog, resources=self.resources
+        )
 
     # ------------------------------------------------------------------ running
 
