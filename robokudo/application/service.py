@@ -387,6 +387,7 @@ class AnsweringService:
                     break
         else:
             self.engine.run(until=lambda _: handle.done or stopped())
+            self.engine.tasks.apply_pending()  # the finished tree leaves the slot now, not at the next tick
         if not handle.done:
             self.cancel(handle)
             raise QueryCancelledError("stopped before the tree finished")
@@ -511,12 +512,16 @@ class AnsweringService:
     def _finish(
         self, handle: TaskHandle, reason: str, *, result: Answer | None = None, timed_out: bool = False
     ) -> None:
-        """End ``handle`` (engine thread, between two ticks) and put the idle subtree into the slot."""
+        """End ``handle`` (engine thread, after a tick) and have the idle subtree put into the slot before the next
+        tick (so every post-tick handler still sees the task's final statuses; a task submitted meanwhile wins)."""
         with self._lock:
             if self._current is handle:
                 self._current = None
         handle._end(reason, result=result, timed_out=timed_out)
-        self._retire(self._slot.set_subtree(self._idle))
+        if handle.tree.status is Status.RUNNING:  # timed out or perception failed: stop it now, not a tick later
+            handle.tree.stop(Status.INVALID)
+        self.engine.tasks.schedule(TASK_SLOT, self._idle, only_replacing=handle.tree)
+        self._retire(handle.tree)
 
     def _retire(self, tree: py_trees.behaviour.Behaviour | None) -> None:
         """Remember a tree taken out of the slot while its experts' worker threads finish (:meth:`close` waits)."""

@@ -51,6 +51,7 @@ def test_a_task_starts_on_a_frame_from_the_camera_pointed_at_its_region(served: 
     assert isinstance(first_step, PerceivedFrameReader)
     camera = outcome.tree.cas.view(CameraInfo)
     assert camera is not None and camera.frame_id == "kitchen/fridge"
+    wait_for_ticks(served, 2)
     assert served.engine.tasks.slot(TASK_SLOT).subtree.name == "idle"  # the finished task was taken out
     cup = served.answer("find the red cup")
     assert cup.tree.cas.view(CameraInfo).frame_id == "kitchen/table"
