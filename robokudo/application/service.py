@@ -433,6 +433,16 @@ class AnsweringService:
         self._retire(self.engine.tasks.replace(TASK_SLOT, self._idle))
 
     @property
+    def perception(self) -> Pipeline | None:
+        """The perceive pipeline of the served root (its CAS holds the newest frame); None without a stream."""
+        return self._perception
+
+    @property
+    def task_tree(self) -> py_trees.behaviour.Behaviour | None:
+        """What the task slot holds now (the idle subtree without a task); read it on the engine thread."""
+        return self._slot.subtree
+
+    @property
     def source_ended(self) -> str | None:
         """Why the live source ended (None while it has frames, and without a stream)."""
         return self._source_ended

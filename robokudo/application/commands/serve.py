@@ -99,7 +99,9 @@ def run(args: argparse.Namespace) -> int:
     config = ServerConfig(host=args.host, port=args.port, token=token)
 
     def ready(address: str) -> None:
+        page = address.replace("ws://", "http://", 1) + "/" + ("?token=TOKEN" if token is not None else "")
         print(f"serving on {address}", flush=True)
+        print(f"live view: {page}", flush=True)
 
     try:
         reason = asyncio.run(serve(service, config, on_ready=ready))

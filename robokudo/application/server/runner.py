@@ -13,11 +13,13 @@ import asyncio
 import contextlib
 import ipaddress
 import signal
+import threading
 from collections.abc import Callable
 from dataclasses import dataclass
 from typing import Any
 
 import py_trees
+from py_trees.common import Status
 from websockets.asyncio.server import ServerConnection
 from websockets.asyncio.server import serve as websocket_server
 
@@ -25,10 +27,13 @@ from queries import format_query, parse_query
 from reasoning.fusion.tracking import TrackStep
 from robokudo.application.commands.plan import task_summary
 from robokudo.application.server.belief_changes import belief_changes
+from robokudo.application.server.camera_topics import FramePicker, ShownFrame, image_messages
 from robokudo.application.server.goals import GoalManager
 from robokudo.application.server.protocol import (
     BELIEFS_SERVICE,
     BELIEFS_TOPIC,
+    DEPTH_TOPIC,
+    IMAGE_TOPIC,
     MAX_MESSAGE_BYTES,
     PLAN_SERVICE,
     TREE_STATUS_TOPIC,
@@ -36,12 +41,16 @@ from robokudo.application.server.protocol import (
 )
 from robokudo.application.server.session import Services, Session
 from robokudo.application.server.tree_status import tree_status
+from robokudo.application.server.web_page import page_handler
 from robokudo.application.service import AnsweringService
+from robokudo.core.pipeline import Pipeline
 from robokudo.core.render import tree_to_dict, unicode_tree
 
 FRAME_LIMIT = 8 * MAX_MESSAGE_BYTES
 """Frames above this are refused by the WebSocket layer (connection closed); up to it, a message over
 :data:`MAX_MESSAGE_BYTES` gets a status error and the connection stays open."""
+
+FINISHED = (Status.SUCCESS, Status.FAILURE)
 
 FLUSH_SECONDS = 2.0
 """How long the shutdown waits for the last results to be written to each client."""
@@ -108,10 +117,33 @@ async def serve(
     def subscribed(topic: str) -> bool:  # engine thread: a stale read only delays or skips one message
         return any(topic in session.topics for session in list(subscribers))
 
+    frames = FramePicker()
+    encoding = threading.Event()  # set while a picked frame is being encoded: later picks are dropped meanwhile
+
+    def encode_and_publish(shown: ShownFrame) -> None:  # a worker thread of the loop's executor
+        try:
+            color, depth = image_messages(shown)
+            loop.call_soon_threadsafe(broadcast, IMAGE_TOPIC, color)
+            if depth is not None:
+                loop.call_soon_threadsafe(broadcast, DEPTH_TOPIC, depth)
+        finally:
+            encoding.clear()
+
+    def publish_frame() -> None:  # engine thread
+        task = service.task_tree
+        finished = task.cas if isinstance(task, Pipeline) and task.status in FINISHED else None
+        perception = service.perception
+        shown = frames.pick(finished, perception.cas if perception is not None else None)
+        if shown is not None and not encoding.is_set():
+            encoding.set()
+            loop.call_soon_threadsafe(loop.run_in_executor, None, encode_and_publish, shown)
+
     def after_tick(tree: py_trees.trees.BehaviourTree) -> None:
         if subscribed(TREE_STATUS_TOPIC):
             status = tree_status(tree.root, service.engine.tick_count)
             loop.call_soon_threadsafe(broadcast, TREE_STATUS_TOPIC, status)
+        if subscribed(IMAGE_TOPIC) or subscribed(DEPTH_TOPIC):
+            publish_frame()
 
     def beliefs_changed(step: TrackStep) -> None:
         if subscribed(BELIEFS_TOPIC):
@@ -132,7 +164,9 @@ async def serve(
 
     closed = False
     try:
-        async with websocket_server(connect, config.host, config.port, max_size=FRAME_LIMIT) as server:
+        async with websocket_server(
+            connect, config.host, config.port, max_size=FRAME_LIMIT, process_request=page_handler(config.token)
+        ) as server:
             if on_ready is not None:
                 on_ready(f"ws://{config.host}:{config.port}")
             reason = await stopping

@@ -23,7 +23,9 @@ from robokudo.application.server.designator import GoalError, MissingQueryError,
 from robokudo.application.server.goals import Goal, GoalManager
 from robokudo.application.server.protocol import (
     BELIEFS_TOPIC,
+    DEPTH_TOPIC,
     GOAL_QUERY_FIELD,
+    IMAGE_TOPIC,
     QUERY_ACTION,
     TREE_STATUS_TOPIC,
     GoalStatus,
@@ -38,7 +40,7 @@ from robokudo.application.service import AnsweringService
 MAX_OPEN_GOALS = 64
 """Goals one client may have open (queued or running) at a time."""
 
-TOPICS = (TREE_STATUS_TOPIC, BELIEFS_TOPIC)
+TOPICS = (TREE_STATUS_TOPIC, BELIEFS_TOPIC, IMAGE_TOPIC, DEPTH_TOPIC)
 
 Services = dict[str, Callable[[AnsweringService, str], dict[str, Any]]]
 

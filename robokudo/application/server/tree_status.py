@@ -6,10 +6,16 @@ from typing import Any
 
 import py_trees
 
+from robokudo.core.explained import reason_of
+
 
 def node_status(node: py_trees.behaviour.Behaviour) -> dict[str, Any]:
-    """``node`` and its children: name, status and feedback message."""
+    """``node`` and its children: name, status, the planner's reason (nodes that explain themselves) and feedback
+    message."""
     entry: dict[str, Any] = {"name": node.name, "status": node.status.name}
+    reason = reason_of(node)
+    if reason:
+        entry["reason"] = reason
     if node.feedback_message:
         entry["message"] = node.feedback_message
     if node.children:
