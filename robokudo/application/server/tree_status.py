@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import time
 from typing import Any
 
 import py_trees
@@ -24,5 +25,6 @@ def node_status(node: py_trees.behaviour.Behaviour) -> dict[str, Any]:
 
 
 def tree_status(root: py_trees.behaviour.Behaviour, tick: int) -> dict[str, Any]:
-    """The ``/robokudo/tree_status`` message of tick number ``tick``."""
-    return {"tick": tick, "tree": node_status(root)}
+    """The ``/robokudo/tree_status`` message of tick number ``tick``, stamped with the wall-clock time it was made
+    (seconds since the epoch)."""
+    return {"tick": tick, "stamp": time.time(), "tree": node_status(root)}
