@@ -102,14 +102,40 @@ def test_a_structured_designator_goal_finds_the_milk_in_the_fridge(kitchen_serve
 
 
 @pytest.mark.parametrize(
+    ("designator", "found"),
+    [
+        ({"color": ["red", "blue"], "location": "table"}, {"red", "blue"}),  # the table's yellow object is left out
+        ({"type": "Milk", "attribute": ["oat", "lactose free"]}, {"lactose free"}),  # the milk reads "lactose free"
+        ({"type": "Milk", "attribute": ["oat", "soy"]}, set()),
+    ],
+    ids=["colors", "texts", "no-text-read"],
+)
+def test_a_designator_with_several_values_answers_the_objects_with_any_of_them(
+    kitchen_server: Served, designator: dict[str, Any], found: set[str]
+) -> None:
+    with connect(kitchen_server.url) as connection:
+        connection.send(
+            json.dumps({"op": "send_action_goal", "id": "any", "action": ACTION, "args": {"obj": designator}})
+        )
+        result = receive(connection, "action_result", "any")
+    assert result["status"] == 4
+    objects = result["values"]["objects"]
+    if "color" in designator:
+        assert sorted(o["attributes"]["color"]["value"] for o in objects) == sorted(found)
+    else:  # one milk whose text reads one of the alternatives, or none when no alternative is read
+        read = [o["attributes"]["text"]["value"].lower() for o in objects]
+        assert len(read) == len(found) and all(any(text in r for text in found) for r in read)
+
+
+@pytest.mark.parametrize(
     ("designator", "problem"),
     [
         ({"type": "lactose free"}, "expected an identifier"),
-        ({"type": "Milk", "pose": [{"x": 1}]}, "'pose' is not mapped onto a query yet"),
-        ({"color": ["red", "white"]}, "several: not yet"),
+        ({"type": "Milk", "pose": [{"header": {"frame_id": "map"}, "pose": {"position": {"x": 1.5}}}]}, "'pose'"),
+        ({"type": ["Milk", "Cup"]}, "'type' has 2 values"),
         ({"weight": "1kg"}, "unknown designator field 'weight'"),
     ],
-    ids=["not-a-name", "pose", "several-colors", "unknown-field"],
+    ids=["not-a-name", "pose", "several-classes", "unknown-field"],
 )
 def test_a_designator_that_makes_no_query_is_aborted_with_the_reason(
     kitchen_server: Served, designator: dict[str, Any], problem: str
