@@ -9,8 +9,9 @@ Parts (each selectable; no part flag runs them all), each printing its goal and 
   ``/robokudo/tree_status`` tick numbers), and whether the server forwarded every answer (the AnswerStep's run
   count in the tree status vs the answers received). Goal: feedback rate within 10% of the engine rate.
 * ``--jitter``: tick period error ``|period - 1/rate|`` at 30 Hz with 8 clients connected and subscribed to
-  ``/robokudo/tree_status``: p50 and p99 ms, with the engine ticking an empty task slot (started by this script
-  when the server does not tick on its own) and with a running track task. Goal: p99 <= 5 ms.
+  ``/robokudo/tree_status``: p50 and p99 ms, with no goal (the engine perceives and the slot idles) and with a
+  running track task; also each tick's own run time and how many ticks ran longer than the period. Goal: p99
+  <= 5 ms.
 * ``--memory``: the server's resident memory after 100 and after 10,000 goals sent one after the other. The goals
   are cheap ones (``detect {obj: {type: Milk}, timeout: 0s}``: parsed, planned, the tree built and swapped into the
   slot, answered from memory as the deadline passed) with a real detect run every ``--real-every`` goals. Goal:
@@ -18,8 +19,9 @@ Parts (each selectable; no part flag runs them all), each printing its goal and 
 
 The server is always a separate process and the clients speak the rosbridge protocol (``websockets``), so the parts
 depend only on the protocol. Only ``--jitter`` starts the server through this script's ``--serve-ticks`` mode, the
-one place that uses the service's Python API (:func:`serve_recording_ticks`): it records each tick's start and end
-(``time.monotonic``, comparable across processes) and writes them when the server stops.
+one place that uses the service's Python API (:func:`serve_recording_ticks`, built like ``robokudo serve``'s own
+``run``): it records each tick's start and end (``time.monotonic``, comparable across processes) and writes them when
+the server stops.
 
 Run: ``.venv/bin/python bench/bench_serve.py [--latency] [--feedback] [--jitter] [--memory] [options]``
 """
@@ -273,30 +275,24 @@ def feedback_part(args: argparse.Namespace, environment: dict[str, str]) -> None
 # ------------------------------------------------------------------------------------------- tick jitter
 
 
-def serve_recording_ticks(log: Path, port: int, rate: float, idle: bool) -> int:
-    """``--serve-ticks``: serve like ``robokudo serve``, recording each tick's start and end; with ``idle``, make
-    the engine tick an empty task slot when it does not tick on its own. Writes ``{starts, ends}`` on exit."""
+def serve_recording_ticks(log: Path, options: list[str]) -> int:
+    """``--serve-ticks``: serve as ``robokudo serve OPTIONS`` does, recording each tick's start and end; writes
+    ``{starts, ends}`` to ``log`` when the server stops. The only part of this script that uses the service's API."""
+    from robokudo.application.commands import serve as serve_command
     from robokudo.application.server.runner import ServerConfig, serve
     from robokudo.application.service import AnsweringService
 
-    service = AnsweringService.open(hz=rate)
+    parser = argparse.ArgumentParser()
+    serve_command.add_arguments(parser)
+    args = parser.parse_args(options)
+    stream = serve_command.source_stream(args)
+    service = AnsweringService.open(args.db, input_path=args.input, hz=args.rate, stream=stream)
     starts: list[float] = []
     ends: list[float] = []
     service.engine.tree.add_pre_tick_handler(lambda _: starts.append(time.monotonic()))
     service.engine.tree.add_post_tick_handler(lambda _: ends.append(time.monotonic()))
-
-    def tick_when_idle() -> None:
-        before = service.engine.tick_count
-        time.sleep(1.0)
-        if service.engine.tick_count == before and not service.engine.is_running_in_background():
-            service.engine.start()
-
-    def ready(address: str) -> None:
-        if idle:
-            threading.Thread(target=tick_when_idle, daemon=True).start()
-        print(f"serving on {address}", flush=True)
-
-    asyncio.run(serve(service, ServerConfig(port=port), on_ready=ready))
+    config = ServerConfig(host=args.host, port=args.port)
+    asyncio.run(serve(service, config, on_ready=lambda address: print(f"serving on {address}", flush=True)))
     log.write_text(json.dumps({"starts": starts, "ends": ends[: len(starts)]}))
     return 0
 
@@ -316,8 +312,6 @@ def tick_jitter(
     with tempfile.TemporaryDirectory() as folder:
         log = Path(folder) / "ticks.json"
         command = [sys.executable, str(Path(__file__).resolve()), "--serve-ticks", str(log), "--rate", f"{rate:g}"]
-        if track is None:
-            command.append("--idle")
         stop = threading.Event()
         counts = [0] * clients
         subscribed = threading.Barrier(clients + 1)
@@ -361,7 +355,7 @@ def tick_jitter(
 
 def jitter_part(args: argparse.Namespace, environment: dict[str, str]) -> None:
     print(f"jitter: |tick period - 1/{args.rate:g} s| with {args.clients} clients subscribed to {TREE_STATUS}")
-    for label, track in (("empty task slot", None), (f"running {args.track_query[-1]!r}", args.track_query[-1])):
+    for label, track in (("no goal", None), (f"running {args.track_query[-1]!r}", args.track_query[-1])):
         figures = tick_jitter(args.clients, args.rate, args.warmup, args.jitter_seconds, track, environment)
         if len(figures.errors_ms) < 2:
             print(f"  {label}: the engine did not tick ({len(figures.errors_ms) + 1} ticks in the window)")
@@ -431,11 +425,11 @@ def main() -> int:
     parser.add_argument("--memory-goals", type=int, default=10_000, help="memory: goals (10000)")
     parser.add_argument("--real-every", type=int, default=50, help="memory: every Nth goal is a real detect (50)")
     parser.add_argument("--serve-ticks", type=Path, help=argparse.SUPPRESS)
-    parser.add_argument("--port", type=int, default=9090, help=argparse.SUPPRESS)
-    parser.add_argument("--idle", action="store_true", help=argparse.SUPPRESS)
-    args = parser.parse_args()
+    args, serve_options = parser.parse_known_args()
     if args.serve_ticks is not None:
-        return serve_recording_ticks(args.serve_ticks, args.port, args.rate, args.idle)
+        return serve_recording_ticks(args.serve_ticks, ["--rate", f"{args.rate:g}", *serve_options])
+    if serve_options:
+        parser.error(f"unrecognized arguments: {' '.join(serve_options)}")
     args.track_query = args.track_query or list(TRACK_QUERIES)
     chosen = [p for p in ("latency", "feedback", "jitter", "memory") if getattr(args, p)] or [
         "latency",
