@@ -39,7 +39,7 @@ from robokudo.application.server.protocol import (
     TREE_STATUS_TOPIC,
     publish,
 )
-from robokudo.application.server.session import Services, Session
+from robokudo.application.server.session import Services, Session, Subscribers
 from robokudo.application.server.tree_status import tree_status
 from robokudo.application.server.web_page import page_handler
 from robokudo.application.service import AnsweringService
@@ -107,15 +107,14 @@ async def serve(
         loop.add_signal_handler(signum, lambda r=reason: stopping.done() or stopping.set_result(r))
     goals = GoalManager(service)
     sessions: set[Session] = set()
-    subscribers: set[Session] = set()
+    subscribers = Subscribers()
 
     def broadcast(topic: str, message: dict[str, Any]) -> None:
-        for session in list(subscribers):
-            if topic in session.topics:
-                session.send(publish(topic, message))
+        for session in subscribers.of(topic):
+            session.send(publish(topic, message))
 
     def subscribed(topic: str) -> bool:  # engine thread: a stale read only delays or skips one message
-        return any(topic in session.topics for session in list(subscribers))
+        return bool(subscribers.of(topic))
 
     frames = FramePicker()
     encoding = threading.Event()  # set while a picked frame is being encoded: later picks are dropped meanwhile
