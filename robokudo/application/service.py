@@ -34,7 +34,7 @@ import queue
 import threading
 import time
 from collections.abc import Callable, Iterator, Mapping
-from dataclasses import dataclass, replace
+from dataclasses import dataclass, field, replace
 from enum import Enum
 from pathlib import Path
 from types import MappingProxyType, TracebackType
@@ -120,6 +120,8 @@ class Outcome:
     answer: Answer
     tree: Pipeline
     plan: QueryPlan
+    timing: Mapping[str, float] = field(default_factory=dict)
+    """Where the time went (:meth:`TaskHandle.timing`)."""
 
 
 class TaskHandle:
@@ -154,6 +156,14 @@ class TaskHandle:
         self._reason = ""
         self._result: Answer | None = None
         self._timed_out = False
+        self.submitted = started
+        """When the query was received (``time.monotonic``)."""
+        self.planned = started
+        """When its tree was planned and built (set by the service)."""
+        self.first_tick: float | None = None
+        """When the first tick that ran its tree began (None before)."""
+        self.ended_at: float | None = None
+        """When the task ended (None while it runs)."""
 
     @property
     def done(self) -> bool:
@@ -195,6 +205,17 @@ class TaskHandle:
         """End the task (its running experts are interrupted); no-op when it already ended."""
         self._service.cancel(self)
 
+    def timing(self) -> dict[str, float]:
+        """Where the time went, in milliseconds: ``plan_ms`` (parse, plan, build), ``wait_ms`` (until a tick first ran
+        the tree: the swap and the wait for a fresh frame), ``run_ms`` (from that tick to the end); the parts known
+        so far."""
+        parts = {"plan_ms": self.planned - self.submitted}
+        if self.first_tick is not None:
+            parts["wait_ms"] = self.first_tick - self.planned
+            if self.ended_at is not None:
+                parts["run_ms"] = self.ended_at - self.first_tick
+        return {name: round(seconds * 1e3, 3) for name, seconds in parts.items()}
+
     def _publish(self, answer: Answer) -> None:
         self._answers.put(answer)
 
@@ -208,6 +229,7 @@ class TaskHandle:
         self._reason = reason
         self._result = result
         self._timed_out = timed_out
+        self.ended_at = time.monotonic()
         self._ended.set()
         self._answers.put(None)
         return True
@@ -346,6 +368,7 @@ class AnsweringService:
         query_plan = self.plan(parsed)
         pipeline = self.tree(parsed, query_plan)
         handle = TaskHandle(parsed, mode, pipeline, query_plan, self, timeout=query_timeout(parsed), started=started)
+        handle.planned = time.monotonic()
         if isinstance(self.stream, KitchenCameraStream):
             region = query_plan.interpretation.task.region or self._remembered_region(parsed)
             self.stream.set_view(kitchen_view_for(region))
@@ -392,10 +415,10 @@ class AnsweringService:
             self.cancel(handle)
             raise QueryCancelledError("stopped before the tree finished")
         if handle.timed_out:
-            return Outcome(self._remembered(parsed, timed_out=True), handle.tree, handle.plan)
+            return Outcome(self._remembered(parsed, timed_out=True), handle.tree, handle.plan, handle.timing())
         if handle.result is None:
             raise PerceptionFailedError(f"perception failed: {handle.reason}")
-        return Outcome(handle.result, handle.tree, handle.plan)
+        return Outcome(handle.result, handle.tree, handle.plan, handle.timing())
 
     def recall(self, query: str | Query) -> Answer:
         """The stored beliefs matching ``query``, answered from memory (nothing runs)."""
@@ -503,6 +526,8 @@ class AnsweringService:
             handle = self._current
         if handle is None or handle.done or self._slot.subtree is not handle.tree:
             return  # no task, or its tree is not in the slot yet (the swap is applied at the next tick)
+        if handle.first_tick is None and handle.tree.status is not Status.INVALID:
+            handle.first_tick = self.engine.tick_started
         pipeline = handle.tree
         if perception_failure is not None:
             self._finish(handle, f"perception failed: {perception_failure}")

@@ -130,6 +130,8 @@ class Engine:
         self.tree = py_trees.trees.BehaviourTree(root)
         self.tasks = TaskInterface(self)
         self.tick_count = 0
+        self.tick_started = 0.0
+        """When the current (or last) tick began (``time.monotonic``)."""
         self.tick_stats = RunStats()
         self._thread: threading.Thread | None = None
         self._stop = threading.Event()
@@ -138,6 +140,7 @@ class Engine:
         """Apply pending task changes, then tick the tree once; returns the root's status."""
         self.tasks.apply_pending()
         start = time.perf_counter()
+        self.tick_started = time.monotonic()
         self.tree.tick()
         self.tick_stats.record(time.perf_counter() - start)
         self.tick_count += 1
