@@ -21,7 +21,9 @@ A query's ``timeout`` (``detect {obj: {type: Milk}, timeout: 2s}``) is a deadlin
 is received: when it passes before the tree finished, the tree is stopped (running experts are interrupted,
 nothing of the unfinished run is fused) and the answer has ``timed_out`` set and holds the stored beliefs that
 match the query (``from_memory``). A continuous task ends with the reason "timed out after ..." instead.
-A query naming an object id (``inspect object 3``) is answered with that belief only; an id the store does not
+The knowledge base is reloaded before a query is planned when an ontology file changed since (one ``stat`` per file),
+so an ontology edit (``robokudo ontology add-object``, from any process) is seen by the next query without a
+restart. A query naming an object id (``inspect object 3``) is answered with that belief only; an id the store does not
 hold raises :class:`UnknownObjectError` before anything runs, and for the built-in kitchen the camera looks at
 the region where the object was last seen.
 
@@ -313,6 +315,7 @@ class AnsweringService:
     def plan(self, query: str | Query) -> QueryPlan:
         """Interpret and plan ``query`` for this service's input (the kitchen camera looks at the query's region,
         else at the region of the object the query names by id)."""
+        self.kb.reload_if_changed()
         parsed = parse_query(query) if isinstance(query, str) else query
         if self.stream is not None:
             return self.planner.plan(parsed, served_source(self.kb, self.stream))
@@ -360,6 +363,7 @@ class AnsweringService:
         live source ended. Nothing changes in the engine when it raises.
         """
         started = time.monotonic()
+        self.kb.reload_if_changed()  # an ontology edit made meanwhile (CLI, another process) counts at once
         parsed = parse_query(query) if isinstance(query, str) else query
         mode = self.mode_of(parsed)
         if self._source_ended is not None:
@@ -422,6 +426,7 @@ class AnsweringService:
 
     def recall(self, query: str | Query) -> Answer:
         """The stored beliefs matching ``query``, answered from memory (nothing runs)."""
+        self.kb.reload_if_changed()
         return self._remembered(parse_query(query) if isinstance(query, str) else query)
 
     def _remembered(self, query: Query, *, timed_out: bool = False) -> Answer:
