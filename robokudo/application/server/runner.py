@@ -16,10 +16,9 @@ import signal
 import threading
 from collections.abc import Callable
 from dataclasses import dataclass
-from typing import Any
+from typing import TYPE_CHECKING, Any
 
 import py_trees
-from py_trees.common import Status
 from websockets.asyncio.server import ServerConnection
 from websockets.asyncio.server import serve as websocket_server
 
@@ -43,14 +42,15 @@ from robokudo.application.server.session import Services, Session, Subscribers
 from robokudo.application.server.tree_status import tree_status
 from robokudo.application.server.web_page import page_handler
 from robokudo.application.service import AnsweringService
-from robokudo.core.pipeline import Pipeline
+from robokudo.core.pipeline import finished_run_cas
 from robokudo.core.render import tree_to_dict, unicode_tree
+
+if TYPE_CHECKING:
+    from robokudo.application.rerun_log import TickRecorder
 
 FRAME_LIMIT = 8 * MAX_MESSAGE_BYTES
 """Frames above this are refused by the WebSocket layer (connection closed); up to it, a message over
 :data:`MAX_MESSAGE_BYTES` gets a status error and the connection stays open."""
-
-FINISHED = (Status.SUCCESS, Status.FAILURE)
 
 FLUSH_SECONDS = 2.0
 """How long the shutdown waits for the last results to be written to each client."""
@@ -97,9 +97,14 @@ SERVICES: Services = {PLAN_SERVICE: plan_service, BELIEFS_SERVICE: beliefs_servi
 
 
 async def serve(
-    service: AnsweringService, config: ServerConfig, *, on_ready: Callable[[str], None] | None = None
+    service: AnsweringService,
+    config: ServerConfig,
+    *,
+    on_ready: Callable[[str], None] | None = None,
+    recorder: TickRecorder | None = None,
 ) -> str:
-    """Serve until SIGINT or SIGTERM; returns the reason it stopped. Closes ``service``."""
+    """Serve until SIGINT or SIGTERM; returns the reason it stopped. Closes ``service`` (not ``recorder``, which
+    records the engine's ticks and belief changes while it serves)."""
     loop = asyncio.get_running_loop()
     stopping: asyncio.Future[str] = loop.create_future()
     for signum in (signal.SIGINT, signal.SIGTERM):
@@ -129,8 +134,7 @@ async def serve(
             encoding.clear()
 
     def publish_frame() -> None:  # engine thread
-        task = service.task_tree
-        finished = task.cas if isinstance(task, Pipeline) and task.status in FINISHED else None
+        finished = finished_run_cas(service.task_tree)
         perception = service.perception
         shown = frames.pick(finished, perception.cas if perception is not None else None)
         if shown is not None and not encoding.is_set():
@@ -151,6 +155,9 @@ async def serve(
 
     service.engine.tree.add_post_tick_handler(after_tick)
     service.add_belief_listener(beliefs_changed)
+    if recorder is not None:
+        service.engine.tree.add_post_tick_handler(recorder.after_tick)
+        service.add_belief_listener(recorder.beliefs_changed)
     service.run_in_background()
 
     async def connect(connection: ServerConnection) -> None:
