@@ -269,7 +269,7 @@ def check_viewer(url: str) -> None:
     parts = urlsplit(url)
     if parts.scheme not in ("rerun", "rerun+http", "rerun+https") or parts.hostname is None:
         raise RerunTargetError(f"{url!r} is no Rerun viewer URL (like {DEFAULT_VIEWER_URL})")
-    port = parts.port or (443 if parts.scheme == "rerun+https" else 80)
+    port = parts.port or (80 if parts.scheme == "rerun+http" else 443)
     try:
         with socket.create_connection((parts.hostname, port), timeout=VIEWER_CHECK_SECONDS):
             pass
@@ -496,8 +496,7 @@ class TickRecorder:
         self._jobs: queue.Queue[Callable[[], None] | None] | None = None
         self._worker: threading.Thread | None = None
         self._dropped = 0
-        self.frames_logged = 0
-        self.failures = 0
+        self._closed = False
         if background:
             self._jobs = queue.Queue()
             self._worker = threading.Thread(target=self._work, name="robokudo-rerun", daemon=True)
@@ -510,6 +509,8 @@ class TickRecorder:
 
     def record(self, root: py_trees.behaviour.Behaviour) -> None:
         """Look at ``root`` after a tick (engine thread); see :meth:`after_tick`."""
+        if self._closed:
+            return
         tick = self.tick_of()
         task = self.task_of(root)
         finished = finished_run_cas(task)
@@ -544,8 +545,7 @@ class TickRecorder:
             for step in steps
             for mark in belief_marks(step.changed, step.gone, step.assigned, self.label_of, recording)
         ]
-        if self.log.log_frame(cas, tick, marks):
-            self.frames_logged += 1
+        self.log.log_frame(cas, tick, marks)
 
     def _submit(self, job: Callable[[], None], *, droppable: bool = False) -> None:
         if self._jobs is None:
@@ -562,14 +562,14 @@ class TickRecorder:
             try:
                 job()
             except Exception as error:  # a frame the SDK refuses must not end the recording
-                self.failures += 1
                 print(f"robokudo: rerun: {type(error).__name__}: {error}", file=sys.stderr, flush=True)
             if self._dropped:
                 dropped, self._dropped = self._dropped, 0
                 self.log.log_note(f"the recorder fell behind: {dropped} frame(s) not recorded")
 
     def close(self) -> None:
-        """Log what is still queued, then close the log."""
+        """Log what is still queued, then close the log; later ticks are not recorded."""
+        self._closed = True
         if self._jobs is not None and self._worker is not None:
             self._jobs.put(None)
             self._worker.join()

@@ -255,9 +255,12 @@ def test_rerun_connect_streams_to_a_running_viewer(
 
 
 def test_rerun_connect_without_a_viewer_is_refused(capsys: pytest.CaptureFixture[str]) -> None:
-    url = f"rerun+http://127.0.0.1:{free_port()}/proxy"
-    status, out, err = run_cli(capsys, "run", "tabletop", "--rerun-connect", url)
-    assert (status, out) == (2, "") and f"no Rerun viewer at {url}" in err
+    port = free_port()
+    for target in (f"rerun+http://127.0.0.1:{port}/proxy", str(port)):
+        status, out, err = run_cli(capsys, "run", "tabletop", "--rerun-connect", target)
+        assert (status, out) == (2, "") and f"no Rerun viewer at rerun+http://127.0.0.1:{port}/proxy" in err
+    status, _, err = run_cli(capsys, "run", "tabletop", "--rerun-connect", "http://example.org/")
+    assert status == 2 and "is no Rerun viewer URL" in err
 
 
 # ---------------------------------------------------------------------------------------------- the parts

@@ -34,7 +34,7 @@ def add_rerun_arguments(parser: argparse.ArgumentParser) -> None:
         metavar="URL",
         nargs="?",
         const=DEFAULT_VIEWER,
-        help="stream the same to a running Rerun viewer (default rerun+http://127.0.0.1:9876/proxy)",
+        help="stream the same to a running Rerun viewer: its URL or port (default rerun+http://127.0.0.1:9876/proxy)",
     )
 
 
@@ -56,9 +56,11 @@ def open_rerun_log(args: argparse.Namespace) -> RerunLog | None:
         if (error.name or "").split(".")[0] in ("rerun", "rerun_bindings", "pyarrow"):
             raise RerunOptionError(INSTALL_HINT) from None
         raise
-    url = None if args.rerun_connect is None else args.rerun_connect
+    url = args.rerun_connect
     if url == DEFAULT_VIEWER:
         url = DEFAULT_VIEWER_URL
+    elif url is not None and url.isdigit():  # a port, as the rerun command takes it
+        url = f"rerun+http://127.0.0.1:{url}/proxy"
     try:
         return RerunLog(args.rerun, url)
     except RerunTargetError as error:
