@@ -23,12 +23,19 @@ D65_WHITE = SRGB_TO_XYZ.sum(axis=1)
 """XYZ of the sRGB white (Y = 1)."""
 
 
+def _decode(values: np.ndarray) -> np.ndarray:
+    return np.where(values <= 0.04045, values / 12.92, ((values + 0.055) / 1.055) ** 2.4)
+
+
+_UINT8_TO_LINEAR = _decode(np.arange(256) / 255.0)
+
+
 def srgb_to_linear(rgb: np.ndarray) -> np.ndarray:
     """Linear-light values (float64, 0..1) of sRGB values (uint8 0..255 or float 0..1), any shape ``...x3``."""
-    values = np.asarray(rgb, dtype=np.float64)
-    if np.asarray(rgb).dtype == np.uint8:
-        values = values / 255.0
-    return np.where(values <= 0.04045, values / 12.92, ((values + 0.055) / 1.055) ** 2.4)
+    values = np.asarray(rgb)
+    if values.dtype == np.uint8:
+        return _UINT8_TO_LINEAR[values]
+    return _decode(values.astype(np.float64))
 
 
 def linear_to_srgb(linear: np.ndarray) -> np.ndarray:
