@@ -68,6 +68,8 @@ _CHROMATIC = np.array([term in CHROMATIC_TERMS for term in _ALL_TERMS])
 _PROTOTYPE_TERMS = tuple(t for t, chromatic in zip(_ALL_TERMS, _CHROMATIC, strict=True) if chromatic)
 _PROTOTYPE_LAB = _ALL_LAB[_CHROMATIC]
 _PROTOTYPE_CODES = np.array([CHROMATIC_TERMS.index(t) for t in _PROTOTYPE_TERMS])
+_TERM_AVERAGE = np.eye(len(CHROMATIC_TERMS))[_PROTOTYPE_CODES] / np.bincount(_PROTOTYPE_CODES)
+"""Prototypes x terms: averages the prototypes' votes per term."""
 
 
 @dataclass(frozen=True)
@@ -90,7 +92,7 @@ class NamedColor:
 def _chromatic_name(lab: np.ndarray, parameters: NamingParameters) -> SurfaceName:
     distances = delta_e_2000(lab[None, :], _PROTOTYPE_LAB)
     votes = np.exp(-0.5 * (distances / parameters.kernel_width) ** 2)
-    density = np.array([votes[code == _PROTOTYPE_CODES].mean() for code in range(len(CHROMATIC_TERMS))])
+    density = votes @ _TERM_AVERAGE
     total = float(density.sum())
     if total <= 1e-300:  # far from every prototype: the nearest one decides
         return SurfaceName(_PROTOTYPE_TERMS[int(np.argmin(distances))], 0.0)

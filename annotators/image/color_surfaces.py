@@ -106,12 +106,15 @@ class Surface:
     kind: str
 
 
-def edge_strength(image: np.ndarray) -> np.ndarray:
-    """Per-pixel colour step (sRGB levels per pixel, the largest over the channels) of an RGB image."""
-    values = image.astype(np.float32)
-    gx = cv2.Sobel(values, cv2.CV_32F, 1, 0, ksize=3)
-    gy = cv2.Sobel(values, cv2.CV_32F, 0, 1, ksize=3)
-    return np.sqrt(gx * gx + gy * gy).max(axis=2) / 8.0
+def edge_strength(image: np.ndarray, where: np.ndarray | None = None) -> np.ndarray:
+    """Per-pixel colour step (sRGB levels per pixel, the largest over the channels) of an RGB image, at the
+    pixels ``where`` (HxW bool) is set (all pixels, as HxW, when it is None)."""
+    gx = cv2.Sobel(image, cv2.CV_16S, 1, 0, ksize=3)
+    gy = cv2.Sobel(image, cv2.CV_16S, 0, 1, ksize=3)
+    if where is not None:
+        gx, gy = gx[where], gy[where]
+    squared = gx.astype(np.float32) ** 2 + gy.astype(np.float32) ** 2
+    return np.sqrt(np.maximum(np.maximum(squared[..., 0], squared[..., 1]), squared[..., 2])) / 8.0
 
 
 def chroma_plane(lab: np.ndarray, softness: float) -> np.ndarray:
@@ -138,11 +141,12 @@ def _modes(features: np.ndarray, radius: float, min_count: float, max_groups: in
         if len(centres) == max_groups or np.count_nonzero(remaining) < min_count:
             break
         fullest = int(np.argmax(np.bincount(keys[remaining])))
-        seed = np.flatnonzero(remaining & (keys == fullest))
-        cx, cy = float(x[seed].mean()), float(y[seed].mean())
+        seed = (remaining & (keys == fullest)).astype(np.float64)
+        cx, cy = float(x @ seed) / seed.sum(), float(y @ seed) / seed.sum()
         for _ in range(10):
-            near = remaining & ((x - cx) ** 2 + (y - cy) ** 2 < limit)
-            new_x, new_y = float(x[near].mean()), float(y[near].mean())
+            near = (remaining & ((x - cx) ** 2 + (y - cy) ** 2 < limit)).astype(np.float64)
+            count = near.sum()
+            new_x, new_y = float(x @ near) / count, float(y @ near) / count
             if (new_x - cx) ** 2 + (new_y - cy) ** 2 < 1e-6 * limit:
                 break
             cx, cy = new_x, new_y
@@ -153,10 +157,17 @@ def _modes(features: np.ndarray, radius: float, min_count: float, max_groups: in
     return np.array(centres, dtype=np.float64).reshape(-1, 2)
 
 
+def _order_statistic(values: np.ndarray, percentile: float) -> float:
+    """The ``percentile`` (0..100) of the values, as the nearest order statistic."""
+    k = round(percentile / 100.0 * (values.size - 1))
+    return float(np.partition(values, k)[k])
+
+
 def _surface(lab: np.ndarray, linear: np.ndarray, percentile: float, kind: str) -> Surface:
     """A surface from its pixels: median chromaticity at the ``percentile`` lightness, mean linear RGB."""
-    lit = float(np.percentile(lab[:, 0], percentile))
-    direction = np.median(lab[:, 1:] / (lab[:, :1] + 16.0), axis=0)
+    lit = _order_statistic(lab[:, 0], percentile)
+    scale = 1.0 / (lab[:, 0] + 16.0)
+    direction = np.array([_order_statistic(lab[:, 1] * scale, 50.0), _order_statistic(lab[:, 2] * scale, 50.0)])
     return Surface(np.array([lit, *(direction * (lit + 16.0))]), linear.mean(axis=0), lab.shape[0], kind)
 
 
@@ -317,8 +328,10 @@ def object_pixels(image: np.ndarray, hypothesis: ObjectHypothesis, max_pixels: i
     inner = cv2.erode(local.view(np.uint8), np.ones((3, 3), np.uint8)).view(bool)
     if np.count_nonzero(inner) >= max(20, np.count_nonzero(local) // 3):
         local = inner
-    crop = image[y0:y1, x0:x1]
-    pixels = crop[local]
-    edges = edge_strength(crop)[local]
-    step = max(1, pixels.shape[0] // max_pixels)
-    return pixels[::step], edges[::step]
+    rows, cols = np.nonzero(local)
+    step = max(1, rows.size // max_pixels)
+    rows, cols = rows[::step], cols[::step]
+    crop = np.ascontiguousarray(image[y0:y1, x0:x1])
+    where = np.zeros(local.shape, dtype=bool)
+    where[rows, cols] = True
+    return crop[rows, cols], edge_strength(crop, where)  # both in row-major order
