@@ -1,0 +1,84 @@
+"""People on a real Kinect frame (pcl_people/five_people.pcd: five people walking away down a corridor).
+
+The reference position of each person found is computed here from the cloud, independently of the detectors'
+segmentation: the points in the image columns the person's keypoints span, higher than the person's lowest
+keypoint (so the floor is left out) and within 0.35 m of depth of the median keypoint depth (so people and walls
+in front of or behind the person are left out). People stand apart in depth or in columns in this frame, so this
+band holds the person's own points.
+"""
+
+from __future__ import annotations
+
+from pathlib import Path
+
+import numpy as np
+import pytest
+from py_trees.common import Status
+
+from annotators.cloud.people import DepthPeopleDetector
+from annotators.image.human_pose import HumanPoseDetector
+from annotators.readers.frame_readers import PcdReader
+from robokudo.core.engine import Engine
+from robokudo.core.pipeline import Pipeline
+from robokudo.core.types import BodyKeypoints, Classification, PersonHypothesis, Pose
+from tests.annotators.conftest import require_folder
+
+pytestmark = pytest.mark.real_data
+
+DEPTH_BAND = 0.35
+MAX_POSITION_ERROR = 0.15
+
+
+@pytest.fixture(scope="module")
+def five_people(shared_data: Path) -> Path:
+    return require_folder(shared_data / "pcl_people") / "five_people.pcd"
+
+
+def run(path: Path, detector: object) -> tuple[list[PersonHypothesis], np.ndarray]:
+    reader = PcdReader(path)
+    root = Pipeline("people", [reader, detector])
+    assert Engine(root).tick() is Status.SUCCESS, [(c.name, c.feedback_message) for c in root.children]
+    return root.cas.annotations(PersonHypothesis), reader.last_frame.points
+
+
+def reference_centroid(points: np.ndarray, keypoints: BodyKeypoints) -> np.ndarray:
+    """The centroid of the cloud points in the keypoints' column range, above the lowest keypoint, within the
+    depth band around the keypoints' median depth (camera frame, y pointing down)."""
+    on_body = np.isfinite(keypoints.points[:, 2])
+    columns = keypoints.pixels[:, 0]
+    c0, c1 = int(np.floor(columns.min())), int(np.ceil(columns.max())) + 1
+    depth = float(np.median(keypoints.points[on_body, 2]))
+    lowest = float(np.max(keypoints.points[on_body, 1]))
+    band = points[:, max(c0, 0) : c1].reshape(-1, 3)
+    with np.errstate(invalid="ignore"):
+        keep = np.isfinite(band[:, 2]) & (np.abs(band[:, 2] - depth) < DEPTH_BAND) & (band[:, 1] < lowest)
+    return band[keep].mean(axis=0)
+
+
+def test_at_least_four_of_five_people_with_keypoints_near_their_points(five_people: Path) -> None:
+    people, points = run(five_people, HumanPoseDetector())
+    assert len(people) >= 4, f"found {len(people)} people"
+    assert len(people) <= 5, f"found {len(people)} people in a frame of five"
+    errors = []
+    for person in people:
+        (keypoints,) = person.find(BodyKeypoints)
+        assert keypoints.pixels.shape == (33, 2) and keypoints.points.shape == (33, 3)
+        assert np.count_nonzero(np.isfinite(keypoints.points[:, 2])) >= 17
+        assert person.first(Classification).class_name == "Human"
+        position = person.first(Pose).position
+        errors.append(float(np.linalg.norm(position - reference_centroid(points, keypoints))))
+    assert max(errors) < MAX_POSITION_ERROR, [round(e, 3) for e in errors]
+    columns = sorted(float(np.median(p.first(BodyKeypoints).pixels[:, 0])) for p in people)
+    assert min(np.diff(columns)) > 40, f"two detections on one person: {columns}"
+
+
+def test_the_depth_detector_alone_finds_the_people_standing_on_the_floor(five_people: Path) -> None:
+    people, _ = run(five_people, DepthPeopleDetector())
+    centres = sorted(float(p.first(Pose).position[0]) for p in people)
+    assert len(people) >= 5, centres
+    assert all(p.first(Classification).class_name == "Human" for p in people)
+    # the five people stand between 1.8 m and 3 m in front of the camera, none closer than 25 cm to another
+    near = [p for p in people if 1.5 < p.first(Pose).position[2] < 3.0]
+    assert len(near) == 5
+    xs = sorted(float(p.first(Pose).position[0]) for p in near)
+    assert min(np.diff(xs)) > 0.25, xs
