@@ -18,10 +18,16 @@ from py_trees.common import Status
 from annotators.cloud.people import DepthPeopleDetector
 from annotators.image.human_pose import HumanPoseDetector
 from annotators.readers.frame_readers import PcdReader
+from queries import parse_query
+from reasoning.planning.query_planner import plan_query
+from robokudo.application.knowledge import load_knowledge_base
+from robokudo.application.sensor_sources import sensor_source
+from robokudo.core.annotator import Annotator
 from robokudo.core.engine import Engine
 from robokudo.core.pipeline import Pipeline
-from robokudo.core.types import BodyKeypoints, Classification, PersonHypothesis, Pose
+from robokudo.core.types import BodyKeypoints, Classification, ColorImage, PersonHypothesis, Pose
 from tests.annotators.conftest import require_folder
+from trees.synthesis import build_tree
 
 pytestmark = pytest.mark.real_data
 
@@ -82,3 +88,28 @@ def test_the_depth_detector_alone_finds_the_people_standing_on_the_floor(five_pe
     assert len(near) == 5
     xs = sorted(float(p.first(Pose).position[0]) for p in near)
     assert min(np.diff(xs)) > 0.25, xs
+
+
+class GreyColour(Annotator):
+    """Test helper: replaces the colour image by a uniform grey one (a camera whose colour stream failed)."""
+
+    inputs = (ColorImage,)
+    outputs = (ColorImage,)
+
+    def analyse(self) -> None:
+        image = self.view(ColorImage).image
+        self.write(ColorImage(np.full_like(image, 128)))
+
+
+def test_when_colour_fails_the_planned_fallback_hands_over_to_the_depth_detector(
+    five_people: Path, tmp_path: Path
+) -> None:
+    kb = load_knowledge_base(tmp_path / "user.ttl")
+    query = parse_query("detect { human: {} }")
+    tree = build_tree(plan_query(query, kb, sensor_source(kb, str(five_people))).plan, query=query)
+    tree.insert_child(GreyColour(), 1)
+    assert Engine(tree).tick() is Status.SUCCESS
+    people = tree.cas.annotations(PersonHypothesis)
+    assert len(people) >= 4
+    assert {p.source for p in people} == {"DepthPeopleDetector"}
+    assert not any(p.find(BodyKeypoints) for p in people)

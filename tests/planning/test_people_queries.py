@@ -5,6 +5,7 @@ from __future__ import annotations
 
 import json
 from dataclasses import replace
+from itertools import pairwise
 from pathlib import Path
 
 import pytest
@@ -36,7 +37,9 @@ def test_the_nested_and_json_forms_are_one_query_and_print_back() -> None:
     assert parse_query(format_query(nested)) == nested
 
 
-@pytest.mark.parametrize("text", ["detect { obj: {} }", "detect { human: { obj: {} } }", "detect { obj: { human: {} } }"])
+@pytest.mark.parametrize(
+    "text", ["detect { obj: {} }", "detect { human: { obj: {} } }", "detect { obj: { human: {} } }"]
+)
 def test_only_a_top_level_human_block_may_be_empty(text: str) -> None:
     with pytest.raises(QueryError, match="empty block"):
         parse_query(text)
@@ -93,4 +96,4 @@ def test_find_the_person_on_a_real_frame_end_to_end(
     assert len(people) >= 4
     assert all(p["class"]["iri"].endswith("#Human") for p in people)
     xs = sorted(p["pose"]["position"][0] for p in people)
-    assert all(b - a > 0.25 for a, b in zip(xs, xs[1:], strict=False)), xs
+    assert all(b - a > 0.25 for a, b in pairwise(xs)), xs
