@@ -4,7 +4,9 @@ The model is mediapipe 0.10.21's legacy pose solution (complexity 1; the model f
 is fetched). It finds one person per image, so with a point cloud it runs on a crop around every person that
 the depth people detector (:func:`annotators.cloud.people.find_people`) finds, and reads each keypoint's 3-D
 point from the organized cloud (the median of the person's points in a small window around the pixel); without
-a cloud it runs once on the whole image and reports 2-D keypoints only. With a cloud, a skeleton counts only when
+a cloud it runs once on the whole image and reports 2-D keypoints only; when the cloud shows no ground to stand
+on (a close view of a person's upper body) it runs on the whole image and the person is where its torso
+keypoints are. With a cloud, a skeleton counts only when
 at least ``min_on_person`` of its keypoints fall on the candidate's points (the model, given a crop without a
 person, may still draw one on whatever is there).
 
@@ -31,6 +33,7 @@ from robokudo.core.types import (
     ColorImage,
     PersonHypothesis,
     PointCloud,
+    Pose,
 )
 
 LANDMARKS: tuple[str, ...] = (
@@ -146,13 +149,27 @@ class HumanPoseDetector(Annotator):
         except PoseModelError as error:
             self.fail(str(error))
         cloud = self.optional_view(PointCloud)
-        usable_cloud = cloud is not None and cloud.points.shape[:2] == image.shape[:2] and cloud.mask.any()
-        if usable_cloud:
+        points = cloud.points if cloud is not None and cloud.points.shape[:2] == image.shape[:2] else None
+        whole_image = [((0, 0, image.shape[1], image.shape[0]), None)]
+        crops: list[tuple[tuple[int, int, int, int], PersonSegment | None]] = []
+        if cloud is not None and points is not None and cloud.mask.any():
             up = up_in_camera(self.optional_view(CameraInfo))
-            candidates = find_people(cloud.points, cloud.mask, IMAGE_UP if up is None else up, self.parameters)
+            candidates = find_people(points, cloud.mask, IMAGE_UP if up is None else up, self.parameters)
             crops = [(crop_box(c.roi, image.shape[:2], self.crop_margin), c) for c in candidates]
-        else:
-            crops = [((0, 0, image.shape[1], image.shape[0]), None)]
+        found = self._look(model, image, points, crops)
+        if not found:  # no cloud, no ground in view (a close view of the upper body) or no candidate was a person
+            found = self._look(model, image, points, whole_image)
+        if not found:
+            self.fail(f"the pose model saw no person's torso in {len(crops)} candidate region(s) nor the whole image")
+
+    def _look(
+        self,
+        model: Guarded[Any],
+        image: np.ndarray,
+        points: np.ndarray | None,
+        crops: list[tuple[tuple[int, int, int, int], PersonSegment | None]],
+    ) -> int:
+        """Run the model on each crop and write the people it sees there; returns how many."""
         found = 0
         for (x0, y0, x1, y1), candidate in crops:
             with model.lock:
@@ -164,14 +181,13 @@ class HumanPoseDetector(Annotator):
                 continue
             pixels = pixels + np.array([x0, y0])
             xyz = None
-            if candidate is not None and cloud is not None:
-                xyz = keypoint_points(pixels, cloud.points, candidate.mask)
+            if points is not None:
+                xyz = keypoint_points(pixels, points, None if candidate is None else candidate.mask)
                 if np.count_nonzero(np.isfinite(xyz[:, 2])) < self.min_on_person * len(LANDMARKS):
                     continue  # the skeleton does not lie on the candidate's points: something else was seen
             found += 1
             self.write(self._person(pixels, visibility, xyz, candidate))
-        if not found:
-            self.fail(f"the pose model saw no person's torso in {len(crops)} image region(s)")
+        return found
 
     def _person(
         self, pixels: np.ndarray, visibility: np.ndarray, xyz: np.ndarray | None, candidate: PersonSegment | None
@@ -193,7 +209,15 @@ class HumanPoseDetector(Annotator):
                 confidence=confidence,
             )
             hypothesis.annotations.append(Classification(class_name=HUMAN, source=self.name, confidence=confidence))
-            xyz = np.full((pixels.shape[0], 3), np.nan)
+            if xyz is None:
+                xyz = np.full((pixels.shape[0], 3), np.nan)
+            torso = xyz[list(TORSO)]
+            torso = torso[np.isfinite(torso[:, 2])]
+            if torso.shape[0]:
+                position = np.median(torso, axis=0)
+                hypothesis.annotations.append(
+                    Pose(position=position, orientation=np.array([0.0, 0.0, 0.0, 1.0]), source=self.name)
+                )
         hypothesis.annotations.append(
             BodyKeypoints(
                 names=LANDMARKS, pixels=pixels, points=xyz, visibility=visibility, source=self.name,

@@ -25,7 +25,7 @@ from robokudo.application.sensor_sources import sensor_source
 from robokudo.core.annotator import Annotator
 from robokudo.core.engine import Engine
 from robokudo.core.pipeline import Pipeline
-from robokudo.core.types import BodyKeypoints, Classification, ColorImage, PersonHypothesis, Pose
+from robokudo.core.types import BodyKeypoints, Classification, ColorImage, PersonHypothesis, PointCloud, Pose
 from tests.annotators.conftest import require_folder
 from trees.synthesis import build_tree
 
@@ -113,3 +113,32 @@ def test_when_colour_fails_the_planned_fallback_hands_over_to_the_depth_detector
     assert len(people) >= 4
     assert {p.source for p in people} == {"DepthPeopleDetector"}
     assert not any(p.find(BodyKeypoints) for p in people)
+
+
+class UpperBodyView(Annotator):
+    """Test helper: keeps only the image rows above the waists (a close view with no floor in sight)."""
+
+    inputs = (PointCloud,)
+    outputs = (PointCloud,)
+
+    def analyse(self) -> None:
+        cloud = self.view(PointCloud)
+        mask = cloud.mask.copy()
+        mask[UPPER_ROWS:] = False
+        self.write(PointCloud(points=np.where(mask[..., None], cloud.points, np.nan), mask=mask, colors=cloud.colors))
+
+
+UPPER_ROWS = 300
+
+
+def test_without_ground_in_view_the_pose_model_looks_at_the_whole_image(five_people: Path) -> None:
+    reader = PcdReader(five_people)
+    root = Pipeline("people", [reader, UpperBodyView(), HumanPoseDetector()])
+    assert Engine(root).tick() is Status.SUCCESS, [(c.name, c.feedback_message) for c in root.children]
+    (person,) = root.cas.annotations(PersonHypothesis)
+    keypoints = person.first(BodyKeypoints)
+    points = root.cas.view(PointCloud).points
+    # the person's position is its torso in 3-D: within the torso keypoints' image box, at the cloud's depth there
+    u, v = np.median(keypoints.pixels[[11, 12, 23, 24]], axis=0).round().astype(int)
+    position = person.first(Pose).position
+    assert abs(position[2] - np.nanmedian(points[v - 10 : v + 10, u - 10 : u + 10, 2])) < 0.15
