@@ -30,11 +30,14 @@ system-deps:
 
 # rapidocr-onnxruntime (OCR, models inside its wheel) requires opencv-python, which would clash with
 # opencv-python-headless: it is installed without its requirements, which pyproject.toml lists instead.
+# mediapipe (human pose; its pose model ships in the wheel) likewise: it pins numpy<2, protobuf<5 and
+# opencv-contrib-python, but its legacy pose solution runs with our numpy, protobuf and headless OpenCV.
 $(STAMP): pyproject.toml Makefile
 	test -x $(PY) || $(PYTHON) -m venv $(VENV)
 	$(PY) -m pip install -q --upgrade pip
 	$(PY) -m pip install -q -e '.[dev]'
 	$(PY) -m pip install -q --no-deps 'rapidocr-onnxruntime==1.4.4'
+	$(PY) -m pip install -q --no-deps 'mediapipe==0.10.21'
 	$(PY) -m pip uninstall -q -y opencv-python 2>/dev/null || true
 	touch $(STAMP)
 

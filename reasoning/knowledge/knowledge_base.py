@@ -300,6 +300,10 @@ class KnowledgeBase:
         """Typical colours, shape, size, material, transparency, storage place, texts and brand of a class."""
         return self._index.profiles[self._name(name, ("class",))]
 
+    def hypothesis_type(self, name: str) -> str:
+        """The CAS type instances of this object class are found as (ObjectHypothesis unless the class says)."""
+        return self._index.hypothesis_types.get(self._name(name, ("class",)), "ObjectHypothesis")
+
     def default_location(self, name: str) -> str | None:
         """The region class objects of this class are typically kept in (inherited), or None."""
         return self.object_profile(name).stored_in
@@ -377,7 +381,9 @@ class KnowledgeBase:
         declared domain holds the value, a subclass of it or a superclass of it (a detector that knows
         WhiteCeramicBowl serves a query for Bowl); an empty domain means any value. ``object_class`` keeps
         the annotators whose class domain (if any) is related to it the same way and drops those whose
-        preconditions exclude it (not for transparent objects). ``conditions`` says whether depth and a
+        preconditions exclude it (not for transparent objects); without ``object_class``, an annotator with a
+        class domain that writes only a subtype of ``annotation_type`` (a people detector's PersonHypothesis)
+        is left out. ``conditions`` says whether depth and a
         region are available (default: both) and whether a detector model is configured (default: not).
         """
         index = self._index
@@ -412,6 +418,8 @@ class KnowledgeBase:
                 and spec.classes.isdisjoint(object_down)
             ):
                 continue
+            if object_class is None and spec.classes and annotation_type not in spec.outputs:
+                continue  # a detector of particular classes writing their own subtype serves queries for them only
             needs = index.annotator_conditions[spec.name]
             if needs and (
                 ("depth" in needs and not conditions.depth)

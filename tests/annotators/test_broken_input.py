@@ -23,6 +23,7 @@ from annotators.classification.knowledge_classifier import KnowledgeClassifier
 from annotators.cloud.clusters import ClusterExtractor
 from annotators.cloud.filters import CropBoxFilter, RangeFilter, RegionFilter
 from annotators.cloud.normals import NormalEstimator
+from annotators.cloud.people import DepthPeopleDetector
 from annotators.cloud.plane import SupportPlaneSegmenter
 from annotators.cloud.point_cloud import PointCloudGenerator
 from annotators.cloud.pose import PoseAnnotator
@@ -30,6 +31,7 @@ from annotators.cloud.shape import ShapeAnnotator
 from annotators.cloud.size import SizeAnnotator
 from annotators.image.color import SemanticColorAnnotator
 from annotators.image.histogram import ColorHistogramAnnotator
+from annotators.image.human_pose import HumanPoseDetector
 from annotators.image.image_regions import ImageRegionSegmenter
 from annotators.image.onnx_detector import OnnxDetector
 from annotators.readers.frame_io import Frame
@@ -178,6 +180,8 @@ BROKEN_CASES: dict[str, tuple[Callable[[], Seeds], tuple[type[Annotator], ...]]]
             TextReader,
             OnnxDetector,
             ImageRegionSegmenter,
+            DepthPeopleDetector,
+            HumanPoseDetector,
         ),
     ),
     "all-NaN cloud": (
@@ -192,6 +196,7 @@ BROKEN_CASES: dict[str, tuple[Callable[[], Seeds], tuple[type[Annotator], ...]]]
             PoseAnnotator,
             ShapeAnnotator,
             SizeAnnotator,
+            DepthPeopleDetector,
         ),
     ),
     "cloud without points of interest": (
@@ -206,13 +211,15 @@ BROKEN_CASES: dict[str, tuple[Callable[[], Seeds], tuple[type[Annotator], ...]]]
             PoseAnnotator,
             ShapeAnnotator,
             SizeAnnotator,
+            DepthPeopleDetector,
         ),
     ),
     "cloud too small for normals": (
         lambda: [PointCloud(points=np.ones((2, 2, 3), np.float32), mask=np.ones((2, 2), bool))],
         (NormalEstimator,),
     ),
-    "collinear cloud": (lambda: [line_cloud()], (SupportPlaneSegmenter,)),
+    "collinear cloud": (lambda: [line_cloud()], (SupportPlaneSegmenter, DepthPeopleDetector)),
+    "a wall, no ground": (lambda: [flat_cloud()], (DepthPeopleDetector,)),
     "cloud out of range": (
         lambda: [PointCloud(points=flat_cloud().points * 10, mask=np.ones((H, W), bool))],
         (RangeFilter, CropBoxFilter),
@@ -264,8 +271,8 @@ BROKEN_CASES: dict[str, tuple[Callable[[], Seeds], tuple[type[Annotator], ...]]]
         lambda: [flat_cloud(), hypothesis(), CameraInfo(K, cam_to_world=np.full((3, 3), np.nan))],
         (PoseAnnotator, RegionFilter),
     ),
-    "uniform colour image": (lambda: [color()], (ImageRegionSegmenter,)),
-    "tiny colour image": (lambda: [color(4, 4)], (ImageRegionSegmenter,)),
+    "uniform colour image": (lambda: [color()], (ImageRegionSegmenter, HumanPoseDetector)),
+    "tiny colour image": (lambda: [color(4, 4)], (ImageRegionSegmenter, HumanPoseDetector)),
     "hypothesis without evidence": (lambda: [hypothesis(), *evidence_types()], (KnowledgeClassifier,)),
 }
 
