@@ -84,9 +84,7 @@ def crop_box(roi: tuple[int, int, int, int], shape: tuple[int, int], margin: flo
     return max(0, x0 - pad), max(0, y0 - pad), min(shape[1], x1 + pad), min(shape[0], y1 + pad)
 
 
-def keypoint_points(
-    pixels: np.ndarray, points: np.ndarray, member: np.ndarray | None, window: int = 4
-) -> np.ndarray:
+def keypoint_points(pixels: np.ndarray, points: np.ndarray, member: np.ndarray | None, window: int = 4) -> np.ndarray:
     """The 3-D point of each keypoint: the median of the valid cloud points (of ``member`` pixels when given)
     within ``window`` pixels of it; NaN where there are none."""
     rows, cols = points.shape[:2]

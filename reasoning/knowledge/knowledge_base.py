@@ -381,10 +381,11 @@ class KnowledgeBase:
         declared domain holds the value, a subclass of it or a superclass of it (a detector that knows
         WhiteCeramicBowl serves a query for Bowl); an empty domain means any value. ``object_class`` keeps
         the annotators whose class domain (if any) is related to it the same way and drops those whose
-        preconditions exclude it (not for transparent objects); without ``object_class``, an annotator with a
-        class domain that writes only a subtype of ``annotation_type`` (a people detector's PersonHypothesis)
-        is left out. ``conditions`` says whether depth and a
-        region are available (default: both) and whether a detector model is configured (default: not).
+        preconditions exclude it (not for transparent objects); an annotator with a class domain that writes only
+        a subtype of ``annotation_type`` (a people detector's PersonHypothesis) is kept only for a query of one of
+        its classes or a subclass (not for "all objects", whose segmenters must each provide the type itself).
+        ``conditions`` says whether depth and a region are available (default: both) and whether a detector model
+        is configured (default: not).
         """
         index = self._index
         if annotation_type not in index.cas_types:
@@ -418,7 +419,11 @@ class KnowledgeBase:
                 and spec.classes.isdisjoint(object_down)
             ):
                 continue
-            if object_class is None and spec.classes and annotation_type not in spec.outputs:
+            if (
+                spec.classes
+                and annotation_type not in spec.outputs
+                and (object_up is None or spec.classes.isdisjoint(object_up))
+            ):
                 continue  # a detector of particular classes writing their own subtype serves queries for them only
             needs = index.annotator_conditions[spec.name]
             if needs and (

@@ -108,8 +108,10 @@ def _interpret_specialised(query: Query, obj: Block, object_class: str, hypothes
     if location is not None and not _is_anywhere(location):
         asked.append("location")
     if asked:
-        raise PlanningError(f"{', '.join(asked)} cannot be asked of a {object_class} yet (its detectors say only "
-                            f"where it is and its body keypoints)")
+        raise PlanningError(
+            f"{', '.join(asked)} cannot be asked of a {object_class} yet (its detectors say only "
+            f"where it is and its body keypoints)"
+        )
     why = f"{object_class} is perceived as {hypothesis}, so a {query.kind} query needs a provider of it"
     task = Task(
         kind=query.kind,

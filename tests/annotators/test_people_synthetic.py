@@ -48,8 +48,7 @@ def scenes(draw: st.DrawFn) -> list[tuple[float, float, float, float]]:
     xs = np.cumsum([0.0, *gaps])
     xs = xs - xs.mean() + draw(st.floats(-0.3, 0.3))
     people = [
-        (float(x), z + draw(st.floats(-0.2, 0.2)), draw(st.floats(0.17, 0.25)), draw(st.floats(1.5, 1.95)))
-        for x in xs
+        (float(x), z + draw(st.floats(-0.2, 0.2)), draw(st.floats(0.17, 0.25)), draw(st.floats(1.5, 1.95))) for x in xs
     ]
     half_view = COLS / 2 / F
     assume(all(abs(x) + radius < half_view * depth for x, depth, radius, _ in people))  # everyone in the image

@@ -97,3 +97,12 @@ def test_find_the_person_on_a_real_frame_end_to_end(
     assert all(p["class"]["iri"].endswith("#Human") for p in people)
     xs = sorted(p["pose"]["position"][0] for p in people)
     assert all(b - a > 0.25 for a, b in pairwise(xs)), xs
+
+
+@pytest.mark.parametrize("text", ["find all objects", "detect { obj: { type: PhysicalObject } }", "find the cup"])
+def test_object_queries_plan_no_people_detector_and_a_valid_tree(kb: KnowledgeBase, text: str) -> None:
+    source = sensor_source(kb, str(SHARED_DATA / "pcl_grabber_sequences"))
+    query_plan = plan_query(parse_query(text), kb, source)
+    steps = {step.annotator for step in query_plan.plan.steps()}
+    assert steps.isdisjoint(PEOPLE), steps  # a person is not a segment of "all objects" on a table
+    validate_data_flow(build_tree(query_plan.plan))

@@ -20,8 +20,10 @@ from reasoning.errors import OntologyError
 from reasoning.planning.planner import PlanningError
 from robokudo.application.commands.input_options import add_input_arguments, frame_number, input_problem
 from robokudo.application.commands.rerun_options import RerunOptionError, add_rerun_arguments, open_rerun_log
+from robokudo.application.report import draw_answer, write_image
 from robokudo.application.service import AnsweringService, Outcome, PerceptionFailedError, UnknownObjectError
 from robokudo.core.render import unicode_tree
+from robokudo.core.types import ColorImage
 from trees.synthesis import SynthesisError
 
 if TYPE_CHECKING:
@@ -39,6 +41,11 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
     parser.add_argument("--json", action="store_true", help="print the answer as JSON")
     parser.add_argument("--explain", action="store_true", help="print the synthesized tree with its reasons")
     parser.add_argument("--store", help="belief store file (default: $ROBOKUDO_BELIEF_STORE or the user data dir)")
+    parser.add_argument(
+        "--annotated-image",
+        metavar="PATH",
+        help="write the analysed frame with the answer's objects boxed and labelled",
+    )
     add_rerun_arguments(parser)
 
 
@@ -71,6 +78,8 @@ def run(args: argparse.Namespace) -> int:
     if args.explain:
         print(unicode_tree(outcome.tree, show_status=True, show_reasons=True))
         print()
+    if args.annotated_image and outcome.tree.cas.view(ColorImage) is not None:
+        print(f"annotated image: {write_image(draw_answer(outcome.tree.cas), args.annotated_image)}", file=sys.stderr)
     if outcome.answer.timed_out:
         print(f"robokudo query: {TIMED_OUT_NOTE}", file=sys.stderr)
     print(outcome.answer.to_json() if args.json else outcome.answer.summary())

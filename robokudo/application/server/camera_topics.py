@@ -22,9 +22,9 @@ from typing import Any
 import cv2
 import numpy as np
 
-from reasoning.beliefs.answer import Answer
+from robokudo.application.report import Box, answer_boxes
 from robokudo.core.cas import CAS
-from robokudo.core.types import CameraInfo, ColorImage, DepthImage, ObjectHypothesis, QueryAnswer
+from robokudo.core.types import CameraInfo, ColorImage, DepthImage
 
 LIVE_PERIOD = 0.5
 """Seconds between two live frames (the page needs no video rate; encoding costs the server CPU)."""
@@ -33,14 +33,6 @@ HOLD_ANALYSED = 3.0
 JPEG_QUALITY = 80
 DEPTH_RANGE_M = (0.3, 4.0)
 """Depths mapped onto the colour scale of the depth image."""
-
-
-@dataclass(frozen=True)
-class Box:
-    """A hypothesis' image box and its label."""
-
-    roi: tuple[int, int, int, int]
-    label: str
 
 
 @dataclass(frozen=True, eq=False)
@@ -53,21 +45,6 @@ class ShownFrame:
     frame_id: str
     kind: str
     boxes: tuple[Box, ...]
-
-
-def boxes_of(cas: CAS) -> tuple[Box, ...]:
-    """The answer's objects seen in this frame (``#id label``), or else every hypothesis, with their boxes."""
-    found = cas.view(QueryAnswer)
-    if found is not None and isinstance(found.answer, Answer):
-        labelled = tuple(
-            Box(tuple(int(v) for v in o.roi), f"#{o.id} {o.class_label}")  # type: ignore[arg-type]
-            for o in found.answer.objects
-            if o.roi is not None
-        )
-        if labelled:
-            return labelled
-    hypotheses = cas.annotations(ObjectHypothesis)
-    return tuple(Box(tuple(int(v) for v in h.roi), f"hypothesis {i}") for i, h in enumerate(hypotheses, 1))  # type: ignore[arg-type]
 
 
 def frame_of(cas: CAS, kind: str, boxes: tuple[Box, ...] = ()) -> ShownFrame | None:
@@ -97,7 +74,7 @@ class FramePicker:
         now = self._clock()
         if finished_task is not None and finished_task is not self._last_cas:
             self._last_cas = finished_task
-            shown = frame_of(finished_task, "analysed", boxes_of(finished_task))
+            shown = frame_of(finished_task, "analysed", answer_boxes(finished_task))
             if shown is not None:
                 self._analysed_at = now
                 return shown
