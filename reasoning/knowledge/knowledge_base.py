@@ -146,6 +146,11 @@ class KnowledgeBase:
             graphs[path] = cached[1]
         return graphs, stamps
 
+    def adopt_parsed(self, path: Path, stamp: Stamp, graph: Graph) -> None:
+        """Take ``graph`` as the parse of source ``path`` while the file has ``stamp`` (an editor that read or wrote
+        it already); the next (re)load uses it instead of parsing the file again."""
+        self._parsed[path] = (stamp, graph)
+
     def reload(self) -> None:
         """Re-read the sources (only changed files are parsed again) and swap in a new index.
 
