@@ -39,7 +39,7 @@ from reasoning.knowledge.folded_triples import (
     mentions,
     subjects,
 )
-from reasoning.knowledge.fresh_classes import annotation_properties, check_fresh_classes, is_logical
+from reasoning.knowledge.fresh_classes import Fragment, annotation_properties, check_fresh_classes, is_logical
 from reasoning.knowledge.hermit import classify, describe_unsatisfiable
 from reasoning.knowledge.history import UNDO, EditHistory, HistoryEntry, history_path
 from reasoning.knowledge.index import OntologyIndex, build_index
@@ -124,6 +124,18 @@ class CheckReport:
 
 
 @dataclass(frozen=True)
+class _Validated:
+    """A validated edit: how it was checked, warnings, the ontology after it and, when proven coherent, the new
+    state's classification."""
+
+    checked_by: str
+    warnings: tuple[str, ...]
+    graphs: Mapping[Path, Graph]
+    index: OntologyIndex
+    classification: Classification | None = None
+
+
+@dataclass(frozen=True)
 class _Change:
     """What an edit does to the user file, worked out from its current content."""
 
@@ -152,6 +164,7 @@ class OntologyEditor:
         self.history = EditHistory(history_path(self.kb.user_file))
         self.reasoner_cache = ReasonerCache(cache_path(self.kb.user_file))
         self._sources_digest: str | None = None
+        self._fixed_fragment: tuple[str, Fragment] | None = None
 
     @property
     def user_file(self) -> Path:
@@ -488,25 +501,28 @@ class OntologyEditor:
                         raise EditRejectedError([f"{self.user_file}: {error}; edit the file by hand"]) from None
                     data = edited.encode("utf-8")
                     edited_graph = parse_turtle(self.user_file, data)
-                    checked_by, warnings, classification = self._validate(
-                        before, edited_graph, change, snapshot.data, data
-                    )
+                    validated = self._validate(before, edited_graph, change, snapshot.data, data)
                     self.layer.replace(snapshot, data)
                     undoes = [e.number for e in change.undone]
                     self.history.append(
-                        number, action, change.name, change.added, change.removed, checked_by, undoes=undoes
+                        number, action, change.name, change.added, change.removed, validated.checked_by, undoes
                     )
-                    if classification is not None:
-                        self.reasoner_cache.put(classification)
+                    if validated.classification is not None:
+                        self.reasoner_cache.put(validated.classification)
                     written = self.layer.read()
+                    adopted = False
                     if written.stamp is not None and written.data == data:
                         self.kb.adopt_parsed(self.user_file, written.stamp, edited_graph)
+                        adopted = self.kb.adopt_index(validated.graphs, validated.index)
             except ChangedMeanwhileError:
                 continue
             except LockTimeoutError as error:
                 raise EditRejectedError([str(error)]) from None
-            self.kb.reload()
-            return EditResult(action, change.name, self.user_file, checked_by, warnings, number, change.undone)
+            if not adopted:
+                self.kb.reload()
+            return EditResult(
+                action, change.name, self.user_file, validated.checked_by, validated.warnings, number, change.undone
+            )
         raise EditRejectedError([f"{self.user_file} kept changing while the edit was validated; try again"])
 
     def _adopt(self, snapshot: Snapshot) -> Graph:
@@ -534,10 +550,8 @@ class OntologyEditor:
 
     def _validate(
         self, before: Mapping[Path, Graph], edited: Graph, change: _Change, old_data: bytes, new_data: bytes
-    ) -> tuple[str, tuple[str, ...], Classification | None]:
-        """Load and reason over the ontology as it would be after the edit; EditRejectedError when it fails.
-
-        Returns how it was checked, warnings and the classification of the new state when it is proven coherent."""
+    ) -> _Validated:
+        """Load and reason over the ontology as it would be after the edit; EditRejectedError when it fails."""
         candidate = {**{p: g for p, g in before.items() if p != self.user_file}, self.user_file: edited}
         try:
             merged, defined = self.kb.combine(candidate)
@@ -564,32 +578,41 @@ class OntologyEditor:
             if cached is not None and all(t[0] in gone for t in logical_removed):
                 names = [local_name(s) for s in gone]
                 classification = cached.without(self._key(new_data), names, "removal from a coherent state")
-            return _NO_AXIOMS, (), classification
+            return _Validated(_NO_AXIOMS, (), candidate, index, classification)
         if not self.use_reasoner:
             conflicts = _asserted_conflicts(index, new_classes)
             if conflicts:
                 raise EditRejectedError(conflicts)
-            return "asserted checks (reasoner not asked for)", (), None
+            return _Validated("asserted checks (reasoner not asked for)", (), candidate, index)
         if cached is not None and not logical_removed:
-            base, _ = self.kb.combine(before)
-            fresh = check_fresh_classes(base, cached, change.added, annotations)
+            fresh = check_fresh_classes(self._fragment(before, annotations), cached, change.added, annotations)
             if fresh.supported:
                 if fresh.problems:
                     raise EditRejectedError(list(fresh.problems))
                 how = f"incremental check of {', '.join(new_classes)} against the stored HermiT classification"
                 classification = cached.extended(self._key(new_data), fresh.parents, fresh.ancestors, how)
-                return f"{how}: consistent", (), classification
+                return _Validated(f"{how}: consistent", (), candidate, index, classification)
         result = classify(merged)
         if not result.available:
             conflicts = _asserted_conflicts(index, new_classes)
             if conflicts:
                 raise EditRejectedError(conflicts)
-            return "asserted checks", (result.message,), None
+            return _Validated("asserted checks", (result.message,), candidate, index)
         if not result.ok:
             raise EditRejectedError(describe_unsatisfiable(index, result))
         assert result.inferred is not None
         inferred = result.inferred
-        return result.message, (), Classification(self._key(new_data), inferred.parents, inferred.ancestors, "HermiT")
+        classification = Classification(self._key(new_data), inferred.parents, inferred.ancestors, "HermiT")
+        return _Validated(result.message, (), candidate, index, classification)
+
+    def _fragment(self, before: Mapping[Path, Graph], annotations: frozenset[URIRef]) -> Fragment:
+        """The fragment of the ontology before the edit; the read-only sources' part is read once."""
+        key = self._key(b"")
+        if self._fixed_fragment is None or self._fixed_fragment[0] != key:
+            fixed = [g for p, g in before.items() if p != self.user_file] + [self.kb.annotator_graph]
+            self._fixed_fragment = (key, Fragment.of(fixed, annotation_properties(*fixed)))
+        user = [g for p, g in before.items() if p == self.user_file]
+        return self._fixed_fragment[1].plus(Fragment.of(user, annotations))
 
 
 def _upgrade_header(text: str) -> str:

@@ -1,10 +1,11 @@
 """Ontologies in and out of the formats other OWL tools use: Turtle, RDF/XML and OWL/XML.
 
-:func:`serialize` writes a graph as Turtle, RDF/XML (Protégé, owlready2) or OWL/XML
-(:mod:`reasoning.knowledge.owl_xml`); :func:`for_export` makes the merged ontology one self-contained ontology
-(the files' headers and ``owl:imports`` between them replaced by one header). :func:`read_ontology` reads any of
-these formats (OWL/XML through owlready2) and :func:`map_to_namespace` renames IRIs of other namespaces into ``rk:``
-as the user maps them; :func:`outside_namespace` names the IRIs that stay outside.
+:func:`export_ontology` writes the user layer or everything a knowledge base loads; :func:`serialize` writes a graph
+as Turtle, RDF/XML (Protégé, owlready2) or OWL/XML (:mod:`reasoning.knowledge.owl_xml`); :func:`for_export` makes
+the merged ontology one self-contained ontology (the files' headers and ``owl:imports`` between them replaced by one
+header). :func:`read_ontology` reads any of these formats (OWL/XML through owlready2) and :func:`map_to_namespace`
+renames IRIs of other namespaces into ``rk:`` as the user maps them; :func:`outside_namespace` names the IRIs that
+stay outside.
 """
 
 from __future__ import annotations
@@ -17,6 +18,7 @@ from rdflib import BNode, Graph, Literal, URIRef
 from rdflib.namespace import DC, DCTERMS
 
 from reasoning.errors import EditRejectedError
+from reasoning.knowledge.knowledge_base import KnowledgeBase
 from reasoning.knowledge.owl_xml import to_owl_xml
 from reasoning.knowledge.vocabulary import OWL, RDF, RDFS, RK, SKOS, XSD, is_rk
 
@@ -42,6 +44,18 @@ def for_export(merged: Graph) -> Graph:
     graph.add((MERGED_IRI, RDF.type, OWL.Ontology))
     graph.add((MERGED_IRI, RDFS.label, Literal("RoboKudo ontology (shipped and user classes)", lang="en")))
     return graph
+
+
+def export_ontology(kb: KnowledgeBase, fmt: str, merged: bool = False) -> bytes:
+    """The user layer of ``kb`` (Turtle: the file's own text, comments included) or, ``merged``, everything it
+    loads (shipped files, annotator classes, user layer) as one ontology, in format ``fmt``."""
+    graphs = kb.source_graphs()
+    if merged:
+        return serialize(for_export(kb.combine(graphs)[0]), fmt)
+    if fmt == "turtle" and kb.user_file.exists():
+        return kb.user_file.read_bytes()
+    user = graphs.get(kb.user_file)
+    return serialize(user if user is not None else Graph(), fmt)
 
 
 def serialize(graph: Graph, fmt: str) -> bytes:

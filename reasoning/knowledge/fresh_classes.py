@@ -101,9 +101,9 @@ class FreshCheck:
     ancestors: Mapping[str, frozenset[str]] = field(default_factory=dict)
 
 
-def annotation_properties(graph: Graph) -> frozenset[URIRef]:
-    """The standard annotation properties plus those ``graph`` declares."""
-    declared = {p for p in graph.subjects(RDF.type, OWL.AnnotationProperty) if isinstance(p, URIRef)}
+def annotation_properties(*graphs: Graph) -> frozenset[URIRef]:
+    """The standard annotation properties plus those the ``graphs`` declare."""
+    declared = {p for g in graphs for p in g.subjects(RDF.type, OWL.AnnotationProperty) if isinstance(p, URIRef)}
     return ANNOTATION_PROPERTIES | declared
 
 
@@ -113,28 +113,67 @@ def is_logical(triple: FoldedTriple, annotations: frozenset[URIRef]) -> bool:
 
 
 def check_fresh_classes(
-    base: Graph, classification: Classification, added: Iterable[FoldedTriple], annotations: frozenset[URIRef]
+    base: Fragment, classification: Classification, added: Iterable[FoldedTriple], annotations: frozenset[URIRef]
 ) -> FreshCheck:
-    """Decide the satisfiability of the classes ``added`` declares, on top of ``base`` (coherent, classified)."""
+    """Decide the satisfiability of the classes ``added`` declares, on top of the ontology ``base`` holds (coherent,
+    classified as ``classification``)."""
+    if base.unsupported is not None:
+        return FreshCheck(False, base.unsupported)
     try:
         return _Checker(base, classification, annotations).check(frozenset(added))
     except Unsupported as reason:
         return FreshCheck(False, str(reason))
 
 
-class _Fragment:
-    """The told axioms of the base ontology, in the supported fragment."""
+class Fragment:
+    """The told axioms of an ontology in the fragment the check decides (:attr:`unsupported` says why not, if not).
 
-    def __init__(self, graph: Graph, annotations: frozenset[URIRef]) -> None:
+    Read from each source graph separately (:meth:`of`) and combined (:meth:`plus`), so the part that does not
+    change between edits is read once."""
+
+    def __init__(self) -> None:
         self.told: dict[URIRef, set[Atom]] = defaultdict(set)
         self.definitions: list[tuple[URIRef, frozenset[Atom]]] = []
         self.disjoint: dict[URIRef, set[URIRef]] = defaultdict(set)
         self.domains: dict[URIRef, set[URIRef]] = defaultdict(set)
         self.ranges: dict[URIRef, set[URIRef]] = defaultdict(set)
-        self.object_properties = {p for p in graph.subjects(RDF.type, OWL.ObjectProperty) if isinstance(p, URIRef)}
-        self.data_properties = {p for p in graph.subjects(RDF.type, OWL.DatatypeProperty) if isinstance(p, URIRef)}
-        self.nodes = {n for n in graph.all_nodes() if isinstance(n, URIRef)} | set(graph.predicates())
-        self._read(graph, annotations)
+        self.object_properties: set[URIRef] = set()
+        self.data_properties: set[URIRef] = set()
+        self.nodes: set[URIRef] = set()
+        self.unsupported: str | None = None
+
+    @classmethod
+    def of(cls, graphs: Iterable[Graph], annotations: frozenset[URIRef]) -> Fragment:
+        """The fragment of the ontology made of ``graphs``."""
+        fragment = cls()
+        for graph in graphs:
+            fragment.object_properties |= {p for p in graph.subjects(RDF.type, OWL.ObjectProperty) if is_iri(p)}
+            fragment.data_properties |= {p for p in graph.subjects(RDF.type, OWL.DatatypeProperty) if is_iri(p)}
+            fragment.nodes |= {n for n in graph.all_nodes() if isinstance(n, URIRef)} | set(graph.predicates())
+            if fragment.unsupported is None:
+                try:
+                    fragment._read(graph, annotations)
+                except Unsupported as reason:
+                    fragment.unsupported = str(reason)
+        return fragment
+
+    def plus(self, other: Fragment) -> Fragment:
+        """The fragment of both ontologies together."""
+        both = Fragment()
+        for mine, theirs, into in (
+            (self.told, other.told, both.told),
+            (self.disjoint, other.disjoint, both.disjoint),
+            (self.domains, other.domains, both.domains),
+            (self.ranges, other.ranges, both.ranges),
+        ):
+            for key in {*mine, *theirs}:
+                into[key] = {*mine.get(key, ()), *theirs.get(key, ())}  # type: ignore[index]
+        both.definitions = [*self.definitions, *other.definitions]
+        both.object_properties = self.object_properties | other.object_properties
+        both.data_properties = self.data_properties | other.data_properties
+        both.nodes = self.nodes | other.nodes
+        both.unsupported = self.unsupported or other.unsupported
+        return both
 
     def _read(self, graph: Graph, annotations: frozenset[URIRef]) -> None:
         consumed: set[BNode] = set()
@@ -210,6 +249,11 @@ class _Fragment:
         return frozenset(self._atom(graph, member, consumed) for member in Collection(graph, head))
 
 
+def is_iri(node: object) -> bool:
+    """True for an IRI."""
+    return isinstance(node, URIRef)
+
+
 def _list_cells(graph: Graph, head: Node) -> Iterable[Node]:
     cell = graph.value(head, RDF.rest)
     while cell is not None and cell != RDF.nil:
@@ -246,8 +290,8 @@ class _Closure:
 
 
 class _Checker:
-    def __init__(self, base: Graph, classification: Classification, annotations: frozenset[URIRef]) -> None:
-        self.fragment = _Fragment(base, annotations)
+    def __init__(self, base: Fragment, classification: Classification, annotations: frozenset[URIRef]) -> None:
+        self.fragment = base
         self.classification = classification
         self.annotations = annotations
         self.fresh: dict[URIRef, set[Atom]] = {}
