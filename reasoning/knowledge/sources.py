@@ -9,8 +9,8 @@ from pathlib import Path
 
 import platformdirs
 from rdflib import Graph
-from rdflib.plugins.stores.memory import SimpleMemory
 from rdflib.namespace import OWL, RDF, SKOS
+from rdflib.plugins.stores.memory import SimpleMemory
 
 from ontology import shipped_files
 from reasoning.errors import OntologyError

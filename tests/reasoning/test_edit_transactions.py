@@ -155,7 +155,7 @@ def test_a_hand_edit_made_during_validation_is_not_overwritten(
     def validate_while_someone_saves(*args: object, **kwargs: object) -> object:
         if not saved:
             text = user_file.read_text(encoding="utf-8")
-            user_file.write_text(text + 'rk:SavedMeanwhile a owl:Class ; rdfs:subClassOf rk:Cup .\n', "utf-8")
+            user_file.write_text(text + "rk:SavedMeanwhile a owl:Class ; rdfs:subClassOf rk:Cup .\n", "utf-8")
             saved.append(True)
         return validate(*args, **kwargs)  # type: ignore[arg-type]
 
