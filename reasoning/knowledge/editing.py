@@ -261,11 +261,12 @@ class OntologyEditor:
                 f"{name} clashes with the existing term {existing}" + (f" (defined in {where.name})" if where else "")
             )
 
-    def _word_clashes(self, name: str, words: Sequence[str]) -> list[str]:
-        """Why the label and synonyms of new class ``name`` cannot be used (they name other terms)."""
+    def _word_clashes(self, name: str, words: Sequence[str], new: bool = True) -> list[str]:
+        """Why new labels and synonyms of class ``name`` cannot be used (they name other terms); the name of a
+        ``new`` class is checked as a word too."""
         problems = []
         words = list(words)
-        if _CLASS_NAME.fullmatch(name) and word_key(name) not in {word_key(w) for w in words}:
+        if new and _CLASS_NAME.fullmatch(name) and word_key(name) not in {word_key(w) for w in words}:
             words.append(name)  # the name is a word too ("Beverage" would clash with the synonym "beverage")
         for word in words:
             if not word_key(word):
@@ -403,9 +404,9 @@ class OntologyEditor:
                         problems.append(f"{name!r} is not a valid class name (letters, digits, underscores)")
                     elif name in index.names or word_key(name) in index.name_keys:
                         problems.append(f"{name} clashes with the existing term {index.name_keys[word_key(name)]}")
-                words = [str(o) for p, o in mapped.predicate_objects(cls) if p in (RDFS.label, SKOS.altLabel)]
+                words = [str(o) for s, p, o in added if s == cls and p in (RDFS.label, SKOS.altLabel)]
                 problems += _text_problems(f"label or synonym of {name}", words)
-                problems += self._word_clashes(name, words)
+                problems += self._word_clashes(name, words, new=name not in index.classes)
             if problems:
                 raise EditRejectedError(sorted(set(problems)))
             if not added:
@@ -555,7 +556,6 @@ class OntologyEditor:
         candidate = {**{p: g for p, g in before.items() if p != self.user_file}, self.user_file: edited}
         try:
             merged, defined = self.kb.combine(candidate)
-            index = build_index(merged, defined)
         except OntologyError as error:
             raise EditRejectedError(error.problems) from None
         gone = [
@@ -568,6 +568,10 @@ class OntologyEditor:
         ]
         if problems:
             raise EditRejectedError(problems)
+        try:
+            index = build_index(merged, defined)
+        except OntologyError as error:
+            raise EditRejectedError(error.problems) from None
         annotations = annotation_properties(merged)
         logical_added = [t for t in change.added if is_logical(t, annotations)]
         logical_removed = [t for t in change.removed if is_logical(t, annotations)]
