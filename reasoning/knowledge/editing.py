@@ -375,7 +375,11 @@ class OntologyEditor:
         mapped = map_to_namespace(source, namespaces, names or {})
 
         def change(_: Graph) -> _Change:
-            classes = sorted(s for s in mapped.subjects(RDF.type, OWL.Class) if isinstance(s, URIRef))
+            known_classes = self.kb.index.classes
+            classes = sorted(
+                {s for s in mapped.subjects(RDF.type, OWL.Class) if isinstance(s, URIRef)}
+                | {s for s in mapped.subjects() if is_rk(s) and local_name(s) in known_classes}
+            )
             try:
                 described = fold(mapped)
             except NotFoldableError as error:

@@ -269,7 +269,7 @@ def _print_result(result: EditResult) -> None:
         "import": f"imported {result.name}",
         "undo": "undid " + ", ".join(f"edit {e.number} ({e.summary})" for e in result.undone),
     }[result.action]
-    print(f"{done} ({result.user_file}, edit {result.number}); checked by: {result.checked_by}")
+    print(f"{done} ({result.user_file}); edit {result.number}, checked by: {result.checked_by}")
     for warning in result.warnings:
         print(f"warning: {warning}", file=sys.stderr)
 
