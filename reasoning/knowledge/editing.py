@@ -52,7 +52,7 @@ from reasoning.knowledge.reasoner_cache import (
     sources_digest,
     state_key,
 )
-from reasoning.knowledge.sources import parse_turtle
+from reasoning.knowledge.sources import Stamp, file_stamp, parse_turtle
 from reasoning.knowledge.turtle_text import TextEditError, edit_turtle
 from reasoning.knowledge.user_layer import ChangedMeanwhileError, LockTimeoutError, Snapshot, UserLayerFile
 from reasoning.knowledge.vocabulary import NAME_PATTERN, OWL, RDF, RDFS, SKOS, XSD, is_rk, local_name, rk
@@ -163,7 +163,7 @@ class OntologyEditor:
         self.layer = UserLayerFile(self.kb.user_file, lock_timeout)
         self.history = EditHistory(history_path(self.kb.user_file))
         self.reasoner_cache = ReasonerCache(cache_path(self.kb.user_file))
-        self._sources_digest: str | None = None
+        self._sources_digest: tuple[tuple[Stamp | None, ...], str] | None = None
         self._fixed_fragment: tuple[str, Fragment] | None = None
 
     @property
@@ -548,10 +548,13 @@ class OntologyEditor:
         return graph
 
     def _key(self, user_file_bytes: bytes) -> str:
-        if self._sources_digest is None:
+        """The reasoner cache key of the sources as they are with this user file content."""
+        files = self.kb.sources.files
+        stamps = tuple(file_stamp(path) for path in files)
+        if self._sources_digest is None or self._sources_digest[0] != stamps:
             annotators = digest(fold(self.kb.annotator_graph))
-            self._sources_digest = sources_digest(self.kb.sources.files, annotators)
-        return state_key(self._sources_digest, user_file_bytes)
+            self._sources_digest = (stamps, sources_digest(files, annotators))
+        return state_key(self._sources_digest[1], user_file_bytes)
 
     def _validate(
         self, before: Mapping[Path, Graph], edited: Graph, change: _Change, old_data: bytes, new_data: bytes

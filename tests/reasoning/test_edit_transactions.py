@@ -230,3 +230,30 @@ def test_kill_9_at_random_points_leaves_the_old_or_the_new_file(user_file: Path)
     leftovers = [p.name for p in user_file.parent.iterdir() if p.name.endswith(".tmp")]
     assert leftovers == []
     print(f"killed editors left the old file {outcomes['old']} times and the new one {outcomes['new']} times")
+
+
+def test_a_user_file_written_by_the_earlier_editor_is_edited_in_place(user_file: Path) -> None:
+    """Before edits kept text, the editor rewrote the whole file with rdflib under a header saying comments are
+    lost; such a file is edited like any other and its header says what is true now."""
+    user_file.parent.mkdir(parents=True)
+    old_body = (
+        "@prefix owl: <http://www.w3.org/2002/07/owl#> .\n@prefix rdfs: <http://www.w3.org/2000/01/rdf-schema#> .\n"
+        "@prefix rk: <http://robokudo.org/ontology#> .\n\n"
+        '<http://robokudo.org/ontology/user> a owl:Ontology ;\n    rdfs:label "RoboKudo user ontology"@en .\n\n'
+        'rk:OatMilk a owl:Class ;\n    rdfs:label "oat milk"@en ;\n'
+        '    rdfs:subClassOf [ a owl:Restriction ;\n            owl:hasValue "oat" ;\n'
+        "            owl:onProperty rk:printedText ],\n        rk:Milk .\n"
+    )
+    old_header = (
+        "# RoboKudo user ontology: object classes and regions added by the user, layered over the shipped\n"
+        "# ontology. Written by `robokudo ontology` (comments in this file are not kept).\n\n"
+    )
+    user_file.write_text(old_header + old_body, encoding="utf-8")
+    editor = OntologyEditor(KnowledgeBase.load(user_file), use_reasoner=False)
+    editor.add_object("RiceMilk", ["Milk"])
+    editor.remove_object("OatMilk")
+    text = user_file.read_text(encoding="utf-8")
+    assert "comments in this file are not kept" not in text
+    assert text.startswith(NEW_USER_FILE.split("@prefix")[0])
+    assert declared(user_file) == {"RiceMilk"}
+    assert editor.kb.resolve("rice milk").name == "RiceMilk"
