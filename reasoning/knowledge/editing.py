@@ -343,7 +343,8 @@ class OntologyEditor:
                         problems.append(f"the word {word!r} already names the {what} {found.name}; choose another")
             removed: set[FoldedTriple] = set()
             for word in remove:
-                own = [o for o in current.objects(subject, SKOS.altLabel) if isinstance(o, Literal) and str(o) == word]
+                key = word_key(word)
+                own = [o for o in current.objects(subject, SKOS.altLabel) if word_key(str(o)) == key]
                 if own:
                     removed |= {(subject, SKOS.altLabel, o) for o in own}
                 elif word_key(word) in {word_key(s) for s in self.kb.synonyms(term)}:
@@ -586,7 +587,7 @@ class OntologyEditor:
         cached = self.reasoner_cache.get(self._key(old_data)) if self.use_reasoner else None
         if not logical_added:
             classification = None
-            if cached is not None and all(t[0] in gone for t in logical_removed):
+            if cached is not None and all(_is_description_of(t, gone) for t in logical_removed):
                 names = [local_name(s) for s in gone]
                 classification = cached.without(self._key(new_data), names, "removal from a coherent state")
             return _Validated(_NO_AXIOMS, (), candidate, index, classification)
@@ -624,6 +625,13 @@ class OntologyEditor:
             self._fixed_fragment = (key, Fragment.of(fixed, annotation_properties(*fixed)))
         user = [g for p, g in before.items() if p == self.user_file]
         return self._fixed_fragment[1].plus(Fragment.of(user, annotations))
+
+
+def _is_description_of(triple: FoldedTriple, classes: Sequence[URIRef]) -> bool:
+    """True for ``X a owl:Class`` and ``X rdfs:subClassOf C`` with X one of ``classes``: axioms whose removal, when
+    nothing else mentions X, leaves every other class where it was."""
+    subject, predicate, obj = triple
+    return subject in classes and (predicate == RDFS.subClassOf or (predicate == RDF.type and obj == OWL.Class))
 
 
 def _upgrade_header(text: str) -> str:
