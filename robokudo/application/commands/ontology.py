@@ -32,7 +32,7 @@ from robokudo.application.knowledge import load_knowledge_base
 from robokudo.application.reclassify import reclassify
 from robokudo.core.regions import RegionBox
 
-HELP = "show, check and edit the ontology"
+HELP = "show, check, edit, undo, export and import the ontology"
 
 
 def add_arguments(parser: argparse.ArgumentParser) -> None:
