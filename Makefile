@@ -18,13 +18,14 @@ lint: setup
 
 setup: system-deps $(STAMP)
 
-# open3d needs libusb-1.0; graphviz renders trees as SVG; HermiT (ontology reasoning) needs Java.
-# Each is installed only when missing.
+# open3d needs libusb-1.0; graphviz renders trees as SVG; HermiT (ontology reasoning) needs Java; the live view's
+# browser test drives Debian's headless Chromium. Each is installed only when missing.
 system-deps:
-	@if ! ldconfig -p | grep -q 'libusb-1.0.so.0' || ! command -v dot >/dev/null || ! command -v java >/dev/null; then \
+	@if ! ldconfig -p | grep -q 'libusb-1.0.so.0' || ! command -v dot >/dev/null || ! command -v java >/dev/null \
+		|| ! command -v chromium >/dev/null || ! command -v chromedriver >/dev/null; then \
 		SUDO=$$( [ "$$(id -u)" = 0 ] && echo "" || echo sudo ); \
 		$$SUDO apt-get update -qq && \
-		$$SUDO apt-get install -y -qq libusb-1.0-0 graphviz default-jre-headless >/dev/null; \
+		$$SUDO apt-get install -y -qq libusb-1.0-0 graphviz default-jre-headless chromium chromium-driver >/dev/null; \
 	fi
 
 # rapidocr-onnxruntime (OCR, models inside its wheel) requires opencv-python, which would clash with

@@ -21,7 +21,9 @@ A query's ``timeout`` (``detect {obj: {type: Milk}, timeout: 2s}``) is a deadlin
 is received: when it passes before the tree finished, the tree is stopped (running experts are interrupted,
 nothing of the unfinished run is fused) and the answer has ``timed_out`` set and holds the stored beliefs that
 match the query (``from_memory``). A continuous task ends with the reason "timed out after ..." instead.
-A query naming an object id (``inspect object 3``) is answered with that belief only; an id the store does not
+The knowledge base is reloaded before a query is planned when an ontology file changed since (one ``stat`` per file),
+so an ontology edit (``robokudo ontology add-object``, from any process) is seen by the next query without a
+restart. A query naming an object id (``inspect object 3``) is answered with that belief only; an id the store does not
 hold raises :class:`UnknownObjectError` before anything runs, and for the built-in kitchen the camera looks at
 the region where the object was last seen.
 
@@ -34,7 +36,7 @@ import queue
 import threading
 import time
 from collections.abc import Callable, Iterator, Mapping
-from dataclasses import dataclass, replace
+from dataclasses import dataclass, field, replace
 from enum import Enum
 from pathlib import Path
 from types import MappingProxyType, TracebackType
@@ -120,6 +122,8 @@ class Outcome:
     answer: Answer
     tree: Pipeline
     plan: QueryPlan
+    timing: Mapping[str, float] = field(default_factory=dict)
+    """Where the time went (:meth:`TaskHandle.timing`)."""
 
 
 class TaskHandle:
@@ -154,6 +158,14 @@ class TaskHandle:
         self._reason = ""
         self._result: Answer | None = None
         self._timed_out = False
+        self.submitted = started
+        """When the query was received (``time.monotonic``)."""
+        self.planned = started
+        """When its tree was planned and built (set by the service)."""
+        self.first_tick: float | None = None
+        """When the first tick that ran its tree began (None before)."""
+        self.ended_at: float | None = None
+        """When the task ended (None while it runs)."""
 
     @property
     def done(self) -> bool:
@@ -195,6 +207,17 @@ class TaskHandle:
         """End the task (its running experts are interrupted); no-op when it already ended."""
         self._service.cancel(self)
 
+    def timing(self) -> dict[str, float]:
+        """Where the time went, in milliseconds: ``plan_ms`` (parse, plan, build), ``wait_ms`` (until a tick first ran
+        the tree: the swap and the wait for a fresh frame), ``run_ms`` (from that tick to the end); the parts known
+        so far."""
+        parts = {"plan_ms": self.planned - self.submitted}
+        if self.first_tick is not None:
+            parts["wait_ms"] = self.first_tick - self.planned
+            if self.ended_at is not None:
+                parts["run_ms"] = self.ended_at - self.first_tick
+        return {name: round(seconds * 1e3, 3) for name, seconds in parts.items()}
+
     def _publish(self, answer: Answer) -> None:
         self._answers.put(answer)
 
@@ -208,6 +231,7 @@ class TaskHandle:
         self._reason = reason
         self._result = result
         self._timed_out = timed_out
+        self.ended_at = time.monotonic()
         self._ended.set()
         self._answers.put(None)
         return True
@@ -291,6 +315,7 @@ class AnsweringService:
     def plan(self, query: str | Query) -> QueryPlan:
         """Interpret and plan ``query`` for this service's input (the kitchen camera looks at the query's region,
         else at the region of the object the query names by id)."""
+        self.kb.reload_if_changed()
         parsed = parse_query(query) if isinstance(query, str) else query
         if self.stream is not None:
             return self.planner.plan(parsed, served_source(self.kb, self.stream))
@@ -338,6 +363,7 @@ class AnsweringService:
         live source ended. Nothing changes in the engine when it raises.
         """
         started = time.monotonic()
+        self.kb.reload_if_changed()  # an ontology edit made meanwhile (CLI, another process) counts at once
         parsed = parse_query(query) if isinstance(query, str) else query
         mode = self.mode_of(parsed)
         if self._source_ended is not None:
@@ -346,6 +372,7 @@ class AnsweringService:
         query_plan = self.plan(parsed)
         pipeline = self.tree(parsed, query_plan)
         handle = TaskHandle(parsed, mode, pipeline, query_plan, self, timeout=query_timeout(parsed), started=started)
+        handle.planned = time.monotonic()
         if isinstance(self.stream, KitchenCameraStream):
             region = query_plan.interpretation.task.region or self._remembered_region(parsed)
             self.stream.set_view(kitchen_view_for(region))
@@ -387,17 +414,19 @@ class AnsweringService:
                     break
         else:
             self.engine.run(until=lambda _: handle.done or stopped())
+            self.engine.tasks.apply_pending()  # the finished tree leaves the slot now, not at the next tick
         if not handle.done:
             self.cancel(handle)
             raise QueryCancelledError("stopped before the tree finished")
         if handle.timed_out:
-            return Outcome(self._remembered(parsed, timed_out=True), handle.tree, handle.plan)
+            return Outcome(self._remembered(parsed, timed_out=True), handle.tree, handle.plan, handle.timing())
         if handle.result is None:
             raise PerceptionFailedError(f"perception failed: {handle.reason}")
-        return Outcome(handle.result, handle.tree, handle.plan)
+        return Outcome(handle.result, handle.tree, handle.plan, handle.timing())
 
     def recall(self, query: str | Query) -> Answer:
         """The stored beliefs matching ``query``, answered from memory (nothing runs)."""
+        self.kb.reload_if_changed()
         return self._remembered(parse_query(query) if isinstance(query, str) else query)
 
     def _remembered(self, query: Query, *, timed_out: bool = False) -> Answer:
@@ -430,6 +459,16 @@ class AnsweringService:
             self._current = None
         current._end("cancelled")
         self._retire(self.engine.tasks.replace(TASK_SLOT, self._idle))
+
+    @property
+    def perception(self) -> Pipeline | None:
+        """The perceive pipeline of the served root (its CAS holds the newest frame); None without a stream."""
+        return self._perception
+
+    @property
+    def task_tree(self) -> py_trees.behaviour.Behaviour | None:
+        """What the task slot holds now (the idle subtree without a task); read it on the engine thread."""
+        return self._slot.subtree
 
     @property
     def source_ended(self) -> str | None:
@@ -492,6 +531,8 @@ class AnsweringService:
             handle = self._current
         if handle is None or handle.done or self._slot.subtree is not handle.tree:
             return  # no task, or its tree is not in the slot yet (the swap is applied at the next tick)
+        if handle.first_tick is None and handle.tree.status is not Status.INVALID:
+            handle.first_tick = self.engine.tick_started
         pipeline = handle.tree
         if perception_failure is not None:
             self._finish(handle, f"perception failed: {perception_failure}")
@@ -511,12 +552,16 @@ class AnsweringService:
     def _finish(
         self, handle: TaskHandle, reason: str, *, result: Answer | None = None, timed_out: bool = False
     ) -> None:
-        """End ``handle`` (engine thread, between two ticks) and put the idle subtree into the slot."""
+        """End ``handle`` (engine thread, after a tick) and have the idle subtree put into the slot before the next
+        tick (so every post-tick handler still sees the task's final statuses; a task submitted meanwhile wins)."""
         with self._lock:
             if self._current is handle:
                 self._current = None
         handle._end(reason, result=result, timed_out=timed_out)
-        self._retire(self._slot.set_subtree(self._idle))
+        if handle.tree.status is Status.RUNNING:  # timed out or perception failed: stop it now, not a tick later
+            handle.tree.stop(Status.INVALID)
+        self.engine.tasks.schedule(TASK_SLOT, self._idle, only_replacing=handle.tree)
+        self._retire(handle.tree)
 
     def _retire(self, tree: py_trees.behaviour.Behaviour | None) -> None:
         """Remember a tree taken out of the slot while its experts' worker threads finish (:meth:`close` waits)."""

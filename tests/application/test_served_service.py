@@ -47,10 +47,12 @@ def test_the_root_perceives_then_holds_the_task_and_ticks_idle_without_one(serve
 def test_a_task_starts_on_a_frame_from_the_camera_pointed_at_its_region(served: AnsweringService) -> None:
     outcome = served.answer("find milk in fridge")
     assert [(o.class_label, o.region) for o in outcome.answer.objects][:1] == [("lactose free milk", "fridge")]
+    assert set(outcome.timing) == {"plan_ms", "wait_ms", "run_ms"} and min(outcome.timing.values()) >= 0
     first_step = outcome.tree.children[0]
     assert isinstance(first_step, PerceivedFrameReader)
     camera = outcome.tree.cas.view(CameraInfo)
     assert camera is not None and camera.frame_id == "kitchen/fridge"
+    wait_for_ticks(served, 2)
     assert served.engine.tasks.slot(TASK_SLOT).subtree.name == "idle"  # the finished task was taken out
     cup = served.answer("find the red cup")
     assert cup.tree.cas.view(CameraInfo).frame_id == "kitchen/table"

@@ -9,25 +9,33 @@ one are aborted with that reason.
 Clients (roslibpy, roslibjs, ``robokudo ask``) send goals to the action ``/robokudo/query``, call the services
 ``/robokudo/plan`` and ``/robokudo/beliefs`` and subscribe to ``/robokudo/tree_status``
 (:mod:`robokudo.application.server`). Binding anything but a loopback address needs a token (``--token`` or
-``$ROBOKUDO_TOKEN``) that clients send in the ``auth`` op. SIGINT or SIGTERM aborts the running goals with the
-reason, closes the belief store and exits 0. Exit status 2 for a bad option or belief store.
+``$ROBOKUDO_TOKEN``) that clients send in the ``auth`` op. ``--rerun FILE.rrd`` / ``--rerun-connect`` record every
+analysed frame, the belief changes and the tree's status changes with Rerun. SIGINT or SIGTERM aborts the running
+goals with the reason, closes the belief store (and finishes the Rerun file) and exits 0. Exit status 2 for a bad
+option or belief store.
 """
 
 from __future__ import annotations
 
 import argparse
 import asyncio
+import contextlib
 import os
 import sys
 from pathlib import Path
+from typing import TYPE_CHECKING
 
 from annotators.readers.bag_io import ANY_TOPICS, BagTopics, is_bag, named_topics
 from annotators.readers.frame_io import FrameError
 from annotators.readers.streams import FrameStream, KitchenCameraStream, stream_for
 from reasoning.beliefs.store import BeliefStoreError
 from reasoning.errors import OntologyError
+from robokudo.application.commands.rerun_options import RerunOptionError, add_rerun_arguments, open_rerun_log
 from robokudo.application.server.runner import ServerConfig, is_loopback, serve
 from robokudo.application.service import AnsweringService
+
+if TYPE_CHECKING:
+    from robokudo.application.rerun_log import RerunLog
 
 HELP = "serve queries to robots over the rosbridge v2 protocol (WebSocket) until SIGINT/SIGTERM"
 
@@ -55,6 +63,7 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
     parser.add_argument("--port", type=int, default=9090, help="port to listen on (default 9090)")
     parser.add_argument("--token", help=f"token clients must send in the 'auth' op (default: ${TOKEN_VARIABLE})")
     parser.add_argument("--db", help="belief store file (default: $ROBOKUDO_BELIEF_STORE or the user data dir)")
+    add_rerun_arguments(parser)
 
 
 def source_stream(args: argparse.Namespace) -> FrameStream:
@@ -86,6 +95,16 @@ def run(args: argparse.Namespace) -> int:
         print(f"robokudo serve: {problem}", file=sys.stderr)
         return 2
     try:
+        rerun_log = open_rerun_log(args)
+    except RerunOptionError as error:
+        print(f"robokudo serve: {error}", file=sys.stderr)
+        return 2
+    with rerun_log or contextlib.nullcontext():
+        return _serve(args, token, rerun_log)
+
+
+def _serve(args: argparse.Namespace, token: str | None, rerun_log: RerunLog | None) -> int:
+    try:
         stream = source_stream(args)
     except (ValueError, FrameError) as error:
         print(f"robokudo serve: {error}", file=sys.stderr)
@@ -96,18 +115,28 @@ def run(args: argparse.Namespace) -> int:
         stream.close()
         print(f"robokudo serve: {error}", file=sys.stderr)
         return 2
+    recorder = None
+    if rerun_log is not None:
+        from robokudo.application.rerun_log import service_recorder
+
+        recorder = service_recorder(rerun_log, service, background=True)
     config = ServerConfig(host=args.host, port=args.port, token=token)
 
     def ready(address: str) -> None:
+        page = address.replace("ws://", "http://", 1) + "/" + ("?token=TOKEN" if token is not None else "")
         print(f"serving on {address}", flush=True)
+        print(f"live view: {page}", flush=True)
 
     try:
-        reason = asyncio.run(serve(service, config, on_ready=ready))
+        reason = asyncio.run(serve(service, config, on_ready=ready, recorder=recorder))
     except OSError as error:  # the address is in use or cannot be bound
         print(f"robokudo serve: {error}", file=sys.stderr)
         return 2
     except BaseException:  # interrupted before the server took over the signals: still close the store
         service.close()
         raise
+    finally:
+        if recorder is not None:  # the engine has stopped: write what is queued and finish the file
+            recorder.close()
     print(f"robokudo serve: stopped: {reason}", file=sys.stderr, flush=True)
     return 0

@@ -20,6 +20,8 @@ QUERY_ACTION_TYPE = "robokudo_msgs/action/Query"
 PLAN_SERVICE = "/robokudo/plan"
 BELIEFS_SERVICE = "/robokudo/beliefs"
 TREE_STATUS_TOPIC = "/robokudo/tree_status"
+IMAGE_TOPIC = "/robokudo/image"
+DEPTH_TOPIC = "/robokudo/depth"
 BELIEFS_TOPIC = "/robokudo/beliefs"
 """The topic of belief changes (a topic and a service may share a name in ROS)."""
 

@@ -13,9 +13,10 @@ import asyncio
 import contextlib
 import ipaddress
 import signal
+import threading
 from collections.abc import Callable
 from dataclasses import dataclass
-from typing import Any
+from typing import TYPE_CHECKING, Any
 
 import py_trees
 from websockets.asyncio.server import ServerConnection
@@ -25,19 +26,27 @@ from queries import format_query, parse_query
 from reasoning.fusion.tracking import TrackStep
 from robokudo.application.commands.plan import task_summary
 from robokudo.application.server.belief_changes import belief_changes
+from robokudo.application.server.camera_topics import FramePicker, ShownFrame, image_messages
 from robokudo.application.server.goals import GoalManager
 from robokudo.application.server.protocol import (
     BELIEFS_SERVICE,
     BELIEFS_TOPIC,
+    DEPTH_TOPIC,
+    IMAGE_TOPIC,
     MAX_MESSAGE_BYTES,
     PLAN_SERVICE,
     TREE_STATUS_TOPIC,
     publish,
 )
-from robokudo.application.server.session import Services, Session
+from robokudo.application.server.session import Services, Session, Subscribers
 from robokudo.application.server.tree_status import tree_status
+from robokudo.application.server.web_page import page_handler
 from robokudo.application.service import AnsweringService
+from robokudo.core.pipeline import finished_run_cas
 from robokudo.core.render import tree_to_dict, unicode_tree
+
+if TYPE_CHECKING:
+    from robokudo.application.rerun_log import TickRecorder
 
 FRAME_LIMIT = 8 * MAX_MESSAGE_BYTES
 """Frames above this are refused by the WebSocket layer (connection closed); up to it, a message over
@@ -88,9 +97,14 @@ SERVICES: Services = {PLAN_SERVICE: plan_service, BELIEFS_SERVICE: beliefs_servi
 
 
 async def serve(
-    service: AnsweringService, config: ServerConfig, *, on_ready: Callable[[str], None] | None = None
+    service: AnsweringService,
+    config: ServerConfig,
+    *,
+    on_ready: Callable[[str], None] | None = None,
+    recorder: TickRecorder | None = None,
 ) -> str:
-    """Serve until SIGINT or SIGTERM; returns the reason it stopped. Closes ``service``."""
+    """Serve until SIGINT or SIGTERM; returns the reason it stopped. Closes ``service`` (not ``recorder``, which
+    records the engine's ticks and belief changes while it serves)."""
     loop = asyncio.get_running_loop()
     stopping: asyncio.Future[str] = loop.create_future()
     for signum in (signal.SIGINT, signal.SIGTERM):
@@ -98,20 +112,41 @@ async def serve(
         loop.add_signal_handler(signum, lambda r=reason: stopping.done() or stopping.set_result(r))
     goals = GoalManager(service)
     sessions: set[Session] = set()
-    subscribers: set[Session] = set()
+    subscribers = Subscribers()
 
     def broadcast(topic: str, message: dict[str, Any]) -> None:
-        for session in list(subscribers):
-            if topic in session.topics:
-                session.send(publish(topic, message))
+        for session in subscribers.of(topic):
+            session.send(publish(topic, message))
 
     def subscribed(topic: str) -> bool:  # engine thread: a stale read only delays or skips one message
-        return any(topic in session.topics for session in list(subscribers))
+        return bool(subscribers.of(topic))
+
+    frames = FramePicker()
+    encoding = threading.Event()  # set while a picked frame is being encoded: later picks are dropped meanwhile
+
+    def encode_and_publish(shown: ShownFrame) -> None:  # a worker thread of the loop's executor
+        try:
+            color, depth = image_messages(shown)
+            loop.call_soon_threadsafe(broadcast, IMAGE_TOPIC, color)
+            if depth is not None:
+                loop.call_soon_threadsafe(broadcast, DEPTH_TOPIC, depth)
+        finally:
+            encoding.clear()
+
+    def publish_frame() -> None:  # engine thread
+        finished = finished_run_cas(service.task_tree)
+        perception = service.perception
+        shown = frames.pick(finished, perception.cas if perception is not None else None)
+        if shown is not None and not encoding.is_set():
+            encoding.set()
+            loop.call_soon_threadsafe(loop.run_in_executor, None, encode_and_publish, shown)
 
     def after_tick(tree: py_trees.trees.BehaviourTree) -> None:
         if subscribed(TREE_STATUS_TOPIC):
             status = tree_status(tree.root, service.engine.tick_count)
             loop.call_soon_threadsafe(broadcast, TREE_STATUS_TOPIC, status)
+        if subscribed(IMAGE_TOPIC) or subscribed(DEPTH_TOPIC):
+            publish_frame()
 
     def beliefs_changed(step: TrackStep) -> None:
         if subscribed(BELIEFS_TOPIC):
@@ -120,6 +155,9 @@ async def serve(
 
     service.engine.tree.add_post_tick_handler(after_tick)
     service.add_belief_listener(beliefs_changed)
+    if recorder is not None:
+        service.engine.tree.add_post_tick_handler(recorder.after_tick)
+        service.add_belief_listener(recorder.beliefs_changed)
     service.run_in_background()
 
     async def connect(connection: ServerConnection) -> None:
@@ -132,7 +170,9 @@ async def serve(
 
     closed = False
     try:
-        async with websocket_server(connect, config.host, config.port, max_size=FRAME_LIMIT) as server:
+        async with websocket_server(
+            connect, config.host, config.port, max_size=FRAME_LIMIT, process_request=page_handler(config.token)
+        ) as server:
             if on_ready is not None:
                 on_ready(f"ws://{config.host}:{config.port}")
             reason = await stopping
