@@ -146,6 +146,31 @@ class KnowledgeBase:
             graphs[path] = cached[1]
         return graphs, stamps
 
+    def adopt_parsed(self, path: Path, stamp: Stamp, graph: Graph) -> None:
+        """Take ``graph`` as the parse of source ``path`` while the file has ``stamp`` (an editor that read or wrote
+        it already); the next (re)load uses it instead of parsing the file again."""
+        self._parsed[path] = (stamp, graph)
+
+    def adopt_index(self, graphs: Mapping[Path, Graph], index: OntologyIndex) -> bool:
+        """Take ``index`` (built by :func:`build_index` from :meth:`combine` of ``graphs``) as the current index when
+        ``graphs`` are the parses of the sources as they are now and this knowledge base does not reason (an
+        editor validated exactly this); True when taken, else nothing changes."""
+        if self._reason:
+            return False
+        paths = (*self._sources.files, self._sources.user_file)
+        stamps = {path: file_stamp(path) for path in paths}
+        for path in paths:
+            parsed = self._parsed.get(path)
+            if stamps[path] is None:
+                if path in graphs:
+                    return False
+            elif parsed is None or parsed[0] != stamps[path] or graphs.get(path) is not parsed[1]:
+                return False
+        self._index = index
+        self._reasoner = None
+        self._stamps = stamps
+        return True
+
     def reload(self) -> None:
         """Re-read the sources (only changed files are parsed again) and swap in a new index.
 
