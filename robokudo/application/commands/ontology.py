@@ -19,7 +19,6 @@ import sys
 from dataclasses import asdict
 from pathlib import Path
 
-from reasoning.beliefs.filters import kb_class_test
 from reasoning.beliefs.store import BeliefStore, BeliefStoreError
 from reasoning.errors import EditRejectedError, OntologyError, TermError
 from reasoning.knowledge.editing import CheckReport, EditResult, OntologyEditor
@@ -29,7 +28,7 @@ from reasoning.knowledge.knowledge_base import KnowledgeBase
 from reasoning.knowledge.model import AnnotatorSpec, Resolved
 from reasoning.knowledge.sources import USER_ONTOLOGY_ENV
 from robokudo.application.knowledge import load_knowledge_base
-from robokudo.application.reclassify import reclassify
+from robokudo.application.reclassify import remove_object_class
 from robokudo.core.regions import RegionBox
 
 HELP = "show, check, edit, undo, export and import the ontology"
@@ -243,18 +242,11 @@ def _remove_object(kb: KnowledgeBase, editor: OntologyEditor, name: str, store_p
     path = (store_path or BeliefStore.default_path()).expanduser()
     store = BeliefStore(path) if path.exists() else None  # an unusable store fails here, before the removal
     try:
-        try:
-            parents = sorted(kb.superclasses(name, direct=True))  # read before the class is gone
-        except LookupError:
-            parents = []  # remove_object says what is wrong with the name
-        result = editor.remove_object(name)
+        result, parent, moved = remove_object_class(kb, editor, name, store)
         _print_result(result)
-        if store is not None:
-            parent = parents[0] if parents else None
-            moved = reclassify(store, result.name, parent, kb_class_test(kb))
-            if moved:
-                target = f"as {parent}" if parent else "with no class"
-                print(f"reclassified {len(moved)} stored belief(s) of {result.name} {target} ({path})")
+        if moved:
+            target = f"as {parent}" if parent else "with no class"
+            print(f"reclassified {len(moved)} stored belief(s) of {result.name} {target} ({path})")
     finally:
         if store is not None:
             store.close()

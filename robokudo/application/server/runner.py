@@ -22,28 +22,24 @@ import py_trees
 from websockets.asyncio.server import ServerConnection
 from websockets.asyncio.server import serve as websocket_server
 
-from queries import format_query, parse_query
 from reasoning.fusion.tracking import TrackStep
-from robokudo.application.commands.plan import task_summary
 from robokudo.application.server.belief_changes import belief_changes
 from robokudo.application.server.camera_topics import FramePicker, ShownFrame, image_messages
 from robokudo.application.server.goals import GoalManager
 from robokudo.application.server.protocol import (
-    BELIEFS_SERVICE,
     BELIEFS_TOPIC,
     DEPTH_TOPIC,
     IMAGE_TOPIC,
     MAX_MESSAGE_BYTES,
-    PLAN_SERVICE,
     TREE_STATUS_TOPIC,
     publish,
 )
-from robokudo.application.server.session import Services, Session, Subscribers
+from robokudo.application.server.services import SERVICES
+from robokudo.application.server.session import Session, Subscribers
 from robokudo.application.server.tree_status import tree_status
 from robokudo.application.server.web_page import page_handler
 from robokudo.application.service import AnsweringService
 from robokudo.core.pipeline import finished_run_cas
-from robokudo.core.render import tree_to_dict, unicode_tree
 
 if TYPE_CHECKING:
     from robokudo.application.rerun_log import TickRecorder
@@ -73,27 +69,6 @@ def is_loopback(host: str) -> bool:
         return ipaddress.ip_address(host).is_loopback
     except ValueError:
         return False
-
-
-def plan_service(service: AnsweringService, text: str) -> dict[str, Any]:
-    """``/robokudo/plan``: the interpretation, the synthesized tree and its explanation (nothing runs)."""
-    query = parse_query(text)
-    query_plan = service.plan(query)
-    tree = service.tree(query, query_plan)
-    return {
-        "query": format_query(query),
-        "task": task_summary(query_plan),
-        "tree": tree_to_dict(tree),
-        "explanation": unicode_tree(tree, show_reasons=True),
-    }
-
-
-def beliefs_service(service: AnsweringService, text: str) -> dict[str, Any]:
-    """``/robokudo/beliefs``: the stored beliefs matching the query (nothing runs)."""
-    return service.recall(text).to_dict()
-
-
-SERVICES: Services = {PLAN_SERVICE: plan_service, BELIEFS_SERVICE: beliefs_service}
 
 
 async def serve(

@@ -18,7 +18,7 @@ from __future__ import annotations
 import asyncio
 import hmac
 import json
-from collections.abc import Callable
+from collections.abc import Mapping
 from concurrent.futures import Future
 from typing import Any
 
@@ -30,7 +30,6 @@ from robokudo.application.server.goals import Goal, GoalManager
 from robokudo.application.server.protocol import (
     BELIEFS_TOPIC,
     DEPTH_TOPIC,
-    GOAL_QUERY_FIELD,
     IMAGE_TOPIC,
     QUERY_ACTION,
     TREE_STATUS_TOPIC,
@@ -41,7 +40,7 @@ from robokudo.application.server.protocol import (
     service_response,
     status,
 )
-from robokudo.application.service import AnsweringService
+from robokudo.application.server.services import Service
 
 MAX_OPEN_GOALS = 64
 """Goals one client may have open (queued or running) at a time."""
@@ -51,7 +50,7 @@ MAX_SUBSCRIPTIONS = 32
 
 TOPICS = (TREE_STATUS_TOPIC, BELIEFS_TOPIC, IMAGE_TOPIC, DEPTH_TOPIC)
 
-Services = dict[str, Callable[[AnsweringService, str], dict[str, Any]]]
+Services = Mapping[str, Service]
 
 
 class Subscribers:
@@ -194,10 +193,11 @@ class Session:
         handler = self.services.get(name)
         if handler is None:
             raise ProtocolError(f"unknown service {name!r}; this server has {', '.join(self.services)}")
-        query = message.get("args", {}).get(GOAL_QUERY_FIELD)
-        if not isinstance(query, str):
-            raise ProtocolError(f"service {name!r} needs the argument {GOAL_QUERY_FIELD!r}: the query text")
-        future = self.goals.call(lambda service: handler(service, query))
+        arguments = message.get("args", {})
+        problem = handler.problem(name, arguments)
+        if problem is not None:
+            raise ProtocolError(problem)
+        future = self.goals.call(lambda service: handler.handler(service, arguments))
         call = asyncio.create_task(self._respond(name, message.get("id"), future))
         self._calls.add(call)  # the loop keeps only weak references to tasks
         call.add_done_callback(self._calls.discard)
