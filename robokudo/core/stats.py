@@ -3,31 +3,38 @@
 from __future__ import annotations
 
 import statistics
-from collections import deque
 from dataclasses import dataclass, field
 
 
 @dataclass
 class RunStats:
     """Durations of an annotator's runs: count, total, maximum and the last; keeps the most recent ``window``
-    samples for the median."""
+    samples for the median.
+
+    Recording is on every node's tick path, so it only updates counters and overwrites one slot of a ring
+    buffer; the median is computed when asked."""
 
     window: int = 1000
     count: int = 0
     max_seconds: float = 0.0
     total_seconds: float = 0.0
     last_seconds: float = 0.0
-    _recent: deque[float] = field(default_factory=deque, repr=False)
+    _recent: list[float] = field(default_factory=list, repr=False)
+    _oldest: int = field(default=0, repr=False)  # index of the oldest sample once the window is full
 
     def record(self, seconds: float) -> None:
         """Add one run's duration."""
         self.count += 1
         self.total_seconds += seconds
         self.last_seconds = seconds
-        self.max_seconds = max(self.max_seconds, seconds)
-        self._recent.append(seconds)
-        if len(self._recent) > self.window:
-            self._recent.popleft()
+        if seconds > self.max_seconds:
+            self.max_seconds = seconds
+        recent = self._recent
+        if len(recent) < self.window:
+            recent.append(seconds)
+        elif recent:
+            recent[self._oldest] = seconds
+            self._oldest = (self._oldest + 1) % len(recent)
 
     @property
     def median_seconds(self) -> float:
