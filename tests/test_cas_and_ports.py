@@ -62,6 +62,22 @@ def test_annotators_in_nested_pipelines_use_their_own_cas_and_reach_others_by_na
     assert seen["own"] is inner.cas and seen["outer"] is outer.cas
 
 
+def test_an_annotator_moved_to_another_pipeline_writes_to_that_pipelines_cas() -> None:
+    writer = annotator_class("Writer", outputs=[Plane])()
+    group = py_trees.composites.Sequence("group", memory=True, children=[writer])
+    first, second = Pipeline("first", [group]), Pipeline("second", [])
+    first.tick_once()
+    assert len(first.cas.annotations(Plane)) == 1
+    first.remove_child(group)
+    second.add_child(group)
+    second.tick_once()
+    assert len(second.cas.annotations(Plane)) == 1
+    group.remove_child(writer)
+    first.add_child(writer)
+    first.tick_once()
+    assert len(first.cas.annotations(Plane)) == 1 and writer.cas is first.cas
+
+
 def test_cross_pipeline_lookup_of_unknown_name_lists_the_pipelines() -> None:
     def look(self) -> None:
         self.cas_of("nowhere")

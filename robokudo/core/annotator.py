@@ -85,6 +85,8 @@ class Annotator(Explained, py_trees.behaviour.Behaviour):
         """Where this annotator keeps its expensive objects (loaded models); a tree builder may hand every node
         one pool shared by many trees (:mod:`robokudo.core.resources`)."""
         self._run: _Run | None = None
+        self._path_to_pipeline: tuple[py_trees.behaviour.Behaviour, ...] = ()  # parent, ..., enclosing Pipeline
+        self._pipeline: Pipeline | None = None
 
     # ------------------------------------------------------------------ to be implemented by experts
 
@@ -97,9 +99,26 @@ class Annotator(Explained, py_trees.behaviour.Behaviour):
     @property
     def cas(self) -> CAS:
         """The CAS of the nearest Pipeline above this annotator."""
+        # Every run looks this up; re-walking the tree costs an ABC isinstance per ancestor, so the ancestors found
+        # last time are kept and only checked to still be this node's chain of parents.
+        node: py_trees.behaviour.Behaviour = self
+        for ancestor in self._path_to_pipeline:
+            if node.parent is not ancestor:
+                break
+            node = ancestor
+        else:
+            if self._pipeline is not None:
+                return self._pipeline.cas
         pipeline = enclosing_pipeline(self)
         if pipeline is None:
             raise StructureError(f"annotator {self.name!r} is not inside a Pipeline, so it has no CAS")
+        path = []
+        ancestor = self.parent
+        while ancestor is not pipeline:
+            path.append(ancestor)
+            ancestor = ancestor.parent
+        path.append(pipeline)
+        self._path_to_pipeline, self._pipeline = tuple(path), pipeline
         return pipeline.cas
 
     def cas_of(self, pipeline_name: str) -> CAS:
@@ -111,8 +130,7 @@ class Annotator(Explained, py_trees.behaviour.Behaviour):
 
     def update(self) -> Status:
         """Run ``analyse`` on the CAS and commit its writes when it succeeds."""
-        parent = self.parent
-        run = _Run(parent.cas if isinstance(parent, Pipeline) else self.cas, None)
+        run = _Run(self.cas, None)
         status, message, elapsed = self._execute(run)
         self.stats.record(elapsed)
         if status is _SUCCESS and run.writes:
