@@ -15,9 +15,11 @@ Parts (each selectable; no part flag runs them all), each printing its goal and 
   running track task; also each tick's own run time and how many ticks ran longer than the period. Goal: p99
   <= 5 ms.
 * ``--memory``: the server's resident memory after 100 and after 10,000 goals sent one after the other. The goals
-  are cheap ones (``detect {obj: {type: Milk}, timeout: 0s}``: parsed, planned, the tree built and swapped into the
-  slot, answered from memory as the deadline passed) with a real detect run every ``--real-every`` goals. Goal:
-  growth <= 10%.
+  are cheap ones (``detect {obj: {color: red, location: anywhere}, timeout: 0s}``: parsed, planned, the tree built
+  and swapped into the slot, where it runs one tick before the passed deadline cancels it and the answer comes
+  from memory) with a real detect run every ``--real-every`` goals. Goal: growth <= 10%. Then, on the same
+  server, ``--ocr-goals`` goals whose tree reads text ("find milk in fridge"): MiB added per goal (each TextReader
+  builds its own OCR engine). A workload stops early when the server's RSS passes ``--memory-cap-mib``.
 
 The server is always a separate process and the clients speak the rosbridge protocol (``websockets``), so the parts
 depend only on the protocol. Only ``--jitter`` starts the server through this script's ``--serve-ticks`` mode, the
@@ -58,8 +60,10 @@ TREE_STATUS = "/robokudo/tree_status"
 START_LIMIT = 180.0
 RECEIVE_LIMIT = 120.0
 TRACK_QUERIES = ("track the milk", "track red objects anywhere")
-CHEAP_GOAL = "detect {obj: {type: Milk}, timeout: 0s}"
+CHEAP_GOAL = "detect {obj: {color: red, location: anywhere}, timeout: 0s}"
 REAL_GOAL = "detect {obj: {location: anywhere}}"
+OCR_GOAL = "find milk in fridge"
+"""A goal whose tree reads text (TextReader): measured on its own, as each such goal adds memory (see the part)."""
 ANSWER_STEP = "AnswerStep"
 
 
@@ -415,32 +419,49 @@ def jitter_part(args: argparse.Namespace, environment: dict[str, str]) -> None:
 # ------------------------------------------------------------------------------------------- memory
 
 
-def memory_part(args: argparse.Namespace, environment: dict[str, str]) -> None:
-    checkpoints = sorted(
-        {100, *(c for c in (1000, args.memory_goals // 2) if c < args.memory_goals), args.memory_goals}
-    )
-    print(
-        f"memory: server RSS over {args.memory_goals} goals ({CHEAP_GOAL!r}, every {args.real_every}th {REAL_GOAL!r})"
-    )
-    rss: dict[int, float] = {}
+def goals_rss(
+    server: Server, connection: ClientConnection, queries: list[str], checkpoints: set[int], cap_mib: float
+) -> tuple[dict[int, float], dict[int, int]]:
+    """Send ``queries`` one after the other; the server's RSS (MiB) at each checkpoint (goal number) and the count of
+    each terminal status. Stops early once the RSS passes ``cap_mib`` (the last goal is then a checkpoint)."""
+    rss: dict[int, float] = {0: server.rss_mib()}
     statuses: dict[int, int] = {}
+    started = time.perf_counter()
+    for number, query in enumerate(queries, start=1):
+        send_goal(connection, f"m{number}", query)
+        status = int(result_of(connection, f"m{number}")["status"])
+        statuses[status] = statuses.get(status, 0) + 1
+        over = number % 50 == 0 and server.rss_mib() > cap_mib
+        if number in checkpoints or over or number == len(queries):
+            rss[number] = server.rss_mib()
+            print(f"  after {number:>6} goals: RSS {rss[number]:.1f} MiB  ({time.perf_counter() - started:.0f} s)")
+        if over:
+            print(f"  stopped: the RSS passed --memory-cap-mib {cap_mib:g}")
+            break
+    return rss, statuses
+
+
+def memory_part(args: argparse.Namespace, environment: dict[str, str]) -> None:
+    goals = args.memory_goals
+    checkpoints = {100, *(c for c in (1000, goals // 2) if c < goals), goals}
+    print(f"memory: server RSS over {goals} goals ({CHEAP_GOAL!r}, every {args.real_every}th {REAL_GOAL!r})")
+    queries = [REAL_GOAL if n % args.real_every == 0 else CHEAP_GOAL for n in range(1, goals + 1)]
     with running(serve_command(), environment) as server, connect(server.url) as connection:
-        started = time.perf_counter()
-        for number in range(1, args.memory_goals + 1):
-            query = REAL_GOAL if number % args.real_every == 0 else CHEAP_GOAL
-            send_goal(connection, f"m{number}", query)
-            status = int(result_of(connection, f"m{number}")["status"])
-            statuses[status] = statuses.get(status, 0) + 1
-            if number in checkpoints:
-                rss[number] = server.rss_mib()
-                print(f"  after {number:>6} goals: RSS {rss[number]:.1f} MiB  ({time.perf_counter() - started:.0f} s)")
-    growth = rss[args.memory_goals] / rss[100] - 1
-    print(f"  goal statuses: {dict(sorted(statuses.items()))}")
-    print(f"  growth from 100 to {args.memory_goals} goals: {growth:+.1%}  (goal <= 10%: {verdict(growth <= 0.10)})")
-    half = args.memory_goals // 2
-    if half in rss and half > 100:  # a leak keeps growing; warming up (allocator, caches, first runs) levels off
-        late = rss[args.memory_goals] / rss[half] - 1
-        print(f"  growth over the second half ({half} to {args.memory_goals} goals): {late:+.1%}")
+        rss, statuses = goals_rss(server, connection, queries, checkpoints, args.memory_cap_mib)
+        last = max(rss)
+        print(f"  goal statuses: {dict(sorted(statuses.items()))}")
+        if 100 in rss and last > 100:
+            growth = rss[last] / rss[100] - 1
+            met = verdict(growth <= 0.10 and last == goals)
+            print(f"  growth from 100 to {last} goals: {growth:+.1%}  (goal <= 10%: {met})")
+        half = goals // 2
+        if half in rss and half > 100 and last == goals:  # a leak keeps growing; warming up levels off
+            print(f"  growth over the second half ({half} to {goals} goals): {rss[goals] / rss[half] - 1:+.1%}")
+        if args.ocr_goals:
+            print(f"  then {args.ocr_goals} goals {OCR_GOAL!r} (their trees read text) on the same server:")
+            ocr, _ = goals_rss(server, connection, [OCR_GOAL] * args.ocr_goals, set(), args.memory_cap_mib)
+            added = (ocr[max(ocr)] - ocr[0]) / max(ocr)
+            print(f"  {added:+.1f} MiB per goal reading text")
 
 
 # ------------------------------------------------------------------------------------------- main
@@ -463,6 +484,8 @@ def main() -> int:
     parser.add_argument("--clients", type=int, default=8, help="jitter: subscribed clients (8)")
     parser.add_argument("--memory-goals", type=int, default=10_000, help="memory: goals (10000)")
     parser.add_argument("--real-every", type=int, default=50, help="memory: every Nth goal is a real detect (50)")
+    parser.add_argument("--ocr-goals", type=int, default=50, help="memory: then goals reading text (50; 0: none)")
+    parser.add_argument("--memory-cap-mib", type=float, default=8000, help="memory: stop above this RSS (8000)")
     parser.add_argument("--serve-ticks", type=Path, help=argparse.SUPPRESS)
     args, serve_options = parser.parse_known_args()
     if args.serve_ticks is not None:
