@@ -175,9 +175,15 @@ def test_fallback_branches_are_in_rank_order_with_their_own_steps(kb: KnowledgeB
     result = plan_query(parse_query("find the red thing"), kb, sensor_source(kb, None))
     (segmenters,) = [u for u in result.plan.units() if isinstance(u, Alternatives)]
     providers = [branch[-1].annotator for branch in segmenters.branches]
-    assert providers == ["ClusterExtractor", "ImageRegionSegmenter"]  # reliability first
-    depth_branch = [s.annotator for s in segmenters.branches[0]]
-    assert depth_branch == ["SupportPlaneSegmenter", "ClusterExtractor"]  # the plane only this branch needs
+    assert providers == ["ClutterSegmenter", "ClusterExtractor", "ImageRegionSegmenter"]  # reliability first
+    # the plane only the depth segmenters need is in each of their branches: when it is not found, the next
+    # branch (in the end the image segmenter) still runs
+    depth_branches = [[s.annotator for s in branch] for branch in segmenters.branches[:2]]
+    assert depth_branches == [
+        ["SupportPlaneSegmenter", "ClutterSegmenter"],
+        ["SupportPlaneSegmenter", "ClusterExtractor"],
+    ]
+    assert [s.annotator for s in segmenters.branches[2]] == ["ImageRegionSegmenter"]
     tree = build_tree(result.plan)
     fallback = next(n for n in tree.iterate() if isinstance(n, py_trees.composites.Selector))
     assert "ObjectHypothesis" in fallback.name and "rank order" in fallback.reason

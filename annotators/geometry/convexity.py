@@ -1,0 +1,247 @@
+"""Convexity-based grouping of surface patches on the organized grid (the LCCP idea on grid cells).
+
+Objects are, to a first approximation, convex: the faces of one object meet at convex edges, while where two
+objects meet - a can standing on a box, a box leaning on another - their surfaces form a concave crease
+(Stein et al., "Object partitioning using local convexity", CVPR 2014). Here the surface is cut into small patches:
+cells of ``cell`` x ``cell`` pixels of the grid, split where depth jumps. Each patch gets a plane fit (centroid and
+normal, which is robust to sensor noise where per-pixel normals are not); two touching patches are connected
+unless their connection is concave, ``(n_a - n_b) . (c_a - c_b) / |c_a - c_b| < -concavity``, which is about 0 on
+one plane, positive across a convex edge and negative across a concave one; the connected groups are the objects.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import numpy as np
+from scipy import sparse
+from scipy.sparse import csgraph
+
+from annotators.geometry.grid_segmentation import grow_labels, pixel_footprint, touching_pairs
+
+
+def grid_patches(surfaces: np.ndarray, cell: int) -> np.ndarray:
+    """Patch labels (int32, 0 = none, 1..n): each labelled surface of ``surfaces`` cut into ``cell`` x ``cell``
+    grid cells; a cell that two surfaces share gives one patch to each."""
+    rows, cols = surfaces.shape
+    across = -(-cols // cell)
+    cell_id = (np.arange(rows)[:, None] // cell) * across + (np.arange(cols)[None, :] // cell)
+    key = surfaces.astype(np.int64) * (across * (-(-rows // cell))) + cell_id
+    inside = surfaces > 0
+    patches = np.zeros(surfaces.shape, dtype=np.int32)
+    _, dense = np.unique(key[inside], return_inverse=True)
+    patches[inside] = dense.reshape(-1).astype(np.int32) + 1
+    return patches
+
+
+def split_by_normals(patches: np.ndarray, normals: np.ndarray, spread: float) -> np.ndarray:
+    """Patches whose pixel normals spread (RMS distance from their mean normal) by more than ``spread`` cut in two:
+    the pixels on either side of the mean along the direction the normals vary most. A cell lying across the edge
+    of a box or across the crease between two objects so becomes two patches, one per surface. Pixels without a
+    normal are left out (0). Labels 1..n."""
+    count = int(patches.max(initial=0)) + 1
+    known = (patches > 0) & np.isfinite(normals[..., 0])
+    labels = patches[known]
+    unit = normals[known].astype(np.float64)
+    sizes = np.maximum(np.bincount(labels, minlength=count), 1).astype(np.float64)
+    mean = np.stack([np.bincount(labels, unit[:, i], count) for i in range(3)], axis=1) / sizes[:, None]
+    centred = unit - mean[labels]
+    second = np.empty((count, 3, 3))
+    for i in range(3):
+        for j in range(i, 3):
+            second[:, i, j] = second[:, j, i] = np.bincount(labels, centred[:, i] * centred[:, j], count) / sizes
+    values, vectors = np.linalg.eigh(second)
+    wide = np.sqrt(np.clip(values.sum(axis=1), 0, None)) > spread
+    side = np.einsum("ij,ij->i", centred, vectors[labels, :, 2]) > 0
+    split = np.zeros(patches.shape, dtype=np.int64)
+    split[known] = labels * 2 + (side & wide[labels])
+    result = np.zeros(patches.shape, dtype=np.int32)
+    _, dense = np.unique(split[known], return_inverse=True)
+    result[known] = dense.reshape(-1).astype(np.int32) + 1
+    return result
+
+
+@dataclass(frozen=True)
+class ConvexityRules:
+    """Thresholds of :func:`convex_groups` (degrees, unit-normal differences, shares, pixels, points)."""
+
+    smooth_degrees: float = 20.0
+    concavity: float = 0.17
+    convex_share: float = 0.5
+    min_patch: int = 6
+    min_face: int = 72
+    min_votes: int = 2
+    gap_width: float = 2.0
+    close_factor: float = 3.0
+
+
+@dataclass(frozen=True, eq=False)
+class PatchPlanes:
+    """Per patch (index = label - 1): point count, centroid (Nx3) and unit normal facing the camera (Nx3)."""
+
+    counts: np.ndarray
+    centroids: np.ndarray
+    normals: np.ndarray
+
+
+def patch_planes(patches: np.ndarray, points: np.ndarray) -> PatchPlanes:
+    """Plane fits of all patches at once (sums by ``bincount``, one batched 3x3 eigen-decomposition)."""
+    count = int(patches.max(initial=0))
+    inside = patches > 0
+    labels = patches[inside] - 1
+    xyz = points[inside].astype(np.float64)
+    shift = xyz.mean(axis=0) if xyz.size else np.zeros(3)
+    xyz -= shift
+    counts = np.bincount(labels, minlength=count).astype(np.float64)
+    safe = np.maximum(counts, 1.0)
+    means = np.stack([np.bincount(labels, xyz[:, i], count) for i in range(3)], axis=1) / safe[:, None]
+    second = np.empty((count, 3, 3))
+    for i in range(3):
+        for j in range(i, 3):
+            second[:, i, j] = second[:, j, i] = np.bincount(labels, xyz[:, i] * xyz[:, j], count) / safe
+    covariance = second - means[:, :, None] * means[:, None, :]
+    normals = np.linalg.eigh(covariance)[1][:, :, 0]
+    centroids = means + shift
+    normals *= np.where(np.einsum("ij,ij->i", normals, centroids) > 0, -1.0, 1.0)[:, None]
+    return PatchPlanes(counts.astype(np.int64), centroids, normals)
+
+
+def connection_convexity(planes: PatchPlanes, pairs: np.ndarray) -> np.ndarray:
+    """For Kx2 patch labels: ``(n_a - n_b) . (c_a - c_b) / |c_a - c_b|`` (positive convex, negative concave)."""
+    a, b = pairs[:, 0] - 1, pairs[:, 1] - 1
+    offset = planes.centroids[a] - planes.centroids[b]
+    length = np.linalg.norm(offset, axis=1)
+    with np.errstate(invalid="ignore", divide="ignore"):
+        value = np.einsum("ij,ij->i", planes.normals[a] - planes.normals[b], offset) / length
+    return np.nan_to_num(value)
+
+
+def close_in_space(
+    patches: np.ndarray, planes: PatchPlanes, pairs: np.ndarray, footprint: float, close_factor: float
+) -> np.ndarray:
+    """For Kx2 patch labels: are the two centroids at most ``close_factor`` times as far apart in 3-D as their
+    distance on the grid (pixels times the pixel ``footprint`` times depth) would be on a surface facing the camera?
+    Patches touching on the grid across a depth jump (an object and what is behind it) are not."""
+    if pairs.size == 0:
+        return np.zeros(0, dtype=bool)
+    inside = patches > 0
+    rows, cols = np.nonzero(inside)
+    labels = patches[inside]
+    counts = np.maximum(np.bincount(labels, minlength=planes.counts.size + 1), 1)
+    pixel = np.stack([np.bincount(labels, rows, counts.size), np.bincount(labels, cols, counts.size)], axis=1)
+    pixel /= counts[:, None]
+    a, b = pairs[:, 0], pairs[:, 1]
+    on_grid = np.linalg.norm(pixel[a] - pixel[b], axis=1)
+    depth = np.minimum(planes.centroids[a - 1, 2], planes.centroids[b - 1, 2])
+    in_space = np.linalg.norm(planes.centroids[a - 1] - planes.centroids[b - 1], axis=1)
+    return in_space <= close_factor * np.maximum(on_grid, 1.0) * footprint * depth
+
+
+def convex_groups(
+    patches: np.ndarray,
+    points: np.ndarray,
+    rules: ConvexityRules,
+    between: np.ndarray | None = None,
+) -> tuple[np.ndarray, np.ndarray]:
+    """Object labels and face labels (int32, 0 = none, 1..n) from surface patches in two steps.
+
+    1. *Faces*: patches joined along smooth connections - normals within ``rules.smooth_degrees`` and the line
+       between the centroids within that angle of both tangent planes (one surface going on, flat or gently
+       curved, not a step between parallel surfaces).
+    2. *Objects*: faces joined where they meet convexly. Every connection between two faces votes: convex when
+       ``(n_a - n_b) . (c_a - c_b) / |c_a - c_b| >= -rules.concavity`` and not a step; two faces join when at
+       least ``rules.convex_share`` of their votes are convex, so a few noisy patches along a crease decide nothing.
+
+    Patches touch when they are 4-neighbours once grown by up to ``rules.gap_width`` pixels into the unlabelled
+    pixels between them that ``between`` allows (HxW bool; default: every pixel with a point) and their centroids
+    are close in 3-D (:func:`close_in_space`). Patches of fewer than ``rules.min_patch`` points have no
+    trustworthy plane: they are left out (0) for the caller.
+    """
+    planes = patch_planes(patches, points)
+    count = planes.counts.size + 1
+    usable = np.concatenate([[False], planes.counts >= rules.min_patch])
+    kept = np.where(usable[patches], patches, 0)
+    between = np.isfinite(points[..., 2]) if between is None else between
+    pairs = touching_pairs(grow_labels(kept, between | (kept > 0), rules.gap_width))
+    pairs = pairs[close_in_space(patches, planes, pairs, pixel_footprint(points), rules.close_factor)]
+    a, b = pairs[:, 0] - 1, pairs[:, 1] - 1
+    offset = planes.centroids[a] - planes.centroids[b]
+    with np.errstate(invalid="ignore", divide="ignore"):
+        direction = np.nan_to_num(offset / np.linalg.norm(offset, axis=1, keepdims=True))
+    along = np.cos(np.radians(rules.smooth_degrees))
+    across = np.sin(np.radians(rules.smooth_degrees))
+    parallel = np.einsum("ij,ij->i", planes.normals[a], planes.normals[b]) >= along
+    in_planes = (np.abs(np.einsum("ij,ij->i", direction, planes.normals[a])) <= across) & (
+        np.abs(np.einsum("ij,ij->i", direction, planes.normals[b])) <= across
+    )
+    smooth = parallel & in_planes
+    faces = _components(pairs[smooth], count)
+
+    face_a, face_b = faces[pairs[:, 0]], faces[pairs[:, 1]]
+    apart = face_a != face_b
+    convex = (connection_convexity(planes, pairs) >= -rules.concavity) & ~parallel
+    low, high = np.minimum(face_a, face_b)[apart], np.maximum(face_a, face_b)[apart]
+    keys, inverse = np.unique(low * count + high, return_inverse=True)
+    votes = np.bincount(inverse, minlength=keys.size)
+    share = np.bincount(inverse, weights=convex[apart], minlength=keys.size) / np.maximum(votes, 1)
+    first, second = keys // count, keys % count
+    face_sizes = np.bincount(faces, weights=planes_sizes(planes, count), minlength=count)
+    large = face_sizes >= rules.min_face
+    both_large = large[first] & large[second]
+    agree = (share > rules.convex_share) & ((share * votes >= rules.min_votes) | ~both_large)
+    apart_pairs = np.column_stack([first, second])[(share <= rules.convex_share) & both_large]
+    order = np.argsort(-(share * votes)[agree], kind="stable")
+    groups = join_unless_apart(count, np.column_stack([first, second])[agree][order], apart_pairs)
+    objects = groups[faces]
+
+    return _dense(objects, usable)[kept], _dense(faces, usable)[kept]
+
+
+def _dense(groups: np.ndarray, usable: np.ndarray) -> np.ndarray:
+    """Per patch label: its group renumbered 1..n over the usable patches (0 for the others)."""
+    present = np.flatnonzero(usable)
+    renumber = np.zeros(groups.size, dtype=np.int32)
+    _, dense = np.unique(groups[present], return_inverse=True)
+    renumber[present] = dense.reshape(-1).astype(np.int32) + 1
+    return renumber
+
+
+def join_unless_apart(count: int, pairs: np.ndarray, apart: np.ndarray) -> np.ndarray:
+    """Group labels of ``count`` nodes: the ``pairs`` (Kx2) joined in the order given, except where joining would
+    put the two nodes of an ``apart`` pair (Mx2) into one group - direct evidence that two faces meet concavely
+    outweighs an indirect path between them through slivers along the crease."""
+    parent = list(range(count))
+    keep_apart: dict[int, set[int]] = {}
+    for a, b in apart.tolist():
+        keep_apart.setdefault(a, set()).add(b)
+        keep_apart.setdefault(b, set()).add(a)
+
+    def root(node: int) -> int:
+        while parent[node] != node:
+            parent[node] = parent[parent[node]]
+            node = parent[node]
+        return node
+
+    for a, b in pairs.tolist():
+        ra, rb = root(a), root(b)
+        if ra == rb:
+            continue
+        against_a, against_b = keep_apart.get(ra, set()), keep_apart.get(rb, set())
+        if any(root(n) == rb for n in against_a) or any(root(n) == ra for n in against_b):
+            continue
+        parent[rb] = ra
+        keep_apart[ra] = against_a | against_b
+    return np.array([root(node) for node in range(count)], dtype=np.int64)
+
+
+def planes_sizes(planes: PatchPlanes, count: int) -> np.ndarray:
+    """Point counts of patches 0..count-1 (patch 0, no patch, has none)."""
+    sizes = np.zeros(count)
+    sizes[1 : planes.counts.size + 1] = planes.counts
+    return sizes
+
+
+def _components(pairs: np.ndarray, count: int) -> np.ndarray:
+    """The connected component of each of ``count`` nodes of the graph with the edges ``pairs`` (Kx2)."""
+    graph = sparse.csr_matrix((np.ones(pairs.shape[0]), (pairs[:, 0], pairs[:, 1])), shape=(count, count))
+    return csgraph.connected_components(graph, directed=False)[1].astype(np.int64)
