@@ -104,6 +104,14 @@ def _harmonic(precision: float, recall: float) -> float:
     return 2 * precision * recall / (precision + recall) if precision + recall > 0 else 0.0
 
 
+def _share(hits: float, total: float, other_total: float) -> float:
+    """``hits / total``; without outline pixels 1 when the other labelling has none either (both fill the
+    image), else 0."""
+    if total:
+        return hits / total
+    return 1.0 if not other_total else 0.0
+
+
 def _dense(labels: np.ndarray) -> tuple[np.ndarray, int]:
     """Labels renumbered 1..n in increasing order (0 stays 0), and n."""
     values, inverse = np.unique(labels, return_inverse=True)
@@ -125,6 +133,7 @@ def _boxes(labels: np.ndarray, count: int) -> np.ndarray:
 
 def box_ious(first: np.ndarray, second: np.ndarray) -> np.ndarray:
     """The IoU of every pair of boxes (Nx4 by Mx4, ``(x0, y0, x1, y1)`` with x1/y1 exclusive) as an NxM array."""
+    first, second = np.asarray(first, dtype=np.float64), np.asarray(second, dtype=np.float64)
     x0 = np.maximum(first[:, None, 0], second[None, :, 0])
     y0 = np.maximum(first[:, None, 1], second[None, :, 1])
     x1 = np.minimum(first[:, None, 2], second[None, :, 2])
@@ -243,8 +252,8 @@ def score_segmentation(
         pair_recall = np.nan_to_num(object_hits / truth_outline[:, None])
         boundary_f = np.nan_to_num(2 * pair_precision * pair_recall / (pair_precision + pair_recall))
     hits_precision, hits_recall, _ = _matched_sums(boundary_f, segment_hits, object_hits)
-    b_precision = hits_precision / predicted_outline.sum() if predicted_outline.sum() else 0.0
-    b_recall = hits_recall / truth_outline.sum() if truth_outline.sum() else 0.0
+    b_precision = _share(hits_precision, predicted_outline.sum(), truth_outline.sum())
+    b_recall = _share(hits_recall, truth_outline.sum(), predicted_outline.sum())
     return SegmentationScore(
         objects=objects,
         segments=segments,
