@@ -34,11 +34,14 @@ from annotators.cloud.point_cloud import cloud_problem
 from annotators.geometry.convexity import ConvexityRules, convex_groups, grid_patches, split_by_normals
 from annotators.geometry.grid_segmentation import (
     MergeRules,
+    boundaries,
     bounding_box,
+    chroma_image,
     color_edges,
     depth_seams,
     grow_labels,
     grow_on_surface,
+    join_unless_apart,
     label_parts,
     merge_parts,
 )
@@ -56,7 +59,7 @@ class ClutterParameters(ClusterParameters):
 
     cell: int = 6
     min_patch: int = 6
-    concavity: float = 0.17
+    concave_bending: float = 20.0
     use_color_edges: bool = False
     normal_step: int = 2
     normal_smoothing: int = 3
@@ -64,6 +67,11 @@ class ClutterParameters(ClusterParameters):
     smooth_degrees: float = 20.0
     convex_share: float = 0.5
     complete_occluded: bool = True
+    use_color: bool = True
+    color_faces: bool = False
+    chroma_difference: float = 30.0
+    concave_share: float = 0.25
+    creased_share: float = 0.2
     gap_width: float = 2.0
     close_factor: float = 3.0
 
@@ -71,11 +79,13 @@ class ClutterParameters(ClusterParameters):
         """The thresholds of :func:`annotators.geometry.convexity.convex_groups`."""
         return ConvexityRules(
             smooth_degrees=self.smooth_degrees,
-            concavity=self.concavity,
+            concave_bending=self.concave_bending,
             convex_share=self.convex_share,
             min_patch=self.min_patch,
             gap_width=self.gap_width,
             close_factor=self.close_factor,
+            chroma_difference=self.chroma_difference,
+            concave_share=self.concave_share,
         )
 
     def merge_rules(self) -> MergeRules:
@@ -109,17 +119,73 @@ def segment_clutter(
     normals = grid_normals(grid, p.normal_step, p.normal_smoothing, p.jump_absolute, p.jump_relative)
     surfaces = label_parts(region & ~cuts, 1)
     patches = split_by_normals(grid_patches(surfaces, p.cell), normals, p.normal_spread)
-    labels, faces = convex_groups(patches, grid, p.convexity_rules(), region & ~seams)
+    chroma = None
+    if colors is not None and p.color_faces:
+        chroma = chroma_image(np.ascontiguousarray(colors[::step, ::step][y0:y1, x0:x1]))[..., :2]
+    labels, faces = convex_groups(patches, grid, p.convexity_rules(), region & ~seams, chroma)
     labels = grow_labels(labels, region & ~seams, p.grow_distance / step)
     labels = grow_on_surface(labels, region, depth, p.jump_absolute, p.jump_relative)
     basis = plane_basis(np.asarray(model[:3], dtype=np.float64)).T.astype(np.float32)
     to_plane = np.column_stack([basis, np.asarray(model[:3], dtype=np.float32)])
     offset = np.array([0.0, 0.0, model[3]], dtype=np.float32)
     crop_points = grid.reshape(-1, 3)
-    labels = merge_parts(labels, depth, lambda pixels: crop_points[pixels] @ to_plane + offset, p.merge_rules())
+    on_plane = lambda pixels: crop_points[pixels] @ to_plane + offset  # noqa: E731
+    labels = merge_parts(labels, depth, on_plane, p.merge_rules())
+    if colors is not None and p.use_color:
+        colors_crop = np.ascontiguousarray(colors[::step, ::step][y0:y1, x0:x1])
+        labels = split_by_color(labels, grid, normals, colors_crop, p)
     if p.complete_occluded:
         labels = join_occluded(labels, faces, grid, p.jump_absolute, p.jump_relative, OcclusionRules())
     return full_resolution_segments(labels, depth, (x0, y0, x1, y1), step, points, mask, model, p)
+
+
+def split_by_color(
+    labels: np.ndarray, grid: np.ndarray, normals: np.ndarray, colors: np.ndarray, p: ClutterParameters
+) -> np.ndarray:
+    """Objects split where a hue edge and a concave crease coincide: two objects whose surfaces continue one
+    another (a can standing on a can with its side flush with the lower one's front, boxes stacked flush) are one
+    convex group, but the colour changes between them and their boundary folds inward along part of its length.
+
+    Each object is cut at hue edges into pieces; pieces whose shared boundary is creased (a share of at least
+    ``p.creased_share`` of it concave, the surfaces not coplanar) must stay apart, and everything else of the
+    object joins again - longest shared boundaries first, so a piece goes with the side it shares most with. A
+    print on a box (no crease) or the pieces of one object seen on both sides of an occluder never split.
+    """
+    step = max(1, p.stride)
+    objects = labels > 0
+    edges = color_edges(colors, p.edge_low, p.edge_high) & objects
+    parts = label_parts(objects & ~edges, max(1, p.min_part_points // (step * step)))
+    key = labels.astype(np.int64) * (int(parts.max(initial=0)) + 1) + parts
+    pieces = np.zeros(labels.shape, dtype=np.int32)
+    _, dense = np.unique(key[parts > 0], return_inverse=True)
+    pieces[parts > 0] = dense.reshape(-1).astype(np.int32) + 1
+    owner = np.zeros(int(pieces.max(initial=0)) + 1, dtype=np.int64)
+    owner[pieces[parts > 0]] = labels[parts > 0]
+    pieces = grow_labels(pieces, objects, p.grow_distance / step)
+    pieces[owner[pieces] != labels] = 0
+    surface = boundaries(pieces, grid, normals, p.jump_absolute, p.jump_relative)
+    rules = p.merge_rules()
+    creased = (
+        (surface.creased > p.creased_share)
+        & (surface.convexity < rules.concave)
+        & (surface.alignment < rules.coplanar_cosine)
+        & (owner[surface.pairs[:, 0]] == owner[surface.pairs[:, 1]])
+    )
+    if not creased.any():
+        return labels
+    same_object = owner[surface.pairs[:, 0]] == owner[surface.pairs[:, 1]]
+    touching = surface.pairs[same_object][np.argsort(-surface.length[same_object], kind="stable")]
+    first_piece = np.full(owner.size, -1, dtype=np.int64)
+    for piece in range(owner.size - 1, 0, -1):
+        first_piece[owner[piece]] = piece
+    rest = np.arange(1, owner.size)
+    chained = np.column_stack([first_piece[owner[rest]], rest])
+    groups = join_unless_apart(owner.size, np.concatenate([touching, chained]), surface.pairs[creased])
+    split = np.where(pieces > 0, groups[pieces], 0)
+    result = np.zeros(labels.shape, dtype=np.int32)
+    _, dense = np.unique(split[split > 0], return_inverse=True)
+    result[split > 0] = dense.reshape(-1).astype(np.int32) + 1
+    return grow_labels(result, objects, p.grow_distance / step)
 
 
 class ClutterSegmenter(Annotator):

@@ -17,7 +17,7 @@ import numpy as np
 from scipy import sparse
 from scipy.sparse import csgraph
 
-from annotators.geometry.grid_segmentation import grow_labels, pixel_footprint, touching_pairs
+from annotators.geometry.grid_segmentation import grow_labels, join_unless_apart, pixel_footprint, touching_pairs
 
 
 def grid_patches(surfaces: np.ndarray, cell: int) -> np.ndarray:
@@ -66,11 +66,13 @@ class ConvexityRules:
     """Thresholds of :func:`convex_groups` (degrees, unit-normal differences, shares, pixels, points)."""
 
     smooth_degrees: float = 20.0
-    concavity: float = 0.17
+    concave_bending: float = 20.0
     convex_share: float = 0.5
     min_patch: int = 6
     min_face: int = 72
     min_votes: int = 2
+    chroma_difference: float = 30.0
+    concave_share: float = 0.25
     gap_width: float = 2.0
     close_factor: float = 3.0
 
@@ -106,11 +108,12 @@ def patch_planes(patches: np.ndarray, points: np.ndarray) -> PatchPlanes:
     return PatchPlanes(counts.astype(np.int64), centroids, normals)
 
 
-def connection_convexity(planes: PatchPlanes, pairs: np.ndarray) -> np.ndarray:
-    """For Kx2 patch labels: ``(n_a - n_b) . (c_a - c_b) / |c_a - c_b|`` (positive convex, negative concave)."""
+def connection_bending(planes: PatchPlanes, pairs: np.ndarray) -> np.ndarray:
+    """For Kx2 patch labels: ``(n_a - n_b) . (c_a - c_b) / |c_a - c_b|^2``, how fast the surface turns between the
+    two patches (1/m; about 1/radius on a cylinder): positive convex, negative concave."""
     a, b = pairs[:, 0] - 1, pairs[:, 1] - 1
     offset = planes.centroids[a] - planes.centroids[b]
-    length = np.linalg.norm(offset, axis=1)
+    length = np.einsum("ij,ij->i", offset, offset)
     with np.errstate(invalid="ignore", divide="ignore"):
         value = np.einsum("ij,ij->i", planes.normals[a] - planes.normals[b], offset) / length
     return np.nan_to_num(value)
@@ -142,6 +145,7 @@ def convex_groups(
     points: np.ndarray,
     rules: ConvexityRules,
     between: np.ndarray | None = None,
+    chroma: np.ndarray | None = None,
 ) -> tuple[np.ndarray, np.ndarray]:
     """Object labels and face labels (int32, 0 = none, 1..n) from surface patches in two steps.
 
@@ -174,16 +178,32 @@ def convex_groups(
     in_planes = (np.abs(np.einsum("ij,ij->i", direction, planes.normals[a])) <= across) & (
         np.abs(np.einsum("ij,ij->i", direction, planes.normals[b])) <= across
     )
-    smooth = parallel & in_planes
-    faces = _components(pairs[smooth], count)
+    bending = connection_bending(planes, pairs)
+    concave = bending < -rules.concave_bending
+    continuous = parallel & in_planes & ~concave
+    same_look = np.ones(pairs.shape[0], dtype=bool)
+    if chroma is not None:
+        tone = patch_means(patches, chroma, count)
+        same_look = np.linalg.norm(tone[pairs[:, 0]] - tone[pairs[:, 1]], axis=1) <= rules.chroma_difference
+    faces = _components(pairs[continuous & same_look], count)
+    if chroma is not None:
+        # a printed surface breaks into many small faces of different colours: those join each other again
+        # (geometry only), so only larger regions of one colour stay apart where the colour changes
+        sizes = np.bincount(faces, weights=planes_sizes(planes, count), minlength=count)
+        small = sizes[faces] < rules.min_face
+        fragments = continuous & small[pairs[:, 0]] & small[pairs[:, 1]]
+        joined = np.concatenate([pairs[continuous & same_look], pairs[fragments]])
+        faces = _components(joined, count)
 
     face_a, face_b = faces[pairs[:, 0]], faces[pairs[:, 1]]
     apart = face_a != face_b
-    convex = (connection_convexity(planes, pairs) >= -rules.concavity) & ~parallel
+    convex = ~concave & (continuous | ~parallel)
     low, high = np.minimum(face_a, face_b)[apart], np.maximum(face_a, face_b)[apart]
     keys, inverse = np.unique(low * count + high, return_inverse=True)
     votes = np.bincount(inverse, minlength=keys.size)
     share = np.bincount(inverse, weights=convex[apart], minlength=keys.size) / np.maximum(votes, 1)
+    concave_share = np.bincount(inverse, weights=concave[apart], minlength=keys.size) / np.maximum(votes, 1)
+    share = np.where(concave_share > rules.concave_share, 0.0, share)
     first, second = keys // count, keys % count
     face_sizes = np.bincount(faces, weights=planes_sizes(planes, count), minlength=count)
     large = face_sizes >= rules.min_face
@@ -206,32 +226,16 @@ def _dense(groups: np.ndarray, usable: np.ndarray) -> np.ndarray:
     return renumber
 
 
-def join_unless_apart(count: int, pairs: np.ndarray, apart: np.ndarray) -> np.ndarray:
-    """Group labels of ``count`` nodes: the ``pairs`` (Kx2) joined in the order given, except where joining would
-    put the two nodes of an ``apart`` pair (Mx2) into one group - direct evidence that two faces meet concavely
-    outweighs an indirect path between them through slivers along the crease."""
-    parent = list(range(count))
-    keep_apart: dict[int, set[int]] = {}
-    for a, b in apart.tolist():
-        keep_apart.setdefault(a, set()).add(b)
-        keep_apart.setdefault(b, set()).add(a)
-
-    def root(node: int) -> int:
-        while parent[node] != node:
-            parent[node] = parent[parent[node]]
-            node = parent[node]
-        return node
-
-    for a, b in pairs.tolist():
-        ra, rb = root(a), root(b)
-        if ra == rb:
-            continue
-        against_a, against_b = keep_apart.get(ra, set()), keep_apart.get(rb, set())
-        if any(root(n) == rb for n in against_a) or any(root(n) == ra for n in against_b):
-            continue
-        parent[rb] = ra
-        keep_apart[ra] = against_a | against_b
-    return np.array([root(node) for node in range(count)], dtype=np.int64)
+def patch_means(patches: np.ndarray, values: np.ndarray, count: int) -> np.ndarray:
+    """``count`` x C: the mean of the HxWxC ``values`` over each patch label 0..count-1."""
+    inside = patches > 0
+    labels = patches[inside]
+    channels = values[inside].astype(np.float64)
+    sizes = np.maximum(np.bincount(labels, minlength=count), 1)
+    return (
+        np.stack([np.bincount(labels, channels[:, i], count) for i in range(channels.shape[1])], axis=1)
+        / sizes[:, None]
+    )
 
 
 def planes_sizes(planes: PatchPlanes, count: int) -> np.ndarray:

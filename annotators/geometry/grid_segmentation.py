@@ -266,7 +266,8 @@ class Boundaries:
     ``close_factor`` pixel footprints apart in 3-D (one surface going on, not two objects side by side a few
     millimetres apart in depth); over the continuous ones with known normals,
     ``alignment`` is the mean cosine between the two normals and ``convexity`` the mean of
-    ``(n_a - n_b) . (p_a - p_b) / |p_a - p_b|`` (positive across a convex edge, negative in a concave crease).
+    ``(n_a - n_b) . (p_a - p_b) / |p_a - p_b|`` (positive across a convex edge, negative in a concave crease);
+    ``creased`` is the share of those whose convexity is below ``-crease`` (a concave crease along that stretch).
     """
 
     pairs: np.ndarray
@@ -275,6 +276,7 @@ class Boundaries:
     close: np.ndarray
     alignment: np.ndarray
     convexity: np.ndarray
+    creased: np.ndarray
 
 
 def pixel_footprint(points: np.ndarray) -> float:
@@ -308,6 +310,7 @@ def boundaries(
     relative: float,
     close_factor: float = 2.5,
     reach: int = 2,
+    crease: float = 0.15,
 ) -> Boundaries:
     """The :class:`Boundaries` of every touching pair of parts (``points``/``normals`` HxWx3, camera frame).
 
@@ -344,7 +347,7 @@ def boundaries(
     key = np.concatenate(keys)
     if key.size == 0:
         empty = np.zeros(0)
-        return Boundaries(np.zeros((0, 2), np.int64), empty, empty, empty, empty, empty)
+        return Boundaries(np.zeros((0, 2), np.int64), empty, empty, empty, empty, empty, empty)
     unique, inverse = np.unique(key, return_inverse=True)
     jump, dot, convexity = np.concatenate(jumps), np.concatenate(dots), np.concatenate(convex)
     length = np.bincount(inverse, minlength=unique.size).astype(np.float64)
@@ -358,7 +361,9 @@ def boundaries(
     continuous = np.bincount(inverse, weights=smooth, minlength=unique.size) / length
     close = np.bincount(inverse, weights=np.concatenate(near), minlength=unique.size) / length
     pairs = np.column_stack([unique // base, unique % base])
-    return Boundaries(pairs, length, continuous, close, alignment, mean_convexity)
+    with np.errstate(invalid="ignore", divide="ignore"):
+        creased = np.bincount(inverse, weights=known & (convexity < -crease), minlength=unique.size) / known_count
+    return Boundaries(pairs, length, continuous, close, alignment, mean_convexity, np.nan_to_num(creased))
 
 
 @dataclass(frozen=True)
@@ -378,6 +383,8 @@ class MergeRules:
     coplanar_cosine: float = float(np.cos(np.radians(18.0)))
     small_part: int = 40
     occlusion: float = 0.5
+    creased: float = 1.0
+    inside: bool = True
 
 
 def merge_parts(
@@ -416,17 +423,21 @@ def merge_parts(
     lengths: dict[tuple[int, int], float] = {}
     smooth: set[tuple[int, int]] = set()
     occluding: set[tuple[int, int]] = set()
+    creases: list[tuple[int, int]] = []
     if surface is not None:
-        for (a, b), length, continuous, close, alignment, convexity in zip(
+        for (a, b), length, continuous, close, alignment, convexity, creased in zip(
             surface.pairs.tolist(),
             surface.length,
             surface.continuous,
             surface.close,
             surface.alignment,
             surface.convexity,
+            surface.creased,
             strict=True,
         ):
             lengths[(a, b)] = float(length)
+            if creased > rules.creased and convexity < rules.concave and alignment < rules.coplanar_cosine:
+                creases.append((a, b))
             if continuous < rules.occlusion:
                 occluding.add((a, b))
             if (
@@ -440,9 +451,12 @@ def merge_parts(
     for first, second in pairs.tolist():
         if (first, second) in smooth or (
             (first, second) not in occluding
+            and rules.overlap < 1.0
             and footprint_overlap(parts.hull(first), parts.hull(second), rules.cell) > rules.overlap
         ):
             allowed.append((first, second))
+            continue
+        if not rules.inside:
             continue
         near, far = sorted((first, second), key=parts.depth_of)
         if looks_like_inside(
@@ -457,7 +471,40 @@ def merge_parts(
             if sizes[small] < rules.small_part and length > best.get(small, (-1.0, 0))[0]:
                 best[small] = (length, other)
     joined += [(small, other) for small, (_, other) in best.items()]
+    if creases:
+        # a crease along part of two parts' boundary keeps them apart, also through a third part they both join
+        joined.sort(key=lambda pair: -lengths.get((min(pair), max(pair)), 1.0))
+        groups = join_unless_apart(int(labels.max()) + 1, np.array(joined).reshape(-1, 2), np.array(creases))
+        joined = [(int(a), int(b)) for a, b in enumerate(groups.tolist()) if a != b]
     return join_labels(labels, joined)
+
+
+def join_unless_apart(count: int, pairs: np.ndarray, apart: np.ndarray) -> np.ndarray:
+    """Group labels of ``count`` nodes: the ``pairs`` (Kx2) joined in the order given, except where joining would
+    put the two nodes of an ``apart`` pair (Mx2) into one group (direct evidence that two parts are separate
+    outweighs an indirect path between them)."""
+    parent = list(range(count))
+    keep_apart: dict[int, set[int]] = {}
+    for a, b in apart.tolist():
+        keep_apart.setdefault(a, set()).add(b)
+        keep_apart.setdefault(b, set()).add(a)
+
+    def root(node: int) -> int:
+        while parent[node] != node:
+            parent[node] = parent[parent[node]]
+            node = parent[node]
+        return node
+
+    for a, b in pairs.tolist():
+        ra, rb = root(a), root(b)
+        if ra == rb:
+            continue
+        against_a, against_b = keep_apart.get(ra, set()), keep_apart.get(rb, set())
+        if any(root(n) == rb for n in against_a) or any(root(n) == ra for n in against_b):
+            continue
+        parent[rb] = ra
+        keep_apart[ra] = against_a | against_b
+    return np.array([root(node) for node in range(count)], dtype=np.int64)
 
 
 def bounding_box(mask: np.ndarray, margin: int = 0) -> tuple[int, int, int, int]:
