@@ -57,6 +57,7 @@ class ClutterParameters(ClusterParameters):
     plus the patches (``cell`` x ``cell`` coarse pixels, at least ``min_patch`` points for a plane) and the
     concavity at which two patches are cut apart."""
 
+    jump_relative: float = 0.01
     cell: int = 6
     min_patch: int = 6
     concave_bending: float = 20.0
@@ -146,8 +147,9 @@ def split_by_color(
     another (a can standing on a can with its side flush with the lower one's front, boxes stacked flush) are one
     convex group, but the colour changes between them and their boundary folds inward along part of its length.
 
-    Each object is cut at hue edges into pieces; pieces whose shared boundary is creased (a share of at least
-    ``p.creased_share`` of it concave, the surfaces not coplanar) must stay apart, and everything else of the
+    Each object is cut at hue edges into pieces; pieces whose shared boundary is creased (the surfaces meet - their
+    points along it are close in 3-D - and a share of at least ``p.creased_share`` of it is concave, the surfaces
+    not coplanar) must stay apart. Everything else of the
     object joins again - longest shared boundaries first, so a piece goes with the side it shares most with. A
     print on a box (no crease) or the pieces of one object seen on both sides of an occluder never split.
     """
@@ -167,6 +169,7 @@ def split_by_color(
     rules = p.merge_rules()
     creased = (
         (surface.creased > p.creased_share)
+        & (surface.close >= rules.continuous)
         & (surface.convexity < rules.concave)
         & (surface.alignment < rules.coplanar_cosine)
         & (owner[surface.pairs[:, 0]] == owner[surface.pairs[:, 1]])
