@@ -1,4 +1,4 @@
-"""The seed's Fig. 2 tabletop tree: capture, cloud, filter, support plane, clusters, then colour and pose in parallel.
+"""The seed's Fig. 2 tabletop tree: capture, cloud, filter, support plane, objects, then colour and pose in parallel.
 
 Without an input path the capture is the built-in kitchen scene (view "table"); with one, the reader is chosen
 from the path by :func:`annotators.readers.choice.reader_for` (TUM, uoc, PCL TIFF, PCD layouts; ValueError for others).
@@ -7,7 +7,7 @@ A reader that writes the point cloud itself (PcdReader) needs no PointCloudGener
 
 from __future__ import annotations
 
-from annotators.cloud.clusters import ClusterExtractor
+from annotators.cloud.clutter import ClutterSegmenter
 from annotators.cloud.filters import RangeFilter
 from annotators.cloud.plane import SupportPlaneSegmenter
 from annotators.cloud.point_cloud import PointCloudGenerator
@@ -48,8 +48,8 @@ def create_pipeline(reader: Annotator) -> Pipeline:
     crop.reason = "drops points outside the sensor's useful range (0.2-2.5 m) before any geometry"
     plane = SupportPlaneSegmenter()
     plane.reason = "finds the table (the dominant, roughly horizontal plane) that objects stand on"
-    clusters = ClusterExtractor()
-    clusters.reason = "segments what stands on the table into object hypotheses"
+    clusters = ClutterSegmenter()
+    clusters.reason = "segments what stands on the table into object hypotheses (convexly connected surfaces)"
     color = SemanticColorAnnotator()
     color.reason = "names each hypothesis' dominant colour"
     pose = PoseAnnotator()

@@ -16,7 +16,7 @@ Works like :mod:`annotators.cloud.clusters` on every ``stride``-th pixel of the 
 
 from __future__ import annotations
 
-from dataclasses import dataclass, replace
+from dataclasses import dataclass, fields, replace
 from typing import ClassVar
 
 import numpy as np
@@ -36,7 +36,6 @@ from annotators.geometry.grid_segmentation import (
     MergeRules,
     boundaries,
     bounding_box,
-    chroma_image,
     color_edges,
     depth_seams,
     grow_labels,
@@ -53,45 +52,39 @@ from robokudo.core.types import CasType, ObjectHypothesis, Plane, PointCloud
 
 @dataclass(frozen=True)
 class ClutterParameters(ClusterParameters):
-    """Thresholds of :func:`segment_clutter`: those of the cluster extractor (candidates, depth jumps, merging)
-    plus the patches (``cell`` x ``cell`` coarse pixels, at least ``min_patch`` points for a plane) and the
-    concavity at which two patches are cut apart."""
+    """Thresholds of :func:`segment_clutter`: those of the cluster extractor (candidates, depth jumps, hue edges,
+    merging), the normals (``normal_step`` / ``normal_smoothing`` coarse pixels), the patches (``cell`` x ``cell``
+    coarse pixels, split when their normals spread by more than ``normal_spread``), the grouping
+    (:class:`~annotators.geometry.convexity.ConvexityRules`) and the share of a boundary that must be creased for a
+    hue edge to split an object (``creased_share``)."""
 
     jump_relative: float = 0.01
-    cell: int = 6
-    min_patch: int = 6
-    concave_bending: float = 20.0
-    use_color_edges: bool = False
     normal_step: int = 2
     normal_smoothing: int = 3
+    cell: int = 6
     normal_spread: float = 0.15
-    smooth_degrees: float = 20.0
-    convex_share: float = 0.5
-    complete_occluded: bool = True
-    use_color: bool = True
-    color_faces: bool = False
-    chroma_difference: float = 30.0
-    concave_share: float = 0.25
+    smooth_degrees: float = ConvexityRules.smooth_degrees
+    concave_bending: float = ConvexityRules.concave_bending
+    convex_share: float = ConvexityRules.convex_share
+    concave_share: float = ConvexityRules.concave_share
+    min_patch: int = ConvexityRules.min_patch
+    min_width: float = ConvexityRules.min_width
+    min_face: int = ConvexityRules.min_face
+    min_votes: int = ConvexityRules.min_votes
+    gap_width: float = ConvexityRules.gap_width
+    close_factor: float = ConvexityRules.close_factor
     creased_share: float = 0.2
-    gap_width: float = 2.0
-    close_factor: float = 3.0
+    use_color: bool = True
+    complete_occluded: bool = True
 
     def convexity_rules(self) -> ConvexityRules:
         """The thresholds of :func:`annotators.geometry.convexity.convex_groups`."""
-        return ConvexityRules(
-            smooth_degrees=self.smooth_degrees,
-            concave_bending=self.concave_bending,
-            convex_share=self.convex_share,
-            min_patch=self.min_patch,
-            gap_width=self.gap_width,
-            close_factor=self.close_factor,
-            chroma_difference=self.chroma_difference,
-            concave_share=self.concave_share,
-        )
+        return ConvexityRules(**{f.name: getattr(self, f.name) for f in fields(ConvexityRules)})
 
     def merge_rules(self) -> MergeRules:
-        """The cluster extractor's merge rules without the footprint rule (stacked objects share footprints)."""
-        return replace(super().merge_rules(), overlap=2.0)
+        """The cluster extractor's merge rules with the footprint rule only for parts whose heights nest (a bowl's
+        inside and outside, a mug's handle): stacked objects share footprints too, but one lies above the other."""
+        return replace(super().merge_rules(), nested=True)
 
 
 def segment_clutter(
@@ -114,16 +107,12 @@ def segment_clutter(
     grid = np.ascontiguousarray(points[::step, ::step][y0:y1, x0:x1])
     depth = grid[..., 2]
     seams = depth_seams(depth, region, p.jump_absolute, p.jump_relative)
-    cuts = seams
-    if colors is not None and p.use_color_edges:
-        cuts = cuts | color_edges(colors[::step, ::step][y0:y1, x0:x1], p.edge_low, p.edge_high)
     normals = grid_normals(grid, p.normal_step, p.normal_smoothing, p.jump_absolute, p.jump_relative)
-    surfaces = label_parts(region & ~cuts, 1)
+    surfaces = label_parts(region & ~seams, 1)
     patches = split_by_normals(grid_patches(surfaces, p.cell), normals, p.normal_spread)
-    chroma = None
-    if colors is not None and p.color_faces:
-        chroma = chroma_image(np.ascontiguousarray(colors[::step, ::step][y0:y1, x0:x1]))[..., :2]
-    labels, faces = convex_groups(patches, grid, p.convexity_rules(), region & ~seams, chroma)
+    labels, faces = convex_groups(patches, grid, p.convexity_rules(), region & ~seams)
+    # patches without a trustworthy plane (a face seen edge-on, a few points) go with the object beside them
+    labels = grow_labels(labels, surfaces > 0, 2.0 * p.cell)
     labels = grow_labels(labels, region & ~seams, p.grow_distance / step)
     labels = grow_on_surface(labels, region, depth, p.jump_absolute, p.jump_relative)
     basis = plane_basis(np.asarray(model[:3], dtype=np.float64)).T.astype(np.float32)

@@ -69,9 +69,9 @@ class ConvexityRules:
     concave_bending: float = 20.0
     convex_share: float = 0.5
     min_patch: int = 6
+    min_width: float = 0.04
     min_face: int = 72
     min_votes: int = 2
-    chroma_difference: float = 30.0
     concave_share: float = 0.25
     gap_width: float = 2.0
     close_factor: float = 3.0
@@ -79,11 +79,14 @@ class ConvexityRules:
 
 @dataclass(frozen=True, eq=False)
 class PatchPlanes:
-    """Per patch (index = label - 1): point count, centroid (Nx3) and unit normal facing the camera (Nx3)."""
+    """Per patch (index = label - 1): point count, centroid (Nx3), unit normal facing the camera (Nx3) and
+    ``width``, the ratio of the middle to the largest covariance eigenvalue (near 0 when the points lie along a
+    line, e.g. a sliver of a face seen edge-on, whose plane - and normal - is then undetermined)."""
 
     counts: np.ndarray
     centroids: np.ndarray
     normals: np.ndarray
+    width: np.ndarray
 
 
 def patch_planes(patches: np.ndarray, points: np.ndarray) -> PatchPlanes:
@@ -102,10 +105,12 @@ def patch_planes(patches: np.ndarray, points: np.ndarray) -> PatchPlanes:
         for j in range(i, 3):
             second[:, i, j] = second[:, j, i] = np.bincount(labels, xyz[:, i] * xyz[:, j], count) / safe
     covariance = second - means[:, :, None] * means[:, None, :]
-    normals = np.linalg.eigh(covariance)[1][:, :, 0]
+    values, vectors = np.linalg.eigh(covariance)
+    normals = vectors[:, :, 0]
     centroids = means + shift
     normals *= np.where(np.einsum("ij,ij->i", normals, centroids) > 0, -1.0, 1.0)[:, None]
-    return PatchPlanes(counts.astype(np.int64), centroids, normals)
+    width = np.clip(values[:, 1], 0, None) / np.maximum(values[:, 2], 1e-12)
+    return PatchPlanes(counts.astype(np.int64), centroids, normals, width)
 
 
 def connection_bending(planes: PatchPlanes, pairs: np.ndarray) -> np.ndarray:
@@ -145,7 +150,6 @@ def convex_groups(
     points: np.ndarray,
     rules: ConvexityRules,
     between: np.ndarray | None = None,
-    chroma: np.ndarray | None = None,
 ) -> tuple[np.ndarray, np.ndarray]:
     """Object labels and face labels (int32, 0 = none, 1..n) from surface patches in two steps.
 
@@ -163,7 +167,7 @@ def convex_groups(
     """
     planes = patch_planes(patches, points)
     count = planes.counts.size + 1
-    usable = np.concatenate([[False], planes.counts >= rules.min_patch])
+    usable = np.concatenate([[False], (planes.counts >= rules.min_patch) & (planes.width >= rules.min_width)])
     kept = np.where(usable[patches], patches, 0)
     between = np.isfinite(points[..., 2]) if between is None else between
     pairs = touching_pairs(grow_labels(kept, between | (kept > 0), rules.gap_width))
@@ -181,19 +185,7 @@ def convex_groups(
     bending = connection_bending(planes, pairs)
     concave = bending < -rules.concave_bending
     continuous = parallel & in_planes & ~concave
-    same_look = np.ones(pairs.shape[0], dtype=bool)
-    if chroma is not None:
-        tone = patch_means(patches, chroma, count)
-        same_look = np.linalg.norm(tone[pairs[:, 0]] - tone[pairs[:, 1]], axis=1) <= rules.chroma_difference
-    faces = _components(pairs[continuous & same_look], count)
-    if chroma is not None:
-        # a printed surface breaks into many small faces of different colours: those join each other again
-        # (geometry only), so only larger regions of one colour stay apart where the colour changes
-        sizes = np.bincount(faces, weights=planes_sizes(planes, count), minlength=count)
-        small = sizes[faces] < rules.min_face
-        fragments = continuous & small[pairs[:, 0]] & small[pairs[:, 1]]
-        joined = np.concatenate([pairs[continuous & same_look], pairs[fragments]])
-        faces = _components(joined, count)
+    faces = _components(pairs[continuous], count)
 
     face_a, face_b = faces[pairs[:, 0]], faces[pairs[:, 1]]
     apart = face_a != face_b
@@ -224,18 +216,6 @@ def _dense(groups: np.ndarray, usable: np.ndarray) -> np.ndarray:
     _, dense = np.unique(groups[present], return_inverse=True)
     renumber[present] = dense.reshape(-1).astype(np.int32) + 1
     return renumber
-
-
-def patch_means(patches: np.ndarray, values: np.ndarray, count: int) -> np.ndarray:
-    """``count`` x C: the mean of the HxWxC ``values`` over each patch label 0..count-1."""
-    inside = patches > 0
-    labels = patches[inside]
-    channels = values[inside].astype(np.float64)
-    sizes = np.maximum(np.bincount(labels, minlength=count), 1)
-    return (
-        np.stack([np.bincount(labels, channels[:, i], count) for i in range(channels.shape[1])], axis=1)
-        / sizes[:, None]
-    )
 
 
 def planes_sizes(planes: PatchPlanes, count: int) -> np.ndarray:

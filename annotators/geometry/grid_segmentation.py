@@ -183,6 +183,17 @@ def _range(values: np.ndarray, low: float, high: float) -> tuple[float, float]:
     return float(ordered[round(low * last)]), float(ordered[round(high * last)])
 
 
+def heights_nest(first: np.ndarray, second: np.ndarray, tolerance: float) -> bool:
+    """Does the 5 %-95 % range of one set of heights above the plane lie within the other's (``tolerance`` metres
+    of slack)? A container's inside or handle lies within its body's heights; an object standing on another lies
+    above it."""
+    low_a, high_a = _range(first, 0.05, 0.95)
+    low_b, high_b = _range(second, 0.05, 0.95)
+    return (low_a >= low_b - tolerance and high_a <= high_b + tolerance) or (
+        low_b >= low_a - tolerance and high_b <= high_a + tolerance
+    )
+
+
 INNER_SPREAD = 0.1
 """An inner surface of a container falls away from the rim: its 50 %-95 % height spread is at least this share of
 the rim height (or it lies in the lower half); the flat top of an object standing behind does not."""
@@ -385,6 +396,7 @@ class MergeRules:
     occlusion: float = 0.5
     creased: float = 1.0
     inside: bool = True
+    nested: bool = False
 
 
 def merge_parts(
@@ -449,13 +461,19 @@ def merge_parts(
                 smooth.add((a, b))
     allowed: list[tuple[int, int]] = []
     for first, second in pairs.tolist():
-        if (first, second) in smooth or (
+        if (first, second) in smooth:
+            allowed.append((first, second))
+            continue
+        if (
             (first, second) not in occluding
             and rules.overlap < 1.0
             and footprint_overlap(parts.hull(first), parts.hull(second), rules.cell) > rules.overlap
         ):
-            allowed.append((first, second))
-            continue
+            heights = (parts.coordinates(first)[:, 2], parts.coordinates(second)[:, 2])
+            if not rules.nested or heights_nest(*heights, 0.0):
+                allowed.append((first, second))
+                continue
+            creases.append((first, second))  # one stands on the other: never joined, not even through a third
         if not rules.inside:
             continue
         near, far = sorted((first, second), key=parts.depth_of)

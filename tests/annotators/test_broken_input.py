@@ -21,6 +21,7 @@ from py_trees.common import Status
 from annotators.catalog import discover_annotators
 from annotators.classification.knowledge_classifier import KnowledgeClassifier
 from annotators.cloud.clusters import ClusterExtractor
+from annotators.cloud.clutter import ClutterSegmenter
 from annotators.cloud.filters import CropBoxFilter, RangeFilter, RegionFilter
 from annotators.cloud.normals import NormalEstimator
 from annotators.cloud.plane import SupportPlaneSegmenter
@@ -170,6 +171,7 @@ BROKEN_CASES: dict[str, tuple[Callable[[], Seeds], tuple[type[Annotator], ...]]]
             NormalEstimator,
             SupportPlaneSegmenter,
             ClusterExtractor,
+            ClutterSegmenter,
             SemanticColorAnnotator,
             ColorHistogramAnnotator,
             PoseAnnotator,
@@ -189,6 +191,7 @@ BROKEN_CASES: dict[str, tuple[Callable[[], Seeds], tuple[type[Annotator], ...]]]
             NormalEstimator,
             SupportPlaneSegmenter,
             ClusterExtractor,
+            ClutterSegmenter,
             PoseAnnotator,
             ShapeAnnotator,
             SizeAnnotator,
@@ -203,6 +206,7 @@ BROKEN_CASES: dict[str, tuple[Callable[[], Seeds], tuple[type[Annotator], ...]]]
             NormalEstimator,
             SupportPlaneSegmenter,
             ClusterExtractor,
+            ClutterSegmenter,
             PoseAnnotator,
             ShapeAnnotator,
             SizeAnnotator,
@@ -221,13 +225,13 @@ BROKEN_CASES: dict[str, tuple[Callable[[], Seeds], tuple[type[Annotator], ...]]]
     "no point inside the region": (lambda: [flat_cloud(), posed_camera(x=50.0)], (RegionFilter,)),
     "degenerate plane": (
         lambda: [flat_cloud(), Plane(model=np.array([0.0, 0.0, 0.0, np.nan]), inlier_indices=np.arange(10))],
-        (ClusterExtractor,),
+        (ClusterExtractor, ClutterSegmenter),
     ),
     "plane indices outside the grid": (
         lambda: [flat_cloud(), Plane(model=np.array([0.0, 0.0, -1.0, 1.0]), inlier_indices=np.array([0, H * W]))],
-        (ClusterExtractor,),
+        (ClusterExtractor, ClutterSegmenter),
     ),
-    "nothing stands on the plane": (lambda: [flat_cloud(), wall_plane()], (ClusterExtractor,)),
+    "nothing stands on the plane": (lambda: [flat_cloud(), wall_plane()], (ClusterExtractor, ClutterSegmenter)),
     "no hypotheses": (
         lambda: [color(), flat_cloud(), up_normals(), CameraInfo(K), *evidence_types()],
         (
@@ -501,7 +505,7 @@ def test_the_tables_cover_every_discovered_annotator() -> None:
     assert {c.__name__ for c in discover_annotators()} >= {
         "KitchenSceneReader", "ColorDepthPairReader", "TumSequenceReader", "TumPairReader", "PcdReader",
         "TiffSequenceReader", "PointCloudGenerator", "RangeFilter", "RegionFilter", "CropBoxFilter",
-        "NormalEstimator", "SupportPlaneSegmenter", "ClusterExtractor", "SemanticColorAnnotator",
+        "NormalEstimator", "SupportPlaneSegmenter", "ClusterExtractor", "ClutterSegmenter", "SemanticColorAnnotator",
         "ColorHistogramAnnotator", "PoseAnnotator", "ShapeAnnotator", "SizeAnnotator", "KnowledgeClassifier",
         "TextReader", "OnnxDetector", "ImageRegionSegmenter",
     }  # fmt: skip
