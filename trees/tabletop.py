@@ -37,8 +37,9 @@ def create_tree(input_path: str | None = None, frame: int = 0) -> Pipeline:
     return create_pipeline(create_reader(input_path, frame))
 
 
-def create_pipeline(reader: Annotator) -> Pipeline:
-    """The tabletop Pipeline behind any capture node that writes ColorImage, DepthImage and CameraInfo."""
+def create_pipeline(reader: Annotator, segmenter: Annotator | None = None) -> Pipeline:
+    """The tabletop Pipeline behind any capture node that writes ColorImage, DepthImage and CameraInfo;
+    ``segmenter`` (default: a ClutterSegmenter) turns the cloud and plane into object hypotheses."""
     front: list[Annotator] = [reader]
     if PointCloud not in reader.outputs:
         cloud = PointCloudGenerator()
@@ -48,8 +49,8 @@ def create_pipeline(reader: Annotator) -> Pipeline:
     crop.reason = "drops points outside the sensor's useful range (0.2-2.5 m) before any geometry"
     plane = SupportPlaneSegmenter()
     plane.reason = "finds the table (the dominant, roughly horizontal plane) that objects stand on"
-    clusters = ClutterSegmenter()
-    clusters.reason = "segments what stands on the table into object hypotheses (convexly connected surfaces)"
+    clusters = segmenter or ClutterSegmenter()
+    clusters.reason = "segments what stands on the table into object hypotheses"
     color = SemanticColorAnnotator()
     color.reason = "names each hypothesis' dominant colour"
     pose = PoseAnnotator()

@@ -31,7 +31,7 @@ from annotators.cloud.clusters import (
 from annotators.cloud.normals import grid_normals
 from annotators.cloud.plane import plane_basis
 from annotators.cloud.point_cloud import cloud_problem
-from annotators.geometry.convexity import ConvexityRules, convex_groups, grid_patches, split_by_normals
+from annotators.geometry.convexity import ConvexityRules, convex_groups, dense_labels, grid_patches, split_by_normals
 from annotators.geometry.grid_segmentation import (
     MergeRules,
     boundaries,
@@ -112,8 +112,7 @@ def segment_clutter(
     patches = split_by_normals(grid_patches(surfaces, p.cell), normals, p.normal_spread)
     labels, faces = convex_groups(patches, grid, p.convexity_rules(), region & ~seams)
     # patches without a trustworthy plane (a face seen edge-on, a few points) go with the object beside them
-    labels = grow_labels(labels, surfaces > 0, 2.0 * p.cell)
-    labels = grow_labels(labels, region & ~seams, p.grow_distance / step)
+    labels = grow_labels(labels, region & ~seams, max(2.0 * p.cell, p.grow_distance / step))
     labels = grow_on_surface(labels, region, depth, p.jump_absolute, p.jump_relative)
     basis = plane_basis(np.asarray(model[:3], dtype=np.float64)).T.astype(np.float32)
     to_plane = np.column_stack([basis, np.asarray(model[:3], dtype=np.float32)])
@@ -138,23 +137,29 @@ def split_by_color(
 
     Each object is cut at hue edges into pieces; pieces whose shared boundary is creased (the surfaces meet - their
     points along it are close in 3-D - and a share of at least ``p.creased_share`` of it is concave, the surfaces
-    not coplanar) must stay apart. Everything else of the
-    object joins again - longest shared boundaries first, so a piece goes with the side it shares most with. A
-    print on a box (no crease) or the pieces of one object seen on both sides of an occluder never split.
+    not coplanar) must stay apart. Everything else of the object joins again - longest shared boundaries first, so a
+    piece goes with the side it shares most with. A print on a box (no crease) or the pieces of one object seen on
+    both sides of an occluder never split.
     """
     step = max(1, p.stride)
     objects = labels > 0
     edges = color_edges(colors, p.edge_low, p.edge_high) & objects
     parts = label_parts(objects & ~edges, max(1, p.min_part_points // (step * step)))
     key = labels.astype(np.int64) * (int(parts.max(initial=0)) + 1) + parts
-    pieces = np.zeros(labels.shape, dtype=np.int32)
-    _, dense = np.unique(key[parts > 0], return_inverse=True)
-    pieces[parts > 0] = dense.reshape(-1).astype(np.int32) + 1
+    pieces = dense_labels(np.where(parts > 0, key, 0))
     owner = np.zeros(int(pieces.max(initial=0)) + 1, dtype=np.int64)
     owner[pieces[parts > 0]] = labels[parts > 0]
+    # only an object with two pieces that could each be an object (min_points) can split
+    large = np.bincount(pieces.reshape(-1), minlength=owner.size) * step * step >= p.min_points
+    pieces_of = np.bincount(owner[1:], weights=large[1:], minlength=int(labels.max()) + 1)
+    if pieces_of.max(initial=0) < 2:
+        return labels
     pieces = grow_labels(pieces, objects, p.grow_distance / step)
     pieces[owner[pieces] != labels] = 0
-    surface = boundaries(pieces, grid, normals, p.jump_absolute, p.jump_relative)
+    several = pieces_of[labels] >= 2  # only objects of several pieces can split: their boundaries are measured
+    x0, y0, x1, y1 = bounding_box(several, margin=3)
+    window = np.where(several[y0:y1, x0:x1], pieces[y0:y1, x0:x1], 0)
+    surface = boundaries(window, grid[y0:y1, x0:x1], normals[y0:y1, x0:x1], p.jump_absolute, p.jump_relative)
     rules = p.merge_rules()
     creased = (
         (surface.creased > p.creased_share)
@@ -173,10 +178,7 @@ def split_by_color(
     rest = np.arange(1, owner.size)
     chained = np.column_stack([first_piece[owner[rest]], rest])
     groups = join_unless_apart(owner.size, np.concatenate([touching, chained]), surface.pairs[creased])
-    split = np.where(pieces > 0, groups[pieces], 0)
-    result = np.zeros(labels.shape, dtype=np.int32)
-    _, dense = np.unique(split[split > 0], return_inverse=True)
-    result[split > 0] = dense.reshape(-1).astype(np.int32) + 1
+    result = dense_labels(np.where(pieces > 0, groups[pieces] + 1, 0))
     return grow_labels(result, objects, p.grow_distance / step)
 
 

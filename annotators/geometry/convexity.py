@@ -27,11 +27,17 @@ def grid_patches(surfaces: np.ndarray, cell: int) -> np.ndarray:
     across = -(-cols // cell)
     cell_id = (np.arange(rows)[:, None] // cell) * across + (np.arange(cols)[None, :] // cell)
     key = surfaces.astype(np.int64) * (across * (-(-rows // cell))) + cell_id
-    inside = surfaces > 0
-    patches = np.zeros(surfaces.shape, dtype=np.int32)
-    _, dense = np.unique(key[inside], return_inverse=True)
-    patches[inside] = dense.reshape(-1).astype(np.int32) + 1
-    return patches
+    return dense_labels(np.where(surfaces > 0, key + 1, 0))
+
+
+def dense_labels(keys: np.ndarray) -> np.ndarray:
+    """Non-negative integer keys (0 = none) renumbered 1..n in increasing order, as int32; by a lookup table over
+    the key range (linear time) rather than by sorting."""
+    present = np.zeros(int(keys.max(initial=0)) + 1, dtype=bool)
+    present[keys.reshape(-1)] = True
+    present[0] = False
+    renumber = np.cumsum(present, dtype=np.int32) * present
+    return renumber[keys]
 
 
 def split_by_normals(patches: np.ndarray, normals: np.ndarray, spread: float) -> np.ndarray:
@@ -54,11 +60,8 @@ def split_by_normals(patches: np.ndarray, normals: np.ndarray, spread: float) ->
     wide = np.sqrt(np.clip(values.sum(axis=1), 0, None)) > spread
     side = np.einsum("ij,ij->i", centred, vectors[labels, :, 2]) > 0
     split = np.zeros(patches.shape, dtype=np.int64)
-    split[known] = labels * 2 + (side & wide[labels])
-    result = np.zeros(patches.shape, dtype=np.int32)
-    _, dense = np.unique(split[known], return_inverse=True)
-    result[known] = dense.reshape(-1).astype(np.int32) + 1
-    return result
+    split[known] = labels * 2 + (side & wide[labels]) + 1
+    return dense_labels(split)
 
 
 @dataclass(frozen=True)

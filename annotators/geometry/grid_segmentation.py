@@ -139,7 +139,10 @@ def label_groups(labels: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
     """Flat pixel indices sorted by label and ``starts`` so label k owns ``pixels[starts[k]:starts[k + 1]]``."""
     flat = labels.reshape(-1)
     pixels = np.flatnonzero(flat)
-    pixels = pixels[np.argsort(flat[pixels], kind="stable")]
+    values = flat[pixels]
+    if values.size and values.max() < 1 << 16:
+        values = values.astype(np.uint16)  # a stable sort of 16-bit keys is a radix sort: linear time
+    pixels = pixels[np.argsort(values, kind="stable")]
     starts = np.searchsorted(flat[pixels], np.arange(int(flat.max(initial=0)) + 2))
     return pixels, starts
 
@@ -149,6 +152,9 @@ def footprint_overlap(first: np.ndarray, second: np.ndarray, cell: float) -> flo
 
     The raster gives even a degenerate footprint (a wall seen edge-on is a line) an area of one cell width.
     """
+    shared_box = np.minimum(first.max(axis=0), second.max(axis=0)) - np.maximum(first.min(axis=0), second.min(axis=0))
+    if np.any(shared_box < -cell):
+        return 0.0  # the footprints' bounding boxes are apart: nothing to rasterize
     low = np.minimum(first.min(axis=0), second.min(axis=0))
     high = np.maximum(first.max(axis=0), second.max(axis=0))
     shape = tuple(int(v) for v in (np.ceil((high - low) / cell) + 2)[::-1])
