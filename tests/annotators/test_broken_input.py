@@ -352,14 +352,14 @@ def write_tum_sequence(folder: Path, depth_list: str = "1.0 a_depth.png\n", trun
     return folder
 
 
-def write_pcd(path: Path, organized: bool = True, truncate: bool = False) -> Path:
-    """A small ASCII PCD (x y z rgb), organized 4x3 or a single row; optionally cut short."""
+def write_pcd(path: Path, organized: bool = True, truncate: bool = False, depth: float = 1.0) -> Path:
+    """A small ASCII PCD (x y z rgb), organized 4x3 or a single row, ``depth`` m ahead; optionally cut short."""
     width, height = (4, 3) if organized else (12, 1)
     header = (
         "VERSION 0.7\nFIELDS x y z rgb\nSIZE 4 4 4 4\nTYPE F F F F\nCOUNT 1 1 1 1\n"
         f"WIDTH {width}\nHEIGHT {height}\nVIEWPOINT 0 0 0 1 0 0 0\nPOINTS {width * height}\nDATA ascii\n"
     )
-    rows = [f"{(c - 1.5) / 10} {(r - 1) / 10} 1.0 0" for r in range(height) for c in range(width)]
+    rows = [f"{(c - 1.5) / 10} {(r - 1) / 10} {depth} 0" for r in range(height) for c in range(width)]
     path.parent.mkdir(parents=True, exist_ok=True)
     path.write_text(header + "\n".join(rows[: 5 if truncate else None]) + "\n")
     return path
@@ -421,7 +421,9 @@ BROKEN_READERS: dict[type[Annotator], dict[str, Callable[[Path], Annotator]]] = 
     PcdReader: {
         "missing file": lambda tmp: PcdReader(tmp / "nowhere.pcd"),
         "truncated file": lambda tmp: PcdReader(write_pcd(tmp / "cut.pcd", truncate=True)),
-        "unorganized cloud": lambda tmp: PcdReader(write_pcd(tmp / "row.pcd", organized=False)),
+        "unorganized cloud behind the camera": lambda tmp: PcdReader(
+            write_pcd(tmp / "row.pcd", organized=False, depth=-1.0)
+        ),
         "not a PCD file": lambda tmp: PcdReader((tmp / "junk.pcd", (tmp / "junk.pcd").write_text("hello"))[0]),
         "zero intrinsics": lambda tmp: PcdReader(
             write_pcd(tmp / "a.pcd"), intrinsics=CameraIntrinsics(0, 0, 0, 0, 0, 0)
