@@ -18,23 +18,26 @@ from annotators.readers.frame_readers import KitchenSceneReader
 from robokudo.core.annotator import Annotator
 from robokudo.core.parallel import ThresholdParallel
 from robokudo.core.pipeline import Pipeline
-from robokudo.core.types import PointCloud
+from robokudo.core.types import CameraIntrinsics, PointCloud
 
 
-def create_reader(input_path: str | None = None, frame: int = 0) -> Annotator:
+def create_reader(
+    input_path: str | None = None, frame: int = 0, intrinsics: CameraIntrinsics | None = None
+) -> Annotator:
     """The capture node: the built-in kitchen scene, or the reader of ``input_path`` (ValueError when none fits)."""
     if input_path is None:
         reader: Annotator = KitchenSceneReader()
         reader.reason = "capture: renders the built-in kitchen scene (camera looking at the table)"
     else:
-        reader = reader_for(input_path, frame)
+        reader = reader_for(input_path, frame, intrinsics)
         reader.reason = f"capture: reads frame {frame} of {input_path} ({type(reader).__name__})"
     return reader
 
 
-def create_tree(input_path: str | None = None, frame: int = 0) -> Pipeline:
-    """A fresh tabletop Pipeline (Fig. 2 of the seed) on the kitchen scene or on a recorded frame."""
-    return create_pipeline(create_reader(input_path, frame))
+def create_tree(input_path: str | None = None, frame: int = 0, intrinsics: CameraIntrinsics | None = None) -> Pipeline:
+    """A fresh tabletop Pipeline (Fig. 2 of the seed) on the kitchen scene or on a recorded frame (``intrinsics``:
+    the camera of a point-cloud input)."""
+    return create_pipeline(create_reader(input_path, frame, intrinsics))
 
 
 def create_pipeline(reader: Annotator, segmenter: Annotator | None = None) -> Pipeline:

@@ -1,16 +1,18 @@
-"""Clutter segmentation: objects as convexly connected surfaces, cut at depth jumps and concave creases.
+"""Clutter segmentation: objects as convexly connected surfaces, on the organized grid.
 
-Works like :mod:`annotators.cloud.clusters` on every ``stride``-th pixel of the organized grid, with different cuts:
+Works like :mod:`annotators.cloud.clusters` on every ``stride``-th pixel of the organized grid, with other cuts:
 
 1. candidates are the points standing on the supporting plane (inside its extent), as for the cluster extractor;
-2. the grid is cut at depth discontinuities and at concave creases (:func:`annotators.geometry.convexity.
-   concave_creases`): where a can stands on a box or a box leans on another, the surfaces fold inward, while the
-   faces of one object meet at convex edges and need no cut. Colour is not used, so a printed box is one part;
-3. the parts are labelled and the cut pixels given back, then touching parts are joined when the surface goes on
-   smoothly or over a convex edge across their boundary, or when one is the inside of the other (a bowl), see
-   :func:`annotators.geometry.grid_segmentation.merge_parts` (without its footprint rule, which would join
-   stacked objects);
-4. parts that an occluder in front splits apart are joined when they continue one surface behind it
+2. they are cut at depth discontinuities and into cells, split where their normals disagree; each cell gets a
+   plane fit, cells join into smooth faces and faces into objects where they meet convexly - where a can stands on
+   a box or a box leans on another the surfaces fold inward and stay apart
+   (:func:`annotators.geometry.convexity.convex_groups`); colour plays no part, so a printed box is one object;
+3. the cut pixels are given back, and a container's inside joins its outside (a handle its body): the footprints on
+   the plane overlap and the heights nest, which an object standing on another never does
+   (:func:`annotators.geometry.grid_segmentation.merge_parts`);
+4. an object is split along a hue edge only where a concave crease runs along it (:func:`split_by_color`: a can
+   standing flush on a can is one convex surface but two colours with a crease between);
+5. pieces that an occluder in front splits apart join when they continue one plane behind it
    (:func:`annotators.geometry.occlusion.join_occluded`).
 """
 
@@ -184,7 +186,8 @@ def split_by_color(
 
 class ClutterSegmenter(Annotator):
     """Segments touching, stacked and occluding objects on the supporting plane into object hypotheses: convexly
-    connected surfaces, cut at depth jumps and concave creases (model-free, geometry only)."""
+    connected surfaces, cut at depth jumps and concave creases (model-free; colour only where a crease runs along
+    a hue edge)."""
 
     inputs: ClassVar[tuple[type[CasType], ...]] = (PointCloud, Plane)
     outputs: ClassVar[tuple[type[CasType], ...]] = (ObjectHypothesis,)

@@ -2,11 +2,12 @@
 
 Objects are, to a first approximation, convex: the faces of one object meet at convex edges, while where two
 objects meet - a can standing on a box, a box leaning on another - their surfaces form a concave crease
-(Stein et al., "Object partitioning using local convexity", CVPR 2014). Here the surface is cut into small patches:
-cells of ``cell`` x ``cell`` pixels of the grid, split where depth jumps. Each patch gets a plane fit (centroid and
-normal, which is robust to sensor noise where per-pixel normals are not); two touching patches are connected
-unless their connection is concave, ``(n_a - n_b) . (c_a - c_b) / |c_a - c_b| < -concavity``, which is about 0 on
-one plane, positive across a convex edge and negative across a concave one; the connected groups are the objects.
+(Stein et al., "Object partitioning using local convexity", CVPR 2014). Here the surface is cut into small patches
+(:func:`grid_patches`: cells of the grid, split where depth jumps, and in two where their normals disagree,
+:func:`split_by_normals`), each with a plane fit - a centroid and a normal, robust to sensor noise where per-pixel
+normals are not. How fast the surface turns between two touching patches, ``(n_a - n_b) . (c_a - c_b) /
+|c_a - c_b|^2`` (1/m), is about 0 on a plane, positive across a convex edge and negative in a concave crease;
+:func:`convex_groups` joins patches into faces and faces into objects by it.
 """
 
 from __future__ import annotations
@@ -66,7 +67,13 @@ def split_by_normals(patches: np.ndarray, normals: np.ndarray, spread: float) ->
 
 @dataclass(frozen=True)
 class ConvexityRules:
-    """Thresholds of :func:`convex_groups` (degrees, unit-normal differences, shares, pixels, points)."""
+    """Thresholds of :func:`convex_groups`: ``smooth_degrees`` between the normals (and of the centroid line off
+    both planes) of a smooth connection; ``concave_bending`` (1/m, a turn tighter than a 5 cm radius) makes a
+    connection concave; two faces join when more than ``convex_share`` of their votes are convex, at least
+    ``min_votes`` when both faces are large, and not when more than ``concave_share`` are concave; a patch needs
+    ``min_patch`` points and a ``min_width`` (middle / largest eigenvalue) for a plane; faces of fewer than
+    ``min_face`` points are slivers; patches touch across up to ``gap_width`` pixels, and only when their centroids
+    are at most ``close_factor`` times their grid distance apart in 3-D."""
 
     smooth_degrees: float = 20.0
     concave_bending: float = 20.0
@@ -156,17 +163,19 @@ def convex_groups(
 ) -> tuple[np.ndarray, np.ndarray]:
     """Object labels and face labels (int32, 0 = none, 1..n) from surface patches in two steps.
 
-    1. *Faces*: patches joined along smooth connections - normals within ``rules.smooth_degrees`` and the line
-       between the centroids within that angle of both tangent planes (one surface going on, flat or gently
-       curved, not a step between parallel surfaces).
-    2. *Objects*: faces joined where they meet convexly. Every connection between two faces votes: convex when
-       ``(n_a - n_b) . (c_a - c_b) / |c_a - c_b| >= -rules.concavity`` and not a step; two faces join when at
-       least ``rules.convex_share`` of their votes are convex, so a few noisy patches along a crease decide nothing.
+    1. *Faces*: patches joined along smooth connections - normals within ``rules.smooth_degrees``, the line between
+       the centroids within that angle of both tangent planes (one surface going on, flat or gently curved, not a
+       step between parallel surfaces) and no concave bend.
+    2. *Objects*: faces joined where they meet convexly. Every connection between two faces votes (convex, or
+       concave when it bends inward faster than ``rules.concave_bending``; a step votes neither); two faces join
+       when more than ``rules.convex_share`` of the votes are convex and at most ``rules.concave_share`` concave.
+       Joins are made strongest first, and two large faces that do not agree are kept apart: a sliver along a
+       crease that agrees with both sides cannot join them.
 
     Patches touch when they are 4-neighbours once grown by up to ``rules.gap_width`` pixels into the unlabelled
     pixels between them that ``between`` allows (HxW bool; default: every pixel with a point) and their centroids
-    are close in 3-D (:func:`close_in_space`). Patches of fewer than ``rules.min_patch`` points have no
-    trustworthy plane: they are left out (0) for the caller.
+    are close in 3-D (:func:`close_in_space`). Patches without a trustworthy plane (fewer than ``rules.min_patch``
+    points, or narrower than ``rules.min_width``) are left out (0) for the caller.
     """
     planes = patch_planes(patches, points)
     count = planes.counts.size + 1
@@ -175,41 +184,53 @@ def convex_groups(
     between = np.isfinite(points[..., 2]) if between is None else between
     pairs = touching_pairs(grow_labels(kept, between | (kept > 0), rules.gap_width))
     pairs = pairs[close_in_space(patches, planes, pairs, pixel_footprint(points), rules.close_factor)]
+    parallel, in_planes = _alignment(planes, pairs, rules.smooth_degrees)
+    concave = connection_bending(planes, pairs) < -rules.concave_bending
+    continuous = parallel & in_planes & ~concave
+    faces = _components(pairs[continuous], count)
+    objects = _join_faces(faces, pairs, ~concave & (continuous | ~parallel), concave, planes, rules)
+    return _dense(objects[faces], usable)[kept], _dense(faces, usable)[kept]
+
+
+def _alignment(planes: PatchPlanes, pairs: np.ndarray, degrees: float) -> tuple[np.ndarray, np.ndarray]:
+    """For Kx2 patch labels: normals within ``degrees``; the centroid line within ``degrees`` of both planes."""
     a, b = pairs[:, 0] - 1, pairs[:, 1] - 1
     offset = planes.centroids[a] - planes.centroids[b]
     with np.errstate(invalid="ignore", divide="ignore"):
         direction = np.nan_to_num(offset / np.linalg.norm(offset, axis=1, keepdims=True))
-    along = np.cos(np.radians(rules.smooth_degrees))
-    across = np.sin(np.radians(rules.smooth_degrees))
-    parallel = np.einsum("ij,ij->i", planes.normals[a], planes.normals[b]) >= along
+    parallel = np.einsum("ij,ij->i", planes.normals[a], planes.normals[b]) >= np.cos(np.radians(degrees))
+    across = np.sin(np.radians(degrees))
     in_planes = (np.abs(np.einsum("ij,ij->i", direction, planes.normals[a])) <= across) & (
         np.abs(np.einsum("ij,ij->i", direction, planes.normals[b])) <= across
     )
-    bending = connection_bending(planes, pairs)
-    concave = bending < -rules.concave_bending
-    continuous = parallel & in_planes & ~concave
-    faces = _components(pairs[continuous], count)
+    return parallel, in_planes
 
+
+def _join_faces(
+    faces: np.ndarray,
+    pairs: np.ndarray,
+    convex: np.ndarray,
+    concave: np.ndarray,
+    planes: PatchPlanes,
+    rules: ConvexityRules,
+) -> np.ndarray:
+    """The object of each face (indexed by face label): faces joined by the votes of the patch connections."""
+    count = faces.size
     face_a, face_b = faces[pairs[:, 0]], faces[pairs[:, 1]]
     apart = face_a != face_b
-    convex = ~concave & (continuous | ~parallel)
     low, high = np.minimum(face_a, face_b)[apart], np.maximum(face_a, face_b)[apart]
     keys, inverse = np.unique(low * count + high, return_inverse=True)
-    votes = np.bincount(inverse, minlength=keys.size)
-    share = np.bincount(inverse, weights=convex[apart], minlength=keys.size) / np.maximum(votes, 1)
-    concave_share = np.bincount(inverse, weights=concave[apart], minlength=keys.size) / np.maximum(votes, 1)
+    votes = np.maximum(np.bincount(inverse, minlength=keys.size), 1)
+    share = np.bincount(inverse, weights=convex[apart], minlength=keys.size) / votes
+    concave_share = np.bincount(inverse, weights=concave[apart], minlength=keys.size) / votes
     share = np.where(concave_share > rules.concave_share, 0.0, share)
     first, second = keys // count, keys % count
-    face_sizes = np.bincount(faces, weights=planes_sizes(planes, count), minlength=count)
-    large = face_sizes >= rules.min_face
+    large = np.bincount(faces, weights=planes_sizes(planes, count), minlength=count) >= rules.min_face
     both_large = large[first] & large[second]
     agree = (share > rules.convex_share) & ((share * votes >= rules.min_votes) | ~both_large)
-    apart_pairs = np.column_stack([first, second])[(share <= rules.convex_share) & both_large]
+    kept_apart = np.column_stack([first, second])[(share <= rules.convex_share) & both_large]
     order = np.argsort(-(share * votes)[agree], kind="stable")
-    groups = join_unless_apart(count, np.column_stack([first, second])[agree][order], apart_pairs)
-    objects = groups[faces]
-
-    return _dense(objects, usable)[kept], _dense(faces, usable)[kept]
+    return join_unless_apart(count, np.column_stack([first, second])[agree][order], kept_apart)
 
 
 def _dense(groups: np.ndarray, usable: np.ndarray) -> np.ndarray:

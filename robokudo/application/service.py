@@ -48,7 +48,7 @@ from robokudo.core.engine import Engine
 from robokudo.core.pipeline import Pipeline
 from robokudo.core.slot import TaskSlot
 from robokudo.core.threaded import has_workers, stop_workers
-from robokudo.core.types import QueryAnswer
+from robokudo.core.types import CameraIntrinsics, QueryAnswer
 from trees.answer_step import AnswerStep
 from trees.synthesis import build_tree
 
@@ -188,8 +188,10 @@ class AnsweringService:
         input_path: str | None = None,
         frame: int = 0,
         hz: float = 100.0,
+        intrinsics: CameraIntrinsics | None = None,
     ) -> None:
         self.kb = kb
+        self.intrinsics = intrinsics
         self.store = store
         self.catalog = catalog if catalog is not None else AnnotatorCatalog.discover()
         self.input_path = input_path
@@ -211,6 +213,7 @@ class AnsweringService:
         frame: int = 0,
         hz: float = 100.0,
         catalog: AnnotatorCatalog | None = None,
+        intrinsics: CameraIntrinsics | None = None,
     ) -> AnsweringService:
         """A service over the shipped and user ontology and the belief store at ``store_path`` (default store
         when None), with the annotators of ``catalog`` (default: this project's).
@@ -225,7 +228,7 @@ class AnsweringService:
         except BaseException:
             store.close()
             raise
-        return cls(kb, store, catalog=catalog, input_path=input_path, frame=frame, hz=hz)
+        return cls(kb, store, catalog=catalog, input_path=input_path, frame=frame, hz=hz, intrinsics=intrinsics)
 
     # ------------------------------------------------------------------ planning
 
@@ -237,7 +240,9 @@ class AnsweringService:
         for object_id in self.object_ids(parsed) or ():
             known = self.store.get(object_id)
             look_at = known.region if known is not None and known.region else look_at
-        return plan_for_input(self.planner, parsed, self.input_path, self.frame, look_at=look_at)
+        return plan_for_input(
+            self.planner, parsed, self.input_path, self.frame, look_at=look_at, intrinsics=self.intrinsics
+        )
 
     def object_ids(self, query: Query) -> tuple[int, ...] | None:
         """The object ids ``query`` names (None when it names none); UnknownObjectError for an id not stored."""

@@ -15,7 +15,12 @@ from queries import QueryError, parse_query
 from reasoning.beliefs.store import BeliefStoreError
 from reasoning.errors import OntologyError
 from reasoning.planning.planner import PlanningError
-from robokudo.application.commands.input_options import add_input_arguments, frame_number, input_problem
+from robokudo.application.commands.input_options import (
+    add_input_arguments,
+    frame_number,
+    input_problem,
+    intrinsics_of,
+)
 from robokudo.application.service import AnsweringService, PerceptionFailedError, UnknownObjectError
 from robokudo.core.render import unicode_tree
 from trees.synthesis import SynthesisError
@@ -43,7 +48,9 @@ def run(args: argparse.Namespace) -> int:
         return 2
     try:
         query = parse_query(text)  # the cheapest check first: a bad query touches nothing
-        with AnsweringService.open(args.store, input_path=args.input, frame=frame_number(args)) as service:
+        with AnsweringService.open(
+            args.store, input_path=args.input, frame=frame_number(args), intrinsics=intrinsics_of(args)
+        ) as service:
             outcome = service.answer(query)
     except QueryError as error:
         print(error, file=sys.stderr)

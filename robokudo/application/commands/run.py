@@ -7,7 +7,12 @@ import sys
 
 from py_trees.common import Status
 
-from robokudo.application.commands.input_options import add_input_arguments, frame_number, input_problem
+from robokudo.application.commands.input_options import (
+    add_input_arguments,
+    frame_number,
+    input_problem,
+    intrinsics_of,
+)
 from robokudo.application.report import describe_hypotheses, write_annotated_image
 from robokudo.core.engine import Engine
 from robokudo.core.pipeline import pipelines
@@ -32,7 +37,7 @@ def run(args: argparse.Namespace) -> int:
     if problem is not None:
         print(f"robokudo run: {problem}", file=sys.stderr)
         return 2
-    root = load_tree(args.name).create(input_path=args.input, frame=frame_number(args))
+    root = load_tree(args.name).create(input_path=args.input, frame=frame_number(args), intrinsics=intrinsics_of(args))
     engine = Engine(root, hz=args.hz)
     until_finished = (lambda s: s is not Status.RUNNING) if args.ticks is None else None
     status = engine.run(ticks=args.ticks, until=until_finished)

@@ -16,7 +16,12 @@ import sys
 
 from reasoning.beliefs.store import BeliefStoreError
 from reasoning.errors import OntologyError
-from robokudo.application.commands.input_options import add_input_arguments, frame_number, input_problem
+from robokudo.application.commands.input_options import (
+    add_input_arguments,
+    frame_number,
+    input_problem,
+    intrinsics_of,
+)
 from robokudo.application.server.runner import ServerConfig, is_loopback, serve
 from robokudo.application.service import AnsweringService
 
@@ -48,7 +53,9 @@ def run(args: argparse.Namespace) -> int:
         print(f"robokudo serve: {problem}", file=sys.stderr)
         return 2
     try:
-        service = AnsweringService.open(args.db, input_path=args.input, frame=frame_number(args), hz=args.rate)
+        service = AnsweringService.open(
+            args.db, input_path=args.input, frame=frame_number(args), hz=args.rate, intrinsics=intrinsics_of(args)
+        )
     except (BeliefStoreError, OntologyError) as error:
         print(f"robokudo serve: {error}", file=sys.stderr)
         return 2
