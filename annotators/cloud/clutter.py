@@ -70,6 +70,7 @@ class ClutterParameters(ClusterParameters):
     convex_share: float = ConvexityRules.convex_share
     concave_share: float = ConvexityRules.concave_share
     min_patch: int = ConvexityRules.min_patch
+    max_thickness: float = ConvexityRules.max_thickness
     min_width: float = ConvexityRules.min_width
     min_face: int = ConvexityRules.min_face
     min_votes: int = ConvexityRules.min_votes

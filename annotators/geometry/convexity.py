@@ -71,7 +71,8 @@ class ConvexityRules:
     both planes) of a smooth connection; ``concave_bending`` (1/m, a turn tighter than a 5 cm radius) makes a
     connection concave; two faces join when more than ``convex_share`` of their votes are convex, at least
     ``min_votes`` when both faces are large, and not when more than ``concave_share`` are concave; a patch needs
-    ``min_patch`` points and a ``min_width`` (middle / largest eigenvalue) for a plane; faces of fewer than
+    ``min_patch`` points, at most ``max_thickness`` (smallest / middle eigenvalue) and at least ``min_width``
+    (middle / largest) for a plane; faces of fewer than
     ``min_face`` points are slivers; patches touch across up to ``gap_width`` pixels, and only when their centroids
     are at most ``close_factor`` times their grid distance apart in 3-D."""
 
@@ -79,6 +80,7 @@ class ConvexityRules:
     concave_bending: float = 20.0
     convex_share: float = 0.5
     min_patch: int = 6
+    max_thickness: float = 0.5
     min_width: float = 0.04
     min_face: int = 72
     min_votes: int = 2
@@ -90,12 +92,15 @@ class ConvexityRules:
 @dataclass(frozen=True, eq=False)
 class PatchPlanes:
     """Per patch (index = label - 1): point count, centroid (Nx3), unit normal facing the camera (Nx3) and
-    ``width``, the ratio of the middle to the largest covariance eigenvalue (near 0 when the points lie along a
-    line, e.g. a sliver of a face seen edge-on, whose plane - and normal - is then undetermined)."""
+    ``thickness``, the ratio of the smallest to the middle covariance eigenvalue: near 0 for a patch much wider
+    than its noise, near 1 when its points lie along a line or a strip hardly wider than the noise (a sliver of a
+    face seen edge-on), whose plane - and normal - is then undetermined; and ``width``, the middle over the largest
+    eigenvalue (near 0 for points along a line)."""
 
     counts: np.ndarray
     centroids: np.ndarray
     normals: np.ndarray
+    thickness: np.ndarray
     width: np.ndarray
 
 
@@ -119,8 +124,9 @@ def patch_planes(patches: np.ndarray, points: np.ndarray) -> PatchPlanes:
     normals = vectors[:, :, 0]
     centroids = means + shift
     normals *= np.where(np.einsum("ij,ij->i", normals, centroids) > 0, -1.0, 1.0)[:, None]
+    thickness = np.clip(values[:, 0], 0, None) / np.maximum(values[:, 1], 1e-12)
     width = np.clip(values[:, 1], 0, None) / np.maximum(values[:, 2], 1e-12)
-    return PatchPlanes(counts.astype(np.int64), centroids, normals, width)
+    return PatchPlanes(counts.astype(np.int64), centroids, normals, thickness, width)
 
 
 def connection_bending(planes: PatchPlanes, pairs: np.ndarray) -> np.ndarray:
@@ -175,11 +181,12 @@ def convex_groups(
     Patches touch when they are 4-neighbours once grown by up to ``rules.gap_width`` pixels into the unlabelled
     pixels between them that ``between`` allows (HxW bool; default: every pixel with a point) and their centroids
     are close in 3-D (:func:`close_in_space`). Patches without a trustworthy plane (fewer than ``rules.min_patch``
-    points, or narrower than ``rules.min_width``) are left out (0) for the caller.
+    points, thicker than ``rules.max_thickness`` or narrower than ``rules.min_width``) are left out (0).
     """
     planes = patch_planes(patches, points)
     count = planes.counts.size + 1
-    usable = np.concatenate([[False], (planes.counts >= rules.min_patch) & (planes.width >= rules.min_width)])
+    trusted = (planes.thickness <= rules.max_thickness) & (planes.width >= rules.min_width)
+    usable = np.concatenate([[False], (planes.counts >= rules.min_patch) & trusted])
     kept = np.where(usable[patches], patches, 0)
     between = np.isfinite(points[..., 2]) if between is None else between
     pairs = touching_pairs(grow_labels(kept, between | (kept > 0), rules.gap_width))
