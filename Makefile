@@ -18,22 +18,26 @@ lint: setup
 
 setup: system-deps $(STAMP)
 
-# open3d needs libusb-1.0; graphviz renders trees as SVG; HermiT (ontology reasoning) needs Java.
-# Each is installed only when missing.
+# open3d needs libusb-1.0; graphviz renders trees as SVG; HermiT (ontology reasoning) needs Java; the live view's
+# browser test drives Debian's headless Chromium. Each is installed only when missing.
 system-deps:
-	@if ! ldconfig -p | grep -q 'libusb-1.0.so.0' || ! command -v dot >/dev/null || ! command -v java >/dev/null; then \
+	@if ! ldconfig -p | grep -q 'libusb-1.0.so.0' || ! command -v dot >/dev/null || ! command -v java >/dev/null \
+		|| ! command -v chromium >/dev/null || ! command -v chromedriver >/dev/null; then \
 		SUDO=$$( [ "$$(id -u)" = 0 ] && echo "" || echo sudo ); \
 		$$SUDO apt-get update -qq && \
-		$$SUDO apt-get install -y -qq libusb-1.0-0 graphviz default-jre-headless >/dev/null; \
+		$$SUDO apt-get install -y -qq libusb-1.0-0 graphviz default-jre-headless chromium chromium-driver >/dev/null; \
 	fi
 
 # rapidocr-onnxruntime (OCR, models inside its wheel) requires opencv-python, which would clash with
 # opencv-python-headless: it is installed without its requirements, which pyproject.toml lists instead.
+# mediapipe (human pose; its pose model ships in the wheel) likewise: it pins numpy<2, protobuf<5 and
+# opencv-contrib-python, but its legacy pose solution runs with our numpy, protobuf and headless OpenCV.
 $(STAMP): pyproject.toml Makefile
 	test -x $(PY) || $(PYTHON) -m venv $(VENV)
 	$(PY) -m pip install -q --upgrade pip
 	$(PY) -m pip install -q -e '.[dev]'
 	$(PY) -m pip install -q --no-deps 'rapidocr-onnxruntime==1.4.4'
+	$(PY) -m pip install -q --no-deps 'mediapipe==0.10.21'
 	$(PY) -m pip uninstall -q -y opencv-python 2>/dev/null || true
 	touch $(STAMP)
 

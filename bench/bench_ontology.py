@@ -1,4 +1,4 @@
-"""Benchmark of the knowledge base: load time (cold, with and without HermiT) and question latency.
+"""Benchmark of the knowledge base: load time (cold, with and without HermiT), question latency and edit latency.
 
 Runs on the shipped ontology with the catalog's annotator classes and on a generated one (the shipped files plus
 1,000 object classes, and 200 generated annotator classes). Cold load = a fresh Python process importing the
@@ -6,13 +6,22 @@ package, finding the annotator classes and loading; warm load = another load in 
 latency = median and p99 over 10,000 mixed questions (word resolution, subsumption, profiles, default locations,
 regions, providers, query keys, annotator inputs).
 
-    python bench/bench_ontology.py [--questions N] [--no-reasoner]
+Edit latency (shipped ontology, ``OntologyEditor.add_object`` in one process, p50/p95 over ``--edits`` edits),
+side by side: without the reasoner; with HermiT as edits run it now (a stored classification, new classes checked
+incrementally); with HermiT when no classification is stored (a full run per edit); and, with ``--before REV``, the
+editor of git revision REV (e.g. ``main``) loaded from git, without and with HermiT. Then the first question after
+an edit (same knowledge base, and a second one that notices the change) against the median question, and the wall
+time of ``robokudo ontology add-object`` processes.
+
+    python bench/bench_ontology.py [--questions N] [--no-reasoner] [--edits N] [--before REV] [--edits-only]
 """
 
 from __future__ import annotations
 
 import argparse
+import importlib.util
 import json
+import os
 import random
 import statistics
 import subprocess
@@ -281,12 +290,141 @@ def bench(
         print(f"{name:26s} {len(values):6d} {statistics.median(values) * 1e6:10.1f} {p99(values) * 1e6:10.1f}")
 
 
+def previous_editor_class(revision: str) -> type | None:
+    """The OntologyEditor of the editing module at a git revision (None when git or the revision is missing)."""
+    root = Path(__file__).resolve().parents[1]
+    try:
+        source = subprocess.run(
+            ["git", "show", f"{revision}:reasoning/knowledge/editing.py"], cwd=root, capture_output=True, check=True
+        ).stdout
+    except (OSError, subprocess.CalledProcessError):
+        return None
+    spec = importlib.util.spec_from_loader(f"editing_at_{revision}", loader=None)
+    assert spec is not None
+    module = importlib.util.module_from_spec(spec)
+    sys.modules[spec.name] = module  # dataclasses look their module up
+    exec(compile(source, f"{revision}:reasoning/knowledge/editing.py", "exec"), module.__dict__)
+    return module.OntologyEditor
+
+
+def percentiles(values: list[float]) -> tuple[float, float]:
+    """p50 and p95."""
+    ordered = sorted(values)
+    return statistics.median(ordered), ordered[min(len(ordered) - 1, round(0.95 * (len(ordered) - 1)))]
+
+
+def time_edits(editor_class: type, folder: Path, label: str, count: int, **options: Any) -> list[float]:
+    """Seconds per ``add_object`` of ``count`` new classes into a fresh user file (one knowledge base, one editor).
+
+    With ``options["forget"]`` the stored classification is deleted before each edit (a full HermiT run each)."""
+    forget = options.pop("forget", False)
+    user_file = folder / label.replace(" ", "-") / "user.ttl"
+    kb = KnowledgeBase.load(user_file, annotators=annotator_classes(None))
+    editor = editor_class(kb, **options)
+    if options.get("use_reasoner") and hasattr(editor, "check"):
+        editor.check(code=False)  # a stored classification, as after `robokudo ontology check` or the first edit
+    times = []
+    colors = ["white", "red", "blue", "green"]
+    for i in range(count):
+        if forget:
+            for stored in user_file.parent.glob("*.reasoner.json"):
+                stored.unlink()
+        start = time.perf_counter()
+        editor.add_object(f"BenchThing{i}", ["Milk" if i % 2 else "Cup"], colors=[colors[i % 4]], texts=[f"t{i}"])
+        times.append(time.perf_counter() - start)
+    return times
+
+
+def bench_edits(count: int, before: str | None) -> None:
+    """Print edit latencies side by side, the first question after an edit and CLI edit wall times."""
+    from reasoning.knowledge.editing import OntologyEditor
+
+    print(f"\n== edit latency: add-object on the shipped ontology, {count} edits per row (in one process)")
+    rows: list[tuple[str, type, int, dict[str, Any]]] = [
+        ("now, no reasoner", OntologyEditor, count, {"use_reasoner": False}),
+        ("now, HermiT (stored classification)", OntologyEditor, count, {"use_reasoner": True}),
+        (
+            "now, HermiT (nothing stored: full run)",
+            OntologyEditor,
+            max(3, count // 4),
+            {"use_reasoner": True, "forget": True},
+        ),
+    ]
+    previous = previous_editor_class(before) if before else None
+    if before and previous is None:
+        print(f"(git revision {before} not found: no 'before' rows)")
+    if previous is not None:
+        rows += [
+            (f"{before}, no reasoner", previous, count, {"use_reasoner": False}),
+            (f"{before}, HermiT", previous, max(3, count // 4), {"use_reasoner": True}),
+        ]
+    print(f"{'editor':42s} {'n':>4s} {'p50 ms':>9s} {'p95 ms':>9s}")
+    with tempfile.TemporaryDirectory() as folder:
+        for label, editor_class, n, options in rows:
+            p50, p95 = percentiles(time_edits(editor_class, Path(folder), label, n, **options))
+            print(f"{label:42s} {n:4d} {p50 * 1e3:9.0f} {p95 * 1e3:9.0f}")
+        first_question_after_edit(Path(folder) / "questions" / "user.ttl")
+        cli_edits(Path(folder) / "cli" / "user.ttl")
+
+
+def first_question_after_edit(user_file: Path, rounds: int = 20) -> None:
+    """The first question after an edit, asked of the editing knowledge base and of a second one (another holder
+    of the ontology, which notices the change with ``reload_if_changed``), against the median question."""
+    from reasoning.knowledge.editing import OntologyEditor
+
+    classes = annotator_classes(None)
+    kb = KnowledgeBase.load(user_file, annotators=classes)
+    other = KnowledgeBase.load(user_file, annotators=classes)
+    editor = OntologyEditor(kb, use_reasoner=False)
+    same, noticing, usual = [], [], []
+    clock = time.perf_counter
+    for i in range(rounds):
+        editor.add_object(f"AskedThing{i}", ["Milk"])
+        start = clock()
+        kb.object_profile(f"AskedThing{i}")
+        same.append(clock() - start)
+        start = clock()
+        other.reload_if_changed()
+        other.object_profile(f"AskedThing{i}")
+        noticing.append(clock() - start)
+        for _ in range(5):
+            start = clock()
+            kb.object_profile(f"AskedThing{i}")  # the same question again
+            usual.append(clock() - start)
+    print("\n== the first question after an edit (object_profile of the new class), median of", rounds)
+    print(f"same knowledge base as the editor : {statistics.median(same) * 1e6:9.1f} µs")
+    print(f"the same question asked again     : {statistics.median(usual) * 1e6:9.1f} µs")
+    print(f"second knowledge base (reloads)   : {statistics.median(noticing) * 1e3:9.1f} ms")
+
+
+def cli_edits(user_file: Path, runs: int = 3) -> None:
+    """Wall time of ``robokudo ontology add-object`` processes (start-up and loading included)."""
+    root = Path(__file__).resolve().parents[1]
+    environment = {**os.environ, "ROBOKUDO_USER_ONTOLOGY": str(user_file), "PYTHONPATH": str(root)}
+    print(f"\n== robokudo ontology add-object as a process, median of {runs}")
+    for label, extra in (("no reasoner", ["--no-reasoner"]), ("HermiT", [])):
+        times = []
+        for i in range(runs):
+            name = f"Cli{label.replace(' ', '')}{i}"
+            command = [sys.executable, "-m", "robokudo", "ontology", *extra, "add-object", name, "--is-a", "Milk"]
+            start = time.perf_counter()
+            subprocess.run(command, env=environment, cwd=root, check=True, capture_output=True)
+            times.append(time.perf_counter() - start)
+        print(f"{label:12s}: {statistics.median(times):6.2f} s   (runs: {', '.join(f'{t:.2f}' for t in times)})")
+
+
 def main() -> int:
     """Run the benchmark."""
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("--questions", type=int, default=10_000)
     parser.add_argument("--no-reasoner", action="store_true", help="skip the HermiT cold loads")
+    parser.add_argument("--edits", type=int, default=20, help="edits per row of the edit latency table")
+    parser.add_argument("--before", metavar="REV", help="also time the editor of this git revision (e.g. main)")
+    parser.add_argument("--edits-only", action="store_true", help="only the edit latency part")
     args = parser.parse_args()
+    bench_edits(args.edits, args.before)
+    if args.edits_only:
+        return 0
     rng = random.Random(SEED)
     with tempfile.TemporaryDirectory() as folder:
         user_file = Path(folder) / "user.ttl"

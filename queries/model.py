@@ -143,6 +143,9 @@ Value: TypeAlias = Symbol | String | Number | ListValue | Range | Block | Asked
 ANYWHERE = "anywhere"
 """The ``location`` value that restricts the search to no region (``location: anywhere``)."""
 
+HUMAN_KEY = "human"
+"""The key whose block describes a person to find (``detect { human: {} }``); its block may be empty."""
+
 KINDS: tuple[str, ...] = ("detect", "inspect", "track", "scan", "stop")
 """The known query kinds, in canonical order."""
 

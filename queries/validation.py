@@ -1,6 +1,6 @@
 """Semantic checks that need no ontology, raising located :class:`QueryError`.
 
-Checked: the kind is known; the body and nested blocks are not empty; no
+Checked: the kind is known; the body and nested blocks are not empty (but ``human: {}``, any person); no
 key is given twice in one block; ``stop`` names a ``task``; sizes,
 distances, durations, counts and ids are not negative (counts and ids are
 whole numbers, ``max_results`` at least 1) and carry a fitting unit; range
@@ -17,6 +17,7 @@ from types import MappingProxyType
 
 from queries.errors import QueryError, describe_alternatives, located_error, offset_to_position
 from queries.model import (
+    HUMAN_KEY,
     KINDS,
     Block,
     Field,
@@ -139,7 +140,7 @@ def _check_field(query: Query, item: Field, depth: int) -> list[tuple[Block, int
         if item.key in WORD_ONLY_KEYS and isinstance(value, Number | Range):
             raise _error(query, item.span, f"'{item.key}' takes {WORD_ONLY_KEYS[item.key]}")
         if isinstance(value, Block):
-            if not value.fields:
+            if not value.fields and not (item.key == HUMAN_KEY and level == 1):
                 raise _error(query, item.span, f"'{item.key}' has an empty block")
             nested.append((value, level + 1))
         elif isinstance(value, ListValue):

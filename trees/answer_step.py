@@ -21,7 +21,7 @@ from reasoning.beliefs.store import BeliefFilter, BeliefStore
 from reasoning.fusion.association import CameraModel
 from reasoning.fusion.frame import FUSED_TYPES, WORLD_FRAME, FrameContext, FrameObject, frame_objects
 from reasoning.fusion.rule import CLASS_ATTRIBUTE
-from reasoning.fusion.tracking import BeliefTracker, ObjectBelief
+from reasoning.fusion.tracking import BeliefTracker, ObjectBelief, TrackStep
 from robokudo.core.annotator import Annotator
 from robokudo.core.types import CameraInfo, CasType, DepthImage, ObjectHypothesis, PointCloud, QueryAnswer, QueryView
 
@@ -69,9 +69,12 @@ class AnswerStep(Annotator):
         fail_when_empty: bool = False,
         clock: Callable[[], float] = time.time,
         label_of: Callable[[str], str] = class_label,
+        on_integrated: Callable[[TrackStep], None] | None = None,
         name: str | None = None,
     ) -> None:
         super().__init__(name=name)
+        self.on_integrated = on_integrated
+        """Told every frame's changes to the store once they are written (e.g. to publish them)."""
         self._store_source = store
         self._store: BeliefStore | None = store if isinstance(store, BeliefStore) else None
         self.tracker = tracker
@@ -117,6 +120,8 @@ class AnswerStep(Annotator):
         camera = camera_model(info, depth.depth if depth is not None else None) if info is not None else None
         store = self.store
         step = store.integrate(objects, stamp, camera=camera, tracker=self.tracker)
+        if self.on_integrated is not None:
+            self.on_integrated(step)
         belief_filter = self._filter()
         seen = {i: o for i, o in zip(step.assigned, objects, strict=True) if i}
         if belief_filter.ids is not None:  # the query names objects (``id:``): answer only those of them seen here

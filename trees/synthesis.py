@@ -20,14 +20,16 @@ from robokudo.core.composites import Fallback, Sequence
 from robokudo.core.dataflow import validate_data_flow
 from robokudo.core.parallel import ThresholdParallel
 from robokudo.core.pipeline import Pipeline
+from robokudo.core.resources import SharedResources
 
 
 class SynthesisError(Exception):
     """A plan names an annotator class that cannot be used."""
 
 
-def instantiate(step: Step, catalog: AnnotatorCatalog) -> Annotator:
-    """A fresh node of the catalog's class for a plan step, with the step's parameters and reason.
+def instantiate(step: Step, catalog: AnnotatorCatalog, resources: SharedResources | None = None) -> Annotator:
+    """A fresh node of the catalog's class for a plan step, with the step's parameters and reason (and the shared
+    ``resources`` pool, when given, instead of its own).
 
     SynthesisError when the catalog has no class of that name, or a different class than the plan was made for.
     """
@@ -43,6 +45,8 @@ def instantiate(step: Step, catalog: AnnotatorCatalog) -> Annotator:
         )
     node = cls(name=step.annotator, **dict(step.parameters))
     node.reason = step.reason
+    if resources is not None:
+        node.resources = resources
     return node
 
 
@@ -88,15 +92,18 @@ def build_tree(
     make: NodeFactory | None = None,
     query: object | None = None,
     catalog: AnnotatorCatalog | None = None,
+    resources: SharedResources | None = None,
 ) -> Pipeline:
     """The Pipeline for ``plan`` (stages in order, then ``final_steps`` such as the answer step), validated.
 
     ``make`` turns a step into a node; by default each step becomes an instance of the ``catalog``'s class of
-    that name (default catalog: :meth:`AnnotatorCatalog.discover`). ``query`` is put into every new CAS of
-    the pipeline. SynthesisError when a step names no class of the catalog.
+    that name (default catalog: :meth:`AnnotatorCatalog.discover`), sharing the ``resources`` pool (loaded
+    models) when given. ``query`` is put into every new CAS of the pipeline. SynthesisError when a step names no
+    class of the catalog.
     """
     if make is None:
-        make = partial(instantiate, catalog=catalog if catalog is not None else AnnotatorCatalog.discover())
+        catalog = catalog if catalog is not None else AnnotatorCatalog.discover()
+        make = partial(instantiate, catalog=catalog, resources=resources)
     children = [_stage_node(index, stage, make) for index, stage in enumerate(plan.stages, start=1)]
     pipeline = Pipeline(name, [*children, *final_steps], query=query, reason=f"answers the {plan.task.kind} query")
     validate_data_flow(pipeline)

@@ -87,7 +87,7 @@ class ClutterParameters(ClusterParameters):
     def merge_rules(self) -> MergeRules:
         """The cluster extractor's merge rules with the footprint rule only for parts whose heights nest (a bowl's
         inside and outside, a mug's handle): stacked objects share footprints too, but one lies above the other."""
-        return replace(super().merge_rules(), nested=True)
+        return replace(super().merge_rules(), nested=True, overlap=0.15)
 
 
 def segment_clutter(

@@ -229,13 +229,16 @@ def _join_faces(
     keys, inverse = np.unique(low * count + high, return_inverse=True)
     votes = np.maximum(np.bincount(inverse, minlength=keys.size), 1)
     share = np.bincount(inverse, weights=convex[apart], minlength=keys.size) / votes
-    concave_share = np.bincount(inverse, weights=concave[apart], minlength=keys.size) / votes
-    share = np.where(concave_share > rules.concave_share, 0.0, share)
+    concave_votes = np.bincount(inverse, weights=concave[apart], minlength=keys.size)
+    share = np.where((concave_votes > rules.concave_share * votes) & (concave_votes >= rules.min_votes), 0.0, share)
     first, second = keys // count, keys % count
     large = np.bincount(faces, weights=planes_sizes(planes, count), minlength=count) >= rules.min_face
     both_large = large[first] & large[second]
     agree = (share > rules.convex_share) & ((share * votes >= rules.min_votes) | ~both_large)
-    kept_apart = np.column_stack([first, second])[(share <= rules.convex_share) & both_large]
+    # one vote decides nothing: a single noisy connection neither joins two large faces nor keeps them apart
+    kept_apart = np.column_stack([first, second])[
+        (share <= rules.convex_share) & both_large & (votes >= rules.min_votes)
+    ]
     order = np.argsort(-(share * votes)[agree], kind="stable")
     return join_unless_apart(count, np.column_stack([first, second])[agree][order], kept_apart)
 

@@ -403,6 +403,7 @@ class MergeRules:
     creased: float = 1.0
     inside: bool = True
     nested: bool = False
+    nest_tolerance: float = 0.003
 
 
 def merge_parts(
@@ -470,23 +471,24 @@ def merge_parts(
         if (first, second) in smooth:
             allowed.append((first, second))
             continue
+        stacked = False
         if (
             (first, second) not in occluding
             and rules.overlap < 1.0
             and footprint_overlap(parts.hull(first), parts.hull(second), rules.cell) > rules.overlap
         ):
             heights = (parts.coordinates(first)[:, 2], parts.coordinates(second)[:, 2])
-            if not rules.nested or heights_nest(*heights, 0.0):
+            if not rules.nested or heights_nest(*heights, rules.nest_tolerance):
                 allowed.append((first, second))
                 continue
-            creases.append((first, second))  # one stands on the other: never joined, not even through a third
-        if not rules.inside:
-            continue
+            stacked = True
         near, far = sorted((first, second), key=parts.depth_of)
-        if looks_like_inside(
+        if rules.inside and looks_like_inside(
             parts.coordinates(near), parts.coordinates(far), rules.inside_tolerance, rules.inside_depth_ratio
         ):
             allowed.append((first, second))
+        elif stacked:
+            creases.append((first, second))  # one stands on the other: never joined, not even through a third
     joined = [(a, b) for a, b in allowed if sizes[a] >= rules.small_part and sizes[b] >= rules.small_part]
     best: dict[int, tuple[float, int]] = {}
     for a, b in allowed:

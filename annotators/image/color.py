@@ -1,8 +1,26 @@
-"""Semantic colour naming: every hypothesis gets the name of the colour most of its pixels have.
+"""Colour names a person would agree with: an object's dominant colour, and a second one when it has two.
 
-Pixels are classified in HSV by :data:`COLOR_RULES`, the one table of colour names and their ranges (the names
-are the ontology's colour classes, lower case). Achromatic pixels (low saturation) are named together per object
-by how bright the object's brighter achromatic pixels are, so a white object is still white where it is shaded.
+An object's pixels are white-balanced for the frame (:mod:`annotators.image.white_balance`: grey-edge) and
+grouped into surfaces, highlights, shadows and edge pixels discounted (:mod:`annotators.image.color_surfaces`).
+Each surface is named (:func:`name_surface`):
+
+* an unsaturated surface (inside the achromatic ellipse, which is wider along the daylight locus where white
+  balance errs) is white when its lit luminance is about the frame's surround luminance or above (and it is not
+  dark in absolute terms), black when it is dark both absolutely and against the surround, else grey;
+* a saturated surface is named in CIELAB by CIEDE2000 distances to the colour-name prototypes of
+  :mod:`annotators.image.color_prototypes` (the xkcd colour survey), as a kernel density classifier: each
+  term's prototypes vote with a Gaussian of their distance (``kernel_width``) averaged per term, and the winning
+  term's share of the votes is the name's certainty;
+* the near-black pool is a dark colour (a navy mug) when its mean colour is clearly saturated, else black; it
+  counts only when it is a sizeable part of the object or has the name of one of its lit surfaces (shadows are
+  dropped).
+
+A name's share is the share of the named pixels its surfaces hold (grey merges into white: an unsaturated
+object's shaded side). The dominant colour is the largest share; a second colour is reported when its share
+and its confidence (share x certainty) are large enough.
+
+:data:`COLOR_TERMS` is the one list of names this namer reports: the lower-case labels of the ontology's colour
+classes (``rk:Color`` in ontology/perception.ttl); the annotator's capability is derived from it.
 """
 
 from __future__ import annotations
@@ -10,138 +28,179 @@ from __future__ import annotations
 from dataclasses import dataclass
 from typing import ClassVar
 
-import cv2
 import numpy as np
 
-from annotators.image.pixel_expert import PixelExpert
+from annotators.image.color_prototypes import prototypes
+from annotators.image.color_space import delta_e_2000, linear_to_lab, linear_to_srgb
+from annotators.image.color_surfaces import (
+    DEFAULT_PARAMETERS,
+    NamingParameters,
+    Surface,
+    is_unsaturated,
+    object_pixels,
+    object_surfaces,
+    tint,
+)
+from annotators.image.pixel_expert import image_and_hypotheses
+from annotators.image.white_balance import NEUTRAL_LIGHT, FrameLight, estimate_frame_light
+from robokudo.core.annotator import Annotator
 from robokudo.core.capability import Capability
-from robokudo.core.types import CasType, SemanticColor
+from robokudo.core.types import CasType, ColorImage, ObjectHypothesis, SemanticColor
+
+COLOR_TERMS: tuple[str, ...] = (
+    "red", "orange", "yellow", "green", "blue", "purple", "pink", "brown", "white", "grey", "black",
+)  # fmt: skip
+"""The colour names reported: the eleven basic colour terms of Berlin and Kay, as the ontology labels them."""
+
+ACHROMATIC_TERMS: tuple[str, ...] = ("white", "grey", "black")
+"""The names of unsaturated surfaces, decided by lightness rather than by prototypes."""
+
+CHROMATIC_TERMS: tuple[str, ...] = tuple(t for t in COLOR_TERMS if t not in ACHROMATIC_TERMS)
+"""The names decided by the colour-name prototypes."""
+
+LUMINANCE = np.array([0.2126, 0.7152, 0.0722])
+"""Relative luminance Y of linear sRGB."""
+
+WHITE_LAB = np.array([100.0, 0.0, 0.0])
+
+_ALL_TERMS, _ALL_LAB, _ALL_NAMES = prototypes(COLOR_TERMS)
+_CHROMATIC = np.array([term in CHROMATIC_TERMS for term in _ALL_TERMS])
+_PROTOTYPE_TERMS = tuple(t for t, chromatic in zip(_ALL_TERMS, _CHROMATIC, strict=True) if chromatic)
+_PROTOTYPE_LAB = _ALL_LAB[_CHROMATIC]
+_PROTOTYPE_CODES = np.array([CHROMATIC_TERMS.index(t) for t in _PROTOTYPE_TERMS])
+_TERM_AVERAGE = np.eye(len(CHROMATIC_TERMS))[_PROTOTYPE_CODES] / np.bincount(_PROTOTYPE_CODES)
+"""Prototypes x terms: averages the prototypes' votes per term."""
 
 
 @dataclass(frozen=True)
-class ColorRule:
-    """A colour name for pixels whose hue (degrees), saturation and value (0..1) lie in these half-open ranges."""
+class SurfaceName:
+    """The name of one surface colour and how certain it is (0..1)."""
 
     name: str
-    hues: tuple[tuple[float, float], ...] = ((0.0, 360.1),)
-    saturation: tuple[float, float] = (0.0, 1.01)
-    value: tuple[float, float] = (0.0, 1.01)
+    certainty: float
 
 
-ACHROMATIC_SATURATION = 0.28
-"""Pixels less saturated than this count as achromatic: white, grey or black."""
+@dataclass(frozen=True)
+class NamedColor:
+    """One colour of an object: its name, its share of the named pixels and its confidence."""
 
-DARK_VALUE = 0.25
-"""Pixels darker than this count as achromatic unless they are at least ``DARK_SATURATION`` saturated."""
-
-DARK_SATURATION = 0.6
-"""Dark pixels (value at least ``BLACK_VALUE``) this saturated keep their hue (a navy mug is blue, not black)."""
-
-BLACK_VALUE = 0.1
-"""Pixels darker than this are always achromatic."""
-
-ACHROMATIC_RULES: tuple[ColorRule, ...] = (
-    ColorRule("black", value=(0.0, 0.22)),
-    ColorRule("grey", value=(0.22, 0.52)),
-    ColorRule("white", value=(0.52, 1.01)),
-)
-"""How an object's achromatic pixels are named, by the 80th percentile of their value."""
-
-COLOR_RULES: tuple[ColorRule, ...] = (
-    ColorRule("brown", hues=((8.0, 45.0),), value=(0.0, 0.55)),
-    ColorRule("pink", hues=((330.0, 360.0), (0.0, 8.0)), saturation=(0.0, 0.5), value=(0.75, 1.01)),
-    ColorRule("red", hues=((345.0, 360.0), (0.0, 8.0))),
-    ColorRule("orange", hues=((8.0, 42.0),)),
-    ColorRule("yellow", hues=((42.0, 70.0),)),
-    ColorRule("green", hues=((70.0, 165.0),)),
-    ColorRule("blue", hues=((165.0, 255.0),)),
-    ColorRule("purple", hues=((255.0, 290.0),)),
-    ColorRule("pink", hues=((290.0, 345.0),)),
-)
-"""Chromatic colour names; the first matching rule names a pixel."""
-
-COLOR_NAMES: tuple[str, ...] = tuple(dict.fromkeys(r.name for r in ACHROMATIC_RULES + COLOR_RULES))
-"""Every colour name this annotator can report."""
-
-ACHROMATIC = len(COLOR_NAMES)
-"""The code :func:`classify_pixels` gives unsaturated (or very dark) pixels."""
-
-_RULE_CODES = tuple(COLOR_NAMES.index(rule.name) for rule in COLOR_RULES)
+    name: str
+    share: float
+    confidence: float
 
 
-def _in_ranges(values: np.ndarray, ranges: tuple[tuple[float, float], ...]) -> np.ndarray:
-    hit = np.zeros(values.shape, dtype=bool)
-    for low, high in ranges:
-        hit |= (values >= low) & (values < high)
-    return hit
+def _chromatic_name(lab: np.ndarray, parameters: NamingParameters) -> SurfaceName:
+    distances = delta_e_2000(lab[None, :], _PROTOTYPE_LAB)
+    votes = np.exp(-0.5 * (distances / parameters.kernel_width) ** 2)
+    density = votes @ _TERM_AVERAGE
+    total = float(density.sum())
+    if total <= 1e-300:  # far from every prototype: the nearest one decides
+        return SurfaceName(_PROTOTYPE_TERMS[int(np.argmin(distances))], 0.0)
+    best = int(np.argmax(density))
+    return SurfaceName(CHROMATIC_TERMS[best], float(density[best] / total))
 
 
-def classify_pixels(rgb: np.ndarray) -> np.ndarray:
-    """Colour codes (indices into :data:`COLOR_NAMES`, or :data:`ACHROMATIC`) of N RGB pixels (Nx3 uint8)."""
-    hsv = cv2.cvtColor(np.ascontiguousarray(rgb, dtype=np.uint8).reshape(-1, 1, 3), cv2.COLOR_RGB2HSV_FULL)
-    hsv = hsv.reshape(-1, 3).astype(np.float32)
-    hue = hsv[:, 0] * np.float32(360.0 / 256.0)
-    saturation = hsv[:, 1] * np.float32(1 / 255)
-    value = hsv[:, 2] * np.float32(1 / 255)
-    codes = np.full(hue.shape, ACHROMATIC, dtype=np.int64)
-    bright = (saturation >= ACHROMATIC_SATURATION) & (value >= DARK_VALUE)
-    dark = (saturation >= DARK_SATURATION) & (value >= BLACK_VALUE)
-    open_ = bright | dark
-    for rule, code in zip(COLOR_RULES, _RULE_CODES, strict=True):
-        hit = open_ & _in_ranges(hue, rule.hues)
-        if rule.saturation != (0.0, 1.01):
-            hit &= (saturation >= rule.saturation[0]) & (saturation < rule.saturation[1])
-        if rule.value != (0.0, 1.01):
-            hit &= (value >= rule.value[0]) & (value < rule.value[1])
-        codes[hit] = code
-        open_ &= ~hit
-    return codes
+def name_surface(surface: Surface, surround: float, parameters: NamingParameters = DEFAULT_PARAMETERS) -> SurfaceName:
+    """The name of one surface against the frame's surround luminance (see the module docstring)."""
+    if surface.kind == "dark":
+        srgb = 255.0 * linear_to_srgb(surface.linear)
+        span = float(srgb.max() - srgb.min())
+        saturation = span / max(float(srgb.max()), 1e-9)
+        if saturation >= parameters.dark_saturation and span >= parameters.dark_span:
+            mean = linear_to_lab(surface.linear)  # judged as the same chromaticity a little lighter
+            lightness = max(float(mean[0]), parameters.dark_lightness * 2.0)
+            return _chromatic_name(
+                np.array([lightness, *(mean[1:] / (mean[0] + 16.0) * (lightness + 16.0))]), parameters
+            )
+        return SurfaceName("black", 0.5 + 0.5 * max(0.0, 1.0 - saturation / parameters.dark_saturation))
+    if not is_unsaturated(surface.lab, parameters):
+        return _chromatic_name(surface.lab, parameters)
+    lightness = float(surface.lab[0])
+    certainty = 0.5 + 0.5 * (1.0 - tint(surface.lab, parameters))
+    luminance = ((lightness + 16.0) / 116.0) ** 3
+    if luminance >= parameters.white_surround_ratio * surround and lightness >= parameters.white_lightness:
+        return SurfaceName("white", certainty)
+    black = lightness < parameters.black_lightness and luminance < parameters.black_surround_ratio * surround
+    return SurfaceName("black" if black else "grey", certainty)
 
 
-def classify_names(rgb: np.ndarray) -> list[str]:
-    """The colour name of each of N RGB pixels (``"achromatic"`` for unsaturated ones)."""
-    names = (*COLOR_NAMES, "achromatic")
-    return [names[code] for code in classify_pixels(rgb)]
+def name_colors(
+    pixels: np.ndarray,
+    light: FrameLight = NEUTRAL_LIGHT,
+    edges: np.ndarray | None = None,
+    parameters: NamingParameters = DEFAULT_PARAMETERS,
+) -> tuple[NamedColor, ...]:
+    """The colours of an object from its RGB pixels (Nx3 uint8): the dominant one, then a second one when the
+    object has two; ``edges`` (N, from :func:`~annotators.image.color_surfaces.edge_strength`) lets pixels on
+    colour edges be left out."""
+    surfaces, count = object_surfaces(pixels, light, edges, parameters)
+    names = [name_surface(surface, light.surround, parameters) for surface in surfaces]
+    weights: dict[str, float] = {}
+    certainties: dict[str, float] = {}
+    lit_names = {n.name for s, n in zip(surfaces, names, strict=True) if s.kind != "dark"}
+    for surface, named in zip(surfaces, names, strict=True):
+        shadow = lit_names and named.name not in lit_names and surface.pixels < parameters.dark_keep_share * count
+        if surface.kind == "dark" and shadow:
+            continue  # shadows of the object's surfaces
+        weights[named.name] = weights.get(named.name, 0.0) + surface.pixels
+        certainties[named.name] = certainties.get(named.name, 0.0) + surface.pixels * named.certainty
+    if "white" in weights and "grey" in weights:  # an unsaturated object's shaded sides
+        weights["white"] += weights.pop("grey")
+        certainties["white"] += certainties.pop("grey")
+    total = sum(weights.values())
+    ranked = sorted(weights, key=lambda name: (-weights[name], COLOR_TERMS.index(name)))
+    result: list[NamedColor] = []
+    for name in ranked[:2]:
+        share = weights[name] / total
+        certainty = certainties[name] / weights[name]
+        if result and (share < parameters.second_share or share * certainty < parameters.second_confidence):
+            break
+        result.append(NamedColor(name=name, share=share, confidence=share * certainty))
+    return tuple(result)
 
 
-def achromatic_name(rgb: np.ndarray) -> str:
-    """White, grey or black for a set of unsaturated pixels (Nx3), by the 80th percentile of their value."""
-    brightness = np.sort(rgb.max(axis=1))
-    value = float(brightness[round(0.8 * (brightness.size - 1))]) / 255.0
-    for rule in ACHROMATIC_RULES:
-        if rule.value[0] <= value < rule.value[1]:
-            return rule.name
-    return ACHROMATIC_RULES[-1].name
+def name_color(pixels: np.ndarray, light: FrameLight = NEUTRAL_LIGHT) -> tuple[str, float, dict[str, float]]:
+    """The dominant colour name of N RGB pixels, its share, and the share of every reported name."""
+    named = name_colors(pixels, light)
+    return named[0].name, named[0].share, {c.name: c.share for c in named}
 
 
-def name_color(rgb: np.ndarray) -> tuple[str, float, dict[str, float]]:
-    """The dominant colour name of N RGB pixels, its share, and the share of every name present (largest first)."""
-    if rgb.shape[0] == 0:
-        raise ValueError("no pixels to name a colour for")
-    codes = classify_pixels(rgb)
-    achromatic = codes == ACHROMATIC
-    if achromatic.any():
-        codes[achromatic] = COLOR_NAMES.index(achromatic_name(rgb[achromatic]))
-    counts = np.bincount(codes, minlength=len(COLOR_NAMES))
-    order = np.argsort(-counts, kind="stable")
-    shares = {COLOR_NAMES[i]: counts[i] / codes.size for i in order if counts[i]}
-    winner = COLOR_NAMES[int(order[0])]
-    return winner, shares[winner], shares
+class SemanticColorAnnotator(Annotator):
+    """Names the dominant colour of every object hypothesis, and its second colour when it has two.
 
+    Attaches one SemanticColor per reported colour, the dominant one first and with the higher confidence;
+    ``ratio`` is the colour's share of the object, ``confidence`` its share times the name's certainty.
+    """
 
-class SemanticColorAnnotator(PixelExpert):
-    """Names the dominant colour of every object hypothesis; confidence is the winning colour's share."""
-
+    inputs: ClassVar[tuple[type[CasType], ...]] = (ObjectHypothesis, ColorImage)
     outputs: ClassVar[tuple[type[CasType], ...]] = (SemanticColor,)
-    purpose: ClassVar[str] = "name colours for"
     capability: ClassVar[Capability] = Capability(
         label="semantic colour annotator",
-        colors=("Red", "Orange", "Yellow", "Green", "Blue", "Purple", "Pink", "Brown", "White", "Grey", "Black"),
+        colors=tuple(term.capitalize() for term in COLOR_TERMS),
         cost_ms=3.0,
         reliability=0.8,
     )
 
-    def describe(self, pixels: np.ndarray) -> SemanticColor:
-        """The dominant colour name of the pixels."""
-        color, share, _ = name_color(pixels)
-        return SemanticColor(color=color, ratio=share, confidence=share)
+    def __init__(
+        self, max_pixels: int = 1000, parameters: NamingParameters = DEFAULT_PARAMETERS, name: str | None = None
+    ) -> None:
+        super().__init__(name=name)
+        self.max_pixels = max_pixels
+        self.parameters = parameters
+
+    def analyse(self) -> None:
+        """Name the colours of each hypothesis with pixels; fail on missing or inconsistent input."""
+        image, hypotheses = image_and_hypotheses(self, "name colours for")
+        light = estimate_frame_light(image)
+        named_any = False
+        for hypothesis in hypotheses:
+            if hypothesis.mask.shape != image.shape[:2]:
+                self.fail(f"hypothesis mask {hypothesis.mask.shape} and colour image {image.shape[:2]} sizes differ")
+            pixels, edges = object_pixels(image, hypothesis, self.max_pixels)
+            if pixels.shape[0] == 0:
+                continue
+            for color in name_colors(pixels, light, edges, self.parameters):
+                self.attach(hypothesis, SemanticColor(color=color.name, ratio=color.share, confidence=color.confidence))
+            named_any = True
+        if not named_any:
+            self.fail("every object hypothesis has an empty mask")

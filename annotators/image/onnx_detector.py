@@ -21,7 +21,6 @@ detection whose box overlaps its image box with IoU >= ``overlap_threshold`` (co
 from __future__ import annotations
 
 import ast
-import threading
 from collections.abc import Mapping, Sequence
 from dataclasses import dataclass
 from pathlib import Path
@@ -198,27 +197,26 @@ class OnnxDetector(Annotator):
         self.iou_threshold = iou_threshold
         self.class_map = dict(class_map or {})
         self.overlap_threshold = overlap_threshold
-        self._session: Any = None
         self._names: list[str] | None = None
-        self._lock = threading.Lock()
 
     # ------------------------------------------------------------------ model
 
     def session(self) -> Any:
-        """The onnxruntime session (loaded on first use); raises DetectorError with the reason."""
-        with self._lock:
-            if self._session is None:
-                if not self.model_path.is_file():
-                    raise DetectorError(f"model file {self.model_path} does not exist")
-                import onnxruntime
+        """The onnxruntime session (loaded on first use, shared through this annotator's resources with every
+        detector of the same model file); raises DetectorError with the reason."""
+        if not self.model_path.is_file():
+            raise DetectorError(f"model file {self.model_path} does not exist")
+        modified = self.model_path.stat().st_mtime_ns
 
-                try:
-                    self._session = onnxruntime.InferenceSession(
-                        str(self.model_path), providers=["CPUExecutionProvider"]
-                    )
-                except Exception as error:  # onnxruntime raises its own types for malformed models
-                    raise DetectorError(f"cannot load ONNX model {self.model_path}: {error}") from None
-            return self._session
+        def load() -> Any:
+            import onnxruntime
+
+            try:
+                return onnxruntime.InferenceSession(str(self.model_path), providers=["CPUExecutionProvider"])
+            except Exception as error:  # onnxruntime raises its own types for malformed models
+                raise DetectorError(f"cannot load ONNX model {self.model_path}: {error}") from None
+
+        return self.resources.get(("onnx", str(self.model_path.resolve()), modified), load)
 
     def names(self) -> list[str]:
         """The model's class names: given, read from a file, or from the model's metadata."""

@@ -146,6 +146,43 @@ def pick_topics(reader: AnyReader, requested: BagTopics = ANY_TOPICS) -> BagTopi
     return BagTopics(color=color, depth=depth, info=info)
 
 
+def named_topics(path: str | Path, names: list[str]) -> BagTopics:
+    """The topics ``names`` (as given to ``--topic``) sorted into their roles by the bag's message types: a
+    PointCloud2 topic, colour and depth Image topics (told apart by encoding) and a CameraInfo topic. FrameError
+    names a topic the bag lacks, one of another type, or two topics for one role."""
+    roles: dict[str, str] = {}
+    reader = open_bag(path)
+    try:
+        for name in names:
+            found = {c.msgtype for c in reader.connections if c.topic == name}
+            if not found:
+                known = ", ".join(sorted({f"{c.topic} ({c.msgtype})" for c in reader.connections})) or "none"
+                raise FrameError(f"the bag has no topic {name}; its topics: {known}")
+            if POINT_CLOUD in found:
+                role = "cloud"
+            elif CAMERA_INFO in found:
+                role = "info"
+            elif IMAGE in found:
+                encoding = _first_message(reader, name).encoding
+                if encoding in COLOR_ENCODINGS:
+                    role = "color"
+                elif encoding in DEPTH_ENCODINGS:
+                    role = "depth"
+                else:
+                    raise FrameError(f"topic {name} carries images of encoding {encoding!r}, neither colour nor depth")
+            else:
+                carried = ", ".join(sorted(found))
+                raise FrameError(f"topic {name} carries {carried}: no Image, CameraInfo or PointCloud2")
+            if role in roles and roles[role] != name:
+                raise FrameError(f"two {role} topics named: {roles[role]} and {name}")
+            roles[role] = name
+    finally:
+        reader.close()
+    if "cloud" in roles and len(roles) > 1:
+        raise FrameError("name either a PointCloud2 topic or image topics, not both")
+    return BagTopics(**roles)
+
+
 def _rows(message: Any, channels: int, itemsize: int) -> np.ndarray:
     """The image's bytes as a (height, width * channels * itemsize) array, honouring the row step."""
     row = message.width * channels * itemsize

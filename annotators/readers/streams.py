@@ -29,6 +29,8 @@ from pathlib import Path
 from types import TracebackType
 from typing import ClassVar, Self
 
+from py_trees.common import Status
+
 from annotators.readers.bag_io import ANY_TOPICS, BagTopics, bag_frames, is_bag
 from annotators.readers.choice import recorded_frames
 from annotators.readers.frame_io import Frame, FrameError
@@ -36,7 +38,12 @@ from annotators.readers.frame_readers import DEFAULT_KITCHEN_VIEW, KITCHEN_RECOR
 from annotators.simulation import kitchen_scene
 from robokudo.core.annotator import Annotator
 from robokudo.core.capability import Capability
+from robokudo.core.pipeline import StructureError
 from robokudo.core.types import CameraInfo, CasType, ColorImage, DepthImage
+
+PERCEPTION_PIPELINE = "perception"
+"""The name of a served root's perceive pipeline (the paper's Fig. 4): its CAS holds the frame read this run, which
+:class:`PerceivedFrameReader` hands to the task's pipeline."""
 
 DEFAULT_RATE_HZ = 30.0
 """The kitchen camera's rate, and the playback rate of recordings without time stamps unless one is given."""
@@ -143,6 +150,7 @@ class KitchenCameraStream(FrameStream):
         self._rendered: dict[str, kitchen_scene.RenderedScene] = {}
         self._start = time.monotonic()
         self._last_slot = -1
+        self._last_view: str | None = None
 
     @staticmethod
     def _checked_view(view: str) -> str:
@@ -170,6 +178,20 @@ class KitchenCameraStream(FrameStream):
         self.set_view(view)
         return view
 
+    def prepare(self) -> None:
+        """Render every view now, so that pointing the camera later costs no rendering on the reading thread."""
+        for view in kitchen_scene.camera_views():
+            self._scene(view)
+
+    def _scene(self, view: str) -> kitchen_scene.RenderedScene:
+        with self._lock:
+            scene = self._rendered.get(view)
+        if scene is None:
+            scene = kitchen_scene.render_kitchen(view, seed=self.seed)
+            with self._lock:
+                scene = self._rendered.setdefault(view, scene)
+        return scene
+
     @property
     def last_scene(self) -> kitchen_scene.RenderedScene | None:
         """The scene (with its ground truth) of the current view, None before it was first rendered."""
@@ -177,21 +199,18 @@ class KitchenCameraStream(FrameStream):
             return self._rendered.get(self._view)
 
     def _next(self, block: bool) -> StreamFrame | None:
-        """The camera's newest frame after the last one delivered (frames a slow caller missed are skipped)."""
+        """The camera's newest frame after the last one delivered (frames a slow caller missed are skipped); after
+        the view changed, a frame from the new view at once."""
         period = 1.0 / self.rate_hz
         slot = math.floor((time.monotonic() - self._start) / period)
-        if slot <= self._last_slot:
+        view = self.view
+        if slot <= self._last_slot and view == self._last_view:
             if not block:
                 return None
             slot = self._last_slot + 1
             self._wait_until(self._start + slot * period)
-        with self._lock:
-            view = self._view
-            scene = self._rendered.get(view)
-        if scene is None:
-            scene = kitchen_scene.render_kitchen(view, seed=self.seed)
-            with self._lock:
-                self._rendered.setdefault(view, scene)
+        slot = max(slot, self._last_slot + 1)
+        scene = self._scene(view)
         camera = CameraInfo(
             intrinsics=scene.intrinsics,
             cam_to_world=scene.cam_to_world,
@@ -201,6 +220,7 @@ class KitchenCameraStream(FrameStream):
         )
         frame = Frame(scene.color, scene.depth, scene.intrinsics, source=f"kitchen/{view}", timestamp=camera.timestamp)
         self._last_slot = slot
+        self._last_view = view
         delivered = StreamFrame(frame, camera, index=slot, sequence=self._delivered)
         self._delivered += 1
         return delivered
@@ -343,10 +363,12 @@ def stream_for(
 
 
 class StreamReader(Annotator):
-    """Writes the stream's next frame (colour, depth, camera info) each time it runs.
+    """Writes the stream's next frame (colour, depth, camera info) each time it runs; never the same frame twice.
 
-    ``wait`` False takes only a frame that is already due and otherwise writes the last one again. Fails with the
-    reason when the source ended (then :attr:`ended` is True) or a frame cannot be read.
+    ``wait`` True blocks the tick until the next frame is due. ``wait`` False never blocks: while no new frame is
+    due the reader stays RUNNING (feedback "waiting for the next frame"), so the engine keeps its tick rate and the
+    rest of the tree runs once per new frame. Fails with the reason when the source ended (then :attr:`ended` is
+    True) or a frame cannot be read.
     """
 
     inputs: ClassVar[tuple[type[CasType], ...]] = ()
@@ -358,22 +380,42 @@ class StreamReader(Annotator):
         reliability=1.0,
     )
 
+    WAITING = "waiting for the next frame"
+
     def __init__(self, stream: FrameStream, wait: bool = True, name: str | None = None) -> None:
         super().__init__(name=name)
         self.stream = stream
         self.wait = wait
         self.ended = False
         self._last: StreamFrame | None = None
+        self._due: StreamFrame | None = None
+        self._problem: Exception | None = None
 
     @property
     def last_frame(self) -> StreamFrame | None:
         """The frame written by the last successful run, None before it."""
         return self._last
 
+    def update(self) -> Status:
+        """Without waiting: RUNNING until a new frame is due, then write it (see the class)."""
+        if not self.wait:
+            try:
+                self._due = self.stream.next_frame(block=False)
+            except (SourceEndedError, FrameError, OSError, ValueError) as error:
+                self._problem = error  # analyse reports it as the run's failure
+            if self._due is None and self._problem is None:
+                self.feedback_message = self.WAITING
+                return Status.RUNNING
+        return super().update()
+
     def analyse(self) -> None:
-        """Take the next frame (or keep the last one when not waiting and none is due) and write it."""
+        """Take the next frame and write it."""
+        due, problem = self._due, self._problem
+        self._due = self._problem = None
         try:
-            delivered = self.stream.next_frame(block=self.wait or self._last is None)
+            if problem is not None:
+                raise problem
+            delivered = due if due is not None else self.stream.next_frame(block=True)
         except SourceEndedError as error:
             self.ended = True
             self.fail(f"source ended: {error}")
@@ -381,9 +423,42 @@ class StreamReader(Annotator):
             self.fail(f"cannot read the next frame of {self.stream.name}: {error}")
         except (OSError, ValueError) as error:
             self.fail(f"cannot read the next frame of {self.stream.name}: {type(error).__name__}: {error}")
-        if delivered is not None:
-            self._last = delivered
-        assert self._last is not None
-        self.write(ColorImage(self._last.frame.color))
-        self.write(DepthImage(self._last.frame.depth))
-        self.write(self._last.camera)
+        assert delivered is not None
+        self._last = delivered
+        self.write(ColorImage(delivered.frame.color))
+        self.write(DepthImage(delivered.frame.depth))
+        self.write(delivered.camera)
+
+
+class PerceivedFrameReader(Annotator):
+    """The first step of a task in a served tree: takes the frame the root's perceive pipeline read this run.
+
+    The views are shared by reference (no copy). Fails with the reason when the tree has no such pipeline or it
+    holds no frame.
+    """
+
+    inputs: ClassVar[tuple[type[CasType], ...]] = ()
+    outputs: ClassVar[tuple[type[CasType], ...]] = (ColorImage, DepthImage, CameraInfo)
+    capability: ClassVar[Capability] = Capability(
+        label="perceived frame",
+        description="Takes the frame the running engine perceived this run (colour, depth, camera info).",
+        cost_ms=0.1,
+        reliability=1.0,
+    )
+
+    def __init__(self, pipeline: str = PERCEPTION_PIPELINE, name: str | None = None) -> None:
+        super().__init__(name=name)
+        self.pipeline = pipeline
+
+    def analyse(self) -> None:
+        """Write the perceived colour, depth and camera info into this task's CAS."""
+        try:
+            perceived = self.cas_of(self.pipeline)
+        except StructureError as error:
+            self.fail(str(error))
+        views = (perceived.view(ColorImage), perceived.view(DepthImage), perceived.view(CameraInfo))
+        if any(view is None for view in views):
+            self.fail(f"no frame was perceived: the {self.pipeline!r} pipeline holds none")
+        for view in views:
+            assert view is not None
+            self.write(view)

@@ -12,7 +12,6 @@ build): ``pip install --no-deps rapidocr-onnxruntime`` plus its other requiremen
 
 from __future__ import annotations
 
-import threading
 from typing import Any, ClassVar
 
 import cv2
@@ -20,6 +19,7 @@ import numpy as np
 
 from annotators.image.pixel_expert import image_and_hypotheses
 from robokudo.core.capability import Capability
+from robokudo.core.resources import Guarded
 from robokudo.core.threaded import ThreadedAnnotator
 from robokudo.core.types import CasType, ColorImage, ObjectHypothesis, Text
 
@@ -72,18 +72,19 @@ class TextReader(ThreadedAnnotator):
         self.min_score = min_score
         self.margin = margin
         self.target_size = target_size
-        self._engine: Any = None
-        self._lock = threading.Lock()
 
-    def engine(self) -> Any:
-        """The OCR engine of this instance (built on first use); fails the run when RapidOCR is missing."""
-        if self._engine is None:
-            try:
-                from rapidocr_onnxruntime import RapidOCR
-            except ImportError as error:
-                self.fail(f"OCR needs rapidocr-onnxruntime ({error}); install it as the README says")
-            self._engine = RapidOCR(det_limit_side_len=float(DETECTOR_SIDE), det_limit_type="max")
-        return self._engine
+    def engine(self) -> Guarded[Any]:
+        """The OCR engine with its lock, from this annotator's resources (built on first use: shared by every
+        tree given the same pool); fails the run when RapidOCR is missing."""
+        try:
+            from rapidocr_onnxruntime import RapidOCR
+        except ImportError as error:
+            self.fail(f"OCR needs rapidocr-onnxruntime ({error}); install it as the README says")
+
+        def build() -> Guarded[Any]:
+            return Guarded(RapidOCR(det_limit_side_len=float(DETECTOR_SIDE), det_limit_type="max"))
+
+        return self.resources.get(("rapidocr", DETECTOR_SIDE), build)
 
     def read(self, image: np.ndarray, roi: tuple[int, int, int, int]) -> Text | None:
         """The text read inside ``roi`` of the RGB ``image``, or None when nothing legible is there."""
@@ -96,8 +97,9 @@ class TextReader(ThreadedAnnotator):
         if scale > 1.0:
             crop = cv2.resize(crop, None, fx=scale, fy=scale, interpolation=cv2.INTER_CUBIC)
         bgr = np.ascontiguousarray(crop[..., ::-1])
-        with self._lock:
-            result, _ = self.engine()(bgr, use_cls=False)
+        engine = self.engine()
+        with engine.lock:
+            result, _ = engine.value(bgr, use_cls=False)
         lines = [
             (np.asarray(corners, dtype=np.float64) / scale + (x0, y0), str(text).strip(), float(score))
             for corners, text, score in (result or [])

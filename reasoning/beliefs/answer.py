@@ -85,6 +85,12 @@ class ObjectDesignator:
     last_seen: float = 0.0
     status: str = "present"
 
+    def shown_label(self) -> str:
+        """The class label for people: ``?`` marks a class more likely wrong than right."""
+        stated = self.attributes.get(CLASS_ATTRIBUTE)
+        doubtful = self.class_label is not None and stated is not None and stated.confidence < 0.5
+        return f"{self.class_label or UNKNOWN_LABEL}{'?' if doubtful else ''}"
+
     def to_dict(self) -> dict[str, Any]:
         """A JSON-ready dict (numbers rounded to 6 decimals)."""
         return {
@@ -162,9 +168,8 @@ class Answer:
             p = o.pose.position
             colour = o.attributes.get(SemanticColor.attribute)
             stated = o.attributes.get(CLASS_ATTRIBUTE)
-            doubtful = o.class_label is not None and stated is not None and stated.confidence < 0.5
             lines.append(
-                f"#{o.id} {o.class_label or UNKNOWN_LABEL}{'?' if doubtful else ''}"
+                f"#{o.id} {o.shown_label()}"
                 + (f" ({colour.value})" if colour else "")
                 + f" at ({p[0]:.3f}, {p[1]:.3f}, {p[2]:.3f}) [{o.pose.frame}]"
                 + (f" in {o.region}" if o.region else "")

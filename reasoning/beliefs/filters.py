@@ -5,6 +5,9 @@ are resolved with the knowledge base (any :class:`Vocabulary`, e.g. the Knowledg
 know is used as it is, so memory can still be searched by name, unless the filter is ``strict``: then the
 knowledge base's LookupError (e.g. ``unknown object class 'unicorn'``) is raised, as planning the query would.
 An ``id`` (``inspect object 3``, ``inspect {obj: {id: 3}}``) selects that stored belief.
+A list of words under an attribute key (``color: [red, blue]``, from ``red or blue cup`` or a robot's designator)
+selects objects with any of those values: an object has one dominant colour, shape and size, so "all of them"
+would match nothing, and RoboKudo's designator lists mean alternatives too.
 
 Which key filters which attribute comes from the ontology (the annotation type answering the key, its value
 kind) and the annotation type's ``attribute`` (:mod:`robokudo.core.types`); without a knowledge base a key
@@ -16,7 +19,7 @@ from __future__ import annotations
 from collections.abc import Callable, Collection, Sequence
 from typing import Protocol
 
-from queries import ANYWHERE, Block, Number, Query, String, Symbol, Value
+from queries import ANYWHERE, Block, ListValue, Number, Query, String, Symbol, Value
 from reasoning.beliefs.store import BeliefFilter
 from reasoning.knowledge.model import Resolved
 from robokudo.core.regions import RegionBox
@@ -119,22 +122,33 @@ def _number(blocks: list[Block], key: str) -> float | None:
     return None
 
 
-def _attributes(blocks: list[Block], kb: Vocabulary | None, strict: bool) -> dict[str, str]:
-    """Attribute name -> the value asked for, resolved to the knowledge base's name when it has a value kind."""
-    words: dict[type[Annotation], str] = {}
+def _attributes(blocks: list[Block], kb: Vocabulary | None, strict: bool) -> dict[str, str | tuple[str, ...]]:
+    """Attribute name -> the value asked for (a tuple: any of several), resolved to the knowledge base's name when
+    it has a value kind."""
+    words: dict[type[Annotation], tuple[str, ...]] = {}
     for block in blocks:
         for field in block.fields:
             annotation_type = _answering_type(kb, field.key)
-            word = _word(field.value)
-            if annotation_type is not None and word is not None:
-                words.setdefault(annotation_type, word)
-    found: dict[str, str] = {}
+            asked = _words(field.value)
+            if annotation_type is not None and asked:
+                words.setdefault(annotation_type, asked)
+    found: dict[str, str | tuple[str, ...]] = {}
     for annotation_type in FILTERED_TYPES:
-        word = words.get(annotation_type)
-        if word is not None:
+        asked = words.get(annotation_type)
+        if asked is not None:
             kind = None if kb is None else kb.value_kind(annotation_type.type_name())
-            found[annotation_type.attribute] = word if kind is None else _resolve(kb, word, kind, strict)
+            names = tuple(dict.fromkeys(word if kind is None else _resolve(kb, word, kind, strict) for word in asked))
+            found[annotation_type.attribute] = names[0] if len(names) == 1 else names
     return found
+
+
+def _words(value: Value | None) -> tuple[str, ...]:
+    """The words of a symbol or string value, or of a list of them; () for anything else."""
+    if isinstance(value, ListValue):
+        words = [_word(item) for item in value.items]
+        return tuple(w for w in words if w is not None) if None not in words else ()
+    word = _word(value)
+    return () if word is None else (word,)
 
 
 def _answering_type(kb: Vocabulary | None, key: str) -> type[Annotation] | None:

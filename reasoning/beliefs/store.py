@@ -72,15 +72,15 @@ class BeliefFilter:
     ignored). A belief is in ``region`` when its stored region has that name (case ignored) or when its world
     position lies in one of ``region_boxes``. ``attributes`` (e.g. ``{"color": "red"}``, case ignored) match the
     fused value or any value more likely than not; ``text`` matches when each of its words is read in such a
-    value, tolerating OCR errors (:func:`~reasoning.fusion.text.text_matches`). ``ids`` restricts the answer to
-    those beliefs.
+    value, tolerating OCR errors (:func:`~reasoning.fusion.text.text_matches`). An attribute given several values
+    (``{"color": ("red", "blue")}``) matches when any of them does. ``ids`` restricts the answer to those beliefs.
     """
 
     object_class: str | None = None
     class_test: ClassTest | None = None
     region: str | None = None
     region_boxes: tuple[RegionBox, ...] = ()
-    attributes: Mapping[str, str] = field(default_factory=dict)
+    attributes: Mapping[str, str | tuple[str, ...]] = field(default_factory=dict)
     include_gone: bool = False
     min_confidence: float = 0.0
     limit: int | None = None
@@ -593,13 +593,16 @@ class BeliefStore:
             for name, value in f.attributes.items():
                 if name in texts:
                     continue  # read text is matched word by word below, tolerating OCR errors
+                wanted = _alternatives(value)
+                marks = ", ".join("?" * len(wanted))
                 # with a class filter, check each candidate; without one, start from the attribute's objects
                 clauses.append(
-                    "EXISTS (SELECT 1 FROM attribute_index a WHERE a.name = ? AND a.value = ? AND a.object_id = id)"
+                    f"EXISTS (SELECT 1 FROM attribute_index a WHERE a.name = ? AND a.value IN ({marks}) "
+                    "AND a.object_id = id)"
                     if f.object_class
-                    else "id IN (SELECT object_id FROM attribute_index WHERE name = ? AND value = ?)"
+                    else f"id IN (SELECT object_id FROM attribute_index WHERE name = ? AND value IN ({marks}))"
                 )
-                parameters.extend([name, value])
+                parameters.extend([name, *wanted])
             # one SELECT per way of being in the region (by stored name, or inside a box), united
             branches: list[tuple[list[str], list[object]]] = [([], [])]
             if f.region:
@@ -624,8 +627,8 @@ class BeliefStore:
             rows = conn.execute(" UNION ".join(selects) + " ORDER BY id", values).fetchall()
             if f.region and f.region_boxes:
                 rows = [row for row in rows if _in_named_region(row, f)]
-            for name, wanted in texts.items():
-                rows = [row for row in rows if _reads(row, name, wanted)]
+            for name, value in texts.items():
+                rows = [row for row in rows if any(_reads(row, name, wanted) for wanted in _alternatives(value))]
             if f.min_confidence > 0:
                 rows = [row for row in rows if sigmoid(row[15]) >= f.min_confidence]
             if f.limit is not None:
@@ -850,6 +853,11 @@ def _box_bounds(pose: np.ndarray, size: Sequence[float]) -> tuple[np.ndarray, np
     pose = np.asarray(pose, dtype=np.float64)
     half = np.abs(pose[:3, :3]) @ (np.asarray(size, dtype=np.float64) / 2.0)
     return pose[:3, 3] - half, pose[:3, 3] + half
+
+
+def _alternatives(value: str | tuple[str, ...]) -> tuple[str, ...]:
+    """The values an attribute filter accepts: the one given, or each of several."""
+    return (value,) if isinstance(value, str) else tuple(value)
 
 
 def _reads(row: tuple, name: str, wanted: str) -> bool:

@@ -94,6 +94,7 @@ class OntologyIndex:
     cas_types: frozenset[str]
     value_domains: Mapping[str, Kind]
     profiles: Mapping[str, ObjectProfile]
+    hypothesis_types: Mapping[str, str]
     text_variants: frozenset[str]
     regions: Mapping[str, RegionBox]
     regions_by_class: Mapping[str, tuple[RegionBox, ...]]
@@ -144,6 +145,7 @@ class _Builder:
         self._disjointness()
         self._types_of_individuals()
         profiles = self._profiles()
+        hypothesis_types = self._hypothesis_types()
         regions = self._regions()
         query_keys = self._query_keys()
         value_domains = self._value_domains()
@@ -170,6 +172,7 @@ class _Builder:
             cas_types=frozenset(self.down.get("CasType", frozenset())),
             value_domains=value_domains,
             profiles=profiles,
+            hypothesis_types=hypothesis_types,
             text_variants=self._text_variants(profiles),
             regions=regions,
             regions_by_class=self._regions_by_class(regions),
@@ -374,6 +377,23 @@ class _Builder:
                 origins=tuple(origins),
             )
         return profiles
+
+    def _hypothesis_types(self) -> dict[str, str]:
+        """Per object class the hypothesis type its instances are found as (``rk:perceivedAs``, inherited from the
+        nearest class declaring it, else ObjectHypothesis)."""
+        hypotheses = self.down.get("ObjectHypothesis", frozenset())
+        own: dict[str, str] = {}
+        for subject, value in self.graph.subject_objects(RK.perceivedAs):
+            name, type_name = local_name(subject), local_name(value)
+            if type_name not in hypotheses:
+                self.problems.append(f"{name}: rk:perceivedAs must name ObjectHypothesis or a subtype, not {type_name}")
+                continue
+            own[name] = type_name
+        found: dict[str, str] = {}
+        for name in self.down.get("PhysicalObject", ()):
+            declared = [own[c] for level in self._levels(name) for c in sorted(level) if c in own]
+            found[name] = declared[0] if declared else "ObjectHypothesis"
+        return found
 
     def _levels(self, name: str) -> list[set[str]]:
         """``name``, then its parents, then their parents, ... (each class at its shortest distance)."""

@@ -146,6 +146,31 @@ class KnowledgeBase:
             graphs[path] = cached[1]
         return graphs, stamps
 
+    def adopt_parsed(self, path: Path, stamp: Stamp, graph: Graph) -> None:
+        """Take ``graph`` as the parse of source ``path`` while the file has ``stamp`` (an editor that read or wrote
+        it already); the next (re)load uses it instead of parsing the file again."""
+        self._parsed[path] = (stamp, graph)
+
+    def adopt_index(self, graphs: Mapping[Path, Graph], index: OntologyIndex) -> bool:
+        """Take ``index`` (built by :func:`build_index` from :meth:`combine` of ``graphs``) as the current index when
+        ``graphs`` are the parses of the sources as they are now and this knowledge base does not reason (an
+        editor validated exactly this); True when taken, else nothing changes."""
+        if self._reason:
+            return False
+        paths = (*self._sources.files, self._sources.user_file)
+        stamps = {path: file_stamp(path) for path in paths}
+        for path in paths:
+            parsed = self._parsed.get(path)
+            if stamps[path] is None:
+                if path in graphs:
+                    return False
+            elif parsed is None or parsed[0] != stamps[path] or graphs.get(path) is not parsed[1]:
+                return False
+        self._index = index
+        self._reasoner = None
+        self._stamps = stamps
+        return True
+
     def reload(self) -> None:
         """Re-read the sources (only changed files are parsed again) and swap in a new index.
 
@@ -300,6 +325,10 @@ class KnowledgeBase:
         """Typical colours, shape, size, material, transparency, storage place, texts and brand of a class."""
         return self._index.profiles[self._name(name, ("class",))]
 
+    def hypothesis_type(self, name: str) -> str:
+        """The CAS type instances of this object class are found as (ObjectHypothesis unless the class says)."""
+        return self._index.hypothesis_types.get(self._name(name, ("class",)), "ObjectHypothesis")
+
     def default_location(self, name: str) -> str | None:
         """The region class objects of this class are typically kept in (inherited), or None."""
         return self.object_profile(name).stored_in
@@ -377,8 +406,11 @@ class KnowledgeBase:
         declared domain holds the value, a subclass of it or a superclass of it (a detector that knows
         WhiteCeramicBowl serves a query for Bowl); an empty domain means any value. ``object_class`` keeps
         the annotators whose class domain (if any) is related to it the same way and drops those whose
-        preconditions exclude it (not for transparent objects). ``conditions`` says whether depth and a
-        region are available (default: both) and whether a detector model is configured (default: not).
+        preconditions exclude it (not for transparent objects); an annotator with a class domain that writes only
+        a subtype of ``annotation_type`` (a people detector's PersonHypothesis) is kept only for a query of one of
+        its classes or a subclass (not for "all objects", whose segmenters must each provide the type itself).
+        ``conditions`` says whether depth and a region are available (default: both) and whether a detector model
+        is configured (default: not).
         """
         index = self._index
         if annotation_type not in index.cas_types:
@@ -412,6 +444,12 @@ class KnowledgeBase:
                 and spec.classes.isdisjoint(object_down)
             ):
                 continue
+            if (
+                spec.classes
+                and annotation_type not in spec.outputs
+                and (object_up is None or spec.classes.isdisjoint(object_up))
+            ):
+                continue  # a detector of particular classes writing their own subtype serves queries for them only
             needs = index.annotator_conditions[spec.name]
             if needs and (
                 ("depth" in needs and not conditions.depth)

@@ -12,7 +12,7 @@ from __future__ import annotations
 
 from dataclasses import dataclass
 
-from queries.model import ANYWHERE, Asked, Block, ListValue, Number, Query, String, Symbol, Value
+from queries.model import ANYWHERE, HUMAN_KEY, Asked, Block, Field, ListValue, Number, Query, String, Symbol, Value
 from reasoning.errors import TermError
 from reasoning.knowledge.knowledge_base import KnowledgeBase
 from reasoning.planning.plan import Constraint, Task
@@ -47,9 +47,11 @@ def interpret(query: Query, kb: KnowledgeBase, depth: bool = True, camera_pose: 
         raise PlanningError("a stop query cancels a running task; there is no perception tree to plan for it")
     if query.kind == "scan":
         return _interpret_scan(query, kb, camera_pose)
-    obj = query.get("obj")
-    if not isinstance(obj, Block):
-        raise PlanningError(f"a {query.kind} query needs an obj block describing the object")
+    obj = _target(query)
+    object_class = _object_class(obj.get("type"), kb)
+    hypothesis = kb.hypothesis_type(object_class) if object_class is not None else "ObjectHypothesis"
+    if hypothesis != "ObjectHypothesis":
+        return _interpret_specialised(query, obj, object_class, hypothesis)
     requirements = [Requirement("ObjectHypothesis", None, f"a {query.kind} query needs object hypotheses")]
     constraints: list[Constraint] = []
     inferences: list[str] = []
@@ -57,7 +59,6 @@ def interpret(query: Query, kb: KnowledgeBase, depth: bool = True, camera_pose: 
         requirements.append(Requirement("Pose", None, f"a {query.kind} query reports each object's pose"))
     else:
         inferences.append("the sensor measures no depth, so objects are reported by image region without a pose")
-    object_class = _object_class(obj.get("type"), kb)
     if object_class is not None:
         constraints.append(Constraint("type", "Classification", object_class))
         requirements.append(Requirement("Classification", object_class, f"query asks type = {object_class}"))
@@ -97,6 +98,45 @@ def interpret(query: Query, kb: KnowledgeBase, depth: bool = True, camera_pose: 
         min_confidence=min_confidence,
     )
     return Interpretation(task, tuple(requirements), region_box, transparent)
+
+
+def _interpret_specialised(query: Query, obj: Block, object_class: str, hypothesis: str) -> Interpretation:
+    """A class perceived as its own hypothesis type (a person): its detectors state the class and the position,
+    so that type is the one requirement; other keys than the structural ones are not answered for it yet."""
+    asked = [f.key for f in obj.fields if f.key not in _STRUCTURAL_KEYS or f.key == "transparent"]
+    location = obj.get("location")
+    if location is not None and not _is_anywhere(location):
+        asked.append("location")
+    if asked:
+        raise PlanningError(
+            f"{', '.join(asked)} cannot be asked of a {object_class} yet (its detectors say only "
+            f"where it is and its body keypoints)"
+        )
+    why = f"{object_class} is perceived as {hypothesis}, so a {query.kind} query needs a provider of it"
+    task = Task(
+        kind=query.kind,
+        object_class=object_class,
+        constraints=(Constraint("type", "Classification", object_class),),
+        inferences=(f"{object_class} is found by its own detectors ({hypothesis}), not by table-top segmentation",),
+        max_results=_whole(query.get("max_results")),
+        object_id=_whole(obj.get("id")),
+        min_confidence=_confidence(obj.get("confidence"), []),
+    )
+    return Interpretation(task, (Requirement(hypothesis, None, why),), None)
+
+
+def _target(query: Query) -> Block:
+    """The block describing what to find: ``obj``, or ``human`` (an object of the class the word human names)."""
+    obj, human = query.get("obj"), query.get("human")
+    if obj is not None and human is not None:
+        raise PlanningError(f"a {query.kind} query names either an obj or a human, not both")
+    if isinstance(human, Block):
+        if human.get("type") is not None:
+            return human
+        return Block((Field("type", Symbol(HUMAN_KEY)), *human.fields))
+    if not isinstance(obj, Block):
+        raise PlanningError(f"a {query.kind} query needs an obj block describing the object (or a human block)")
+    return obj
 
 
 def _transparency(value: Value | None, object_class: str | None, kb: KnowledgeBase, inferences: list[str]) -> bool:

@@ -630,7 +630,6 @@ class _Layout:
             if len(unit.providers) < 2:
                 continue
             branches[type_name] = {}
-            rivals = {s.name for s in unit.providers}
             for spec in unit.providers:
                 owned: list[str] = []
                 members = {spec.name}
@@ -641,9 +640,7 @@ class _Layout:
                     if key is None or key in owned or key == type_name or len(self.units[key].providers) != 1:
                         continue
                     outputs = [t for t, k in guaranteed.items() if k == key]
-                    # a unit only alternatives of this type need goes into each of their branches: a branch
-                    # that fails (its plane not found) then hands over to the next, which makes its own
-                    if any(not consumers.get(t, set()) <= members | rivals for t in outputs):
+                    if any(not consumers.get(t, set()) <= members for t in outputs):
                         continue
                     owned.append(key)
                     inner = self.units[key].providers[0]

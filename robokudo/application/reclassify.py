@@ -11,9 +11,12 @@ from __future__ import annotations
 
 from dataclasses import replace
 
+from reasoning.beliefs.filters import kb_class_test
 from reasoning.beliefs.store import BeliefFilter, BeliefStore
 from reasoning.fusion.rule import CLASS_ATTRIBUTE, AttributeBelief, ClassTest
 from reasoning.fusion.tracking import ObjectBelief
+from reasoning.knowledge.editing import EditResult, OntologyEditor
+from reasoning.knowledge.knowledge_base import KnowledgeBase
 
 
 def reclassify(store: BeliefStore, removed: str, parent: str | None, class_test: ClassTest | None = None) -> list[int]:
@@ -35,3 +38,18 @@ def _moved(belief: ObjectBelief, removed: str, parent: str | None) -> ObjectBeli
             moved.merge(AttributeBelief(CLASS_ATTRIBUTE, {parent: stated.values[removed]}))
         attributes[CLASS_ATTRIBUTE] = moved
     return replace(belief, attributes=attributes, class_name=parent)
+
+
+def remove_object_class(
+    kb: KnowledgeBase, editor: OntologyEditor, name: str, store: BeliefStore | None
+) -> tuple[EditResult, str | None, list[int]]:
+    """Remove the user class ``name`` (validated and locked, as every edit), then move the beliefs of it in
+    ``store`` to its parent class; the edit, the parent (None without one) and the ids of the moved beliefs."""
+    try:
+        parents = sorted(kb.superclasses(name, direct=True))  # read before the class is gone
+    except LookupError:
+        parents = []  # remove_object says what is wrong with the name
+    result = editor.remove_object(name)
+    parent = parents[0] if parents else None
+    moved = reclassify(store, result.name, parent, kb_class_test(kb)) if store is not None else []
+    return result, parent, moved

@@ -1,8 +1,9 @@
-"""Sensor sources: which reader starts a plan for a given input, as a plan step."""
+"""Sensor sources: which reader starts a plan for a given input or live stream, as a plan step."""
 
 from __future__ import annotations
 
 from annotators.readers.choice import reader_choice
+from annotators.readers.streams import FrameStream, KitchenCameraStream, PerceivedFrameReader
 from annotators.simulation.kitchen_scene import camera_looking_at
 from reasoning.knowledge.knowledge_base import KnowledgeBase
 from reasoning.planning.plan import Step
@@ -11,6 +12,31 @@ from robokudo.core.types import CameraIntrinsics
 
 READERS_WITH_CAMERA_POSE: frozenset[str] = frozenset({"KitchenSceneReader"})
 """The readers whose frames carry the camera pose (``CameraInfo.cam_to_world``); recorded inputs have none."""
+
+
+def kitchen_view_for(region: str | None) -> str:
+    """The kitchen camera view that looks at ``region`` ("table" for None, "overview" when no view looks at it)."""
+    if region is None:
+        return "table"
+    try:
+        return camera_looking_at(region)
+    except ValueError:
+        return "overview"
+
+
+def served_source(kb: KnowledgeBase, stream: FrameStream) -> SensorSource:
+    """The source of a task in a served tree: the frame the engine perceived from ``stream`` this run (frames of
+    the kitchen camera carry its pose, recordings none)."""
+    spec = kb.annotator(PerceivedFrameReader.__name__)
+    step = Step(
+        annotator=spec.name,
+        implemented_by=spec.implemented_by,
+        inputs=spec.inputs,
+        outputs=spec.outputs,
+        parameters=(),
+        reason=f"{spec.name}: takes the frame the engine perceived from {stream.name}",
+    )
+    return SensorSource(step, camera_pose=isinstance(stream, KitchenCameraStream))
 
 
 def sensor_source(
@@ -28,14 +54,10 @@ def sensor_source(
     layout raises ValueError listing the supported ones.
     """
     if input_path is None:
-        view = "table"
-        reason = "renders the built-in kitchen from the 'table' camera"
+        view = kitchen_view_for(region)
+        reason = f"renders the built-in kitchen from the {view!r} camera"
         if region is not None:
-            try:
-                view = camera_looking_at(region)
-            except ValueError:
-                view = "overview"
-            reason = f"renders the built-in kitchen from the {view!r} camera (the robot looks at region {region!r})"
+            reason += f" (the robot looks at region {region!r})"
         spec = kb.annotator("KitchenSceneReader")
         parameters: tuple[tuple[str, object], ...] = (("view", view),)
     else:

@@ -4,15 +4,26 @@ Everything that only changes with the ontology or the mission is made once and k
 reload picks up ontology edits), the QueryPlanner with its caches, the BeliefStore, and one Engine whose root
 holds a task slot. Each query is parsed, planned and synthesized into a Pipeline that ends in the answer step;
 the Pipeline goes into the task slot between ticks, and how it runs follows from the query's kind
-(:data:`EXECUTION_MODES`): one-shot kinds run until the tree finishes and return one Answer; continuous kinds
-run again and again, one Answer per run, until cancelled or until a run fails. One task runs at a time: a new
-task replaces the one in the slot.
+(:data:`EXECUTION_MODES`): a one-shot task runs until its tree finishes and has one Answer; a continuous task runs
+again on every run of the root, one Answer per run, until cancelled or until a run fails. One task runs at a
+time: a new task replaces the one in the slot. Without a task the slot holds an idle subtree.
+
+Over a live stream (``stream=``, as ``robokudo serve`` runs it) the root is the paper's Fig. 4 shape: a perceive
+pipeline reads the stream's newest frame, then the task slot; the engine ticks at its fixed rate in the
+background for the service's lifetime (:meth:`AnsweringService.run_in_background`), every task starts on a freshly
+perceived frame (:class:`~annotators.readers.streams.PerceivedFrameReader` is its first step), and the kitchen
+camera is pointed at the task's region. When perception fails (the source ended, a frame cannot be read) the
+running task ends with that reason; once the source ended, new tasks are refused with it
+(:class:`SourceEndedError`). Without a stream (``robokudo query``), each task's tree reads its own frame and the
+engine ticks on the calling thread while :meth:`AnsweringService.answer` waits.
 
 A query's ``timeout`` (``detect {obj: {type: Milk}, timeout: 2s}``) is a deadline counted from when the query
 is received: when it passes before the tree finished, the tree is stopped (running experts are interrupted,
 nothing of the unfinished run is fused) and the answer has ``timed_out`` set and holds the stored beliefs that
 match the query (``from_memory``). A continuous task ends with the reason "timed out after ..." instead.
-A query naming an object id (``inspect object 3``) is answered with that belief only; an id the store does not
+The knowledge base is reloaded before a query is planned when an ontology file changed since (one ``stat`` per file),
+so an ontology edit (``robokudo ontology add-object``, from any process) is seen by the next query without a
+restart. A query naming an object id (``inspect object 3``) is answered with that belief only; an id the store does not
 hold raises :class:`UnknownObjectError` before anything runs, and for the built-in kitchen the camera looks at
 the region where the object was last seen.
 
@@ -25,7 +36,7 @@ import queue
 import threading
 import time
 from collections.abc import Callable, Iterator, Mapping
-from dataclasses import dataclass, replace
+from dataclasses import dataclass, field, replace
 from enum import Enum
 from pathlib import Path
 from types import MappingProxyType, TracebackType
@@ -34,19 +45,22 @@ import py_trees
 from py_trees.common import Status
 
 from annotators.catalog import AnnotatorCatalog
+from annotators.readers.streams import PERCEPTION_PIPELINE, FrameStream, KitchenCameraStream, StreamReader
 from queries import Number, Query, parse_query
 from reasoning.beliefs.answer import Answer, answer_from_memory
 from reasoning.beliefs.filters import belief_filter, kb_class_test
 from reasoning.beliefs.store import BeliefStore
-from reasoning.fusion.tracking import BeliefTracker
+from reasoning.fusion.tracking import BeliefTracker, TrackStep
 from reasoning.knowledge.knowledge_base import KnowledgeBase
 from reasoning.planning.query_planner import QueryPlan, QueryPlanner
 from robokudo.application.knowledge import load_knowledge_base
 from robokudo.application.planning import plan_for_input
+from robokudo.application.sensor_sources import kitchen_view_for, served_source
 from robokudo.core.composites import Sequence
 from robokudo.core.engine import Engine
 from robokudo.core.pipeline import Pipeline
-from robokudo.core.slot import TaskSlot
+from robokudo.core.resources import SharedResources
+from robokudo.core.slot import Idle, TaskSlot
 from robokudo.core.threaded import has_workers, stop_workers
 from robokudo.core.types import CameraIntrinsics, QueryAnswer
 from trees.answer_step import AnswerStep
@@ -108,18 +122,22 @@ class Outcome:
     answer: Answer
     tree: Pipeline
     plan: QueryPlan
+    timing: Mapping[str, float] = field(default_factory=dict)
+    """Where the time went (:meth:`TaskHandle.timing`)."""
 
 
 class TaskHandle:
-    """A continuous task in the engine: its answers as they come, and a way to cancel it.
+    """A task in the engine: its answers as they come (continuous) or its one answer (one-shot), and a way to
+    cancel it.
 
     ``next_answer`` and ``answers`` block until the engine produced the next answer or the task ended;
-    ``reason`` says why it ended (cancelled, replaced by another task, or the failure of a run).
+    ``reason`` says why it ended (finished, cancelled, replaced by another task, timed out, or a failure).
     """
 
     def __init__(
         self,
-        kind: str,
+        query: Query,
+        mode: ExecutionMode,
         tree: Pipeline,
         plan: QueryPlan,
         service: AnsweringService,
@@ -127,7 +145,9 @@ class TaskHandle:
         timeout: float | None = None,
         started: float = 0.0,
     ) -> None:
-        self.kind = kind
+        self.query = query
+        self.kind = query.kind
+        self.mode = mode
         self.tree = tree
         self.plan = plan
         self.timeout = timeout
@@ -136,6 +156,16 @@ class TaskHandle:
         self._answers: queue.SimpleQueue[Answer | None] = queue.SimpleQueue()
         self._ended = threading.Event()
         self._reason = ""
+        self._result: Answer | None = None
+        self._timed_out = False
+        self.submitted = started
+        """When the query was received (``time.monotonic``)."""
+        self.planned = started
+        """When its tree was planned and built (set by the service)."""
+        self.first_tick: float | None = None
+        """When the first tick that ran its tree began (None before)."""
+        self.ended_at: float | None = None
+        """When the task ended (None while it runs)."""
 
     @property
     def done(self) -> bool:
@@ -146,6 +176,20 @@ class TaskHandle:
     def reason(self) -> str:
         """Why the task ended ("" while it runs)."""
         return self._reason
+
+    @property
+    def result(self) -> Answer | None:
+        """A one-shot task's answer once its tree succeeded (None before, and when it did not)."""
+        return self._result
+
+    @property
+    def timed_out(self) -> bool:
+        """True when the task ended because its timeout passed."""
+        return self._timed_out
+
+    def wait(self, timeout: float | None = None) -> bool:
+        """Wait until the task ended (at most ``timeout`` seconds); True when it has."""
+        return self._ended.wait(timeout)
 
     def next_answer(self, timeout: float | None = None) -> Answer | None:
         """The next answer; None when the task ended (or nothing came within ``timeout`` seconds)."""
@@ -163,17 +207,38 @@ class TaskHandle:
         """End the task (its running experts are interrupted); no-op when it already ended."""
         self._service.cancel(self)
 
+    def timing(self) -> dict[str, float]:
+        """Where the time went, in milliseconds: ``plan_ms`` (parse, plan, build), ``wait_ms`` (until a tick first ran
+        the tree: the swap and the wait for a fresh frame), ``run_ms`` (from that tick to the end); the parts known
+        so far."""
+        parts = {"plan_ms": self.planned - self.submitted}
+        if self.first_tick is not None:
+            parts["wait_ms"] = self.first_tick - self.planned
+            if self.ended_at is not None:
+                parts["run_ms"] = self.ended_at - self.first_tick
+        return {name: round(seconds * 1e3, 3) for name, seconds in parts.items()}
+
     def _publish(self, answer: Answer) -> None:
         self._answers.put(answer)
 
     def _expired(self) -> bool:
         return self._deadline is not None and time.monotonic() >= self._deadline
 
-    def _end(self, reason: str) -> None:
-        if not self._ended.is_set():
-            self._reason = reason
-            self._ended.set()
-            self._answers.put(None)
+    def _end(self, reason: str, *, result: Answer | None = None, timed_out: bool = False) -> bool:
+        """End the task once (False when it had ended already)."""
+        if self._ended.is_set():
+            return False
+        self._reason = reason
+        self._result = result
+        self._timed_out = timed_out
+        self.ended_at = time.monotonic()
+        self._ended.set()
+        self._answers.put(None)
+        return True
+
+
+class SourceEndedError(Exception):
+    """The live source ended (a recording played once reached its end): no task can perceive any more."""
 
 
 class AnsweringService:
@@ -189,6 +254,7 @@ class AnsweringService:
         frame: int = 0,
         hz: float = 100.0,
         intrinsics: CameraIntrinsics | None = None,
+        stream: FrameStream | None = None,
     ) -> None:
         self.kb = kb
         self.intrinsics = intrinsics
@@ -196,13 +262,29 @@ class AnsweringService:
         self.catalog = catalog if catalog is not None else AnnotatorCatalog.discover()
         self.input_path = input_path
         self.frame = frame
+        self.stream = stream
         self.planner = QueryPlanner(kb)
-        root = Sequence("robot", [TaskSlot(TASK_SLOT)], reason="the robot's perception: the current task")
+        self.resources = SharedResources()
+        """Loaded models shared by every task's tree (the first task loads them)."""
+        self._idle = Idle(reason="no task: the engine keeps perceiving until the next one")
+        self._slot = TaskSlot(TASK_SLOT)
+        self._slot.set_subtree(self._idle)
+        self._reader: StreamReader | None = None
+        self._perception: Pipeline | None = None
+        if stream is None:
+            root = Sequence("robot", [self._slot], reason="the robot's perception: the current task")
+        else:
+            self._reader = StreamReader(stream, wait=False, name="read frame")
+            self._reader.reason = f"reads the newest frame of {stream.name}"
+            self._perception = Pipeline(PERCEPTION_PIPELINE, [self._reader], reason="perceives: the newest frame")
+            root = Sequence("robot", [self._perception, self._slot], reason="perceive, then the current task")
         self.engine = Engine(root, hz=hz)
         self.engine.tree.add_post_tick_handler(self._after_tick)
         self._lock = threading.Lock()
-        self._continuous: TaskHandle | None = None
+        self._current: TaskHandle | None = None
         self._retired: list[py_trees.behaviour.Behaviour] = []
+        self._source_ended: str | None = None
+        self._belief_listeners: list[Callable[[TrackStep], None]] = []
 
     @classmethod
     def open(
@@ -214,6 +296,7 @@ class AnsweringService:
         hz: float = 100.0,
         catalog: AnnotatorCatalog | None = None,
         intrinsics: CameraIntrinsics | None = None,
+        stream: FrameStream | None = None,
     ) -> AnsweringService:
         """A service over the shipped and user ontology and the belief store at ``store_path`` (default store
         when None), with the annotators of ``catalog`` (default: this project's).
@@ -228,21 +311,35 @@ class AnsweringService:
         except BaseException:
             store.close()
             raise
-        return cls(kb, store, catalog=catalog, input_path=input_path, frame=frame, hz=hz, intrinsics=intrinsics)
+        return cls(
+            kb, store, catalog=catalog, input_path=input_path, frame=frame, hz=hz, stream=stream, intrinsics=intrinsics
+        )
 
     # ------------------------------------------------------------------ planning
 
     def plan(self, query: str | Query) -> QueryPlan:
         """Interpret and plan ``query`` for this service's input (the kitchen camera looks at the query's region,
         else at the region of the object the query names by id)."""
+        self.kb.reload_if_changed()
         parsed = parse_query(query) if isinstance(query, str) else query
-        look_at = None
-        for object_id in self.object_ids(parsed) or ():
-            known = self.store.get(object_id)
-            look_at = known.region if known is not None and known.region else look_at
+        if self.stream is not None:
+            return self.planner.plan(parsed, served_source(self.kb, self.stream))
         return plan_for_input(
-            self.planner, parsed, self.input_path, self.frame, look_at=look_at, intrinsics=self.intrinsics
+            self.planner,
+            parsed,
+            self.input_path,
+            self.frame,
+            look_at=self._remembered_region(parsed),
+            intrinsics=self.intrinsics,
         )
+
+    def _remembered_region(self, query: Query) -> str | None:
+        """Where the last object the query names by id was last seen (None when it names none, or no region)."""
+        region = None
+        for object_id in self.object_ids(query) or ():
+            known = self.store.get(object_id)
+            region = known.region if known is not None and known.region else region
+        return region
 
     def object_ids(self, query: Query) -> tuple[int, ...] | None:
         """The object ids ``query`` names (None when it names none); UnknownObjectError for an id not stored."""
@@ -259,62 +356,87 @@ class AnsweringService:
             tracker=BeliefTracker(class_test=kb_class_test(self.kb), regions=self.kb.regions()),
             filter_for=lambda q: belief_filter(q, self.kb),
             label_of=self.kb.label,
+            on_integrated=self._beliefs_changed,
         )
         step.reason = ANSWER_REASON
-        return build_tree(query_plan.plan, final_steps=[step], query=query, catalog=self.catalog)
+        return build_tree(
+            query_plan.plan, final_steps=[step], query=query, catalog=self.catalog, resources=self.resources
+        )
 
     # ------------------------------------------------------------------ running
+
+    def submit(self, query: str | Query) -> TaskHandle:
+        """Plan ``query`` and put its tree into the task slot (replacing the running task); its handle.
+
+        Raises QueryError / PlanningError / SynthesisError for a query no tree can answer, ValueError for a
+        ``stop`` query, UnknownObjectError for an object id the store does not hold, SourceEndedError once the
+        live source ended. Nothing changes in the engine when it raises.
+        """
+        started = time.monotonic()
+        self.kb.reload_if_changed()  # an ontology edit made meanwhile (CLI, another process) counts at once
+        parsed = parse_query(query) if isinstance(query, str) else query
+        mode = self.mode_of(parsed)
+        if self._source_ended is not None:
+            raise SourceEndedError(self._source_ended)
+        self.object_ids(parsed)  # an id that is not stored is refused before anything runs
+        query_plan = self.plan(parsed)
+        pipeline = self.tree(parsed, query_plan)
+        handle = TaskHandle(parsed, mode, pipeline, query_plan, self, timeout=query_timeout(parsed), started=started)
+        handle.planned = time.monotonic()
+        if isinstance(self.stream, KitchenCameraStream):
+            region = query_plan.interpretation.task.region or self._remembered_region(parsed)
+            self.stream.set_view(kitchen_view_for(region))
+        with self._lock:
+            previous, self._current = self._current, handle
+        if previous is not None:
+            previous._end("replaced by another task")
+        self._retire(self.engine.tasks.replace(TASK_SLOT, pipeline, restart=True))
+        return handle
 
     def answer(self, query: str | Query, *, stop: Callable[[], bool] | None = None) -> Outcome:
         """Answer a one-shot query (detect, inspect, scan): plan, run once in the task slot, fuse, answer.
 
-        ``stop`` is asked after every tick (on the calling thread); when it holds before the tree finished, the
-        tree is stopped (running experts are interrupted, nothing is fused) and QueryCancelledError is raised.
+        ``stop`` is asked after every tick period (on the calling thread); when it holds before the tree finished,
+        the tree is stopped (running experts are interrupted, nothing is fused) and QueryCancelledError is raised.
+        When the engine ticks in the background (a served instance) this waits for the task; otherwise the engine
+        ticks on the calling thread until the task ended.
 
-        Raises QueryError / PlanningError / SynthesisError for a query that cannot be answered by any tree,
-        ValueError for a continuous kind (use :meth:`start`), UnknownObjectError for an object id the store does
-        not hold, PerceptionFailedError when the tree failed. When the query's timeout passes first, the answer
-        is the stored beliefs matching the query, with ``timed_out`` set (see the module).
+        Raises what :meth:`submit` raises, ValueError for a continuous kind (use :meth:`start`),
+        PerceptionFailedError when the tree failed. When the query's timeout passes first, the answer is the
+        stored beliefs matching the query, with ``timed_out`` set (see the module).
         """
         started = time.monotonic()
         parsed = parse_query(query) if isinstance(query, str) else query
-        mode = self.mode_of(parsed)
-        if mode is not ExecutionMode.ONCE:
+        if self.mode_of(parsed) is not ExecutionMode.ONCE:
             raise ValueError(f"a {parsed.kind} query runs continuously; start it with start() and read its answers")
         timeout = query_timeout(parsed)
-        deadline = None if timeout is None else started + timeout
-        self.object_ids(parsed)  # an id that is not stored is refused before anything runs
-        query_plan = self.plan(parsed)
-        pipeline = self.tree(parsed, query_plan)
-        if self.engine.is_running_in_background():
-            self._end_continuous("replaced by a one-shot query")
-            self.engine.stop()
-
-        def finished() -> bool:
-            return pipeline.status in (Status.SUCCESS, Status.FAILURE)
-
-        def expired() -> bool:
-            return deadline is not None and time.monotonic() >= deadline
+        handle = self.submit(parsed)
+        if timeout is not None and time.monotonic() - started >= timeout:
+            self.cancel(handle)  # the deadline passed while planning: answer from memory without running
+            return Outcome(self._remembered(parsed, timed_out=True), handle.tree, handle.plan)
 
         def stopped() -> bool:
             return stop is not None and stop()
 
-        # The finished tree stays in the slot (with its statuses, for explanations) until the next task.
-        self._retire(self.engine.tasks.replace(TASK_SLOT, pipeline))
-        if not expired():
-            self.engine.run(until=lambda _: finished() or expired() or stopped())
-        if not finished():
-            self._retire(self.engine.tasks.remove(TASK_SLOT))  # stops the tree: running experts are interrupted
-            if stopped():
-                raise QueryCancelledError("stopped before the tree finished")
-            return Outcome(self._remembered(parsed, timed_out=True), pipeline, query_plan)
-        found = pipeline.cas.view(QueryAnswer) if pipeline.status is Status.SUCCESS else None
-        if found is None or not isinstance(found.answer, Answer):
-            raise PerceptionFailedError(f"perception failed: {failure_reason(pipeline)}")
-        return Outcome(found.answer, pipeline, query_plan)
+        if self.engine.is_running_in_background():
+            while not handle.wait(1.0 / self.engine.hz):
+                if stopped():
+                    break
+        else:
+            self.engine.run(until=lambda _: handle.done or stopped())
+            self.engine.tasks.apply_pending()  # the finished tree leaves the slot now, not at the next tick
+        if not handle.done:
+            self.cancel(handle)
+            raise QueryCancelledError("stopped before the tree finished")
+        if handle.timed_out:
+            return Outcome(self._remembered(parsed, timed_out=True), handle.tree, handle.plan, handle.timing())
+        if handle.result is None:
+            raise PerceptionFailedError(f"perception failed: {handle.reason}")
+        return Outcome(handle.result, handle.tree, handle.plan, handle.timing())
 
     def recall(self, query: str | Query) -> Answer:
         """The stored beliefs matching ``query``, answered from memory (nothing runs)."""
+        self.kb.reload_if_changed()
         return self._remembered(parse_query(query) if isinstance(query, str) else query)
 
     def _remembered(self, query: Query, *, timed_out: bool = False) -> Answer:
@@ -325,33 +447,43 @@ class AnsweringService:
     def start(self, query: str | Query) -> TaskHandle:
         """Start a continuous query (track): the engine ticks in the background and every run of the tree
         yields an answer on the returned handle until it is cancelled or a run fails."""
-        started = time.monotonic()
         parsed = parse_query(query) if isinstance(query, str) else query
         if self.mode_of(parsed) is not ExecutionMode.CONTINUOUS:
             raise ValueError(f"a {parsed.kind} query ends with one answer; ask it with answer()")
-        self.object_ids(parsed)  # an id that is not stored is refused before anything runs
-        query_plan = self.plan(parsed)
-        pipeline = self.tree(parsed, query_plan)
-        handle = TaskHandle(parsed.kind, pipeline, query_plan, self, timeout=query_timeout(parsed), started=started)
-        repeat = py_trees.decorators.Repeat(f"every run of {pipeline.name}", pipeline, num_success=-1)
-        self._end_continuous("replaced by another task")
-        with self._lock:
-            self._continuous = handle
-        self._retire(self.engine.tasks.replace(TASK_SLOT, repeat))
-        if not self.engine.is_running_in_background():
-            self.engine.start()
+        handle = self.submit(parsed)
+        self.run_in_background()
         return handle
 
+    def run_in_background(self) -> None:
+        """Tick the engine at its rate on its own thread until :meth:`close` (no-op when it already does)."""
+        if not self.engine.is_running_in_background():
+            self.engine.start()
+
     def cancel(self, handle: TaskHandle | None = None) -> None:
-        """Cancel the running continuous task (``handle``, or whichever runs); its experts are interrupted."""
+        """Cancel the running task (``handle``, or whichever runs); its experts are interrupted and the slot
+        becomes idle."""
         with self._lock:
-            current = self._continuous
-        if current is None or (handle is not None and handle is not current):
-            return
-        self._end_continuous("cancelled")
-        if self.engine.is_running_in_background():
-            self.engine.stop()
-        self._retire(self.engine.tasks.remove(TASK_SLOT))
+            current = self._current
+            if current is None or (handle is not None and handle is not current):
+                return
+            self._current = None
+        current._end("cancelled")
+        self._retire(self.engine.tasks.replace(TASK_SLOT, self._idle))
+
+    @property
+    def perception(self) -> Pipeline | None:
+        """The perceive pipeline of the served root (its CAS holds the newest frame); None without a stream."""
+        return self._perception
+
+    @property
+    def task_tree(self) -> py_trees.behaviour.Behaviour | None:
+        """What the task slot holds now (the idle subtree without a task); read it on the engine thread."""
+        return self._slot.subtree
+
+    @property
+    def source_ended(self) -> str | None:
+        """Why the live source ended (None while it has frames, and without a stream)."""
+        return self._source_ended
 
     @staticmethod
     def mode_of(query: Query) -> ExecutionMode:
@@ -362,10 +494,15 @@ class AnsweringService:
             raise ValueError(f"a {query.kind} query plans no perception tree") from None
 
     def close(self) -> None:
-        """Stop the engine (ending any continuous task), wait for interrupted experts' worker threads to end
-        (up to :data:`WORKER_WAIT` s) and close the belief store."""
-        self._end_continuous("the service closed")
+        """Stop the engine (ending the running task), close the stream, wait for interrupted experts' worker
+        threads to end (up to :data:`WORKER_WAIT` s) and close the belief store."""
+        with self._lock:
+            current, self._current = self._current, None
+        if current is not None:
+            current._end("the service closed")
         try:
+            if self.stream is not None:
+                self.stream.close()
             self.engine.stop()
             with self._lock:
                 retired, self._retired = self._retired, []
@@ -381,27 +518,60 @@ class AnsweringService:
     ) -> None:
         self.close()
 
+    def add_belief_listener(self, listener: Callable[[TrackStep], None]) -> None:
+        """Call ``listener`` with every frame's changes to the belief store (on the engine's thread, right after
+        they are written; keep it short)."""
+        self._belief_listeners.append(listener)
+
     # ------------------------------------------------------------------ engine side
 
+    def _beliefs_changed(self, step: TrackStep) -> None:
+        for listener in self._belief_listeners:
+            listener(step)
+
     def _after_tick(self, _: py_trees.trees.BehaviourTree) -> None:
-        """After every tick (engine thread): hand a finished run's answer to the continuous task's handle."""
+        """After every tick (engine thread): end a finished one-shot task or hand a continuous task's answer to
+        its handle; end the task when perception failed, its run failed or its deadline passed."""
+        perception_failure = None
+        if self._perception is not None and self._perception.status is Status.FAILURE:
+            perception_failure = failure_reason(self._perception)
+            if self._reader is not None and self._reader.ended:
+                self._source_ended = perception_failure
         with self._lock:
-            handle = self._continuous
-        if handle is None or handle.done:
-            return
+            handle = self._current
+        if handle is None or handle.done or self._slot.subtree is not handle.tree:
+            return  # no task, or its tree is not in the slot yet (the swap is applied at the next tick)
+        if handle.first_tick is None and handle.tree.status is not Status.INVALID:
+            handle.first_tick = self.engine.tick_started
         pipeline = handle.tree
-        if pipeline.status is Status.SUCCESS:
+        if perception_failure is not None:
+            self._finish(handle, f"perception failed: {perception_failure}")
+        elif pipeline.status is Status.SUCCESS:
             found = pipeline.cas.view(QueryAnswer)
-            if found is not None and isinstance(found.answer, Answer):
-                handle._publish(found.answer)
-        failed = pipeline.status is Status.FAILURE
-        if failed or handle._expired():
-            why = f"a run failed: {failure_reason(pipeline)}" if failed else f"timed out after {handle.timeout:g} s"
-            handle._end(why)
-            with self._lock:
-                self._continuous = None
-            # Between two ticks on the engine thread, the slot may be emptied directly (as the engine does).
-            self._retire(self.engine.tasks.slot(TASK_SLOT).set_subtree(None))
+            answer = found.answer if found is not None and isinstance(found.answer, Answer) else None
+            if handle.mode is ExecutionMode.ONCE:
+                self._finish(handle, "answered", result=answer)
+            elif answer is not None:
+                handle._publish(answer)
+        elif pipeline.status is Status.FAILURE:
+            reason = failure_reason(pipeline)
+            self._finish(handle, reason if handle.mode is ExecutionMode.ONCE else f"a run failed: {reason}")
+        if not handle.done and handle._expired():
+            self._finish(handle, f"timed out after {handle.timeout:g} s", timed_out=True)
+
+    def _finish(
+        self, handle: TaskHandle, reason: str, *, result: Answer | None = None, timed_out: bool = False
+    ) -> None:
+        """End ``handle`` (engine thread, after a tick) and have the idle subtree put into the slot before the next
+        tick (so every post-tick handler still sees the task's final statuses; a task submitted meanwhile wins)."""
+        with self._lock:
+            if self._current is handle:
+                self._current = None
+        handle._end(reason, result=result, timed_out=timed_out)
+        if handle.tree.status is Status.RUNNING:  # timed out or perception failed: stop it now, not a tick later
+            handle.tree.stop(Status.INVALID)
+        self.engine.tasks.schedule(TASK_SLOT, self._idle, only_replacing=handle.tree)
+        self._retire(handle.tree)
 
     def _retire(self, tree: py_trees.behaviour.Behaviour | None) -> None:
         """Remember a tree taken out of the slot while its experts' worker threads finish (:meth:`close` waits)."""
@@ -411,12 +581,6 @@ class AnsweringService:
             self._retired = [t for t in self._retired if has_workers(t)]
             if has_workers(tree):
                 self._retired.append(tree)
-
-    def _end_continuous(self, reason: str) -> None:
-        with self._lock:
-            handle, self._continuous = self._continuous, None
-        if handle is not None:
-            handle._end(reason)
 
 
 def query_timeout(query: Query) -> float | None:

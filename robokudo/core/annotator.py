@@ -26,6 +26,7 @@ from robokudo.core.capability import Capability
 from robokudo.core.cas import CAS, AddAnnotation, AttachAnnotation, CasWrite, SetView
 from robokudo.core.explained import Explained
 from robokudo.core.pipeline import StructureError, enclosing_pipeline, pipeline_named, tree_root
+from robokudo.core.resources import SharedResources
 from robokudo.core.stats import RunStats
 from robokudo.core.types import Annotation, CasType, ObjectHypothesis, View
 
@@ -75,6 +76,9 @@ class Annotator(Explained, py_trees.behaviour.Behaviour):
         super().__init__(name=name or type(self).__name__)
         self.reason = ""
         self.stats = RunStats()
+        self.resources = SharedResources()
+        """Where this annotator keeps its expensive objects (loaded models); a tree builder may hand every node
+        one pool shared by many trees (:mod:`robokudo.core.resources`)."""
         self._run: _Run | None = None
 
     # ------------------------------------------------------------------ to be implemented by experts

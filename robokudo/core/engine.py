@@ -22,6 +22,8 @@ from robokudo.core.structure import check_structure
 class _SlotChange:
     slot: TaskSlot
     subtree: py_trees.behaviour.Behaviour | None
+    restart: bool = False
+    only_replacing: py_trees.behaviour.Behaviour | None = None
     applied: threading.Event = field(default_factory=threading.Event)
     previous: py_trees.behaviour.Behaviour | None = None
 
@@ -46,18 +48,25 @@ class TaskInterface:
         raise KeyError(f"no TaskSlot named {name!r} (slots: {', '.join(s.name for s in slots) or 'none'})")
 
     def replace(
-        self, slot_name: str, subtree: py_trees.behaviour.Behaviour | None, timeout: float = 5.0
+        self,
+        slot_name: str,
+        subtree: py_trees.behaviour.Behaviour | None,
+        timeout: float = 5.0,
+        *,
+        restart: bool = False,
     ) -> py_trees.behaviour.Behaviour | None:
         """Put ``subtree`` into the slot (None removes); returns the subtree taken out.
 
         The tree structure is checked first, so a bad subtree is rejected before anything changes. When the
         engine ticks in a background thread this waits (up to ``timeout`` s) until the change is applied.
+        ``restart`` also ends the root's current run, so the next tick starts the root from its first child (in
+        the Fig. 4 shape: the new task starts on a freshly perceived frame).
         """
         slot = self.slot(slot_name)
         if subtree is not None:
             check_structure(subtree, attach_to=slot)
             validate_data_flow(self._engine.root, substitute={slot: subtree})
-        change = _SlotChange(slot, subtree)
+        change = _SlotChange(slot, subtree, restart)
         self._changes.put(change)
         if self._engine.is_running_in_background():
             if not change.applied.wait(timeout):
@@ -65,6 +74,21 @@ class TaskInterface:
         else:
             self.apply_pending()
         return change.previous
+
+    def schedule(
+        self,
+        slot_name: str,
+        subtree: py_trees.behaviour.Behaviour | None,
+        *,
+        only_replacing: py_trees.behaviour.Behaviour | None = None,
+    ) -> None:
+        """Queue a change for the start of the next tick without waiting (callable from the engine's own thread,
+        e.g. a post-tick handler, so every handler still sees this tick's tree). With ``only_replacing`` the
+        change is dropped unless the slot still holds that subtree then (a change queued meanwhile wins)."""
+        slot = self.slot(slot_name)
+        if subtree is not None:
+            check_structure(subtree, attach_to=slot)
+        self._changes.put(_SlotChange(slot, subtree, only_replacing=only_replacing))
 
     def insert(self, slot_name: str, subtree: py_trees.behaviour.Behaviour) -> None:
         """Put ``subtree`` into an empty slot."""
@@ -83,7 +107,12 @@ class TaskInterface:
                 change = self._changes.get_nowait()
             except queue.Empty:
                 return
+            if change.only_replacing is not None and change.slot.subtree is not change.only_replacing:
+                change.applied.set()
+                continue
             change.previous = change.slot.set_subtree(change.subtree)
+            if change.restart and self._engine.root.status is Status.RUNNING:
+                self._engine.root.stop(Status.INVALID)
             change.applied.set()
 
 
@@ -101,6 +130,8 @@ class Engine:
         self.tree = py_trees.trees.BehaviourTree(root)
         self.tasks = TaskInterface(self)
         self.tick_count = 0
+        self.tick_started = 0.0
+        """When the current (or last) tick began (``time.monotonic``)."""
         self.tick_stats = RunStats()
         self._thread: threading.Thread | None = None
         self._stop = threading.Event()
@@ -109,6 +140,7 @@ class Engine:
         """Apply pending task changes, then tick the tree once; returns the root's status."""
         self.tasks.apply_pending()
         start = time.perf_counter()
+        self.tick_started = time.monotonic()
         self.tree.tick()
         self.tick_stats.record(time.perf_counter() - start)
         self.tick_count += 1

@@ -5,6 +5,7 @@ from __future__ import annotations
 from collections.abc import Iterator, Sequence
 
 import py_trees
+from py_trees.common import Status
 
 from robokudo.core.cas import CAS
 from robokudo.core.explained import Explained
@@ -70,6 +71,14 @@ def pipelines(root: py_trees.behaviour.Behaviour) -> Iterator[Pipeline]:
     for node in root.iterate():
         if isinstance(node, Pipeline):
             yield node
+
+
+def finished_run_cas(node: py_trees.behaviour.Behaviour | None) -> CAS | None:
+    """The CAS of ``node``'s last run when ``node`` is a Pipeline whose run ended (SUCCESS or FAILURE), else None
+    (how a server finds the frame a task just analysed)."""
+    if isinstance(node, Pipeline) and node.status in (Status.SUCCESS, Status.FAILURE):
+        return node.cas
+    return None
 
 
 def pipeline_named(root: py_trees.behaviour.Behaviour, name: str) -> Pipeline:

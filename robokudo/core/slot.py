@@ -1,4 +1,5 @@
-"""TaskSlot: a placeholder in a root tree that holds the current task's subtree (the seed's Fig. 4)."""
+"""TaskSlot: a placeholder in a root tree that holds the current task's subtree (the paper's Fig. 4), and Idle,
+the subtree a slot holds while there is no task."""
 
 from __future__ import annotations
 
@@ -27,10 +28,14 @@ class TaskSlot(Explained, py_trees.composites.Composite):
         return self.children[0] if self.children else None
 
     def set_subtree(self, subtree: py_trees.behaviour.Behaviour | None) -> py_trees.behaviour.Behaviour | None:
-        """Put ``subtree`` in the slot (None empties it); the old one is stopped and returned."""
+        """Put ``subtree`` in the slot (None empties it) and return the old one.
+
+        A running old subtree is stopped (its running annotators are interrupted); a finished one keeps its final
+        statuses, so it can still be explained after it was taken out.
+        """
         old = self.subtree
         if old is not None:
-            if old.status is not Status.INVALID:
+            if old.status is Status.RUNNING:
                 old.stop(Status.INVALID)
             self.remove_child(old)
         if subtree is not None:
@@ -56,3 +61,15 @@ class TaskSlot(Explained, py_trees.composites.Composite):
             self.stop(new_status)
         self.status = new_status
         yield self
+
+
+class Idle(Explained, py_trees.behaviour.Behaviour):
+    """The subtree of a slot without a task: succeeds at once on every tick, so the root keeps perceiving."""
+
+    def __init__(self, name: str = "idle", reason: str = "no task: waits for the next one") -> None:
+        super().__init__(name=name)
+        self.reason = reason
+
+    def update(self) -> Status:
+        """Nothing to do."""
+        return Status.SUCCESS

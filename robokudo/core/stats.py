@@ -9,18 +9,21 @@ from dataclasses import dataclass, field
 
 @dataclass
 class RunStats:
-    """Durations of an annotator's runs; keeps the most recent ``window`` samples for the median."""
+    """Durations of an annotator's runs: count, total, maximum and the last; keeps the most recent ``window``
+    samples for the median."""
 
     window: int = 1000
     count: int = 0
     max_seconds: float = 0.0
     total_seconds: float = 0.0
+    last_seconds: float = 0.0
     _recent: deque[float] = field(default_factory=deque, repr=False)
 
     def record(self, seconds: float) -> None:
         """Add one run's duration."""
         self.count += 1
         self.total_seconds += seconds
+        self.last_seconds = seconds
         self.max_seconds = max(self.max_seconds, seconds)
         self._recent.append(seconds)
         if len(self._recent) > self.window:

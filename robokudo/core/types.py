@@ -213,6 +213,22 @@ class ObjectHypothesis(Annotation):
 
 
 @dataclass(eq=False, kw_only=True)
+class PersonHypothesis(ObjectHypothesis):
+    """An object hypothesis that is a person: its segment, plus the body keypoints and pose experts attach."""
+
+
+@dataclass(eq=False, kw_only=True)
+class BodyKeypoints(Annotation):
+    """A person's body landmarks: ``names`` (N), image positions ``pixels`` (Nx2, pixels), camera-frame
+    ``points`` (Nx3, metres, NaN where the cloud has no depth there) and ``visibility`` (N, 0..1)."""
+
+    names: tuple[str, ...]
+    pixels: np.ndarray
+    points: np.ndarray
+    visibility: np.ndarray
+
+
+@dataclass(eq=False, kw_only=True)
 class SemanticColor(Annotation):
     """A colour name (an ontology colour class, lower case) with its share of the object's pixels."""
 

@@ -24,6 +24,7 @@ from annotators.cloud.clusters import ClusterExtractor
 from annotators.cloud.clutter import ClutterSegmenter
 from annotators.cloud.filters import CropBoxFilter, RangeFilter, RegionFilter
 from annotators.cloud.normals import NormalEstimator
+from annotators.cloud.people import DepthPeopleDetector
 from annotators.cloud.plane import SupportPlaneSegmenter
 from annotators.cloud.point_cloud import PointCloudGenerator
 from annotators.cloud.pose import PoseAnnotator
@@ -31,6 +32,7 @@ from annotators.cloud.shape import ShapeAnnotator
 from annotators.cloud.size import SizeAnnotator
 from annotators.image.color import SemanticColorAnnotator
 from annotators.image.histogram import ColorHistogramAnnotator
+from annotators.image.human_pose import HumanPoseDetector
 from annotators.image.image_regions import ImageRegionSegmenter
 from annotators.image.onnx_detector import OnnxDetector
 from annotators.readers.frame_io import Frame
@@ -44,7 +46,7 @@ from annotators.readers.frame_readers import (
     TumPairReader,
     TumSequenceReader,
 )
-from annotators.readers.streams import FrameStream, StreamReader, recorded_stream
+from annotators.readers.streams import FrameStream, PerceivedFrameReader, StreamReader, recorded_stream
 from annotators.text.reader import TextReader
 from robokudo.core.annotator import Annotator
 from robokudo.core.pipeline import Pipeline
@@ -180,6 +182,8 @@ BROKEN_CASES: dict[str, tuple[Callable[[], Seeds], tuple[type[Annotator], ...]]]
             TextReader,
             OnnxDetector,
             ImageRegionSegmenter,
+            DepthPeopleDetector,
+            HumanPoseDetector,
         ),
     ),
     "all-NaN cloud": (
@@ -195,6 +199,7 @@ BROKEN_CASES: dict[str, tuple[Callable[[], Seeds], tuple[type[Annotator], ...]]]
             PoseAnnotator,
             ShapeAnnotator,
             SizeAnnotator,
+            DepthPeopleDetector,
         ),
     ),
     "cloud without points of interest": (
@@ -210,13 +215,15 @@ BROKEN_CASES: dict[str, tuple[Callable[[], Seeds], tuple[type[Annotator], ...]]]
             PoseAnnotator,
             ShapeAnnotator,
             SizeAnnotator,
+            DepthPeopleDetector,
         ),
     ),
     "cloud too small for normals": (
         lambda: [PointCloud(points=np.ones((2, 2, 3), np.float32), mask=np.ones((2, 2), bool))],
         (NormalEstimator,),
     ),
-    "collinear cloud": (lambda: [line_cloud()], (SupportPlaneSegmenter,)),
+    "collinear cloud": (lambda: [line_cloud()], (SupportPlaneSegmenter, DepthPeopleDetector)),
+    "a wall, no ground": (lambda: [flat_cloud()], (DepthPeopleDetector,)),
     "cloud out of range": (
         lambda: [PointCloud(points=flat_cloud().points * 10, mask=np.ones((H, W), bool))],
         (RangeFilter, CropBoxFilter),
@@ -268,8 +275,8 @@ BROKEN_CASES: dict[str, tuple[Callable[[], Seeds], tuple[type[Annotator], ...]]]
         lambda: [flat_cloud(), hypothesis(), CameraInfo(K, cam_to_world=np.full((3, 3), np.nan))],
         (PoseAnnotator, RegionFilter),
     ),
-    "uniform colour image": (lambda: [color()], (ImageRegionSegmenter,)),
-    "tiny colour image": (lambda: [color(4, 4)], (ImageRegionSegmenter,)),
+    "uniform colour image": (lambda: [color()], (ImageRegionSegmenter, HumanPoseDetector)),
+    "tiny colour image": (lambda: [color(4, 4)], (ImageRegionSegmenter, HumanPoseDetector)),
     "hypothesis without evidence": (lambda: [hypothesis(), *evidence_types()], (KnowledgeClassifier,)),
 }
 
@@ -443,6 +450,10 @@ BROKEN_READERS: dict[type[Annotator], dict[str, Callable[[Path], Annotator]]] = 
         "source ended": lambda tmp: StreamReader(played_once(recorded_stream(str(write_uoc(tmp / "a")), loop=False))),
         "unreadable frame": lambda tmp: StreamReader(recorded_stream(str(truncated_uoc(tmp / "b")))),
         "closed stream": lambda tmp: StreamReader(closed(recorded_stream(str(write_uoc(tmp / "c"))))),
+    },
+    PerceivedFrameReader: {
+        "no perception pipeline in the tree": lambda tmp: PerceivedFrameReader(),
+        "a perception pipeline without a frame": lambda tmp: PerceivedFrameReader(pipeline="broken"),
     },
     TiffSequenceReader: {
         "missing folder": lambda tmp: TiffSequenceReader(tmp / "nowhere"),

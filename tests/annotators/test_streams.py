@@ -152,14 +152,24 @@ def test_the_stream_reader_feeds_a_pipeline_until_the_source_ends(uoc_bag: Path)
     assert reader.feedback_message.startswith("source ended:")
 
 
-def test_a_stream_reader_that_does_not_wait_keeps_the_last_frame() -> None:
-    reader = StreamReader(stream_for(None, rate_hz=1.0), wait=False)
+def test_a_stream_reader_that_does_not_wait_runs_until_a_new_frame_is_due() -> None:
+    camera = KitchenCameraStream(rate_hz=2.0)
+    camera.prepare()
+    reader = StreamReader(camera, wait=False)
     pipeline = Pipeline("perceive", [reader])
     pipeline.tick_once()
     first = reader.last_frame
-    pipeline.tick_once()
-    assert reader.status is Status.SUCCESS and reader.last_frame is first
+    assert reader.status is Status.SUCCESS
     assert first is not None and first.camera.frame_id == "kitchen/table"
+    pipeline.tick_once()  # a new run: the next frame is not due yet, and the last one is not handed out again
+    assert reader.status is Status.RUNNING and reader.feedback_message == "waiting for the next frame"
+    assert reader.last_frame is first
+    deadline = time.monotonic() + 5
+    while reader.status is Status.RUNNING and time.monotonic() < deadline:
+        time.sleep(0.02)
+        pipeline.tick_once()
+    assert reader.status is Status.SUCCESS and reader.last_frame is not first
+    assert reader.last_frame is not None and reader.last_frame.sequence == first.sequence + 1
 
 
 def test_bad_rates_and_paths_are_refused(tmp_path: Path) -> None:

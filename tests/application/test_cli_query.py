@@ -57,7 +57,7 @@ def test_a_timeout_stops_the_running_tree_and_a_track_task(tmp_path: Path) -> No
     with AnsweringService.open(tmp_path / "beliefs.sqlite") as service:
         outcome = service.answer("detect {obj: {type: Milk}, timeout: 0.3s}")
         assert outcome.answer.timed_out and outcome.answer.objects == ()
-        assert service.engine.tasks.slot("task").subtree is None
+        assert service.engine.tasks.slot("task").subtree.name == "idle"  # the stopped tree was taken out
         handle = service.start("track {obj: {type: cup, color: red}, timeout: 1s}")
         list(handle.answers())
         assert handle.done and handle.reason == "timed out after 1 s"
@@ -132,3 +132,15 @@ def test_a_broken_png_fails_the_reader_with_the_reason_and_libpng_stays_quiet(
     assert status == 1
     assert f"ColorDepthPairReader: cannot decode {color}: truncated: chunk IDAT" in err
     assert "libpng" not in err
+
+
+def test_the_annotated_image_boxes_the_answered_objects(capsys: pytest.CaptureFixture[str], tmp_path: Path) -> None:
+    picture = tmp_path / "milk.png"
+    status, out, err = query(capsys, "find milk in fridge", "--annotated-image", str(picture))
+    assert status == 0 and out.startswith("#1 lactose free milk"), err
+    assert f"annotated image: {picture}" in err
+    drawn = cv2.cvtColor(cv2.imread(str(picture)), cv2.COLOR_BGR2RGB)
+    box = np.all(drawn == (0, 229, 255), axis=2)  # the answer's box colour
+    rows, columns = np.nonzero(box)
+    assert box.sum() > 200
+    assert drawn.shape[:2] == (480, 640) and columns.min() > 150 and columns.max() < 500 and rows.min() > 50

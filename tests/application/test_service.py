@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import time
 from collections.abc import Iterator
 from pathlib import Path
 
@@ -9,7 +10,7 @@ import pytest
 
 from queries import KINDS, parse_query
 from reasoning.knowledge.knowledge_base import KnowledgeBase
-from robokudo.application.service import EXECUTION_MODES, AnsweringService, ExecutionMode
+from robokudo.application.service import EXECUTION_MODES, TASK_SLOT, AnsweringService, ExecutionMode
 
 
 @pytest.fixture
@@ -66,7 +67,13 @@ def test_a_track_query_answers_every_run_until_cancelled(service: AnsweringServi
     assert not handle.done
     handle.cancel()
     assert handle.done and handle.reason == "cancelled"
-    assert not service.engine.is_running_in_background()
+    slot = service.engine.tasks.slot(TASK_SLOT)
+    assert slot.subtree is not None and slot.subtree.name == "idle"  # the slot idles; the engine keeps ticking
+    ticks = service.engine.tick_count
+    deadline = time.monotonic() + 10
+    while service.engine.tick_count < ticks + 3 and time.monotonic() < deadline:
+        time.sleep(0.01)
+    assert service.engine.tick_count >= ticks + 3
     assert all(late.objects for late in handle.answers())  # answers() ends once the task ended
     # the engine answers one-shot queries again after the continuous task
     assert [o.class_label for o in service.answer("find the red cup").answer.objects] == ["cup"]
@@ -84,3 +91,12 @@ def test_kinds_that_do_not_fit_the_call_are_refused(service: AnsweringService) -
         service.start("find the red cup")
     with pytest.raises(ValueError, match="plans no perception tree"):
         service.mode_of(parse_query("stop { task: 1 }"))
+
+
+def test_the_trees_of_one_service_share_the_loaded_ocr_model(service: AnsweringService) -> None:
+    readers = []
+    for _ in range(2):
+        tree = service.answer("find milk in fridge").tree
+        readers += [node for node in tree.iterate() if node.name == "TextReader"]
+    assert len(readers) == 2 and readers[0] is not readers[1]
+    assert readers[0].engine() is readers[1].engine()  # the second tree did not load the OCR models again

@@ -265,6 +265,25 @@ def test_query_to_filter_with_the_real_knowledge_base(filled: Path) -> None:
         assert milk.class_name == "LactoseFreeMilk"
 
 
+def test_several_values_of_an_attribute_select_objects_with_any_of_them(filled: Path) -> None:
+    f = belief_filter(parse("detect { obj: { color: [red, blue] } }"), None)
+    assert f.attributes == {"color": ("red", "blue")}
+    with BeliefStore(filled) as store:  # a white (lactose free) milk and a red cup
+        assert [b.class_name for b in store.query(f)] == ["Cup"]
+        either = store.query(BeliefFilter(attributes={"color": ("white", "RED")}))
+        assert {b.class_name for b in either} == {"LactoseFreeMilk", "Cup"}
+        milk = BeliefFilter(object_class="Milk", class_test=is_subclass, attributes={"color": ("red", "white")})
+        assert [b.class_name for b in store.query(milk)] == ["LactoseFreeMilk"]
+        assert store.query(BeliefFilter(object_class="Cup", attributes={"color": ("white", "blue")})) == []
+
+
+def test_a_list_under_an_attribute_key_resolves_each_word_with_the_knowledge_base() -> None:
+    f = belief_filter(parse("find the red or green cup"), FakeKnowledgeBase())
+    assert f.attributes == {"color": ("Red", "green")}  # a word the knowledge base does not know stays as it is
+    one = belief_filter(parse("detect { obj: { color: [red, Red] } }"), FakeKnowledgeBase())
+    assert one.attributes == {"color": "Red"}
+
+
 # -------------------------------------------------------------------------------------------------- CLI
 
 

@@ -109,7 +109,7 @@ def test_depth_and_region_preconditions(test_kb: KnowledgeBase) -> None:
 def test_providers_include_subtypes_and_views(kb: KnowledgeBase) -> None:
     assert set(names(kb.providers("ColorImage"))) == {
         "KitchenSceneReader", "ColorDepthPairReader", "TumSequenceReader", "TumPairReader", "PcdReader",
-        "TiffSequenceReader", "BagReader", "BagCloudReader", "StreamReader",
+        "TiffSequenceReader", "BagReader", "BagCloudReader", "StreamReader", "PerceivedFrameReader",
     }  # fmt: skip
     assert "SemanticColorAnnotator" in names(kb.providers("Annotation"))
 

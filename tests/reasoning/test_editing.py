@@ -125,7 +125,7 @@ def test_bad_edit_is_rejected_and_leaves_files_byte_identical(
 def test_rejected_first_edit_creates_no_file(editor: OntologyEditor, user_file: Path) -> None:
     with pytest.raises(EditRejectedError):
         editor.add_object("OatMilk", ["Mlik"])
-    assert not user_file.parent.exists()
+    assert sorted(p.name for p in user_file.parent.iterdir()) == ["user.ttl.lock"]  # no user file, no history
 
 
 @pytest.mark.slow
@@ -182,7 +182,7 @@ def test_remove_object(editor: OntologyEditor, user_file: Path) -> None:
 def test_writes_are_atomic_and_leave_no_temporary_files(editor: OntologyEditor, user_file: Path) -> None:
     editor.add_object("OatMilk", ["Milk"])
     editor.add_object("RiceMilk", ["Milk"])
-    assert sorted(p.name for p in user_file.parent.iterdir()) == ["user.ttl"]
+    assert sorted(p.name for p in user_file.parent.iterdir()) == ["user.ttl", "user.ttl.history.jsonl", "user.ttl.lock"]
 
 
 def test_user_file_location(tmp_path: Path, monkeypatch: pytest.MonkeyPatch) -> None:

@@ -82,3 +82,51 @@ def test_works_as_a_robokudo_subcommand(capsys: pytest.CaptureFixture[str], user
     assert cli.main(["ontology", "--user-file", str(user_file), "show", "cereal boxes"]) == 0
     assert capsys.readouterr().out.startswith("CerealBox  (object class")
     assert cli.main(["ontology", "--user-file", str(user_file), "show", "mlik"]) == 2
+
+
+def test_log_undo_synonym_export_and_import(
+    capsys: pytest.CaptureFixture[str], user_file: Path, tmp_path: Path
+) -> None:
+    base = ("--user-file", str(user_file), "--no-reasoner")
+    assert run(*base, "add-object", "OatMilk", "--is-a", "Milk", "--synonym", "oat drink") == 0
+    assert run(*base, "synonym", "milk", "--add", "moo juice") == 0
+    assert "changed the synonyms of Milk" in capsys.readouterr().out
+    assert run(*base, "log") == 0
+    lines = capsys.readouterr().out.splitlines()
+    assert "add-object OatMilk" in lines[1] and "synonym Milk" in lines[2] and lines[2].endswith("+1 -0")
+    exported = tmp_path / "layer.owl"
+    assert run(*base, "export", "--format", "owl", "--output", str(exported)) == 0
+    assert exported.read_text(encoding="utf-8").startswith('<?xml version="1.0" encoding="UTF-8"?>\n<Ontology')
+    assert run(*base, "undo", "2") == 0
+    assert "undid edit 2 (synonym Milk), edit 1 (add-object OatMilk)" in capsys.readouterr().out
+    assert run(*base, "show", "moo juice") == 2
+    assert run(*base, "import", str(exported)) == 0
+    assert "imported 2 class(es) from layer.owl" in capsys.readouterr().out
+    assert run(*base, "show", "oat drinks") == 0
+    assert run(*base, "undo", "9") == 2
+    assert "can be undone" in capsys.readouterr().err
+
+
+def test_import_of_a_foreign_class_needs_a_map(
+    capsys: pytest.CaptureFixture[str], user_file: Path, tmp_path: Path
+) -> None:
+    foreign = tmp_path / "food.ttl"
+    foreign.write_text(
+        "@prefix owl: <http://www.w3.org/2002/07/owl#> .\n@prefix rdfs: <http://www.w3.org/2000/01/rdf-schema#> .\n"
+        "<http://example.org/food#SoyMilk> a owl:Class ; rdfs:subClassOf <http://example.org/food#Milch> .\n",
+        encoding="utf-8",
+    )
+    base = ("--user-file", str(user_file), "--no-reasoner")
+    assert run(*base, "import", str(foreign)) == 2
+    assert "IRI(s) outside the rk: namespace" in capsys.readouterr().err
+    assert not user_file.exists()
+    mapped = ("--map", "http://example.org/food#", "--map", "http://example.org/food#Milch=Milk")
+    assert run(*base, "import", str(foreign), *mapped) == 0
+    assert run(*base, "show", "SoyMilk") == 0
+    assert "is a         Milk" in capsys.readouterr().out
+
+
+def test_export_of_the_merged_ontology_to_stdout(capsysbinary: pytest.CaptureFixture[bytes], user_file: Path) -> None:
+    assert run("--user-file", str(user_file), "export", "--merged", "--format", "xml") == 0
+    out = capsysbinary.readouterr().out
+    assert b"http://robokudo.org/ontology/merged" in out and b"rdf:RDF" in out

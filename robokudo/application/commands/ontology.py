@@ -1,7 +1,9 @@
-"""``robokudo ontology``: show terms, check the ontology, add and remove user object classes.
+"""``robokudo ontology``: show terms, check the ontology, edit the user layer, its history, export and import.
 
-A rejected edit or an unknown name exits with status 2 and a message on
-stderr; a failed ``check`` exits with 1.
+Edits (``add-object``, ``remove-object``, ``synonym``, ``import``, ``undo``) go through
+:class:`~reasoning.knowledge.editing.OntologyEditor`: locked, validated, written atomically and recorded in the
+history ``log`` lists. A rejected edit or an unknown name exits with status 2 and a message on stderr; a failed
+``check`` exits with 1.
 
 ``remove-object NAME`` also updates the belief store (``--store``, else ``$ROBOKUDO_BELIEF_STORE``, else the
 user data dir; a store that does not exist is left alone): after the class is removed, the stored beliefs of
@@ -12,21 +14,24 @@ that class are reclassified as its parent class, keeping their other class alter
 from __future__ import annotations
 
 import argparse
+import json
 import sys
+from dataclasses import asdict
 from pathlib import Path
 
-from reasoning.beliefs.filters import kb_class_test
 from reasoning.beliefs.store import BeliefStore, BeliefStoreError
 from reasoning.errors import EditRejectedError, OntologyError, TermError
 from reasoning.knowledge.editing import CheckReport, EditResult, OntologyEditor
+from reasoning.knowledge.exchange import FORMATS, export_ontology
+from reasoning.knowledge.history import HistoryEntry
 from reasoning.knowledge.knowledge_base import KnowledgeBase
 from reasoning.knowledge.model import AnnotatorSpec, Resolved
 from reasoning.knowledge.sources import USER_ONTOLOGY_ENV
 from robokudo.application.knowledge import load_knowledge_base
-from robokudo.application.reclassify import reclassify
+from robokudo.application.reclassify import remove_object_class
 from robokudo.core.regions import RegionBox
 
-HELP = "show, check and edit the ontology"
+HELP = "show, check, edit, undo, export and import the ontology"
 
 
 def add_arguments(parser: argparse.ArgumentParser) -> None:
@@ -112,6 +117,50 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
     )
     _common_options(remove, suppress=True)
 
+    synonym = actions.add_parser("synonym", help="add or remove synonyms of a class, region or value")
+    synonym.add_argument("name", help="the term (a name or a word)")
+    synonym.add_argument("--add", action="append", default=[], metavar="WORD", help="a synonym to add (repeatable)")
+    synonym.add_argument(
+        "--remove", action="append", default=[], metavar="WORD", help="a synonym the user added to remove (repeatable)"
+    )
+    _common_options(synonym, suppress=True)
+
+    log = actions.add_parser("log", help="list the edits of the user ontology (newest last)")
+    log.add_argument("--triples", action="store_true", help="also print the triples each edit added and removed")
+    log.add_argument("--json", action="store_true", help="print the history entries as JSON")
+    _common_options(log, suppress=True)
+
+    undo = actions.add_parser("undo", help="revert the last N edits of the user ontology (validated like any edit)")
+    undo.add_argument("count", nargs="?", type=int, default=1, metavar="N", help="how many edits (default 1)")
+    _common_options(undo, suppress=True)
+
+    export = actions.add_parser("export", help="write the user layer (or everything) for Protégé, owlready2, ...")
+    export.add_argument(
+        "--format",
+        choices=FORMATS,
+        default="turtle",
+        help="turtle, xml (RDF/XML) or owl (OWL/XML); default turtle",
+    )
+    export.add_argument("--merged", action="store_true", help="the shipped ontology, annotators and user layer as one")
+    export.add_argument("--output", "-o", type=Path, default=None, metavar="FILE", help="write here (default stdout)")
+    _common_options(export, suppress=True)
+
+    imported = actions.add_parser(
+        "import",
+        help="bring classes (parents, labels, synonyms, colours, shapes, default locations) from an OWL file",
+    )
+    imported.add_argument("file", type=Path, help="Turtle, RDF/XML or OWL/XML")
+    imported.add_argument(
+        "--map",
+        dest="mappings",
+        action="append",
+        default=[],
+        metavar="NAMESPACE|IRI=NAME",
+        help="take IRIs of another namespace as rk: names (NAMESPACE: every IRI starting with it becomes rk:<rest>; "
+        "IRI=NAME: that IRI becomes rk:NAME); repeatable",
+    )
+    _common_options(imported, suppress=True)
+
 
 def _common_options(parser: argparse.ArgumentParser, suppress: bool) -> None:
     """``--user-file`` and ``--no-reasoner``, accepted before or after the action (no default after it)."""
@@ -165,6 +214,23 @@ def run(args: argparse.Namespace) -> int:
             return 0
         if action == "remove-object":
             return _remove_object(kb, editor, args.name, args.store)
+        if action == "synonym":
+            _print_result(editor.change_synonyms(args.name, add=args.add, remove=args.remove))
+            print(describe(kb, args.name))
+            return 0
+        if action == "log":
+            _print_log(editor.log(), triples=args.triples, as_json=args.json)
+            return 0
+        if action == "undo":
+            _print_result(editor.undo(args.count))
+            return 0
+        if action == "export":
+            return _export(kb, args.format, args.merged, args.output)
+        if action == "import":
+            namespaces = [m for m in args.mappings if "=" not in m]
+            names = dict(m.rsplit("=", 1) for m in args.mappings if "=" in m)
+            _print_result(editor.import_file(args.file, namespaces, names))
+            return 0
     except (EditRejectedError, TermError, BeliefStoreError) as error:
         print(f"robokudo ontology {action}: {error}", file=sys.stderr)
         return 2
@@ -176,18 +242,11 @@ def _remove_object(kb: KnowledgeBase, editor: OntologyEditor, name: str, store_p
     path = (store_path or BeliefStore.default_path()).expanduser()
     store = BeliefStore(path) if path.exists() else None  # an unusable store fails here, before the removal
     try:
-        try:
-            parents = sorted(kb.superclasses(name, direct=True))  # read before the class is gone
-        except LookupError:
-            parents = []  # remove_object says what is wrong with the name
-        result = editor.remove_object(name)
+        result, parent, moved = remove_object_class(kb, editor, name, store)
         _print_result(result)
-        if store is not None:
-            parent = parents[0] if parents else None
-            moved = reclassify(store, result.name, parent, kb_class_test(kb))
-            if moved:
-                target = f"as {parent}" if parent else "with no class"
-                print(f"reclassified {len(moved)} stored belief(s) of {result.name} {target} ({path})")
+        if moved:
+            target = f"as {parent}" if parent else "with no class"
+            print(f"reclassified {len(moved)} stored belief(s) of {result.name} {target} ({path})")
     finally:
         if store is not None:
             store.close()
@@ -195,10 +254,46 @@ def _remove_object(kb: KnowledgeBase, editor: OntologyEditor, name: str, store_p
 
 
 def _print_result(result: EditResult) -> None:
-    verb = "added" if result.action == "add-object" else "removed"
-    print(f"{verb} {result.name} ({result.user_file}); checked by: {result.checked_by}")
+    done = {
+        "add-object": f"added {result.name}",
+        "remove-object": f"removed {result.name}",
+        "synonym": f"changed the synonyms of {result.name}",
+        "import": f"imported {result.name}",
+        "undo": "undid " + ", ".join(f"edit {e.number} ({e.summary})" for e in result.undone),
+    }[result.action]
+    print(f"{done} ({result.user_file}); edit {result.number}, checked by: {result.checked_by}")
     for warning in result.warnings:
         print(f"warning: {warning}", file=sys.stderr)
+
+
+def _print_log(entries: list[HistoryEntry], triples: bool, as_json: bool) -> None:
+    if as_json:
+        print(json.dumps([asdict(e) for e in entries], indent=2, ensure_ascii=False))
+        return
+    if not entries:
+        print("no edits recorded")
+        return
+    print(f"{'#':>4}  {'time (UTC)':20s}  {'user':12s}  {'edit':40s}  triples")
+    for entry in entries:
+        counts = f"+{len(entry.added)} -{len(entry.removed)}"
+        print(f"{entry.number:>4}  {entry.time:20s}  {entry.user[:12]:12s}  {entry.summary[:40]:40s}  {counts}")
+        if triples:
+            for line in entry.added:
+                print(f"        + {line}")
+            for line in entry.removed:
+                print(f"        - {line}")
+
+
+def _export(kb: KnowledgeBase, fmt: str, merged: bool, output: Path | None) -> int:
+    data = export_ontology(kb, fmt, merged)
+    if output is None:
+        sys.stdout.buffer.write(data)
+        sys.stdout.flush()
+    else:
+        output.write_bytes(data)
+        what = "the merged ontology" if merged else f"the user layer {kb.user_file}"
+        print(f"wrote {what} to {output} ({fmt})", file=sys.stderr)
+    return 0
 
 
 def _report(report: CheckReport) -> int:

@@ -2,16 +2,19 @@
 
 Exit status: 0 with an answer (also when the query's ``timeout`` passed first: the answer then holds the stored
 beliefs matching the query, ``"timed_out": true`` in the JSON and a note on stderr), 1 when perception failed,
-2 for a bad query, plan, option, input, belief store or an object id the store does not hold (``no object 3``).
+2 for a bad query, plan, option, input, belief store or an object id the store does not hold (``no object 3``), and
+for ``--rerun`` / ``--rerun-connect`` without the Rerun SDK or a viewer to reach.
 The query is parsed first, then the belief store is checked, before anything else is loaded.
 """
 
 from __future__ import annotations
 
 import argparse
+import contextlib
 import sys
+from typing import TYPE_CHECKING
 
-from queries import QueryError, parse_query
+from queries import Query, QueryError, parse_query
 from reasoning.beliefs.store import BeliefStoreError
 from reasoning.errors import OntologyError
 from reasoning.planning.planner import PlanningError
@@ -21,9 +24,15 @@ from robokudo.application.commands.input_options import (
     input_problem,
     intrinsics_of,
 )
-from robokudo.application.service import AnsweringService, PerceptionFailedError, UnknownObjectError
+from robokudo.application.commands.rerun_options import RerunOptionError, add_rerun_arguments, open_rerun_log
+from robokudo.application.report import draw_answer, write_image
+from robokudo.application.service import AnsweringService, Outcome, PerceptionFailedError, UnknownObjectError
 from robokudo.core.render import unicode_tree
+from robokudo.core.types import ColorImage
 from trees.synthesis import SynthesisError
+
+if TYPE_CHECKING:
+    from robokudo.application.rerun_log import RerunLog
 
 HELP = "plan and run a query on an input and print the answer"
 
@@ -37,6 +46,12 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
     parser.add_argument("--json", action="store_true", help="print the answer as JSON")
     parser.add_argument("--explain", action="store_true", help="print the synthesized tree with its reasons")
     parser.add_argument("--store", help="belief store file (default: $ROBOKUDO_BELIEF_STORE or the user data dir)")
+    parser.add_argument(
+        "--annotated-image",
+        metavar="PATH",
+        help="write the analysed frame with the answer's objects boxed and labelled",
+    )
+    add_rerun_arguments(parser)
 
 
 def run(args: argparse.Namespace) -> int:
@@ -48,14 +63,20 @@ def run(args: argparse.Namespace) -> int:
         return 2
     try:
         query = parse_query(text)  # the cheapest check first: a bad query touches nothing
-        with AnsweringService.open(
-            args.store, input_path=args.input, frame=frame_number(args), intrinsics=intrinsics_of(args)
-        ) as service:
-            outcome = service.answer(query)
+        with (
+            open_rerun_log(args) or contextlib.nullcontext() as rerun_log,
+            AnsweringService.open(
+                args.store, input_path=args.input, frame=frame_number(args), intrinsics=intrinsics_of(args)
+            ) as service,
+        ):
+            outcome = answer(service, query, rerun_log)
     except QueryError as error:
         print(error, file=sys.stderr)
         return 2
     except (PlanningError, SynthesisError, OntologyError, BeliefStoreError, UnknownObjectError, ValueError) as error:
+        print(f"robokudo query: {error}", file=sys.stderr)
+        return 2
+    except RerunOptionError as error:
         print(f"robokudo query: {error}", file=sys.stderr)
         return 2
     except PerceptionFailedError as error:
@@ -64,7 +85,24 @@ def run(args: argparse.Namespace) -> int:
     if args.explain:
         print(unicode_tree(outcome.tree, show_status=True, show_reasons=True))
         print()
+    if args.annotated_image and outcome.tree.cas.view(ColorImage) is not None:
+        print(f"annotated image: {write_image(draw_answer(outcome.tree.cas), args.annotated_image)}", file=sys.stderr)
     if outcome.answer.timed_out:
         print(f"robokudo query: {TIMED_OUT_NOTE}", file=sys.stderr)
     print(outcome.answer.to_json() if args.json else outcome.answer.summary())
     return 0
+
+
+def answer(service: AnsweringService, query: Query, rerun_log: RerunLog | None) -> Outcome:
+    """The service's answer to ``query``, recorded into ``rerun_log`` when there is one."""
+    if rerun_log is None:
+        return service.answer(query)
+    from robokudo.application.rerun_log import service_recorder
+
+    recorder = service_recorder(rerun_log, service)
+    service.engine.tree.add_post_tick_handler(recorder.after_tick)
+    service.add_belief_listener(recorder.beliefs_changed)
+    try:
+        return service.answer(query)
+    finally:
+        recorder.close()

@@ -13,6 +13,7 @@ from robokudo.application.commands.input_options import (
     input_problem,
     intrinsics_of,
 )
+from robokudo.application.commands.rerun_options import RerunOptionError, add_rerun_arguments, open_rerun_log
 from robokudo.application.report import describe_hypotheses, write_annotated_image
 from robokudo.core.engine import Engine
 from robokudo.core.pipeline import pipelines
@@ -29,18 +30,35 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
     parser.add_argument("--ticks", type=int, default=None, help="tick this many times (default: until it finishes)")
     parser.add_argument("--hz", type=float, default=30.0, help="tick frequency")
     parser.add_argument("--annotated-image", metavar="PATH", help="write the colour image with the hypotheses drawn")
+    add_rerun_arguments(parser)
 
 
 def run(args: argparse.Namespace) -> int:
-    """Run the tree (once, or ``--ticks`` times); 0 when it succeeded, 2 for bad options."""
+    """Run the tree (once, or ``--ticks`` times); 0 when it succeeded, 2 for bad options (``--rerun`` without the
+    Rerun SDK, ...)."""
     problem = input_problem(args)
     if problem is not None:
         print(f"robokudo run: {problem}", file=sys.stderr)
         return 2
     root = load_tree(args.name).create(input_path=args.input, frame=frame_number(args), intrinsics=intrinsics_of(args))
     engine = Engine(root, hz=args.hz)
+    try:
+        rerun_log = open_rerun_log(args)
+    except RerunOptionError as error:
+        print(f"robokudo run: {error}", file=sys.stderr)
+        return 2
     until_finished = (lambda s: s is not Status.RUNNING) if args.ticks is None else None
-    status = engine.run(ticks=args.ticks, until=until_finished)
+    if rerun_log is None:
+        status = engine.run(ticks=args.ticks, until=until_finished)
+    else:
+        from robokudo.application.rerun_log import TickRecorder
+
+        recorder = TickRecorder(rerun_log, task_of=lambda tree: tree, tick_of=lambda: engine.tick_count)
+        engine.tree.add_post_tick_handler(recorder.after_tick)
+        try:
+            status = engine.run(ticks=args.ticks, until=until_finished)
+        finally:
+            recorder.close()
     print(unicode_tree(root, show_status=True, show_reasons=False))
     print()
     print(stats_table(root))

@@ -226,7 +226,7 @@ class GoalManager:
         if goal.stop_requested() is not None:
             goal.finish_stopped()
         else:
-            goal.finish(GoalStatus.SUCCEEDED, outcome.answer.to_dict())
+            goal.finish(GoalStatus.SUCCEEDED, {**outcome.answer.to_dict(), "timing": dict(outcome.timing)})
 
     def _run_continuous(self, goal: Goal) -> None:
         handle = self.service.start(goal.query)

@@ -2,7 +2,8 @@
 
 Goals and service calls run on the goal manager's worker thread (:mod:`.goals`), never on the event loop. After
 every engine tick the tree's statuses are handed to the loop (``call_soon_threadsafe``) and published to the
-``/robokudo/tree_status`` subscribers. SIGINT or SIGTERM stops the server: open goals are aborted with the
+``/robokudo/tree_status`` subscribers, and every frame's belief changes to the ``/robokudo/beliefs`` subscribers.
+SIGINT or SIGTERM stops the server: open goals are aborted with the
 reason, their results are sent, the belief store is closed and :func:`serve` returns.
 """
 
@@ -12,28 +13,36 @@ import asyncio
 import contextlib
 import ipaddress
 import signal
+import threading
 from collections.abc import Callable
 from dataclasses import dataclass
-from typing import Any
+from typing import TYPE_CHECKING, Any
 
 import py_trees
 from websockets.asyncio.server import ServerConnection
 from websockets.asyncio.server import serve as websocket_server
 
-from queries import format_query, parse_query
-from robokudo.application.commands.plan import task_summary
+from reasoning.fusion.tracking import TrackStep
+from robokudo.application.server.belief_changes import belief_changes
+from robokudo.application.server.camera_topics import FramePicker, ShownFrame, image_messages
 from robokudo.application.server.goals import GoalManager
 from robokudo.application.server.protocol import (
-    BELIEFS_SERVICE,
+    BELIEFS_TOPIC,
+    DEPTH_TOPIC,
+    IMAGE_TOPIC,
     MAX_MESSAGE_BYTES,
-    PLAN_SERVICE,
     TREE_STATUS_TOPIC,
     publish,
 )
-from robokudo.application.server.session import Services, Session
+from robokudo.application.server.services import SERVICES
+from robokudo.application.server.session import Session, Subscribers
 from robokudo.application.server.tree_status import tree_status
+from robokudo.application.server.web_page import page_handler
 from robokudo.application.service import AnsweringService
-from robokudo.core.render import tree_to_dict, unicode_tree
+from robokudo.core.pipeline import finished_run_cas
+
+if TYPE_CHECKING:
+    from robokudo.application.rerun_log import TickRecorder
 
 FRAME_LIMIT = 8 * MAX_MESSAGE_BYTES
 """Frames above this are refused by the WebSocket layer (connection closed); up to it, a message over
@@ -62,31 +71,15 @@ def is_loopback(host: str) -> bool:
         return False
 
 
-def plan_service(service: AnsweringService, text: str) -> dict[str, Any]:
-    """``/robokudo/plan``: the interpretation, the synthesized tree and its explanation (nothing runs)."""
-    query = parse_query(text)
-    query_plan = service.plan(query)
-    tree = service.tree(query, query_plan)
-    return {
-        "query": format_query(query),
-        "task": task_summary(query_plan),
-        "tree": tree_to_dict(tree),
-        "explanation": unicode_tree(tree, show_reasons=True),
-    }
-
-
-def beliefs_service(service: AnsweringService, text: str) -> dict[str, Any]:
-    """``/robokudo/beliefs``: the stored beliefs matching the query (nothing runs)."""
-    return service.recall(text).to_dict()
-
-
-SERVICES: Services = {PLAN_SERVICE: plan_service, BELIEFS_SERVICE: beliefs_service}
-
-
 async def serve(
-    service: AnsweringService, config: ServerConfig, *, on_ready: Callable[[str], None] | None = None
+    service: AnsweringService,
+    config: ServerConfig,
+    *,
+    on_ready: Callable[[str], None] | None = None,
+    recorder: TickRecorder | None = None,
 ) -> str:
-    """Serve until SIGINT or SIGTERM; returns the reason it stopped. Closes ``service``."""
+    """Serve until SIGINT or SIGTERM; returns the reason it stopped. Closes ``service`` (not ``recorder``, which
+    records the engine's ticks and belief changes while it serves)."""
     loop = asyncio.get_running_loop()
     stopping: asyncio.Future[str] = loop.create_future()
     for signum in (signal.SIGINT, signal.SIGTERM):
@@ -94,18 +87,53 @@ async def serve(
         loop.add_signal_handler(signum, lambda r=reason: stopping.done() or stopping.set_result(r))
     goals = GoalManager(service)
     sessions: set[Session] = set()
-    subscribers: set[Session] = set()
+    subscribers = Subscribers()
 
-    def broadcast(message: dict[str, Any]) -> None:
-        for session in list(subscribers):
-            session.send(message)
+    def broadcast(topic: str, message: dict[str, Any]) -> None:
+        for session in subscribers.of(topic):
+            session.send(publish(topic, message))
+
+    def subscribed(topic: str) -> bool:  # engine thread: a stale read only delays or skips one message
+        return bool(subscribers.of(topic))
+
+    frames = FramePicker()
+    encoding = threading.Event()  # set while a picked frame is being encoded: later picks are dropped meanwhile
+
+    def encode_and_publish(shown: ShownFrame) -> None:  # a worker thread of the loop's executor
+        try:
+            color, depth = image_messages(shown)
+            loop.call_soon_threadsafe(broadcast, IMAGE_TOPIC, color)
+            if depth is not None:
+                loop.call_soon_threadsafe(broadcast, DEPTH_TOPIC, depth)
+        finally:
+            encoding.clear()
+
+    def publish_frame() -> None:  # engine thread
+        finished = finished_run_cas(service.task_tree)
+        perception = service.perception
+        shown = frames.pick(finished, perception.cas if perception is not None else None)
+        if shown is not None and not encoding.is_set():
+            encoding.set()
+            loop.call_soon_threadsafe(loop.run_in_executor, None, encode_and_publish, shown)
 
     def after_tick(tree: py_trees.trees.BehaviourTree) -> None:
-        if subscribers:  # engine thread: a stale read only delays or skips one message
+        if subscribed(TREE_STATUS_TOPIC):
             status = tree_status(tree.root, service.engine.tick_count)
-            loop.call_soon_threadsafe(broadcast, publish(TREE_STATUS_TOPIC, status))
+            loop.call_soon_threadsafe(broadcast, TREE_STATUS_TOPIC, status)
+        if subscribed(IMAGE_TOPIC) or subscribed(DEPTH_TOPIC):
+            publish_frame()
+
+    def beliefs_changed(step: TrackStep) -> None:
+        if subscribed(BELIEFS_TOPIC):
+            changes = belief_changes(step, service.engine.tick_count, service.kb.label)
+            loop.call_soon_threadsafe(broadcast, BELIEFS_TOPIC, changes)
 
     service.engine.tree.add_post_tick_handler(after_tick)
+    service.add_belief_listener(beliefs_changed)
+    if recorder is not None:
+        service.engine.tree.add_post_tick_handler(recorder.after_tick)
+        service.add_belief_listener(recorder.beliefs_changed)
+    service.run_in_background()
 
     async def connect(connection: ServerConnection) -> None:
         session = Session(connection, goals, SERVICES, subscribers, config.token)
@@ -117,7 +145,9 @@ async def serve(
 
     closed = False
     try:
-        async with websocket_server(connect, config.host, config.port, max_size=FRAME_LIMIT) as server:
+        async with websocket_server(
+            connect, config.host, config.port, max_size=FRAME_LIMIT, process_request=page_handler(config.token)
+        ) as server:
             if on_ready is not None:
                 on_ready(f"ws://{config.host}:{config.port}")
             reason = await stopping

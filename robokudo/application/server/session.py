@@ -5,6 +5,12 @@ Replies go through an outbox drained by one writer task, so the worker thread ha
 error and the connection keeps working; a client that must authenticate (the server has a token) and sends any
 other op first, or a wrong token, gets a ``status`` error and is disconnected. When the connection closes, the
 client's open goals are cancelled.
+
+A client's subscriptions are told apart, as in rosbridge, by topic and the ``subscribe`` op's ``id`` (roslibpy gives
+each ``Topic`` object its own): subscribing again with the same topic and id changes nothing, ``unsubscribe`` with an
+id ends that subscription and without one every subscription to the topic. A client receives each publication once
+however many subscriptions to its topic it has. It may hold :data:`MAX_SUBSCRIPTIONS` at a time; one more gets a
+``status`` error naming the cap (the connection keeps working) until an unsubscribe frees a place.
 """
 
 from __future__ import annotations
@@ -12,7 +18,7 @@ from __future__ import annotations
 import asyncio
 import hmac
 import json
-from collections.abc import Callable
+from collections.abc import Mapping
 from concurrent.futures import Future
 from typing import Any
 
@@ -22,7 +28,9 @@ from websockets.exceptions import ConnectionClosed
 from robokudo.application.server.designator import GoalError, MissingQueryError, goal_query
 from robokudo.application.server.goals import Goal, GoalManager
 from robokudo.application.server.protocol import (
-    GOAL_QUERY_FIELD,
+    BELIEFS_TOPIC,
+    DEPTH_TOPIC,
+    IMAGE_TOPIC,
     QUERY_ACTION,
     TREE_STATUS_TOPIC,
     GoalStatus,
@@ -32,14 +40,35 @@ from robokudo.application.server.protocol import (
     service_response,
     status,
 )
-from robokudo.application.service import AnsweringService
+from robokudo.application.server.services import Service
 
 MAX_OPEN_GOALS = 64
 """Goals one client may have open (queued or running) at a time."""
 
-TOPICS = (TREE_STATUS_TOPIC,)
+MAX_SUBSCRIPTIONS = 32
+"""Subscriptions (topic and subscription id) one client may hold at a time."""
 
-Services = dict[str, Callable[[AnsweringService, str], dict[str, Any]]]
+TOPICS = (TREE_STATUS_TOPIC, BELIEFS_TOPIC, IMAGE_TOPIC, DEPTH_TOPIC)
+
+Services = Mapping[str, Service]
+
+
+class Subscribers:
+    """The sessions that subscribe to any topic. Changed on the event loop, read by the engine's thread: the set is
+    replaced on every change, never changed in place, so a reader on another thread never sees it half-changed."""
+
+    def __init__(self) -> None:
+        self._sessions: frozenset[Session] = frozenset()
+
+    def add(self, session: Session) -> None:
+        self._sessions = self._sessions | {session}
+
+    def discard(self, session: Session) -> None:
+        self._sessions = self._sessions - {session}
+
+    def of(self, topic: str) -> list[Session]:
+        """The sessions subscribed to ``topic`` (any thread)."""
+        return [session for session in self._sessions if topic in session.topics]
 
 
 class Session:
@@ -50,7 +79,7 @@ class Session:
         connection: ServerConnection,
         goals: GoalManager,
         services: Services,
-        subscribers: set[Session],
+        subscribers: Subscribers,
         token: str | None,
     ) -> None:
         self.connection = connection
@@ -59,7 +88,9 @@ class Session:
         self.subscribers = subscribers
         self.token = token
         self.authenticated = token is None
-        self.topics: set[str] = set()
+        self.subscriptions: frozenset[tuple[str, str | None]] = frozenset()
+        """Replaced, never changed in place: the engine thread reads it to decide what to publish."""
+        """(topic, subscription id) of each subscription; the id is None when the client gave none."""
         self._loop = asyncio.get_running_loop()
         self._outbox: asyncio.Queue[dict[str, Any] | None] = asyncio.Queue()
         self._calls: set[asyncio.Task[None]] = set()
@@ -120,9 +151,7 @@ class Session:
             elif op == "subscribe":
                 self._subscribe(message)
             elif op == "unsubscribe":
-                self.topics.discard(message["topic"])
-                if not self.topics:
-                    self.subscribers.discard(self)
+                self._unsubscribe(message)
         except ProtocolError as error:
             self.send(status("error", str(error), message.get("id")))
         return True
@@ -164,10 +193,11 @@ class Session:
         handler = self.services.get(name)
         if handler is None:
             raise ProtocolError(f"unknown service {name!r}; this server has {', '.join(self.services)}")
-        query = message.get("args", {}).get(GOAL_QUERY_FIELD)
-        if not isinstance(query, str):
-            raise ProtocolError(f"service {name!r} needs the argument {GOAL_QUERY_FIELD!r}: the query text")
-        future = self.goals.call(lambda service: handler(service, query))
+        arguments = message.get("args", {})
+        problem = handler.problem(name, arguments)
+        if problem is not None:
+            raise ProtocolError(problem)
+        future = self.goals.call(lambda service: handler.handler(service, arguments))
         call = asyncio.create_task(self._respond(name, message.get("id"), future))
         self._calls.add(call)  # the loop keeps only weak references to tasks
         call.add_done_callback(self._calls.discard)
@@ -180,9 +210,31 @@ class Session:
             return
         self.send(service_response(name, request_id, values, result=True))
 
+    @property
+    def topics(self) -> frozenset[str]:
+        """The topics this client subscribes to."""
+        return frozenset(topic for topic, _ in self.subscriptions)
+
     def _subscribe(self, message: dict[str, Any]) -> None:
         topic = message["topic"]
         if topic not in TOPICS:
             raise ProtocolError(f"unknown topic {topic!r}; this server publishes {', '.join(TOPICS)}")
-        self.topics.add(topic)
+        subscription = (topic, message.get("id"))
+        if subscription in self.subscriptions:
+            return
+        if len(self.subscriptions) >= MAX_SUBSCRIPTIONS:
+            raise ProtocolError(
+                f"too many subscriptions (at most {MAX_SUBSCRIPTIONS} per client); unsubscribe one first",
+                message.get("id"),
+            )
+        self.subscriptions = self.subscriptions | {subscription}
         self.subscribers.add(self)
+
+    def _unsubscribe(self, message: dict[str, Any]) -> None:
+        topic, subscription_id = message["topic"], message.get("id")
+        if subscription_id is None:
+            self.subscriptions = frozenset(s for s in self.subscriptions if s[0] != topic)
+        else:
+            self.subscriptions = self.subscriptions - {(topic, subscription_id)}
+        if not self.subscriptions:
+            self.subscribers.discard(self)

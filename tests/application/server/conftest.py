@@ -44,9 +44,12 @@ def free_port(host: str = "127.0.0.1") -> int:
         return int(probe.getsockname()[1])
 
 
-def start_server(folder: Path, *extra: str, host: str = "127.0.0.1", env: dict[str, str] | None = None) -> Served:
-    """Start ``robokudo serve`` with its user data in ``folder``; returns once it listens."""
-    port = free_port(host)
+def start_server(
+    folder: Path, *extra: str, host: str = "127.0.0.1", env: dict[str, str] | None = None, port: int | None = None
+) -> Served:
+    """Start ``robokudo serve`` with its user data in ``folder`` (on ``port``, else a free one); returns once it
+    listens."""
+    port = port if port is not None else free_port(host)
     environment = {
         **os.environ,
         "PYTHONPATH": str(REPO),

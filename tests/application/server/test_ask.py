@@ -56,9 +56,12 @@ def test_ctrl_c_cancels_the_goal_and_exits_130(kitchen_server: Served) -> None:
 @pytest.mark.parametrize(
     ("options", "problem"),
     [
-        (["--frame", "2"], "--frame needs --input"),
         (["--rate", "0"], "--rate must be positive"),
+        (["--sensor-rate", "-1"], "--sensor-rate must be positive"),
         (["--host", "0.0.0.0"], "needs a token"),
+        (["--once"], "--once plays a recording once"),
+        (["--topic", "/camera/rgb"], "--topic names topics of a bag"),
+        (["--input", "/no/such/recording"], "no such file or folder"),
     ],
 )
 def test_serve_refuses_bad_options(

@@ -13,6 +13,7 @@ import pytest
 from websockets.exceptions import ConnectionClosed
 from websockets.sync.client import ClientConnection, connect
 
+from robokudo.application.server.session import MAX_SUBSCRIPTIONS
 from tests.application.server.conftest import TOKEN, Served, start_server
 
 ACTION = "/robokudo/query"
@@ -31,14 +32,21 @@ def receive(connection: ClientConnection, op: str, goal_id: str | None = None) -
             return message
 
 
-def went_quiet(connection: ClientConnection) -> bool:
-    """True once nothing arrived for :data:`QUIET` seconds (within :data:`WAIT`)."""
+def task_in_slot(tree: dict[str, Any]) -> str:
+    """The name of what the task slot holds, in a ``/robokudo/tree_status`` tree."""
+    slot = next(child for child in tree["children"] if child["name"] == "task")
+    return str(slot["children"][0]["name"])
+
+
+def went_idle(connection: ClientConnection) -> bool:
+    """True once a tree status shows the idle subtree in the task slot while the engine still ticks (within
+    :data:`WAIT`); the connection must be subscribed to ``/robokudo/tree_status``."""
     deadline = time.monotonic() + WAIT
     while time.monotonic() < deadline:
-        try:
-            connection.recv(timeout=QUIET)
-        except TimeoutError:
-            return True
+        status = receive(connection, "publish")["msg"]
+        if task_in_slot(status["tree"]) == "idle":
+            later = receive(connection, "publish")["msg"]
+            return bool(later["tick"] > status["tick"])
     return False
 
 
@@ -94,14 +102,40 @@ def test_a_structured_designator_goal_finds_the_milk_in_the_fridge(kitchen_serve
 
 
 @pytest.mark.parametrize(
+    ("designator", "found"),
+    [
+        ({"color": ["red", "blue"], "location": "table"}, {"red", "blue"}),  # the table's yellow object is left out
+        ({"type": "Milk", "attribute": ["oat", "lactose free"]}, {"lactose free"}),  # the milk reads "lactose free"
+        ({"type": "Milk", "attribute": ["oat", "soy"]}, set()),
+    ],
+    ids=["colors", "texts", "no-text-read"],
+)
+def test_a_designator_with_several_values_answers_the_objects_with_any_of_them(
+    kitchen_server: Served, designator: dict[str, Any], found: set[str]
+) -> None:
+    with connect(kitchen_server.url) as connection:
+        connection.send(
+            json.dumps({"op": "send_action_goal", "id": "any", "action": ACTION, "args": {"obj": designator}})
+        )
+        result = receive(connection, "action_result", "any")
+    assert result["status"] == 4
+    objects = result["values"]["objects"]
+    if "color" in designator:
+        assert sorted(o["attributes"]["color"]["value"] for o in objects) == sorted(found)
+    else:  # one milk whose text reads one of the alternatives, or none when no alternative is read
+        read = [o["attributes"]["text"]["value"].lower() for o in objects]
+        assert len(read) == len(found) and all(any(text in r for text in found) for r in read)
+
+
+@pytest.mark.parametrize(
     ("designator", "problem"),
     [
         ({"type": "lactose free"}, "expected an identifier"),
-        ({"type": "Milk", "pose": [{"x": 1}]}, "'pose' is not mapped onto a query yet"),
-        ({"color": ["red", "white"]}, "several: not yet"),
+        ({"type": "Milk", "pose": [{"header": {"frame_id": "map"}, "pose": {"position": {"x": 1.5}}}]}, "'pose'"),
+        ({"type": ["Milk", "Cup"]}, "'type' has 2 values"),
         ({"weight": "1kg"}, "unknown designator field 'weight'"),
     ],
-    ids=["not-a-name", "pose", "several-colors", "unknown-field"],
+    ids=["not-a-name", "pose", "several-classes", "unknown-field"],
 )
 def test_a_designator_that_makes_no_query_is_aborted_with_the_reason(
     kitchen_server: Served, designator: dict[str, Any], problem: str
@@ -122,7 +156,7 @@ def test_a_client_vanishing_mid_goal_has_its_goal_canceled_and_others_are_served
         watcher.send(json.dumps({"op": "subscribe", "topic": "/robokudo/tree_status"}))
         receive(watcher, "publish")
         leaving.close()
-        assert went_quiet(watcher), "the vanished client's task kept running"  # its cancelled task stops ticking
+        assert went_idle(watcher), "the vanished client's task kept running"  # its task was taken out
         watcher.send(json.dumps({"op": "unsubscribe", "topic": "/robokudo/tree_status"}))
         watcher.send(goal("next"))
         result = receive(watcher, "action_result", "next")
@@ -220,3 +254,54 @@ def test_eight_clients_sending_fifty_goals_each_get_exactly_one_result_per_goal(
     assert len(ids) == CLIENTS * GOALS_PER_CLIENT and len(set(ids)) == len(ids)
     assert {r["status"] for r in results} <= {4, 5}
     assert sum(r["status"] == 4 for r in results) >= 1
+
+
+def subscribe(subscription_id: str, op: str = "subscribe") -> str:
+    return json.dumps({"op": op, "id": subscription_id, "topic": "/robokudo/tree_status"})
+
+
+def next_reply(connection: ClientConnection) -> dict[str, Any]:
+    """The next status error or service response (publications and goal messages skipped)."""
+    while True:
+        message = json.loads(connection.recv(timeout=WAIT))
+        if message["op"] in ("status", "service_response"):
+            return message
+
+
+def test_subscriptions_beyond_the_cap_get_a_status_error_and_an_unsubscribe_frees_a_place(
+    kitchen_server: Served,
+) -> None:
+    with connect(kitchen_server.url) as connection:
+        for number in range(MAX_SUBSCRIPTIONS):
+            connection.send(subscribe(f"s{number}"))
+        connection.send(subscribe("s0"))  # the same subscription again takes no second place
+        connection.send(beliefs_call("within"))
+        assert next_reply(connection)["op"] == "service_response"
+
+        connection.send(subscribe("over"))
+        error = next_reply(connection)
+        assert error["op"] == "status" and error["level"] == "error" and error.get("id") == "over"
+        assert f"at most {MAX_SUBSCRIPTIONS}" in error["msg"]
+
+        connection.send(goal("ticking"))  # the connection keeps working, its subscriptions publish each tick once
+        publications = []
+        while (message := json.loads(connection.recv(timeout=WAIT)))["op"] != "action_result":
+            if message["op"] == "publish":
+                publications.append(message["msg"])
+        assert message["status"] == 4 and publications
+        ticks = [p["tick"] for p in publications]
+        assert len(set(ticks)) == len(ticks)
+        nodes, timed = [publications[-1]["tree"]], []
+        while nodes:
+            node = nodes.pop()
+            nodes.extend(node.get("children", []))
+            if "timing" in node:
+                timed.append(node["timing"])
+        assert timed and any(t["runs"] > 0 and t["last_ms"] > 0 for t in timed)  # the annotators' run times
+
+        connection.send(subscribe("s1", "unsubscribe"))
+        connection.send(subscribe("over"))
+        connection.send(beliefs_call("freed"))
+        assert next_reply(connection)["op"] == "service_response"
+        connection.send(subscribe("one-more"))
+        assert f"at most {MAX_SUBSCRIPTIONS}" in next_reply(connection)["msg"]

@@ -4,6 +4,7 @@ service and the tree status topic."""
 from __future__ import annotations
 
 import threading
+import time
 from collections.abc import Iterator
 from typing import Any
 
@@ -128,11 +129,42 @@ def test_the_tree_status_topic_publishes_ticks(ros: roslibpy.Ros) -> None:
         _, record = send(action, "find milk in fridge")
         assert seen.wait(WAIT)
         ended(record)
+        wanted = len(statuses) + 3
+        deadline = time.monotonic() + WAIT
+        while len(statuses) < wanted and time.monotonic() < deadline:  # a few ticks after the result
+            time.sleep(0.02)
     finally:
         topic.unsubscribe()
     ticks = [s["tick"] for s in statuses]
     assert ticks == sorted(ticks) and len(set(ticks)) == len(ticks)
     assert statuses[0]["tree"]["name"] == "robot"
+    in_slot = [next(c for c in s["tree"]["children"] if c["name"] == "task")["children"][0] for s in statuses]
+    assert any(task["status"] == "SUCCESS" and task["name"] != "idle" for task in in_slot)  # the finished task
+    assert in_slot[-1]["name"] == "idle"  # then the slot idles again
+
+
+def test_the_beliefs_topic_publishes_what_a_goal_changed_in_the_store(ros: roslibpy.Ros) -> None:
+    changes: list[dict[str, Any]] = []
+    arrived = threading.Event()
+
+    def on_changes(message: dict[str, Any]) -> None:
+        changes.append(message)
+        arrived.set()
+
+    topic = roslibpy.Topic(ros, "/robokudo/beliefs", "std_msgs/String")
+    topic.subscribe(on_changes)
+    try:
+        action = roslibpy.ActionClient(ros, ACTION, ACTION_TYPE)
+        _, record = send(action, "find milk in fridge")
+        result = ended(record)
+        assert arrived.wait(WAIT)
+    finally:
+        topic.unsubscribe()
+    milk = result["values"]["objects"][0]
+    changed = {belief["id"]: belief for message in changes for belief in message["changed"]}
+    assert milk["id"] in changed  # the milk the goal saw was published as a changed belief
+    assert changed[milk["id"]]["region"] == "fridge"
+    assert changed[milk["id"]]["class"] == milk["class"]
 
 
 def test_roslibpy_authenticates_with_the_token_on_a_guarded_server(guarded_server: Served) -> None:

@@ -1,0 +1,337 @@
+"""The surfaces of an object: its pixels grouped into the few colours a person would see on it.
+
+Pixels on strong colour edges (print outlines, the object's border) mix two surfaces and are left out when
+enough remain. Pixels with a clipped channel and no dark channel are highlights or an over-exposed white: they
+are white when they are most of the object, else left out. Near-black pixels form a dark pool (shadows or a black
+surface), judged apart by the namer. The other pixels are grouped in the log-chroma plane (:func:`chroma_plane`),
+where the lit and the shaded side of a surface stay together. A surface's colour is its median chromaticity
+``(a*, b*) / (L* + 16)`` (unchanged by a uniform change of light where L* > 8) at its lit lightness (a high
+percentile of its L*): people name the lit side. An unsaturated group (:func:`is_unsaturated`) is split into
+black and the rest; a group whose colour is a blend of two larger ones (pixels mixing a red and a white print)
+joins the nearer of the two, and a darker group of nearly the same hue and saturation as a larger one is its
+shaded side.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import cv2
+import numpy as np
+
+from annotators.image.color_space import linear_to_lab, srgb_to_linear
+from annotators.image.white_balance import NEUTRAL_LIGHT, FrameLight
+from robokudo.core.types import ObjectHypothesis
+
+WHITE_LAB = np.array([100.0, 0.0, 0.0])
+
+
+@dataclass(frozen=True)
+class NamingParameters:
+    """The constants of colour naming (see the module docstring for what each step does)."""
+
+    edge_step: float = 18.0
+    """Pixels whose colour changes by more than this many sRGB levels per pixel lie on an edge."""
+    min_interior_share: float = 0.4
+    """Edge pixels are left out only when at least this share of the pixels remains."""
+    clipped_level: int = 240
+    """A channel at or above this sRGB level is clipped."""
+    highlight_floor: int = 170
+    """A clipped pixel whose channels are all at least this level is a highlight (or an over-exposed white,
+    whose hue clipping has made unreliable); a clipped saturated pixel (a bright yellow) keeps its hue."""
+    highlight_tint: float = 1.5
+    """... and whose tint (:func:`is_unsaturated`'s ellipse measure) is at most this: clipping distorts the hue of
+    a white, but a clipped bright yellow stays clearly yellow."""
+    highlight_keep_share: float = 0.5
+    """Highlights count as white when at least this share of the object is highlight."""
+    dark_lightness: float = 15.0
+    """Pixels darker than this L* (after white balance) form the dark pool."""
+    dark_keep_share: float = 0.25
+    """The dark pool counts on its own when at least this share of the object is in it."""
+    dark_saturation: float = 0.35
+    """The dark pool is a dark colour, not black, when its mean sRGB colour is this saturated ((max-min)/max)."""
+    dark_span: int = 8
+    """... and its channels differ by at least this many sRGB levels."""
+    chroma_softness: float = 20.0
+    """Chroma scale of the log-chroma plane pixels are grouped in."""
+    group_radius: float = 0.3
+    """Radius of a surface group in the log-chroma plane."""
+    min_group_share: float = 0.08
+    """Groups smaller than this share of the object are noise (small print, mixed pixels)."""
+    max_groups: int = 5
+    mixture_tolerance: float = 0.02
+    """A group whose rg-chromaticity lies this close to the segment between two larger groups is their mixture."""
+    shade_hue: float = 30.0
+    """A saturated surface within this many degrees of hue of a larger one ..."""
+    shade_lightness: float = 8.0
+    """... at least this much darker (L*) ..."""
+    shade_saturation: float = 1.6
+    """... and whose saturation C*/(L* + 16) is within this factor of the larger one's is its shaded side."""
+    lit_percentile: float = 80.0
+    """The lit lightness of a surface: this percentile of its L*."""
+    achromatic_chroma: float = 12.0
+    """Surfaces whose a* (green-magenta) and b* (blue-yellow) lie within the ellipse of this radius along a* ..."""
+    daylight_chroma: float = 20.0
+    """... and this radius along b* are unsaturated: white, grey or black. Residual white-balance errors run along
+    the daylight locus (bluish or yellowish whites), and people discount casts along it most."""
+    dark_tint_ratio: float = 0.2
+    """For dark colours the ellipse's radii are at most this (along a*) and 1.5 x this (along b*) times L* + 16."""
+    white_surround_ratio: float = 0.85
+    """An unsaturated surface whose lit luminance is at least this fraction of the surround's is white."""
+    white_lightness: float = 55.0
+    """... and its lit L* is at least this (a surface darker than this is not seen as white even in the dark)."""
+    black_lightness: float = 38.0
+    """An unsaturated surface darker than this lit L* ..."""
+    black_surround_ratio: float = 0.5
+    """... and than this fraction of the surround's luminance is black (else grey)."""
+    kernel_width: float = 8.0
+    """Width (CIEDE2000 units) of each prototype's vote."""
+    second_share: float = 0.3
+    """A second colour is reported when its share of the named pixels is at least this ..."""
+    second_confidence: float = 0.1
+    """... and its confidence at least this."""
+
+
+DEFAULT_PARAMETERS = NamingParameters()
+
+
+@dataclass(frozen=True)
+class Surface:
+    """One surface of an object: its colour (CIELAB at its lit lightness), its mean linear RGB, its pixel
+    count and its kind: ``"regular"`` or ``"dark"`` (the near-black pool)."""
+
+    lab: np.ndarray
+    linear: np.ndarray
+    pixels: int
+    kind: str
+
+
+def edge_strength(image: np.ndarray, where: np.ndarray | None = None) -> np.ndarray:
+    """Per-pixel colour step (sRGB levels per pixel, the largest over the channels) of an RGB image, at the
+    pixels ``where`` (HxW bool) is set (all pixels, as HxW, when it is None)."""
+    gx = cv2.Sobel(image, cv2.CV_16S, 1, 0, ksize=3)
+    gy = cv2.Sobel(image, cv2.CV_16S, 0, 1, ksize=3)
+    if where is not None:
+        gx, gy = gx[where], gy[where]
+    squared = gx.astype(np.float32) ** 2 + gy.astype(np.float32) ** 2
+    return np.sqrt(np.maximum(np.maximum(squared[..., 0], squared[..., 1]), squared[..., 2])) / 8.0
+
+
+def chroma_plane(lab: np.ndarray, softness: float) -> np.ndarray:
+    """Pixels (CIELAB, Nx3) in the log-chroma plane: hue as direction, ``log(1 + C*/softness)`` as radius.
+
+    Distances there compare saturated colours by hue and chroma ratio (shading scales chroma), while the hue
+    of a nearly neutral pixel, which is noise, hardly counts."""
+    chroma = np.hypot(lab[:, 1], lab[:, 2])
+    scale = np.log1p(chroma / softness) / np.maximum(chroma, 1e-9)
+    return lab[:, 1:] * scale[:, None]
+
+
+def _modes(features: np.ndarray, radius: float, min_count: float, max_groups: int) -> np.ndarray:
+    """Centres of the densest modes of 2-D features: flat-kernel mean shift from the fullest histogram cell,
+    each mode taking the features within ``radius``; modes with fewer than ``min_count`` members are dropped."""
+    x, y = features[:, 0], features[:, 1]
+    cells = np.floor(features / (radius / 2)).astype(np.int64)
+    cells -= cells.min(axis=0)
+    keys = cells[:, 0] * (int(cells[:, 1].max()) + 1) + cells[:, 1]
+    remaining = np.ones(features.shape[0], dtype=bool)
+    limit = radius * radius
+    centres: list[tuple[float, float]] = []
+    for _ in range(4 * max_groups):
+        if len(centres) == max_groups or np.count_nonzero(remaining) < min_count:
+            break
+        fullest = int(np.argmax(np.bincount(keys[remaining])))
+        seed = (remaining & (keys == fullest)).astype(np.float64)
+        cx, cy = float(x @ seed) / seed.sum(), float(y @ seed) / seed.sum()
+        for _ in range(10):
+            near = (remaining & ((x - cx) ** 2 + (y - cy) ** 2 < limit)).astype(np.float64)
+            count = near.sum()
+            new_x, new_y = float(x @ near) / count, float(y @ near) / count
+            if (new_x - cx) ** 2 + (new_y - cy) ** 2 < 1e-6 * limit:
+                break
+            cx, cy = new_x, new_y
+        member = remaining & ((x - cx) ** 2 + (y - cy) ** 2 < limit)
+        remaining &= ~member
+        if np.count_nonzero(member) >= min_count:
+            centres.append((cx, cy))
+    return np.array(centres, dtype=np.float64).reshape(-1, 2)
+
+
+def _order_statistic(values: np.ndarray, percentile: float) -> float:
+    """The ``percentile`` (0..100) of the values, as the nearest order statistic."""
+    k = round(percentile / 100.0 * (values.size - 1))
+    return float(np.partition(values, k)[k])
+
+
+def _surface(lab: np.ndarray, linear: np.ndarray, percentile: float, kind: str) -> Surface:
+    """A surface from its pixels: median chromaticity at the ``percentile`` lightness, mean linear RGB."""
+    lit = _order_statistic(lab[:, 0], percentile)
+    scale = 1.0 / (lab[:, 0] + 16.0)
+    direction = np.array([_order_statistic(lab[:, 1] * scale, 50.0), _order_statistic(lab[:, 2] * scale, 50.0)])
+    return Surface(np.array([lit, *(direction * (lit + 16.0))]), linear.mean(axis=0), lab.shape[0], kind)
+
+
+def _rg(linear: np.ndarray) -> np.ndarray:
+    return linear[:2] / max(float(linear.sum()), 1e-9)
+
+
+def _mixture_target(surface: Surface, larger: list[Surface], tolerance: float) -> int | None:
+    """The index (in ``larger``) of the surface that ``surface`` is mostly made of when its chromaticity lies
+    on the segment between two larger surfaces (a blend of the two), else None."""
+    point = _rg(surface.linear)
+    for i, first in enumerate(larger):
+        for j in range(i + 1, len(larger)):
+            a, b = _rg(first.linear), _rg(larger[j].linear)
+            segment = b - a
+            length = float(segment @ segment)
+            if length < 1e-8:
+                continue
+            t = float((point - a) @ segment) / length
+            if 0.1 <= t <= 0.9 and np.linalg.norm(a + t * segment - point) <= tolerance:
+                return i if t < 0.5 else j
+    return None
+
+
+def _merge_mixtures(surfaces: list[Surface], tolerance: float) -> list[Surface]:
+    """Surfaces with every blend of two larger ones merged into the nearer of the two (largest first)."""
+    ordered = sorted(surfaces, key=lambda s: -s.pixels)
+    kept: list[Surface] = []
+    for surface in ordered:
+        target = _mixture_target(surface, kept, tolerance) if len(kept) >= 2 else None
+        if target is None:
+            kept.append(surface)
+        else:
+            host = kept[target]
+            kept[target] = Surface(host.lab, host.linear, host.pixels + surface.pixels, host.kind)
+    return kept
+
+
+def _hue(lab: np.ndarray) -> float:
+    return float(np.degrees(np.arctan2(lab[2], lab[1])) % 360.0)
+
+
+def _saturation(lab: np.ndarray) -> float:
+    return float(np.hypot(lab[1], lab[2]) / (lab[0] + 16.0))
+
+
+def _merge_shaded(surfaces: list[Surface], parameters: NamingParameters) -> list[Surface]:
+    """Surfaces with every saturated surface that is a shaded side of a larger one (a hue within ``shade_hue``
+    degrees, a similar saturation, at least ``shade_lightness`` darker) merged into it: a yellow brick's shaded
+    side turns orange in a camera image, but the brick is yellow."""
+    ordered = sorted(surfaces, key=lambda s: -s.pixels)
+    kept: list[Surface] = []
+    for surface in ordered:
+        host_index = None
+        if not is_unsaturated(surface.lab, parameters):
+            for index, host in enumerate(kept):
+                offset = abs((_hue(surface.lab) - _hue(host.lab) + 180.0) % 360.0 - 180.0)
+                darker = host.lab[0] - surface.lab[0] >= parameters.shade_lightness
+                ratio = _saturation(surface.lab) / max(_saturation(host.lab), 1e-9)
+                alike = (
+                    offset <= parameters.shade_hue
+                    and 1.0 / parameters.shade_saturation <= ratio <= parameters.shade_saturation
+                )
+                if not is_unsaturated(host.lab, parameters) and alike and darker:
+                    host_index = index
+                    break
+        if host_index is None:
+            kept.append(surface)
+        else:
+            host = kept[host_index]
+            kept[host_index] = Surface(host.lab, host.linear, host.pixels + surface.pixels, host.kind)
+    return kept
+
+
+def object_surfaces(
+    pixels: np.ndarray,
+    light: FrameLight = NEUTRAL_LIGHT,
+    edges: np.ndarray | None = None,
+    parameters: NamingParameters = DEFAULT_PARAMETERS,
+) -> tuple[list[Surface], int]:
+    """The surfaces of an object's RGB pixels (Nx3 uint8) and how many pixels were considered (after edge
+    pixels were left out); the dark pool comes last. ``edges`` (N, from :func:`edge_strength`) lets pixels on
+    colour edges be left out."""
+    rgb = np.asarray(pixels, dtype=np.uint8).reshape(-1, 3)
+    if rgb.shape[0] == 0:
+        raise ValueError("no pixels to name a colour for")
+    if edges is not None:
+        interior = np.asarray(edges).reshape(-1) <= parameters.edge_step
+        if np.count_nonzero(interior) >= parameters.min_interior_share * rgb.shape[0]:
+            rgb = rgb[interior]
+    count = rgb.shape[0]
+    linear = srgb_to_linear(rgb) * light.gains
+    lab = linear_to_lab(linear)
+    highlight = (rgb.max(axis=1) >= parameters.clipped_level) & (rgb.min(axis=1) >= parameters.highlight_floor)
+    highlight[highlight] = tints(lab[highlight], parameters) <= parameters.highlight_tint
+    dark = ~highlight & (lab[:, 0] < parameters.dark_lightness)
+    regular = ~highlight & ~dark
+    if np.count_nonzero(highlight) >= parameters.highlight_keep_share * count:
+        # an over-exposed white surface: its clipped pixels are white, and group with its unclipped ones
+        lab[highlight] = WHITE_LAB
+        regular |= highlight
+    min_count = max(3.0, parameters.min_group_share * count)
+    surfaces: list[Surface] = []
+    if np.count_nonzero(regular) >= min_count:
+        colors, colors_linear = lab[regular], linear[regular]
+        features = chroma_plane(colors, parameters.chroma_softness)
+        centres = _modes(features, parameters.group_radius, min_count, parameters.max_groups)
+        if centres.size:
+            owner = np.argmin(((features[:, None, :] - centres[None]) ** 2).sum(axis=2), axis=1)
+            for group in range(centres.shape[0]):
+                member = owner == group
+                if np.count_nonzero(member) < min_count:
+                    continue
+                surface = _surface(colors[member], colors_linear[member], parameters.lit_percentile, "regular")
+                if not is_unsaturated(surface.lab, parameters):
+                    surfaces.append(surface)
+                    continue
+                blackish = member & (colors[:, 0] < parameters.black_lightness)
+                for part in (member & ~blackish, blackish):  # black print on white: two surfaces
+                    if np.count_nonzero(part) >= min_count:
+                        surfaces.append(
+                            _surface(colors[part], colors_linear[part], parameters.lit_percentile, "regular")
+                        )
+    if not surfaces and np.count_nonzero(regular):  # too few pixels for a group: they are one surface
+        surfaces.append(_surface(lab[regular], linear[regular], parameters.lit_percentile, "regular"))
+    surfaces = _merge_shaded(_merge_mixtures(surfaces, parameters.mixture_tolerance), parameters)
+    if np.count_nonzero(dark):
+        surfaces.append(_surface(lab[dark], linear[dark], 50.0, "dark"))
+    if not surfaces:  # only highlights, too few of them to count as a white surface otherwise
+        surfaces.append(Surface(WHITE_LAB, linear[highlight].mean(axis=0), int(np.count_nonzero(highlight)), "regular"))
+    return surfaces, count
+
+
+def tints(lab: np.ndarray, parameters: NamingParameters) -> np.ndarray:
+    """How far colours (CIELAB, ...x3) are from neutral relative to the achromatic ellipse (below 1: inside);
+    the ellipse shrinks for dark colours, where a small chroma is already a clear hue (a dark blue panel)."""
+    scale = np.asarray(lab)[..., 0] + 16.0
+    radius_a = np.minimum(parameters.achromatic_chroma, parameters.dark_tint_ratio * scale)
+    radius_b = np.minimum(parameters.daylight_chroma, 1.5 * parameters.dark_tint_ratio * scale)
+    return np.hypot(np.asarray(lab)[..., 1] / radius_a, np.asarray(lab)[..., 2] / radius_b)
+
+
+def tint(lab: np.ndarray, parameters: NamingParameters = DEFAULT_PARAMETERS) -> float:
+    """How far one colour (CIELAB) is from neutral relative to the achromatic ellipse (see :func:`tints`)."""
+    return float(tints(lab, parameters))
+
+
+def is_unsaturated(lab: np.ndarray, parameters: NamingParameters = DEFAULT_PARAMETERS) -> bool:
+    """Whether a surface colour (CIELAB) is white, grey or black rather than a hue (see ``daylight_chroma``)."""
+    return tint(lab, parameters) < 1.0
+
+
+def object_pixels(image: np.ndarray, hypothesis: ObjectHypothesis, max_pixels: int) -> tuple[np.ndarray, np.ndarray]:
+    """Up to ``max_pixels`` RGB pixels of the hypothesis, its outline left out when enough remain (as
+    :func:`~annotators.image.pixel_expert.hypothesis_pixels` picks them), and their edge strengths."""
+    x0, y0, x1, y1 = hypothesis.roi
+    local = hypothesis.mask[y0:y1, x0:x1]
+    inner = cv2.erode(local.view(np.uint8), np.ones((3, 3), np.uint8)).view(bool)
+    if np.count_nonzero(inner) >= max(20, np.count_nonzero(local) // 3):
+        local = inner
+    rows, cols = np.nonzero(local)
+    step = max(1, rows.size // max_pixels)
+    rows, cols = rows[::step], cols[::step]
+    crop = np.ascontiguousarray(image[y0:y1, x0:x1])
+    where = np.zeros(local.shape, dtype=bool)
+    where[rows, cols] = True
+    return crop[rows, cols], edge_strength(crop, where)  # both in row-major order

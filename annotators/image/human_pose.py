@@ -1,0 +1,225 @@
+"""Human pose: people with 2-D and 3-D body keypoints, from mediapipe's pose landmark model.
+
+The model is mediapipe 0.10.21's legacy pose solution (complexity 1; the model files ship in its wheel, nothing
+is fetched). It finds one person per image, so with a point cloud it runs on a crop around every person that
+the depth people detector (:func:`annotators.cloud.people.find_people`) finds, and reads each keypoint's 3-D
+point from the organized cloud (the median of the person's points in a small window around the pixel); without
+a cloud it runs once on the whole image and reports 2-D keypoints only; when the cloud shows no ground to stand
+on (a close view of a person's upper body) it runs on the whole image and the person is where its torso
+keypoints are. With a cloud, a skeleton counts only when
+at least ``min_on_person`` of its keypoints fall on the candidate's points (the model, given a crop without a
+person, may still draw one on whatever is there).
+
+mediapipe's option setter reads ``FieldDescriptor.label``, which protobuf 6 removed, so the detector passes no
+score thresholds (the graph's are cleared) and keeps a person only when its torso landmarks are visible.
+"""
+
+from __future__ import annotations
+
+from typing import Any, ClassVar
+
+import numpy as np
+
+from annotators.cloud.people import HUMAN, IMAGE_UP, PeopleParameters, PersonSegment, find_people, person_hypothesis
+from annotators.cloud.plane import up_in_camera
+from robokudo.core.annotator import Annotator
+from robokudo.core.capability import Capability
+from robokudo.core.resources import Guarded
+from robokudo.core.types import (
+    BodyKeypoints,
+    CameraInfo,
+    CasType,
+    Classification,
+    ColorImage,
+    PersonHypothesis,
+    PointCloud,
+    Pose,
+)
+
+LANDMARKS: tuple[str, ...] = (
+    "nose", "left_eye_inner", "left_eye", "left_eye_outer", "right_eye_inner", "right_eye", "right_eye_outer",
+    "left_ear", "right_ear", "mouth_left", "mouth_right", "left_shoulder", "right_shoulder", "left_elbow",
+    "right_elbow", "left_wrist", "right_wrist", "left_pinky", "right_pinky", "left_index", "right_index",
+    "left_thumb", "right_thumb", "left_hip", "right_hip", "left_knee", "right_knee", "left_ankle", "right_ankle",
+    "left_heel", "right_heel", "left_foot_index", "right_foot_index",
+)  # fmt: skip
+"""mediapipe's 33 pose landmarks, in its order."""
+
+TORSO: tuple[int, ...] = tuple(LANDMARKS.index(n) for n in ("left_shoulder", "right_shoulder", "left_hip", "right_hip"))
+"""The landmarks that must be visible for a crop to count as a person."""
+
+
+class PoseModelError(RuntimeError):
+    """The pose model cannot be loaded (mediapipe missing or broken)."""
+
+
+def load_pose_model() -> Any:
+    """mediapipe's legacy pose solution for single images (complexity 1); raises PoseModelError."""
+    try:
+        import mediapipe as mp
+
+        return mp.solutions.pose.Pose(
+            static_image_mode=True, model_complexity=1, min_detection_confidence=None, min_tracking_confidence=None
+        )
+    except Exception as error:  # ImportError, or mediapipe's own errors when its graph cannot start
+        raise PoseModelError(f"the mediapipe pose model cannot be loaded: {error}") from None
+
+
+def detect_landmarks(model: Any, image: np.ndarray) -> tuple[np.ndarray, np.ndarray] | None:
+    """The one person's landmarks in an RGB uint8 image: pixels (33x2) and visibility (33), or None."""
+    result = model.process(np.ascontiguousarray(image))
+    if result.pose_landmarks is None:
+        return None
+    marks = result.pose_landmarks.landmark
+    height, width = image.shape[:2]
+    pixels = np.array([(m.x * width, m.y * height) for m in marks], dtype=np.float64)
+    visibility = np.array([m.visibility for m in marks], dtype=np.float64)
+    return pixels, visibility
+
+
+def crop_box(roi: tuple[int, int, int, int], shape: tuple[int, int], margin: float) -> tuple[int, int, int, int]:
+    """The ROI grown by ``margin`` of its height on every side and clipped to the image (x1/y1 exclusive)."""
+    x0, y0, x1, y1 = roi
+    pad = round(margin * (y1 - y0))
+    return max(0, x0 - pad), max(0, y0 - pad), min(shape[1], x1 + pad), min(shape[0], y1 + pad)
+
+
+def keypoint_points(pixels: np.ndarray, points: np.ndarray, member: np.ndarray | None, window: int = 4) -> np.ndarray:
+    """The 3-D point of each keypoint: the median of the valid cloud points (of ``member`` pixels when given)
+    within ``window`` pixels of it; NaN where there are none."""
+    rows, cols = points.shape[:2]
+    found = np.full((pixels.shape[0], 3), np.nan)
+    for number, (u, v) in enumerate(pixels):
+        if not (np.isfinite(u) and np.isfinite(v)):
+            continue
+        c, r = round(u), round(v)
+        r0, r1, c0, c1 = max(0, r - window), min(rows, r + window + 1), max(0, c - window), min(cols, c + window + 1)
+        if r0 >= r1 or c0 >= c1:
+            continue
+        patch = points[r0:r1, c0:c1].reshape(-1, 3)
+        keep = np.isfinite(patch[:, 2])
+        if member is not None:
+            keep &= member[r0:r1, c0:c1].reshape(-1)
+        if keep.any():
+            found[number] = np.median(patch[keep], axis=0)
+    return found
+
+
+class HumanPoseDetector(Annotator):
+    """Finds people with 2-D and 3-D body keypoints (mediapipe pose on crops around depth person candidates)."""
+
+    inputs: ClassVar[tuple[type[CasType], ...]] = (ColorImage,)
+    optional_inputs: ClassVar[tuple[type[CasType], ...]] = (PointCloud, CameraInfo)
+    outputs: ClassVar[tuple[type[CasType], ...]] = (PersonHypothesis, BodyKeypoints)
+    capability: ClassVar[Capability] = Capability(
+        label="human pose detector",
+        synonyms=("pose estimator", "body keypoint detector", "skeleton tracker"),
+        classes=(HUMAN,),
+        cost_ms=1000.0,
+        reliability=0.85,
+    )
+
+    def __init__(
+        self,
+        min_torso_visibility: float = 0.5,
+        crop_margin: float = 0.12,
+        min_on_person: float = 0.5,
+        parameters: PeopleParameters | None = None,
+        name: str | None = None,
+    ) -> None:
+        super().__init__(name=name)
+        self.min_torso_visibility = min_torso_visibility
+        self.crop_margin = crop_margin
+        self.min_on_person = min_on_person
+        self.parameters = parameters or PeopleParameters()
+
+    def model(self) -> Guarded[Any]:
+        """The pose model, loaded on first use and shared through this annotator's resources."""
+        return self.resources.get(("mediapipe-pose", 1), lambda: Guarded(load_pose_model()))
+
+    def analyse(self) -> None:
+        """Write a PersonHypothesis with BodyKeypoints per person whose torso the model sees."""
+        image = self.view(ColorImage).image
+        if image.ndim != 3 or image.shape[2] != 3 or image.dtype != np.uint8 or min(image.shape[:2]) < 16:
+            self.fail(f"the colour image is not an RGB uint8 image of at least 16x16 pixels (got {image.shape})")
+        try:
+            model = self.model()
+        except PoseModelError as error:
+            self.fail(str(error))
+        cloud = self.optional_view(PointCloud)
+        points = cloud.points if cloud is not None and cloud.points.shape[:2] == image.shape[:2] else None
+        whole_image = [((0, 0, image.shape[1], image.shape[0]), None)]
+        crops: list[tuple[tuple[int, int, int, int], PersonSegment | None]] = []
+        if cloud is not None and points is not None and cloud.mask.any():
+            up = up_in_camera(self.optional_view(CameraInfo))
+            candidates = find_people(points, cloud.mask, IMAGE_UP if up is None else up, self.parameters)
+            crops = [(crop_box(c.roi, image.shape[:2], self.crop_margin), c) for c in candidates]
+        found = self._look(model, image, points, crops)
+        if not found:  # no cloud, no ground in view (a close view of the upper body) or no candidate was a person
+            found = self._look(model, image, points, whole_image)
+        if not found:
+            self.fail(f"the pose model saw no person's torso in {len(crops)} candidate region(s) nor the whole image")
+
+    def _look(
+        self,
+        model: Guarded[Any],
+        image: np.ndarray,
+        points: np.ndarray | None,
+        crops: list[tuple[tuple[int, int, int, int], PersonSegment | None]],
+    ) -> int:
+        """Run the model on each crop and write the people it sees there; returns how many."""
+        found = 0
+        for (x0, y0, x1, y1), candidate in crops:
+            with model.lock:
+                landmarks = detect_landmarks(model.value, image[y0:y1, x0:x1])
+            if landmarks is None:
+                continue
+            pixels, visibility = landmarks
+            if float(np.mean(visibility[list(TORSO)])) < self.min_torso_visibility:
+                continue
+            pixels = pixels + np.array([x0, y0])
+            xyz = None
+            if points is not None:
+                xyz = keypoint_points(pixels, points, None if candidate is None else candidate.mask)
+                if np.count_nonzero(np.isfinite(xyz[:, 2])) < self.min_on_person * len(LANDMARKS):
+                    continue  # the skeleton does not lie on the candidate's points: something else was seen
+            found += 1
+            self.write(self._person(pixels, visibility, xyz, candidate))
+        return found
+
+    def _person(
+        self, pixels: np.ndarray, visibility: np.ndarray, xyz: np.ndarray | None, candidate: PersonSegment | None
+    ) -> PersonHypothesis:
+        confidence = float(np.mean(visibility[list(TORSO)]))
+        if candidate is not None and xyz is not None:
+            hypothesis = person_hypothesis(candidate, self.name, confidence)
+        else:
+            height, width = self.view(ColorImage).image.shape[:2]
+            x0, y0 = np.clip(np.floor(pixels.min(axis=0)).astype(int), 0, (width - 1, height - 1))
+            x1, y1 = np.clip(np.ceil(pixels.max(axis=0)).astype(int) + 1, 1, (width, height))
+            mask = np.zeros((height, width), dtype=bool)
+            mask[y0:y1, x0:x1] = True
+            hypothesis = PersonHypothesis(
+                point_indices=np.flatnonzero(mask),
+                mask=mask,
+                roi=(int(x0), int(y0), int(x1), int(y1)),
+                source=self.name,
+                confidence=confidence,
+            )
+            hypothesis.annotations.append(Classification(class_name=HUMAN, source=self.name, confidence=confidence))
+            if xyz is None:
+                xyz = np.full((pixels.shape[0], 3), np.nan)
+            torso = xyz[list(TORSO)]
+            torso = torso[np.isfinite(torso[:, 2])]
+            if torso.shape[0]:
+                position = np.median(torso, axis=0)
+                hypothesis.annotations.append(
+                    Pose(position=position, orientation=np.array([0.0, 0.0, 0.0, 1.0]), source=self.name)
+                )
+        hypothesis.annotations.append(
+            BodyKeypoints(
+                names=LANDMARKS, pixels=pixels, points=xyz, visibility=visibility, source=self.name,
+                confidence=confidence,
+            )
+        )  # fmt: skip
+        return hypothesis
