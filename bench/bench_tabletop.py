@@ -2,7 +2,7 @@
 
 Three measurements in one run, on frame 000003 of ../shared/data/uoc_tabletop_realsense:
 
-* tree: the Engine ticks ``trees.tabletop`` (reader, cloud, range filter, plane, clusters, colour || pose);
+* tree: the Engine ticks ``trees.tabletop`` (reader, cloud, range filter, plane, objects, colour || pose);
   per-annotator times come from each node's RunStats, the total from the engine's tick stats;
 * bare: the same functions the annotators call (back-projection, range mask, RANSAC plane, cluster extraction,
   colour naming, oriented boxes) called directly in a loop, without tree or CAS;
@@ -29,7 +29,7 @@ import open3d as o3d
 ROOT = Path(__file__).resolve().parents[1]
 sys.path.insert(0, str(ROOT))
 
-from annotators.cloud.clusters import ClusterParameters, extract_clusters  # noqa: E402
+from annotators.cloud.clutter import ClutterParameters, segment_clutter  # noqa: E402
 from annotators.cloud.filters import range_mask  # noqa: E402
 from annotators.cloud.plane import ransac_support_plane  # noqa: E402
 from annotators.cloud.point_cloud import back_project, pixel_rays  # noqa: E402
@@ -59,7 +59,7 @@ STAGES = (
     "PointCloudGenerator",
     "RangeFilter",
     "SupportPlaneSegmenter",
-    "ClusterExtractor",
+    "ClutterSegmenter",
     "SemanticColorAnnotator",
     "PoseAnnotator",
 )
@@ -79,8 +79,8 @@ def bare_frame(frame, rays, timings: dict[str, list[float]]) -> int:
     mask = timed("RangeFilter", lambda: range_mask(points, valid, 0.2, 2.5))
     fit = timed("SupportPlaneSegmenter", lambda: ransac_support_plane(points, mask))
     segments = timed(
-        "ClusterExtractor",
-        lambda: extract_clusters(points, mask, fit.model, fit.inlier_indices, ClusterParameters(), frame.color),
+        "ClutterSegmenter",
+        lambda: segment_clutter(points, mask, fit.model, fit.inlier_indices, ClutterParameters(), frame.color),
     )
     hypotheses = [ObjectHypothesis(point_indices=s.indices, mask=s.mask, roi=s.roi) for s in segments]
     cloud = PointCloud(points=points, mask=mask, colors=frame.color)

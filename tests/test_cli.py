@@ -25,7 +25,7 @@ def test_tree_list_and_show(capsys: pytest.CaptureFixture) -> None:
     assert "tabletop" in capsys.readouterr().out
     assert cli.main(["tree", "show", "tabletop"]) == 0
     text = capsys.readouterr().out
-    assert "Pipeline tabletop" in text and "ClusterExtractor" in text
+    assert "Pipeline tabletop" in text and "ClutterSegmenter" in text
     assert "(PointCloud, Plane → ObjectHypothesis)" in text
     assert cli.main(["tree", "show", "tabletop", "--format", "dot"]) == 0
     assert capsys.readouterr().out.startswith("digraph ppt {")

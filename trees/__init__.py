@@ -13,6 +13,8 @@ from types import ModuleType
 
 import py_trees
 
+from robokudo.core.types import CameraIntrinsics
+
 
 @dataclass(frozen=True)
 class TreeSpec:
@@ -22,9 +24,13 @@ class TreeSpec:
     summary: str
     module: ModuleType
 
-    def create(self, input_path: str | None = None, frame: int = 0) -> py_trees.behaviour.Behaviour:
-        """Build a fresh instance of the tree."""
-        return self.module.create_tree(input_path=input_path, frame=frame)
+    def create(
+        self, input_path: str | None = None, frame: int = 0, intrinsics: CameraIntrinsics | None = None
+    ) -> py_trees.behaviour.Behaviour:
+        """Build a fresh instance of the tree (``intrinsics``: the camera of a point-cloud input, when given)."""
+        if intrinsics is None:
+            return self.module.create_tree(input_path=input_path, frame=frame)
+        return self.module.create_tree(input_path=input_path, frame=frame, intrinsics=intrinsics)
 
 
 def available_trees() -> dict[str, TreeSpec]:

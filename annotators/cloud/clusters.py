@@ -135,20 +135,11 @@ def extract_clusters(
     """
     p = parameters or ClusterParameters()
     step = max(1, p.stride)
-    flat = points.reshape(-1, 3)
     basis = plane_basis(np.asarray(model[:3], dtype=np.float64)).T.astype(np.float32)
     coarse_points = points[::step, ::step]
-    coarse = _candidates(coarse_points, mask[::step, ::step], model, p)
-    coarse_indices = np.flatnonzero(coarse)
-    if coarse_indices.size == 0:
+    coarse = standing_region(points, mask, model, plane_indices, p)
+    if not coarse.any():
         return []
-    plane_points = flat[plane_indices[:: max(1, plane_indices.size // 2000)]]
-    plane_points = plane_points[np.isfinite(plane_points).all(axis=1)]
-    feet = coarse_points.reshape(-1, 3)[coarse_indices] @ basis
-    inside = inside_plane_extent(feet, plane_points @ basis, p.hull_margin, p.hull_cell)
-    if not inside.any():
-        return []
-    coarse.reshape(-1)[coarse_indices[~inside]] = False
 
     x0, y0, x1, y1 = bounding_box(coarse, margin=2)
     region = coarse[y0:y1, x0:x1]
@@ -169,10 +160,31 @@ def extract_clusters(
         labels, depth, lambda pixels: crop_points[pixels] @ to_plane + offset, p.merge_rules(), surface
     )
 
-    return _full_resolution(labels, depth, (x0, y0, x1, y1), step, points, mask, model, p)
+    return full_resolution_segments(labels, depth, (x0, y0, x1, y1), step, points, mask, model, p)
 
 
-def _full_resolution(
+def standing_region(
+    points: np.ndarray, mask: np.ndarray, model: np.ndarray, plane_indices: np.ndarray, p: ClusterParameters
+) -> np.ndarray:
+    """The candidates on every ``p.stride``-th pixel: points between ``min_height`` and ``max_height`` above the
+    plane ``model`` whose foot lies inside the extent of its inliers ``plane_indices`` (shrunk by ``hull_margin``)."""
+    step = max(1, p.stride)
+    basis = plane_basis(np.asarray(model[:3], dtype=np.float64)).T.astype(np.float32)
+    coarse_points = points[::step, ::step]
+    coarse = _candidates(coarse_points, mask[::step, ::step], model, p)
+    coarse_indices = np.flatnonzero(coarse)
+    if coarse_indices.size == 0:
+        return coarse
+    flat = points.reshape(-1, 3)
+    plane_points = flat[plane_indices[:: max(1, plane_indices.size // 2000)]]
+    plane_points = plane_points[np.isfinite(plane_points).all(axis=1)]
+    feet = coarse_points.reshape(-1, 3)[coarse_indices] @ basis
+    inside = inside_plane_extent(feet, plane_points @ basis, p.hull_margin, p.hull_cell)
+    coarse.reshape(-1)[coarse_indices[~inside]] = False
+    return coarse
+
+
+def full_resolution_segments(
     labels: np.ndarray,
     coarse_depth: np.ndarray,
     box: tuple[int, int, int, int],

@@ -139,7 +139,10 @@ def label_groups(labels: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
     """Flat pixel indices sorted by label and ``starts`` so label k owns ``pixels[starts[k]:starts[k + 1]]``."""
     flat = labels.reshape(-1)
     pixels = np.flatnonzero(flat)
-    pixels = pixels[np.argsort(flat[pixels], kind="stable")]
+    values = flat[pixels]
+    if values.size and values.max() < 1 << 16:
+        values = values.astype(np.uint16)  # a stable sort of 16-bit keys is a radix sort: linear time
+    pixels = pixels[np.argsort(values, kind="stable")]
     starts = np.searchsorted(flat[pixels], np.arange(int(flat.max(initial=0)) + 2))
     return pixels, starts
 
@@ -149,6 +152,9 @@ def footprint_overlap(first: np.ndarray, second: np.ndarray, cell: float) -> flo
 
     The raster gives even a degenerate footprint (a wall seen edge-on is a line) an area of one cell width.
     """
+    shared_box = np.minimum(first.max(axis=0), second.max(axis=0)) - np.maximum(first.min(axis=0), second.min(axis=0))
+    if np.any(shared_box < -cell):
+        return 0.0  # the footprints' bounding boxes are apart: nothing to rasterize
     low = np.minimum(first.min(axis=0), second.min(axis=0))
     high = np.maximum(first.max(axis=0), second.max(axis=0))
     shape = tuple(int(v) for v in (np.ceil((high - low) / cell) + 2)[::-1])
@@ -181,6 +187,17 @@ def _range(values: np.ndarray, low: float, high: float) -> tuple[float, float]:
     ordered = np.sort(values)
     last = ordered.size - 1
     return float(ordered[round(low * last)]), float(ordered[round(high * last)])
+
+
+def heights_nest(first: np.ndarray, second: np.ndarray, tolerance: float) -> bool:
+    """Does the 5 %-95 % range of one set of heights above the plane lie within the other's (``tolerance`` metres
+    of slack)? A container's inside or handle lies within its body's heights; an object standing on another lies
+    above it."""
+    low_a, high_a = _range(first, 0.05, 0.95)
+    low_b, high_b = _range(second, 0.05, 0.95)
+    return (low_a >= low_b - tolerance and high_a <= high_b + tolerance) or (
+        low_b >= low_a - tolerance and high_b <= high_a + tolerance
+    )
 
 
 INNER_SPREAD = 0.1
@@ -266,7 +283,8 @@ class Boundaries:
     ``close_factor`` pixel footprints apart in 3-D (one surface going on, not two objects side by side a few
     millimetres apart in depth); over the continuous ones with known normals,
     ``alignment`` is the mean cosine between the two normals and ``convexity`` the mean of
-    ``(n_a - n_b) . (p_a - p_b) / |p_a - p_b|`` (positive across a convex edge, negative in a concave crease).
+    ``(n_a - n_b) . (p_a - p_b) / |p_a - p_b|`` (positive across a convex edge, negative in a concave crease);
+    ``creased`` is the share of those whose convexity is below ``-crease`` (a concave crease along that stretch).
     """
 
     pairs: np.ndarray
@@ -275,6 +293,7 @@ class Boundaries:
     close: np.ndarray
     alignment: np.ndarray
     convexity: np.ndarray
+    creased: np.ndarray
 
 
 def pixel_footprint(points: np.ndarray) -> float:
@@ -308,6 +327,7 @@ def boundaries(
     relative: float,
     close_factor: float = 2.5,
     reach: int = 2,
+    crease: float = 0.15,
 ) -> Boundaries:
     """The :class:`Boundaries` of every touching pair of parts (``points``/``normals`` HxWx3, camera frame).
 
@@ -344,7 +364,7 @@ def boundaries(
     key = np.concatenate(keys)
     if key.size == 0:
         empty = np.zeros(0)
-        return Boundaries(np.zeros((0, 2), np.int64), empty, empty, empty, empty, empty)
+        return Boundaries(np.zeros((0, 2), np.int64), empty, empty, empty, empty, empty, empty)
     unique, inverse = np.unique(key, return_inverse=True)
     jump, dot, convexity = np.concatenate(jumps), np.concatenate(dots), np.concatenate(convex)
     length = np.bincount(inverse, minlength=unique.size).astype(np.float64)
@@ -358,7 +378,9 @@ def boundaries(
     continuous = np.bincount(inverse, weights=smooth, minlength=unique.size) / length
     close = np.bincount(inverse, weights=np.concatenate(near), minlength=unique.size) / length
     pairs = np.column_stack([unique // base, unique % base])
-    return Boundaries(pairs, length, continuous, close, alignment, mean_convexity)
+    with np.errstate(invalid="ignore", divide="ignore"):
+        creased = np.bincount(inverse, weights=known & (convexity < -crease), minlength=unique.size) / known_count
+    return Boundaries(pairs, length, continuous, close, alignment, mean_convexity, np.nan_to_num(creased))
 
 
 @dataclass(frozen=True)
@@ -378,6 +400,10 @@ class MergeRules:
     coplanar_cosine: float = float(np.cos(np.radians(18.0)))
     small_part: int = 40
     occlusion: float = 0.5
+    creased: float = 1.0
+    inside: bool = True
+    nested: bool = False
+    nest_tolerance: float = 0.003
 
 
 def merge_parts(
@@ -416,17 +442,21 @@ def merge_parts(
     lengths: dict[tuple[int, int], float] = {}
     smooth: set[tuple[int, int]] = set()
     occluding: set[tuple[int, int]] = set()
+    creases: list[tuple[int, int]] = []
     if surface is not None:
-        for (a, b), length, continuous, close, alignment, convexity in zip(
+        for (a, b), length, continuous, close, alignment, convexity, creased in zip(
             surface.pairs.tolist(),
             surface.length,
             surface.continuous,
             surface.close,
             surface.alignment,
             surface.convexity,
+            surface.creased,
             strict=True,
         ):
             lengths[(a, b)] = float(length)
+            if creased > rules.creased and convexity < rules.concave and alignment < rules.coplanar_cosine:
+                creases.append((a, b))
             if continuous < rules.occlusion:
                 occluding.add((a, b))
             if (
@@ -438,17 +468,27 @@ def merge_parts(
                 smooth.add((a, b))
     allowed: list[tuple[int, int]] = []
     for first, second in pairs.tolist():
-        if (first, second) in smooth or (
-            (first, second) not in occluding
-            and footprint_overlap(parts.hull(first), parts.hull(second), rules.cell) > rules.overlap
-        ):
+        if (first, second) in smooth:
             allowed.append((first, second))
             continue
+        stacked = False
+        if (
+            (first, second) not in occluding
+            and rules.overlap < 1.0
+            and footprint_overlap(parts.hull(first), parts.hull(second), rules.cell) > rules.overlap
+        ):
+            heights = (parts.coordinates(first)[:, 2], parts.coordinates(second)[:, 2])
+            if not rules.nested or heights_nest(*heights, rules.nest_tolerance):
+                allowed.append((first, second))
+                continue
+            stacked = True
         near, far = sorted((first, second), key=parts.depth_of)
-        if looks_like_inside(
+        if rules.inside and looks_like_inside(
             parts.coordinates(near), parts.coordinates(far), rules.inside_tolerance, rules.inside_depth_ratio
         ):
             allowed.append((first, second))
+        elif stacked:
+            creases.append((first, second))  # one stands on the other: never joined, not even through a third
     joined = [(a, b) for a, b in allowed if sizes[a] >= rules.small_part and sizes[b] >= rules.small_part]
     best: dict[int, tuple[float, int]] = {}
     for a, b in allowed:
@@ -457,7 +497,40 @@ def merge_parts(
             if sizes[small] < rules.small_part and length > best.get(small, (-1.0, 0))[0]:
                 best[small] = (length, other)
     joined += [(small, other) for small, (_, other) in best.items()]
+    if creases:
+        # a crease along part of two parts' boundary keeps them apart, also through a third part they both join
+        joined.sort(key=lambda pair: -lengths.get((min(pair), max(pair)), 1.0))
+        groups = join_unless_apart(int(labels.max()) + 1, np.array(joined).reshape(-1, 2), np.array(creases))
+        joined = [(int(a), int(b)) for a, b in enumerate(groups.tolist()) if a != b]
     return join_labels(labels, joined)
+
+
+def join_unless_apart(count: int, pairs: np.ndarray, apart: np.ndarray) -> np.ndarray:
+    """Group labels of ``count`` nodes: the ``pairs`` (Kx2) joined in the order given, except where joining would
+    put the two nodes of an ``apart`` pair (Mx2) into one group (direct evidence that two parts are separate
+    outweighs an indirect path between them)."""
+    parent = list(range(count))
+    keep_apart: dict[int, set[int]] = {}
+    for a, b in apart.tolist():
+        keep_apart.setdefault(a, set()).add(b)
+        keep_apart.setdefault(b, set()).add(a)
+
+    def root(node: int) -> int:
+        while parent[node] != node:
+            parent[node] = parent[parent[node]]
+            node = parent[node]
+        return node
+
+    for a, b in pairs.tolist():
+        ra, rb = root(a), root(b)
+        if ra == rb:
+            continue
+        against_a, against_b = keep_apart.get(ra, set()), keep_apart.get(rb, set())
+        if any(root(n) == rb for n in against_a) or any(root(n) == ra for n in against_b):
+            continue
+        parent[rb] = ra
+        keep_apart[ra] = against_a | against_b
+    return np.array([root(node) for node in range(count)], dtype=np.int64)
 
 
 def bounding_box(mask: np.ndarray, margin: int = 0) -> tuple[int, int, int, int]:

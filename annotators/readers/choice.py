@@ -47,6 +47,7 @@ from annotators.readers.frame_readers import (
 from annotators.readers.tiff_io import frame_stamps, is_tiff_sequence, tiff_folder
 from annotators.readers.tum_io import associate, is_tum_pair, is_tum_sequence, pair_color_files, read_image_list
 from robokudo.core.annotator import Annotator
+from robokudo.core.types import CameraIntrinsics
 
 SUPPORTED_LAYOUTS = (
     "no path: the built-in kitchen scene",
@@ -115,7 +116,7 @@ def _bag_choice(path: Path, frame: int) -> ReaderChoice:
     return ReaderChoice(reader, {"path": str(path), "frame": frame})
 
 
-def _folder_choice(folder: Path, frame: int) -> ReaderChoice:
+def _folder_choice(folder: Path, frame: int, intrinsics: CameraIntrinsics | None = None) -> ReaderChoice:
     if is_tum_sequence(folder):
         return ReaderChoice(TumSequenceReader, {"folder": str(folder), "frame": frame})
     if (folder / CAMERA_PARAMS_FILE).is_file() and any(_UOC_COLOR.match(p.name) for p in folder.iterdir()):
@@ -126,7 +127,7 @@ def _folder_choice(folder: Path, frame: int) -> ReaderChoice:
     if clouds:
         if not 0 <= frame < len(clouds):
             raise ValueError(f"{folder} holds {len(clouds)} .pcd files, no frame {frame}")
-        return ReaderChoice(PcdReader, {"path": str(clouds[frame])})
+        return ReaderChoice(PcdReader, _with_intrinsics({"path": str(clouds[frame])}, intrinsics))
     # uoc-named files without camera_params.json are not pairs: their intrinsics would be guessed
     pairs = sorted(
         (p for p in pair_color_files(folder, _IMAGE_SUFFIXES) if not _UOC_COLOR.match(p.name)), key=_natural_key
@@ -138,11 +139,15 @@ def _folder_choice(folder: Path, frame: int) -> ReaderChoice:
     raise _unsupported(folder, "the folder matches no known layout")
 
 
-def _file_choice(path: Path, frame: int) -> ReaderChoice:
+def _with_intrinsics(parameters: dict[str, object], intrinsics: CameraIntrinsics | None) -> dict[str, object]:
+    return {**parameters, "intrinsics": intrinsics} if intrinsics is not None else parameters
+
+
+def _file_choice(path: Path, frame: int, intrinsics: CameraIntrinsics | None = None) -> ReaderChoice:
     suffix = path.suffix.lower()
     if suffix == ".pcd":
         _single_frame(path, frame)
-        return ReaderChoice(PcdReader, {"path": str(path)})
+        return ReaderChoice(PcdReader, _with_intrinsics({"path": str(path)}, intrinsics))
     uoc = _UOC_COLOR.match(path.name)
     if uoc and (path.parent / CAMERA_PARAMS_FILE).is_file():
         _single_frame(path, frame)
@@ -153,8 +158,11 @@ def _file_choice(path: Path, frame: int) -> ReaderChoice:
     raise _unsupported(path, "the file matches no known layout")
 
 
-def reader_choice(path: str | None, frame: int = 0) -> ReaderChoice:
-    """The reader for ``path`` and frame ``frame`` (see the module docstring); ValueError when none fits."""
+def reader_choice(path: str | None, frame: int = 0, intrinsics: CameraIntrinsics | None = None) -> ReaderChoice:
+    """The reader for ``path`` and frame ``frame`` (see the module docstring); ValueError when none fits.
+
+    ``intrinsics`` are given to a PCD reader (the camera of the cloud; other layouts carry their own).
+    """
     if frame < 0:
         raise ValueError(f"frame number must be >= 0, got {frame}")
     if path is None:
@@ -163,15 +171,15 @@ def reader_choice(path: str | None, frame: int = 0) -> ReaderChoice:
     if is_bag(resolved):
         return _bag_choice(resolved, frame)
     if resolved.is_dir():
-        return _folder_choice(resolved, frame)
+        return _folder_choice(resolved, frame, intrinsics)
     if resolved.is_file():
-        return _file_choice(resolved, frame)
+        return _file_choice(resolved, frame, intrinsics)
     raise _unsupported(resolved, "no such file or folder")
 
 
-def reader_for(path: str | None, frame: int = 0) -> Annotator:
+def reader_for(path: str | None, frame: int = 0, intrinsics: CameraIntrinsics | None = None) -> Annotator:
     """A new reader annotator for ``path`` and frame ``frame``; ValueError listing the layouts when none fits."""
-    return reader_choice(path, frame).create()
+    return reader_choice(path, frame, intrinsics).create()
 
 
 def reader_name_for(path: str | None, frame: int = 0) -> str:

@@ -14,6 +14,7 @@ from collections.abc import Mapping, Sequence
 from types import MappingProxyType, ModuleType
 
 from robokudo.application.commands import ask, beliefs, ontology, parse, plan, query, run, serve, tree
+from robokudo.application.commands import eval as evaluation
 from robokudo.application.interrupts import InterruptHandling
 
 COMMANDS: Mapping[str, ModuleType] = MappingProxyType(
@@ -27,6 +28,7 @@ COMMANDS: Mapping[str, ModuleType] = MappingProxyType(
         "ontology": ontology,
         "serve": serve,
         "ask": ask,
+        "eval": evaluation,
     }
 )
 """Subcommand name -> the module implementing it."""

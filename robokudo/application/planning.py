@@ -5,10 +5,17 @@ from __future__ import annotations
 from queries import Query
 from reasoning.planning.query_planner import QueryPlan, QueryPlanner
 from robokudo.application.sensor_sources import sensor_source
+from robokudo.core.types import CameraIntrinsics
 
 
 def plan_for_input(
-    planner: QueryPlanner, query: Query, input_path: str | None, frame: int = 0, *, look_at: str | None = None
+    planner: QueryPlanner,
+    query: Query,
+    input_path: str | None,
+    frame: int = 0,
+    *,
+    look_at: str | None = None,
+    intrinsics: CameraIntrinsics | None = None,
 ) -> QueryPlan:
     """Plan ``query`` to run on ``input_path`` (the built-in kitchen when None).
 
@@ -16,7 +23,7 @@ def plan_for_input(
     where the object a query names by id was last seen), so the plan is made twice only when the reader
     depends on that region.
     """
-    draft = planner.plan(query, sensor_source(planner.kb, input_path, frame))
+    draft = planner.plan(query, sensor_source(planner.kb, input_path, frame, intrinsics=intrinsics))
     region = draft.interpretation.task.region or look_at
     if input_path is None and region is not None:
         return planner.plan(query, sensor_source(planner.kb, input_path, frame, region))

@@ -8,6 +8,7 @@ from annotators.simulation.kitchen_scene import camera_looking_at
 from reasoning.knowledge.knowledge_base import KnowledgeBase
 from reasoning.planning.plan import Step
 from reasoning.planning.planner import SensorSource
+from robokudo.core.types import CameraIntrinsics
 
 READERS_WITH_CAMERA_POSE: frozenset[str] = frozenset({"KitchenSceneReader"})
 """The readers whose frames carry the camera pose (``CameraInfo.cam_to_world``); recorded inputs have none."""
@@ -38,8 +39,15 @@ def served_source(kb: KnowledgeBase, stream: FrameStream) -> SensorSource:
     return SensorSource(step, camera_pose=isinstance(stream, KitchenCameraStream))
 
 
-def sensor_source(kb: KnowledgeBase, input_path: str | None, frame: int = 0, region: str | None = None) -> SensorSource:
-    """The reader for ``input_path`` (the built-in kitchen when None, looking at ``region`` if given).
+def sensor_source(
+    kb: KnowledgeBase,
+    input_path: str | None,
+    frame: int = 0,
+    region: str | None = None,
+    intrinsics: CameraIntrinsics | None = None,
+) -> SensorSource:
+    """The reader for ``input_path`` (the built-in kitchen when None, looking at ``region`` if given; the camera
+    ``intrinsics`` of a point-cloud input when given).
 
     The source says whether the reader's frames carry the camera pose, which regions of the map need. The reader is
     picked from the path's layout (``annotators.readers.choice.reader_choice``); a path of no known
@@ -53,7 +61,7 @@ def sensor_source(kb: KnowledgeBase, input_path: str | None, frame: int = 0, reg
         spec = kb.annotator("KitchenSceneReader")
         parameters: tuple[tuple[str, object], ...] = (("view", view),)
     else:
-        choice = reader_choice(input_path, frame)
+        choice = reader_choice(input_path, frame, intrinsics)
         spec = kb.annotator(choice.name)
         parameters = tuple(sorted(choice.parameters.items()))
         reason = f"reads frame {frame} of {input_path}"

@@ -62,7 +62,7 @@ from robokudo.core.pipeline import Pipeline
 from robokudo.core.resources import SharedResources
 from robokudo.core.slot import Idle, TaskSlot
 from robokudo.core.threaded import has_workers, stop_workers
-from robokudo.core.types import QueryAnswer
+from robokudo.core.types import CameraIntrinsics, QueryAnswer
 from trees.answer_step import AnswerStep
 from trees.synthesis import build_tree
 
@@ -253,9 +253,11 @@ class AnsweringService:
         input_path: str | None = None,
         frame: int = 0,
         hz: float = 100.0,
+        intrinsics: CameraIntrinsics | None = None,
         stream: FrameStream | None = None,
     ) -> None:
         self.kb = kb
+        self.intrinsics = intrinsics
         self.store = store
         self.catalog = catalog if catalog is not None else AnnotatorCatalog.discover()
         self.input_path = input_path
@@ -293,6 +295,7 @@ class AnsweringService:
         frame: int = 0,
         hz: float = 100.0,
         catalog: AnnotatorCatalog | None = None,
+        intrinsics: CameraIntrinsics | None = None,
         stream: FrameStream | None = None,
     ) -> AnsweringService:
         """A service over the shipped and user ontology and the belief store at ``store_path`` (default store
@@ -308,7 +311,9 @@ class AnsweringService:
         except BaseException:
             store.close()
             raise
-        return cls(kb, store, catalog=catalog, input_path=input_path, frame=frame, hz=hz, stream=stream)
+        return cls(
+            kb, store, catalog=catalog, input_path=input_path, frame=frame, hz=hz, stream=stream, intrinsics=intrinsics
+        )
 
     # ------------------------------------------------------------------ planning
 
@@ -320,7 +325,12 @@ class AnsweringService:
         if self.stream is not None:
             return self.planner.plan(parsed, served_source(self.kb, self.stream))
         return plan_for_input(
-            self.planner, parsed, self.input_path, self.frame, look_at=self._remembered_region(parsed)
+            self.planner,
+            parsed,
+            self.input_path,
+            self.frame,
+            look_at=self._remembered_region(parsed),
+            intrinsics=self.intrinsics,
         )
 
     def _remembered_region(self, query: Query) -> str | None:

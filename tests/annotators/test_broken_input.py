@@ -21,6 +21,7 @@ from py_trees.common import Status
 from annotators.catalog import discover_annotators
 from annotators.classification.knowledge_classifier import KnowledgeClassifier
 from annotators.cloud.clusters import ClusterExtractor
+from annotators.cloud.clutter import ClutterSegmenter
 from annotators.cloud.filters import CropBoxFilter, RangeFilter, RegionFilter
 from annotators.cloud.normals import NormalEstimator
 from annotators.cloud.people import DepthPeopleDetector
@@ -172,6 +173,7 @@ BROKEN_CASES: dict[str, tuple[Callable[[], Seeds], tuple[type[Annotator], ...]]]
             NormalEstimator,
             SupportPlaneSegmenter,
             ClusterExtractor,
+            ClutterSegmenter,
             SemanticColorAnnotator,
             ColorHistogramAnnotator,
             PoseAnnotator,
@@ -193,6 +195,7 @@ BROKEN_CASES: dict[str, tuple[Callable[[], Seeds], tuple[type[Annotator], ...]]]
             NormalEstimator,
             SupportPlaneSegmenter,
             ClusterExtractor,
+            ClutterSegmenter,
             PoseAnnotator,
             ShapeAnnotator,
             SizeAnnotator,
@@ -208,6 +211,7 @@ BROKEN_CASES: dict[str, tuple[Callable[[], Seeds], tuple[type[Annotator], ...]]]
             NormalEstimator,
             SupportPlaneSegmenter,
             ClusterExtractor,
+            ClutterSegmenter,
             PoseAnnotator,
             ShapeAnnotator,
             SizeAnnotator,
@@ -228,13 +232,13 @@ BROKEN_CASES: dict[str, tuple[Callable[[], Seeds], tuple[type[Annotator], ...]]]
     "no point inside the region": (lambda: [flat_cloud(), posed_camera(x=50.0)], (RegionFilter,)),
     "degenerate plane": (
         lambda: [flat_cloud(), Plane(model=np.array([0.0, 0.0, 0.0, np.nan]), inlier_indices=np.arange(10))],
-        (ClusterExtractor,),
+        (ClusterExtractor, ClutterSegmenter),
     ),
     "plane indices outside the grid": (
         lambda: [flat_cloud(), Plane(model=np.array([0.0, 0.0, -1.0, 1.0]), inlier_indices=np.array([0, H * W]))],
-        (ClusterExtractor,),
+        (ClusterExtractor, ClutterSegmenter),
     ),
-    "nothing stands on the plane": (lambda: [flat_cloud(), wall_plane()], (ClusterExtractor,)),
+    "nothing stands on the plane": (lambda: [flat_cloud(), wall_plane()], (ClusterExtractor, ClutterSegmenter)),
     "no hypotheses": (
         lambda: [color(), flat_cloud(), up_normals(), CameraInfo(K), *evidence_types()],
         (
@@ -355,14 +359,14 @@ def write_tum_sequence(folder: Path, depth_list: str = "1.0 a_depth.png\n", trun
     return folder
 
 
-def write_pcd(path: Path, organized: bool = True, truncate: bool = False) -> Path:
-    """A small ASCII PCD (x y z rgb), organized 4x3 or a single row; optionally cut short."""
+def write_pcd(path: Path, organized: bool = True, truncate: bool = False, depth: float = 1.0) -> Path:
+    """A small ASCII PCD (x y z rgb), organized 4x3 or a single row, ``depth`` m ahead; optionally cut short."""
     width, height = (4, 3) if organized else (12, 1)
     header = (
         "VERSION 0.7\nFIELDS x y z rgb\nSIZE 4 4 4 4\nTYPE F F F F\nCOUNT 1 1 1 1\n"
         f"WIDTH {width}\nHEIGHT {height}\nVIEWPOINT 0 0 0 1 0 0 0\nPOINTS {width * height}\nDATA ascii\n"
     )
-    rows = [f"{(c - 1.5) / 10} {(r - 1) / 10} 1.0 0" for r in range(height) for c in range(width)]
+    rows = [f"{(c - 1.5) / 10} {(r - 1) / 10} {depth} 0" for r in range(height) for c in range(width)]
     path.parent.mkdir(parents=True, exist_ok=True)
     path.write_text(header + "\n".join(rows[: 5 if truncate else None]) + "\n")
     return path
@@ -424,7 +428,9 @@ BROKEN_READERS: dict[type[Annotator], dict[str, Callable[[Path], Annotator]]] = 
     PcdReader: {
         "missing file": lambda tmp: PcdReader(tmp / "nowhere.pcd"),
         "truncated file": lambda tmp: PcdReader(write_pcd(tmp / "cut.pcd", truncate=True)),
-        "unorganized cloud": lambda tmp: PcdReader(write_pcd(tmp / "row.pcd", organized=False)),
+        "unorganized cloud behind the camera": lambda tmp: PcdReader(
+            write_pcd(tmp / "row.pcd", organized=False, depth=-1.0)
+        ),
         "not a PCD file": lambda tmp: PcdReader((tmp / "junk.pcd", (tmp / "junk.pcd").write_text("hello"))[0]),
         "zero intrinsics": lambda tmp: PcdReader(
             write_pcd(tmp / "a.pcd"), intrinsics=CameraIntrinsics(0, 0, 0, 0, 0, 0)
@@ -512,7 +518,7 @@ def test_the_tables_cover_every_discovered_annotator() -> None:
     assert {c.__name__ for c in discover_annotators()} >= {
         "KitchenSceneReader", "ColorDepthPairReader", "TumSequenceReader", "TumPairReader", "PcdReader",
         "TiffSequenceReader", "PointCloudGenerator", "RangeFilter", "RegionFilter", "CropBoxFilter",
-        "NormalEstimator", "SupportPlaneSegmenter", "ClusterExtractor", "SemanticColorAnnotator",
+        "NormalEstimator", "SupportPlaneSegmenter", "ClusterExtractor", "ClutterSegmenter", "SemanticColorAnnotator",
         "ColorHistogramAnnotator", "PoseAnnotator", "ShapeAnnotator", "SizeAnnotator", "KnowledgeClassifier",
         "TextReader", "OnnxDetector", "ImageRegionSegmenter",
     }  # fmt: skip

@@ -3,9 +3,10 @@
 * mOSD (pcl_mosd_tabletop learn0: two stacked cereal boxes; learn35: bowl, tub, tin) with its ground-truth labels
   (1-9 table, object id = label // 10 for labels >= 20): the table plane is found and every labelled object is
   matched by a hypothesis with point IoU >= 0.5.
-* uoc_tabletop_realsense frames 0-4: every listed object has its own hypothesis; the red Cheez-It box is named
-  red and OCR reads "CHEEZ" inside its image box. Objects standing on or in another object (frame 2: a soup can on
-  a spam can, a small can in a bowl) share their support's hypothesis: their footprints overlap (a known limit).
+* uoc_tabletop_realsense frames 0-4: every listed object has its own hypothesis - also the soup can standing on
+  the spam can in frames 2 and 3 - and the red Cheez-It box is named red and OCR reads "CHEEZ" inside its image box.
+  The power drill (orange body, black grip, battery below) is one hypothesis in frame 2; in frame 3 its grip folds
+  inward like an object standing on another and it comes out in pieces (a known limit, marked xfail).
 """
 
 from __future__ import annotations
@@ -77,13 +78,13 @@ UOC_OBJECTS: dict[int, dict[str, tuple[int, int]]] = {
         "cheez-it box": (480, 320), "mustard bottle": (280, 170), "blue mug": (220, 230), "white mug": (325, 285),
         "teal bowl": (140, 330), "soup can": (175, 185), "spam can": (70, 320),
     },
-    2: {  # the soup can stands on the spam can and a small can inside the bowl: one hypothesis per stack (known)
-        "cheez-it box": (260, 60), "mustard bottle": (180, 110), "soup can on spam can": (150, 260),
+    2: {  # the soup can stands on the spam can
+        "cheez-it box": (260, 60), "mustard bottle": (180, 110), "soup can": (150, 180), "spam can": (150, 260),
         "teal bowl": (360, 200), "blue mug": (480, 140), "white bowl": (410, 235),
     },
-    3: {
+    3: {  # the soup can stands on the spam can
         "cheez-it box": (260, 70), "water bottle": (560, 150), "teal bowl": (340, 185), "white bowl": (410, 250),
-        "blue mug": (490, 130), "mustard bottle": (190, 160), "soup can": (150, 170),
+        "blue mug": (490, 130), "mustard bottle": (190, 160), "soup can": (150, 170), "spam can": (150, 260),
     },
     4: {"wipes tub": (240, 120), "cashew can": (425, 190), "purple cup": (470, 290), "duplo brick": (245, 300)},
 }  # fmt: skip
@@ -141,3 +142,31 @@ def test_uoc_objects_get_their_own_hypotheses_and_the_cheez_it_box_is_red_and_re
     x0, y0, x1, y1 = texts[0].box
     rx0, ry0, rx1, ry1 = box.roi
     assert rx0 - 8 <= x0 < x1 <= rx1 + 8 and ry0 - 8 <= y0 < y1 <= ry1 + 8
+
+
+DRILL = {  # body top, grip, battery of the power drill
+    2: {"drill body": (380, 110), "drill grip": (370, 150), "drill battery": (400, 180)},
+    3: {"drill body": (370, 115), "drill grip": (365, 150), "drill battery": (395, 180)},
+}
+
+
+@pytest.mark.parametrize(
+    "frame",
+    [
+        2,
+        pytest.param(
+            3,
+            marks=pytest.mark.xfail(
+                strict=True, reason="the grip folds inward under the body: split like an object standing on another"
+            ),
+        ),
+    ],
+)
+def test_the_drill_is_one_hypothesis_of_its_own(uoc_folder: Path, frame: int) -> None:
+    root = create_pipeline(reader_for(str(uoc_folder), frame))
+    assert Engine(root).tick() is Status.SUCCESS, [(c.name, c.feedback_message) for c in root.children]
+    hypotheses = root.cas.annotations(ObjectHypothesis)
+    drill = {hypothesis_at(hypotheses, x, y) for x, y in DRILL[frame].values()}
+    others = {hypothesis_at(hypotheses, x, y) for x, y in UOC_OBJECTS[frame].values()}
+    assert len(drill) == 1 and 0 not in drill, f"the drill's parts are in hypotheses {drill}"
+    assert not drill & others, "the drill shares its hypothesis with another object"

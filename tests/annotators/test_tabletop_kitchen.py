@@ -130,7 +130,7 @@ def test_tree_module_is_listed_explained_and_valid() -> None:
         "PointCloudGenerator",
         "RangeFilter",
         "SupportPlaneSegmenter",
-        "ClusterExtractor",
+        "ClutterSegmenter",
     ]
     describe = root.children[5]
     assert [type(c).__name__ for c in describe.children] == ["SemanticColorAnnotator", "PoseAnnotator"]

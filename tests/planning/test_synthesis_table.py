@@ -175,9 +175,14 @@ def test_fallback_branches_are_in_rank_order_with_their_own_steps(kb: KnowledgeB
     result = plan_query(parse_query("find the red thing"), kb, sensor_source(kb, None))
     (segmenters,) = [u for u in result.plan.units() if isinstance(u, Alternatives)]
     providers = [branch[-1].annotator for branch in segmenters.branches]
-    assert providers == ["ClusterExtractor", "ImageRegionSegmenter"]  # reliability first
-    depth_branch = [s.annotator for s in segmenters.branches[0]]
-    assert depth_branch == ["SupportPlaneSegmenter", "ClusterExtractor"]  # the plane only this branch needs
+    assert providers == ["ClutterSegmenter", "ClusterExtractor", "ImageRegionSegmenter"]  # reliability first
+    # both depth segmenters need the plane: it is planned once, before the alternatives
+    assert [len(branch) for branch in segmenters.branches] == [1, 1, 1]
+    plane_stage = next(i for i, stage in enumerate(result.plan.stages) if any(
+        getattr(u, "annotator", "") == "SupportPlaneSegmenter" for u in stage
+    ))  # fmt: skip
+    fallback_stage = next(i for i, stage in enumerate(result.plan.stages) if segmenters in stage)
+    assert plane_stage < fallback_stage
     tree = build_tree(result.plan)
     fallback = next(n for n in tree.iterate() if isinstance(n, py_trees.composites.Selector))
     assert "ObjectHypothesis" in fallback.name and "rank order" in fallback.reason

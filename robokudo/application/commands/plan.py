@@ -11,7 +11,12 @@ from queries import QueryError, format_query, parse_query
 from reasoning.errors import OntologyError
 from reasoning.planning.planner import PlanningError
 from reasoning.planning.query_planner import QueryPlan, QueryPlanner
-from robokudo.application.commands.input_options import add_input_arguments, frame_number, input_problem
+from robokudo.application.commands.input_options import (
+    add_input_arguments,
+    frame_number,
+    input_problem,
+    intrinsics_of,
+)
 from robokudo.application.knowledge import load_knowledge_base
 from robokudo.application.planning import plan_for_input
 from robokudo.core.render import tree_to_dict, unicode_tree
@@ -50,7 +55,9 @@ def run(args: argparse.Namespace) -> int:
     try:
         catalog = AnnotatorCatalog.discover()
         planner = QueryPlanner(load_knowledge_base(catalog=catalog))
-        query_plan = plan_for_input(planner, parse_query(text), args.input, frame_number(args))
+        query_plan = plan_for_input(
+            planner, parse_query(text), args.input, frame_number(args), intrinsics=intrinsics_of(args)
+        )
         tree = build_tree(query_plan.plan, catalog=catalog)
     except QueryError as error:
         print(error, file=sys.stderr)

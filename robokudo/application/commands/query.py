@@ -18,7 +18,12 @@ from queries import Query, QueryError, parse_query
 from reasoning.beliefs.store import BeliefStoreError
 from reasoning.errors import OntologyError
 from reasoning.planning.planner import PlanningError
-from robokudo.application.commands.input_options import add_input_arguments, frame_number, input_problem
+from robokudo.application.commands.input_options import (
+    add_input_arguments,
+    frame_number,
+    input_problem,
+    intrinsics_of,
+)
 from robokudo.application.commands.rerun_options import RerunOptionError, add_rerun_arguments, open_rerun_log
 from robokudo.application.report import draw_answer, write_image
 from robokudo.application.service import AnsweringService, Outcome, PerceptionFailedError, UnknownObjectError
@@ -60,7 +65,9 @@ def run(args: argparse.Namespace) -> int:
         query = parse_query(text)  # the cheapest check first: a bad query touches nothing
         with (
             open_rerun_log(args) or contextlib.nullcontext() as rerun_log,
-            AnsweringService.open(args.store, input_path=args.input, frame=frame_number(args)) as service,
+            AnsweringService.open(
+                args.store, input_path=args.input, frame=frame_number(args), intrinsics=intrinsics_of(args)
+            ) as service,
         ):
             outcome = answer(service, query, rerun_log)
     except QueryError as error:

@@ -7,7 +7,12 @@ import sys
 
 from py_trees.common import Status
 
-from robokudo.application.commands.input_options import add_input_arguments, frame_number, input_problem
+from robokudo.application.commands.input_options import (
+    add_input_arguments,
+    frame_number,
+    input_problem,
+    intrinsics_of,
+)
 from robokudo.application.commands.rerun_options import RerunOptionError, add_rerun_arguments, open_rerun_log
 from robokudo.application.report import describe_hypotheses, write_annotated_image
 from robokudo.core.engine import Engine
@@ -35,7 +40,7 @@ def run(args: argparse.Namespace) -> int:
     if problem is not None:
         print(f"robokudo run: {problem}", file=sys.stderr)
         return 2
-    root = load_tree(args.name).create(input_path=args.input, frame=frame_number(args))
+    root = load_tree(args.name).create(input_path=args.input, frame=frame_number(args), intrinsics=intrinsics_of(args))
     engine = Engine(root, hz=args.hz)
     try:
         rerun_log = open_rerun_log(args)

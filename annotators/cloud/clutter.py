@@ -1,0 +1,229 @@
+"""Clutter segmentation: objects as convexly connected surfaces, on the organized grid.
+
+Works like :mod:`annotators.cloud.clusters` on every ``stride``-th pixel of the organized grid, with other cuts:
+
+1. candidates are the points standing on the supporting plane (inside its extent), as for the cluster extractor;
+2. they are cut at depth discontinuities and into cells, split where their normals disagree; each cell gets a
+   plane fit, cells join into smooth faces and faces into objects where they meet convexly - where a can stands on
+   a box or a box leans on another the surfaces fold inward and stay apart
+   (:func:`annotators.geometry.convexity.convex_groups`); colour plays no part, so a printed box is one object;
+3. the cut pixels are given back, and a container's inside joins its outside (a handle its body): the footprints on
+   the plane overlap and the heights nest, which an object standing on another never does
+   (:func:`annotators.geometry.grid_segmentation.merge_parts`);
+4. an object is split along a hue edge only where a concave crease runs along it (:func:`split_by_color`: a can
+   standing flush on a can is one convex surface but two colours with a crease between);
+5. pieces that an occluder in front splits apart join when they continue one plane behind it
+   (:func:`annotators.geometry.occlusion.join_occluded`).
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass, fields, replace
+from typing import ClassVar
+
+import numpy as np
+
+from annotators.cloud.clusters import (
+    ClusterParameters,
+    Segment,
+    full_resolution_segments,
+    plane_problem,
+    standing_region,
+)
+from annotators.cloud.normals import grid_normals
+from annotators.cloud.plane import plane_basis
+from annotators.cloud.point_cloud import cloud_problem
+from annotators.geometry.convexity import ConvexityRules, convex_groups, dense_labels, grid_patches, split_by_normals
+from annotators.geometry.grid_segmentation import (
+    MergeRules,
+    boundaries,
+    bounding_box,
+    color_edges,
+    depth_seams,
+    grow_labels,
+    grow_on_surface,
+    join_unless_apart,
+    label_parts,
+    merge_parts,
+)
+from annotators.geometry.occlusion import OcclusionRules, join_occluded
+from robokudo.core.annotator import Annotator
+from robokudo.core.capability import Capability
+from robokudo.core.types import CasType, ObjectHypothesis, Plane, PointCloud
+
+
+@dataclass(frozen=True)
+class ClutterParameters(ClusterParameters):
+    """Thresholds of :func:`segment_clutter`: those of the cluster extractor (candidates, depth jumps, hue edges,
+    merging), the normals (``normal_step`` / ``normal_smoothing`` coarse pixels), the patches (``cell`` x ``cell``
+    coarse pixels, split when their normals spread by more than ``normal_spread``), the grouping
+    (:class:`~annotators.geometry.convexity.ConvexityRules`) and the share of a boundary that must be creased for a
+    hue edge to split an object (``creased_share``)."""
+
+    jump_relative: float = 0.01
+    normal_step: int = 2
+    normal_smoothing: int = 3
+    cell: int = 6
+    normal_spread: float = 0.15
+    smooth_degrees: float = ConvexityRules.smooth_degrees
+    concave_bending: float = ConvexityRules.concave_bending
+    convex_share: float = ConvexityRules.convex_share
+    concave_share: float = ConvexityRules.concave_share
+    min_patch: int = ConvexityRules.min_patch
+    max_thickness: float = ConvexityRules.max_thickness
+    min_width: float = ConvexityRules.min_width
+    min_face: int = ConvexityRules.min_face
+    min_votes: int = ConvexityRules.min_votes
+    gap_width: float = ConvexityRules.gap_width
+    close_factor: float = ConvexityRules.close_factor
+    creased_share: float = 0.2
+    use_color: bool = True
+    complete_occluded: bool = True
+
+    def convexity_rules(self) -> ConvexityRules:
+        """The thresholds of :func:`annotators.geometry.convexity.convex_groups`."""
+        return ConvexityRules(**{f.name: getattr(self, f.name) for f in fields(ConvexityRules)})
+
+    def merge_rules(self) -> MergeRules:
+        """The cluster extractor's merge rules with the footprint rule only for parts whose heights nest (a bowl's
+        inside and outside, a mug's handle): stacked objects share footprints too, but one lies above the other."""
+        return replace(super().merge_rules(), nested=True, overlap=0.15)
+
+
+def segment_clutter(
+    points: np.ndarray,
+    mask: np.ndarray,
+    model: np.ndarray,
+    plane_indices: np.ndarray,
+    parameters: ClutterParameters | None = None,
+    colors: np.ndarray | None = None,
+) -> list[Segment]:
+    """The objects standing on the plane ``model`` (unit normal toward the camera) in an organized cloud, largest
+    first; ``plane_indices`` are the plane's inliers (flat indices) and define its extent."""
+    p = parameters or ClutterParameters()
+    step = max(1, p.stride)
+    coarse = standing_region(points, mask, model, plane_indices, p)
+    if not coarse.any():
+        return []
+    x0, y0, x1, y1 = bounding_box(coarse, margin=2)
+    region = coarse[y0:y1, x0:x1]
+    grid = np.ascontiguousarray(points[::step, ::step][y0:y1, x0:x1])
+    depth = grid[..., 2]
+    seams = depth_seams(depth, region, p.jump_absolute, p.jump_relative)
+    normals = grid_normals(grid, p.normal_step, p.normal_smoothing, p.jump_absolute, p.jump_relative)
+    surfaces = label_parts(region & ~seams, 1)
+    patches = split_by_normals(grid_patches(surfaces, p.cell), normals, p.normal_spread)
+    labels, faces = convex_groups(patches, grid, p.convexity_rules(), region & ~seams)
+    # patches without a trustworthy plane (a face seen edge-on, a few points) go with the object beside them
+    labels = grow_labels(labels, region & ~seams, max(2.0 * p.cell, p.grow_distance / step))
+    labels = grow_on_surface(labels, region, depth, p.jump_absolute, p.jump_relative)
+    basis = plane_basis(np.asarray(model[:3], dtype=np.float64)).T.astype(np.float32)
+    to_plane = np.column_stack([basis, np.asarray(model[:3], dtype=np.float32)])
+    offset = np.array([0.0, 0.0, model[3]], dtype=np.float32)
+    crop_points = grid.reshape(-1, 3)
+    on_plane = lambda pixels: crop_points[pixels] @ to_plane + offset  # noqa: E731
+    labels = merge_parts(labels, depth, on_plane, p.merge_rules())
+    if colors is not None and p.use_color:
+        colors_crop = np.ascontiguousarray(colors[::step, ::step][y0:y1, x0:x1])
+        labels = split_by_color(labels, grid, normals, colors_crop, p)
+    if p.complete_occluded:
+        labels = join_occluded(labels, faces, grid, p.jump_absolute, p.jump_relative, OcclusionRules())
+    return full_resolution_segments(labels, depth, (x0, y0, x1, y1), step, points, mask, model, p)
+
+
+def split_by_color(
+    labels: np.ndarray, grid: np.ndarray, normals: np.ndarray, colors: np.ndarray, p: ClutterParameters
+) -> np.ndarray:
+    """Objects split where a hue edge and a concave crease coincide: two objects whose surfaces continue one
+    another (a can standing on a can with its side flush with the lower one's front, boxes stacked flush) are one
+    convex group, but the colour changes between them and their boundary folds inward along part of its length.
+
+    Each object is cut at hue edges into pieces; pieces whose shared boundary is creased (the surfaces meet - their
+    points along it are close in 3-D - and a share of at least ``p.creased_share`` of it is concave, the surfaces
+    not coplanar) must stay apart. Everything else of the object joins again - longest shared boundaries first, so a
+    piece goes with the side it shares most with. A print on a box (no crease) or the pieces of one object seen on
+    both sides of an occluder never split.
+    """
+    step = max(1, p.stride)
+    objects = labels > 0
+    edges = color_edges(colors, p.edge_low, p.edge_high) & objects
+    parts = label_parts(objects & ~edges, max(1, p.min_part_points // (step * step)))
+    key = labels.astype(np.int64) * (int(parts.max(initial=0)) + 1) + parts
+    pieces = dense_labels(np.where(parts > 0, key, 0))
+    owner = np.zeros(int(pieces.max(initial=0)) + 1, dtype=np.int64)
+    owner[pieces[parts > 0]] = labels[parts > 0]
+    # only an object with two pieces that could each be an object (min_points) can split
+    large = np.bincount(pieces.reshape(-1), minlength=owner.size) * step * step >= p.min_points
+    pieces_of = np.bincount(owner[1:], weights=large[1:], minlength=int(labels.max()) + 1)
+    if pieces_of.max(initial=0) < 2:
+        return labels
+    pieces = grow_labels(pieces, objects, p.grow_distance / step)
+    pieces[owner[pieces] != labels] = 0
+    several = pieces_of[labels] >= 2  # only objects of several pieces can split: their boundaries are measured
+    x0, y0, x1, y1 = bounding_box(several, margin=3)
+    window = np.where(several[y0:y1, x0:x1], pieces[y0:y1, x0:x1], 0)
+    surface = boundaries(window, grid[y0:y1, x0:x1], normals[y0:y1, x0:x1], p.jump_absolute, p.jump_relative)
+    rules = p.merge_rules()
+    creased = (
+        (surface.creased > p.creased_share)
+        & (surface.close >= rules.continuous)
+        & (surface.convexity < rules.concave)
+        & (surface.alignment < rules.coplanar_cosine)
+        & (owner[surface.pairs[:, 0]] == owner[surface.pairs[:, 1]])
+    )
+    if not creased.any():
+        return labels
+    same_object = owner[surface.pairs[:, 0]] == owner[surface.pairs[:, 1]]
+    touching = surface.pairs[same_object][np.argsort(-surface.length[same_object], kind="stable")]
+    first_piece = np.full(owner.size, -1, dtype=np.int64)
+    for piece in range(owner.size - 1, 0, -1):
+        first_piece[owner[piece]] = piece
+    rest = np.arange(1, owner.size)
+    chained = np.column_stack([first_piece[owner[rest]], rest])
+    groups = join_unless_apart(owner.size, np.concatenate([touching, chained]), surface.pairs[creased])
+    result = dense_labels(np.where(pieces > 0, groups[pieces] + 1, 0))
+    return grow_labels(result, objects, p.grow_distance / step)
+
+
+class ClutterSegmenter(Annotator):
+    """Segments touching, stacked and occluding objects on the supporting plane into object hypotheses: convexly
+    connected surfaces, cut at depth jumps and concave creases (model-free; colour only where a crease runs along
+    a hue edge)."""
+
+    inputs: ClassVar[tuple[type[CasType], ...]] = (PointCloud, Plane)
+    outputs: ClassVar[tuple[type[CasType], ...]] = (ObjectHypothesis,)
+    capability: ClassVar[Capability] = Capability(
+        label="clutter segmenter",
+        synonyms=("convexity segmenter",),
+        preconditions=("NeedsDepth", "NotForTransparentObjects"),
+        cost_ms=30.0,
+        reliability=0.9,
+    )
+
+    def __init__(self, name: str | None = None, **thresholds: float) -> None:
+        """``thresholds`` sets any field of :class:`ClutterParameters`."""
+        super().__init__(name=name)
+        self.parameters = ClutterParameters(**thresholds)
+
+    def analyse(self) -> None:
+        """Write one ObjectHypothesis per object; fail when the inputs are unusable or nothing stands there."""
+        cloud = self.view(PointCloud)
+        problem = cloud_problem(cloud)
+        if problem:
+            self.fail(problem)
+        planes = self.annotations(Plane)
+        if not planes:
+            self.fail("no supporting Plane in the CAS")
+        plane = max(planes, key=lambda candidate: np.asarray(candidate.inlier_indices).size)
+        problem = plane_problem(plane.model)
+        if problem:
+            self.fail(problem)
+        inliers = np.asarray(plane.inlier_indices)
+        if inliers.size < 3 or inliers.min() < 0 or inliers.max() >= cloud.mask.size:
+            self.fail(f"the plane has {inliers.size} inliers or indices outside the {cloud.shape} grid")
+        model = np.asarray(plane.model, dtype=np.float64)
+        segments = segment_clutter(cloud.points, cloud.mask, model, inliers, self.parameters, cloud.colors)
+        if not segments:
+            self.fail("no object stands on the supporting plane")
+        for segment in segments:
+            self.write(ObjectHypothesis(point_indices=segment.indices, mask=segment.mask, roi=segment.roi))

@@ -1,0 +1,265 @@
+"""Convexity-based grouping of surface patches on the organized grid (the LCCP idea on grid cells).
+
+Objects are, to a first approximation, convex: the faces of one object meet at convex edges, while where two
+objects meet - a can standing on a box, a box leaning on another - their surfaces form a concave crease
+(Stein et al., "Object partitioning using local convexity", CVPR 2014). Here the surface is cut into small patches
+(:func:`grid_patches`: cells of the grid, split where depth jumps, and in two where their normals disagree,
+:func:`split_by_normals`), each with a plane fit - a centroid and a normal, robust to sensor noise where per-pixel
+normals are not. How fast the surface turns between two touching patches, ``(n_a - n_b) . (c_a - c_b) /
+|c_a - c_b|^2`` (1/m), is about 0 on a plane, positive across a convex edge and negative in a concave crease;
+:func:`convex_groups` joins patches into faces and faces into objects by it.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import numpy as np
+from scipy import sparse
+from scipy.sparse import csgraph
+
+from annotators.geometry.grid_segmentation import grow_labels, join_unless_apart, pixel_footprint, touching_pairs
+
+
+def grid_patches(surfaces: np.ndarray, cell: int) -> np.ndarray:
+    """Patch labels (int32, 0 = none, 1..n): each labelled surface of ``surfaces`` cut into ``cell`` x ``cell``
+    grid cells; a cell that two surfaces share gives one patch to each."""
+    rows, cols = surfaces.shape
+    across = -(-cols // cell)
+    cell_id = (np.arange(rows)[:, None] // cell) * across + (np.arange(cols)[None, :] // cell)
+    key = surfaces.astype(np.int64) * (across * (-(-rows // cell))) + cell_id
+    return dense_labels(np.where(surfaces > 0, key + 1, 0))
+
+
+def dense_labels(keys: np.ndarray) -> np.ndarray:
+    """Non-negative integer keys (0 = none) renumbered 1..n in increasing order, as int32; by a lookup table over
+    the key range (linear time) rather than by sorting."""
+    present = np.zeros(int(keys.max(initial=0)) + 1, dtype=bool)
+    present[keys.reshape(-1)] = True
+    present[0] = False
+    renumber = np.cumsum(present, dtype=np.int32) * present
+    return renumber[keys]
+
+
+def split_by_normals(patches: np.ndarray, normals: np.ndarray, spread: float) -> np.ndarray:
+    """Patches whose pixel normals spread (RMS distance from their mean normal) by more than ``spread`` cut in two:
+    the pixels on either side of the mean along the direction the normals vary most. A cell lying across the edge
+    of a box or across the crease between two objects so becomes two patches, one per surface. Pixels without a
+    normal are left out (0). Labels 1..n."""
+    count = int(patches.max(initial=0)) + 1
+    known = (patches > 0) & np.isfinite(normals[..., 0])
+    labels = patches[known]
+    unit = normals[known].astype(np.float64)
+    sizes = np.maximum(np.bincount(labels, minlength=count), 1).astype(np.float64)
+    mean = np.stack([np.bincount(labels, unit[:, i], count) for i in range(3)], axis=1) / sizes[:, None]
+    centred = unit - mean[labels]
+    second = np.empty((count, 3, 3))
+    for i in range(3):
+        for j in range(i, 3):
+            second[:, i, j] = second[:, j, i] = np.bincount(labels, centred[:, i] * centred[:, j], count) / sizes
+    values, vectors = np.linalg.eigh(second)
+    wide = np.sqrt(np.clip(values.sum(axis=1), 0, None)) > spread
+    side = np.einsum("ij,ij->i", centred, vectors[labels, :, 2]) > 0
+    split = np.zeros(patches.shape, dtype=np.int64)
+    split[known] = labels * 2 + (side & wide[labels]) + 1
+    return dense_labels(split)
+
+
+@dataclass(frozen=True)
+class ConvexityRules:
+    """Thresholds of :func:`convex_groups`: ``smooth_degrees`` between the normals (and of the centroid line off
+    both planes) of a smooth connection; ``concave_bending`` (1/m, a turn tighter than a 5 cm radius) makes a
+    connection concave; two faces join when more than ``convex_share`` of their votes are convex, at least
+    ``min_votes`` when both faces are large, and not when more than ``concave_share`` are concave; a patch needs
+    ``min_patch`` points, at most ``max_thickness`` (smallest / middle eigenvalue) and at least ``min_width``
+    (middle / largest) for a plane; faces of fewer than
+    ``min_face`` points are slivers; patches touch across up to ``gap_width`` pixels, and only when their centroids
+    are at most ``close_factor`` times their grid distance apart in 3-D."""
+
+    smooth_degrees: float = 20.0
+    concave_bending: float = 20.0
+    convex_share: float = 0.5
+    min_patch: int = 6
+    max_thickness: float = 0.5
+    min_width: float = 0.04
+    min_face: int = 72
+    min_votes: int = 2
+    concave_share: float = 0.25
+    gap_width: float = 2.0
+    close_factor: float = 3.0
+
+
+@dataclass(frozen=True, eq=False)
+class PatchPlanes:
+    """Per patch (index = label - 1): point count, centroid (Nx3), unit normal facing the camera (Nx3) and
+    ``thickness``, the ratio of the smallest to the middle covariance eigenvalue: near 0 for a patch much wider
+    than its noise, near 1 when its points lie along a line or a strip hardly wider than the noise (a sliver of a
+    face seen edge-on), whose plane - and normal - is then undetermined; and ``width``, the middle over the largest
+    eigenvalue (near 0 for points along a line)."""
+
+    counts: np.ndarray
+    centroids: np.ndarray
+    normals: np.ndarray
+    thickness: np.ndarray
+    width: np.ndarray
+
+
+def patch_planes(patches: np.ndarray, points: np.ndarray) -> PatchPlanes:
+    """Plane fits of all patches at once (sums by ``bincount``, one batched 3x3 eigen-decomposition)."""
+    count = int(patches.max(initial=0))
+    inside = patches > 0
+    labels = patches[inside] - 1
+    xyz = points[inside].astype(np.float64)
+    shift = xyz.mean(axis=0) if xyz.size else np.zeros(3)
+    xyz -= shift
+    counts = np.bincount(labels, minlength=count).astype(np.float64)
+    safe = np.maximum(counts, 1.0)
+    means = np.stack([np.bincount(labels, xyz[:, i], count) for i in range(3)], axis=1) / safe[:, None]
+    second = np.empty((count, 3, 3))
+    for i in range(3):
+        for j in range(i, 3):
+            second[:, i, j] = second[:, j, i] = np.bincount(labels, xyz[:, i] * xyz[:, j], count) / safe
+    covariance = second - means[:, :, None] * means[:, None, :]
+    values, vectors = np.linalg.eigh(covariance)
+    normals = vectors[:, :, 0]
+    centroids = means + shift
+    normals *= np.where(np.einsum("ij,ij->i", normals, centroids) > 0, -1.0, 1.0)[:, None]
+    thickness = np.clip(values[:, 0], 0, None) / np.maximum(values[:, 1], 1e-12)
+    width = np.clip(values[:, 1], 0, None) / np.maximum(values[:, 2], 1e-12)
+    return PatchPlanes(counts.astype(np.int64), centroids, normals, thickness, width)
+
+
+def connection_bending(planes: PatchPlanes, pairs: np.ndarray) -> np.ndarray:
+    """For Kx2 patch labels: ``(n_a - n_b) . (c_a - c_b) / |c_a - c_b|^2``, how fast the surface turns between the
+    two patches (1/m; about 1/radius on a cylinder): positive convex, negative concave."""
+    a, b = pairs[:, 0] - 1, pairs[:, 1] - 1
+    offset = planes.centroids[a] - planes.centroids[b]
+    length = np.einsum("ij,ij->i", offset, offset)
+    with np.errstate(invalid="ignore", divide="ignore"):
+        value = np.einsum("ij,ij->i", planes.normals[a] - planes.normals[b], offset) / length
+    return np.nan_to_num(value)
+
+
+def close_in_space(
+    patches: np.ndarray, planes: PatchPlanes, pairs: np.ndarray, footprint: float, close_factor: float
+) -> np.ndarray:
+    """For Kx2 patch labels: are the two centroids at most ``close_factor`` times as far apart in 3-D as their
+    distance on the grid (pixels times the pixel ``footprint`` times depth) would be on a surface facing the camera?
+    Patches touching on the grid across a depth jump (an object and what is behind it) are not."""
+    if pairs.size == 0:
+        return np.zeros(0, dtype=bool)
+    inside = patches > 0
+    rows, cols = np.nonzero(inside)
+    labels = patches[inside]
+    counts = np.maximum(np.bincount(labels, minlength=planes.counts.size + 1), 1)
+    pixel = np.stack([np.bincount(labels, rows, counts.size), np.bincount(labels, cols, counts.size)], axis=1)
+    pixel /= counts[:, None]
+    a, b = pairs[:, 0], pairs[:, 1]
+    on_grid = np.linalg.norm(pixel[a] - pixel[b], axis=1)
+    depth = np.minimum(planes.centroids[a - 1, 2], planes.centroids[b - 1, 2])
+    in_space = np.linalg.norm(planes.centroids[a - 1] - planes.centroids[b - 1], axis=1)
+    return in_space <= close_factor * np.maximum(on_grid, 1.0) * footprint * depth
+
+
+def convex_groups(
+    patches: np.ndarray,
+    points: np.ndarray,
+    rules: ConvexityRules,
+    between: np.ndarray | None = None,
+) -> tuple[np.ndarray, np.ndarray]:
+    """Object labels and face labels (int32, 0 = none, 1..n) from surface patches in two steps.
+
+    1. *Faces*: patches joined along smooth connections - normals within ``rules.smooth_degrees``, the line between
+       the centroids within that angle of both tangent planes (one surface going on, flat or gently curved, not a
+       step between parallel surfaces) and no concave bend.
+    2. *Objects*: faces joined where they meet convexly. Every connection between two faces votes (convex, or
+       concave when it bends inward faster than ``rules.concave_bending``; a step votes neither); two faces join
+       when more than ``rules.convex_share`` of the votes are convex and at most ``rules.concave_share`` concave.
+       Joins are made strongest first, and two large faces that do not agree are kept apart: a sliver along a
+       crease that agrees with both sides cannot join them.
+
+    Patches touch when they are 4-neighbours once grown by up to ``rules.gap_width`` pixels into the unlabelled
+    pixels between them that ``between`` allows (HxW bool; default: every pixel with a point) and their centroids
+    are close in 3-D (:func:`close_in_space`). Patches without a trustworthy plane (fewer than ``rules.min_patch``
+    points, thicker than ``rules.max_thickness`` or narrower than ``rules.min_width``) are left out (0).
+    """
+    planes = patch_planes(patches, points)
+    count = planes.counts.size + 1
+    trusted = (planes.thickness <= rules.max_thickness) & (planes.width >= rules.min_width)
+    usable = np.concatenate([[False], (planes.counts >= rules.min_patch) & trusted])
+    kept = np.where(usable[patches], patches, 0)
+    between = np.isfinite(points[..., 2]) if between is None else between
+    pairs = touching_pairs(grow_labels(kept, between | (kept > 0), rules.gap_width))
+    pairs = pairs[close_in_space(patches, planes, pairs, pixel_footprint(points), rules.close_factor)]
+    parallel, in_planes = _alignment(planes, pairs, rules.smooth_degrees)
+    concave = connection_bending(planes, pairs) < -rules.concave_bending
+    continuous = parallel & in_planes & ~concave
+    faces = _components(pairs[continuous], count)
+    objects = _join_faces(faces, pairs, ~concave & (continuous | ~parallel), concave, planes, rules)
+    return _dense(objects[faces], usable)[kept], _dense(faces, usable)[kept]
+
+
+def _alignment(planes: PatchPlanes, pairs: np.ndarray, degrees: float) -> tuple[np.ndarray, np.ndarray]:
+    """For Kx2 patch labels: normals within ``degrees``; the centroid line within ``degrees`` of both planes."""
+    a, b = pairs[:, 0] - 1, pairs[:, 1] - 1
+    offset = planes.centroids[a] - planes.centroids[b]
+    with np.errstate(invalid="ignore", divide="ignore"):
+        direction = np.nan_to_num(offset / np.linalg.norm(offset, axis=1, keepdims=True))
+    parallel = np.einsum("ij,ij->i", planes.normals[a], planes.normals[b]) >= np.cos(np.radians(degrees))
+    across = np.sin(np.radians(degrees))
+    in_planes = (np.abs(np.einsum("ij,ij->i", direction, planes.normals[a])) <= across) & (
+        np.abs(np.einsum("ij,ij->i", direction, planes.normals[b])) <= across
+    )
+    return parallel, in_planes
+
+
+def _join_faces(
+    faces: np.ndarray,
+    pairs: np.ndarray,
+    convex: np.ndarray,
+    concave: np.ndarray,
+    planes: PatchPlanes,
+    rules: ConvexityRules,
+) -> np.ndarray:
+    """The object of each face (indexed by face label): faces joined by the votes of the patch connections."""
+    count = faces.size
+    face_a, face_b = faces[pairs[:, 0]], faces[pairs[:, 1]]
+    apart = face_a != face_b
+    low, high = np.minimum(face_a, face_b)[apart], np.maximum(face_a, face_b)[apart]
+    keys, inverse = np.unique(low * count + high, return_inverse=True)
+    votes = np.maximum(np.bincount(inverse, minlength=keys.size), 1)
+    share = np.bincount(inverse, weights=convex[apart], minlength=keys.size) / votes
+    concave_votes = np.bincount(inverse, weights=concave[apart], minlength=keys.size)
+    share = np.where((concave_votes > rules.concave_share * votes) & (concave_votes >= rules.min_votes), 0.0, share)
+    first, second = keys // count, keys % count
+    large = np.bincount(faces, weights=planes_sizes(planes, count), minlength=count) >= rules.min_face
+    both_large = large[first] & large[second]
+    agree = (share > rules.convex_share) & ((share * votes >= rules.min_votes) | ~both_large)
+    # one vote decides nothing: a single noisy connection neither joins two large faces nor keeps them apart
+    kept_apart = np.column_stack([first, second])[
+        (share <= rules.convex_share) & both_large & (votes >= rules.min_votes)
+    ]
+    order = np.argsort(-(share * votes)[agree], kind="stable")
+    return join_unless_apart(count, np.column_stack([first, second])[agree][order], kept_apart)
+
+
+def _dense(groups: np.ndarray, usable: np.ndarray) -> np.ndarray:
+    """Per patch label: its group renumbered 1..n over the usable patches (0 for the others)."""
+    present = np.flatnonzero(usable)
+    renumber = np.zeros(groups.size, dtype=np.int32)
+    _, dense = np.unique(groups[present], return_inverse=True)
+    renumber[present] = dense.reshape(-1).astype(np.int32) + 1
+    return renumber
+
+
+def planes_sizes(planes: PatchPlanes, count: int) -> np.ndarray:
+    """Point counts of patches 0..count-1 (patch 0, no patch, has none)."""
+    sizes = np.zeros(count)
+    sizes[1 : planes.counts.size + 1] = planes.counts
+    return sizes
+
+
+def _components(pairs: np.ndarray, count: int) -> np.ndarray:
+    """The connected component of each of ``count`` nodes of the graph with the edges ``pairs`` (Kx2)."""
+    graph = sparse.csr_matrix((np.ones(pairs.shape[0]), (pairs[:, 0], pairs[:, 1])), shape=(count, count))
+    return csgraph.connected_components(graph, directed=False)[1].astype(np.int64)

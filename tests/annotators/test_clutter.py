@@ -1,0 +1,80 @@
+"""The clutter segmenter on rendered tabletops whose ground truth is known per pixel (ray-cast geometry ids)."""
+
+from __future__ import annotations
+
+import numpy as np
+import open3d as o3d
+import pytest
+
+from annotators.cloud.clutter import segment_clutter
+from annotators.cloud.filters import range_mask
+from annotators.cloud.plane import ransac_support_plane
+from annotators.geometry.convexity import dense_labels
+
+Box = tuple[tuple[float, float, float], tuple[float, float, float]]  # (size, corner)
+
+
+def render(boxes: list[Box], seed: int = 0) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """Organized 480x640 camera-frame points, colours and per-pixel object ids (0 = table or nothing) of boxes on
+    a table, seen from 0.8 m at 45 degrees with 1.5 mm depth noise."""
+    scene = o3d.t.geometry.RaycastingScene()
+    table = o3d.geometry.TriangleMesh.create_box(1.2, 1.0, 0.02).translate((-0.6, -0.3, -0.02))
+    scene.add_triangles(o3d.t.geometry.TriangleMesh.from_legacy(table))
+    for size, corner in boxes:
+        mesh = o3d.geometry.TriangleMesh.create_box(*size).translate(corner)
+        scene.add_triangles(o3d.t.geometry.TriangleMesh.from_legacy(mesh))
+    eye, target = np.array([0.0, -0.55, 0.55]), np.array([0.0, 0.1, 0.0])
+    rays = o3d.t.geometry.RaycastingScene.create_rays_pinhole(55.0, target.tolist(), eye.tolist(), [0, 0, 1], 640, 480)
+    hits = scene.cast_rays(rays)
+    t, ids = hits["t_hit"].numpy(), hits["geometry_ids"].numpy().astype(np.int64)
+    forward = (target - eye) / np.linalg.norm(target - eye)
+    right = np.cross(forward, [0.0, 0.0, 1.0])
+    right /= np.linalg.norm(right)
+    down = np.cross(forward, right)
+    offset = rays.numpy()[..., 3:] * np.where(np.isfinite(t), t, 0.0)[..., None]
+    points = np.stack([offset @ right, offset @ down, offset @ forward], axis=-1)
+    points[~np.isfinite(t)] = np.nan
+    points *= (1.0 + np.random.default_rng(seed).normal(0.0, 0.0015, t.shape) / points[..., 2])[..., None]
+    objects = np.where(np.isfinite(t) & (ids >= 1) & (ids <= len(boxes)), ids, 0)
+    palette = np.array([[150, 110, 70], [200, 40, 40], [40, 160, 60], [40, 60, 200], [220, 200, 40]], np.uint8)
+    colors = palette[np.where(np.isfinite(t), np.minimum(ids, len(palette) - 1), 0)]
+    return points.astype(np.float32), np.ascontiguousarray(colors), objects
+
+
+def segment(points: np.ndarray, colors: np.ndarray) -> np.ndarray:
+    mask = range_mask(points, np.isfinite(points[..., 2]), 0.2, 2.5)
+    plane = ransac_support_plane(points, mask)
+    labels = np.zeros(points.shape[:2], dtype=np.int32)
+    for number, found in enumerate(segment_clutter(points, mask, plane.model, plane.inlier_indices, colors=colors), 1):
+        labels[found.mask] = number
+    return labels
+
+
+def best_ious(objects: np.ndarray, labels: np.ndarray) -> list[float]:
+    """Per object: the best IoU any segment reaches on its pixels."""
+    result = []
+    for object_id in range(1, int(objects.max()) + 1):
+        truth = objects == object_id
+        result.append(max(np.count_nonzero(truth & (labels == s)) / np.count_nonzero(truth | (labels == s))
+                          for s in range(1, int(labels.max()) + 1)))  # fmt: skip
+    return result
+
+
+SCENES = {
+    "apart": [((0.10, 0.08, 0.12), (-0.20, 0.05, 0.0)), ((0.12, 0.12, 0.06), (0.05, 0.10, 0.0))],
+    "touching": [((0.10, 0.08, 0.12), (-0.10, 0.05, 0.0)), ((0.12, 0.10, 0.10), (0.0, 0.08, 0.0))],
+    "stacked": [((0.16, 0.12, 0.05), (-0.08, 0.04, 0.0)), ((0.08, 0.06, 0.08), (-0.05, 0.06, 0.05))],
+}
+
+
+@pytest.mark.parametrize("name", sorted(SCENES))
+def test_every_box_is_one_segment_whether_apart_touching_or_stacked(name: str) -> None:
+    points, colors, objects = render(SCENES[name])
+    labels = segment(points, colors)
+    assert int(labels.max()) == len(SCENES[name])
+    assert all(iou >= 0.8 for iou in best_ious(objects, labels)), best_ious(objects, labels)
+
+
+def test_dense_labels_number_present_keys_in_order() -> None:
+    keys = np.array([[0, 7, 7], [30, 0, 2]])
+    assert dense_labels(keys).tolist() == [[0, 2, 2], [3, 0, 1]]
