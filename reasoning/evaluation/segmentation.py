@@ -70,34 +70,11 @@ class SegmentationScore:
 
 
 @dataclass(frozen=True)
-class ScoreSummary:
-    """Several scenes together: summed counts and per-scene means of the overlap and boundary figures."""
+class ScoreSummary(SegmentationScore):
+    """Several scenes together: summed counts (so recall and precision are over all objects and segments) and
+    per-scene means of the overlap and boundary figures."""
 
-    scenes: int
-    objects: int
-    segments: int
-    matched: int
-    objects_f75: int
-    overlap_precision: float
-    overlap_recall: float
-    overlap_f: float
-    boundary_precision: float
-    boundary_recall: float
-    boundary_f: float
-
-    @property
-    def recall(self) -> float:
-        """Share of all objects found at box IoU >= 0.5."""
-        return self.matched / self.objects if self.objects else 1.0
-
-    @property
-    def precision(self) -> float:
-        """Share of all segments that found an object."""
-        return self.matched / self.segments if self.segments else 1.0
-
-    def as_dict(self) -> dict[str, float | int]:
-        """The figures as plain data, with recall and precision."""
-        return {**asdict(self), "recall": self.recall, "precision": self.precision}
+    scenes: int = 0
 
 
 def _harmonic(precision: float, recall: float) -> float:
