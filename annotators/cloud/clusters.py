@@ -241,6 +241,24 @@ def plane_problem(model: np.ndarray) -> str | None:
     return None
 
 
+def supporting_plane(cloud: PointCloud, planes: list[Plane]) -> tuple[np.ndarray, np.ndarray] | str:
+    """The model and inlier indices of the largest plane, checked against ``cloud``; or why the cloud or the
+    planes cannot be segmented (the shared input checks of the depth segmenters)."""
+    problem = cloud_problem(cloud)
+    if problem:
+        return problem
+    if not planes:
+        return "no supporting Plane in the CAS"
+    plane = max(planes, key=lambda candidate: np.asarray(candidate.inlier_indices).size)
+    problem = plane_problem(plane.model)
+    if problem:
+        return problem
+    inliers = np.asarray(plane.inlier_indices)
+    if inliers.size < 3 or inliers.min() < 0 or inliers.max() >= cloud.mask.size:
+        return f"the plane has {inliers.size} inliers or indices outside the {cloud.shape} grid"
+    return np.asarray(plane.model, dtype=np.float64), inliers
+
+
 class ClusterExtractor(Annotator):
     """Segments the points standing on the supporting plane into object hypotheses (one per cluster)."""
 
@@ -272,23 +290,13 @@ class ClusterExtractor(Annotator):
     def analyse(self) -> None:
         """Write one ObjectHypothesis per cluster; fail when the inputs are unusable or nothing stands there."""
         cloud = self.view(PointCloud)
-        problem = cloud_problem(cloud)
-        if problem:
-            self.fail(problem)
-        planes = self.annotations(Plane)
-        if not planes:
-            self.fail("no supporting Plane in the CAS")
-        plane = max(planes, key=lambda candidate: np.asarray(candidate.inlier_indices).size)
-        problem = plane_problem(plane.model)
-        if problem:
-            self.fail(problem)
-        inliers = np.asarray(plane.inlier_indices)
-        if inliers.size < 3 or inliers.min() < 0 or inliers.max() >= cloud.mask.size:
-            self.fail(f"the plane has {inliers.size} inliers or indices outside the {cloud.shape} grid")
+        support = supporting_plane(cloud, self.annotations(Plane))
+        if isinstance(support, str):
+            self.fail(support)
+        model, inliers = support
         colors = cloud.colors if self.use_color else None
         if colors is not None and colors.shape[:2] != cloud.shape:
             self.fail(f"the cloud's colours {colors.shape} do not match its grid {cloud.shape}")
-        model = np.asarray(plane.model, dtype=np.float64)
         segments = extract_clusters(cloud.points, cloud.mask, model, inliers, self.parameters, colors)
         if not segments:
             self.fail("no object cluster stands on the supporting plane")

@@ -27,12 +27,11 @@ from annotators.cloud.clusters import (
     ClusterParameters,
     Segment,
     full_resolution_segments,
-    plane_problem,
     standing_region,
+    supporting_plane,
 )
 from annotators.cloud.normals import grid_normals
 from annotators.cloud.plane import plane_basis
-from annotators.cloud.point_cloud import cloud_problem
 from annotators.geometry.convexity import ConvexityRules, convex_groups, dense_labels, grid_patches, split_by_normals
 from annotators.geometry.grid_segmentation import (
     MergeRules,
@@ -208,20 +207,10 @@ class ClutterSegmenter(Annotator):
     def analyse(self) -> None:
         """Write one ObjectHypothesis per object; fail when the inputs are unusable or nothing stands there."""
         cloud = self.view(PointCloud)
-        problem = cloud_problem(cloud)
-        if problem:
-            self.fail(problem)
-        planes = self.annotations(Plane)
-        if not planes:
-            self.fail("no supporting Plane in the CAS")
-        plane = max(planes, key=lambda candidate: np.asarray(candidate.inlier_indices).size)
-        problem = plane_problem(plane.model)
-        if problem:
-            self.fail(problem)
-        inliers = np.asarray(plane.inlier_indices)
-        if inliers.size < 3 or inliers.min() < 0 or inliers.max() >= cloud.mask.size:
-            self.fail(f"the plane has {inliers.size} inliers or indices outside the {cloud.shape} grid")
-        model = np.asarray(plane.model, dtype=np.float64)
+        support = supporting_plane(cloud, self.annotations(Plane))
+        if isinstance(support, str):
+            self.fail(support)
+        model, inliers = support
         segments = segment_clutter(cloud.points, cloud.mask, model, inliers, self.parameters, cloud.colors)
         if not segments:
             self.fail("no object stands on the supporting plane")
