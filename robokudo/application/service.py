@@ -61,6 +61,7 @@ from robokudo.core.engine import Engine
 from robokudo.core.pipeline import Pipeline
 from robokudo.core.resources import SharedResources
 from robokudo.core.slot import Idle, TaskSlot
+from robokudo.core.structure import running_leaves
 from robokudo.core.threaded import has_workers, stop_workers
 from robokudo.core.types import CameraIntrinsics, QueryAnswer
 from trees.answer_step import AnswerStep
@@ -126,6 +127,14 @@ class Outcome:
     """Where the time went (:meth:`TaskHandle.timing`)."""
 
 
+@dataclass(frozen=True)
+class TickProgress:
+    """What one tick did to a running task: the tick's number and the task's leaves still running after it."""
+
+    tick: int
+    running: tuple[str, ...]
+
+
 class TaskHandle:
     """A task in the engine: its answers as they come (continuous) or its one answer (one-shot), and a way to
     cancel it.
@@ -154,6 +163,7 @@ class TaskHandle:
         self._deadline = None if timeout is None else started + timeout
         self._service = service
         self._answers: queue.SimpleQueue[Answer | None] = queue.SimpleQueue()
+        self._tick_listener: Callable[[TickProgress], None] | None = None
         self._ended = threading.Event()
         self._reason = ""
         self._result: Answer | None = None
@@ -207,6 +217,11 @@ class TaskHandle:
         """End the task (its running experts are interrupted); no-op when it already ended."""
         self._service.cancel(self)
 
+    def on_tick(self, listener: Callable[[TickProgress], None] | None) -> None:
+        """Have ``listener`` called after every tick that ran this task's tree, with that tick's progress (on the
+        engine thread, so it must be quick; None removes it)."""
+        self._tick_listener = listener
+
     def timing(self) -> dict[str, float]:
         """Where the time went, in milliseconds: ``plan_ms`` (parse, plan, build), ``wait_ms`` (until a tick first ran
         the tree: the swap and the wait for a fresh frame), ``run_ms`` (from that tick to the end); the parts known
@@ -220,6 +235,11 @@ class TaskHandle:
 
     def _publish(self, answer: Answer) -> None:
         self._answers.put(answer)
+
+    def _ticked(self, tick: int) -> None:
+        listener = self._tick_listener
+        if listener is not None:
+            listener(TickProgress(tick, tuple(running_leaves(self.tree))))
 
     def _expired(self) -> bool:
         return self._deadline is not None and time.monotonic() >= self._deadline
@@ -365,8 +385,9 @@ class AnsweringService:
 
     # ------------------------------------------------------------------ running
 
-    def submit(self, query: str | Query) -> TaskHandle:
+    def submit(self, query: str | Query, *, on_tick: Callable[[TickProgress], None] | None = None) -> TaskHandle:
         """Plan ``query`` and put its tree into the task slot (replacing the running task); its handle.
+        ``on_tick`` is the handle's tick listener from the first tick on (:meth:`TaskHandle.on_tick`).
 
         Raises QueryError / PlanningError / SynthesisError for a query no tree can answer, ValueError for a
         ``stop`` query, UnknownObjectError for an object id the store does not hold, SourceEndedError once the
@@ -383,6 +404,7 @@ class AnsweringService:
         pipeline = self.tree(parsed, query_plan)
         handle = TaskHandle(parsed, mode, pipeline, query_plan, self, timeout=query_timeout(parsed), started=started)
         handle.planned = time.monotonic()
+        handle.on_tick(on_tick)
         if isinstance(self.stream, KitchenCameraStream):
             region = query_plan.interpretation.task.region or self._remembered_region(parsed)
             self.stream.set_view(kitchen_view_for(region))
@@ -393,13 +415,20 @@ class AnsweringService:
         self._retire(self.engine.tasks.replace(TASK_SLOT, pipeline, restart=True))
         return handle
 
-    def answer(self, query: str | Query, *, stop: Callable[[], bool] | None = None) -> Outcome:
+    def answer(
+        self,
+        query: str | Query,
+        *,
+        stop: Callable[[], bool] | None = None,
+        on_tick: Callable[[TickProgress], None] | None = None,
+    ) -> Outcome:
         """Answer a one-shot query (detect, inspect, scan): plan, run once in the task slot, fuse, answer.
 
         ``stop`` is asked after every tick period (on the calling thread); when it holds before the tree finished,
         the tree is stopped (running experts are interrupted, nothing is fused) and QueryCancelledError is raised.
-        When the engine ticks in the background (a served instance) this waits for the task; otherwise the engine
-        ticks on the calling thread until the task ended.
+        ``on_tick`` hears every tick that ran the task (:meth:`TaskHandle.on_tick`). When the engine ticks in the
+        background (a served instance) this waits for the task; otherwise the engine ticks on the calling thread
+        until the task ended.
 
         Raises what :meth:`submit` raises, ValueError for a continuous kind (use :meth:`start`),
         PerceptionFailedError when the tree failed. When the query's timeout passes first, the answer is the
@@ -410,7 +439,7 @@ class AnsweringService:
         if self.mode_of(parsed) is not ExecutionMode.ONCE:
             raise ValueError(f"a {parsed.kind} query runs continuously; start it with start() and read its answers")
         timeout = query_timeout(parsed)
-        handle = self.submit(parsed)
+        handle = self.submit(parsed, on_tick=on_tick)
         if timeout is not None and time.monotonic() - started >= timeout:
             self.cancel(handle)  # the deadline passed while planning: answer from memory without running
             return Outcome(self._remembered(parsed, timed_out=True), handle.tree, handle.plan)
@@ -444,13 +473,14 @@ class AnsweringService:
         answer = answer_from_memory(self.store, belief_filter(query, self.kb), query.source, label_of=self.kb.label)
         return replace(answer, timed_out=timed_out)
 
-    def start(self, query: str | Query) -> TaskHandle:
+    def start(self, query: str | Query, *, on_tick: Callable[[TickProgress], None] | None = None) -> TaskHandle:
         """Start a continuous query (track): the engine ticks in the background and every run of the tree
-        yields an answer on the returned handle until it is cancelled or a run fails."""
+        yields an answer on the returned handle until it is cancelled or a run fails; ``on_tick`` hears every tick
+        that ran it (:meth:`TaskHandle.on_tick`)."""
         parsed = parse_query(query) if isinstance(query, str) else query
         if self.mode_of(parsed) is not ExecutionMode.CONTINUOUS:
             raise ValueError(f"a {parsed.kind} query ends with one answer; ask it with answer()")
-        handle = self.submit(parsed)
+        handle = self.submit(parsed, on_tick=on_tick)
         self.run_in_background()
         return handle
 
@@ -541,8 +571,10 @@ class AnsweringService:
             handle = self._current
         if handle is None or handle.done or self._slot.subtree is not handle.tree:
             return  # no task, or its tree is not in the slot yet (the swap is applied at the next tick)
-        if handle.first_tick is None and handle.tree.status is not Status.INVALID:
-            handle.first_tick = self.engine.tick_started
+        if handle.tree.status is not Status.INVALID:  # this tick ran the task's tree
+            if handle.first_tick is None:
+                handle.first_tick = self.engine.tick_started
+            handle._ticked(self.engine.tick_count)
         pipeline = handle.tree
         if perception_failure is not None:
             self._finish(handle, f"perception failed: {perception_failure}")

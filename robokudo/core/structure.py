@@ -1,10 +1,11 @@
-"""Static checks of a tree's structure, run when a tree is built or a subtree is inserted."""
+"""A tree's structure: static checks run when a tree is built or a subtree is inserted, and which leaves run."""
 
 from __future__ import annotations
 
 from collections import Counter
 
 import py_trees
+from py_trees.common import Status
 
 from robokudo.core.annotator import Annotator
 from robokudo.core.pipeline import Pipeline, StructureError, enclosing_pipeline, tree_root
@@ -43,3 +44,8 @@ def _pipeline_names_outside(root: py_trees.behaviour.Behaviour, excluded: py_tre
         if node is not excluded:
             stack.extend(node.children)
     return names
+
+
+def running_leaves(root: py_trees.behaviour.Behaviour) -> list[str]:
+    """The names of the leaves below ``root`` that are running, in tree order."""
+    return [node.name for node in root.iterate() if not node.children and node.status is Status.RUNNING]

@@ -63,12 +63,17 @@ def run(args: argparse.Namespace) -> int:
 
 
 def _wait(connection: ClientConnection) -> dict[str, Any]:
-    """Print feedback until the goal's result (or a server error about it) arrives; returns that message."""
+    """Print feedback until the goal's result (or a server error about it) arrives; returns that message.
+    The server sends feedback every tick; a line is printed only when it says something new."""
+    last_line = None
     for raw in connection:
         message = json.loads(raw)
         op = message.get("op")
         if op == "action_feedback" and message.get("id") == GOAL_ID:
-            print(_feedback_line(message.get("values", {})), file=sys.stderr, flush=True)
+            line = _feedback_line(message.get("values", {}))
+            if line != last_line:
+                print(line, file=sys.stderr, flush=True)
+                last_line = line
             continue
         ours = op == "action_result" and message.get("id") == GOAL_ID
         if ours or (op == "status" and message.get("level") == "error"):

@@ -17,12 +17,9 @@ from collections.abc import Callable
 from concurrent.futures import Future
 from typing import Any
 
-import py_trees
-from py_trees.common import Status
-
 from queries import Query, format_query, parse_query
 from robokudo.application.server.protocol import GoalStatus, action_feedback, action_result
-from robokudo.application.service import AnsweringService, ExecutionMode, QueryCancelledError
+from robokudo.application.service import AnsweringService, ExecutionMode, QueryCancelledError, TickProgress
 
 Send = Callable[[dict[str, Any]], None]
 
@@ -44,8 +41,6 @@ class Goal:
         self._lock = threading.Lock()
         self._stop: tuple[int, str] | None = None
         self._ended = False
-        self.last_running: list[str] | None = None
-        """The running leaves last reported in feedback (worker thread only)."""
 
     @property
     def ended(self) -> bool:
@@ -65,9 +60,14 @@ class Goal:
                 self._stop = (goal_status, reason)
 
     def feedback(self, values: dict[str, Any]) -> None:
-        """Send feedback unless the goal ended."""
-        if not self.ended:
-            self._send(action_feedback(self.id, values))
+        """Send feedback unless the goal ended (never after its result: both are sent under the goal's lock)."""
+        with self._lock:
+            if not self._ended:
+                self._send(action_feedback(self.id, values))
+
+    def progress(self, tick: TickProgress) -> None:
+        """Feedback for a tick that ran the goal's tree: the tick's number and the leaves still running."""
+        self.feedback({"phase": "running", "running": list(tick.running), "tick": tick.tick})
 
     def finish(self, goal_status: int, values: dict[str, Any]) -> bool:
         """Send the terminal result; False (nothing sent) when the goal had already ended."""
@@ -75,7 +75,7 @@ class Goal:
             if self._ended:
                 return False
             self._ended = True
-        self._send(action_result(self.id, goal_status, values))
+            self._send(action_result(self.id, goal_status, values))
         return True
 
     def finish_stopped(self) -> bool:
@@ -216,7 +216,7 @@ class GoalManager:
             if mode is ExecutionMode.CONTINUOUS:
                 self._run_continuous(goal)
                 return
-            outcome = self.service.answer(goal.query, stop=lambda: self._between_ticks(goal))
+            outcome = self.service.answer(goal.query, stop=lambda: self._between_ticks(goal), on_tick=goal.progress)
         except QueryCancelledError:
             goal.finish_stopped()
             return
@@ -229,7 +229,7 @@ class GoalManager:
             goal.finish(GoalStatus.SUCCEEDED, {**outcome.answer.to_dict(), "timing": dict(outcome.timing)})
 
     def _run_continuous(self, goal: Goal) -> None:
-        handle = self.service.start(goal.query)
+        handle = self.service.start(goal.query, on_tick=goal.progress)
         try:
             while True:
                 answer = handle.next_answer(timeout=POLL_SECONDS)
@@ -246,15 +246,6 @@ class GoalManager:
             handle.cancel()
 
     def _between_ticks(self, goal: Goal) -> bool:
-        """Run waiting jobs, send running-node feedback when it changed; True when the goal is to stop."""
+        """Run waiting jobs; True when the goal is to stop."""
         self._drain()
-        running = running_leaves(self.service.engine.root)
-        if running != goal.last_running:
-            goal.last_running = running
-            goal.feedback({"phase": "running", "running": running})
         return goal.stop_requested() is not None
-
-
-def running_leaves(root: py_trees.behaviour.Behaviour) -> list[str]:
-    """The names of the tree's leaves that are running."""
-    return [n.name for n in root.iterate() if not n.children and n.status is Status.RUNNING]
