@@ -50,7 +50,6 @@ def test_sigkill_at_random_points_keeps_the_store_sound_and_every_commit(tmp_pat
     rng = random.Random(20240611)
     committed: dict[int, int] = {}
     env = {**os.environ, "PYTHONPATH": str(REPO_ROOT)}
-    started = time.monotonic()
     for round_index in range(ROUNDS):
         writer = subprocess.Popen(
             [sys.executable, "-c", WRITER, str(path), str(round_index * 1_000_000)],
@@ -88,4 +87,3 @@ def test_sigkill_at_random_points_keeps_the_store_sound_and_every_commit(tmp_pat
     assert not missing, f"committed beliefs lost: {sorted(missing)[:10]}"
     regressed = {i: (n, stored[i]) for i, n in committed.items() if stored[i] < n}
     assert not regressed, f"committed updates lost: {regressed}"
-    assert time.monotonic() - started < 20.0
