@@ -24,7 +24,8 @@ when read, Text) a profile gets an agreement in [0, 1]:
   when the profile has no texts.
 
 Colour, shape, size, handle and open-top agreements are pulled toward 0.5 by the expert's confidence
-(``0.5 + (a - 0.5) * c``), so uncertain evidence counts less. The score is the weighted mean over the observed cues with :data:`WEIGHTS`
+(``0.5 + (a - 0.5) * c``), so uncertain evidence counts less. The score is the weighted mean over the observed
+cues with :data:`WEIGHTS`
 (text is strong evidence). The best match is the top score (among related profiles with that score, the most
 specific one with the most matched texts when text matched, lactose-free milk over milk; else the most general
 one: no evidence for a variant); its lead is how far it scores above the best profile not related to it.
