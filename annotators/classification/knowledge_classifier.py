@@ -72,10 +72,10 @@ WEIGHTS: Mapping[str, float] = MappingProxyType(
 )
 """How much each cue counts in the score."""
 
-HANDLE_HIDDEN = 0.3
+HANDLE_HIDDEN = 0.5
 """Handle agreement of a class with a handle when none was seen (it may be on the hidden side)."""
 
-NO_HANDLE = 0.7
+NO_HANDLE = 0.6
 """Handle agreement of a class without a handle when none was seen (most objects show none)."""
 
 RATIO_FALLOFF = 1.5
