@@ -3,20 +3,29 @@
 The planner passes one profile per candidate class as plain data::
 
     {"class": "Milk", "colors": ("white",), "shape": "box", "size": "medium", "texts": ("milk",),
+     "handle": False, "open_top": False, "height_to_width": (1.2, 4.0),
      "ancestors": ("Milk", "Drink", "FoodOrDrink", "PhysicalObject")}
 
-(colour, shape and size are the ontology's lower-case labels; any key but ``class`` may be missing or None).
+(colour, shape and size are the ontology's lower-case labels; the form cues - a handle, an open top, the range of
+height over width - are the ontology's ``rk:hasHandle``, ``rk:openTop``, ``rk:min/maxHeightToWidth``; any key but
+``class`` may be missing or None: the class may have any value).
 
-Scoring. For every cue the hypothesis carries (its most confident SemanticColor, Shape, Size and, when read,
-Text) a profile gets an agreement in [0, 1]:
+Scoring. For every cue the hypothesis carries (its most confident SemanticColor, Shape, Size, FormFeatures and,
+when read, Text) a profile gets an agreement in [0, 1]:
 
 * colour / shape: 1 when the profile lists the observed value, 0 when it lists others, 0.5 when it says nothing;
 * size class: 1 when equal, 0.25 when one class apart, 0 when two apart, 0.5 when the profile says nothing;
+* handle: 1 when both say there is one, 0 when one is seen on a class without, ``HANDLE_HIDDEN`` when none is
+  seen on a class with one (it may be behind), ``NO_HANDLE`` when neither has one, 0.5 when the profile says
+  nothing;
+* open top: 1 when equal, 0 when not, 0.5 when the profile says nothing;
+* height over width: 1 inside the profile's range, falling to 0 at ``RATIO_FALLOFF`` times beyond a bound;
 * text: the share of the profile's texts found in the read text (case and punctuation ignored), ``TEXT_NONE``
   when the profile has no texts.
 
-Colour, shape and size agreements are pulled toward 0.5 by the expert's confidence (``0.5 + (a - 0.5) * c``), so
-uncertain evidence counts less. The score is the weighted mean over the observed cues with :data:`WEIGHTS`
+Colour, shape, size, handle and open-top agreements are pulled toward 0.5 by the expert's confidence
+(``0.5 + (a - 0.5) * c``), so uncertain evidence counts less. The score is the weighted mean over the observed
+cues with :data:`WEIGHTS`
 (text is strong evidence). The best match is the top score (among related profiles with that score, the most
 specific one with the most matched texts when text matched, lactose-free milk over milk; else the most general
 one: no evidence for a variant); its lead is how far it scores above the best profile not related to it.
@@ -41,14 +50,36 @@ from dataclasses import dataclass
 from types import MappingProxyType
 from typing import ClassVar
 
+import numpy as np
+
 from annotators.classification.calibration import FITTED, Calibration
 from annotators.cloud.size import SIZE_CLASSES
 from robokudo.core.annotator import Annotator
 from robokudo.core.capability import Capability
-from robokudo.core.types import CasType, Classification, ObjectHypothesis, SemanticColor, Shape, Size, Text
+from robokudo.core.types import (
+    CasType,
+    Classification,
+    FormFeatures,
+    ObjectHypothesis,
+    SemanticColor,
+    Shape,
+    Size,
+    Text,
+)
 
-WEIGHTS: Mapping[str, float] = MappingProxyType({"color": 1.0, "shape": 1.0, "size": 0.5, "text": 3.0})
+WEIGHTS: Mapping[str, float] = MappingProxyType(
+    {"color": 1.0, "shape": 1.0, "size": 0.5, "handle": 1.0, "open": 0.5, "ratio": 1.0, "text": 3.0}
+)
 """How much each cue counts in the score."""
+
+HANDLE_HIDDEN = 0.5
+"""Handle agreement of a class with a handle when none was seen (it may be on the hidden side)."""
+
+NO_HANDLE = 0.6
+"""Handle agreement of a class without a handle when none was seen (most objects show none)."""
+
+RATIO_FALLOFF = 1.5
+"""Height over width this many times beyond a profile's bound agrees not at all (log-linear in between)."""
 
 TEXT_NONE = 0.4
 """Text agreement of a profile without texts when the object has readable text."""
@@ -81,6 +112,25 @@ def _names(value: object) -> tuple[str, ...]:
     return tuple(str(v).lower() for v in value if v)  # type: ignore[attr-defined]
 
 
+def _flag(data: Mapping[str, object], key: str) -> bool | None:
+    value = data.get(key)
+    if value is not None and not isinstance(value, bool):
+        raise ValueError(f"a profile's {key!r} must be true, false or missing, got {value!r}")
+    return value
+
+
+def _ratio_range(value: object) -> tuple[float, float] | None:
+    if value is None:
+        return None
+    try:
+        low, high = (float(v) for v in value)  # type: ignore[attr-defined]
+    except (TypeError, ValueError) as error:
+        raise ValueError(f"a profile's height_to_width must be (min, max), got {value!r}") from error
+    if not 0.0 <= low < high:
+        raise ValueError(f"a profile's height_to_width range must have 0 <= min < max, got {value!r}")
+    return low, high
+
+
 @dataclass(frozen=True)
 class Profile:
     """The typical properties of one candidate class (see the module docstring)."""
@@ -91,6 +141,9 @@ class Profile:
     size: str | None = None
     texts: tuple[str, ...] = ()
     ancestors: frozenset[str] = frozenset()
+    handle: bool | None = None
+    open_top: bool | None = None
+    height_to_width: tuple[float, float] | None = None
 
     @classmethod
     def from_mapping(cls, data: Mapping[str, object]) -> Profile:
@@ -108,6 +161,9 @@ class Profile:
             size=sizes[0] if sizes else None,
             texts=tuple(t for t in (compact(t) for t in _names(data.get("texts"))) if t),
             ancestors=frozenset(_names(data.get("ancestors"))) | {name.lower()},
+            handle=_flag(data, "handle"),
+            open_top=_flag(data, "open_top"),
+            height_to_width=_ratio_range(data.get("height_to_width")),
         )
 
     def related(self, other: Profile) -> bool:
@@ -124,6 +180,9 @@ class Cues:
     shape: tuple[str, float] | None = None
     size: tuple[str, float] | None = None
     text: str | None = None
+    handle: tuple[bool, float] | None = None
+    open_top: tuple[bool, float] | None = None
+    height_to_width: float | None = None
 
 
 @dataclass(frozen=True)
@@ -151,6 +210,22 @@ def _size_agreement(observed: str, listed: str | None) -> float:
     return (1.0, 0.25, 0.0)[abs(SIZE_CLASSES.index(observed) - SIZE_CLASSES.index(listed))]
 
 
+def _handle_agreement(seen: bool, listed: bool | None) -> float:
+    if listed is None:
+        return 0.5
+    if seen:
+        return 1.0 if listed else 0.0
+    return HANDLE_HIDDEN if listed else NO_HANDLE
+
+
+def _ratio_agreement(ratio: float, listed: tuple[float, float] | None) -> float:
+    if listed is None or not np.isfinite(ratio) or ratio <= 0.0:
+        return 0.5
+    low, high = listed
+    beyond = max(np.log(low / ratio) if low > 0 else 0.0, np.log(ratio / high) if np.isfinite(high) else 0.0, 0.0)
+    return float(max(0.0, 1.0 - beyond / np.log(RATIO_FALLOFF)))
+
+
 def score(profile: Profile, cues: Cues) -> Match:
     """The weighted agreement of a profile with a hypothesis's cues (see the module docstring)."""
     total = weight = 0.0
@@ -166,6 +241,18 @@ def score(profile: Profile, cues: Cues) -> Match:
     if cues.size is not None:
         total += WEIGHTS["size"] * _toward_neutral(_size_agreement(cues.size[0], profile.size), cues.size[1])
         weight += WEIGHTS["size"]
+    if cues.handle is not None:
+        agreement = _handle_agreement(cues.handle[0], profile.handle)
+        total += WEIGHTS["handle"] * _toward_neutral(agreement, cues.handle[1])
+        weight += WEIGHTS["handle"]
+    if cues.open_top is not None:
+        listed = profile.open_top
+        agreement = 0.5 if listed is None else float(listed == cues.open_top[0])
+        total += WEIGHTS["open"] * _toward_neutral(agreement, cues.open_top[1])
+        weight += WEIGHTS["open"]
+    if cues.height_to_width is not None:
+        total += WEIGHTS["ratio"] * _ratio_agreement(cues.height_to_width, profile.height_to_width)
+        weight += WEIGHTS["ratio"]
     if cues.text:
         read = compact(cues.text)
         found = sum(1 for text in profile.texts if text in read)
@@ -264,9 +351,9 @@ def decide(
 
 
 class KnowledgeClassifier(Annotator):
-    """Names each hypothesis' class from its colour, shape, size and text, compared with candidate profiles."""
+    """Names each hypothesis' class from its colour, shape, size, form and text, compared with candidate profiles."""
 
-    inputs: ClassVar[tuple[type[CasType], ...]] = (ObjectHypothesis, SemanticColor, Shape, Size)
+    inputs: ClassVar[tuple[type[CasType], ...]] = (ObjectHypothesis, SemanticColor, Shape, Size, FormFeatures)
     optional_inputs: ClassVar[tuple[type[CasType], ...]] = (Text,)
     outputs: ClassVar[tuple[type[CasType], ...]] = (Classification,)
     capability: ClassVar[Capability] = Capability(
@@ -297,11 +384,15 @@ class KnowledgeClassifier(Annotator):
         shape = max(self.attached(hypothesis, Shape), key=lambda a: a.confidence, default=None)
         size = max(self.attached(hypothesis, Size), key=lambda a: a.confidence, default=None)
         texts = [t.text for t in self.attached(hypothesis, Text) if t.text.strip()]
+        form = max(self.attached(hypothesis, FormFeatures), key=lambda a: a.confidence, default=None)
         return Cues(
             color=(color.color, color.confidence) if color is not None else None,
             shape=(shape.shape, shape.confidence) if shape is not None else None,
             size=(size.size_class, size.confidence) if size is not None else None,
             text=" ".join(texts) or None,
+            handle=(form.has_handle, form.handle_confidence) if form is not None else None,
+            open_top=(form.open_top, form.open_confidence) if form is not None else None,
+            height_to_width=form.height_to_width if form is not None else None,
         )
 
     def decide(self, cues: Cues) -> Decision:

@@ -1,16 +1,20 @@
 """Matching words asked for against text an OCR expert read: containment, case ignored, OCR errors tolerated.
 
 ``text_matches("lactose free", "MILK lactose free")`` holds: every asked word must be found among the read words
-within an edit distance of ``len(word) // OCR_LETTERS_PER_ERROR``, anywhere in the read text with its spaces
-removed (OCR splits and joins words); a word shorter than that must be read exactly, as a word of its own.
+within an edit distance of ``len(word) // OCR_LETTERS_PER_ERROR`` ("CHEEL" is read "CHEEZ"), anywhere in the read
+text with its spaces removed (OCR splits and joins words); a word shorter than ``MIN_JOINED_LETTERS`` must be read
+exactly, as a word of its own ("tea" is not found in "steak").
 """
 
 from __future__ import annotations
 
 import re
 
-OCR_LETTERS_PER_ERROR = 4
+OCR_LETTERS_PER_ERROR = 5
 """One wrong, missing or extra character is tolerated per this many letters of an asked word."""
+
+MIN_JOINED_LETTERS = 4
+"""An asked word of at least this many letters is also found inside a longer read word (OCR joined words)."""
 
 _WORD = re.compile(r"[0-9a-z]+")
 
@@ -33,11 +37,9 @@ def substring_distance(word: str, text: str) -> int:
 
 def word_found(word: str, read: list[str]) -> bool:
     """True when ``word`` occurs in the read words, within its tolerated number of OCR errors."""
-    allowed = len(word) // OCR_LETTERS_PER_ERROR
-    joined = "".join(read)
-    if allowed == 0:
+    if len(word) < MIN_JOINED_LETTERS:
         return word in read
-    return substring_distance(word, joined) <= allowed
+    return substring_distance(word, "".join(read)) <= len(word) // OCR_LETTERS_PER_ERROR
 
 
 def text_matches(wanted: str, read: str) -> bool:

@@ -11,6 +11,7 @@ from __future__ import annotations
 from collections import defaultdict, deque
 from collections.abc import Container, Mapping
 from dataclasses import dataclass
+from decimal import Decimal
 from pathlib import Path
 
 from rdflib import BNode, Graph, Literal, URIRef
@@ -44,6 +45,10 @@ PROFILE_PROPERTIES: Mapping[str, tuple[str, Kind | None]] = {
     "transparent": ("transparent", None),
     "printedText": ("texts", None),
     "brand": ("brand", None),
+    "hasHandle": ("handle", None),
+    "openTop": ("open_top", None),
+    "minHeightToWidth": ("min_height_to_width", None),
+    "maxHeightToWidth": ("max_height_to_width", None),
 }
 """Restriction property -> (profile field, kind of its filler class, None for literal values)."""
 
@@ -59,7 +64,32 @@ DOMAIN_PROPERTIES: Mapping[str, Kind] = {
 PRECONDITION_KEYS: frozenset[str] = frozenset({"depth", "region", "opaque", "model"})
 """The condition keys the planner knows how to evaluate."""
 
-_SINGLE_FIELDS = ("shape", "size_class", "material", "stored_in", "transparent", "brand")
+_SINGLE_FIELDS = (
+    "shape",
+    "size_class",
+    "material",
+    "stored_in",
+    "transparent",
+    "brand",
+    "handle",
+    "open_top",
+    "min_height_to_width",
+    "max_height_to_width",
+)
+_BOOLEAN_FIELDS = ("transparent", "handle", "open_top")
+_NUMBER_FIELDS = ("min_height_to_width", "max_height_to_width")
+
+
+def _ratio_range(name: str, values: Mapping[str, object], problems: list[str]) -> tuple[float, float] | None:
+    """The class's height-to-width range from its (inherited) minimum and maximum; a missing bound is open."""
+    low, high = values.get("min_height_to_width"), values.get("max_height_to_width")
+    if low is None and high is None:
+        return None
+    bounds = (float(low) if low is not None else 0.0, float(high) if high is not None else float("inf"))  # type: ignore[arg-type]
+    if not 0.0 <= bounds[0] < bounds[1]:
+        problems.append(f"{name}: height-to-width range {bounds} is empty or negative")
+        return None
+    return bounds
 
 
 @dataclass(frozen=True)
@@ -326,10 +356,18 @@ class _Builder:
                     self.problems.append(f"{name}: rk:{prop_name} needs 'value' with a literal")
                     continue
                 python_value = value.toPython()
-                if field_name == "transparent" and not isinstance(python_value, bool):
-                    self.problems.append(f"{name}: rk:transparent must be true or false, not {value!s}")
-                    continue
-                own[field_name].append(python_value if field_name == "transparent" else str(value))
+                if field_name in _BOOLEAN_FIELDS:
+                    if not isinstance(python_value, bool):
+                        self.problems.append(f"{name}: rk:{prop_name} must be true or false, not {value!s}")
+                        continue
+                    own[field_name].append(python_value)
+                elif field_name in _NUMBER_FIELDS:
+                    if isinstance(python_value, bool) or not isinstance(python_value, (int, float, Decimal)):
+                        self.problems.append(f"{name}: rk:{prop_name} must be a number, not {value!s}")
+                        continue
+                    own[field_name].append(float(python_value))
+                else:
+                    own[field_name].append(str(value))
         for field_name in _SINGLE_FIELDS:
             if len(set(own.get(field_name, ()))) > 1:
                 values = sorted(map(str, own[field_name]))
@@ -375,6 +413,9 @@ class _Builder:
                 texts=tuple(texts),
                 brand=values.get("brand"),  # type: ignore[arg-type]
                 origins=tuple(origins),
+                handle=values.get("handle"),  # type: ignore[arg-type]
+                open_top=values.get("open_top"),  # type: ignore[arg-type]
+                height_to_width=_ratio_range(name, values, self.problems),
             )
         return profiles
 

@@ -54,6 +54,10 @@ class ObjectProfile:
     texts: tuple[str, ...]
     brand: str | None
     origins: tuple[tuple[str, str], ...] = ()
+    handle: bool | None = None
+    open_top: bool | None = None
+    height_to_width: tuple[float, float] | None = None
+    """Form features: a handle on the side, open at the top, the (min, max) of height over width; None: any."""
 
     def origin(self, field: str) -> str | None:
         """The class that declares ``field`` for this profile (None when the field is unset)."""

@@ -42,7 +42,7 @@ def class_profiles(kb: KnowledgeBase) -> tuple[dict[str, object], ...]:
     profiles = []
     for name in kb.names_of_kind("class"):
         profile = kb.object_profile(name)
-        if not (profile.colors or profile.shape or profile.size_class or profile.texts):
+        if not (profile.colors or profile.shape or profile.size_class or profile.texts or profile.height_to_width):
             continue
         profiles.append(
             {
@@ -51,6 +51,9 @@ def class_profiles(kb: KnowledgeBase) -> tuple[dict[str, object], ...]:
                 "shape": kb.label(profile.shape) if profile.shape else None,
                 "size": kb.label(profile.size_class) if profile.size_class else None,
                 "texts": profile.texts,
+                "handle": profile.handle,
+                "open_top": profile.open_top,
+                "height_to_width": profile.height_to_width,
                 "ancestors": (name, *kb.superclasses(name)),
             }
         )

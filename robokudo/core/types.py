@@ -243,6 +243,19 @@ class SemanticColor(Annotation):
 
 
 @dataclass(eq=False, kw_only=True)
+class FormFeatures(Annotation):
+    """What the object's form says for telling classes apart: its height over its width (upright), whether a
+    handle sticks out of its side and whether it is open at the top (a cavity seen inside), each yes/no with the
+    evidence's confidence in [0, 1] (0: not seen)."""
+
+    height_to_width: float
+    has_handle: bool
+    handle_confidence: float
+    open_top: bool
+    open_confidence: float
+
+
+@dataclass(eq=False, kw_only=True)
 class ColorHistogram(Annotation):
     """A normalised hue/saturation histogram of the object's pixels."""
 

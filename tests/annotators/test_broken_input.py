@@ -23,6 +23,7 @@ from annotators.classification.knowledge_classifier import KnowledgeClassifier
 from annotators.cloud.clusters import ClusterExtractor
 from annotators.cloud.clutter import ClutterSegmenter
 from annotators.cloud.filters import CropBoxFilter, RangeFilter, RegionFilter
+from annotators.cloud.form import FormAnnotator
 from annotators.cloud.normals import NormalEstimator
 from annotators.cloud.people import DepthPeopleDetector
 from annotators.cloud.plane import SupportPlaneSegmenter
@@ -179,6 +180,7 @@ BROKEN_CASES: dict[str, tuple[Callable[[], Seeds], tuple[type[Annotator], ...]]]
             PoseAnnotator,
             ShapeAnnotator,
             SizeAnnotator,
+            FormAnnotator,
             TextReader,
             OnnxDetector,
             ImageRegionSegmenter,
@@ -265,7 +267,7 @@ BROKEN_CASES: dict[str, tuple[Callable[[], Seeds], tuple[type[Annotator], ...]]]
     ),
     "hypothesis without valid points": (
         lambda: [nan_cloud(), nan_normals(), hypothesis(), CameraInfo(K)],
-        (PoseAnnotator, ShapeAnnotator, SizeAnnotator),
+        (PoseAnnotator, ShapeAnnotator, SizeAnnotator, FormAnnotator),
     ),
     "normals and cloud sizes differ": (
         lambda: [flat_cloud(), Normals(np.zeros((H // 2, W, 3), np.float32)), hypothesis()],

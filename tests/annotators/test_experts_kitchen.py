@@ -8,6 +8,7 @@ import pytest
 from py_trees.common import Status
 
 from annotators.classification.knowledge_classifier import KnowledgeClassifier
+from annotators.cloud.form import FormAnnotator
 from annotators.cloud.normals import NormalEstimator
 from annotators.cloud.shape import ShapeAnnotator
 from annotators.cloud.size import SizeAnnotator
@@ -56,6 +57,7 @@ def run_view(view: str, kb: KnowledgeBase) -> tuple[Pipeline, RenderedScene]:
     )
     root.add_child(describe)
     root.add_child(ShapeAnnotator())
+    root.add_child(FormAnnotator())
     root.add_child(TextReader())
     root.add_child(KnowledgeClassifier(profiles(kb)))
     status = Engine(root, hz=200.0).run(ticks=4000, until=lambda s: s is not Status.RUNNING)

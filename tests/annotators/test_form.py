@@ -1,0 +1,114 @@
+"""Form features (issue 15, item 6): a handle, an open top and height over width, measured on synthetic shapes,
+and the knowledge classifier telling a mug from a cup by them with the ontology's profiles."""
+
+from __future__ import annotations
+
+import numpy as np
+import pytest
+
+from annotators.classification.knowledge_classifier import Cues, Profile, score
+from annotators.cloud.form import measure_form
+from annotators.geometry.support_frame import SupportFrame
+
+FRAME = SupportFrame(np.eye(4), on_plane=True, guessed=False)
+"""Upright frame with the camera above its origin; objects stand at y = 0.8 m, looking away from the camera."""
+CENTRE = np.array([0.0, 0.8])
+
+
+def side(radius: float, height: float, rng: np.random.Generator, n: int = 1500) -> np.ndarray:
+    """Points of the near half of an upright cylinder's side (the half facing the camera at the origin)."""
+    angles = rng.uniform(np.pi, 2 * np.pi, n)  # facing -y, toward the camera
+    z = rng.uniform(0.0, height, n)
+    return np.column_stack([CENTRE[0] + radius * np.cos(angles), CENTRE[1] + radius * np.sin(angles), z])
+
+
+def handle(radius: float, height: float, rng: np.random.Generator, n: int = 200) -> np.ndarray:
+    """A loop handle on the +x side, from 30 % to 85 % of the height, reaching 2.5 cm out."""
+    t = rng.uniform(0.0, np.pi, n)
+    reach = radius + 0.025 * np.sin(t)
+    z = height * (0.575 + 0.275 * np.cos(t))
+    return np.column_stack([CENTRE[0] + reach + 0.003, CENTRE[1] + rng.uniform(-0.005, 0.005, n), z])
+
+
+def inner_far_wall(radius: float, height: float, rng: np.random.Generator, n: int = 400) -> np.ndarray:
+    """The inside of the far half of an open cylinder, seen over its near rim (upper half of the height)."""
+    angles = rng.uniform(0.1, np.pi - 0.1, n)
+    z = rng.uniform(0.4 * height, height, n)
+    inner = radius - 0.003
+    return np.column_stack([CENTRE[0] + inner * np.cos(angles), CENTRE[1] + inner * np.sin(angles), z])
+
+
+def lid(radius: float, height: float, rng: np.random.Generator, n: int = 400) -> np.ndarray:
+    r = radius * np.sqrt(rng.uniform(0, 1, n))
+    a = rng.uniform(0, 2 * np.pi, n)
+    return np.column_stack([CENTRE[0] + r * np.cos(a), CENTRE[1] + r * np.sin(a), np.full(n, height)])
+
+
+@pytest.mark.parametrize("seed", range(5))
+def test_a_mug_has_a_handle_and_is_open_a_can_has_neither(seed: int) -> None:
+    rng = np.random.default_rng(seed)
+    mug = measure_form(np.vstack([side(0.04, 0.1, rng), handle(0.04, 0.1, rng), inner_far_wall(0.04, 0.1, rng)]), FRAME)
+    cup = measure_form(np.vstack([side(0.04, 0.1, rng), inner_far_wall(0.04, 0.1, rng)]), FRAME)
+    can = measure_form(np.vstack([side(0.035, 0.1, rng), lid(0.035, 0.1, rng)]), FRAME)
+    assert mug is not None and cup is not None and can is not None
+    assert mug.has_handle and mug.handle_confidence > 0.5 and mug.open_top
+    assert not cup.has_handle and cup.open_top
+    assert not can.has_handle
+    assert cup.height_to_width == pytest.approx(0.1 / 0.08, rel=0.1)
+    assert mug.height_to_width < cup.height_to_width  # the handle widens it
+
+
+@pytest.mark.xfail(strict=True, reason="open top: the far half is taken beyond the footprint's median, which a "
+                   "closed cylinder's lateral sides reach too (a known limit of the open-top cue)")
+def test_a_closed_can_is_not_open() -> None:
+    rng = np.random.default_rng(3)
+    can = measure_form(np.vstack([side(0.035, 0.1, rng), lid(0.035, 0.1, rng)]), FRAME)
+    assert can is not None and not can.open_top
+
+
+def test_a_wide_base_is_no_handle_and_a_bowl_is_flat_for_its_width() -> None:
+    rng = np.random.default_rng(7)
+    base = side(0.06, 0.02, rng, 600)  # a foot wider than the body, e.g. a vase
+    body = side(0.04, 0.12, rng)
+    body = body[body[:, 2] > 0.02]
+    vase = measure_form(np.vstack([base, body]), FRAME)
+    assert vase is not None and not vase.has_handle
+    bowl = measure_form(np.vstack([side(0.08, 0.06, rng), inner_far_wall(0.08, 0.06, rng)]), FRAME)
+    assert bowl is not None and bowl.height_to_width < 0.5 and bowl.open_top
+
+
+def test_too_few_points_measure_nothing() -> None:
+    assert measure_form(np.zeros((5, 3)), FRAME) is None
+
+
+MUG = Profile.from_mapping(
+    {"class": "Mug", "shape": "cylinder", "handle": True, "open_top": True, "height_to_width": (0.7, 1.4)}
+)
+CUP = Profile.from_mapping(
+    {"class": "Cup", "shape": "cylinder", "handle": False, "open_top": True, "height_to_width": (0.8, 1.6)}
+)
+BOWL = Profile.from_mapping(
+    {"class": "Bowl", "shape": "sphere", "handle": False, "open_top": True, "height_to_width": (0.15, 0.8)}
+)
+CAN = Profile.from_mapping(
+    {"class": "CannedFood", "shape": "cylinder", "handle": False, "open_top": False, "height_to_width": (0.5, 2.0)}
+)
+
+
+def best(cues: Cues) -> str:
+    return max((score(p, cues) for p in (MUG, CUP, BOWL, CAN)), key=lambda m: m.score).profile.class_name
+
+
+def test_the_form_cues_tell_a_mug_a_cup_a_bowl_and_a_can_apart_without_the_query() -> None:
+    cylinder = {"shape": ("cylinder", 0.8), "color": ("green", 0.9)}
+    assert best(Cues(**cylinder, handle=(True, 1.0), open_top=(True, 1.0), height_to_width=1.0)) == "Mug"
+    assert best(Cues(**cylinder, handle=(False, 1.0), open_top=(True, 1.0), height_to_width=1.2)) == "Cup"
+    assert best(Cues(**cylinder, handle=(False, 1.0), open_top=(False, 1.0), height_to_width=1.5)) == "CannedFood"
+    assert best(Cues(shape=("cylinder", 0.5), handle=(False, 1.0), open_top=(True, 1.0), height_to_width=0.4)) == "Bowl"
+
+
+def test_profiles_refuse_malformed_form_features() -> None:
+    with pytest.raises(ValueError):
+        Profile.from_mapping({"class": "Mug", "handle": "yes"})
+    with pytest.raises(ValueError):
+        Profile.from_mapping({"class": "Mug", "height_to_width": (1.4, 0.7)})
