@@ -22,19 +22,20 @@ class ClusterError(Exception):
     """No cluster to work on: Ray is missing or the address cannot be reached (the message says which)."""
 
 
-def ray_module() -> ModuleType:
-    """The ``ray`` module; ClusterError with the install hint without it."""
+def ray_module(purpose: str = "this") -> ModuleType:
+    """The ``ray`` module; ClusterError (``PURPOSE needs Ray``, with the install hint) without it."""
     try:
         return require_ray()
     except PlacementError:
-        raise ClusterError(INSTALL_HINT) from None
+        raise ClusterError(f"{purpose} needs Ray. {INSTALL_HINT}") from None
 
 
 @contextmanager
-def ray_cluster(address: str | None = None, num_cpus: int | None = None) -> Iterator[ModuleType]:
+def ray_cluster(address: str | None = None, num_cpus: int | None = None, purpose: str = "this") -> Iterator[ModuleType]:
     """Connected to the cluster at ``address`` (None: a new local cluster with ``num_cpus`` CPUs) for the block;
-    yields the ``ray`` module. ClusterError without Ray or when the cluster cannot be reached."""
-    ray = ray_module()
+    yields the ``ray`` module. ClusterError without Ray (``PURPOSE needs Ray``) or when the cluster cannot be
+    reached."""
+    ray = ray_module(purpose)
     if ray.is_initialized():
         yield ray
         return

@@ -32,6 +32,7 @@ import contextlib
 import copy
 import functools
 import os
+import time
 from collections.abc import Collection, Hashable
 from dataclasses import dataclass, replace
 from types import ModuleType
@@ -46,7 +47,7 @@ from robokudo.core.placement import Placement
 from robokudo.core.threaded import ThreadedAnnotator
 from robokudo.core.types import Annotation, CasType, ObjectHypothesis, View
 
-INSTALL_HINT = "running experts on other machines needs Ray: pip install 'robokudo[ray]' (or ray)"
+INSTALL_HINT = "Ray is not installed: pip install 'robokudo[ray]' (or ray)"
 
 POLL_SECONDS = 0.05
 """How often a waiting worker checks whether its run was cancelled."""
@@ -64,7 +65,7 @@ def require_ray() -> ModuleType:
     try:
         import ray
     except ImportError:
-        raise PlacementError(INSTALL_HINT) from None
+        raise PlacementError(f"remote experts need Ray. {INSTALL_HINT}") from None
     return ray
 
 
@@ -177,6 +178,7 @@ class RemoteAnnotator(ThreadedAnnotator):
         self.recipe = recipe
         self.where = placement
         self._actor: Any = None
+        self._actor_failed = False
 
     def actor(self) -> Any:
         """The Ray actor handle (started on first use; shared through this node's resources)."""
@@ -229,22 +231,17 @@ class RemoteAnnotator(ThreadedAnnotator):
         ray = require_ray()
         views, sent, local = self._inputs()
         actor = self.actor()
-        pending = actor.analyse.remote((views, sent))
-        del views, sent
+        if self._actor_failed:
+            self._await_restart(ray, actor)
         try:
-            while not ray.wait([pending], timeout=POLL_SECONDS)[0]:
-                if self.cancelled:  # raises RunCancelledError once the run is cancelled
-                    break
-            status, message, writes = ray.get(pending)
-        except RunCancelledError:
-            _cancel(ray, pending)
-            raise
+            status, message, writes = self._wait(ray, actor.analyse.remote((views, sent)))
         except ray.exceptions.RayTaskError as error:
             cause = getattr(error, "cause", None)
             if isinstance(cause, PortError | StructureError | NotImplementedError):
                 raise cause from None
             self.fail(f"remote {self.name} raised {_summary(error)}")
         except (ray.exceptions.RayActorError, ray.exceptions.ActorUnavailableError) as error:
+            self._actor_failed = True
             self.fail(f"remote actor of {self.name} died: {_summary(error)}")
         except ray.exceptions.RayError as error:
             self.fail(f"remote {self.name} failed: {type(error).__name__}: {_summary(error)}")
@@ -258,6 +255,31 @@ class RemoteAnnotator(ThreadedAnnotator):
                 if not 0 <= index < len(local) or not isinstance(local[index], ObjectHypothesis):
                     self.fail(f"remote {self.name} attached to hypothesis {index}, which it was not sent")
                 self.attach(local[index], annotation)  # type: ignore[arg-type]
+
+    def _wait(self, ray: ModuleType, pending: Any) -> Any:
+        """The result of the call ``pending``, polling this run's cancel flag meanwhile (a cancelled run asks Ray
+        to cancel the call and ends with RunCancelledError)."""
+        try:
+            while not ray.wait([pending], timeout=POLL_SECONDS)[0]:
+                if self.cancelled:  # raises RunCancelledError once the run is cancelled
+                    break
+        except RunCancelledError:
+            _cancel(ray, pending)
+            raise
+        return ray.get(pending)
+
+    def _await_restart(self, ray: ModuleType, actor: Any) -> None:
+        """After the actor died: wait until Ray has restarted it (a call sent while it restarts would fail)."""
+        while True:
+            try:
+                self._wait(ray, actor.process_id.remote())
+            except ray.exceptions.ActorUnavailableError:
+                time.sleep(POLL_SECONDS)
+                continue
+            except ray.exceptions.RayActorError as error:
+                self.fail(f"remote actor of {self.name} is gone: {_summary(error)}")
+            self._actor_failed = False
+            return
 
     def stop_actor(self) -> None:
         """End the actor's process now (an actor also ends when the last handle to it is gone)."""

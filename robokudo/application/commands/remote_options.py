@@ -64,7 +64,7 @@ def check_remote_options(args: argparse.Namespace, classes: Iterable[type[Annota
             raise RemoteOptionError("--remote-cpus, --remote-gpus and --address go with --remote NAME")
         return None
     try:
-        ray_module()
+        ray_module("--remote")
     except ClusterError as error:
         raise RemoteOptionError(str(error)) from None
     return hints
@@ -76,7 +76,7 @@ def remote_cluster(
     """The cluster the options ask for, connected for the block (nothing when no annotator runs remotely)."""
     if not args.remote and not any(cls.placement.remote for cls in classes):
         return contextlib.nullcontext()
-    return ray_cluster(args.address)
+    return ray_cluster(args.address, purpose="--remote")
 
 
 def unknown_names(names: Iterable[str], known: Iterable[str]) -> list[str]:
