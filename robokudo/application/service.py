@@ -35,7 +35,7 @@ from __future__ import annotations
 import queue
 import threading
 import time
-from collections.abc import Callable, Iterator, Mapping
+from collections.abc import Callable, Collection, Iterator, Mapping
 from dataclasses import dataclass, field, replace
 from enum import Enum
 from pathlib import Path
@@ -59,6 +59,8 @@ from robokudo.application.sensor_sources import kitchen_view_for, served_source
 from robokudo.core.composites import Sequence
 from robokudo.core.engine import Engine
 from robokudo.core.pipeline import Pipeline
+from robokudo.core.placement import Placement
+from robokudo.core.remote import place_remote
 from robokudo.core.resources import SharedResources
 from robokudo.core.slot import Idle, TaskSlot
 from robokudo.core.structure import running_leaves
@@ -275,6 +277,8 @@ class AnsweringService:
         hz: float = 100.0,
         intrinsics: CameraIntrinsics | None = None,
         stream: FrameStream | None = None,
+        remote: Collection[str] = (),
+        remote_hints: Placement | None = None,
     ) -> None:
         self.kb = kb
         self.intrinsics = intrinsics
@@ -285,7 +289,10 @@ class AnsweringService:
         self.stream = stream
         self.planner = QueryPlanner(kb)
         self.resources = SharedResources()
-        """Loaded models shared by every task's tree (the first task loads them)."""
+        """Loaded models shared by every task's tree (the first task loads them), and remote experts' actors."""
+        self.remote = frozenset(remote)
+        """Annotators (class names) every task's tree runs on Ray actors, besides those whose class says so."""
+        self.remote_hints = remote_hints
         self._idle = Idle(reason="no task: the engine keeps perceiving until the next one")
         self._slot = TaskSlot(TASK_SLOT)
         self._slot.set_subtree(self._idle)
@@ -317,9 +324,12 @@ class AnsweringService:
         catalog: AnnotatorCatalog | None = None,
         intrinsics: CameraIntrinsics | None = None,
         stream: FrameStream | None = None,
+        remote: Collection[str] = (),
+        remote_hints: Placement | None = None,
     ) -> AnsweringService:
         """A service over the shipped and user ontology and the belief store at ``store_path`` (default store
-        when None), with the annotators of ``catalog`` (default: this project's).
+        when None), with the annotators of ``catalog`` (default: this project's); the annotators named in
+        ``remote`` run on Ray actors (with ``remote_hints``, default their classes' placement hints).
 
         The store is opened (and checked) first, so an unusable store raises BeliefStoreError before the
         knowledge base is loaded or anything runs.
@@ -332,7 +342,16 @@ class AnsweringService:
             store.close()
             raise
         return cls(
-            kb, store, catalog=catalog, input_path=input_path, frame=frame, hz=hz, stream=stream, intrinsics=intrinsics
+            kb,
+            store,
+            catalog=catalog,
+            input_path=input_path,
+            frame=frame,
+            hz=hz,
+            stream=stream,
+            intrinsics=intrinsics,
+            remote=remote,
+            remote_hints=remote_hints,
         )
 
     # ------------------------------------------------------------------ planning
@@ -370,7 +389,8 @@ class AnsweringService:
         return ids
 
     def tree(self, query: Query, query_plan: QueryPlan) -> Pipeline:
-        """The Pipeline answering ``query``: the synthesized experts, then the answer step into this store."""
+        """The Pipeline answering ``query``: the synthesized experts (those to run remotely placed on their
+        actors), then the answer step into this store."""
         step = AnswerStep(
             self.store,
             tracker=BeliefTracker(class_test=kb_class_test(self.kb), regions=self.kb.regions()),
@@ -379,9 +399,11 @@ class AnsweringService:
             on_integrated=self._beliefs_changed,
         )
         step.reason = ANSWER_REASON
-        return build_tree(
+        tree = build_tree(
             query_plan.plan, final_steps=[step], query=query, catalog=self.catalog, resources=self.resources
         )
+        place_remote(tree, self.remote, self.remote_hints)
+        return tree
 
     # ------------------------------------------------------------------ running
 

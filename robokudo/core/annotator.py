@@ -26,6 +26,7 @@ from robokudo.core.capability import Capability
 from robokudo.core.cas import CAS, AddAnnotation, AttachAnnotation, CasWrite, SetView
 from robokudo.core.explained import Explained
 from robokudo.core.pipeline import Pipeline, StructureError, enclosing_pipeline, pipeline_named, tree_root
+from robokudo.core.placement import Placement
 from robokudo.core.resources import SharedResources
 from robokudo.core.stats import RunStats
 from robokudo.core.types import Annotation, CasType, ObjectHypothesis, View
@@ -69,13 +70,16 @@ class Annotator(Explained, py_trees.behaviour.Behaviour):
     ``inputs`` must be in the CAS before it runs (the data-flow validator checks this); ``optional_inputs``
     are used when present; ``outputs`` are what it may write. ``capability`` says which values it can report,
     what it needs, what it costs and how reliable it is (the defaults: any value, no preconditions, 10 ms,
-    reliability 0.5); the planner chooses experts from these declarations.
+    reliability 0.5); the planner chooses experts from these declarations. ``placement`` says where it runs.
     """
 
     inputs: ClassVar[tuple[type[CasType], ...]] = ()
     optional_inputs: ClassVar[tuple[type[CasType], ...]] = ()
     outputs: ClassVar[tuple[type[CasType], ...]] = ()
     capability: ClassVar[Capability] = Capability()
+    placement: ClassVar[Placement] = Placement()
+    """Where it runs: locally (the default) or, with ``Placement(remote=True, ...)``, on a Ray actor whenever a tree
+    holding it is placed (:func:`robokudo.core.remote.place_remote`)."""
 
     def __init__(self, name: str | None = None) -> None:
         super().__init__(name=name or type(self).__name__)

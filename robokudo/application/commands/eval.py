@@ -5,7 +5,9 @@ folder of them. For each scene it prints the objects and segments, the objects f
 (recall and precision), the overlap and boundary precision / recall / F-measure of the unseen-object-segmentation
 literature (Hungarian matching, see :mod:`reasoning.evaluation.segmentation`) and the segmentation time; then the
 same per category (mOSD: from the scene number; other files: their folder) and overall. ``--json`` prints one
-JSON document instead. Exit status 0, or 2 for a path that is no labelled frame or an unknown segmenter.
+JSON document instead. ``--workers N`` scores N scenes at a time as Ray tasks, on a local cluster or the one at
+``--address`` (the scene files must be readable at the same path there): the same figures as in one process.
+Exit status 0, or 2 for a path that is no labelled frame, an unknown segmenter, or ``--workers`` without Ray.
 """
 
 from __future__ import annotations
@@ -23,6 +25,8 @@ from annotators.readers.frame_io import FrameError
 from annotators.readers.frame_readers import PcdReader
 from reasoning.evaluation.mosd import object_labels, scene_category
 from reasoning.evaluation.segmentation import ScoreSummary, SegmentationScore, score_segmentation, summarize
+from robokudo.application.cluster import ClusterError
+from robokudo.application.parallel import map_on_cluster, run_in_order
 from trees.segmenters import SEGMENTERS, segmenter
 
 HELP = "score a segmentation against labelled frames"
@@ -42,6 +46,18 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
         help="what segments the frames: " + "; ".join(f"{s.name}: {s.description}" for s in SEGMENTERS.values()),
     )
     segmentation.add_argument("--json", action="store_true", help="print the scores as JSON")
+    segmentation.add_argument(
+        "--workers",
+        type=int,
+        default=1,
+        metavar="N",
+        help="score N scenes at a time as Ray tasks (needs robokudo[ray]; default 1: in this process)",
+    )
+    segmentation.add_argument(
+        "--address",
+        metavar="ADDRESS",
+        help="the Ray cluster for --workers: ray://HOST:10001 or HOST:6379 (default: a local cluster with N CPUs)",
+    )
 
 
 @dataclass(frozen=True)
@@ -88,9 +104,24 @@ def score_scene(path: Path, segmenter_name: str) -> SceneResult:
 
 def run(args: argparse.Namespace) -> int:
     """Score the scenes and print the results; 2 for bad paths or unlabelled files."""
+    if args.workers < 1:
+        print(f"robokudo eval: --workers must be at least 1, got {args.workers}", file=sys.stderr)
+        return 2
     try:
-        results = [score_scene(path, args.segmenter) for path in scene_files(args.paths)]
-    except (ValueError, FrameError) as error:
+        files = scene_files(args.paths)
+        if args.workers == 1 and args.address is None:
+            results = run_in_order(score_scene, files, args.segmenter, label="scenes")
+        else:
+            results = map_on_cluster(
+                score_scene,
+                files,
+                args.segmenter,
+                workers=args.workers,
+                address=args.address,
+                label="scenes",
+                purpose=f"--workers {args.workers}" if args.address is None else "--address",
+            )
+    except (ValueError, FrameError, ClusterError) as error:
         print(f"robokudo eval: {error}", file=sys.stderr)
         return 2
     categories: dict[str, list[SceneResult]] = {}

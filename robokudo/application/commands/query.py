@@ -3,7 +3,8 @@
 Exit status: 0 with an answer (also when the query's ``timeout`` passed first: the answer then holds the stored
 beliefs matching the query, ``"timed_out": true`` in the JSON and a note on stderr), 1 when perception failed,
 2 for a bad query, plan, option, input, belief store or an object id the store does not hold (``no object 3``), and
-for ``--rerun`` / ``--rerun-connect`` without the Rerun SDK or a viewer to reach.
+for ``--rerun`` / ``--rerun-connect`` without the Rerun SDK or a viewer to reach, and for ``--remote`` without Ray
+or naming no annotator class.
 The query is parsed first, then the belief store is checked, before anything else is loaded.
 """
 
@@ -14,19 +15,29 @@ import contextlib
 import sys
 from typing import TYPE_CHECKING
 
+from annotators.catalog import AnnotatorCatalog
 from queries import Query, QueryError, parse_query
 from reasoning.beliefs.store import BeliefStoreError
 from reasoning.errors import OntologyError
 from reasoning.planning.planner import PlanningError
+from robokudo.application.cluster import ClusterError
 from robokudo.application.commands.input_options import (
     add_input_arguments,
     frame_number,
     input_problem,
     intrinsics_of,
 )
+from robokudo.application.commands.remote_options import (
+    RemoteOptionError,
+    add_remote_arguments,
+    check_remote_options,
+    remote_cluster,
+    unknown_names,
+)
 from robokudo.application.commands.rerun_options import RerunOptionError, add_rerun_arguments, open_rerun_log
 from robokudo.application.report import draw_answer, write_image
 from robokudo.application.service import AnsweringService, Outcome, PerceptionFailedError, UnknownObjectError
+from robokudo.core.remote import PlacementError
 from robokudo.core.render import unicode_tree
 from robokudo.core.types import ColorImage
 from trees.synthesis import SynthesisError
@@ -52,6 +63,7 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
         help="write the analysed frame with the answer's objects boxed and labelled",
     )
     add_rerun_arguments(parser)
+    add_remote_arguments(parser)
 
 
 def run(args: argparse.Namespace) -> int:
@@ -63,10 +75,24 @@ def run(args: argparse.Namespace) -> int:
         return 2
     try:
         query = parse_query(text)  # the cheapest check first: a bad query touches nothing
+        catalog = None
+        hints = check_remote_options(args)
+        if args.remote:  # names to check against the catalog (else it loads after the store is checked)
+            catalog = AnnotatorCatalog.discover()
+            unknown = unknown_names(args.remote, catalog)
+            if unknown:
+                raise RemoteOptionError(f"--remote {unknown[0]}: no annotator class of that name")
         with (
             open_rerun_log(args) or contextlib.nullcontext() as rerun_log,
+            remote_cluster(args),
             AnsweringService.open(
-                args.store, input_path=args.input, frame=frame_number(args), intrinsics=intrinsics_of(args)
+                args.store,
+                input_path=args.input,
+                frame=frame_number(args),
+                intrinsics=intrinsics_of(args),
+                catalog=catalog,
+                remote=args.remote,
+                remote_hints=hints,
             ) as service,
         ):
             outcome = answer(service, query, rerun_log)
@@ -76,7 +102,7 @@ def run(args: argparse.Namespace) -> int:
     except (PlanningError, SynthesisError, OntologyError, BeliefStoreError, UnknownObjectError, ValueError) as error:
         print(f"robokudo query: {error}", file=sys.stderr)
         return 2
-    except RerunOptionError as error:
+    except (RerunOptionError, RemoteOptionError, PlacementError, ClusterError) as error:
         print(f"robokudo query: {error}", file=sys.stderr)
         return 2
     except PerceptionFailedError as error:

@@ -5,18 +5,29 @@ from __future__ import annotations
 import argparse
 import sys
 
+from py_trees.behaviour import Behaviour
 from py_trees.common import Status
 
+from robokudo.application.cluster import ClusterError
 from robokudo.application.commands.input_options import (
     add_input_arguments,
     frame_number,
     input_problem,
     intrinsics_of,
 )
+from robokudo.application.commands.remote_options import (
+    RemoteOptionError,
+    add_remote_arguments,
+    check_remote_options,
+    remote_cluster,
+    unknown_names,
+)
 from robokudo.application.commands.rerun_options import RerunOptionError, add_rerun_arguments, open_rerun_log
 from robokudo.application.report import describe_hypotheses, write_annotated_image
+from robokudo.core.annotator import Annotator
 from robokudo.core.engine import Engine
 from robokudo.core.pipeline import pipelines
+from robokudo.core.remote import PlacementError, place_remote
 from robokudo.core.render import stats_table, unicode_tree
 from trees import load_tree
 
@@ -31,16 +42,33 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
     parser.add_argument("--hz", type=float, default=30.0, help="tick frequency")
     parser.add_argument("--annotated-image", metavar="PATH", help="write the colour image with the hypotheses drawn")
     add_rerun_arguments(parser)
+    add_remote_arguments(parser)
 
 
 def run(args: argparse.Namespace) -> int:
     """Run the tree (once, or ``--ticks`` times); 0 when it succeeded, 2 for bad options (``--rerun`` without the
-    Rerun SDK, ...)."""
+    Rerun SDK, ``--remote`` without Ray or naming no annotator of the tree, ...)."""
     problem = input_problem(args)
     if problem is not None:
         print(f"robokudo run: {problem}", file=sys.stderr)
         return 2
     root = load_tree(args.name).create(input_path=args.input, frame=frame_number(args), intrinsics=intrinsics_of(args))
+    annotators = [node for node in root.iterate() if isinstance(node, Annotator)]
+    try:
+        hints = check_remote_options(args, (type(node) for node in annotators))
+        unknown = unknown_names(args.remote, [n for node in annotators for n in (node.name, type(node).__name__)])
+        if unknown:
+            names = ", ".join(sorted({node.name for node in annotators}))
+            raise RemoteOptionError(f"--remote {unknown[0]}: no annotator of that name in the tree ({names})")
+        with remote_cluster(args, (type(node) for node in annotators)):
+            place_remote(root, args.remote, hints)
+            return _run(args, root)
+    except (RemoteOptionError, PlacementError, ClusterError) as error:
+        print(f"robokudo run: {error}", file=sys.stderr)
+        return 2
+
+
+def _run(args: argparse.Namespace, root: Behaviour) -> int:
     engine = Engine(root, hz=args.hz)
     try:
         rerun_log = open_rerun_log(args)

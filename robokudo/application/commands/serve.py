@@ -25,14 +25,24 @@ import sys
 from pathlib import Path
 from typing import TYPE_CHECKING
 
+from annotators.catalog import AnnotatorCatalog
 from annotators.readers.bag_io import ANY_TOPICS, BagTopics, is_bag, named_topics
 from annotators.readers.frame_io import FrameError
 from annotators.readers.streams import FrameStream, KitchenCameraStream, stream_for
 from reasoning.beliefs.store import BeliefStoreError
 from reasoning.errors import OntologyError
+from robokudo.application.cluster import ClusterError
+from robokudo.application.commands.remote_options import (
+    RemoteOptionError,
+    add_remote_arguments,
+    check_remote_options,
+    remote_cluster,
+    unknown_names,
+)
 from robokudo.application.commands.rerun_options import RerunOptionError, add_rerun_arguments, open_rerun_log
 from robokudo.application.server.runner import ServerConfig, is_loopback, serve
 from robokudo.application.service import AnsweringService
+from robokudo.core.placement import Placement
 
 if TYPE_CHECKING:
     from robokudo.application.rerun_log import RerunLog
@@ -64,6 +74,7 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
     parser.add_argument("--token", help=f"token clients must send in the 'auth' op (default: ${TOKEN_VARIABLE})")
     parser.add_argument("--db", help="belief store file (default: $ROBOKUDO_BELIEF_STORE or the user data dir)")
     add_rerun_arguments(parser)
+    add_remote_arguments(parser)
 
 
 def source_stream(args: argparse.Namespace) -> FrameStream:
@@ -95,22 +106,34 @@ def run(args: argparse.Namespace) -> int:
         print(f"robokudo serve: {problem}", file=sys.stderr)
         return 2
     try:
+        hints = check_remote_options(args)
+        if args.remote:
+            catalog = AnnotatorCatalog.discover()
+            unknown = unknown_names(args.remote, catalog)
+            if unknown:
+                raise RemoteOptionError(f"--remote {unknown[0]}: no annotator class of that name")
         rerun_log = open_rerun_log(args)
-    except RerunOptionError as error:
+    except (RerunOptionError, RemoteOptionError) as error:
         print(f"robokudo serve: {error}", file=sys.stderr)
         return 2
-    with rerun_log or contextlib.nullcontext():
-        return _serve(args, token, rerun_log)
+    try:
+        with rerun_log or contextlib.nullcontext(), remote_cluster(args):
+            return _serve(args, token, rerun_log, hints)
+    except ClusterError as error:
+        print(f"robokudo serve: {error}", file=sys.stderr)
+        return 2
 
 
-def _serve(args: argparse.Namespace, token: str | None, rerun_log: RerunLog | None) -> int:
+def _serve(args: argparse.Namespace, token: str | None, rerun_log: RerunLog | None, hints: Placement | None) -> int:
     try:
         stream = source_stream(args)
     except (ValueError, FrameError) as error:
         print(f"robokudo serve: {error}", file=sys.stderr)
         return 2
     try:
-        service = AnsweringService.open(args.db, input_path=args.input, hz=args.rate, stream=stream)
+        service = AnsweringService.open(
+            args.db, input_path=args.input, hz=args.rate, stream=stream, remote=args.remote, remote_hints=hints
+        )
     except (BeliefStoreError, OntologyError) as error:
         stream.close()
         print(f"robokudo serve: {error}", file=sys.stderr)

@@ -1,0 +1,84 @@
+"""Data-parallel work on a Ray cluster: one task per item, at most N at a time, results in the items' order.
+
+Used by ``robokudo eval ... --workers N [--address ...]``: each scene is a Ray task (one CPU), run on a local
+cluster (default) or the one at the address, with a progress bar on a terminal. The tasks run the same code as
+the sequential loop, so the figures are the same. An exception a task raises is raised here as itself.
+"""
+
+from __future__ import annotations
+
+import sys
+from collections.abc import Callable, Sequence
+from typing import Any, TypeVar
+
+from tqdm import tqdm
+
+from robokudo.application.cluster import ray_cluster
+
+T = TypeVar("T")
+R = TypeVar("R")
+
+
+def progress(total: int, label: str) -> tqdm:
+    """A progress bar on stderr (shown only when stderr is a terminal)."""
+    return tqdm(total=total, desc=label, unit="item", file=sys.stderr, disable=None, leave=False)
+
+
+def run_in_order(function: Callable[..., R], items: Sequence[T], *extra: Any, label: str = "") -> list[R]:
+    """``function(item, *extra)`` for each item in this process, with a progress bar."""
+    results = []
+    with progress(len(items), label) as bar:
+        for item in items:
+            results.append(function(item, *extra))
+            bar.update()
+    return results
+
+
+def map_on_cluster(
+    function: Callable[..., R],
+    items: Sequence[T],
+    *extra: Any,
+    workers: int,
+    address: str | None = None,
+    label: str = "",
+    purpose: str = "running tasks on a cluster",
+) -> list[R]:
+    """``function(item, *extra)`` for each item as Ray tasks, at most ``workers`` at once, on the cluster at
+    ``address`` (None: a local one with ``workers`` CPUs); the results in the items' order. The task's own
+    exception when one fails; ClusterError without Ray (``PURPOSE needs Ray``) or a cluster."""
+    if workers < 1:
+        raise ValueError(f"workers must be at least 1, got {workers}")
+    with ray_cluster(address, num_cpus=workers, purpose=purpose) as ray:
+        task = ray.remote(num_cpus=1, max_retries=0)(function)
+        shared = [ray.put(value) for value in extra]
+        results: list[Any] = [None] * len(items)
+        running: dict[Any, int] = {}
+        upcoming = iter(enumerate(items))
+        with progress(len(items), label) as bar:
+            try:
+                while True:
+                    while len(running) < workers:
+                        index, item = next(upcoming, (-1, None))
+                        if index < 0:
+                            break
+                        running[task.remote(item, *shared)] = index
+                    if not running:
+                        break
+                    done, _ = ray.wait(list(running), num_returns=1)
+                    for reference in done:
+                        results[running.pop(reference)] = _result(ray, reference)
+                        bar.update()
+            finally:
+                for reference in running:
+                    ray.cancel(reference)
+        return results
+
+
+def _result(ray: Any, reference: Any) -> Any:
+    try:
+        return ray.get(reference)
+    except ray.exceptions.RayTaskError as error:
+        cause = getattr(error, "cause", None)
+        if isinstance(cause, Exception):
+            raise cause from None
+        raise

@@ -1,0 +1,387 @@
+"""Remote experts: any annotator runs on a Ray actor while its node stays in the tree as a threaded annotator.
+
+:func:`place_remote` replaces the annotators of a tree that are to run elsewhere (their class declares
+``Placement(remote=True)``, or the caller names them) by :class:`RemoteAnnotator` nodes. Such a node has the
+annotator's name, reason, ports and capability; on each run its worker thread
+
+1. takes the annotator's *declared* inputs from the CAS (the views of its input types, the annotations of its
+   input types; a hypothesis goes without the annotations other experts attached to it unless they are of a
+   declared input type too, as a shallow copy that shares its arrays),
+2. sends them to the actor in one call: Ray serialises numpy arrays out of band into its object store (the
+   one copy the transfer needs; nothing else is copied here), and on the actor's node they are read in place,
+   read-only,
+3. waits (the node is RUNNING, the tick loop goes on), polling its cancel flag: a cancelled or timed-out run
+   asks Ray to cancel the call and discards its result, as a local threaded annotator does,
+4. commits what the actor's annotator wrote through its own port checks (attachments go to the local
+   hypotheses they were made for).
+
+The actor rebuilds the annotator from its class and its own attributes (its parameters; framework state is
+left behind), so an annotator whose attributes cannot be pickled cannot be placed (:class:`PlacementError`
+names the attribute). A dead actor makes the run FAIL with the reason; Ray restarts the actor's process (up to
+``max_restarts`` times) and the next run goes to the new one. Actors are kept in the node's
+:class:`~robokudo.core.resources.SharedResources` under the class and parameters, so every tree built with
+one pool (a serving instance's) shares one actor per expert.
+
+Ray is optional (``pip install 'robokudo[ray]'``) and imported only when something is placed remotely; this
+module imports nothing else above the runtime core.
+"""
+
+from __future__ import annotations
+
+import contextlib
+import copy
+import functools
+import os
+import time
+from collections.abc import Collection, Hashable
+from dataclasses import dataclass, replace
+from types import ModuleType
+from typing import Any, ClassVar
+
+import py_trees
+
+from robokudo.core.annotator import Annotator, PortError, RunCancelledError, _Run
+from robokudo.core.cas import CAS, AddAnnotation, SetView
+from robokudo.core.pipeline import StructureError
+from robokudo.core.placement import Placement
+from robokudo.core.threaded import ThreadedAnnotator
+from robokudo.core.types import Annotation, CasType, ObjectHypothesis, View
+
+INSTALL_HINT = "Ray is not installed: pip install 'robokudo[ray]' (or ray)"
+
+POLL_SECONDS = 0.05
+"""How often a waiting worker checks whether its run was cancelled."""
+
+DEFAULT_TIMEOUT = 60.0
+"""Seconds a remote run may take (the first run also waits for the actor's process to start)."""
+
+
+class PlacementError(Exception):
+    """An annotator cannot be placed on a Ray actor (Ray missing, parameters that cannot be sent, bad name)."""
+
+
+def require_ray() -> ModuleType:
+    """The ``ray`` module; PlacementError with the install hint when it is not installed."""
+    try:
+        import ray
+    except ImportError:
+        raise PlacementError(f"remote experts need Ray. {INSTALL_HINT}") from None
+    return ray
+
+
+# --------------------------------------------------------------------------------------------- the recipe
+
+
+@functools.cache
+def _framework_attributes() -> frozenset[str]:
+    """The instance attributes every (threaded) annotator has from the framework; the rest are parameters."""
+    return frozenset(vars(ThreadedAnnotator(name="probe")))
+
+
+@dataclass(frozen=True)
+class Recipe:
+    """How the actor rebuilds an annotator: its class, its name and its parameters (its own attributes)."""
+
+    cls: type[Annotator]
+    name: str
+    parameters: dict[str, Any]
+
+    @classmethod
+    def of(cls, annotator: Annotator) -> Recipe:
+        """The recipe of ``annotator``; PlacementError when a parameter cannot be sent to another process."""
+        ray = require_ray()
+        framework = _framework_attributes()
+        parameters = {key: value for key, value in vars(annotator).items() if key not in framework}
+        for key, value in parameters.items():
+            try:
+                ray.cloudpickle.dumps(value)
+            except Exception as error:
+                raise PlacementError(
+                    f"cannot place {annotator.name!r} ({type(annotator).__name__}) remotely: its attribute {key!r} "
+                    f"cannot be sent to another process ({type(error).__name__}: {error})"
+                ) from None
+        return cls(type(annotator), annotator.name, parameters)
+
+    def key(self) -> Hashable:
+        """Equal for recipes that build the same annotator (the actor a resource pool shares)."""
+        ray = require_ray()
+        parameters = ray.cloudpickle.dumps(self.parameters)
+        return ("remote expert", self.cls.__module__, self.cls.__qualname__, self.name, parameters)
+
+    def build(self) -> Annotator:
+        """A fresh annotator of the class with these parameters (its framework state new)."""
+        annotator = self.cls.__new__(self.cls)
+        Annotator.__init__(annotator, name=self.name)
+        vars(annotator).update(self.parameters)
+        return annotator
+
+
+# --------------------------------------------------------------------------------------------- the actor side
+
+Write = tuple[str, Any] | tuple[str, int, Annotation]
+
+
+class ExpertHost:
+    """What a Ray actor holds: one annotator, run on the inputs each call brings in a CAS of their own."""
+
+    def __init__(self, recipe: Recipe) -> None:
+        self._annotator = recipe.build()
+
+    def process_id(self) -> int:
+        """The actor's process id (to watch or stop it)."""
+        return os.getpid()
+
+    def analyse(self, inputs: tuple[list[View], list[Annotation]]) -> tuple[str, str, list[Write]]:
+        """Run the annotator on ``inputs`` (views, annotations); its status name, message and writes, each
+        attachment naming its hypothesis by its index among the annotations sent."""
+        views, annotations = inputs
+        cas = CAS()
+        for view in views:
+            cas.set_view(view)
+        for annotation in annotations:
+            cas.add(annotation)
+        run = _Run(cas, thread_ident=None)
+        status, message, _ = self._annotator._execute(run)
+        if status.name != "SUCCESS":
+            return status.name, message, []
+        position = {id(annotation): index for index, annotation in enumerate(annotations)}
+        writes: list[Write] = []
+        for write in run.writes:
+            if isinstance(write, SetView):
+                writes.append(("view", write.view))
+            elif isinstance(write, AddAnnotation):
+                writes.append(("add", write.annotation))
+            elif id(write.hypothesis) in position:
+                writes.append(("attach", position[id(write.hypothesis)], write.annotation))
+            else:
+                return "FAILURE", "attached an annotation to a hypothesis it was not sent", []
+        return status.name, message, writes
+
+
+@functools.cache
+def _actor_class() -> Any:
+    return require_ray().remote(ExpertHost)
+
+
+# --------------------------------------------------------------------------------------------- the tree side
+
+
+class RemoteAnnotator(ThreadedAnnotator):
+    """An annotator placed on a Ray actor (see the module); build it with :func:`remote_annotator`."""
+
+    local_type: ClassVar[type[Annotator]] = Annotator
+
+    def __init__(self, recipe: Recipe, placement: Placement, timeout: float = DEFAULT_TIMEOUT) -> None:
+        super().__init__(name=recipe.name, timeout=timeout)
+        if not placement.remote:
+            placement = replace(placement, remote=True)
+        self.recipe = recipe
+        self.where = placement
+        self._actor: Any = None
+        self._actor_failed = False
+
+    def actor(self) -> Any:
+        """The Ray actor handle (started on first use; shared through this node's resources)."""
+        if self._actor is None:
+            placement = self.where
+
+            def start() -> Any:
+                return (
+                    _actor_class()
+                    .options(
+                        num_cpus=placement.num_cpus,
+                        num_gpus=placement.num_gpus,
+                        max_restarts=placement.max_restarts,
+                        max_task_retries=0,
+                    )
+                    .remote(self.recipe)
+                )
+
+            self._actor = self.resources.get((*self.recipe.key(), placement), start)
+        return self._actor
+
+    def actor_process_id(self, timeout: float = 60.0) -> int:
+        """The process id of the actor's current process (waits for it to start)."""
+        ray = require_ray()
+        return int(ray.get(self.actor().process_id.remote(), timeout=timeout))
+
+    def _inputs(self) -> tuple[list[View], list[Annotation], list[Annotation]]:
+        """The declared inputs present: views, the annotations to send and the local annotations they stand for."""
+        declared = self.inputs + self.optional_inputs
+        views: list[View] = []
+        for cas_type in declared:
+            if issubclass(cas_type, View):
+                view = self.optional_view(cas_type)
+                if view is not None and all(view is not v for v in views):
+                    views.append(view)
+        local: list[Annotation] = []
+        seen: set[int] = set()
+        for cas_type in declared:
+            if issubclass(cas_type, Annotation):
+                for annotation in self.annotations(cas_type):
+                    if id(annotation) not in seen:
+                        seen.add(id(annotation))
+                        local.append(annotation)
+        annotation_types = tuple(t for t in declared if issubclass(t, Annotation))
+        sent = [_only_declared(annotation, annotation_types) for annotation in local]
+        return views, sent, local
+
+    def analyse(self) -> None:
+        """Send the declared inputs, wait for the actor's answer, commit its writes."""
+        ray = require_ray()
+        views, sent, local = self._inputs()
+        actor = self.actor()
+        if self._actor_failed:
+            self._await_restart(ray, actor)
+        try:
+            status, message, writes = self._wait(ray, actor.analyse.remote((views, sent)))
+        except ray.exceptions.RayTaskError as error:
+            cause = getattr(error, "cause", None)
+            if isinstance(cause, PortError | StructureError | NotImplementedError):
+                raise cause from None
+            self.fail(f"remote {self.name} raised {_summary(error)}")
+        except (ray.exceptions.RayActorError, ray.exceptions.ActorUnavailableError) as error:
+            self._actor_failed = True
+            self.fail(f"remote actor of {self.name} died: {_summary(error)}")
+        except ray.exceptions.RayError as error:
+            self.fail(f"remote {self.name} failed: {type(error).__name__}: {_summary(error)}")
+        if status != "SUCCESS":
+            self.fail(message or f"remote {self.name} ended {status}")
+        for write in writes:
+            if write[0] in ("view", "add"):
+                self.write(write[1])
+            else:
+                _, index, annotation = write
+                if not 0 <= index < len(local) or not isinstance(local[index], ObjectHypothesis):
+                    self.fail(f"remote {self.name} attached to hypothesis {index}, which it was not sent")
+                self.attach(local[index], annotation)  # type: ignore[arg-type]
+
+    def _wait(self, ray: ModuleType, pending: Any) -> Any:
+        """The result of the call ``pending``, polling this run's cancel flag meanwhile (a cancelled run asks Ray
+        to cancel the call and ends with RunCancelledError)."""
+        try:
+            while not ray.wait([pending], timeout=POLL_SECONDS)[0]:
+                if self.cancelled:  # raises RunCancelledError once the run is cancelled
+                    break
+        except RunCancelledError:
+            _cancel(ray, pending)
+            raise
+        return ray.get(pending)
+
+    def _await_restart(self, ray: ModuleType, actor: Any) -> None:
+        """After the actor died: wait until Ray has restarted it (a call sent while it restarts would fail)."""
+        while True:
+            try:
+                self._wait(ray, actor.process_id.remote())
+            except ray.exceptions.ActorUnavailableError:
+                time.sleep(POLL_SECONDS)
+                continue
+            except ray.exceptions.RayActorError as error:
+                self.fail(f"remote actor of {self.name} is gone: {_summary(error)}")
+            self._actor_failed = False
+            return
+
+    def stop_actor(self) -> None:
+        """End the actor's process now (an actor also ends when the last handle to it is gone)."""
+        if self._actor is not None:
+            require_ray().kill(self._actor, no_restart=True)
+            self._actor = None
+
+
+def _only_declared(annotation: Annotation, declared: tuple[type[CasType], ...]) -> Annotation:
+    """``annotation``, or for a hypothesis a shallow copy (arrays shared) whose attached annotations are those of
+    the declared types only."""
+    if not isinstance(annotation, ObjectHypothesis):
+        return annotation
+    kept = [a for a in annotation.annotations if isinstance(a, declared)]
+    if len(kept) == len(annotation.annotations):
+        return annotation
+    stripped = copy.copy(annotation)
+    stripped.annotations = kept
+    return stripped
+
+
+def _cancel(ray: ModuleType, pending: Any) -> None:
+    with contextlib.suppress(Exception):  # best effort: the result is discarded anyway
+        ray.cancel(pending)
+
+
+def _summary(error: BaseException, limit: int = 300) -> str:
+    """The first meaningful line of a Ray error, shortened."""
+    lines = [line.strip() for line in str(error).splitlines() if line.strip()]
+    text = lines[0] if lines else type(error).__name__
+    detail = next((line for line in lines[1:] if "exit" in line.lower() or "signal" in line.lower()), "")
+    if detail and detail not in text:
+        text = f"{text} ({detail})"
+    return text if len(text) <= limit else text[: limit - 3] + "..."
+
+
+@functools.cache
+def _remote_class(cls: type[Annotator]) -> type[RemoteAnnotator]:
+    """The RemoteAnnotator subclass with ``cls``'s ports and capability (one per annotator class)."""
+    return type(
+        f"Remote{cls.__name__}",
+        (RemoteAnnotator,),
+        {
+            "__module__": __name__,
+            "__doc__": cls.__doc__,
+            "inputs": cls.inputs,
+            "optional_inputs": cls.optional_inputs,
+            "outputs": cls.outputs,
+            "capability": cls.capability,
+            "local_type": cls,
+        },
+    )
+
+
+def remote_annotator(
+    annotator: Annotator, placement: Placement | None = None, timeout: float = DEFAULT_TIMEOUT
+) -> RemoteAnnotator:
+    """A node that runs ``annotator`` on a Ray actor (hints: ``placement``, default the class's declaration);
+    it takes over the annotator's name, reason and resource pool. PlacementError as :meth:`Recipe.of` says."""
+    if isinstance(annotator, RemoteAnnotator):
+        raise PlacementError(f"{annotator.name!r} is placed remotely already")
+    cls = type(annotator)
+    node = _remote_class(cls)(Recipe.of(annotator), placement or cls.placement, timeout)
+    node.reason = annotator.reason
+    node.resources = annotator.resources
+    if isinstance(annotator, ThreadedAnnotator):
+        node.timeout = max(node.timeout, annotator.timeout)
+    return node
+
+
+def wants_remote(annotator: Annotator, names: Collection[str]) -> bool:
+    """True when ``annotator`` is to run remotely: its class declares it, or ``names`` holds its name or class."""
+    if isinstance(annotator, RemoteAnnotator):
+        return False
+    return type(annotator).placement.remote or annotator.name in names or type(annotator).__name__ in names
+
+
+def place_remote(
+    root: py_trees.behaviour.Behaviour,
+    names: Collection[str] = (),
+    hints: Placement | None = None,
+    *,
+    start: bool = True,
+) -> list[RemoteAnnotator]:
+    """Replace the annotators of ``root`` that are to run remotely (:func:`wants_remote`) by RemoteAnnotators,
+    in place; the new nodes. ``hints`` overrides the classes' resource hints for annotators chosen by ``names``;
+    ``start`` starts their actors at once (they boot while the tree's first steps run). PlacementError as
+    :func:`remote_annotator` says, or when the root itself would be replaced (it has no parent to hold the node).
+    """
+    chosen = [node for node in root.iterate() if isinstance(node, Annotator) and wants_remote(node, names)]
+    placed = []
+    for node in chosen:
+        parent = node.parent
+        if not isinstance(parent, py_trees.composites.Composite):
+            where = "it is the root of the tree" if parent is None else f"its parent {parent.name!r} is no composite"
+            raise PlacementError(f"cannot place {node.name!r} remotely: {where}")
+        declared = type(node).placement
+        placement = declared if declared.remote or hints is None else hints
+        remote = remote_annotator(node, placement)
+        parent.replace_child(node, remote)
+        placed.append(remote)
+    if start:
+        for remote in placed:
+            remote.actor()
+    return placed

@@ -1,0 +1,246 @@
+"""Beyond one machine, on a real local Ray cluster (2 CPUs, started once for this module and shut down after it).
+
+* The tabletop tree with its colour expert on a Ray actor gives the local answer; the actor's process killed
+  while it works makes that node FAIL with the reason, and the next run (on the restarted actor) works.
+* ``robokudo eval segmentation --workers 2`` gives exactly the sequential figures on 4 shared mOSD scenes.
+
+Without Ray these tests are skipped, except under CI (which installs the ``dev`` extra, Ray included), where a
+missing Ray fails them. The messages the options give without Ray are tested by hiding the module.
+"""
+
+from __future__ import annotations
+
+import json
+import logging
+import os
+import signal
+import sys
+import threading
+import time
+from collections.abc import Iterator
+from types import ModuleType
+
+import numpy as np
+import pytest
+from py_trees.common import Status
+
+from annotators.image.color import SemanticColorAnnotator
+from robokudo.application import cli
+from robokudo.core.cas import CAS
+from robokudo.core.engine import Engine
+from robokudo.core.pipeline import pipelines
+from robokudo.core.placement import Placement
+from robokudo.core.remote import ExpertHost, PlacementError, Recipe, RemoteAnnotator, place_remote
+from robokudo.core.types import ColorImage, DepthImage, ObjectHypothesis, Pose, SemanticColor
+from tests.annotators.conftest import SHARED_DATA, require_folder
+from trees import tabletop
+
+DEADLINE = 60.0
+"""Seconds a run may take on a loaded machine before the test gives up."""
+
+
+def require_ray() -> ModuleType:
+    try:
+        import ray
+    except ImportError:
+        if os.environ.get("CI"):
+            raise
+        pytest.skip("Ray is not installed (pip install 'robokudo[ray]')")
+    return ray
+
+
+@pytest.fixture(scope="module")
+def cluster() -> Iterator[ModuleType]:
+    ray = require_ray()
+    ray.init(num_cpus=2, include_dashboard=False, log_to_driver=False, logging_level=logging.ERROR)
+    try:
+        yield ray
+    finally:
+        ray.shutdown()
+
+
+def run_to_end(engine: Engine) -> Status:
+    start = time.monotonic()
+    status = engine.tick()
+    while status is Status.RUNNING:
+        assert time.monotonic() - start < DEADLINE, "the tree did not finish in time"
+        time.sleep(0.005)
+        status = engine.tick()
+    return status
+
+
+def colours(root: object) -> list[tuple[tuple[int, int, int, int], list[tuple[str, object, str]]]]:
+    """Each hypothesis' box and colours (name, confidence, source). Confidences are compared to 1e-9: Ray runs an
+    actor with OMP_NUM_THREADS set to its CPUs, so BLAS may add up in another order than in this process."""
+    cas = next(pipelines(root)).cas
+    return [
+        (h.roi, [(c.color, pytest.approx(c.confidence, rel=1e-9, abs=1e-12), c.source) for c in h.find(SemanticColor)])
+        for h in cas.annotations(ObjectHypothesis)
+    ]
+
+
+@pytest.fixture(scope="module")
+def local_colours() -> list:
+    root = tabletop.create_tree()
+    assert run_to_end(Engine(root, hz=1000)) is Status.SUCCESS
+    found = colours(root)
+    assert len(found) >= 2 and all(named for _, named in found)
+    return found
+
+
+def test_the_colour_expert_on_an_actor_gives_the_local_answer(cluster: ModuleType, local_colours: list) -> None:
+    root = tabletop.create_tree()
+    [remote] = place_remote(root, ["SemanticColorAnnotator"])
+    try:
+        assert isinstance(remote, RemoteAnnotator) and remote.name == "SemanticColorAnnotator"
+        assert remote.actor_process_id() != os.getpid()
+        assert run_to_end(Engine(root, hz=1000)) is Status.SUCCESS
+        assert colours(root) == local_colours
+    finally:
+        remote.stop_actor()
+
+
+def test_a_killed_actor_fails_its_node_with_the_reason_and_the_next_run_works(
+    cluster: ModuleType, local_colours: list
+) -> None:
+    root = tabletop.create_tree()
+    [remote] = place_remote(root, ["SemanticColorAnnotator"])
+    engine = Engine(root, hz=1000)
+    try:
+        pid = remote.actor_process_id()
+        os.kill(pid, signal.SIGSTOP)  # the actor cannot answer: the call is in flight when it is killed
+        try:
+            assert engine.tick() is Status.RUNNING
+            waited = time.monotonic()
+            while remote.status is not Status.RUNNING:
+                assert time.monotonic() - waited < DEADLINE
+                engine.tick()
+            for _ in range(3):  # the tick loop goes on while the actor does not answer
+                assert engine.tick() is Status.RUNNING and remote.status is Status.RUNNING
+        finally:
+            os.kill(pid, signal.SIGKILL)
+        assert run_to_end(engine) is Status.FAILURE
+        assert remote.status is Status.FAILURE
+        assert "remote actor of SemanticColorAnnotator died" in remote.feedback_message
+        assert run_to_end(engine) is Status.SUCCESS, remote.feedback_message
+        assert colours(root) == local_colours
+        assert remote.actor_process_id() != pid
+    finally:
+        remote.stop_actor()
+
+
+def scene_paths() -> list[str]:
+    learn = require_folder(SHARED_DATA / "pcl_mosd_tabletop" / "learn")
+    return [str(learn / f"learn{n}.pcd") for n in (0, 17, 30, 40)]
+
+
+def figures(capsys: pytest.CaptureFixture[str], *argv: str) -> dict:
+    capsys.readouterr()
+    assert cli.main(["eval", "segmentation", *argv, "--json"]) == 0
+    document = json.loads(capsys.readouterr().out)
+    for scene in document["scenes"]:
+        assert scene.pop("milliseconds") >= 0  # a time, measured where the scene ran
+    return document
+
+
+@pytest.mark.real_data
+def test_eval_with_two_workers_gives_exactly_the_sequential_figures(
+    cluster: ModuleType, capsys: pytest.CaptureFixture[str]
+) -> None:
+    paths = scene_paths()
+    sequential = figures(capsys, *paths)
+    parallel = figures(capsys, *paths, "--workers", "2")
+    assert [s["scene"] for s in parallel["scenes"]] == ["learn0", "learn17", "learn30", "learn40"]
+    assert parallel == sequential
+
+
+@pytest.mark.real_data
+def test_an_error_in_a_task_is_reported_as_in_one_process(
+    cluster: ModuleType, capsys: pytest.CaptureFixture[str]
+) -> None:
+    unlabelled = require_folder(SHARED_DATA / "pcl_tabletop_pcd") / "milk_color.pcd"
+    capsys.readouterr()
+    assert cli.main(["eval", "segmentation", str(unlabelled), "--workers", "2"]) == 2
+    assert capsys.readouterr().err == f"robokudo eval: {unlabelled} has no label field to score against\n"
+
+
+# ------------------------------------------------------------------------------------------ without a cluster
+
+
+def test_the_actor_side_runs_the_expert_on_the_declared_inputs_alone() -> None:
+    """What an actor does with the inputs it is sent, in this process: the colour expert's attachments come back
+    naming the hypotheses by their position."""
+    image = np.zeros((40, 60, 3), np.uint8)
+    image[:, 30:] = (200, 30, 30)
+    mask = np.zeros((40, 60), bool)
+    mask[10:30, 35:55] = True
+    hypothesis = ObjectHypothesis(point_indices=np.flatnonzero(mask), mask=mask, roi=(35, 10, 55, 30))
+    require_ray()  # the recipe checks with Ray's pickler that the parameters can be sent
+    host = ExpertHost(Recipe.of(SemanticColorAnnotator(name="colour", max_pixels=500)))
+    status, message, writes = host.analyse(([ColorImage(image)], [hypothesis]))
+    assert (status, message) == ("SUCCESS", "")
+    [(kind, index, colour)] = writes
+    assert (kind, index, colour.color, colour.source) == ("attach", 0, "red", "colour")
+    assert not hypothesis.annotations  # the actor's writes are returned, not applied
+    status, message, writes = host.analyse(([], [hypothesis]))
+    assert (status, message, writes) == ("FAILURE", "no ColorImage in the CAS", [])
+
+
+def test_only_declared_inputs_are_sent() -> None:
+    require_ray()
+    mask = np.ones((4, 4), bool)
+    hypothesis = ObjectHypothesis(point_indices=np.arange(16), mask=mask, roi=(0, 0, 4, 4))
+    hypothesis.annotations.append(Pose(position=np.zeros(3), orientation=np.array([0.0, 0.0, 0.0, 1.0])))
+    cas = CAS()
+    cas.set_view(ColorImage(np.zeros((4, 4, 3), np.uint8)))
+    cas.set_view(DepthImage(np.ones((4, 4), np.float32)))
+    cas.add(hypothesis)
+    node = place_remote_probe()
+    from robokudo.core.annotator import _Run
+
+    node._run = _Run(cas, thread_ident=None)
+    views, sent, local = node._inputs()
+    assert [type(v) for v in views] == [ColorImage]
+    assert local == [hypothesis] and sent[0] is not hypothesis
+    assert sent[0].annotations == [] and sent[0].mask is hypothesis.mask  # shares its arrays, drops the pose
+    assert hypothesis.annotations and isinstance(hypothesis.annotations[0], Pose)
+
+
+def place_remote_probe() -> RemoteAnnotator:
+    from robokudo.core.pipeline import Pipeline
+
+    pipeline = Pipeline("probe", [SemanticColorAnnotator()])
+    [node] = place_remote(pipeline, ["SemanticColorAnnotator"], start=False)
+    return node
+
+
+def test_placement_hints_are_checked() -> None:
+    with pytest.raises(ValueError, match="num_gpus"):
+        Placement(remote=True, num_gpus=-1)
+    assert Placement(remote=True, num_cpus=2, num_gpus=1).describe() == "remote (2 CPU, 1 GPU)"
+
+
+def test_parameters_that_cannot_be_sent_are_named() -> None:
+    require_ray()
+    from robokudo.core.pipeline import Pipeline
+
+    colour = SemanticColorAnnotator()
+    colour.guard = threading.Lock()  # a lock cannot go to another process
+    with pytest.raises(PlacementError, match="attribute 'guard'"):
+        place_remote(Pipeline("probe", [colour]), ["SemanticColorAnnotator"], start=False)
+
+
+@pytest.fixture
+def without_ray(monkeypatch: pytest.MonkeyPatch) -> None:
+    monkeypatch.setitem(sys.modules, "ray", None)  # import ray raises ImportError
+
+
+@pytest.mark.real_data
+def test_without_ray_the_options_say_what_to_install(without_ray: None, capsys: pytest.CaptureFixture[str]) -> None:
+    [path, *_] = scene_paths()
+    assert cli.main(["eval", "segmentation", path, "--workers", "2"]) == 2
+    err = capsys.readouterr().err
+    assert "--workers 2 needs Ray" in err and "pip install 'robokudo[ray]'" in err
+    assert cli.main(["run", "tabletop", "--remote", "SemanticColorAnnotator"]) == 2
+    err = capsys.readouterr().err
+    assert "--remote needs Ray" in err and "pip install 'robokudo[ray]'" in err
