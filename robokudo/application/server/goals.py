@@ -10,6 +10,7 @@ ticks of a running goal, so the knowledge base, planner and store are only ever 
 
 from __future__ import annotations
 
+import gc
 import itertools
 import queue
 import threading
@@ -104,8 +105,11 @@ _CLOSE = object()
 class GoalManager:
     """Runs goals and jobs on one worker thread that owns ``service`` (see the module)."""
 
-    def __init__(self, service: AnsweringService) -> None:
+    def __init__(self, service: AnsweringService, *, collect_after_goals: bool = False) -> None:
+        """``collect_after_goals``: run the garbage collector after every goal (see
+        :func:`~robokudo.application.server.runner.keep_startup_objects_out_of_collections`; cheap only then)."""
         self.service = service
+        self._collect_after_goals = collect_after_goals
         self._queue: queue.SimpleQueue[Goal | _Job | object] = queue.SimpleQueue()
         self._lock = threading.Lock()
         self._open: list[Goal] = []
@@ -182,6 +186,8 @@ class GoalManager:
                 item.run(self.service)
             elif isinstance(item, Goal):
                 self._run(item)
+                if self._collect_after_goals:
+                    gc.collect()  # the goal's tree is a reference cycle holding its frames: free them now
 
     def _drain(self, *, final: bool = False) -> None:
         """Run the queued jobs; queued goals are only looked at to end the stopped ones (they wait their turn)."""

@@ -11,6 +11,7 @@ from __future__ import annotations
 
 import asyncio
 import contextlib
+import gc
 import ipaddress
 import signal
 import threading
@@ -71,6 +72,22 @@ def is_loopback(host: str) -> bool:
         return False
 
 
+def keep_startup_objects_out_of_collections() -> None:
+    """Move everything loaded so far (knowledge base, rendered views, imported modules: it lives as long as the
+    server) out of the garbage collector's reach, so that a full collection only looks at what goals made.
+
+    Each goal's tree is a reference cycle (parents and children) holding its CAS, frames and clouds, and it lives
+    long enough to reach the oldest generation, which CPython collects only when the objects promoted since the
+    last full collection reach a quarter of those that survived it. With ~150,000 startup objects counted, that
+    took hundreds of goals and the server's memory grew by ~0.2 MiB per goal meanwhile. With them frozen, a full
+    collection costs well under a millisecond, and the goal manager runs one after every goal (the second
+    collection here resets the count to the few objects left outside the frozen ones).
+    """
+    gc.collect()
+    gc.freeze()
+    gc.collect()
+
+
 async def serve(
     service: AnsweringService,
     config: ServerConfig,
@@ -85,7 +102,8 @@ async def serve(
     for signum in (signal.SIGINT, signal.SIGTERM):
         reason = f"the server is shutting down ({signal.Signals(signum).name})"
         loop.add_signal_handler(signum, lambda r=reason: stopping.done() or stopping.set_result(r))
-    goals = GoalManager(service)
+    keep_startup_objects_out_of_collections()
+    goals = GoalManager(service, collect_after_goals=True)
     sessions: set[Session] = set()
     subscribers = Subscribers()
 
