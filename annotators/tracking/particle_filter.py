@@ -25,7 +25,7 @@ class FilterSettings:
     """Random acceleration per axis, m/s² (standard deviation)."""
     measurement_noise: float = 0.06
     """Detection noise per axis, metres (standard deviation)."""
-    gate: float = 0.6
+    gate: float = 0.35
     """The largest distance (metres) of an associated detection from a settled estimate."""
     initial_speed: float = 0.5
     """Spread of the velocities at the first sighting, m/s per axis."""

@@ -57,9 +57,7 @@ def test_it_follows_a_walk_through_noise_clutter_and_missed_frames(seed: int) ->
 
 @settings(max_examples=60, deadline=None)
 @given(
-    st.lists(
-        st.tuples(*(st.floats(-5, 5, allow_nan=False) for _ in range(3))), min_size=1, max_size=8
-    ),
+    st.lists(st.tuples(*(st.floats(-5, 5, allow_nan=False) for _ in range(3))), min_size=1, max_size=8),
     st.integers(0, 1000),
 )
 def test_association_takes_the_nearest_detection_within_the_gate(points: list[tuple[float, ...]], seed: int) -> None:

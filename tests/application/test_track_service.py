@@ -70,9 +70,7 @@ def test_the_service_default_applies_when_the_query_gives_no_lost_after(tmp_path
 
 
 def _goal(goal_id: str, query: str) -> str:
-    return json.dumps(
-        {"op": "send_action_goal", "id": goal_id, "action": "/robokudo/query", "args": {"query": query}}
-    )
+    return json.dumps({"op": "send_action_goal", "id": goal_id, "action": "/robokudo/query", "args": {"query": query}})
 
 
 def _until_result(connection: object, goal_id: str) -> tuple[list[dict], dict]:
