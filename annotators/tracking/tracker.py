@@ -87,8 +87,15 @@ class TargetTracker(Annotator, metaclass=ABCMeta):
     def candidates(self) -> list[Candidate]:
         """This frame's hypotheses of the tracker's type that it accepts and that have a 3-D position."""
         cloud = self.optional_view(PointCloud)
+        size = cloud.points.shape[0] * cloud.points.shape[1] if cloud is not None else 0
+        hypotheses = self.annotations(self.hypothesis_type)
+        if not hypotheses:
+            self.fail(f"no {self.hypothesis_type.__name__} in this frame: nothing to follow")
         found = []
-        for hypothesis in self.annotations(self.hypothesis_type):
+        for number, hypothesis in enumerate(hypotheses, start=1):
+            indices = hypothesis.point_indices
+            if cloud is not None and indices.size and (indices.min() < 0 or indices.max() >= size):
+                self.fail(f"hypothesis {number}'s point indices lie outside the cloud of {size} points")
             if not self.accepts(hypothesis):
                 continue
             position = _position(hypothesis, cloud)

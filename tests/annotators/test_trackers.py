@@ -123,5 +123,6 @@ def test_the_object_tracker_locks_onto_and_follows_only_the_described_object() -
 
 
 def test_without_a_candidate_the_track_says_not_seen_and_has_no_position() -> None:
-    (track,) = run_loop(HumanTracker(), [(1.0, [])])
+    nowhere = PersonHypothesis(point_indices=np.zeros(0, dtype=int), mask=np.zeros((1, 1), bool), roi=(0, 0, 1, 1))
+    (track,) = run_loop(HumanTracker(), [(1.0, [nowhere])])  # a person without a position is no candidate
     assert not track.seen and track.pixel is None and np.isnan(track.position).all()
