@@ -149,6 +149,12 @@ HUMAN_KEY = "human"
 KINDS: tuple[str, ...] = ("detect", "inspect", "track", "scan", "stop")
 """The known query kinds, in canonical order."""
 
+CONTINUOUS_KINDS: frozenset[str] = frozenset({"track"})
+"""The kinds that run until cancelled (one answer per frame) rather than ending with one answer."""
+
+LOST_AFTER_KEY = "lost_after"
+"""The key of a continuous query saying how long its target may go unseen before the task ends (a duration)."""
+
 
 @dataclass(frozen=True, slots=True)
 class Query:

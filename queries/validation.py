@@ -49,6 +49,7 @@ NON_NEGATIVE_KEYS: frozenset[str] = frozenset(
         "diameter",
         "distance",
         "timeout",
+        "lost_after",
         "duration",
         "max_results",
         "task",
@@ -72,6 +73,7 @@ KEY_UNITS: MappingProxyType[str, str] = MappingProxyType(
         "diameter": "m",
         "distance": "m",
         "timeout": "s",
+        "lost_after": "s",
         "duration": "s",
     }
 )

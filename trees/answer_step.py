@@ -16,14 +16,23 @@ from typing import ClassVar
 import numpy as np
 
 from queries import Query
-from reasoning.beliefs.answer import Answer, class_label, designator
+from reasoning.beliefs.answer import Answer, TrackDesignator, class_label, designator
 from reasoning.beliefs.store import BeliefFilter, BeliefStore
 from reasoning.fusion.association import CameraModel
 from reasoning.fusion.frame import FUSED_TYPES, WORLD_FRAME, FrameContext, FrameObject, frame_objects
 from reasoning.fusion.rule import CLASS_ATTRIBUTE
 from reasoning.fusion.tracking import BeliefTracker, ObjectBelief, TrackStep
 from robokudo.core.annotator import Annotator
-from robokudo.core.types import CameraInfo, CasType, DepthImage, ObjectHypothesis, PointCloud, QueryAnswer, QueryView
+from robokudo.core.types import (
+    CameraInfo,
+    CasType,
+    DepthImage,
+    ObjectHypothesis,
+    PointCloud,
+    QueryAnswer,
+    QueryView,
+    TargetTrack,
+)
 
 
 def camera_model(info: CameraInfo, depth: np.ndarray | None = None) -> CameraModel:
@@ -48,14 +57,17 @@ class AnswerStep(Annotator):
     first run. ``tracker`` (class test, regions, gates) defaults to the store's. The query's filter is
     ``belief_filter``, or ``filter_for(query)`` of the CAS's QueryView, or everything seen. The answer holds
     the matching objects seen in this frame, most confident first, with their image ROI (an object an expert only
-    guessed to be of the asked class is a candidate too, see :meth:`_guessed`); ``label_of`` names classes (e.g.
+    guessed to be of the asked class is a candidate too, see :meth:`_guessed`); when a tracker wrote the frame's
+    TargetTrack (a continuous task), only the tracked object, with the track; ``label_of`` names classes (e.g.
     the knowledge base's labels). Objects whose geometry is in doubt confirm known beliefs but create none. With
     ``fail_when_empty`` the step fails when nothing matches. ``timestamp`` 0 in CameraInfo means unknown: ``clock()``
     is used instead.
     """
 
     inputs: ClassVar[tuple[type[CasType], ...]] = (ObjectHypothesis,)
-    optional_inputs: ClassVar[tuple[type[CasType], ...]] = (CameraInfo, PointCloud, DepthImage, QueryView, *FUSED_TYPES)
+    optional_inputs: ClassVar[tuple[type[CasType], ...]] = (
+        CameraInfo, PointCloud, DepthImage, QueryView, TargetTrack, *FUSED_TYPES,
+    )  # fmt: skip
     outputs: ClassVar[tuple[type[CasType], ...]] = (QueryAnswer,)
 
     def __init__(
@@ -126,6 +138,11 @@ class AnswerStep(Annotator):
         seen = {i: o for i, o in zip(step.assigned, objects, strict=True) if i}
         if belief_filter.ids is not None:  # the query names objects (``id:``): answer only those of them seen here
             seen = {i: o for i, o in seen.items() if i in belief_filter.ids}
+        tracks = self.annotations(TargetTrack)
+        track = tracks[0] if tracks else None
+        tracked = _tracked_object(track, seen) if track is not None else None
+        if track is not None:  # a continuous task answers with its one target
+            seen = {tracked: seen[tracked]} if tracked is not None else {}
         matching = store.query(replace(belief_filter, ids=tuple(seen), limit=None))
         guesses = self._guessed(store, belief_filter, seen, {b.id for b in matching})
         matching += guesses.values()
@@ -147,6 +164,7 @@ class AnswerStep(Annotator):
                 for b in matching
             ),
             observed=tuple(step.assigned),
+            track=None if track is None else _track_designator(track, tracked),
         )
         self.write(QueryAnswer(answer))
         if self.fail_when_empty and not matching:
@@ -183,3 +201,44 @@ class AnswerStep(Annotator):
         if self.filter_for is not None and query_view is not None:
             return self.filter_for(query_view.query)
         return BeliefFilter(class_test=(self.tracker or self.store.tracker).class_test)
+
+
+def _tracked_object(track: TargetTrack, seen: dict[int, FrameObject]) -> int | None:
+    """The belief id of the object the tracker associated in this frame (the one whose image box overlaps the
+    tracked hypothesis' box most), or None when the target was not seen."""
+    if not track.seen or track.hypothesis is None:
+        return None
+    best, best_overlap = None, 0.0
+    for belief_id, item in seen.items():
+        overlap = _box_iou(track.hypothesis.roi, item.roi)
+        if overlap > best_overlap:
+            best, best_overlap = belief_id, overlap
+    return best
+
+
+def _box_iou(a: tuple[int, int, int, int], b: tuple[int, int, int, int] | None) -> float:
+    if b is None:
+        return 0.0
+    width = min(a[2], b[2]) - max(a[0], b[0])
+    height = min(a[3], b[3]) - max(a[1], b[1])
+    if width <= 0 or height <= 0:
+        return 0.0
+    inter = width * height
+    union = (a[2] - a[0]) * (a[3] - a[1]) + (b[2] - b[0]) * (b[3] - b[1]) - inter
+    return inter / union if union > 0 else 0.0
+
+
+def _track_designator(track: TargetTrack, object_id: int | None) -> TrackDesignator:
+    known = bool(np.all(np.isfinite(track.position)))
+    return TrackDesignator(
+        target=track.target,
+        seen=track.seen,
+        position=tuple(float(v) for v in track.position) if known else None,
+        velocity=tuple(float(v) for v in track.velocity) if known else None,
+        frame=track.frame,
+        pixel=track.pixel,
+        spread=float(track.spread) if known else None,
+        unseen_for=float(track.unseen_for),
+        object_id=object_id,
+        tracker=track.source,
+    )

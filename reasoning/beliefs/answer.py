@@ -125,6 +125,39 @@ class ObjectDesignator:
         }
 
 
+@dataclass(frozen=True, slots=True)
+class TrackDesignator:
+    """A continuous task's target in this frame: the tracked class, whether it was seen, the filtered position and
+    velocity in ``frame`` (None before it was first seen), its image position, the estimate's spread (metres),
+    the seconds since it was last seen, the belief it was associated with (None when not seen) and the tracker."""
+
+    target: str
+    seen: bool
+    position: tuple[float, float, float] | None
+    velocity: tuple[float, float, float] | None
+    frame: str
+    pixel: tuple[float, float] | None
+    spread: float | None
+    unseen_for: float
+    object_id: int | None
+    tracker: str
+
+    def to_dict(self) -> dict[str, Any]:
+        """A JSON-ready dict (numbers rounded to 6 decimals)."""
+        return {
+            "target": self.target,
+            "seen": self.seen,
+            "position": None if self.position is None else _rounded(self.position),
+            "velocity": None if self.velocity is None else _rounded(self.velocity),
+            "frame": self.frame,
+            "pixel": None if self.pixel is None else _rounded(self.pixel),
+            "spread": None if self.spread is None else round(self.spread, 6),
+            "unseen_for": round(self.unseen_for, 6),
+            "object_id": self.object_id,
+            "tracker": self.tracker,
+        }
+
+
 def _local(class_name: str) -> str:
     return re.split(r"[#/]", class_name)[-1]
 
@@ -144,15 +177,20 @@ class Answer:
     """The belief id of each object seen in this frame, in the order perception found them (not in the JSON)."""
     timed_out: bool = False
     """True when the query's timeout passed before perception finished (the objects then come from memory)."""
+    track: TrackDesignator | None = None
+    """A continuous task's target in this frame (None for other answers; ``track`` in the JSON only when set)."""
 
     def to_dict(self) -> dict[str, Any]:
         """A JSON-ready dict."""
-        return {
+        found = {
             "query": self.query,
             "from_memory": self.from_memory,
             "timed_out": self.timed_out,
             "objects": [o.to_dict() for o in self.objects],
         }
+        if self.track is not None:
+            found["track"] = self.track.to_dict()
+        return found
 
     def to_json(self, indent: int | None = 2) -> str:
         """The answer as JSON text."""

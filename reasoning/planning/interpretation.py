@@ -12,7 +12,20 @@ from __future__ import annotations
 
 from dataclasses import dataclass
 
-from queries.model import ANYWHERE, HUMAN_KEY, Asked, Block, Field, ListValue, Number, Query, String, Symbol, Value
+from queries.model import (
+    ANYWHERE,
+    CONTINUOUS_KINDS,
+    HUMAN_KEY,
+    Asked,
+    Block,
+    Field,
+    ListValue,
+    Number,
+    Query,
+    String,
+    Symbol,
+    Value,
+)
 from reasoning.errors import TermError
 from reasoning.knowledge.knowledge_base import KnowledgeBase
 from reasoning.planning.plan import Constraint, Task
@@ -23,6 +36,8 @@ _RELATIONS = ("in", "inside", "on", "at", "near")
 _STRUCTURAL_KEYS = frozenset({"type", "location", "id", "transparent", "confidence"})
 _TRUTH = {"true": True, "yes": True, "false": False, "no": False}
 _KINDS_WITH_OBJECTS = ("detect", "inspect", "track")
+TRACK_TYPE = "TargetTrack"
+"""What a continuous query needs in every frame: the estimate of its one target (a tracker's output)."""
 
 
 @dataclass(frozen=True)
@@ -97,7 +112,7 @@ def interpret(query: Query, kb: KnowledgeBase, depth: bool = True, camera_pose: 
         object_id=_whole(obj.get("id")),
         min_confidence=min_confidence,
     )
-    return Interpretation(task, tuple(requirements), region_box, transparent)
+    return Interpretation(task, (*requirements, *_tracking(query)), region_box, transparent)
 
 
 def _interpret_specialised(query: Query, obj: Block, object_class: str, hypothesis: str) -> Interpretation:
@@ -122,7 +137,15 @@ def _interpret_specialised(query: Query, obj: Block, object_class: str, hypothes
         object_id=_whole(obj.get("id")),
         min_confidence=_confidence(obj.get("confidence"), []),
     )
-    return Interpretation(task, (Requirement(hypothesis, None, why),), None)
+    return Interpretation(task, (Requirement(hypothesis, None, why), *_tracking(query)), None)
+
+
+def _tracking(query: Query) -> tuple[Requirement, ...]:
+    """The tracker a continuous query needs (none for a one-shot query)."""
+    if query.kind not in CONTINUOUS_KINDS:
+        return ()
+    why = f"a {query.kind} query follows its target from frame to frame"
+    return (Requirement(TRACK_TYPE, None, why),)
 
 
 def _target(query: Query) -> Block:

@@ -7,10 +7,11 @@ from dataclasses import dataclass
 from queries.model import Query
 from reasoning.knowledge.knowledge_base import KnowledgeBase
 from reasoning.knowledge.model import Conditions
-from reasoning.planning.interpretation import Interpretation, interpret
-from reasoning.planning.plan import Plan
+from reasoning.planning.interpretation import TRACK_TYPE, Interpretation, interpret
+from reasoning.planning.plan import Plan, Task
 from reasoning.planning.planner import SensorSource, plan_requirements
 from robokudo.core.regions import RegionBox
+from robokudo.core.types import type_by_name
 
 DEPTH_TYPES = frozenset({"DepthImage", "PointCloud"})
 REGION_PRECONDITION = "NeedsRegion"
@@ -84,6 +85,22 @@ def annotator_parameters(
     return parameters
 
 
+def target_parameters(kb: KnowledgeBase, task: Task) -> dict[str, object]:
+    """Constructor arguments telling an object tracker which object to follow: the asked class and its subclasses,
+    and the asked attribute values (``{"color": ("blue",)}``), as plain names."""
+    classes: tuple[str, ...] = ()
+    if task.object_class is not None:
+        classes = (task.object_class, *kb.subclasses(task.object_class))
+    values: dict[str, list[str]] = {}
+    for constraint in task.constraints:
+        if constraint.annotation_type == "Classification" or constraint.value is None:
+            continue
+        attribute = getattr(type_by_name(constraint.annotation_type), "attribute", "")
+        if attribute:
+            values.setdefault(attribute, []).append(constraint.value)
+    return {"target_classes": classes, "target_values": tuple((k, tuple(v)) for k, v in sorted(values.items()))}
+
+
 class QueryPlanner:
     """Plans queries against one knowledge base, keeping what only changes with the ontology (class profiles)."""
 
@@ -112,6 +129,9 @@ class QueryPlanner:
         box = interpretation.region_box
         conditions = Conditions(depth=depth, region=box is not None, transparent=interpretation.transparent)
         parameters = annotator_parameters(self.kb, box, self.profiles(), interpretation.task.object_class)
+        for spec in self.kb.annotators():
+            if TRACK_TYPE in spec.outputs:  # a tracker of any object: told which one to follow
+                parameters.setdefault(spec.name, {}).update(target_parameters(self.kb, interpretation.task))
         plan = plan_requirements(
             interpretation.task,
             interpretation.requirements,

@@ -344,6 +344,32 @@ class Location(Annotation):
         return self.region.strip().lower()
 
 
+@dataclass(eq=False, kw_only=True)
+class TargetTrack(Annotation):
+    """A continuous task's estimate of its one target in this frame (camera frame, metres).
+
+    ``seen`` says whether a detection was associated with the target in this frame (``hypothesis``, None when
+    not); ``position`` and ``velocity`` are the filtered estimate, ``pixel`` its image position (None when it
+    is behind the camera), ``spread`` the estimate's standard deviation in metres, ``unseen_for`` the seconds
+    since the target was last seen (0 when seen now) and ``target`` the class tracked ("" for any object).
+    """
+
+    target: str
+    seen: bool
+    position: np.ndarray
+    velocity: np.ndarray
+    pixel: tuple[float, float] | None
+    spread: float
+    unseen_for: float = 0.0
+    hypothesis: ObjectHypothesis | None = None
+    frame: str = "camera"
+
+
+@dataclass(eq=False, kw_only=True)
+class PersonTrack(TargetTrack):
+    """The track of a person (from a people tracker)."""
+
+
 def _declared(root: type[T]) -> tuple[type[T], ...]:
     """The classes derived from ``root`` in this module, in declaration order."""
     found: list[type[T]] = []

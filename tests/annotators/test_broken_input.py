@@ -49,6 +49,8 @@ from annotators.readers.frame_readers import (
 )
 from annotators.readers.streams import FrameStream, PerceivedFrameReader, StreamReader, recorded_stream
 from annotators.text.reader import TextReader
+from annotators.tracking.human_tracker import HumanTracker
+from annotators.tracking.object_tracker import ObjectTracker
 from robokudo.core.annotator import Annotator
 from robokudo.core.pipeline import Pipeline
 from robokudo.core.types import (
@@ -61,6 +63,7 @@ from robokudo.core.types import (
     DepthImage,
     Normals,
     ObjectHypothesis,
+    PersonHypothesis,
     Plane,
     PointCloud,
     SemanticColor,
@@ -225,6 +228,13 @@ BROKEN_CASES: dict[str, tuple[Callable[[], Seeds], tuple[type[Annotator], ...]]]
         (NormalEstimator,),
     ),
     "collinear cloud": (lambda: [line_cloud()], (SupportPlaneSegmenter, DepthPeopleDetector)),
+    "hypotheses beyond the cloud": (
+        lambda: [
+            flat_cloud(),
+            PersonHypothesis(point_indices=np.array([H * W + 5]), mask=np.zeros((H, W), bool), roi=(0, 0, 1, 1)),
+        ],
+        (HumanTracker, ObjectTracker),
+    ),
     "a wall, no ground": (lambda: [flat_cloud()], (DepthPeopleDetector,)),
     "cloud out of range": (
         lambda: [PointCloud(points=flat_cloud().points * 10, mask=np.ones((H, W), bool))],
