@@ -10,7 +10,7 @@ domains and ranges and data values:
 * the ontology: the same in class descriptions, ``owl:equivalentClass`` to a named class, a restriction or an
   intersection of those (defined classes such as ``RefrigeratedItem``), disjointness (``owl:disjointWith``,
   ``owl:AllDisjointClasses``), ``rdfs:domain`` / ``rdfs:range`` (a named class, or ``xsd:string`` / ``xsd:boolean``
-  / ``rdfs:Literal`` for data properties), and individuals with their types and property values.
+  / ``xsd:decimal`` / ``rdfs:Literal`` for data properties), and individuals with their types and property values.
 
 A new class's subsumers are closed under its parents' classified ancestors and told restrictions, domains, defined
 classes whose definition it meets (an existential conjunct is met by a successor whose own closure, range included,
@@ -22,6 +22,7 @@ expressions, ...) makes the result :attr:`FreshCheck.supported` False with the r
 
 from __future__ import annotations
 
+import re
 from collections import defaultdict
 from collections.abc import Iterable, Mapping
 from dataclasses import dataclass, field
@@ -53,7 +54,9 @@ ANNOTATION_PROPERTIES: frozenset[URIRef] = frozenset(
 """Properties whose triples state nothing a reasoner uses (the ontology may declare more)."""
 
 _MAX_DEPTH = 4
-_DATA_RANGES = {XSD.string, XSD.boolean, RDFS.Literal}
+_DATA_RANGES = {XSD.string, XSD.boolean, XSD.decimal, RDFS.Literal}
+_DECIMAL_TYPES = {XSD.decimal, XSD.integer, XSD.nonNegativeInteger, XSD.positiveInteger, XSD.int, XSD.long}
+_DECIMAL_TEXT = re.compile(r"[+-]?(\d+(\.\d*)?|\.\d+)")
 _OWL_TYPES = {
     OWL.Class,
     OWL.NamedIndividual,
@@ -483,4 +486,6 @@ def _fits(value: Literal, kind: URIRef) -> bool:
         return True
     if kind == XSD.string:
         return value.language is None and value.datatype in (None, XSD.string)
+    if kind == XSD.decimal:  # xsd:integer and its kin are decimals too
+        return value.datatype in _DECIMAL_TYPES and _DECIMAL_TEXT.fullmatch(str(value)) is not None
     return value.datatype == XSD.boolean and str(value) in ("true", "false", "1", "0")

@@ -31,7 +31,8 @@ def restrict(graph: Graph, subject: Node, prop: str, kind: Node, value: Node) ->
 
 def random_classes(kb: KnowledgeBase, rng: random.Random) -> Graph:
     """New classes as users and imports write them: one or two parents (sometimes disjoint ones), colours, shapes,
-    storage places (sometimes a colour, which is no region), transparency and printed texts of every type."""
+    storage places (sometimes a colour, which is no region), transparency, printed texts and height-to-width
+    ratios of every type."""
     objects = kb.names_of_kind("class")
     everything = sorted(kb.index.classes)
     colors, shapes = kb.names_of_kind("color"), kb.names_of_kind("shape")
@@ -55,6 +56,11 @@ def random_classes(kb: KnowledgeBase, rng: random.Random) -> Graph:
                 [Literal("oat"), Literal("oat", lang="en"), Literal("oat", datatype=vocabulary.XSD.string)]
             )
             restrict(graph, subject, "printedText", OWL.hasValue, value)
+        if rng.random() < 0.2:
+            value = rng.choice(
+                [Literal("1.5", datatype=vocabulary.XSD.decimal), Literal(2), Literal("tall"), Literal(0.5)]
+            )
+            restrict(graph, subject, "maxHeightToWidth", OWL.hasValue, value)
     return graph
 
 
