@@ -16,14 +16,23 @@ from typing import ClassVar
 import numpy as np
 
 from queries import Query
-from reasoning.beliefs.answer import Answer, class_label, designator
+from reasoning.beliefs.answer import Answer, PointingAnswer, class_label, designator
 from reasoning.beliefs.store import BeliefFilter, BeliefStore
 from reasoning.fusion.association import CameraModel
 from reasoning.fusion.frame import FUSED_TYPES, WORLD_FRAME, FrameContext, FrameObject, frame_objects
 from reasoning.fusion.rule import CLASS_ATTRIBUTE
 from reasoning.fusion.tracking import BeliefTracker, ObjectBelief, TrackStep
 from robokudo.core.annotator import Annotator
-from robokudo.core.types import CameraInfo, CasType, DepthImage, ObjectHypothesis, PointCloud, QueryAnswer, QueryView
+from robokudo.core.types import (
+    CameraInfo,
+    CasType,
+    DepthImage,
+    ObjectHypothesis,
+    PointCloud,
+    PointingTarget,
+    QueryAnswer,
+    QueryView,
+)
 
 
 def camera_model(info: CameraInfo, depth: np.ndarray | None = None) -> CameraModel:
@@ -55,7 +64,14 @@ class AnswerStep(Annotator):
     """
 
     inputs: ClassVar[tuple[type[CasType], ...]] = (ObjectHypothesis,)
-    optional_inputs: ClassVar[tuple[type[CasType], ...]] = (CameraInfo, PointCloud, DepthImage, QueryView, *FUSED_TYPES)
+    optional_inputs: ClassVar[tuple[type[CasType], ...]] = (
+        CameraInfo,
+        PointCloud,
+        DepthImage,
+        QueryView,
+        PointingTarget,
+        *FUSED_TYPES,
+    )
     outputs: ClassVar[tuple[type[CasType], ...]] = (QueryAnswer,)
 
     def __init__(
@@ -132,6 +148,13 @@ class AnswerStep(Annotator):
         matching.sort(key=lambda b: (-b.confidence, b.id))
         if belief_filter.limit is not None:
             matching = matching[: belief_filter.limit]
+        pointing = self._pointing(seen, info)
+        if pointing is not None:  # a pointing query answers with the pointed object (none for a region)
+            matching = [
+                b
+                for b in matching + store.query(replace(belief_filter, ids=tuple(seen), limit=None))
+                if b.id == pointing.object_id
+            ][:1]
         query_view = self.optional_view(QueryView)
         text = query_view.query.source if query_view is not None and isinstance(query_view.query, Query) else ""
         answer = Answer(
@@ -147,10 +170,39 @@ class AnswerStep(Annotator):
                 for b in matching
             ),
             observed=tuple(step.assigned),
+            pointing=pointing,
         )
         self.write(QueryAnswer(answer))
         if self.fail_when_empty and not matching:
             self.fail(f"no object matches the query among {len(objects)} seen")
+
+    def _pointing(self, seen: dict[int, FrameObject], info: CameraInfo | None) -> PointingAnswer | None:
+        """The most confident PointingTarget of this frame, with the belief of the pointed object (the object seen
+        here whose image box overlaps the target's most) and the ray in the world frame when the pose is known."""
+        targets = self.annotations(PointingTarget)
+        if not targets:
+            return None
+        target = max(targets, key=lambda t: t.confidence)
+        object_id = None
+        if target.kind == "object" and target.roi is not None:
+            overlaps = {i: _box_overlap(o.roi, target.roi) for i, o in seen.items() if o.roi is not None}
+            best = max(overlaps, key=lambda i: overlaps[i], default=None)
+            object_id = best if best is not None and overlaps[best] > 0.5 else None
+        origin, direction, frame = target.origin, target.direction, "camera"
+        if info is not None and info.cam_to_world is not None:
+            pose = np.asarray(info.cam_to_world, dtype=np.float64)
+            origin, direction, frame = pose[:3, :3] @ origin + pose[:3, 3], pose[:3, :3] @ direction, WORLD_FRAME
+        return PointingAnswer(
+            kind=target.kind,
+            object_id=object_id,
+            region=target.name,
+            angular_error_degrees=float(np.degrees(target.angular_error)),
+            spread_degrees=float(np.degrees(target.spread)),
+            confidence=target.confidence,
+            origin=tuple(float(v) for v in origin),
+            direction=tuple(float(v) for v in direction),
+            frame=frame,
+        )
 
     @staticmethod
     def _guessed(
@@ -183,3 +235,13 @@ class AnswerStep(Annotator):
         if self.filter_for is not None and query_view is not None:
             return self.filter_for(query_view.query)
         return BeliefFilter(class_test=(self.tracker or self.store.tracker).class_test)
+
+
+def _box_overlap(a: tuple[int, int, int, int], b: tuple[int, int, int, int]) -> float:
+    """Intersection over union of two image boxes (x1/y1 exclusive)."""
+    width = min(a[2], b[2]) - max(a[0], b[0])
+    height = min(a[3], b[3]) - max(a[1], b[1])
+    if width <= 0 or height <= 0:
+        return 0.0
+    inter = width * height
+    return inter / ((a[2] - a[0]) * (a[3] - a[1]) + (b[2] - b[0]) * (b[3] - b[1]) - inter)

@@ -125,9 +125,12 @@ class HumanPoseDetector(Annotator):
         crop_margin: float = 0.12,
         min_on_person: float = 0.5,
         parameters: PeopleParameters | None = None,
+        depth_reach: float = 0.5,
         name: str | None = None,
     ) -> None:
         super().__init__(name=name)
+        self.depth_reach = depth_reach
+        """Without a depth candidate, how far (m, in depth) from its torso a pixel of the box counts as the person."""
         self.min_torso_visibility = min_torso_visibility
         self.crop_margin = crop_margin
         self.min_on_person = min_on_person
@@ -184,11 +187,16 @@ class HumanPoseDetector(Annotator):
                 if np.count_nonzero(np.isfinite(xyz[:, 2])) < self.min_on_person * len(LANDMARKS):
                     continue  # the skeleton does not lie on the candidate's points: something else was seen
             found += 1
-            self.write(self._person(pixels, visibility, xyz, candidate))
+            self.write(self._person(pixels, visibility, xyz, candidate, points))
         return found
 
     def _person(
-        self, pixels: np.ndarray, visibility: np.ndarray, xyz: np.ndarray | None, candidate: PersonSegment | None
+        self,
+        pixels: np.ndarray,
+        visibility: np.ndarray,
+        xyz: np.ndarray | None,
+        candidate: PersonSegment | None,
+        points: np.ndarray | None = None,
     ) -> PersonHypothesis:
         confidence = float(np.mean(visibility[list(TORSO)]))
         if candidate is not None and xyz is not None:
@@ -199,6 +207,11 @@ class HumanPoseDetector(Annotator):
             x1, y1 = np.clip(np.ceil(pixels.max(axis=0)).astype(int) + 1, 1, (width, height))
             mask = np.zeros((height, width), dtype=bool)
             mask[y0:y1, x0:x1] = True
+            torso_depth = np.nanmedian(xyz[list(TORSO), 2]) if xyz is not None else np.nan
+            if points is not None and np.isfinite(torso_depth):
+                # the person's pixels in the box: those at its depth (not a table and its objects in front)
+                with np.errstate(invalid="ignore"):
+                    mask &= np.abs(points[..., 2] - torso_depth) < self.depth_reach
             hypothesis = PersonHypothesis(
                 point_indices=np.flatnonzero(mask),
                 mask=mask,

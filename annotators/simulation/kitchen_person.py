@@ -28,7 +28,7 @@ from annotators.simulation.kitchen_map import map_regions
 
 __all__ = (
     "PERSON_OBJECT_ID",
-    "PERSON_VIEW_EYE",
+    "PERSON_VIEWS",
     "Motion",
     "PersonPose",
     "PersonScript",
@@ -45,10 +45,15 @@ Mesh = tuple[NDArray[np.float32], NDArray[np.uint32]]
 PERSON_OBJECT_ID: int = 100
 """The person's id in ``RenderedScene.object_ids`` (ground truth only)."""
 
-PERSON_VIEW_EYE: tuple[tuple[float, float, float], tuple[float, float, float]] = ((0.0, -2.35, 1.65), (0.0, 0.3, 0.95))
-"""Eye and target of the camera that sees the table and a person standing behind it."""
+PERSON_VIEWS: dict[str, tuple[tuple[float, float, float], tuple[float, float, float]]] = {
+    "person": ((0.0, -1.6, 1.65), (0.0, 0.3, 1.05)),
+    "room": ((0.0, -2.35, 1.65), (0.0, 0.3, 0.95)),
+}
+"""Eye and target of the cameras that see the table and a person behind it: ``person`` near (the table objects
+within 2.5 m), ``room`` farther back (more of the floor in view, which the depth people detector stands people
+on)."""
 
-DEFAULT_SPOT: tuple[float, float] = (0.0, 0.8)
+DEFAULT_SPOT: tuple[float, float] = (0.0, 0.7)
 """Where the person stands by default: behind the table, facing the robot (-y)."""
 
 SKIN = (214, 160, 128)
@@ -67,18 +72,20 @@ _UPPER_ARM, _FOREARM = 0.29, 0.26
 _HEAD_RADIUS = 0.105
 
 
-def person_view() -> FloatArray:
-    """cam_to_world of the camera that sees the table objects and the person behind the table."""
+def person_view(name: str = "person") -> FloatArray:
+    """cam_to_world of a camera of ``PERSON_VIEWS`` (default: the near one)."""
     from annotators.simulation.kitchen_scene import look_at  # the scene imports this module
 
-    return look_at(*PERSON_VIEW_EYE)
+    if name not in PERSON_VIEWS:
+        raise ValueError(f"unknown person view {name!r}; known: {', '.join(PERSON_VIEWS)}")
+    return look_at(*PERSON_VIEWS[name])
 
 
 @dataclass(frozen=True)
 class Posture:
     """Where the person stands (x, y on the floor), the direction it faces (yaw, radians, 0 = +x) and what its
-    right arm does: ``"hang"``, ``"point"`` (at ``target``, a world point) or ``"wave"`` (``phase`` in radians
-    swings the forearm)."""
+    arms do: ``"hang"``, ``"point"`` (at ``target``, a world point, with the arm on the target's side) or
+    ``"wave"`` (the right hand; ``phase`` in radians swings the forearm)."""
 
     x: float
     y: float
@@ -143,24 +150,25 @@ def pose_person(posture: Posture, activity: str | None = None, target_name: str 
     joints["neck"] = at(_NECK)
     joints["head"] = at(_HEAD)
     joints["nose"] = at(_HEAD, 0.0, 0.11)
-    # the left arm hangs; the right arm's posture decides it
-    joints["left_elbow"] = at(_SHOULDER - _UPPER_ARM, _SHOULDER_HALF + 0.03)
-    joints["left_wrist"] = at(_SHOULDER - _UPPER_ARM - _FOREARM, _SHOULDER_HALF + 0.04, 0.03)
-    shoulder = joints["right_shoulder"]
+    # both arms hang, then the posture moves one: a pointing arm is the one on the target's side, a waving one
+    # the right
+    for sign, side in ((1.0, "left"), (-1.0, "right")):
+        joints[f"{side}_elbow"] = at(_SHOULDER - _UPPER_ARM, sign * (_SHOULDER_HALF + 0.03))
+        joints[f"{side}_wrist"] = at(_SHOULDER - _UPPER_ARM - _FOREARM, sign * (_SHOULDER_HALF + 0.04), 0.03)
     if posture.arm == "point":
-        direction = np.asarray(posture.target, dtype=np.float64) - shoulder
-        direction /= np.linalg.norm(direction)
-        joints["right_elbow"] = shoulder + _UPPER_ARM * direction
-        joints["right_wrist"] = shoulder + (_UPPER_ARM + _FOREARM) * direction
+        target = np.asarray(posture.target, dtype=np.float64)
+        side = "left" if np.dot(target - base, left) > 0 else "right"
+        shoulder = joints[f"{side}_shoulder"]
+        direction = _unit(target - shoulder)
+        joints[f"{side}_elbow"] = shoulder + _UPPER_ARM * direction
+        joints[f"{side}_wrist"] = shoulder + (_UPPER_ARM + _FOREARM) * direction
     elif posture.arm == "wave":
+        shoulder = joints["right_shoulder"]
         elbow = shoulder + _UPPER_ARM * _unit(-0.85 * left + 0.5 * up + 0.15 * forward)
         swing = 0.5 * math.sin(posture.phase)
         forearm = _unit(math.sin(swing) * -left + math.cos(swing) * up)
         joints["right_elbow"] = elbow
         joints["right_wrist"] = elbow + _FOREARM * forearm
-    else:
-        joints["right_elbow"] = at(_SHOULDER - _UPPER_ARM, -_SHOULDER_HALF - 0.03)
-        joints["right_wrist"] = at(_SHOULDER - _UPPER_ARM - _FOREARM, -_SHOULDER_HALF - 0.04, 0.03)
     for side in ("left", "right"):
         elbow, wrist = joints[f"{side}_elbow"], joints[f"{side}_wrist"]
         joints[f"{side}_index"] = wrist + 0.08 * _unit(wrist - elbow)

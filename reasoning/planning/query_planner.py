@@ -81,6 +81,18 @@ def annotator_parameters(
     return parameters
 
 
+POINTING_OUTPUT = "PointingTarget"
+
+
+def pointing_parameters(kb: KnowledgeBase, target: str) -> dict[str, dict[str, object]]:
+    """Constructor arguments of the annotators that say what a person points at: the kind of target and, for
+    regions, every region box of the semantic map (plain data)."""
+    regions = tuple(region_parameters(box) for box in kb.regions()) if target == "region" else ()
+    return {
+        spec.name: {"target": target, "regions": regions} for spec in kb.annotators() if POINTING_OUTPUT in spec.outputs
+    }
+
+
 class QueryPlanner:
     """Plans queries against one knowledge base, keeping what only changes with the ontology (class profiles)."""
 
@@ -109,6 +121,8 @@ class QueryPlanner:
         box = interpretation.region_box
         conditions = Conditions(depth=depth, region=box is not None, transparent=interpretation.transparent)
         parameters = annotator_parameters(self.kb, box, self.profiles(), interpretation.task.object_class)
+        if interpretation.task.pointing is not None:
+            parameters.update(pointing_parameters(self.kb, interpretation.task.pointing))
         plan = plan_requirements(
             interpretation.task,
             interpretation.requirements,

@@ -255,9 +255,12 @@ class AnsweringService:
         hz: float = 100.0,
         intrinsics: CameraIntrinsics | None = None,
         stream: FrameStream | None = None,
+        person: str | None = None,
     ) -> None:
         self.kb = kb
         self.intrinsics = intrinsics
+        self.person = person
+        """A person put into the built-in kitchen (a ``kitchen_person`` spec), None for none."""
         self.store = store
         self.catalog = catalog if catalog is not None else AnnotatorCatalog.discover()
         self.input_path = input_path
@@ -297,6 +300,7 @@ class AnsweringService:
         catalog: AnnotatorCatalog | None = None,
         intrinsics: CameraIntrinsics | None = None,
         stream: FrameStream | None = None,
+        person: str | None = None,
     ) -> AnsweringService:
         """A service over the shipped and user ontology and the belief store at ``store_path`` (default store
         when None), with the annotators of ``catalog`` (default: this project's).
@@ -312,7 +316,15 @@ class AnsweringService:
             store.close()
             raise
         return cls(
-            kb, store, catalog=catalog, input_path=input_path, frame=frame, hz=hz, stream=stream, intrinsics=intrinsics
+            kb,
+            store,
+            catalog=catalog,
+            input_path=input_path,
+            frame=frame,
+            hz=hz,
+            stream=stream,
+            intrinsics=intrinsics,
+            person=person,
         )
 
     # ------------------------------------------------------------------ planning
@@ -331,6 +343,7 @@ class AnsweringService:
             self.frame,
             look_at=self._remembered_region(parsed),
             intrinsics=self.intrinsics,
+            person=self.person,
         )
 
     def _remembered_region(self, query: Query) -> str | None:

@@ -46,7 +46,13 @@ def test_without_a_person_the_kitchen_renders_exactly_as_before() -> None:
 @pytest.mark.parametrize("target", ["red_cup", "bowl", "cereal_box", "fridge"])
 def test_a_pointing_arm_is_straight_and_its_ray_passes_through_the_target(target: str) -> None:
     pose = person_spec_pose(f"point:{target}@0.3,0.8")
-    shoulder, elbow, wrist = (pose.joint(f"right_{n}") for n in ("shoulder", "elbow", "wrist"))
+    moved = [  # the raised arm: its elbow is no longer below its shoulder
+        s
+        for s in ("left", "right")
+        if np.linalg.norm((pose.joint(f"{s}_elbow") - pose.joint(f"{s}_shoulder"))[:2]) > 0.06
+    ]
+    assert len(moved) == 1
+    shoulder, elbow, wrist = (pose.joint(f"{moved[0]}_{n}") for n in ("shoulder", "elbow", "wrist"))
     ray = (wrist - shoulder) / np.linalg.norm(wrist - shoulder)
     goal = target_point(target) - shoulder
     assert np.linalg.norm(np.cross(ray, goal)) < 1e-9 and ray @ goal > 0
@@ -101,7 +107,7 @@ def test_bad_motions_are_refused() -> None:
 @pytest.mark.parametrize("spec", ["stand", "point:red_cup@-0.4,0.8", "point:fridge@0.3,0.75"])
 def test_the_depth_people_detector_finds_the_person_where_it_stands(spec: str) -> None:
     pose = person_spec_pose(spec)
-    scene = render_kitchen(person_view(), person=pose)
+    scene = render_kitchen(person_view("room"), person=pose)  # with the floor in view to stand people on
     up = scene.world_to_cam[:3, :3] @ np.array([0.0, 0.0, 1.0])
     people = find_people(_cloud(scene), scene.depth > 0, up)
     truth = scene.object_ids == PERSON_OBJECT_ID

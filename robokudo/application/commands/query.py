@@ -51,6 +51,12 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
         metavar="PATH",
         help="write the analysed frame with the answer's objects boxed and labelled",
     )
+    parser.add_argument(
+        "--person",
+        metavar="SPEC",
+        help="put a person into the built-in kitchen: stand, wave or point:<object or region>, optionally @x,y "
+        "(where it stands, metres), e.g. point:red_cup@0.2,0.7",
+    )
     add_rerun_arguments(parser)
 
 
@@ -66,7 +72,11 @@ def run(args: argparse.Namespace) -> int:
         with (
             open_rerun_log(args) or contextlib.nullcontext() as rerun_log,
             AnsweringService.open(
-                args.store, input_path=args.input, frame=frame_number(args), intrinsics=intrinsics_of(args)
+                args.store,
+                input_path=args.input,
+                frame=frame_number(args),
+                intrinsics=intrinsics_of(args),
+                person=args.person,
             ) as service,
         ):
             outcome = answer(service, query, rerun_log)
