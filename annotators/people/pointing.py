@@ -1,7 +1,7 @@
 """What a person points at: the arm's 3-D ray intersected with the object hypotheses or the map's regions.
 
-The ray starts at the pointing arm's shoulder and goes through its wrist; the elbow-to-wrist direction is a
-second estimate, and the angle between the two (``spread``) says how well the arm pose is known. Objects are
+The ray has the pointing arm's shoulder-to-wrist direction and starts at the wrist; the elbow-to-wrist direction
+is a second estimate, and the angle between the two (``spread``) says how well the arm pose is known. Objects are
 the frame's object hypotheses that are not part of a person (their centroid from the cloud); regions are the
 semantic-map boxes the plan hands over (world frame, so they need the camera pose). The target is the candidate
 with the least angle between the ray and the direction to it (for a region: to its nearest point to the ray);
@@ -78,9 +78,10 @@ def segment_distance(point: np.ndarray, a: np.ndarray, b: np.ndarray) -> float:
 
 
 def ranked(ray: Ray, candidates: Sequence[tuple[str, np.ndarray]]) -> list[tuple[float, str, np.ndarray]]:
-    """Candidates (name, point) by the angle between the ray and the direction from its origin to the point."""
+    """Candidates (name, point) by the angle between the ray and the direction from its origin to the point (the
+nearer first among equal angles: of two regions the ray passes through, the one it enters first)."""
     scored = [(angle(ray.direction, p - ray.origin), name, p) for name, p in candidates]
-    return sorted(scored, key=lambda item: item[0])
+    return sorted(scored, key=lambda item: (round(item[0], 6), float(np.linalg.norm(item[2] - ray.origin))))
 
 
 def confidence(error: float, margin: float, spread: float, pointing: float) -> float:
