@@ -79,7 +79,7 @@ def segment_distance(point: np.ndarray, a: np.ndarray, b: np.ndarray) -> float:
 
 def ranked(ray: Ray, candidates: Sequence[tuple[str, np.ndarray]]) -> list[tuple[float, str, np.ndarray]]:
     """Candidates (name, point) by the angle between the ray and the direction from its origin to the point (the
-nearer first among equal angles: of two regions the ray passes through, the one it enters first)."""
+    nearer first among equal angles: of two regions the ray passes through, the one it enters first)."""
     scored = [(angle(ray.direction, p - ray.origin), name, p) for name, p in candidates]
     return sorted(scored, key=lambda item: (round(item[0], 6), float(np.linalg.norm(item[2] - ray.origin))))
 
