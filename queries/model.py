@@ -146,6 +146,12 @@ ANYWHERE = "anywhere"
 HUMAN_KEY = "human"
 """The key whose block describes a person to find (``detect { human: {} }``); its block may be empty."""
 
+POINTING_KEY = "pointing"
+"""The key whose block asks what a person points at (``detect { pointing: { target: object } }``)."""
+
+POINTING_TARGETS: tuple[str, ...] = ("object", "region")
+"""What a pointing query may ask for: the object pointed at, or the region (a place of the semantic map)."""
+
 KINDS: tuple[str, ...] = ("detect", "inspect", "track", "scan", "stop")
 """The known query kinds, in canonical order."""
 

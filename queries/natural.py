@@ -78,6 +78,7 @@ from queries.lexicon import (
 )
 from queries.model import (
     ANYWHERE,
+    POINTING_KEY,
     Asked,
     Block,
     Field,
@@ -276,6 +277,9 @@ class _PhraseParser:
             raise self.error("expected a phrase such as 'find the red cup'", VERB_EXAMPLES)
         while (filler := self.match(FILLERS)) is not None:
             self.take(len(filler))
+        pointing = self.pointing_question()
+        if pointing is not None:
+            return pointing
         asked_key: str | None = None
         if self.word() == "what" and self.word(1) in QUESTION_ATTRIBUTES:
             verb_tokens = self.take(2)
@@ -309,6 +313,23 @@ class _PhraseParser:
             else:
                 body = self.object_body(kind, phrase)
         query = Query(kind, body, self.text, kind_span)
+        validate_query(query)
+        return query
+
+    def pointing_question(self) -> Query | None:
+        """``which object is the person pointing at`` (also ``what ... point at``, ``which region / place ...``,
+        ``where is the person pointing``): ``detect { pointing: { target: object | region } }``; None when the
+        phrase is no such question."""
+        words = [t.text for t in self.tokens if t.kind == "word"]
+        if not words or words[0] not in POINTING_QUESTION_WORDS or not POINTING_VERBS & set(words):
+            return None
+        if not PERSON_WORDS & set(words):
+            raise self.error("a pointing question names the person, e.g. 'which object is the person pointing at'")
+        target = "region" if words[0] == "where" or REGION_WORDS & set(words) else "object"
+        first, last = self.tokens[0].span, self.tokens[-1].span
+        span = _join_span(first, last)
+        block = Block((Field("target", Symbol(target), span),))
+        query = Query("detect", Block((Field(POINTING_KEY, block, span),)), self.text, first)
         validate_query(query)
         return query
 
@@ -539,6 +560,12 @@ class _PhraseParser:
             self.take()
         self.expect_end()
         return Block(tuple(fields))
+
+
+POINTING_QUESTION_WORDS = frozenset({"which", "what", "where"})
+POINTING_VERBS = frozenset({"pointing", "point", "points", "pointed", "gesturing"})
+PERSON_WORDS = frozenset({"person", "human", "man", "woman", "someone", "somebody", "she", "he", "they", "people"})
+REGION_WORDS = frozenset({"region", "place", "area", "storage", "location", "shelf", "counter"})
 
 
 def parse_natural(text: str) -> Query:

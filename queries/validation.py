@@ -19,6 +19,8 @@ from queries.errors import QueryError, describe_alternatives, located_error, off
 from queries.model import (
     HUMAN_KEY,
     KINDS,
+    POINTING_KEY,
+    POINTING_TARGETS,
     Block,
     Field,
     ListValue,
@@ -126,6 +128,20 @@ def validate_query(query: Query) -> None:
         stack.extend(reversed(nested))
 
 
+def _check_pointing(query: Query, item: Field, block: Block) -> None:
+    """A pointing block names its target, ``object`` or ``region``, and nothing else."""
+    target = block.field("target")
+    if target is None:
+        raise _error(query, item.span, f"'{POINTING_KEY}' needs a target: {' or '.join(POINTING_TARGETS)}")
+    if not isinstance(target.value, Symbol) or target.value.name.lower() not in POINTING_TARGETS:
+        raise _error(
+            query, target.span, f"a pointing target is {' or '.join(POINTING_TARGETS)}", list(POINTING_TARGETS)
+        )
+    others = [f.key for f in block.fields if f.key != "target"]
+    if others:
+        raise _error(query, item.span, f"'{POINTING_KEY}' takes only a target, not {', '.join(others)}")
+
+
 def _error(query: Query, span: Span, message: str, expected: tuple[str, ...] | list[str] = ()) -> QueryError:
     """Build an error located at the start of ``span`` in the query's source."""
     return located_error(query.source, message, span.line, span.column, expected)
@@ -142,6 +158,8 @@ def _check_field(query: Query, item: Field, depth: int) -> list[tuple[Block, int
         if item.key in WORD_ONLY_KEYS and isinstance(value, Number | Range):
             raise _error(query, item.span, f"'{item.key}' takes {WORD_ONLY_KEYS[item.key]}")
         if isinstance(value, Block):
+            if item.key == POINTING_KEY and level == 1:
+                _check_pointing(query, item, value)
             if not value.fields and not (item.key == HUMAN_KEY and level == 1):
                 raise _error(query, item.span, f"'{item.key}' has an empty block")
             nested.append((value, level + 1))

@@ -16,7 +16,7 @@ from typing import ClassVar
 import numpy as np
 
 from queries import Query
-from reasoning.beliefs.answer import Answer, TrackDesignator, class_label, designator
+from reasoning.beliefs.answer import Answer, PointingAnswer, TrackDesignator, class_label, designator
 from reasoning.beliefs.store import BeliefFilter, BeliefStore
 from reasoning.fusion.association import CameraModel
 from reasoning.fusion.frame import FUSED_TYPES, WORLD_FRAME, FrameContext, FrameObject, frame_objects
@@ -29,6 +29,7 @@ from robokudo.core.types import (
     DepthImage,
     ObjectHypothesis,
     PointCloud,
+    PointingTarget,
     QueryAnswer,
     QueryView,
     TargetTrack,
@@ -66,7 +67,7 @@ class AnswerStep(Annotator):
 
     inputs: ClassVar[tuple[type[CasType], ...]] = (ObjectHypothesis,)
     optional_inputs: ClassVar[tuple[type[CasType], ...]] = (
-        CameraInfo, PointCloud, DepthImage, QueryView, TargetTrack, *FUSED_TYPES,
+        CameraInfo, PointCloud, DepthImage, QueryView, TargetTrack, PointingTarget, *FUSED_TYPES,
     )  # fmt: skip
     outputs: ClassVar[tuple[type[CasType], ...]] = (QueryAnswer,)
 
@@ -149,6 +150,13 @@ class AnswerStep(Annotator):
         matching.sort(key=lambda b: (-b.confidence, b.id))
         if belief_filter.limit is not None:
             matching = matching[: belief_filter.limit]
+        pointing = self._pointing(seen, info)
+        if pointing is not None:  # a pointing query answers with the pointed object (none for a region)
+            matching = [
+                b
+                for b in matching + store.query(replace(belief_filter, ids=tuple(seen), limit=None))
+                if b.id == pointing.object_id
+            ][:1]
         query_view = self.optional_view(QueryView)
         text = query_view.query.source if query_view is not None and isinstance(query_view.query, Query) else ""
         answer = Answer(
@@ -165,10 +173,39 @@ class AnswerStep(Annotator):
             ),
             observed=tuple(step.assigned),
             track=None if track is None else _track_designator(track, tracked),
+            pointing=pointing,
         )
         self.write(QueryAnswer(answer))
         if self.fail_when_empty and not matching:
             self.fail(f"no object matches the query among {len(objects)} seen")
+
+    def _pointing(self, seen: dict[int, FrameObject], info: CameraInfo | None) -> PointingAnswer | None:
+        """The most confident PointingTarget of this frame, with the belief of the pointed object (the object seen
+        here whose image box overlaps the target's most) and the ray in the world frame when the pose is known."""
+        targets = self.annotations(PointingTarget)
+        if not targets:
+            return None
+        target = max(targets, key=lambda t: t.confidence)
+        object_id = None
+        if target.kind == "object" and target.roi is not None:
+            overlaps = {i: _box_iou(o.roi, target.roi) for i, o in seen.items() if o.roi is not None}
+            best = max(overlaps, key=lambda i: overlaps[i], default=None)
+            object_id = best if best is not None and overlaps[best] > 0.5 else None
+        origin, direction, frame = target.origin, target.direction, "camera"
+        if info is not None and info.cam_to_world is not None:
+            pose = np.asarray(info.cam_to_world, dtype=np.float64)
+            origin, direction, frame = pose[:3, :3] @ origin + pose[:3, 3], pose[:3, :3] @ direction, WORLD_FRAME
+        return PointingAnswer(
+            kind=target.kind,
+            object_id=object_id,
+            region=target.name,
+            angular_error_degrees=float(np.degrees(target.angular_error)),
+            spread_degrees=float(np.degrees(target.spread)),
+            confidence=target.confidence,
+            origin=tuple(float(v) for v in origin),
+            direction=tuple(float(v) for v in direction),
+            frame=frame,
+        )
 
     @staticmethod
     def _guessed(

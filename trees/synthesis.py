@@ -91,6 +91,20 @@ def _stage_node(index: int, stage: Ordered[Unit], make: NodeFactory) -> py_trees
     )
 
 
+def stage_nodes(
+    plan: Plan,
+    make: NodeFactory | None = None,
+    catalog: AnnotatorCatalog | None = None,
+    resources: SharedResources | None = None,
+) -> list[py_trees.behaviour.Behaviour]:
+    """One node per stage of ``plan`` (a threshold Parallel of independent units, a Fallback of alternatives, or
+    a leaf), in order: the body of a Pipeline, or of a subtree embedded in another tree."""
+    if make is None:
+        catalog = catalog if catalog is not None else AnnotatorCatalog.discover()
+        make = partial(instantiate, catalog=catalog, resources=resources)
+    return [_stage_node(index, stage, make) for index, stage in enumerate(plan.stages, start=1)]
+
+
 def build_tree(
     plan: Plan,
     name: str = "query",
@@ -107,10 +121,7 @@ def build_tree(
     models) when given. ``query`` is put into every new CAS of the pipeline. SynthesisError when a step names no
     class of the catalog.
     """
-    if make is None:
-        catalog = catalog if catalog is not None else AnnotatorCatalog.discover()
-        make = partial(instantiate, catalog=catalog, resources=resources)
-    children = [_stage_node(index, stage, make) for index, stage in enumerate(plan.stages, start=1)]
+    children = stage_nodes(plan, make=make, catalog=catalog, resources=resources)
     pipeline = Pipeline(name, [*children, *final_steps], query=query, reason=f"answers the {plan.task.kind} query")
     validate_data_flow(pipeline)
     return pipeline

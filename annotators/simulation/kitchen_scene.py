@@ -33,6 +33,7 @@ from numpy.typing import NDArray
 
 from annotators.cloud.size import SIZE_CLASS_THRESHOLDS, size_class_for
 from annotators.simulation.kitchen_map import map_regions
+from annotators.simulation.kitchen_person import PERSON_OBJECT_ID, PersonPose, person_meshes
 from robokudo.core.regions import RegionBox, region_of
 from robokudo.core.types import CameraIntrinsics
 
@@ -104,6 +105,8 @@ class RenderedScene:
     object_ids: NDArray[np.int32]
     objects: tuple[SceneObject, ...]
     view: str
+    person: PersonPose | None = None
+    """The person in the scene (ground truth for scoring only), None when there is none."""
 
     def object(self, name: str) -> SceneObject:
         """Return the scene object called ``name`` (KeyError if unknown)."""
@@ -572,17 +575,21 @@ def render_kitchen(
     noise: bool = True,
     moved: Mapping[str, NDArray[np.floating]] | None = None,
     intrinsics: CameraIntrinsics = DEFAULT_INTRINSICS,
+    person: PersonPose | None = None,
 ) -> RenderedScene:
     """Render one RGB-D frame of the kitchen.
 
     ``view`` is a named view (see :func:`camera_views`) or a 4x4 cam_to_world.
     ``noise`` toggles the seeded colour (sigma ``COLOR_NOISE_SIGMA``) and depth
     (sigma ``DEPTH_NOISE_SIGMA``) noise; without noise the output does not
-    depend on ``seed``.  ``moved`` is passed to :func:`kitchen_objects`.
+    depend on ``seed``.  ``moved`` is passed to :func:`kitchen_objects`.  ``person`` adds the articulated
+    figure of :mod:`annotators.simulation.kitchen_person` in that pose (pixels of id ``PERSON_OBJECT_ID``).
     """
     view_name, cam_to_world = _resolve_view(view)
     objects = kitchen_objects(moved)
     parts = _furniture_parts() + _object_parts(objects)
+    if person is not None:
+        parts += [_Part(mesh, color, PERSON_OBJECT_ID) for mesh, color in person_meshes(person)]
 
     scene = o3d.t.geometry.RaycastingScene()
     for part in parts:
@@ -641,4 +648,5 @@ def render_kitchen(
         object_ids=np.ascontiguousarray(object_ids.reshape(shape2)),
         objects=objects,
         view=view_name,
+        person=person,
     )

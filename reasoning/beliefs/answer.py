@@ -167,8 +167,43 @@ def _rounded(values: tuple[float, ...]) -> list[float]:
 
 
 @dataclass(frozen=True, slots=True)
+class PointingAnswer:
+    """What a person points at: ``kind`` (``object`` or ``region``), the object's belief id or the region's name,
+    the angle between the arm's ray and the target, the angle between the ray's two estimates (shoulder-wrist,
+    elbow-wrist), both in degrees, the confidence, and the ray (``origin``, unit ``direction``) in ``frame``."""
+
+    kind: str
+    object_id: int | None
+    region: str
+    angular_error_degrees: float
+    spread_degrees: float
+    confidence: float
+    origin: tuple[float, float, float]
+    direction: tuple[float, float, float]
+    frame: str
+
+    @property
+    def target(self) -> str:
+        """The target in words: ``object #12`` or ``region fridge``."""
+        return f"object #{self.object_id}" if self.kind == "object" else f"region {self.region}"
+
+    def to_dict(self) -> dict[str, Any]:
+        """A JSON-ready dict."""
+        return {
+            "kind": self.kind,
+            "object_id": self.object_id,
+            "region": self.region or None,
+            "angular_error_degrees": round(self.angular_error_degrees, 3),
+            "spread_degrees": round(self.spread_degrees, 3),
+            "confidence": round(self.confidence, 6),
+            "ray": {"origin": _rounded(self.origin), "direction": _rounded(self.direction), "frame": self.frame},
+        }
+
+
+@dataclass(frozen=True, slots=True)
 class Answer:
-    """The answer to one query: the matching objects, best first."""
+    """The answer to one query: the matching objects, best first (for a pointing query: the pointed object, and
+    ``pointing`` says what is pointed at)."""
 
     query: str
     objects: tuple[ObjectDesignator, ...] = ()
@@ -179,6 +214,8 @@ class Answer:
     """True when the query's timeout passed before perception finished (the objects then come from memory)."""
     track: TrackDesignator | None = None
     """A continuous task's target in this frame (None for other answers; ``track`` in the JSON only when set)."""
+    pointing: PointingAnswer | None = None
+    """The pointing target of a pointing query (None for other queries, and then absent from the JSON)."""
 
     def to_dict(self) -> dict[str, Any]:
         """A JSON-ready dict."""
@@ -190,6 +227,8 @@ class Answer:
         }
         if self.track is not None:
             found["track"] = self.track.to_dict()
+        if self.pointing is not None:
+            found["pointing"] = self.pointing.to_dict()
         return found
 
     def to_json(self, indent: int | None = 2) -> str:
@@ -199,9 +238,15 @@ class Answer:
     def summary(self) -> str:
         """One line per object, for people: a class more likely wrong than right is marked ``?``; ``class`` is the
         probability that the class is right, ``exists`` the confidence that the object is there."""
-        if not self.objects:
-            return "no matching object"
         lines = []
+        if self.pointing is not None:
+            p = self.pointing
+            lines.append(
+                f"pointing at {p.target}: {p.angular_error_degrees:.1f}° off the arm's ray, "
+                f"confidence {p.confidence:.2f}"
+            )
+        if not self.objects:
+            return "\n".join([*lines, "no matching object"]) if not lines else "\n".join(lines)
         for o in self.objects:
             p = o.pose.position
             colour = o.attributes.get(SemanticColor.attribute)

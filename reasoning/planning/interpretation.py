@@ -16,6 +16,7 @@ from queries.model import (
     ANYWHERE,
     CONTINUOUS_KINDS,
     HUMAN_KEY,
+    POINTING_KEY,
     Asked,
     Block,
     Field,
@@ -62,6 +63,9 @@ def interpret(query: Query, kb: KnowledgeBase, depth: bool = True, camera_pose: 
         raise PlanningError("a stop query cancels a running task; there is no perception tree to plan for it")
     if query.kind == "scan":
         return _interpret_scan(query, kb, camera_pose)
+    pointing = query.get(POINTING_KEY)
+    if isinstance(pointing, Block):
+        return _interpret_pointing(query, pointing, depth, camera_pose)
     obj = _target(query)
     object_class = _object_class(obj.get("type"), kb)
     hypothesis = kb.hypothesis_type(object_class) if object_class is not None else "ObjectHypothesis"
@@ -146,6 +150,37 @@ def _tracking(query: Query) -> tuple[Requirement, ...]:
         return ()
     why = f"a {query.kind} query follows its target from frame to frame"
     return (Requirement(TRACK_TYPE, None, why),)
+
+
+def _interpret_pointing(query: Query, pointing: Block, depth: bool, camera_pose: bool) -> Interpretation:
+    """``detect { pointing: { target: object | region } }``: a person's pointing target, so its body keypoints,
+    its activity and the pointing ray are required; an object target needs the frame's object hypotheses (with
+    their poses), a region target the semantic map, which needs the camera pose."""
+    if query.kind != "detect":
+        raise PlanningError(f"pointing is detected (detect {{ {POINTING_KEY}: ... }}), not asked by {query.kind}")
+    others = [f.key for f in query.body.fields if f.key != POINTING_KEY]
+    if others:
+        raise PlanningError(f"a pointing query asks only what is pointed at; {', '.join(others)} cannot be added")
+    target_value = pointing.get("target")
+    target = target_value.name.lower() if isinstance(target_value, Symbol) else "object"
+    if not depth:
+        raise PlanningError("a pointing ray needs 3-D body keypoints, and the input has no depth")
+    requirements = [
+        Requirement("PointingTarget", None, f"the query asks which {target} the person points at"),
+    ]
+    inferences = ["the pointing person is found with body keypoints; the arm's 3-D ray picks the target"]
+    if target == "object":
+        requirements.append(Requirement("ObjectHypothesis", None, "the objects the person may point at"))
+        requirements.append(Requirement("Pose", None, "the answer reports the pointed object's pose"))
+    elif not camera_pose:
+        raise PlanningError(
+            "a region target needs the camera pose to place the semantic map's regions, and this input has none; "
+            "ask for target: object instead"
+        )
+    else:
+        inferences.append("the semantic map's regions are the candidate targets")
+    task = Task(kind=query.kind, inferences=tuple(inferences), pointing=target)
+    return Interpretation(task, tuple(requirements), None)
 
 
 def _target(query: Query) -> Block:

@@ -32,6 +32,8 @@ class Task:
     max_results: int | None = None
     object_id: int | None = None
     min_confidence: float = 0.0
+    pointing: str | None = None
+    """What a pointing query asks for (``object`` or ``region``), None for other queries."""
 
     def constraint(self, key: str) -> Constraint | None:
         """The constraint on ``key``, or None."""

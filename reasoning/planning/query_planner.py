@@ -101,6 +101,18 @@ def target_parameters(kb: KnowledgeBase, task: Task) -> dict[str, object]:
     return {"target_classes": classes, "target_values": tuple((k, tuple(v)) for k, v in sorted(values.items()))}
 
 
+POINTING_OUTPUT = "PointingTarget"
+
+
+def pointing_parameters(kb: KnowledgeBase, target: str) -> dict[str, dict[str, object]]:
+    """Constructor arguments of the annotators that say what a person points at: the kind of target and, for
+    regions, every region box of the semantic map (plain data)."""
+    regions = tuple(region_parameters(box) for box in kb.regions()) if target == "region" else ()
+    return {
+        spec.name: {"target": target, "regions": regions} for spec in kb.annotators() if POINTING_OUTPUT in spec.outputs
+    }
+
+
 class QueryPlanner:
     """Plans queries against one knowledge base, keeping what only changes with the ontology (class profiles)."""
 
@@ -132,6 +144,8 @@ class QueryPlanner:
         for spec in self.kb.annotators():
             if TRACK_TYPE in spec.outputs:  # a tracker of any object: told which one to follow
                 parameters.setdefault(spec.name, {}).update(target_parameters(self.kb, interpretation.task))
+        if interpretation.task.pointing is not None:
+            parameters.update(pointing_parameters(self.kb, interpretation.task.pointing))
         plan = plan_requirements(
             interpretation.task,
             interpretation.requirements,

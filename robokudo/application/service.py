@@ -300,12 +300,15 @@ class AnsweringService:
         remote: Collection[str] = (),
         remote_hints: Placement | None = None,
         lost_after: float = DEFAULT_LOST_AFTER,
+        person: str | None = None,
     ) -> None:
         TargetWatch(lost_after)  # checks the default now rather than at the first continuous task
         self.lost_after = lost_after
         """How long (seconds) a continuous task's target may go unseen when its query does not say."""
         self.kb = kb
         self.intrinsics = intrinsics
+        self.person = person
+        """A person put into the built-in kitchen (a ``kitchen_person`` spec), None for none."""
         self.store = store
         self.catalog = catalog if catalog is not None else AnnotatorCatalog.discover()
         self.input_path = input_path
@@ -353,6 +356,7 @@ class AnsweringService:
         remote: Collection[str] = (),
         remote_hints: Placement | None = None,
         lost_after: float = DEFAULT_LOST_AFTER,
+        person: str | None = None,
     ) -> AnsweringService:
         """A service over the shipped and user ontology and the belief store at ``store_path`` (default store
         when None), with the annotators of ``catalog`` (default: this project's); the annotators named in
@@ -380,6 +384,7 @@ class AnsweringService:
             remote=remote,
             remote_hints=remote_hints,
             lost_after=lost_after,
+            person=person,
         )
 
     # ------------------------------------------------------------------ planning
@@ -398,6 +403,7 @@ class AnsweringService:
             self.frame,
             look_at=self._remembered_region(parsed),
             intrinsics=self.intrinsics,
+            person=self.person,
         )
 
     def _remembered_region(self, query: Query) -> str | None:

@@ -229,6 +229,36 @@ class BodyKeypoints(Annotation):
 
 
 @dataclass(eq=False, kw_only=True)
+class Activity(Annotation):
+    """What a person is doing: ``activity`` (``pointing``, ``standing``, ``waving``) with the score of every
+    activity considered (``scores``, 0..1) and, for pointing, the arm (``left`` / ``right``)."""
+
+    activity: str
+    scores: tuple[tuple[str, float], ...] = ()
+    arm: str = ""
+
+
+@dataclass(eq=False, kw_only=True)
+class PointingTarget(Annotation):
+    """What a person points at: ``kind`` (``object`` or ``region``), the ray (camera frame: ``origin``,
+    unit ``direction``; ``second_direction`` the elbow-to-wrist estimate), the pointed object hypothesis' image
+    box ``roi`` (objects) or the region's ``name`` (regions), the ``point`` aimed at (camera frame), the angle
+    between the ray and that target (``angular_error``, radians), the angle between the two ray estimates
+    (``spread``, radians) and the ``margin`` to the next-best candidate (radians)."""
+
+    kind: str
+    origin: np.ndarray
+    direction: np.ndarray
+    second_direction: np.ndarray
+    point: np.ndarray
+    angular_error: float
+    spread: float
+    margin: float
+    name: str = ""
+    roi: tuple[int, int, int, int] | None = None
+
+
+@dataclass(eq=False, kw_only=True)
 class SemanticColor(Annotation):
     """A colour name (an ontology colour class, lower case) with its share of the object's pixels."""
 

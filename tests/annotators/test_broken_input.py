@@ -33,9 +33,11 @@ from annotators.cloud.shape import ShapeAnnotator
 from annotators.cloud.size import SizeAnnotator
 from annotators.image.color import SemanticColorAnnotator
 from annotators.image.histogram import ColorHistogramAnnotator
-from annotators.image.human_pose import HumanPoseDetector
+from annotators.image.human_pose import LANDMARKS, HumanPoseDetector
 from annotators.image.image_regions import ImageRegionSegmenter
 from annotators.image.onnx_detector import OnnxDetector
+from annotators.people.activity import ActivityRecognizer
+from annotators.people.pointing import PointingEstimator
 from annotators.readers.frame_io import Frame
 from annotators.readers.frame_readers import (
     BagCloudReader,
@@ -56,7 +58,9 @@ from robokudo.core.pipeline import Pipeline
 from robokudo.core.types import (
     ANNOTATION_TYPES,
     VIEW_TYPES,
+    Activity,
     Annotation,
+    BodyKeypoints,
     CameraInfo,
     CameraIntrinsics,
     ColorImage,
@@ -134,6 +138,22 @@ def line_cloud() -> PointCloud:
     cloud.points[..., 1] = 0.0
     cloud.points[..., 2] = 1.0 + np.linspace(0, 1, W)[None, :]
     return cloud
+
+
+def keypoints(depth: float = np.nan) -> BodyKeypoints:
+    """33 keypoints in the image middle, all at ``depth`` (NaN: no depth)."""
+    return BodyKeypoints(
+        names=LANDMARKS,
+        pixels=np.full((len(LANDMARKS), 2), 20.0),
+        points=np.full((len(LANDMARKS), 3), depth),
+        visibility=np.ones(len(LANDMARKS)),
+    )
+
+
+def person(*attached: Annotation) -> PersonHypothesis:
+    mask = np.zeros((H, W), dtype=bool)
+    mask[5:40, 20:30] = True
+    return PersonHypothesis(point_indices=np.flatnonzero(mask), mask=mask, roi=(20, 5, 30, 40), annotations=[*attached])
 
 
 Seeds = list[View | Annotation]
@@ -290,6 +310,20 @@ BROKEN_CASES: dict[str, tuple[Callable[[], Seeds], tuple[type[Annotator], ...]]]
     "uniform colour image": (lambda: [color()], (ImageRegionSegmenter, HumanPoseDetector)),
     "tiny colour image": (lambda: [color(4, 4)], (ImageRegionSegmenter, HumanPoseDetector)),
     "hypothesis without evidence": (lambda: [hypothesis(), *evidence_types()], (KnowledgeClassifier,)),
+    "a person without keypoints": (
+        lambda: [person(), keypoints(), Activity(activity="pointing"), flat_cloud(), posed_camera()],
+        (ActivityRecognizer, PointingEstimator),
+    ),
+    "a pointing person's arm without depth": (
+        lambda: [
+            person(keypoints(), Activity(activity="pointing", arm="right")),
+            keypoints(),
+            Activity(activity="pointing"),
+            flat_cloud(),
+            posed_camera(),
+        ],
+        (PointingEstimator,),
+    ),
 }
 
 PROFILES = ({"class": "Milk", "colors": ("white",), "shape": "box", "size": "medium", "texts": ("milk",)},)
@@ -304,6 +338,10 @@ FACTORIES: dict[type[Annotator], Callable[[Path], Annotator]] = {
 # experts broken through their configuration: class -> {case: factory(tmp_path)}
 BROKEN_CONFIGURATIONS: dict[type[Annotator], dict[str, Callable[[Path], Annotator]]] = {
     KnowledgeClassifier: {"no profiles": lambda tmp: KnowledgeClassifier([])},
+    ActivityRecognizer: {
+        "missing image-text model": lambda tmp: ActivityRecognizer(model_path=tmp / "nowhere.onnx"),
+        "malformed image-text model": lambda tmp: ActivityRecognizer(model_path=junk_file(tmp / "junk.onnx")),
+    },
     OnnxDetector: {
         "missing model file": lambda tmp: OnnxDetector(str(tmp / "nowhere.onnx")),
         "malformed model file": lambda tmp: OnnxDetector(str(junk_file(tmp / "junk.onnx"))),
@@ -566,7 +604,15 @@ def test_experts_fail_with_a_reason_on_broken_input(expert: type[Annotator], cas
     ids=lambda value: value.__name__ if isinstance(value, type) else value,
 )
 def test_experts_fail_with_a_reason_on_broken_configuration(expert: type[Annotator], case: str, tmp_path) -> None:
-    seeds = [color(), flat_cloud(), up_normals(), CameraInfo(K), hypothesis(), *evidence_types()]
+    seeds = [
+        color(),
+        flat_cloud(),
+        up_normals(),
+        CameraInfo(K),
+        hypothesis(),
+        *evidence_types(),
+        person(keypoints(1.0)),
+    ]
     assert_fails_with_a_reason(BROKEN_CONFIGURATIONS[expert][case](tmp_path), seeds)
 
 
