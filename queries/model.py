@@ -146,6 +146,14 @@ ANYWHERE = "anywhere"
 HUMAN_KEY = "human"
 """The key whose block describes a person to find (``detect { human: {} }``); its block may be empty."""
 
+FREE_SPACE_KEY = "free_space"
+"""The key of a scan's free-space block (``scan { free_space: { region: shelf, for: Cup } }``), and the value of
+``for`` in the short form ``scan { region: shelf, for: free_space }``."""
+
+FREE_SPACE_KEYS: tuple[str, ...] = ("region", "for", "footprint")
+"""The keys a free-space block may hold: where, what is to be put there (a class), and its footprint
+(``footprint: [10cm, 8cm]``, width and depth; one length for a square)."""
+
 KINDS: tuple[str, ...] = ("detect", "inspect", "track", "scan", "stop")
 """The known query kinds, in canonical order."""
 

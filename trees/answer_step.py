@@ -16,14 +16,23 @@ from typing import ClassVar
 import numpy as np
 
 from queries import Query
-from reasoning.beliefs.answer import Answer, class_label, designator
+from reasoning.beliefs.answer import Answer, PlacementDesignator, PoseDesignator, class_label, designator
 from reasoning.beliefs.store import BeliefFilter, BeliefStore
 from reasoning.fusion.association import CameraModel
 from reasoning.fusion.frame import FUSED_TYPES, WORLD_FRAME, FrameContext, FrameObject, frame_objects
 from reasoning.fusion.rule import CLASS_ATTRIBUTE
 from reasoning.fusion.tracking import BeliefTracker, ObjectBelief, TrackStep
 from robokudo.core.annotator import Annotator
-from robokudo.core.types import CameraInfo, CasType, DepthImage, ObjectHypothesis, PointCloud, QueryAnswer, QueryView
+from robokudo.core.types import (
+    CameraInfo,
+    CasType,
+    DepthImage,
+    FreePlacement,
+    ObjectHypothesis,
+    PointCloud,
+    QueryAnswer,
+    QueryView,
+)
 
 
 def camera_model(info: CameraInfo, depth: np.ndarray | None = None) -> CameraModel:
@@ -51,11 +60,18 @@ class AnswerStep(Annotator):
     guessed to be of the asked class is a candidate too, see :meth:`_guessed`); ``label_of`` names classes (e.g.
     the knowledge base's labels). Objects whose geometry is in doubt confirm known beliefs but create none. With
     ``fail_when_empty`` the step fails when nothing matches. ``timestamp`` 0 in CameraInfo means unknown: ``clock()``
-    is used instead.
+    is used instead. With ``free_space`` the answer also holds the CAS's free placements, largest first.
     """
 
     inputs: ClassVar[tuple[type[CasType], ...]] = (ObjectHypothesis,)
-    optional_inputs: ClassVar[tuple[type[CasType], ...]] = (CameraInfo, PointCloud, DepthImage, QueryView, *FUSED_TYPES)
+    optional_inputs: ClassVar[tuple[type[CasType], ...]] = (
+        CameraInfo,
+        PointCloud,
+        DepthImage,
+        QueryView,
+        FreePlacement,
+        *FUSED_TYPES,
+    )
     outputs: ClassVar[tuple[type[CasType], ...]] = (QueryAnswer,)
 
     def __init__(
@@ -70,9 +86,11 @@ class AnswerStep(Annotator):
         clock: Callable[[], float] = time.time,
         label_of: Callable[[str], str] = class_label,
         on_integrated: Callable[[TrackStep], None] | None = None,
+        free_space: bool = False,
         name: str | None = None,
     ) -> None:
         super().__init__(name=name)
+        self.free_space = free_space
         self.on_integrated = on_integrated
         """Told every frame's changes to the store once they are written (e.g. to publish them)."""
         self._store_source = store
@@ -147,10 +165,31 @@ class AnswerStep(Annotator):
                 for b in matching
             ),
             observed=tuple(step.assigned),
+            placements=self._placements() if self.free_space else None,
         )
         self.write(QueryAnswer(answer))
         if self.fail_when_empty and not matching:
             self.fail(f"no object matches the query among {len(objects)} seen")
+
+    def _placements(self) -> tuple[PlacementDesignator, ...]:
+        """The CAS's free placements as designators, largest first."""
+        found = sorted(self.annotations(FreePlacement), key=lambda p: -p.size[0] * p.size[1])
+        return tuple(
+            PlacementDesignator(
+                pose=PoseDesignator(
+                    position=tuple(float(v) for v in p.position),  # type: ignore[arg-type]
+                    orientation=tuple(float(v) for v in p.orientation),  # type: ignore[arg-type]
+                    frame=p.frame,
+                ),
+                size=(float(p.size[0]), float(p.size[1])),
+                footprint=(float(p.footprint[0]), float(p.footprint[1])),
+                fits=p.fits,
+                region=p.region or None,
+                confidence=p.confidence,
+                experts=(p.source,) if p.source else (),
+            )
+            for p in found
+        )
 
     @staticmethod
     def _guessed(
