@@ -29,6 +29,22 @@ DEFAULT_FOOTPRINT = (0.1, 0.1)
 """The footprint (width, depth in metres) looked for when none is given."""
 
 
+def grid_stride(points: np.ndarray, surface: np.ndarray, cell: float, samples: int = 500) -> int:
+    """The pixel stride that keeps about two measured points per ``cell`` along the surface: the median distance
+    between horizontally neighbouring surface points (a sample of them) says how far apart pixels are."""
+    rows, cols = np.nonzero(surface[::8, :-1:8])
+    rows, cols = rows * 8, cols * 8
+    paired = surface[rows, cols + 1]
+    rows, cols = rows[paired], cols[paired]
+    if rows.size == 0:
+        return 1
+    pick = np.linspace(0, rows.size - 1, min(samples, rows.size)).astype(np.int64)
+    gaps = np.linalg.norm(points[rows[pick], cols[pick] + 1] - points[rows[pick], cols[pick]], axis=1)
+    gaps = gaps[np.isfinite(gaps)]
+    spacing = float(np.median(gaps)) if gaps.size else 0.0
+    return max(1, int(cell / 2 / spacing)) if spacing > 0 else 1
+
+
 class FreeSpaceEstimator(Annotator):
     """Finds free placements for a footprint on the supporting surface: an occupancy grid of the plane's inliers
     and the points above them, then the largest free rectangles that hold the footprint.
@@ -92,24 +108,26 @@ class FreeSpaceEstimator(Annotator):
         if isinstance(support, str):
             self.fail(support)
         model, inliers = support
-        flat = cloud.points.reshape(-1, 3)
-        of_interest = cloud.mask.reshape(-1).copy()
+        of_interest = cloud.mask.copy()
         on_surface = np.zeros_like(of_interest)
-        on_surface[inliers] = True
+        on_surface.reshape(-1)[inliers] = True
         on_surface &= of_interest
         if not on_surface.any():
             self.fail("no point of the supporting plane is among the points of interest")
-        of_interest[on_surface] = False
+        of_interest &= ~on_surface
+        stride = grid_stride(cloud.points, on_surface, self.cell)
+        points = cloud.points[::stride, ::stride]
+        surface_points = points[on_surface[::stride, ::stride]].astype(np.float64)
+        other_points = points[of_interest[::stride, ::stride]]
         camera = self.optional_view(CameraInfo)
         cam_to_world = usable_pose(camera)
-        surface_points = flat[on_surface]
         hint = None
         if self.box_pose is not None and cam_to_world is not None:
             hint = cam_to_world[:3, :3].T @ self.box_pose[:3, 0]
         grid = surface_grid(
             surface_points,
-            flat[of_interest],
-            surface_frame(model, hint, surface_points.astype(np.float64)),
+            other_points,
+            surface_frame(model, hint, surface_points),
             cell=self.cell,
             min_height=self.min_height,
             max_height=self.max_height,

@@ -19,7 +19,7 @@ from __future__ import annotations
 
 import time
 from abc import abstractmethod
-from collections.abc import Mapping
+from collections.abc import Mapping, Sequence
 from pathlib import Path
 from typing import ClassVar
 
@@ -43,7 +43,8 @@ KITCHEN_RECORDING = "kitchen"
 class KitchenSceneReader(Annotator):
     """Renders the built-in kitchen from a named camera view (``"table"`` when ``view`` is None).
 
-    ``seed`` seeds the sensor noise; ``moved`` moves objects (see ``kitchen_scene.kitchen_objects``). The
+    ``seed`` seeds the sensor noise; ``moved`` moves objects (see ``kitchen_scene.kitchen_objects``); ``extra`` adds
+    objects with their albedo (``render_kitchen(extra=...)``, e.g. a storage layout's ``extra()``). The
     optional QueryView input is declared for choosing the view from the query's region (not used yet).
     """
 
@@ -62,9 +63,11 @@ class KitchenSceneReader(Annotator):
         view: str | None = None,
         seed: int = 0,
         moved: Mapping[str, np.ndarray] | None = None,
+        extra: Sequence[tuple[kitchen_scene.SceneObject, tuple[int, int, int]]] = (),
         name: str | None = None,
     ) -> None:
         super().__init__(name=name)
+        self.extra = tuple(extra)
         self.scene_view = view
         self.seed = seed
         self.moved = dict(moved) if moved else None
@@ -86,7 +89,7 @@ class KitchenSceneReader(Annotator):
         scene = self._rendered.get(view)
         if scene is None:
             try:
-                scene = kitchen_scene.render_kitchen(view, seed=self.seed, moved=self.moved)
+                scene = kitchen_scene.render_kitchen(view, seed=self.seed, moved=self.moved, extra=self.extra)
             except ValueError as error:
                 self.fail(f"cannot render the kitchen: {error}")
             self._rendered[view] = scene
