@@ -25,9 +25,6 @@ from robokudo.core.capability import Capability
 from robokudo.core.geometry import quaternion_from_matrix
 from robokudo.core.types import CameraInfo, CasType, FreePlacement, Plane, PointCloud
 
-DEFAULT_FOOTPRINT = (0.1, 0.1)
-"""The footprint (width, depth in metres) looked for when none is given."""
-
 
 def grid_stride(points: np.ndarray, surface: np.ndarray, cell: float, samples: int = 500) -> int:
     """The pixel stride that keeps about two measured points per ``cell`` along the surface: the median distance
@@ -67,7 +64,7 @@ class FreeSpaceEstimator(Annotator):
 
     def __init__(
         self,
-        footprint: Sequence[float] = DEFAULT_FOOTPRINT,
+        footprint: Sequence[float],
         *,
         region: str = "",
         box_pose: Sequence[float] | None = None,
@@ -118,6 +115,9 @@ class FreeSpaceEstimator(Annotator):
         stride = grid_stride(cloud.points, on_surface, self.cell)
         points = cloud.points[::stride, ::stride]
         surface_points = points[on_surface[::stride, ::stride]].astype(np.float64)
+        surface_points = surface_points[np.isfinite(surface_points).all(axis=1)]
+        if surface_points.shape[0] < 3:
+            self.fail(f"the supporting plane has {surface_points.shape[0]} finite points among the points of interest")
         other_points = points[of_interest[::stride, ::stride]]
         camera = self.optional_view(CameraInfo)
         cam_to_world = usable_pose(camera)
