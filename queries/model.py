@@ -152,6 +152,14 @@ POINTING_KEY = "pointing"
 POINTING_TARGETS: tuple[str, ...] = ("object", "region")
 """What a pointing query may ask for: the object pointed at, or the region (a place of the semantic map)."""
 
+FREE_SPACE_KEY = "free_space"
+"""The key of a scan's free-space block (``scan { free_space: { region: shelf, for: Cup } }``), and the value of
+``for`` in the short form ``scan { region: shelf, for: free_space }``."""
+
+FREE_SPACE_KEYS: tuple[str, ...] = ("region", "for", "footprint")
+"""The keys a free-space block may hold: where, what is to be put there (a class), and its footprint
+(``footprint: [10cm, 8cm]``, width and depth; one length for a square)."""
+
 KINDS: tuple[str, ...] = ("detect", "inspect", "track", "scan", "stop")
 """The known query kinds, in canonical order."""
 

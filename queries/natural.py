@@ -13,6 +13,7 @@ inspect / examine / look at / check             ``inspect``
 what color / size / shape is X                  ``inspect { obj: { ..., color: ? } }``
 scan X [for Y]                                  ``scan { region: X, for: Y }``
 find / look for free space on X                 ``scan { region: X, for: free_space }``
+where can I put / place / set X on Y            ``scan { free_space: { region: Y, for: X } }``
 stop / cancel [task] N, stop all                ``stop { task: N }``, ``task: all``
 noun words (unknown words joined by ``_``)      ``obj: { type: cereal_box }``
 plural head noun                                singular ``type``, no result limit
@@ -62,6 +63,7 @@ from queries.lexicon import (
     IRREGULAR_PLURALS,
     LIMITING_DETERMINERS,
     OPEN_DETERMINERS,
+    PLACEMENT_VERBS,
     PLURAL_ONLY,
     PLURAL_SUFFIXES,
     PREPOSITIONS,
@@ -78,6 +80,7 @@ from queries.lexicon import (
 )
 from queries.model import (
     ANYWHERE,
+    FREE_SPACE_KEY,
     POINTING_KEY,
     Asked,
     Block,
@@ -97,7 +100,9 @@ from queries.validation import MAX_QUERY_LENGTH, check_length, validate_query
 VERB_EXAMPLES: tuple[str, ...] = ("find", "track", "inspect", "scan", "stop")
 """The verbs named when a phrase starts with none."""
 
-_LONGEST_PHRASE = max(len(words) for table in (VERBS, PREPOSITIONS, FILLERS, TEXT_MARKERS) for words in table)
+_LONGEST_PHRASE = max(
+    len(words) for table in (VERBS, PLACEMENT_VERBS, PREPOSITIONS, FILLERS, TEXT_MARKERS) for words in table
+)
 
 
 def singularise(word: str) -> tuple[str, bool]:
@@ -281,6 +286,13 @@ class _PhraseParser:
         if pointing is not None:
             return pointing
         asked_key: str | None = None
+        placement = self.match(PLACEMENT_VERBS)
+        if placement is not None:
+            verb_tokens = self.take(len(placement))
+            kind_span = _join_span(verb_tokens[0].span, verb_tokens[-1].span)
+            query = Query("scan", self.placement(kind_span), self.text, kind_span)
+            validate_query(query)
+            return query
         if self.word() == "what" and self.word(1) in QUESTION_ATTRIBUTES:
             verb_tokens = self.take(2)
             asked_key = QUESTION_ATTRIBUTES[verb_tokens[1].text]
@@ -543,6 +555,23 @@ class _PhraseParser:
             target = Symbol(SCAN_TARGETS.get(phrase.noun, phrase.noun))
             fields.append(Field("for", target, phrase.noun_span or phrase.start))
         return Block(tuple(fields))
+
+    def placement(self, verb_span: Span) -> Block:
+        """``where can I put the cup on the shelf``: what to put (a class) and where, as a free-space block."""
+        phrase = self.object_phrase()
+        self.modifiers(phrase)
+        self.expect_end()
+        if phrase.adjectives or phrase.extras or phrase.object_id is not None or phrase.anywhere is not None:
+            raise self.error_at(phrase.start, "expected only what to put (an object class) and where")
+        if len(phrase.locations) > 1:
+            raise self.error_at(phrase.locations[1].span, "expected one place to put it")
+        fields = [Field("region", place.value, place.span) for place in phrase.locations]
+        if phrase.noun and not phrase.generic:
+            fields.append(Field("for", Symbol(phrase.noun), phrase.noun_span or phrase.start))
+        if not fields:
+            raise self.error_at(phrase.start, "expected what to put (an object class) or where")
+        span = _join_span(verb_span, phrase.end)
+        return Block((Field(FREE_SPACE_KEY, Block(tuple(fields)), span),))
 
     def error_at(self, span: Span, message: str) -> QueryError:
         return located_error(self.text, message, span.line, span.column)

@@ -16,7 +16,15 @@ from typing import ClassVar
 import numpy as np
 
 from queries import Query
-from reasoning.beliefs.answer import Answer, PointingAnswer, TrackDesignator, class_label, designator
+from reasoning.beliefs.answer import (
+    Answer,
+    PlacementDesignator,
+    PointingAnswer,
+    PoseDesignator,
+    TrackDesignator,
+    class_label,
+    designator,
+)
 from reasoning.beliefs.store import BeliefFilter, BeliefStore
 from reasoning.fusion.association import CameraModel
 from reasoning.fusion.frame import FUSED_TYPES, WORLD_FRAME, FrameContext, FrameObject, frame_objects
@@ -27,6 +35,7 @@ from robokudo.core.types import (
     CameraInfo,
     CasType,
     DepthImage,
+    FreePlacement,
     ObjectHypothesis,
     PointCloud,
     PointingTarget,
@@ -62,12 +71,12 @@ class AnswerStep(Annotator):
     TargetTrack (a continuous task), only the tracked object, with the track; ``label_of`` names classes (e.g.
     the knowledge base's labels). Objects whose geometry is in doubt confirm known beliefs but create none. With
     ``fail_when_empty`` the step fails when nothing matches. ``timestamp`` 0 in CameraInfo means unknown: ``clock()``
-    is used instead.
+    is used instead. With ``free_space`` the answer also holds the CAS's free placements, largest first.
     """
 
     inputs: ClassVar[tuple[type[CasType], ...]] = (ObjectHypothesis,)
     optional_inputs: ClassVar[tuple[type[CasType], ...]] = (
-        CameraInfo, PointCloud, DepthImage, QueryView, TargetTrack, PointingTarget, *FUSED_TYPES,
+        CameraInfo, PointCloud, DepthImage, QueryView, TargetTrack, PointingTarget, FreePlacement, *FUSED_TYPES,
     )  # fmt: skip
     outputs: ClassVar[tuple[type[CasType], ...]] = (QueryAnswer,)
 
@@ -83,9 +92,11 @@ class AnswerStep(Annotator):
         clock: Callable[[], float] = time.time,
         label_of: Callable[[str], str] = class_label,
         on_integrated: Callable[[TrackStep], None] | None = None,
+        free_space: bool = False,
         name: str | None = None,
     ) -> None:
         super().__init__(name=name)
+        self.free_space = free_space
         self.on_integrated = on_integrated
         """Told every frame's changes to the store once they are written (e.g. to publish them)."""
         self._store_source = store
@@ -174,6 +185,7 @@ class AnswerStep(Annotator):
             observed=tuple(step.assigned),
             track=None if track is None else _track_designator(track, tracked),
             pointing=pointing,
+            placements=self._placements() if self.free_space else None,
         )
         self.write(QueryAnswer(answer))
         if self.fail_when_empty and not matching:
@@ -205,6 +217,26 @@ class AnswerStep(Annotator):
             origin=tuple(float(v) for v in origin),
             direction=tuple(float(v) for v in direction),
             frame=frame,
+        )
+
+    def _placements(self) -> tuple[PlacementDesignator, ...]:
+        """The CAS's free placements as designators, largest first."""
+        found = sorted(self.annotations(FreePlacement), key=lambda p: -p.size[0] * p.size[1])
+        return tuple(
+            PlacementDesignator(
+                pose=PoseDesignator(
+                    position=tuple(float(v) for v in p.position),  # type: ignore[arg-type]
+                    orientation=tuple(float(v) for v in p.orientation),  # type: ignore[arg-type]
+                    frame=p.frame,
+                ),
+                size=(float(p.size[0]), float(p.size[1])),
+                footprint=(float(p.footprint[0]), float(p.footprint[1])),
+                fits=p.fits,
+                region=p.region or None,
+                confidence=p.confidence,
+                experts=(p.source,) if p.source else (),
+            )
+            for p in found
         )
 
     @staticmethod

@@ -19,7 +19,7 @@ from __future__ import annotations
 
 import time
 from abc import abstractmethod
-from collections.abc import Mapping
+from collections.abc import Mapping, Sequence
 from pathlib import Path
 from typing import ClassVar
 
@@ -47,7 +47,8 @@ class KitchenSceneReader(Annotator):
 
     ``seed`` seeds the sensor noise; ``moved`` moves objects (see ``kitchen_scene.kitchen_objects``); ``person``
     puts a person into the kitchen (a spec of ``kitchen_person.person_spec_pose``: ``stand``, ``wave``,
-    ``point:<target>``, optionally ``@x,y``), seen by default from the ``"person"`` view (table and person). The
+    ``point:<target>``, optionally ``@x,y``), seen by default from the ``"person"`` view (table and person); ``extra``
+    adds objects with their albedo (``render_kitchen(extra=...)``, e.g. a storage layout's ``extra()``). The
     optional QueryView input is declared for choosing the view from the query's region (not used yet).
     """
 
@@ -67,9 +68,11 @@ class KitchenSceneReader(Annotator):
         seed: int = 0,
         moved: Mapping[str, np.ndarray] | None = None,
         person: str | None = None,
+        extra: Sequence[tuple[kitchen_scene.SceneObject, tuple[int, int, int]]] = (),
         name: str | None = None,
     ) -> None:
         super().__init__(name=name)
+        self.extra = tuple(extra)
         self.scene_view = view
         self.seed = seed
         self.moved = dict(moved) if moved else None
@@ -94,7 +97,9 @@ class KitchenSceneReader(Annotator):
             try:
                 person = kitchen_person.person_spec_pose(self.person) if self.person else None
                 camera = kitchen_person.person_view() if view == PERSON_VIEW else view
-                scene = kitchen_scene.render_kitchen(camera, seed=self.seed, moved=self.moved, person=person)
+                scene = kitchen_scene.render_kitchen(
+                    camera, seed=self.seed, moved=self.moved, person=person, extra=self.extra
+                )
             except ValueError as error:
                 self.fail(f"cannot render the kitchen: {error}")
             self._rendered[view] = scene

@@ -158,6 +158,47 @@ class TrackDesignator:
         }
 
 
+@dataclass(frozen=True, slots=True)
+class PlacementDesignator:
+    """A free place on a surface: its centre ``pose`` on the surface (x along ``size[0]``, z the surface normal),
+    the free ``size`` (metres), the ``footprint`` asked for, how many such footprints ``fits``, the ``region`` and
+    how much of it was measured (``confidence``: the share of its surface the sensor saw)."""
+
+    pose: PoseDesignator
+    size: tuple[float, float]
+    footprint: tuple[float, float]
+    fits: int
+    region: str | None
+    confidence: float
+    experts: tuple[str, ...] = ()
+
+    def to_dict(self) -> dict[str, Any]:
+        """A JSON-ready dict (numbers rounded to 6 decimals)."""
+        return {
+            "pose": {
+                "position": _rounded(self.pose.position),
+                "orientation": _rounded(self.pose.orientation),
+                "frame": self.pose.frame,
+            },
+            "size": _rounded(self.size),
+            "footprint": _rounded(self.footprint),
+            "fits": self.fits,
+            "region": self.region,
+            "confidence": round(self.confidence, 6),
+            "experts": list(self.experts),
+        }
+
+    def summary(self) -> str:
+        """One line for people."""
+        p = self.pose.position
+        where = f"({p[0]:.3f}, {p[1]:.3f}, {p[2]:.3f}) [{self.pose.frame}]"
+        return (
+            f"free {self.size[0]:.2f} x {self.size[1]:.2f} m at {where}"
+            + (f" in {self.region}" if self.region else "")
+            + f", fits {self.fits} x {self.footprint[0]:.2f} x {self.footprint[1]:.2f} m, seen {self.confidence:.2f}"
+        )
+
+
 def _local(class_name: str) -> str:
     return re.split(r"[#/]", class_name)[-1]
 
@@ -216,10 +257,12 @@ class Answer:
     """A continuous task's target in this frame (None for other answers; ``track`` in the JSON only when set)."""
     pointing: PointingAnswer | None = None
     """The pointing target of a pointing query (None for other queries, and then absent from the JSON)."""
+    placements: tuple[PlacementDesignator, ...] | None = None
+    """Free places, largest first, when the query asked for free space (None when it did not)."""
 
     def to_dict(self) -> dict[str, Any]:
-        """A JSON-ready dict."""
-        found = {
+        """A JSON-ready dict (``placements`` only when the query asked for free space)."""
+        found: dict[str, Any] = {
             "query": self.query,
             "from_memory": self.from_memory,
             "timed_out": self.timed_out,
@@ -229,6 +272,8 @@ class Answer:
             found["track"] = self.track.to_dict()
         if self.pointing is not None:
             found["pointing"] = self.pointing.to_dict()
+        if self.placements is not None:
+            found["placements"] = [p.to_dict() for p in self.placements]
         return found
 
     def to_json(self, indent: int | None = 2) -> str:
@@ -237,8 +282,15 @@ class Answer:
 
     def summary(self) -> str:
         """One line per object, for people: a class more likely wrong than right is marked ``?``; ``class`` is the
-        probability that the class is right, ``exists`` the confidence that the object is there."""
-        lines = []
+        probability that the class is right, ``exists`` the confidence that the object is there; then the free places
+        when the query asked for free space."""
+        lines = self._object_lines()
+        if self.placements is not None:
+            lines += [p.summary() for p in self.placements] or ["no free place for the footprint"]
+        return "\n".join(lines)
+
+    def _object_lines(self) -> list[str]:
+        lines: list[str] = []
         if self.pointing is not None:
             p = self.pointing
             lines.append(
@@ -246,7 +298,7 @@ class Answer:
                 f"confidence {p.confidence:.2f}"
             )
         if not self.objects:
-            return "\n".join([*lines, "no matching object"]) if not lines else "\n".join(lines)
+            return lines or ["no matching object"]
         for o in self.objects:
             p = o.pose.position
             colour = o.attributes.get(SemanticColor.attribute)
@@ -259,7 +311,7 @@ class Answer:
                 + (f", class {stated.confidence:.2f}" if stated is not None and o.class_label else "")
                 + f", exists {o.confidence:.2f}, by {', '.join(o.experts) or 'nobody'}"
             )
-        return "\n".join(lines)
+        return lines
 
 
 def designator(

@@ -10,7 +10,7 @@ from __future__ import annotations
 
 from collections import defaultdict, deque
 from collections.abc import Container, Mapping
-from dataclasses import dataclass
+from dataclasses import dataclass, field
 from decimal import Decimal
 from pathlib import Path
 
@@ -136,6 +136,8 @@ class OntologyIndex:
     defined_in: Mapping[str, Path]
     names: frozenset[str]
     name_keys: Mapping[str, str]
+    size_bounds: Mapping[str, float] = field(default_factory=dict)
+    """Size class -> the bound on its objects' largest extent in metres (``rk:largestExtentBelow``)."""
 
     def of_kind(self, kind: Kind) -> list[str]:
         """All names of ``kind``, sorted."""
@@ -182,6 +184,7 @@ class _Builder:
         preconditions = self._preconditions()
         annotators = self._annotators(preconditions)
         words, word_labels = self._words(regions)
+        size_bounds = self._size_bounds()
         if self.problems:
             raise OntologyError(sorted(set(self.problems)))
         annotator_conditions = {
@@ -214,6 +217,7 @@ class _Builder:
             defined_in=dict(self.defined_in),
             names=frozenset(self.all_names),
             name_keys=self._name_keys(),
+            size_bounds=size_bounds,
         )
 
     # ------------------------------------------------------------------ labels and names
@@ -331,6 +335,22 @@ class _Builder:
         self.disjoint = {name: frozenset(values) for name, values in pairs.items()}
 
     # ------------------------------------------------------------------ object profiles
+
+    def _size_bounds(self) -> dict[str, float]:
+        """Each size class's ``rk:largestExtentBelow`` (a positive number of metres)."""
+        bounds: dict[str, float] = {}
+        for subject, value in self.graph.subject_objects(RK["largestExtentBelow"]):
+            name = local_name(subject) if is_rk(subject) else str(subject)
+            number = value.toPython() if isinstance(value, Literal) else None
+            if self.kind_of.get(name) != "size":
+                self.problems.append(f"{name}: rk:largestExtentBelow is said only of size classes")
+            elif isinstance(number, bool) or not isinstance(number, int | float | Decimal) or not number > 0:
+                self.problems.append(
+                    f"{name}: rk:largestExtentBelow must be a positive number of metres, not {value!s}"
+                )
+            else:
+                bounds[name] = float(number)
+        return bounds
 
     def _own_properties(self, name: str) -> dict[str, list[object]]:
         """The profile values a class declares itself (restrictions on its superclass list)."""

@@ -333,6 +333,14 @@ class KnowledgeBase:
         """The region class objects of this class are typically kept in (inherited), or None."""
         return self.object_profile(name).stored_in
 
+    def largest_extent(self, name: str) -> float | None:
+        """The bound on the largest extent (metres) of objects of this class, from its size class's
+        ``rk:largestExtentBelow`` (None when the class has no size class or its size class has no bound)."""
+        size_class = self.object_profile(name).size_class
+        if size_class is None:
+            return None
+        return self._index.size_bounds.get(size_class)
+
     def variants_differ_by_text(self, name: str) -> bool:
         """True when a sibling class looks the same and only printed text or brand tells them apart."""
         return self._name(name, ("class",)) in self._index.text_variants

@@ -15,6 +15,7 @@ from dataclasses import dataclass
 from queries.model import (
     ANYWHERE,
     CONTINUOUS_KINDS,
+    FREE_SPACE_KEY,
     HUMAN_KEY,
     POINTING_KEY,
     Asked,
@@ -39,6 +40,9 @@ _TRUTH = {"true": True, "yes": True, "false": False, "no": False}
 _KINDS_WITH_OBJECTS = ("detect", "inspect", "track")
 TRACK_TYPE = "TargetTrack"
 """What a continuous query needs in every frame: the estimate of its one target (a tracker's output)."""
+
+DEFAULT_FOOTPRINT = (0.1, 0.1)
+"""The footprint (width, depth in metres) a free-space scan looks for when it names neither a class nor a size."""
 
 
 @dataclass(frozen=True)
@@ -250,13 +254,63 @@ def _why_text_matters(object_class: str, kb: KnowledgeBase) -> str:
 
 
 def _interpret_scan(query: Query, kb: KnowledgeBase, camera_pose: bool) -> Interpretation:
-    region_box = _region(query.get("region"), kb, camera_pose)
-    requirements = (
-        Requirement("Plane", None, "a scan for free space needs the supporting surface"),
-        Requirement("ObjectHypothesis", None, "a scan for free space needs the objects occupying the surface"),
+    """A scan lists the objects on a region's supporting surface; asked for free space (``free_space: {...}``, or
+    ``for: free_space``) it also finds where a footprint fits."""
+    block = query.get(FREE_SPACE_KEY)
+    wanted = query.get("for")
+    free_space = isinstance(block, Block) or any(
+        isinstance(v, Symbol | String) and _word(v, "for").lower() == FREE_SPACE_KEY for v in _values(wanted or Block())
     )
-    task = Task(kind="scan", region=region_box.name if region_box else None)
-    return Interpretation(task, requirements, region_box)
+    inner = block if isinstance(block, Block) else Block()
+    region_box = _region(inner.get("region") or query.get("region"), kb, camera_pose)
+    requirements = [
+        Requirement("Plane", None, "a scan needs the supporting surface"),
+        Requirement("ObjectHypothesis", None, "a scan needs the objects occupying the surface"),
+    ]
+    if not free_space:
+        task = Task(kind="scan", region=region_box.name if region_box else None)
+        return Interpretation(task, tuple(requirements), region_box)
+    footprint, why = _footprint(inner, kb)
+    requirements.append(Requirement(kb.annotation_type_for_key(FREE_SPACE_KEY), None, why))
+    task = Task(
+        kind="scan",
+        object_class=None,
+        region=region_box.name if region_box else None,
+        inferences=(why,),
+        max_results=_whole(query.get("max_results")),
+        footprint=footprint,
+    )
+    return Interpretation(task, tuple(requirements), region_box)
+
+
+def _footprint(block: Block, kb: KnowledgeBase) -> tuple[tuple[float, float], str]:
+    """The footprint a free-space block asks room for (given, else its class's size bound, else the default), and
+    the sentence saying where it came from."""
+    given = block.get("footprint")
+    if given is not None:
+        lengths = [v.value for v in _values(given) if isinstance(v, Number)]
+        width, depth = (lengths[0], lengths[-1]) if lengths else DEFAULT_FOOTPRINT
+        return (width, depth), f"the query asks room for a {width:g} m x {depth:g} m footprint"
+    target = block.get("for")
+    object_class = _object_class(target, kb)
+    if object_class is None:
+        width, depth = DEFAULT_FOOTPRINT
+        return (
+            DEFAULT_FOOTPRINT,
+            f"the query names no object or footprint, so room for {width:g} m x {depth:g} m is asked",
+        )
+    bound = kb.largest_extent(object_class)
+    if bound is None:
+        size_class = kb.object_profile(object_class).size_class
+        said = f"its size class {size_class} has no upper bound" if size_class else "it has no size class"
+        raise PlanningError(
+            f"the ontology gives no size for {object_class} ({said}); give its footprint: "
+            f"scan {{ free_space: {{ for: {object_class}, footprint: [30cm, 20cm] }} }}"
+        )
+    size_class = kb.object_profile(object_class).size_class
+    return (bound, bound), (
+        f"{object_class} is {size_class} (largest extent below {bound:g} m), so room for a {bound:g} m square is asked"
+    )
 
 
 def _word(value: Value, what: str) -> str:

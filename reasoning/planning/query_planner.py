@@ -4,7 +4,7 @@ from __future__ import annotations
 
 from dataclasses import dataclass
 
-from queries.model import Query
+from queries.model import FREE_SPACE_KEY, Query
 from reasoning.knowledge.knowledge_base import KnowledgeBase
 from reasoning.knowledge.model import Conditions
 from reasoning.planning.interpretation import TRACK_TYPE, Interpretation, interpret
@@ -66,15 +66,24 @@ def annotator_parameters(
     box: RegionBox | None,
     profiles: tuple[dict[str, object], ...] | None = None,
     expected: str | None = None,
+    task: Task | None = None,
 ) -> dict[str, dict[str, object]]:
-    """Constructor arguments the plan hands to annotators, from the ontology.
+    """Constructor arguments the plan hands to annotators, from the ontology and the task.
 
     An annotator that needs a region gets the region box; one that can report any object class (its class
     domain is the root class) is a classifier by knowledge and gets the profiles of the classes and the class
-    the query asks for (``expected``).
+    the query asks for (``expected``). A provider of free placements gets the task's footprint, the region box
+    when there is one and the task's result limit.
     """
     parameters: dict[str, dict[str, object]] = {}
+    free_space_type = kb.annotation_type_for_key(FREE_SPACE_KEY)
     for spec in kb.annotators():
+        if task is not None and task.footprint is not None and free_space_type in spec.outputs:
+            parameters[spec.name] = {"footprint": task.footprint}
+            if box is not None:
+                parameters[spec.name].update(region_parameters(box))
+            if task.max_results is not None:
+                parameters[spec.name]["max_placements"] = task.max_results
         if box is not None and REGION_PRECONDITION in spec.preconditions:
             parameters[spec.name] = region_parameters(box)
         if "Classification" in spec.outputs and ROOT_CLASS in spec.classes:
@@ -140,7 +149,8 @@ class QueryPlanner:
         interpretation = interpret(query, self.kb, depth=depth, camera_pose=source.camera_pose)
         box = interpretation.region_box
         conditions = Conditions(depth=depth, region=box is not None, transparent=interpretation.transparent)
-        parameters = annotator_parameters(self.kb, box, self.profiles(), interpretation.task.object_class)
+        task = interpretation.task
+        parameters = annotator_parameters(self.kb, box, self.profiles(), task.object_class, task)
         for spec in self.kb.annotators():
             if TRACK_TYPE in spec.outputs:  # a tracker of any object: told which one to follow
                 parameters.setdefault(spec.name, {}).update(target_parameters(self.kb, interpretation.task))

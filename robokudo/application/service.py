@@ -432,6 +432,7 @@ class AnsweringService:
             filter_for=lambda q: belief_filter(q, self.kb),
             label_of=self.kb.label,
             on_integrated=self._beliefs_changed,
+            free_space=query_plan.plan.task.footprint is not None,
         )
         step.reason = ANSWER_REASON
         tree = build_task_tree(

@@ -400,6 +400,24 @@ class PersonTrack(TargetTrack):
     """The track of a person (from a people tracker)."""
 
 
+@dataclass(eq=False, kw_only=True)
+class FreePlacement(Annotation):
+    """A free rectangle on a supporting surface where an object of the asked footprint can be put.
+
+    ``position`` is the rectangle's centre on the surface and ``orientation`` (x, y, z, w) turns ``frame`` into
+    the rectangle's axes (x along ``size[0]``, y along ``size[1]``, z the surface normal); ``size`` is the free
+    extent (metres) and ``footprint`` the footprint asked for; ``fits`` is how many such footprints fit side by side.
+    """
+
+    position: np.ndarray
+    orientation: np.ndarray
+    size: tuple[float, float]
+    footprint: tuple[float, float]
+    frame: str = "camera"
+    region: str = ""
+    fits: int = 1
+
+
 def _declared(root: type[T]) -> tuple[type[T], ...]:
     """The classes derived from ``root`` in this module, in declaration order."""
     found: list[type[T]] = []

@@ -24,6 +24,7 @@ from annotators.cloud.clusters import ClusterExtractor
 from annotators.cloud.clutter import ClutterSegmenter
 from annotators.cloud.filters import CropBoxFilter, RangeFilter, RegionFilter
 from annotators.cloud.form import FormAnnotator
+from annotators.cloud.free_space import FreeSpaceEstimator
 from annotators.cloud.normals import NormalEstimator
 from annotators.cloud.people import DepthPeopleDetector
 from annotators.cloud.plane import SupportPlaneSegmenter
@@ -198,6 +199,7 @@ BROKEN_CASES: dict[str, tuple[Callable[[], Seeds], tuple[type[Annotator], ...]]]
             SupportPlaneSegmenter,
             ClusterExtractor,
             ClutterSegmenter,
+            FreeSpaceEstimator,
             SemanticColorAnnotator,
             ColorHistogramAnnotator,
             PoseAnnotator,
@@ -221,6 +223,7 @@ BROKEN_CASES: dict[str, tuple[Callable[[], Seeds], tuple[type[Annotator], ...]]]
             SupportPlaneSegmenter,
             ClusterExtractor,
             ClutterSegmenter,
+            FreeSpaceEstimator,
             PoseAnnotator,
             ShapeAnnotator,
             SizeAnnotator,
@@ -237,6 +240,7 @@ BROKEN_CASES: dict[str, tuple[Callable[[], Seeds], tuple[type[Annotator], ...]]]
             SupportPlaneSegmenter,
             ClusterExtractor,
             ClutterSegmenter,
+            FreeSpaceEstimator,
             PoseAnnotator,
             ShapeAnnotator,
             SizeAnnotator,
@@ -264,11 +268,11 @@ BROKEN_CASES: dict[str, tuple[Callable[[], Seeds], tuple[type[Annotator], ...]]]
     "no point inside the region": (lambda: [flat_cloud(), posed_camera(x=50.0)], (RegionFilter,)),
     "degenerate plane": (
         lambda: [flat_cloud(), Plane(model=np.array([0.0, 0.0, 0.0, np.nan]), inlier_indices=np.arange(10))],
-        (ClusterExtractor, ClutterSegmenter),
+        (ClusterExtractor, ClutterSegmenter, FreeSpaceEstimator),
     ),
     "plane indices outside the grid": (
         lambda: [flat_cloud(), Plane(model=np.array([0.0, 0.0, -1.0, 1.0]), inlier_indices=np.array([0, H * W]))],
-        (ClusterExtractor, ClutterSegmenter),
+        (ClusterExtractor, ClutterSegmenter, FreeSpaceEstimator),
     ),
     "nothing stands on the plane": (lambda: [flat_cloud(), wall_plane()], (ClusterExtractor, ClutterSegmenter)),
     "no hypotheses": (
@@ -333,6 +337,7 @@ FACTORIES: dict[type[Annotator], Callable[[Path], Annotator]] = {
     RegionFilter: lambda tmp: RegionFilter("table", np.eye(4).ravel(), (4.0, 4.0, 4.0)),
     KnowledgeClassifier: lambda tmp: KnowledgeClassifier(PROFILES),
     OnnxDetector: lambda tmp: OnnxDetector(str(one_box_model(tmp / "model.onnx"))),
+    FreeSpaceEstimator: lambda tmp: FreeSpaceEstimator((0.1, 0.1)),
 }
 
 # experts broken through their configuration: class -> {case: factory(tmp_path)}
