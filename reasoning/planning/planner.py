@@ -98,42 +98,63 @@ def plan_requirements(
 
 
 class _Catalog:
-    """Candidate providers (memoised per type and value) and what can be produced from the sensors."""
+    """Candidate providers (memoised per type and value) and what can be produced from the sensors.
+
+    Type sets of the fixpoints are bit masks over the ontology's CAS types (``OntologyIndex.type_bits``): each
+    usable provider is one rule, its inputs -> the types it provides, and a fixpoint fires rules until none fires.
+    """
 
     def __init__(
         self, index: KnowledgeBase, sensors: frozenset[str], object_class: str | None, conditions: Conditions
     ) -> None:
         self.index = index
+        self.ontology = index.index
         self._supertypes: dict[str, frozenset[str]] = {}
+        self._written: dict[str, frozenset[str]] = {}
         # a type is present when it or a subtype of it is: track each written type together with its supertypes
         self.sensors = self.with_supertypes(sensors)
         self.object_class = object_class
         self.conditions = conditions
         self._providers: dict[tuple[str, str | None], tuple[AnnotatorSpec, ...]] = {}
         self._refiners: dict[str, list[AnnotatorSpec]] = {}
-        self._without: dict[frozenset[str], frozenset[str]] = {}
-        outputs = sorted({t for spec in index.annotators() for t in self.with_supertypes(spec.outputs)})
-        self.edges = [(spec, t) for t in outputs for spec in self.providers(t)]
-        self._waiting: dict[str, list[int]] = {}
-        for index, (spec, _) in enumerate(self.edges):
-            for needed in set(spec.inputs) - self.sensors:
-                self._waiting.setdefault(needed, []).append(index)
-        self._missing_at_start = [len(set(spec.inputs) - self.sensors) for spec, _ in self.edges]
-        self._ready_at_start = [i for i, count in enumerate(self._missing_at_start) if count == 0]
+        self._without: dict[int, int] = {}
+        self._excluded, self._own_types_only = index.provider_exclusions(object_class, conditions)
+        masks = self.ontology.port_masks
+        rules: list[tuple[int, int]] = []
+        for spec in self.ontology.ranked:
+            # annotators without inputs are sensor readers; a provider does not provide what it reads (a refiner)
+            if not spec.inputs or spec.name in self._excluded:
+                continue
+            inputs, outputs, written = masks[spec.name]
+            provided = (outputs if spec.name in self._own_types_only else written) & ~inputs
+            if provided:
+                rules.append((inputs, provided))
+        self._rules = rules
+        self._sensor_mask = self.ontology.mask(self.sensors)
         self.rounds = self._rounds()
         self.producible = frozenset(self.rounds)
 
     def _rounds(self) -> dict[str, int]:
         """The fixpoint round in which each producible type first becomes producible (sensors: 0)."""
         rounds = dict.fromkeys(self.sensors, 0)
+        known = self._sensor_mask
+        pending = self._rules
         current = 0
         while True:
             current += 1
-            known = set(rounds)
-            new = {t for spec, t in self.edges if t not in known and known.issuperset(spec.inputs)}
+            new = 0
+            waiting = []
+            for rule in pending:
+                if rule[0] & known == rule[0]:
+                    new |= rule[1]
+                else:
+                    waiting.append(rule)
+            new &= ~known
             if not new:
                 return rounds
-            rounds.update(dict.fromkeys(new, current))
+            rounds.update(dict.fromkeys((t for t, bit in self.ontology.type_bits.items() if bit & new), current))
+            known |= new
+            pending = waiting
 
     def with_supertypes(self, types: Iterable[str]) -> frozenset[str]:
         """The types and all their supertypes."""
@@ -146,13 +167,30 @@ class _Catalog:
 
     def written(self, spec: AnnotatorSpec) -> frozenset[str]:
         """What an annotator makes present for others: its outputs and their supertypes, minus what it reads."""
-        return self.with_supertypes(spec.outputs) - self.with_supertypes(spec.inputs)
+        found = self._written.get(spec.name)
+        if found is None:
+            found = self._written[spec.name] = self.with_supertypes(spec.outputs) - self.with_supertypes(spec.inputs)
+        return found
+
+    def _admitted(self, type_name: str) -> list[AnnotatorSpec]:
+        """``index.providers(type_name)`` for this catalog's object class and conditions (no value asked)."""
+        if type_name not in self.ontology.cas_types:
+            return self.index.providers(type_name, None, self.object_class, self.conditions)  # says what is wrong
+        excluded, own_types_only = self._excluded, self._own_types_only
+        return [
+            s
+            for s in self.ontology.providers[type_name]
+            if s.name not in excluded and (s.name not in own_types_only or type_name in s.outputs)
+        ]
 
     def providers(self, type_name: str, value: str | None = None) -> tuple[AnnotatorSpec, ...]:
         """Ranked providers of ``type_name`` for ``value`` (refiners of the type excluded)."""
         key = (type_name, value)
         if key not in self._providers:
-            found = self.index.providers(type_name, value, self.object_class, self.conditions)
+            if value is None:
+                found = self._admitted(type_name)
+            else:
+                found = self.index.providers(type_name, value, self.object_class, self.conditions)
             # annotators without inputs are sensor readers: the plan's source is chosen by its input, not here
             self._providers[key] = tuple(s for s in found if s.inputs and type_name not in s.inputs)
         return self._providers[key]
@@ -160,33 +198,34 @@ class _Catalog:
     def refiners(self, type_name: str) -> list[AnnotatorSpec]:
         """Annotators that read and write ``type_name`` and whose preconditions hold, cheapest first."""
         if type_name not in self._refiners:
-            found = self.index.providers(type_name, None, self.object_class, self.conditions)
             self._refiners[type_name] = sorted(
-                (s for s in found if type_name in s.inputs), key=lambda s: (s.cost_ms, s.name)
+                (s for s in self._admitted(type_name) if type_name in s.inputs), key=lambda s: (s.cost_ms, s.name)
             )
         return self._refiners[type_name]
 
-    def _fixpoint(self, forbidden: frozenset[str]) -> frozenset[str]:
-        """Worklist closure: each provider fires once all its inputs are known (linear in the ports)."""
-        known = set(self.sensors)
-        missing = list(self._missing_at_start)
-        queue = list(self._ready_at_start)
-        while queue:
-            produced = self.edges[queue.pop()][1]
-            if produced in known or produced in forbidden:
-                continue
-            known.add(produced)
-            for index in self._waiting.get(produced, ()):
-                missing[index] -= 1
-                if missing[index] == 0:
-                    queue.append(index)
-        return frozenset(known)
+    def _fixpoint(self, forbidden: int) -> int:
+        """Fire every rule whose inputs are known until none fires (each rule fires once)."""
+        known = self._sensor_mask
+        allowed = ~forbidden
+        pending = self._rules
+        while True:
+            waiting = []
+            for rule in pending:
+                if rule[0] & known == rule[0]:
+                    known |= rule[1] & allowed
+                else:
+                    waiting.append(rule)
+            if len(waiting) == len(pending):
+                return known
+            pending = waiting
 
-    def producible_without(self, forbidden: frozenset[str]) -> frozenset[str]:
-        """What can be produced when the ``forbidden`` types may not be used."""
-        if forbidden not in self._without:
-            self._without[forbidden] = self._fixpoint(forbidden)
-        return self._without[forbidden]
+    def producible_without(self, forbidden: frozenset[str]) -> int:
+        """What can be produced when the ``forbidden`` types may not be used, as a mask of types."""
+        key = self.ontology.mask(forbidden)
+        found = self._without.get(key)
+        if found is None:
+            found = self._without[key] = self._fixpoint(key)
+        return found
 
     def valid(
         self, type_name: str, value: str | None, above: frozenset[str] = frozenset(), by_rounds: bool = False
@@ -195,7 +234,8 @@ class _Catalog:
         (those that need it), so that choosing them cannot create a cycle; ``by_rounds`` keeps only those whose
         inputs are derived earliest."""
         usable = self.producible_without(above | {type_name})
-        found = [s for s in self.providers(type_name, value) if usable.issuperset(s.inputs)]
+        masks = self.ontology.port_masks
+        found = [s for s in self.providers(type_name, value) if masks[s.name][0] & usable == masks[s.name][0]]
         if by_rounds and found:
             depth = {s.name: max((self.rounds.get(t, 0) for t in s.inputs), default=0) for s in found}
             limit = min(depth.values())
@@ -213,7 +253,8 @@ class _Catalog:
         ]
         producible = self.producible_without(frozenset({type_name}))
         for spec in self.providers(type_name, value):
-            missing = sorted(set(spec.inputs) - producible)
+            bits = self.ontology.type_bits
+            missing = sorted(t for t in set(spec.inputs) if not bits[t] & producible)
             details.append(f"{spec.name} needs {', '.join(missing)}, which cannot be produced")
         if not details:
             return f"no annotator in the ontology provides {asked}"

@@ -2,11 +2,12 @@
 
 from __future__ import annotations
 
+from collections.abc import Iterable
 from dataclasses import dataclass
 
 from queries.model import Query
 from reasoning.knowledge.knowledge_base import KnowledgeBase
-from reasoning.knowledge.model import Conditions
+from reasoning.knowledge.model import AnnotatorSpec, Conditions
 from reasoning.planning.interpretation import Interpretation, interpret
 from reasoning.planning.plan import Plan
 from reasoning.planning.planner import SensorSource, plan_requirements
@@ -62,15 +63,17 @@ def annotator_parameters(
     box: RegionBox | None,
     profiles: tuple[dict[str, object], ...] | None = None,
     expected: str | None = None,
+    annotators: Iterable[AnnotatorSpec] | None = None,
 ) -> dict[str, dict[str, object]]:
     """Constructor arguments the plan hands to annotators, from the ontology.
 
     An annotator that needs a region gets the region box; one that can report any object class (its class
     domain is the root class) is a classifier by knowledge and gets the profiles of the classes and the class
-    the query asks for (``expected``).
+    the query asks for (``expected``). ``annotators`` limits the search (default: all; see
+    :func:`parameterised_annotators`).
     """
     parameters: dict[str, dict[str, object]] = {}
-    for spec in kb.annotators():
+    for spec in kb.annotators() if annotators is None else annotators:
         if box is not None and REGION_PRECONDITION in spec.preconditions:
             parameters[spec.name] = region_parameters(box)
         if "Classification" in spec.outputs and ROOT_CLASS in spec.classes:
@@ -81,13 +84,31 @@ def annotator_parameters(
     return parameters
 
 
-class QueryPlanner:
-    """Plans queries against one knowledge base, keeping what only changes with the ontology (class profiles)."""
+def parameterised_annotators(kb: KnowledgeBase) -> tuple[AnnotatorSpec, ...]:
+    """The annotators :func:`annotator_parameters` may give arguments to (those needing a region, classifiers by
+    knowledge), sorted by name."""
+    return tuple(
+        spec
+        for spec in kb.annotators()
+        if REGION_PRECONDITION in spec.preconditions
+        or ("Classification" in spec.outputs and ROOT_CLASS in spec.classes)
+    )
 
-    def __init__(self, kb: KnowledgeBase) -> None:
+
+class QueryPlanner:
+    """Plans queries against one knowledge base, keeping what only changes with the ontology (class profiles, the
+    annotators that take parameters).
+
+    With ``keep_catalogs`` (the default) the requirement-independent work of a plan (providers and fixpoints per
+    object class, conditions and sensor types) is kept for later queries; without it every plan starts cold.
+    """
+
+    def __init__(self, kb: KnowledgeBase, keep_catalogs: bool = True) -> None:
         self.kb = kb
+        self.keep_catalogs = keep_catalogs
         self._index: object | None = None
         self._profiles: tuple[dict[str, object], ...] = ()
+        self._parameterised: tuple[AnnotatorSpec, ...] = ()
         self._catalogs: dict[tuple[object, ...], object] = {}
 
     def _refresh(self) -> None:
@@ -95,6 +116,7 @@ class QueryPlanner:
         if self._index is not self.kb.index:
             self._index = self.kb.index
             self._profiles = class_profiles(self.kb)
+            self._parameterised = parameterised_annotators(self.kb)
             self._catalogs = {}
 
     def profiles(self) -> tuple[dict[str, object], ...]:
@@ -108,7 +130,9 @@ class QueryPlanner:
         interpretation = interpret(query, self.kb, depth=depth, camera_pose=source.camera_pose)
         box = interpretation.region_box
         conditions = Conditions(depth=depth, region=box is not None, transparent=interpretation.transparent)
-        parameters = annotator_parameters(self.kb, box, self.profiles(), interpretation.task.object_class)
+        profiles = self.profiles()
+        expected = interpretation.task.object_class
+        parameters = annotator_parameters(self.kb, box, profiles, expected, self._parameterised)
         plan = plan_requirements(
             interpretation.task,
             interpretation.requirements,
@@ -116,7 +140,7 @@ class QueryPlanner:
             source,
             conditions=conditions,
             parameters=parameters,
-            catalogs=self._catalogs,
+            catalogs=self._catalogs if self.keep_catalogs else None,
         )
         return QueryPlan(plan, interpretation)
 
