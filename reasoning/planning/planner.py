@@ -129,16 +129,21 @@ class _Catalog:
             provided = (outputs if spec.name in self._own_types_only else written) & ~inputs
             if provided:
                 rules.append((inputs, provided))
-        self._rules = rules
         self._sensor_mask = self.ontology.mask(self.sensors)
-        self.rounds = self._rounds()
+        self.rounds, self._rules = self._rounds(rules)
         self.producible = frozenset(self.rounds)
 
-    def _rounds(self) -> dict[str, int]:
-        """The fixpoint round in which each producible type first becomes producible (sensors: 0)."""
+    def _rounds(self, rules: list[tuple[int, int]]) -> tuple[dict[str, int], list[tuple[int, int]]]:
+        """The fixpoint round in which each producible type first becomes producible (sensors: 0), and the rules
+        that can fire at all, merged per inputs and in the order they fire (later fixpoints, which forbid types,
+        fire a subset of them and mostly in one pass)."""
         rounds = dict.fromkeys(self.sensors, 0)
         known = self._sensor_mask
-        pending = self._rules
+        merged: dict[int, int] = {}
+        for inputs, provided in rules:
+            merged[inputs] = merged.get(inputs, 0) | provided
+        pending = list(merged.items())
+        fired: list[tuple[int, int]] = []
         current = 0
         while True:
             current += 1
@@ -147,11 +152,12 @@ class _Catalog:
             for rule in pending:
                 if rule[0] & known == rule[0]:
                     new |= rule[1]
+                    fired.append(rule)
                 else:
                     waiting.append(rule)
             new &= ~known
             if not new:
-                return rounds
+                return rounds, fired
             rounds.update(dict.fromkeys((t for t, bit in self.ontology.type_bits.items() if bit & new), current))
             known |= new
             pending = waiting
@@ -281,6 +287,7 @@ class _UnitChoice:
     def providers(self, providers: list[AnnotatorSpec]) -> None:
         self._providers = providers
         self._guaranteed = frozenset.intersection(*(self._written(s) for s in providers))
+        self.guaranteed_sorted = tuple(sorted(self._guaranteed))
 
     def guaranteed(self) -> frozenset[str]:
         """Types the unit produces for others: outputs every provider writes without having read them."""
@@ -306,6 +313,10 @@ class _Assignment:
         self.above: dict[str, set[str]] = {}
         self._guaranteed: dict[str, str] | None = None
         self._dependencies: dict[str, set[str]] | None = None
+        self._owner: dict[str, str] | None = None
+        self._version = 0  # counts changes of the units
+        self._inputs_for: dict[str, str] | None = None
+        self._input_units_of: dict[str, tuple[str, ...]] = {}
         self.pinned: dict[str, str] = {}  # type -> unit chosen for it when several units write it
         self._check_feasible()
         self._assign()
@@ -327,12 +338,16 @@ class _Assignment:
                 )
 
     def owner(self) -> dict[str, str]:
-        """Annotator name -> the type of the unit it belongs to."""
-        return {s.name: key for key, unit in self.units.items() for s in unit.providers}
+        """Annotator name -> the type of the unit it belongs to (cached until the units change; read only)."""
+        if self._owner is None:
+            self._owner = {s.name: key for key, unit in self.units.items() for s in unit.providers}
+        return self._owner
 
     def _invalidate(self) -> None:
+        self._version += 1
         self._guaranteed = None
         self._dependencies = None
+        self._owner = None
 
     def _set_providers(self, key: str, providers: list[AnnotatorSpec]) -> None:
         self.units[key].providers = providers
@@ -350,7 +365,9 @@ class _Assignment:
         # by-products come from the unit derived earliest, the one least likely to depend on their readers
         for key in sorted(self.units, key=lambda k: (rounds.get(k, 0), k)):
             providers = self.units[key].providers
-            for type_name in sorted(self.units[key].guaranteed()):
+            for type_name in self.units[key].guaranteed_sorted:
+                if type_name in found:
+                    continue
                 if self.by_rounds and any(
                     max((rounds.get(t, 0) for t in s.inputs), default=0) >= rounds.get(type_name, 0) for s in providers
                 ):
@@ -372,9 +389,23 @@ class _Assignment:
     def _compute_dependencies(self) -> dict[str, set[str]]:
         guaranteed = self.guaranteed_by()
         return {
-            key: {guaranteed[t] for s in unit.providers for t in s.inputs if t in guaranteed} - {key}
+            key: set().union(*(self._input_units(s, guaranteed) for s in unit.providers)) - {key}
             for key, unit in self.units.items()
         }
+
+    def _input_units(self, spec: AnnotatorSpec, guaranteed: dict[str, str]) -> tuple[str, ...]:
+        """The units (sorted) that guarantee the required inputs of ``spec`` by ``guaranteed`` (a result of
+        :meth:`guaranteed_by`; memoised while it is the current one)."""
+        if guaranteed is not self._inputs_for:
+            if guaranteed is not self._guaranteed:
+                return tuple(sorted({guaranteed[t] for t in spec.inputs if t in guaranteed}))
+            self._inputs_for = guaranteed
+            self._input_units_of = {}
+        found = self._input_units_of.get(spec.name)
+        if found is None:
+            found = tuple(sorted({guaranteed[t] for t in spec.inputs if t in guaranteed}))
+            self._input_units_of[spec.name] = found
+        return found
 
     def _below(self, key: str) -> set[str]:
         """The unit and every unit it (transitively) needs."""
@@ -388,14 +419,26 @@ class _Assignment:
                     frontier.append(dep)
         return seen
 
-    def _reuse(self, key: str, above: set[str]) -> bool:
-        """Let the types ``above`` use unit ``key`` when that makes no cycle."""
-        below = self._below(key)
+    def _reuse(self, key: str, above: set[str], below: set[str] | None = None) -> bool:
+        """Let the types ``above`` use unit ``key`` when that makes no cycle (``below``: :meth:`_below` of ``key``,
+        when known)."""
+        below = self._below(key) if below is None else below
         if below & above:
             return False
         for unit in below:
             self.above.setdefault(unit, set()).update(above)
         return True
+
+    def _cut_and_reuse(self, key: str, above: set[str]) -> bool:
+        """:meth:`_cut`, then :meth:`_reuse` when the cut kept some alternatives.
+
+        A cut that changed nothing has visited exactly the units below ``key``: they are not searched again.
+        """
+        memo: dict[str, bool] = {}
+        version = self._version
+        if not self._cut_below(key, above, frozenset(), memo):
+            return False
+        return self._reuse(key, above, set(memo) if self._version == version else None)
 
     def _cut(self, key: str, above: set[str]) -> bool:
         """Drop the alternatives below unit ``key`` that need a type in ``above``; False when none can remain."""
@@ -404,14 +447,18 @@ class _Assignment:
     def _cut_below(self, key: str, above: set[str], path: frozenset[str], memo: dict[str, bool]) -> bool:
         if key in above or key in path:
             return False
-        if key in memo:
-            return memo[key]
+        known = memo.get(key)
+        if known is not None:
+            return known
         unit = self.units[key]
-        guaranteed = self.guaranteed_by()
+        guaranteed = self.guaranteed_by()  # as it is now: cuts further down do not change what this level reads
+        inner = path | {key}
         keep = []
         for spec in unit.providers:
-            inputs = {guaranteed[t] for t in spec.inputs if t in guaranteed} - {key}
-            if all(self._cut_below(dep, above, path | {key}, memo) for dep in sorted(inputs)):
+            for dep in self._input_units(spec, guaranteed):
+                if dep != key and not self._cut_below(dep, above, inner, memo):
+                    break
+            else:
                 keep.append(spec)
         memo[key] = bool(keep)
         if keep and len(keep) < len(unit.providers):
@@ -439,7 +486,7 @@ class _Assignment:
                 continue
             previous = list(self.units[key].providers)
             self._set_providers(key, [spec])
-            if self._cut(key, above) and self._reuse(key, above):
+            if self._cut_and_reuse(key, above):
                 self._note(type_name, f"{spec.name} also provides it")
                 self.pinned[type_name] = key
                 self._invalidate()
@@ -459,7 +506,7 @@ class _Assignment:
                 continue  # the consumer's alternatives that needed it were dropped
             above = set() if consumer is None else self.above.get(consumer, set()) | {consumer}
             existing = self.guaranteed_by().get(type_name)
-            if existing is not None and self._cut(existing, above) and self._reuse(existing, above):
+            if existing is not None and self._cut_and_reuse(existing, above):
                 continue
             if existing is not None and consumer is not None and self._drop_needing(consumer, type_name):
                 continue

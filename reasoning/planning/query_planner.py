@@ -73,9 +73,10 @@ def annotator_parameters(
     :func:`parameterised_annotators`).
     """
     parameters: dict[str, dict[str, object]] = {}
+    region = region_parameters(box) if box is not None else {}
     for spec in kb.annotators() if annotators is None else annotators:
         if box is not None and REGION_PRECONDITION in spec.preconditions:
-            parameters[spec.name] = region_parameters(box)
+            parameters[spec.name] = dict(region)
         if "Classification" in spec.outputs and ROOT_CLASS in spec.classes:
             profiles = profiles if profiles is not None else class_profiles(kb)
             parameters.setdefault(spec.name, {})["profiles"] = profiles
