@@ -312,6 +312,7 @@ class _Assignment:
         self.units: dict[str, _UnitChoice] = {}
         self.above: dict[str, set[str]] = {}
         self._guaranteed: dict[str, str] | None = None
+        self._last_guaranteed: dict[str, str] | None = None
         self._dependencies: dict[str, set[str]] | None = None
         self._owner: dict[str, str] | None = None
         self._version = 0  # counts changes of the units
@@ -356,7 +357,12 @@ class _Assignment:
     def guaranteed_by(self) -> dict[str, str]:
         """Type -> the unit (by its type) that guarantees it (cached until the units change)."""
         if self._guaranteed is None:
-            self._guaranteed = self._compute_guaranteed()
+            found = self._compute_guaranteed()
+            previous = self._last_guaranteed
+            # the same mapping as before (most changes of providers keep it) is the same object, so that what was
+            # derived from it stays valid
+            same = previous is not None and list(found.items()) == list(previous.items())
+            self._guaranteed = self._last_guaranteed = previous if same else found
         return self._guaranteed
 
     def _compute_guaranteed(self) -> dict[str, str]:
@@ -619,6 +625,7 @@ class _Layout:
                     self.final[type_name] = f"type:{owner_type}"
         self.unrefined = dict(self.final)
         self.refinements = self._refinements()
+        self._unit_inputs = self._branch_inputs()
         while True:
             self._connect()
             cycle = self._required_cycle()
@@ -633,7 +640,6 @@ class _Layout:
 
     def _connect(self) -> None:
         """Compute the final producer of each type and every unit's dependencies for the current refinements."""
-        absorbed = {t for owned in self.branches.values() for types in owned.values() for t in types}
         self.final = dict(self.unrefined)
         for type_name, specs in self.refinements.items():
             self.final[type_name] = f"refine:{specs[-1].name}"
@@ -650,19 +656,31 @@ class _Layout:
                 self.optional_edges |= {(key, dep) for dep in optional}
                 self.dependencies[key] = (required | optional) - {key}
                 previous = key
+        final = self.final
+        for type_name, (required_types, optional_types) in self._unit_inputs.items():
+            key = f"type:{type_name}"
+            deps = {final[t] for t in required_types if t in final}
+            optional = {final[t] for t in optional_types if t in final}
+            self.optional_edges |= {(key, dep) for dep in optional - deps}
+            self.dependencies[key] = (deps | optional) - {key}
+
+    def _branch_inputs(self) -> dict[str, tuple[tuple[str, ...], tuple[str, ...]]]:
+        """Per provider unit not absorbed into a branch (sorted): the required and the optional input types its
+        branches read from outside themselves (they do not change with the refinements)."""
+        absorbed = {t for owned in self.branches.values() for types in owned.values() for t in types}
+        found: dict[str, tuple[tuple[str, ...], tuple[str, ...]]] = {}
         for type_name in sorted(self.units):
             if type_name in absorbed:
                 continue
-            key = f"type:{type_name}"
-            deps: set[str] = set()
-            optional: set[str] = set()
+            required: dict[str, None] = {}
+            optional: dict[str, None] = {}
             for spec in self.units[type_name].providers:
                 members = self._members(type_name, spec)
                 inside = set(self.branches.get(type_name, {}).get(spec.name, []))
-                deps |= self._producers([t for m in members for t in m.inputs if t not in inside])
-                optional |= self._producers([t for m in members for t in m.optional_inputs if t not in inside])
-            self.optional_edges |= {(key, dep) for dep in optional - deps}
-            self.dependencies[key] = (deps | optional) - {key}
+                required.update(dict.fromkeys(t for m in members for t in m.inputs if t not in inside))
+                optional.update(dict.fromkeys(t for m in members for t in m.optional_inputs if t not in inside))
+            found[type_name] = (tuple(required), tuple(optional))
+        return found
 
     def _refinements(self) -> dict[str, list[AnnotatorSpec]]:
         """Refiners of planned types whose other inputs are planned too and that are not otherwise used."""
