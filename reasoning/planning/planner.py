@@ -166,9 +166,12 @@ class _Catalog:
         """The types and all their supertypes."""
         found: set[str] = set()
         for type_name in types:
-            if type_name not in self._supertypes:
-                self._supertypes[type_name] = frozenset({type_name, *self.index.superclasses(type_name)})
-            found |= self._supertypes[type_name]
+            known = self._supertypes.get(type_name)
+            if known is None:
+                # the index holds each class with its superclasses; anything else is resolved (or rejected) by name
+                known = self.ontology.up.get(type_name) or frozenset({type_name, *self.index.superclasses(type_name)})
+                self._supertypes[type_name] = known
+            found |= known
         return frozenset(found)
 
     def written(self, spec: AnnotatorSpec) -> frozenset[str]:
@@ -313,7 +316,6 @@ class _Assignment:
         self.above: dict[str, set[str]] = {}
         self._guaranteed: dict[str, str] | None = None
         self._last_guaranteed: dict[str, str] | None = None
-        self._dependencies: dict[str, set[str]] | None = None
         self._owner: dict[str, str] | None = None
         self._version = 0  # counts changes of the units
         self._inputs_for: dict[str, str] | None = None
@@ -347,7 +349,6 @@ class _Assignment:
     def _invalidate(self) -> None:
         self._version += 1
         self._guaranteed = None
-        self._dependencies = None
         self._owner = None
 
     def _set_providers(self, key: str, providers: list[AnnotatorSpec]) -> None:
@@ -386,19 +387,6 @@ class _Assignment:
             found[key] = key
         return found
 
-    def dependencies(self) -> dict[str, set[str]]:
-        """Unit -> the units its providers' required inputs come from (cached until the units change)."""
-        if self._dependencies is None:
-            self._dependencies = self._compute_dependencies()
-        return self._dependencies
-
-    def _compute_dependencies(self) -> dict[str, set[str]]:
-        guaranteed = self.guaranteed_by()
-        return {
-            key: set().union(*(self._input_units(s, guaranteed) for s in unit.providers)) - {key}
-            for key, unit in self.units.items()
-        }
-
     def _input_units(self, spec: AnnotatorSpec, guaranteed: dict[str, str]) -> tuple[str, ...]:
         """The units (sorted) that guarantee the required inputs of ``spec`` by ``guaranteed`` (a result of
         :meth:`guaranteed_by`; memoised while it is the current one)."""
@@ -414,15 +402,17 @@ class _Assignment:
         return found
 
     def _below(self, key: str) -> set[str]:
-        """The unit and every unit it (transitively) needs."""
-        graph = self.dependencies()
+        """The unit and every unit it (transitively) needs (through its providers' required inputs)."""
+        guaranteed = self.guaranteed_by()
         seen = {key}
         frontier = [key]
         while frontier:
-            for dep in graph.get(frontier.pop(), ()):
-                if dep not in seen:
-                    seen.add(dep)
-                    frontier.append(dep)
+            node = frontier.pop()
+            for spec in self.units[node].providers:
+                for dep in self._input_units(spec, guaranteed):
+                    if dep not in seen:
+                        seen.add(dep)
+                        frontier.append(dep)
         return seen
 
     def _reuse(self, key: str, above: set[str], below: set[str] | None = None) -> bool:
@@ -613,6 +603,7 @@ class _Layout:
         self.units = assignment.units
         self.source = source
         self.parameters = parameters
+        self._labels: dict[str, str] = {}
         self.branches = self._branches()
         absorbed = {t for owned in self.branches.values() for types in owned.values() for t in types}
         self.final: dict[str, str] = dict.fromkeys(catalog.sensors, "reader")
@@ -730,6 +721,9 @@ class _Layout:
                 for needed in (*spec.inputs, *spec.optional_inputs):
                     consumers.setdefault(needed, set()).add(spec.name)
         guaranteed = self.assignment.guaranteed_by()
+        guarantees: dict[str, list[str]] = {}
+        for type_name, key in guaranteed.items():
+            guarantees.setdefault(key, []).append(type_name)
         branches: dict[str, dict[str, list[str]]] = {}
         for type_name in sorted(self.units):
             unit = self.units[type_name]
@@ -745,8 +739,7 @@ class _Layout:
                     key = guaranteed.get(needed)
                     if key is None or key in owned or key == type_name or len(self.units[key].providers) != 1:
                         continue
-                    outputs = [t for t, k in guaranteed.items() if k == key]
-                    if any(not consumers.get(t, set()) <= members for t in outputs):
+                    if any(not consumers.get(t, set()) <= members for t in guarantees[key]):
                         continue
                     owned.append(key)
                     inner = self.units[key].providers[0]
@@ -783,6 +776,12 @@ class _Layout:
         return tuple(tuple(self._unit(key) for key in sorted(keys)) for _, keys in sorted(by_level.items()))
 
     def _label(self, key: str) -> str:
+        found = self._labels.get(key)
+        if found is None:
+            found = self._labels[key] = self._make_label(key)
+        return found
+
+    def _make_label(self, key: str) -> str:
         if key == "reader":
             return self.source.step.annotator
         kind, name = key.split(":", 1)
@@ -833,11 +832,12 @@ class _Layout:
         if len(unit.providers) == 1:
             return self._step(unit.providers[0], self._why(name), provides=name)
         branches = []
+        why = self._why(name)
         for spec in unit.providers:
             members = self._members(name, spec)
             owned = self.branches[name][spec.name]
             inner = tuple(self._step(m, f"needed only by {spec.name}", inside=owned) for m in members[:-1])
-            branches.append((*inner, self._step(spec, self._why(name), provides=name, inside=owned)))
+            branches.append((*inner, self._step(spec, why, provides=name, inside=owned)))
         ranking = ", ".join(f"{s.name} (reliability {s.reliability:g}, {s.cost_ms:g} ms)" for s in unit.providers)
         return Alternatives(
             provides=name,
