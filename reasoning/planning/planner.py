@@ -118,6 +118,7 @@ class _Catalog:
         self._providers: dict[tuple[str, str | None], tuple[AnnotatorSpec, ...]] = {}
         self._refiners: dict[str, list[AnnotatorSpec]] = {}
         self._without: dict[int, int] = {}
+        self._producing: list[tuple[int, tuple[int, ...]]] | None = None
         self._excluded, self._own_types_only = index.provider_exclusions(object_class, conditions)
         masks = self.ontology.port_masks
         rules: list[tuple[int, int]] = []
@@ -132,6 +133,8 @@ class _Catalog:
         self._sensor_mask = self.ontology.mask(self.sensors)
         self.rounds, self._rules = self._rounds(rules)
         self.producible = frozenset(self.rounds)
+        # forbidding a sensor type or one nothing produces changes no fixpoint: such types are left out of the key
+        self._forbiddable = self.ontology.mask(self.producible) & ~self._sensor_mask
 
     def _rounds(self, rules: list[tuple[int, int]]) -> tuple[dict[str, int], list[tuple[int, int]]]:
         """The fixpoint round in which each producible type first becomes producible (sensors: 0), and the rules
@@ -213,24 +216,36 @@ class _Catalog:
         return self._refiners[type_name]
 
     def _fixpoint(self, forbidden: int) -> int:
-        """Fire every rule whose inputs are known until none fires (each rule fires once)."""
+        """Make each type known once one of its producing rules has all its inputs known, until none becomes so.
+
+        The rules are regrouped per type (the distinct input masks of the rules providing it) at the first call.
+        """
+        if self._producing is None:
+            rules = self._rules
+            self._producing = [
+                (bit, masks)
+                for bit in self.ontology.type_bits.values()
+                if (masks := tuple({inputs: None for inputs, provided in rules if provided & bit}))
+            ]
         known = self._sensor_mask
-        allowed = ~forbidden
-        pending = self._rules
+        skip = known | forbidden
+        pending = [entry for entry in self._producing if not entry[0] & skip]
         while True:
             waiting = []
-            for rule in pending:
-                if rule[0] & known == rule[0]:
-                    known |= rule[1] & allowed
+            for bit, masks in pending:
+                for inputs in masks:
+                    if inputs & known == inputs:
+                        known |= bit
+                        break
                 else:
-                    waiting.append(rule)
+                    waiting.append((bit, masks))
             if len(waiting) == len(pending):
                 return known
             pending = waiting
 
     def producible_without(self, forbidden: frozenset[str]) -> int:
         """What can be produced when the ``forbidden`` types may not be used, as a mask of types."""
-        key = self.ontology.mask(forbidden)
+        key = self.ontology.mask(forbidden) & self._forbiddable
         found = self._without.get(key)
         if found is None:
             found = self._without[key] = self._fixpoint(key)
@@ -318,6 +333,7 @@ class _Assignment:
         self._last_guaranteed: dict[str, str] | None = None
         self._owner: dict[str, str] | None = None
         self._version = 0  # counts changes of the units
+        self._clean_below: dict[str, set[str]] = {}  # unit -> the units below it, while they are unchanged
         self._inputs_for: dict[str, str] | None = None
         self._input_units_of: dict[str, tuple[str, ...]] = {}
         self.pinned: dict[str, str] = {}  # type -> unit chosen for it when several units write it
@@ -348,6 +364,7 @@ class _Assignment:
 
     def _invalidate(self) -> None:
         self._version += 1
+        self._clean_below = {}
         self._guaranteed = None
         self._owner = None
 
@@ -430,11 +447,19 @@ class _Assignment:
 
         A cut that changed nothing has visited exactly the units below ``key``: they are not searched again.
         """
+        below = self._clean_below.get(key)
+        if below is not None and below.isdisjoint(above):
+            # the units are as when a cut from ``key`` found no cycle and changed nothing: none of them is above,
+            # so this cut too would visit exactly them and change nothing
+            return self._reuse(key, above, below)
         memo: dict[str, bool] = {}
         version = self._version
         if not self._cut_below(key, above, frozenset(), memo):
             return False
-        return self._reuse(key, above, set(memo) if self._version == version else None)
+        if self._version != version:
+            return self._reuse(key, above)
+        self._clean_below[key] = below = set(memo)
+        return self._reuse(key, above, below)
 
     def _cut(self, key: str, above: set[str]) -> bool:
         """Drop the alternatives below unit ``key`` that need a type in ``above``; False when none can remain."""
@@ -448,11 +473,19 @@ class _Assignment:
             return known
         unit = self.units[key]
         guaranteed = self.guaranteed_by()  # as it is now: cuts further down do not change what this level reads
-        inner = path | {key}
+        inner: frozenset[str] | None = None
         keep = []
         for spec in unit.providers:
             for dep in self._input_units(spec, guaranteed):
-                if dep != key and not self._cut_below(dep, above, inner, memo):
+                if dep == key:
+                    continue
+                if dep in above or dep in path:  # what the call for ``dep`` would answer first
+                    break
+                done = memo.get(dep)
+                if done is None:
+                    inner = path | {key} if inner is None else inner
+                    done = self._cut_below(dep, above, inner, memo)
+                if not done:
                     break
             else:
                 keep.append(spec)
