@@ -101,7 +101,9 @@ class _Catalog:
     """Candidate providers (memoised per type and value) and what can be produced from the sensors.
 
     Type sets of the fixpoints are bit masks over the ontology's CAS types (``OntologyIndex.type_bits``): each
-    usable provider is one rule, its inputs -> the types it provides, and a fixpoint fires rules until none fires.
+    usable provider is one rule, its inputs -> the types it provides; a fixpoint makes a type known once a rule
+    providing it has all its inputs known. Nothing here is kept between plans: a catalog is built per plan (unless
+    the caller keeps catalogs), from the index's per-annotator masks and one pass over the annotators.
     """
 
     def __init__(
@@ -139,7 +141,7 @@ class _Catalog:
     def _rounds(self, rules: list[tuple[int, int]]) -> tuple[dict[str, int], list[tuple[int, int]]]:
         """The fixpoint round in which each producible type first becomes producible (sensors: 0), and the rules
         that can fire at all, merged per inputs and in the order they fire (later fixpoints, which forbid types,
-        fire a subset of them and mostly in one pass)."""
+        fire a subset of them)."""
         rounds = dict.fromkeys(self.sensors, 0)
         known = self._sensor_mask
         merged: dict[int, int] = {}
