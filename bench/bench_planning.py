@@ -321,7 +321,8 @@ def main() -> int:
         plot(series, slopes, path)
         print(f"log-log plot written to {path}")
         for varied, value in slopes.items():
-            print(f"fitted slope of log(plan p50) over log({varied}): {value:.2f}")
+            tail = f", between the two largest {slope(series[varied][-2:]):.2f}" if len(series[varied]) > 2 else ""
+            print(f"fitted slope of log(plan p50) over log({varied}): {value:.2f}{tail}")
         results += [
             goal(f"planning grows near-linearly with {varied} (slope {value:.2f} <= {SLOPE_GOAL})", value <= SLOPE_GOAL)
             for varied, value in slopes.items()
