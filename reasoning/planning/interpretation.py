@@ -239,12 +239,8 @@ def _why_text_matters(object_class: str, kb: KnowledgeBase) -> str:
     profile = kb.object_profile(object_class)
     if not profile.texts:
         return ""
-    looks = (frozenset(profile.colors), profile.shape, profile.size_class)
-    for other in kb.names_of_kind("class"):
-        if kb.is_subclass(other, object_class) or kb.is_subclass(object_class, other):
-            continue
-        seen = kb.object_profile(other)
-        if (frozenset(seen.colors), seen.shape, seen.size_class) == looks:
+    for other in kb.look_alikes(object_class):
+        if not (kb.is_subclass(other, object_class) or kb.is_subclass(object_class, other)):
             texts = ", ".join(repr(t) for t in profile.texts)
             return (
                 f"{object_class} looks like {other} (same colour, shape and size); the text printed on it "

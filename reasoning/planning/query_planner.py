@@ -2,11 +2,12 @@
 
 from __future__ import annotations
 
+from collections.abc import Iterable
 from dataclasses import dataclass
 
 from queries.model import FREE_SPACE_KEY, Query
 from reasoning.knowledge.knowledge_base import KnowledgeBase
-from reasoning.knowledge.model import Conditions
+from reasoning.knowledge.model import AnnotatorSpec, Conditions
 from reasoning.planning.interpretation import TRACK_TYPE, Interpretation, interpret
 from reasoning.planning.plan import Plan, Task
 from reasoning.planning.planner import SensorSource, plan_requirements
@@ -67,31 +68,45 @@ def annotator_parameters(
     profiles: tuple[dict[str, object], ...] | None = None,
     expected: str | None = None,
     task: Task | None = None,
+    annotators: Iterable[AnnotatorSpec] | None = None,
 ) -> dict[str, dict[str, object]]:
     """Constructor arguments the plan hands to annotators, from the ontology and the task.
 
     An annotator that needs a region gets the region box; one that can report any object class (its class
     domain is the root class) is a classifier by knowledge and gets the profiles of the classes and the class
     the query asks for (``expected``). A provider of free placements gets the task's footprint, the region box
-    when there is one and the task's result limit.
+    when there is one and the task's result limit. ``annotators`` limits the search (default: all; see
+    :func:`parameterised_annotators`).
     """
     parameters: dict[str, dict[str, object]] = {}
+    region = region_parameters(box) if box is not None else {}
     free_space_type = kb.annotation_type_for_key(FREE_SPACE_KEY)
-    for spec in kb.annotators():
+    for spec in kb.annotators() if annotators is None else annotators:
         if task is not None and task.footprint is not None and free_space_type in spec.outputs:
-            parameters[spec.name] = {"footprint": task.footprint}
-            if box is not None:
-                parameters[spec.name].update(region_parameters(box))
+            parameters[spec.name] = {"footprint": task.footprint, **region}
             if task.max_results is not None:
                 parameters[spec.name]["max_placements"] = task.max_results
         if box is not None and REGION_PRECONDITION in spec.preconditions:
-            parameters[spec.name] = region_parameters(box)
+            parameters.setdefault(spec.name, {}).update(region)
         if "Classification" in spec.outputs and ROOT_CLASS in spec.classes:
             profiles = profiles if profiles is not None else class_profiles(kb)
             parameters.setdefault(spec.name, {})["profiles"] = profiles
             if expected is not None:
                 parameters[spec.name]["expected"] = expected
     return parameters
+
+
+def parameterised_annotators(kb: KnowledgeBase) -> tuple[AnnotatorSpec, ...]:
+    """The annotators :func:`annotator_parameters` may give arguments to (those needing a region, classifiers by
+    knowledge, providers of free placements), sorted by name."""
+    free_space_type = kb.annotation_type_for_key(FREE_SPACE_KEY)
+    return tuple(
+        spec
+        for spec in kb.annotators()
+        if REGION_PRECONDITION in spec.preconditions
+        or ("Classification" in spec.outputs and ROOT_CLASS in spec.classes)
+        or free_space_type in spec.outputs
+    )
 
 
 def target_parameters(kb: KnowledgeBase, task: Task) -> dict[str, object]:
@@ -123,12 +138,19 @@ def pointing_parameters(kb: KnowledgeBase, target: str) -> dict[str, dict[str, o
 
 
 class QueryPlanner:
-    """Plans queries against one knowledge base, keeping what only changes with the ontology (class profiles)."""
+    """Plans queries against one knowledge base, keeping what only changes with the ontology (class profiles, the
+    annotators that take parameters).
 
-    def __init__(self, kb: KnowledgeBase) -> None:
+    With ``keep_catalogs`` (the default) the requirement-independent work of a plan (providers and fixpoints per
+    object class, conditions and sensor types) is kept for later queries; without it every plan starts cold.
+    """
+
+    def __init__(self, kb: KnowledgeBase, keep_catalogs: bool = True) -> None:
         self.kb = kb
+        self.keep_catalogs = keep_catalogs
         self._index: object | None = None
         self._profiles: tuple[dict[str, object], ...] = ()
+        self._parameterised: tuple[AnnotatorSpec, ...] = ()
         self._catalogs: dict[tuple[object, ...], object] = {}
 
     def _refresh(self) -> None:
@@ -136,6 +158,7 @@ class QueryPlanner:
         if self._index is not self.kb.index:
             self._index = self.kb.index
             self._profiles = class_profiles(self.kb)
+            self._parameterised = parameterised_annotators(self.kb)
             self._catalogs = {}
 
     def profiles(self) -> tuple[dict[str, object], ...]:
@@ -150,12 +173,12 @@ class QueryPlanner:
         box = interpretation.region_box
         conditions = Conditions(depth=depth, region=box is not None, transparent=interpretation.transparent)
         task = interpretation.task
-        parameters = annotator_parameters(self.kb, box, self.profiles(), task.object_class, task)
+        parameters = annotator_parameters(self.kb, box, self.profiles(), task.object_class, task, self._parameterised)
         for spec in self.kb.annotators():
             if TRACK_TYPE in spec.outputs:  # a tracker of any object: told which one to follow
-                parameters.setdefault(spec.name, {}).update(target_parameters(self.kb, interpretation.task))
-        if interpretation.task.pointing is not None:
-            parameters.update(pointing_parameters(self.kb, interpretation.task.pointing))
+                parameters.setdefault(spec.name, {}).update(target_parameters(self.kb, task))
+        if task.pointing is not None:
+            parameters.update(pointing_parameters(self.kb, task.pointing))
         plan = plan_requirements(
             interpretation.task,
             interpretation.requirements,
@@ -163,7 +186,7 @@ class QueryPlanner:
             source,
             conditions=conditions,
             parameters=parameters,
-            catalogs=self._catalogs,
+            catalogs=self._catalogs if self.keep_catalogs else None,
         )
         return QueryPlan(plan, interpretation)
 
