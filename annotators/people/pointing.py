@@ -77,6 +77,13 @@ def segment_distance(point: np.ndarray, a: np.ndarray, b: np.ndarray) -> float:
     return float(np.linalg.norm(point - (a + t * ab)))
 
 
+def segment_distances(points: np.ndarray, a: np.ndarray, b: np.ndarray) -> np.ndarray:
+    """The distance of each of the Nx3 points from the segment a-b."""
+    ab = b - a
+    t = np.clip((points - a) @ ab / max(float(np.dot(ab, ab)), 1e-12), 0.0, 1.0)
+    return np.linalg.norm(points - (a + t[:, None] * ab), axis=1)
+
+
 def ranked(ray: Ray, candidates: Sequence[tuple[str, np.ndarray]]) -> list[tuple[float, str, np.ndarray]]:
     """Candidates (name, point) by the angle between the ray and the direction from its origin to the point (the
     nearer first among equal angles: of two regions the ray passes through, the one it enters first)."""
@@ -109,7 +116,7 @@ class PointingEstimator(Annotator):
         target: str = "object",
         regions: Sequence[Mapping[str, object]] = (),
         max_error_degrees: float = 20.0,
-        body_clearance: float = 0.12,
+        body_clearance: float = 0.08,
         name: str | None = None,
     ) -> None:
         super().__init__(name=name)
@@ -168,8 +175,8 @@ class PointingEstimator(Annotator):
         return best
 
     def _objects(self, person: PersonHypothesis) -> tuple[list[tuple[str, np.ndarray]], dict[str, tuple]]:
-        """The centroids of the object hypotheses that are not part of the person (not within ``body_clearance``
-        of its arms' bones), named by their index."""
+        """The centroids of the object hypotheses that are not part of the person (not mostly within
+        ``body_clearance`` of its arms' bones), named by their index."""
         points = self.view(PointCloud).points.reshape(-1, 3)
         keypoints = self.attached(person, BodyKeypoints)
         bones = [
@@ -185,9 +192,13 @@ class PointingEstimator(Annotator):
             own = own[np.isfinite(own[:, 2])]
             if not own.shape[0]:
                 continue
+            sample = own[:: max(1, own.shape[0] // 500)]
+            near = np.zeros(sample.shape[0], dtype=bool)
+            for a, b in bones:
+                near |= segment_distances(sample, a, b) < self.body_clearance
+            if bones and np.mean(near) > 0.5:
+                continue  # most of it lies on the arm: the hand or forearm, segmented as an object
             centre = own.mean(axis=0)
-            if any(segment_distance(centre, a, b) < self.body_clearance for a, b in bones):
-                continue  # the hand or forearm, segmented as an object
             key = f"hypothesis {number}"
             candidates.append((key, centre))
             rois[key] = hypothesis.roi
