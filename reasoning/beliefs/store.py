@@ -19,8 +19,8 @@ with its recording and the experts' statements, bounded per object), ``classes``
 
 from __future__ import annotations
 
+import functools
 import json
-import math
 import operator
 import os
 import shlex
@@ -423,25 +423,32 @@ class BeliefStore:
 
         Also returns how each one was stored, so unchanged R*Tree entries and index columns are not rewritten.
         """
-        columns = ", ".join(f"o.{c.strip()}" for c in _OBJECT_COLUMNS.split(","))
-        query = (
-            f"SELECT {columns}, r.x0, r.x1, r.y0, r.y1, r.z0, r.z1 FROM objects_place r JOIN objects o ON o.id = r.id "
-            "WHERE r.x0 <= ? AND r.x1 >= ? AND r.y0 <= ? AND r.y1 >= ? AND r.z0 <= ? AND r.z1 >= ? "
-            "AND o.frame = ? AND (o.frame = ? OR o.recording = ?) AND o.status = ?"
-        )
         rows: dict[int, tuple] = {}
+        groups: dict[tuple[str, str], list[FrameObject]] = {}
         for item in objects:
-            x, y, z = (float(v) for v in item.position)
-            world = (item.frame, WORLD_FRAME, item.recording)
-            parameters = (x + gate, x - gate, y + gate, y - gate, z + gate, z - gate, *world, PRESENT)
-            for row in conn.execute(query, parameters):
-                if row[0] not in rows and _distance(row, item.position) <= gate:
+            groups.setdefault((item.frame, item.recording), []).append(item)
+        for (frame, recording), members in groups.items():
+            # one statement per world: the union of the R*Tree boxes around its observations
+            centres = np.array([[float(v) for v in item.position[:3]] for item in members], dtype=np.float64)
+            parameters: list[object] = []
+            for x, y, z in centres.tolist():
+                parameters += [x + gate, x - gate, y + gate, y - gate, z + gate, z - gate]
+            found = conn.execute(_candidate_query(len(members)), (*parameters, frame, WORLD_FRAME, recording, PRESENT))
+            found = found.fetchall()
+            if not found:
+                continue
+            positions = np.array([(row[3], row[4], row[5]) for row in found], dtype=np.float64)
+            delta = positions[:, None, :] - centres[None, :, :]
+            near = (np.sqrt(np.einsum("ijk,ijk->ij", delta, delta)) <= gate).any(axis=1)
+            for row, keep in zip(found, near.tolist(), strict=True):
+                if keep:
                     rows[row[0]] = row
         if camera is not None:
             low, high = _frustum_bounds(camera)
             world = (camera.frame, WORLD_FRAME, camera.recording)
-            parameters = (high[0], low[0], high[1], low[1], high[2], low[2], *world, PRESENT)
-            in_frustum = [row for row in conn.execute(query, parameters) if row[0] not in rows]
+            box = (high[0], low[0], high[1], low[1], high[2], low[2])
+            found = conn.execute(_candidate_query(1), (*box, *world, PRESENT))
+            in_frustum = [row for row in found if row[0] not in rows]
             if in_frustum:
                 positions = np.array([(row[3], row[4], row[5]) for row in in_frustum], dtype=np.float64)
                 for row, seen in zip(in_frustum, in_view(positions, camera), strict=True):
@@ -452,7 +459,7 @@ class BeliefStore:
             i: _Loaded(((r[n] + r[n + 1]) / 2, (r[n + 2] + r[n + 3]) / 2, (r[n + 4] + r[n + 5]) / 2), *_labels(r))
             for i, r in rows.items()
         }
-        return [_belief_from_row(row) for row in rows.values()], loaded
+        return [_belief_from_row(rows[i]) for i in sorted(rows)], loaded
 
     def _write_beliefs(
         self,
@@ -519,6 +526,7 @@ class BeliefStore:
         time: float,
     ) -> None:
         """Record each object's sighting under (belief id, its sighting number)."""
+        cache: dict[frozenset[str], str] = {}
         rows = [
             (
                 object_id,
@@ -529,7 +537,7 @@ class BeliefStore:
                 float(item.position[1]),
                 float(item.position[2]),
                 _roi_text(item.roi),
-                json.dumps(sorted(item.sources)),
+                _encoded_sources(item.sources, cache),
                 json.dumps([[e.attribute, e.value, round(e.confidence, 6), e.source] for e in item.evidence]),
                 item.recording,
             )
@@ -620,9 +628,13 @@ class BeliefStore:
                         )
                     )
             selects, values = [], []
-            for extra, extra_parameters in branches:
+            for number, (extra, extra_parameters) in enumerate(branches):
                 where = " AND ".join(clauses + extra)
-                selects.append(f"SELECT {_OBJECT_COLUMNS} FROM objects" + (f" WHERE {where}" if where else ""))
+                # without statistics SQLite may pick the region index and filter the class row by row; the class
+                # index (class, region) answers both at once (a box branch starts from the R*Tree's ids instead)
+                by_class = f.object_class and f.ids is None and number == 0
+                table = "objects INDEXED BY objects_class" if by_class else "objects"
+                selects.append(f"SELECT {_OBJECT_COLUMNS} FROM {table}" + (f" WHERE {where}" if where else ""))
                 values.extend(parameters + extra_parameters)
             rows = conn.execute(" UNION ".join(selects) + " ORDER BY id", values).fetchall()
             if f.region and f.region_boxes:
@@ -672,6 +684,19 @@ class BeliefStore:
 
 
 # ---------------------------------------------------------------------------------------- row mapping
+
+
+@functools.lru_cache(maxsize=64)
+def _candidate_query(boxes: int) -> str:
+    """The present beliefs of one world whose R*Tree entries meet any of ``boxes`` boxes (one statement; its
+    parameters: x1, x0, y1, y0, z1, z0 of each box, then the frame, the world frame, the recording, the status)."""
+    box = "SELECT * FROM objects_place WHERE x0 <= ? AND x1 >= ? AND y0 <= ? AND y1 >= ? AND z0 <= ? AND z1 >= ?"
+    columns = ", ".join(f"o.{c.strip()}" for c in _OBJECT_COLUMNS.split(","))
+    return (
+        f"WITH hit AS ({' UNION '.join([box] * boxes)}) "
+        f"SELECT {columns}, hit.x0, hit.x1, hit.y0, hit.y1, hit.z0, hit.z1 FROM hit JOIN objects o ON o.id = hit.id "
+        "WHERE o.frame = ? AND (o.frame = ? OR o.recording = ?) AND o.status = ?"
+    )
 
 
 def _roi_text(roi: tuple[int, int, int, int] | None) -> str | None:
@@ -843,10 +868,6 @@ def _belief_from_row(row: tuple) -> ObjectBelief:
         class_name=class_name,
         recording=recording,
     )
-
-
-def _distance(row: tuple, position: np.ndarray) -> float:
-    return math.dist((row[3], row[4], row[5]), (float(position[0]), float(position[1]), float(position[2])))
 
 
 def _box_bounds(pose: np.ndarray, size: Sequence[float]) -> tuple[np.ndarray, np.ndarray]:
