@@ -363,6 +363,8 @@ def rss_kib(pid: int | str = "self") -> int:
 
 def rss_child(path: Path, count: int) -> None:
     """In a fresh process: RSS before opening the store of ``count`` beliefs and after using it (prints KiB)."""
+    import scipy.optimize  # noqa: F401 - code the first integration imports, not memory per belief
+
     seeded = Seeded(np.load(f"{path}.positions.npy"), ["Milk"] * count, ["red"] * count)
     rng = np.random.default_rng(5)
     prepared = [frame_objects(hypotheses_near(seeded, rng, 20)) for _ in range(50)]
@@ -410,6 +412,34 @@ def serve_idle_rss(folder: Path) -> float | None:
         return None
 
 
+def profile_updates(size: int, frames: int, per_frame: int, folder: Path, out: Path) -> None:
+    """cProfile of ``store.integrate`` over ``frames`` frames into a store of ``size``; the top entries by own time
+    and by cumulative time are written to ``out``."""
+    import cProfile
+    import io
+    import pstats
+
+    path = folder / f"profile-{size}.sqlite"
+    seeded = seed_file(path, size, np.random.default_rng(size))
+    rng = np.random.default_rng(1)
+    objects = [frame_objects(hypotheses_near(seeded, rng, per_frame)) for _ in range(frames + 1)]
+    store = BeliefStore(path, tracker=BeliefTracker(class_test=is_subclass))
+    store.integrate(objects[0], 999.0)
+    profiler = cProfile.Profile()
+    profiler.enable()
+    for index, frame in enumerate(objects[1:]):
+        store.integrate(frame, 1000.0 + index)
+    profiler.disable()
+    store.close()
+    text = io.StringIO()
+    text.write(f"store.integrate, {frames} frames x {per_frame} hypotheses into {size} stored objects\n")
+    pstats.Stats(profiler, stream=text).sort_stats("tottime").print_stats(25)
+    pstats.Stats(profiler, stream=text).sort_stats("cumulative").print_stats(25)
+    out.parent.mkdir(parents=True, exist_ok=True)
+    out.write_text(text.getvalue().replace(str(ROOT) + "/", ""))
+    print(f"profile written to {out}")
+
+
 def goal_for(size: int) -> float:
     return next((goal for limit, goal in sorted(QUERY_GOALS.items()) if size <= limit), max(QUERY_GOALS.values()))
 
@@ -425,11 +455,16 @@ def main() -> int:
     parser.add_argument("--repeats", type=int, default=300)
     parser.add_argument("--trials", type=int, default=3)
     parser.add_argument("--no-serve", action="store_true", help="skip the RSS of robokudo serve")
+    parser.add_argument("--profile", type=Path, help="only write a cProfile of integrate (10,000 stored) to PROFILE")
     parser.add_argument("--rss-child", type=Path, help=argparse.SUPPRESS)
     parser.add_argument("--rss-count", type=int, help=argparse.SUPPRESS)
     args = parser.parse_args()
     if args.rss_child:
         rss_child(args.rss_child, args.rss_count)
+        return 0
+    if args.profile:
+        with tempfile.TemporaryDirectory() as name:
+            profile_updates(10_000, args.frames, args.per_frame, Path(name), args.profile)
         return 0
     print(f"load average before: {os.getloadavg()[0]:.2f} on {os.cpu_count()} CPUs")
     met: list[bool] = []
