@@ -499,8 +499,12 @@ class BeliefStore:
         added: list[tuple[str, str, int]] = []
         removed: list[tuple[str, str, int]] = []
         for b in beliefs:
-            new = _index_entries(rows[b.id][_INDEXED])
-            old = _index_entries(loaded[b.id].indexed) if b.id in loaded else set()
+            state = loaded.get(b.id)
+            indexed = rows[b.id][_INDEXED]
+            if state is not None and state.indexed == indexed:
+                continue
+            new = _index_entries(indexed)
+            old = _index_entries(state.indexed) if state is not None else set()
             added.extend((name, value, b.id) for name, value in new - old)
             removed.extend((name, value, b.id) for name, value in old - new)
         if removed:
@@ -509,7 +513,7 @@ class BeliefStore:
             conn.executemany("INSERT OR IGNORE INTO attribute_index VALUES (?, ?, ?)", added)
         moved = []
         for b in beliefs:
-            x, y, z = (float(v) for v in b.position)
+            x, y, z = rows[b.id][3:6]
             state = loaded.get(b.id)
             centre = state.place if state is not None else None
             if centre is None or max(abs(x - centre[0]), abs(y - centre[1]), abs(z - centre[2])) > RTREE_SLACK / 2:
@@ -536,9 +540,7 @@ class BeliefStore:
                 seq,
                 time,
                 item.frame,
-                float(item.position[0]),
-                float(item.position[1]),
-                float(item.position[2]),
+                *_floats(item.position, 3),
                 _roi_text(item.roi),
                 _encoded_sources(item.sources, cache),
                 json.dumps([[e.attribute, e.value, round(e.confidence, 6), e.source] for e in item.evidence]),
@@ -715,23 +717,25 @@ def _roi_from_text(text: str | None) -> tuple[int, int, int, int] | None:
 
 def _object_row(b: ObjectBelief, class_test: ClassTest | None, sources: dict[frozenset[str], str]) -> tuple:
     """The ``objects`` row of a belief (columns as in ``_OBJECT_COLUMNS``); ``sources`` caches encodings."""
-    dims = b.dimensions if b.dimensions is not None else (None, None, None)
+    x, y, z = _floats(b.position, 3)
+    qx, qy, qz, qw = _floats(b.orientation, 4)
+    sx, sy, sz = (None, None, None) if b.dimensions is None else _floats(b.dimensions, 3)
     appearance = None if b.appearance is None else np.asarray(b.appearance, dtype=np.float32).tobytes()
     encoded, indexed = _encode_attributes(b.attributes, class_test)
     return (
         b.id,
         b.class_name,
         b.frame,
-        float(b.position[0]),
-        float(b.position[1]),
-        float(b.position[2]),
-        float(b.orientation[0]),
-        float(b.orientation[1]),
-        float(b.orientation[2]),
-        float(b.orientation[3]),
-        None if dims[0] is None else float(dims[0]),
-        None if dims[1] is None else float(dims[1]),
-        None if dims[2] is None else float(dims[2]),
+        x,
+        y,
+        z,
+        qx,
+        qy,
+        qz,
+        qw,
+        sx,
+        sy,
+        sz,
         float(b.position_variance),
         appearance,
         float(b.existence),
@@ -748,6 +752,11 @@ def _object_row(b: ObjectBelief, class_test: ClassTest | None, sources: dict[fro
         encoded,
         indexed,
     )
+
+
+def _floats(values: np.ndarray | Sequence[float], count: int) -> list[float]:
+    """The first ``count`` values as Python floats (one conversion of the array, not one per element)."""
+    return [float(v) for v in np.asarray(values).tolist()[:count]]
 
 
 _COLUMN_COUNT = len(_OBJECT_COLUMNS.split(","))

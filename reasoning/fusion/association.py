@@ -205,8 +205,8 @@ def _near_pairs(
     if not observations or not beliefs:
         empty = np.empty(0, dtype=np.int64)
         return empty, empty, np.empty(0)
-    a = np.array([_triple(o.position) for o in observations])
-    b = np.array([_triple(x.position) for x in beliefs])
+    a = np.array([o.position[:3] for o in observations], dtype=np.float64)
+    b = np.array([x.position[:3] for x in beliefs], dtype=np.float64)
     delta = a[:, None, :] - b[None, :, :]
     distance = np.sqrt(np.einsum("ijk,ijk->ij", delta, delta))
     near = distance <= gate

@@ -276,8 +276,7 @@ class BeliefTracker:
     def _refresh(self, belief: ObjectBelief) -> None:
         """Recompute the cached class and the region after a change."""
         known = belief.attributes.get(CLASS_ATTRIBUTE)
-        fused = known.fuse(self.class_test) if known is not None else None
-        belief.class_name = fused.value if fused is not None and fused.supported else None
+        belief.class_name = known.supported_value(self.class_test) if known is not None else None
         region = region_of(belief.position, self.regions) if belief.frame == WORLD_FRAME and self.regions else None
         if region is not None:
             belief.region = region.name
