@@ -9,6 +9,7 @@ a list of them; both turn into JSON-ready dicts. The tree leaf that answers from
 
 from __future__ import annotations
 
+import functools
 import json
 import re
 from collections.abc import Callable
@@ -30,8 +31,10 @@ def class_iri(class_name: str) -> str:
     return class_name if "://" in class_name or class_name.startswith("urn:") else ONTOLOGY_NAMESPACE + class_name
 
 
+@functools.lru_cache(maxsize=1024)
 def class_label(class_name: str) -> str:
-    """A readable label: the IRI's local name split at case changes, lower case (``lactose free milk``)."""
+    """A readable label: the IRI's local name split at case changes, lower case (``lactose free milk``); the
+    labels of the few classes answers name are made once."""
     local = re.split(r"[#/]", class_name)[-1]
     words = re.findall(r"[A-Z]+(?=[A-Z][a-z])|[A-Z]?[a-z]+|[A-Z]+|\d+", local)
     return " ".join(words).lower() if words else local
@@ -200,7 +203,7 @@ class PlacementDesignator:
 
 
 def _local(class_name: str) -> str:
-    return re.split(r"[#/]", class_name)[-1]
+    return class_name.replace("#", "/").rsplit("/", 1)[-1]
 
 
 def _rounded(values: tuple[float, ...]) -> list[float]:
