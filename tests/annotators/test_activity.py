@@ -43,8 +43,11 @@ def test_an_arm_raised_away_from_the_body_towards_any_target_is_pointing(
 ) -> None:
     target = np.array([tx, ty, tz])
     pose = pose_person(Posture(x, y, yaw, "point", tuple(target)))
-    shoulder = pose.joint("right_shoulder")
-    reach = target - shoulder
+    side = max(  # the arm the figure points with: the one whose wrist is held farthest out from its shoulder
+        ("left", "right"),
+        key=lambda arm: np.linalg.norm((pose.joint(f"{arm}_wrist") - pose.joint(f"{arm}_shoulder"))[:2]),
+    )
+    reach = target - pose.joint(f"{side}_shoulder")
     if np.linalg.norm(reach[:2]) < math.sin(math.radians(45.0)) * np.linalg.norm(reach):
         return  # within 45 degrees of straight down: near the recognizer's 35-degree limit, hardly a gesture
     if np.linalg.norm(reach) < 0.8:
