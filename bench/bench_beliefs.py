@@ -246,9 +246,7 @@ def bench_store(
                     entries=reader.execute(
                         f"SELECT * FROM attribute_index WHERE object_id IN ({', '.join('?' * len(new))})", list(new)
                     ).fetchall(),
-                    sightings=reader.execute(
-                        "SELECT * FROM observations WHERE time = ?", (1000.0 + index,)
-                    ).fetchall(),
+                    sightings=reader.execute("SELECT * FROM observations WHERE time = ?", (1000.0 + index,)).fetchall(),
                 )
             )
     reader.close()
