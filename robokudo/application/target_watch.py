@@ -40,5 +40,5 @@ class TargetWatch:
             return None
         unseen = self.unseen_for(stamp)
         if unseen > self.lost_after:
-            return f"target lost: {self.target} not seen for {unseen:.1f} s (lost after {self.lost_after:g} s)"
+            return f"target lost: {self.target} not seen for {unseen:.2f} s (lost after {self.lost_after:g} s)"
         return None

@@ -26,7 +26,7 @@ def test_lost_exactly_when_the_time_since_the_last_sighting_exceeds_lost_after(
         reason = watch.observe(stamp, seen)
         if stamp - since > lost_after:
             assert reason is not None and reason.startswith("target lost: the human not seen for ")
-            assert f"{stamp - since:.1f} s" in reason
+            assert f"{stamp - since:.2f} s" in reason
             return
         assert reason is None
 

@@ -54,7 +54,7 @@ def test_a_target_never_seen_is_lost_after_lost_after_with_the_reason(served: An
     assert handle.wait(WAIT), "the task did not end"
     assert handle.reason.startswith("target lost: the human not seen for "), handle.reason
     unseen = float(handle.reason.split("not seen for ")[1].split(" s")[0])
-    assert unseen > 0.5
+    assert unseen >= 0.5  # longer than 0.5 s, shown to 10 ms
     assert "lost after 0.5 s" in handle.reason and "DepthPeopleDetector" in handle.reason
     assert handle.runs >= 2
 
