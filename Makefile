@@ -4,7 +4,7 @@ VENV := .venv
 PY := $(VENV)/bin/python
 STAMP := $(VENV)/.installed
 
-.PHONY: demo test setup system-deps bench lint
+.PHONY: demo test setup system-deps bench bench-all lint
 
 demo: setup
 	$(PY) -m robokudo run tabletop --annotated-image robokudo-demo.png
@@ -41,5 +41,23 @@ $(STAMP): pyproject.toml Makefile
 	$(PY) -m pip uninstall -q -y opencv-python 2>/dev/null || true
 	touch $(STAMP)
 
+# The benchmarks of issue 19 (belief store, planning, tick overhead): each prints its goals with met / NOT met; the
+# output goes to bench/output/ and the goal lines are summed up at the end (a script that fails counts as NOT met).
+# The make fails when a goal is not met. `make bench-all` runs every script in bench/.
+BENCH_GOALS := bench/bench_beliefs.py bench/bench_planning.py bench/bench_tick_overhead.py
+
 bench: setup
+	@mkdir -p bench/output
+	@for script in $(BENCH_GOALS); do \
+		name=$$(basename $$script .py); echo "== $$script"; \
+		{ $(PY) $$script || echo "goal: $$script runs to the end: NOT met (exit $$?)"; } 2>&1 | tee bench/output/$$name.txt; \
+	done
+	@echo "== goals of issue 19"
+	@for script in $(BENCH_GOALS); do \
+		name=$$(basename $$script .py); \
+		grep -E '(^|[^A-Za-z])(met|NOT met)([^A-Za-z]|$$)' bench/output/$$name.txt | sed "s|^|$$name: |"; \
+	done
+	@! grep -qE 'NOT met' $(patsubst bench/%.py,bench/output/%.txt,$(BENCH_GOALS))
+
+bench-all: setup
 	for script in bench/*.py; do $(PY) $$script || exit 1; done

@@ -88,8 +88,16 @@ def annotator_classes(declarations: list[Declaration] | None) -> list[type[Annot
     return classes
 
 
-def generate(folder: Path, rng: random.Random) -> tuple[list[Path], list[Declaration]]:
-    """Write the generated object classes and regions; return the full file list and the annotator declarations."""
+def generate(
+    folder: Path,
+    rng: random.Random,
+    classes_count: int = GENERATED_CLASSES,
+    annotators_count: int = GENERATED_ANNOTATORS,
+) -> tuple[list[Path], list[Declaration]]:
+    """Write the generated object classes and regions; return the full file list and the annotator declarations.
+
+    ``classes_count`` object classes and ``annotators_count`` annotators are generated on top of the shipped ones.
+    """
     base = KnowledgeBase.load(folder / "none.ttl")
     colors = base.names_of_kind("color")
     shapes = base.names_of_kind("shape")
@@ -105,9 +113,10 @@ def generate(folder: Path, rng: random.Random) -> tuple[list[Path], list[Declara
         return f"[ a owl:Restriction ; owl:onProperty rk:{prop} ; {kind} {value} ]"
 
     generated: list[str] = []
-    for i in range(GENERATED_CLASSES):
+    for i in range(classes_count):
         name = f"GenObject{i:04d}"
-        parent = rng.choice(classes + generated)
+        drawn = rng.randrange(len(classes) + len(generated))  # as rng.choice(classes + generated), without the copy
+        parent = classes[drawn] if drawn < len(classes) else generated[drawn - len(classes)]
         supers = [f"rk:{parent}"]
         if rng.random() < 0.5:
             supers.append(restriction("typicalColor", "rk:" + rng.choice(colors)))
@@ -133,7 +142,7 @@ def generate(folder: Path, rng: random.Random) -> tuple[list[Path], list[Declara
     preconditions = ["NeedsDepth", "NeedsRegion", "NotForTransparentObjects"]
     all_classes = classes + generated
     declarations: list[Declaration] = []
-    for i in range(GENERATED_ANNOTATORS):
+    for i in range(annotators_count):
         inputs = rng.sample(types, rng.randint(1, 3))
         outputs = rng.sample(types, rng.randint(1, 2))
         capability: dict[str, Any] = {

@@ -10,7 +10,9 @@ from queries.errors import QueryError
 from queries.json_form import parse_json, query_from_json, query_to_json
 from queries.model import (
     ANYWHERE,
+    CONTINUOUS_KINDS,
     KINDS,
+    LOST_AFTER_KEY,
     NO_SPAN,
     Asked,
     Block,
@@ -31,7 +33,9 @@ from queries.validation import MAX_DEPTH, MAX_QUERY_LENGTH, validate_query
 
 __all__ = [
     "ANYWHERE",
+    "CONTINUOUS_KINDS",
     "KINDS",
+    "LOST_AFTER_KEY",
     "MAX_DEPTH",
     "MAX_QUERY_LENGTH",
     "NO_SPAN",

@@ -41,6 +41,15 @@ VERBS: MappingProxyType[tuple[str, ...], str] = MappingProxyType(
 )
 """Verb phrases and the query kind they start."""
 
+PLACEMENT_VERBS: frozenset[tuple[str, ...]] = frozenset(
+    (opening, modal, person, verb)
+    for opening in ("where",)
+    for modal in ("can", "could", "should", "do", "may")
+    for person in ("i", "we", "you")
+    for verb in ("put", "place", "set", "leave", "store")
+)
+"""``where can I put X on Y``: a free-space scan for X's footprint in region Y."""
+
 QUESTION_ATTRIBUTES: MappingProxyType[str, str] = MappingProxyType(
     {"color": "color", "colour": "color", "size": "size", "shape": "shape"}
 )

@@ -146,8 +146,28 @@ ANYWHERE = "anywhere"
 HUMAN_KEY = "human"
 """The key whose block describes a person to find (``detect { human: {} }``); its block may be empty."""
 
+POINTING_KEY = "pointing"
+"""The key whose block asks what a person points at (``detect { pointing: { target: object } }``)."""
+
+POINTING_TARGETS: tuple[str, ...] = ("object", "region")
+"""What a pointing query may ask for: the object pointed at, or the region (a place of the semantic map)."""
+
+FREE_SPACE_KEY = "free_space"
+"""The key of a scan's free-space block (``scan { free_space: { region: shelf, for: Cup } }``), and the value of
+``for`` in the short form ``scan { region: shelf, for: free_space }``."""
+
+FREE_SPACE_KEYS: tuple[str, ...] = ("region", "for", "footprint")
+"""The keys a free-space block may hold: where, what is to be put there (a class), and its footprint
+(``footprint: [10cm, 8cm]``, width and depth; one length for a square)."""
+
 KINDS: tuple[str, ...] = ("detect", "inspect", "track", "scan", "stop")
 """The known query kinds, in canonical order."""
+
+CONTINUOUS_KINDS: frozenset[str] = frozenset({"track"})
+"""The kinds that run until cancelled (one answer per frame) rather than ending with one answer."""
+
+LOST_AFTER_KEY = "lost_after"
+"""The key of a continuous query saying how long its target may go unseen before the task ends (a duration)."""
 
 
 @dataclass(frozen=True, slots=True)

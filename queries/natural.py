@@ -13,6 +13,7 @@ inspect / examine / look at / check             ``inspect``
 what color / size / shape is X                  ``inspect { obj: { ..., color: ? } }``
 scan X [for Y]                                  ``scan { region: X, for: Y }``
 find / look for free space on X                 ``scan { region: X, for: free_space }``
+where can I put / place / set X on Y            ``scan { free_space: { region: Y, for: X } }``
 stop / cancel [task] N, stop all                ``stop { task: N }``, ``task: all``
 noun words (unknown words joined by ``_``)      ``obj: { type: cereal_box }``
 plural head noun                                singular ``type``, no result limit
@@ -62,6 +63,7 @@ from queries.lexicon import (
     IRREGULAR_PLURALS,
     LIMITING_DETERMINERS,
     OPEN_DETERMINERS,
+    PLACEMENT_VERBS,
     PLURAL_ONLY,
     PLURAL_SUFFIXES,
     PREPOSITIONS,
@@ -78,6 +80,8 @@ from queries.lexicon import (
 )
 from queries.model import (
     ANYWHERE,
+    FREE_SPACE_KEY,
+    POINTING_KEY,
     Asked,
     Block,
     Field,
@@ -96,7 +100,9 @@ from queries.validation import MAX_QUERY_LENGTH, check_length, validate_query
 VERB_EXAMPLES: tuple[str, ...] = ("find", "track", "inspect", "scan", "stop")
 """The verbs named when a phrase starts with none."""
 
-_LONGEST_PHRASE = max(len(words) for table in (VERBS, PREPOSITIONS, FILLERS, TEXT_MARKERS) for words in table)
+_LONGEST_PHRASE = max(
+    len(words) for table in (VERBS, PLACEMENT_VERBS, PREPOSITIONS, FILLERS, TEXT_MARKERS) for words in table
+)
 
 
 def singularise(word: str) -> tuple[str, bool]:
@@ -276,7 +282,17 @@ class _PhraseParser:
             raise self.error("expected a phrase such as 'find the red cup'", VERB_EXAMPLES)
         while (filler := self.match(FILLERS)) is not None:
             self.take(len(filler))
+        pointing = self.pointing_question()
+        if pointing is not None:
+            return pointing
         asked_key: str | None = None
+        placement = self.match(PLACEMENT_VERBS)
+        if placement is not None:
+            verb_tokens = self.take(len(placement))
+            kind_span = _join_span(verb_tokens[0].span, verb_tokens[-1].span)
+            query = Query("scan", self.placement(kind_span), self.text, kind_span)
+            validate_query(query)
+            return query
         if self.word() == "what" and self.word(1) in QUESTION_ATTRIBUTES:
             verb_tokens = self.take(2)
             asked_key = QUESTION_ATTRIBUTES[verb_tokens[1].text]
@@ -309,6 +325,23 @@ class _PhraseParser:
             else:
                 body = self.object_body(kind, phrase)
         query = Query(kind, body, self.text, kind_span)
+        validate_query(query)
+        return query
+
+    def pointing_question(self) -> Query | None:
+        """``which object is the person pointing at`` (also ``what ... point at``, ``which region / place ...``,
+        ``where is the person pointing``): ``detect { pointing: { target: object | region } }``; None when the
+        phrase is no such question."""
+        words = [t.text for t in self.tokens if t.kind == "word"]
+        if not words or words[0] not in POINTING_QUESTION_WORDS or not POINTING_VERBS & set(words):
+            return None
+        if not PERSON_WORDS & set(words):
+            raise self.error("a pointing question names the person, e.g. 'which object is the person pointing at'")
+        target = "region" if words[0] == "where" or REGION_WORDS & set(words) else "object"
+        first, last = self.tokens[0].span, self.tokens[-1].span
+        span = _join_span(first, last)
+        block = Block((Field("target", Symbol(target), span),))
+        query = Query("detect", Block((Field(POINTING_KEY, block, span),)), self.text, first)
         validate_query(query)
         return query
 
@@ -523,6 +556,23 @@ class _PhraseParser:
             fields.append(Field("for", target, phrase.noun_span or phrase.start))
         return Block(tuple(fields))
 
+    def placement(self, verb_span: Span) -> Block:
+        """``where can I put the cup on the shelf``: what to put (a class) and where, as a free-space block."""
+        phrase = self.object_phrase()
+        self.modifiers(phrase)
+        self.expect_end()
+        if phrase.adjectives or phrase.extras or phrase.object_id is not None or phrase.anywhere is not None:
+            raise self.error_at(phrase.start, "expected only what to put (an object class) and where")
+        if len(phrase.locations) > 1:
+            raise self.error_at(phrase.locations[1].span, "expected one place to put it")
+        fields = [Field("region", place.value, place.span) for place in phrase.locations]
+        if phrase.noun and not phrase.generic:
+            fields.append(Field("for", Symbol(phrase.noun), phrase.noun_span or phrase.start))
+        if not fields:
+            raise self.error_at(phrase.start, "expected what to put (an object class) or where")
+        span = _join_span(verb_span, phrase.end)
+        return Block((Field(FREE_SPACE_KEY, Block(tuple(fields)), span),))
+
     def error_at(self, span: Span, message: str) -> QueryError:
         return located_error(self.text, message, span.line, span.column)
 
@@ -539,6 +589,12 @@ class _PhraseParser:
             self.take()
         self.expect_end()
         return Block(tuple(fields))
+
+
+POINTING_QUESTION_WORDS = frozenset({"which", "what", "where"})
+POINTING_VERBS = frozenset({"pointing", "point", "points", "pointed", "gesturing"})
+PERSON_WORDS = frozenset({"person", "human", "man", "woman", "someone", "somebody", "she", "he", "they", "people"})
+REGION_WORDS = frozenset({"region", "place", "area", "storage", "location", "shelf", "counter"})
 
 
 def parse_natural(text: str) -> Query:

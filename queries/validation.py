@@ -7,7 +7,8 @@ whole numbers, ``max_results`` at least 1) and carry a fitting unit; range
 bounds are scalars of one type, numbers share a unit and ``low <= high``;
 ``confidence`` is a plain number from 0 to 1; ``size`` is a size word (the
 answer is filtered by size class, so a metric size or range is refused here
-rather than ignored later); nesting is at most :data:`MAX_DEPTH` deep.  Whether an object class exists
+rather than ignored later); a ``free_space`` block of a ``scan`` holds only ``region``, ``for`` and
+``footprint`` (one or two positive lengths); nesting is at most :data:`MAX_DEPTH` deep.  Whether an object class exists
 is left to the reasoning layer.
 """
 
@@ -17,8 +18,12 @@ from types import MappingProxyType
 
 from queries.errors import QueryError, describe_alternatives, located_error, offset_to_position
 from queries.model import (
+    FREE_SPACE_KEY,
+    FREE_SPACE_KEYS,
     HUMAN_KEY,
     KINDS,
+    POINTING_KEY,
+    POINTING_TARGETS,
     Block,
     Field,
     ListValue,
@@ -49,6 +54,7 @@ NON_NEGATIVE_KEYS: frozenset[str] = frozenset(
         "diameter",
         "distance",
         "timeout",
+        "lost_after",
         "duration",
         "max_results",
         "task",
@@ -72,6 +78,7 @@ KEY_UNITS: MappingProxyType[str, str] = MappingProxyType(
         "diameter": "m",
         "distance": "m",
         "timeout": "s",
+        "lost_after": "s",
         "duration": "s",
     }
 )
@@ -107,6 +114,9 @@ def validate_query(query: Query) -> None:
         raise _error(query, query.kind_span, "'stop' needs a 'task' to stop", ["task"])
     if not query.body.fields:
         raise _error(query, query.kind_span, f"'{query.kind}' needs at least one key")
+    free_space = query.body.field(FREE_SPACE_KEY)
+    if free_space is not None:
+        _check_free_space(query, free_space)
     stack: list[tuple[Block, int]] = [(query.body, 1)]
     while stack:
         block, depth = stack.pop()
@@ -122,6 +132,20 @@ def validate_query(query: Query) -> None:
             seen[item.key] = item
             nested.extend(_check_field(query, item, depth))
         stack.extend(reversed(nested))
+
+
+def _check_pointing(query: Query, item: Field, block: Block) -> None:
+    """A pointing block names its target, ``object`` or ``region``, and nothing else."""
+    target = block.field("target")
+    if target is None:
+        raise _error(query, item.span, f"'{POINTING_KEY}' needs a target: {' or '.join(POINTING_TARGETS)}")
+    if not isinstance(target.value, Symbol) or target.value.name.lower() not in POINTING_TARGETS:
+        raise _error(
+            query, target.span, f"a pointing target is {' or '.join(POINTING_TARGETS)}", list(POINTING_TARGETS)
+        )
+    others = [f.key for f in block.fields if f.key != "target"]
+    if others:
+        raise _error(query, item.span, f"'{POINTING_KEY}' takes only a target, not {', '.join(others)}")
 
 
 def _error(query: Query, span: Span, message: str, expected: tuple[str, ...] | list[str] = ()) -> QueryError:
@@ -140,6 +164,8 @@ def _check_field(query: Query, item: Field, depth: int) -> list[tuple[Block, int
         if item.key in WORD_ONLY_KEYS and isinstance(value, Number | Range):
             raise _error(query, item.span, f"'{item.key}' takes {WORD_ONLY_KEYS[item.key]}")
         if isinstance(value, Block):
+            if item.key == POINTING_KEY and level == 1:
+                _check_pointing(query, item, value)
             if not value.fields and not (item.key == HUMAN_KEY and level == 1):
                 raise _error(query, item.span, f"'{item.key}' has an empty block")
             nested.append((value, level + 1))
@@ -150,6 +176,42 @@ def _check_field(query: Query, item: Field, depth: int) -> list[tuple[Block, int
         elif isinstance(value, Number):
             _check_number(query, item, value)
     return nested
+
+
+def _check_free_space(query: Query, item: Field) -> None:
+    """Check a ``free_space`` block: a scan's, with known keys, one region and a footprint of positive lengths."""
+    if query.kind != "scan":
+        raise _error(query, item.span, f"'{FREE_SPACE_KEY}' belongs to a 'scan' query, not '{query.kind}'", ["scan"])
+    block = item.value
+    if not isinstance(block, Block):
+        raise _error(query, item.span, f"'{FREE_SPACE_KEY}' takes a block such as {{ region: shelf, for: Cup }}", ["{"])
+    if query.body.field("region") is not None and block.field("region") is not None:
+        raise _error(query, item.span, f"the region is given twice: once in '{FREE_SPACE_KEY}', once beside it")
+    for entry in block.fields:
+        if entry.key not in FREE_SPACE_KEYS:
+            expected = ", ".join(FREE_SPACE_KEYS)
+            message = f"'{FREE_SPACE_KEY}' has no key '{entry.key}' (expected {expected})"
+            raise _error(query, entry.span, message, FREE_SPACE_KEYS)
+    target = block.get("for")
+    if target is not None and not isinstance(target, Symbol | String):
+        raise _error(query, _span(block, "for"), "'for' in 'free_space' names one object class, such as Cup")
+    footprint = block.get("footprint")
+    if footprint is not None:
+        lengths = footprint.items if isinstance(footprint, ListValue) else (footprint,)
+        if not 1 <= len(lengths) <= 2 or not all(
+            isinstance(v, Number) and v.unit in (None, "m") and v.value > 0 for v in lengths
+        ):
+            raise _error(
+                query,
+                _span(block, "footprint"),
+                "'footprint' takes one or two positive lengths, width and depth, such as [10cm, 8cm] or 0.1",
+            )
+
+
+def _span(block: Block, key: str) -> Span:
+    """The span of ``key``'s field in ``block`` (no span when absent)."""
+    found = block.field(key)
+    return found.span if found is not None else Span(0, 0, 0, 0)
 
 
 def _check_number(query: Query, item: Field, number: Number) -> None:

@@ -71,3 +71,17 @@ def test_subtypes_satisfy_inputs() -> None:
     tree = Pipeline("p", [make("Seg", outputs=[special_hyp]), make("Col", [Hyp], [Color])])
     validate_data_flow(tree)
     assert data_flow_violations(Pipeline("p", [make("Seg", outputs=[special]), make("Col", [Hyp])]))
+
+
+def test_fallback_branches_writing_a_type_or_its_subtype_guarantee_the_type() -> None:
+    special = type("SpecialHyp3", (Hyp,), {})
+    fallback = py_trees.composites.Selector(
+        "segmenters", memory=False, children=[make("SegA", outputs=[special]), make("SegB", outputs=[Hyp])]
+    )
+    validate_data_flow(Pipeline("p", [fallback, make("Col", [Hyp], [Color])]))
+    # the subtype itself is written in one branch only
+    fallback = py_trees.composites.Selector(
+        "segmenters", memory=False, children=[make("SegA", outputs=[special]), make("SegB", outputs=[Hyp])]
+    )
+    with pytest.raises(DataFlowError, match="only in one branch of Fallback 'segmenters'"):
+        validate_data_flow(Pipeline("p", [fallback, make("Use", [special])]))

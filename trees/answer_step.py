@@ -16,14 +16,33 @@ from typing import ClassVar
 import numpy as np
 
 from queries import Query
-from reasoning.beliefs.answer import Answer, class_label, designator
+from reasoning.beliefs.answer import (
+    Answer,
+    PlacementDesignator,
+    PointingAnswer,
+    PoseDesignator,
+    TrackDesignator,
+    class_label,
+    designator,
+)
 from reasoning.beliefs.store import BeliefFilter, BeliefStore
 from reasoning.fusion.association import CameraModel
 from reasoning.fusion.frame import FUSED_TYPES, WORLD_FRAME, FrameContext, FrameObject, frame_objects
 from reasoning.fusion.rule import CLASS_ATTRIBUTE
 from reasoning.fusion.tracking import BeliefTracker, ObjectBelief, TrackStep
 from robokudo.core.annotator import Annotator
-from robokudo.core.types import CameraInfo, CasType, DepthImage, ObjectHypothesis, PointCloud, QueryAnswer, QueryView
+from robokudo.core.types import (
+    CameraInfo,
+    CasType,
+    DepthImage,
+    FreePlacement,
+    ObjectHypothesis,
+    PointCloud,
+    PointingTarget,
+    QueryAnswer,
+    QueryView,
+    TargetTrack,
+)
 
 
 def camera_model(info: CameraInfo, depth: np.ndarray | None = None) -> CameraModel:
@@ -48,14 +67,17 @@ class AnswerStep(Annotator):
     first run. ``tracker`` (class test, regions, gates) defaults to the store's. The query's filter is
     ``belief_filter``, or ``filter_for(query)`` of the CAS's QueryView, or everything seen. The answer holds
     the matching objects seen in this frame, most confident first, with their image ROI (an object an expert only
-    guessed to be of the asked class is a candidate too, see :meth:`_guessed`); ``label_of`` names classes (e.g.
+    guessed to be of the asked class is a candidate too, see :meth:`_guessed`); when a tracker wrote the frame's
+    TargetTrack (a continuous task), only the tracked object, with the track; ``label_of`` names classes (e.g.
     the knowledge base's labels). Objects whose geometry is in doubt confirm known beliefs but create none. With
     ``fail_when_empty`` the step fails when nothing matches. ``timestamp`` 0 in CameraInfo means unknown: ``clock()``
-    is used instead.
+    is used instead. With ``free_space`` the answer also holds the CAS's free placements, largest first.
     """
 
     inputs: ClassVar[tuple[type[CasType], ...]] = (ObjectHypothesis,)
-    optional_inputs: ClassVar[tuple[type[CasType], ...]] = (CameraInfo, PointCloud, DepthImage, QueryView, *FUSED_TYPES)
+    optional_inputs: ClassVar[tuple[type[CasType], ...]] = (
+        CameraInfo, PointCloud, DepthImage, QueryView, TargetTrack, PointingTarget, FreePlacement, *FUSED_TYPES,
+    )  # fmt: skip
     outputs: ClassVar[tuple[type[CasType], ...]] = (QueryAnswer,)
 
     def __init__(
@@ -70,9 +92,11 @@ class AnswerStep(Annotator):
         clock: Callable[[], float] = time.time,
         label_of: Callable[[str], str] = class_label,
         on_integrated: Callable[[TrackStep], None] | None = None,
+        free_space: bool = False,
         name: str | None = None,
     ) -> None:
         super().__init__(name=name)
+        self.free_space = free_space
         self.on_integrated = on_integrated
         """Told every frame's changes to the store once they are written (e.g. to publish them)."""
         self._store_source = store
@@ -126,12 +150,24 @@ class AnswerStep(Annotator):
         seen = {i: o for i, o in zip(step.assigned, objects, strict=True) if i}
         if belief_filter.ids is not None:  # the query names objects (``id:``): answer only those of them seen here
             seen = {i: o for i, o in seen.items() if i in belief_filter.ids}
+        tracks = self.annotations(TargetTrack)
+        track = tracks[0] if tracks else None
+        tracked = _tracked_object(track, seen) if track is not None else None
+        if track is not None:  # a continuous task answers with its one target
+            seen = {tracked: seen[tracked]} if tracked is not None else {}
         matching = store.query(replace(belief_filter, ids=tuple(seen), limit=None))
         guesses = self._guessed(store, belief_filter, seen, {b.id for b in matching})
         matching += guesses.values()
         matching.sort(key=lambda b: (-b.confidence, b.id))
         if belief_filter.limit is not None:
             matching = matching[: belief_filter.limit]
+        pointing = self._pointing(seen, info)
+        if pointing is not None:  # a pointing query answers with the pointed object (none for a region)
+            matching = [
+                b
+                for b in matching + store.query(replace(belief_filter, ids=tuple(seen), limit=None))
+                if b.id == pointing.object_id
+            ][:1]
         query_view = self.optional_view(QueryView)
         text = query_view.query.source if query_view is not None and isinstance(query_view.query, Query) else ""
         answer = Answer(
@@ -147,10 +183,61 @@ class AnswerStep(Annotator):
                 for b in matching
             ),
             observed=tuple(step.assigned),
+            track=None if track is None else _track_designator(track, tracked),
+            pointing=pointing,
+            placements=self._placements() if self.free_space else None,
         )
         self.write(QueryAnswer(answer))
         if self.fail_when_empty and not matching:
             self.fail(f"no object matches the query among {len(objects)} seen")
+
+    def _pointing(self, seen: dict[int, FrameObject], info: CameraInfo | None) -> PointingAnswer | None:
+        """The most confident PointingTarget of this frame, with the belief of the pointed object (the object seen
+        here whose image box overlaps the target's most) and the ray in the world frame when the pose is known."""
+        targets = self.annotations(PointingTarget)
+        if not targets:
+            return None
+        target = max(targets, key=lambda t: t.confidence)
+        object_id = None
+        if target.kind == "object" and target.roi is not None:
+            overlaps = {i: _box_iou(o.roi, target.roi) for i, o in seen.items() if o.roi is not None}
+            best = max(overlaps, key=lambda i: overlaps[i], default=None)
+            object_id = best if best is not None and overlaps[best] > 0.5 else None
+        origin, direction, frame = target.origin, target.direction, "camera"
+        if info is not None and info.cam_to_world is not None:
+            pose = np.asarray(info.cam_to_world, dtype=np.float64)
+            origin, direction, frame = pose[:3, :3] @ origin + pose[:3, 3], pose[:3, :3] @ direction, WORLD_FRAME
+        return PointingAnswer(
+            kind=target.kind,
+            object_id=object_id,
+            region=target.name,
+            angular_error_degrees=float(np.degrees(target.angular_error)),
+            spread_degrees=float(np.degrees(target.spread)),
+            confidence=target.confidence,
+            origin=tuple(float(v) for v in origin),
+            direction=tuple(float(v) for v in direction),
+            frame=frame,
+        )
+
+    def _placements(self) -> tuple[PlacementDesignator, ...]:
+        """The CAS's free placements as designators, largest first."""
+        found = sorted(self.annotations(FreePlacement), key=lambda p: -p.size[0] * p.size[1])
+        return tuple(
+            PlacementDesignator(
+                pose=PoseDesignator(
+                    position=tuple(float(v) for v in p.position),  # type: ignore[arg-type]
+                    orientation=tuple(float(v) for v in p.orientation),  # type: ignore[arg-type]
+                    frame=p.frame,
+                ),
+                size=(float(p.size[0]), float(p.size[1])),
+                footprint=(float(p.footprint[0]), float(p.footprint[1])),
+                fits=p.fits,
+                region=p.region or None,
+                confidence=p.confidence,
+                experts=(p.source,) if p.source else (),
+            )
+            for p in found
+        )
 
     @staticmethod
     def _guessed(
@@ -183,3 +270,44 @@ class AnswerStep(Annotator):
         if self.filter_for is not None and query_view is not None:
             return self.filter_for(query_view.query)
         return BeliefFilter(class_test=(self.tracker or self.store.tracker).class_test)
+
+
+def _tracked_object(track: TargetTrack, seen: dict[int, FrameObject]) -> int | None:
+    """The belief id of the object the tracker associated in this frame (the one whose image box overlaps the
+    tracked hypothesis' box most), or None when the target was not seen."""
+    if not track.seen or track.hypothesis is None:
+        return None
+    best, best_overlap = None, 0.0
+    for belief_id, item in seen.items():
+        overlap = _box_iou(track.hypothesis.roi, item.roi)
+        if overlap > best_overlap:
+            best, best_overlap = belief_id, overlap
+    return best
+
+
+def _box_iou(a: tuple[int, int, int, int], b: tuple[int, int, int, int] | None) -> float:
+    if b is None:
+        return 0.0
+    width = min(a[2], b[2]) - max(a[0], b[0])
+    height = min(a[3], b[3]) - max(a[1], b[1])
+    if width <= 0 or height <= 0:
+        return 0.0
+    inter = width * height
+    union = (a[2] - a[0]) * (a[3] - a[1]) + (b[2] - b[0]) * (b[3] - b[1]) - inter
+    return inter / union if union > 0 else 0.0
+
+
+def _track_designator(track: TargetTrack, object_id: int | None) -> TrackDesignator:
+    known = bool(np.all(np.isfinite(track.position)))
+    return TrackDesignator(
+        target=track.target,
+        seen=track.seen,
+        position=tuple(float(v) for v in track.position) if known else None,
+        velocity=tuple(float(v) for v in track.velocity) if known else None,
+        frame=track.frame,
+        pixel=track.pixel,
+        spread=float(track.spread) if known else None,
+        unseen_for=float(track.unseen_for),
+        object_id=object_id,
+        tracker=track.source,
+    )

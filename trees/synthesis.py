@@ -1,5 +1,9 @@
 """Turn a Plan into a Perception Pipeline Tree: Pipeline > stages (Parallel when independent) > Fallbacks.
 
+A continuous query's tree (:func:`build_task_tree` for a kind of ``queries.CONTINUOUS_KINDS``, e.g. ``track``) is
+that Pipeline inside a :class:`~robokudo.core.loop.Loop` (the paper's ↻): it analyses one frame per run and runs
+again until the task is cancelled; a failed run (nobody seen in a frame) is a frame without an answer.
+
 A plan names annotators; their classes come from an :class:`~annotators.catalog.AnnotatorCatalog` (by default
 the ``annotators`` package's, plus any classes a caller adds), the only place that turns names into classes.
 """
@@ -13,11 +17,13 @@ from functools import partial
 import py_trees
 
 from annotators.catalog import AnnotatorCatalog, CatalogError
+from queries.model import CONTINUOUS_KINDS
 from reasoning.knowledge.capabilities import implementation_path
 from reasoning.planning.plan import Alternatives, Plan, Step, Unit
 from robokudo.core.annotator import Annotator
 from robokudo.core.composites import Fallback, Sequence
 from robokudo.core.dataflow import validate_data_flow
+from robokudo.core.loop import Loop
 from robokudo.core.parallel import ThresholdParallel
 from robokudo.core.pipeline import Pipeline
 from robokudo.core.resources import SharedResources
@@ -85,6 +91,20 @@ def _stage_node(index: int, stage: Ordered[Unit], make: NodeFactory) -> py_trees
     )
 
 
+def stage_nodes(
+    plan: Plan,
+    make: NodeFactory | None = None,
+    catalog: AnnotatorCatalog | None = None,
+    resources: SharedResources | None = None,
+) -> list[py_trees.behaviour.Behaviour]:
+    """One node per stage of ``plan`` (a threshold Parallel of independent units, a Fallback of alternatives, or
+    a leaf), in order: the body of a Pipeline, or of a subtree embedded in another tree."""
+    if make is None:
+        catalog = catalog if catalog is not None else AnnotatorCatalog.discover()
+        make = partial(instantiate, catalog=catalog, resources=resources)
+    return [_stage_node(index, stage, make) for index, stage in enumerate(plan.stages, start=1)]
+
+
 def build_tree(
     plan: Plan,
     name: str = "query",
@@ -101,10 +121,40 @@ def build_tree(
     models) when given. ``query`` is put into every new CAS of the pipeline. SynthesisError when a step names no
     class of the catalog.
     """
-    if make is None:
-        catalog = catalog if catalog is not None else AnnotatorCatalog.discover()
-        make = partial(instantiate, catalog=catalog, resources=resources)
-    children = [_stage_node(index, stage, make) for index, stage in enumerate(plan.stages, start=1)]
+    children = stage_nodes(plan, make=make, catalog=catalog, resources=resources)
     pipeline = Pipeline(name, [*children, *final_steps], query=query, reason=f"answers the {plan.task.kind} query")
     validate_data_flow(pipeline)
     return pipeline
+
+
+def build_task_tree(
+    plan: Plan,
+    name: str = "query",
+    final_steps: Ordered[py_trees.behaviour.Behaviour] = (),
+    make: NodeFactory | None = None,
+    query: object | None = None,
+    catalog: AnnotatorCatalog | None = None,
+    resources: SharedResources | None = None,
+) -> Pipeline | Loop:
+    """The tree running ``plan`` as its task: :func:`build_tree`'s Pipeline for a one-shot kind; for a continuous
+    kind that Pipeline (named "every frame") in a Loop that repeats it until stopped, tolerating failed runs."""
+    continuous = plan.task.kind in CONTINUOUS_KINDS
+    pipeline = build_tree(
+        plan,
+        name="every frame" if continuous else name,
+        final_steps=final_steps,
+        make=make,
+        query=query,
+        catalog=catalog,
+        resources=resources,
+    )
+    if not continuous:
+        return pipeline
+    pipeline.reason = f"analyses one frame for the {plan.task.kind} query"
+    return Loop(
+        name,
+        pipeline,
+        runs=None,
+        max_failures=None,
+        reason=f"a {plan.task.kind} query runs once per frame until it is cancelled or its target is lost",
+    )

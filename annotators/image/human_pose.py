@@ -105,6 +105,60 @@ def keypoint_points(pixels: np.ndarray, points: np.ndarray, member: np.ndarray |
     return found
 
 
+BONES: tuple[tuple[str, str], ...] = (
+    ("left_shoulder", "right_shoulder"), ("left_hip", "right_hip"), ("left_shoulder", "left_hip"),
+    ("right_shoulder", "right_hip"), ("left_shoulder", "left_elbow"), ("left_elbow", "left_wrist"),
+    ("right_shoulder", "right_elbow"), ("right_elbow", "right_wrist"), ("left_hip", "left_knee"),
+    ("left_knee", "left_ankle"), ("right_hip", "right_knee"), ("right_knee", "right_ankle"), ("nose", "nose"),
+)  # fmt: skip
+"""The skeleton's bones (pairs of landmarks); the nose stands for the head."""
+
+
+ARM_JOINTS: frozenset[str] = frozenset(
+    f"{side}_{joint}" for side in ("left", "right") for joint in ("elbow", "wrist", "pinky", "index", "thumb")
+)
+
+
+def _unoccluded(keypoints: np.ndarray, body_depth: float = 0.3, arm_reach: float = 0.8) -> np.ndarray:
+    """The keypoints without those whose depth says they lie on something in front of the body (an object that
+    hides the hips): farther than ``body_depth`` in depth from the shoulders (``arm_reach`` for arm joints)."""
+    shoulders = keypoints[[LANDMARKS.index("left_shoulder"), LANDMARKS.index("right_shoulder")], 2]
+    if not np.isfinite(shoulders).any():
+        return keypoints
+    reference = float(np.nanmedian(shoulders))
+    limits = np.array([arm_reach if name in ARM_JOINTS else body_depth for name in LANDMARKS])
+    kept = keypoints.copy()
+    with np.errstate(invalid="ignore"):
+        kept[np.abs(keypoints[:, 2] - reference) > limits] = np.nan
+    return kept
+
+
+def near_skeleton(points: np.ndarray, keypoints: np.ndarray, reach: float) -> np.ndarray | None:
+    """Which of the Nx3 ``points`` lie within ``reach`` of a bone between keypoints with depth (33x3); the torso
+    (between the shoulders and the hips) counts too. None when no bone has depth at both ends."""
+    keypoints = _unoccluded(keypoints)
+    near = np.zeros(points.shape[0], dtype=bool)
+    valid = np.isfinite(points[:, 2])
+    used = 0
+    for first, second in BONES:
+        a, b = keypoints[LANDMARKS.index(first)], keypoints[LANDMARKS.index(second)]
+        if not (np.all(np.isfinite(a)) and np.all(np.isfinite(b))):
+            continue
+        used += 1
+        ab = b - a
+        length = float(ab @ ab)
+        t = np.zeros(points.shape[0]) if length < 1e-12 else np.clip((points - a) @ ab / length, 0.0, 1.0)
+        with np.errstate(invalid="ignore"):
+            near |= valid & (np.linalg.norm(points - (a + t[:, None] * ab), axis=1) < reach + (first == "nose") * 0.05)
+    corners = keypoints[list(TORSO)]
+    if np.all(np.isfinite(corners)):
+        centre = corners.mean(axis=0)
+        radius = float(np.max(np.linalg.norm(corners - centre, axis=1)))
+        with np.errstate(invalid="ignore"):
+            near |= valid & (np.linalg.norm(points - centre, axis=1) < radius)
+    return near if used else None
+
+
 class HumanPoseDetector(Annotator):
     """Finds people with 2-D and 3-D body keypoints (mediapipe pose on crops around depth person candidates)."""
 
@@ -125,9 +179,12 @@ class HumanPoseDetector(Annotator):
         crop_margin: float = 0.12,
         min_on_person: float = 0.5,
         parameters: PeopleParameters | None = None,
+        body_reach: float = 0.15,
         name: str | None = None,
     ) -> None:
         super().__init__(name=name)
+        self.body_reach = body_reach
+        """Without a depth candidate, how far (m) from its skeleton's bones a point counts as the person's."""
         self.min_torso_visibility = min_torso_visibility
         self.crop_margin = crop_margin
         self.min_on_person = min_on_person
@@ -184,21 +241,40 @@ class HumanPoseDetector(Annotator):
                 if np.count_nonzero(np.isfinite(xyz[:, 2])) < self.min_on_person * len(LANDMARKS):
                     continue  # the skeleton does not lie on the candidate's points: something else was seen
             found += 1
-            self.write(self._person(pixels, visibility, xyz, candidate))
+            self.write(self._person(pixels, visibility, xyz, candidate, points))
         return found
 
     def _person(
-        self, pixels: np.ndarray, visibility: np.ndarray, xyz: np.ndarray | None, candidate: PersonSegment | None
+        self,
+        pixels: np.ndarray,
+        visibility: np.ndarray,
+        xyz: np.ndarray | None,
+        candidate: PersonSegment | None,
+        points: np.ndarray | None = None,
     ) -> PersonHypothesis:
         confidence = float(np.mean(visibility[list(TORSO)]))
         if candidate is not None and xyz is not None:
             hypothesis = person_hypothesis(candidate, self.name, confidence)
+            if points is not None:
+                # the candidate's column may hold what stands in front of the person (a table's objects): keep
+                # the points near its skeleton
+                near = near_skeleton(points.reshape(-1, 3)[candidate.indices], xyz, self.body_reach)
+                if near is not None and near.any():
+                    hypothesis.point_indices = candidate.indices[near]
+                    hypothesis.mask = np.zeros(candidate.mask.size, dtype=bool)
+                    hypothesis.mask[hypothesis.point_indices] = True
+                    hypothesis.mask = hypothesis.mask.reshape(candidate.mask.shape)
         else:
             height, width = self.view(ColorImage).image.shape[:2]
             x0, y0 = np.clip(np.floor(pixels.min(axis=0)).astype(int), 0, (width - 1, height - 1))
             x1, y1 = np.clip(np.ceil(pixels.max(axis=0)).astype(int) + 1, 1, (width, height))
             mask = np.zeros((height, width), dtype=bool)
             mask[y0:y1, x0:x1] = True
+            if points is not None and xyz is not None:
+                # the person's pixels in the box: those near its skeleton (not a table and the objects in front)
+                near = near_skeleton(points[y0:y1, x0:x1].reshape(-1, 3), xyz, self.body_reach)
+                if near is not None:
+                    mask[y0:y1, x0:x1] = near.reshape(y1 - y0, x1 - x0)
             hypothesis = PersonHypothesis(
                 point_indices=np.flatnonzero(mask),
                 mask=mask,

@@ -19,7 +19,7 @@ from __future__ import annotations
 
 import time
 from abc import abstractmethod
-from collections.abc import Mapping
+from collections.abc import Mapping, Sequence
 from pathlib import Path
 from typing import ClassVar
 
@@ -30,12 +30,14 @@ from annotators.readers.frame_io import Frame, FrameError, read_color_depth_pair
 from annotators.readers.pcd_io import read_pcd
 from annotators.readers.tiff_io import read_tiff_frame
 from annotators.readers.tum_io import TUM_DEPTH_SCALE, read_tum_pair, read_tum_sequence
-from annotators.simulation import kitchen_scene
+from annotators.simulation import kitchen_person, kitchen_scene
 from robokudo.core.annotator import Annotator
 from robokudo.core.capability import Capability
 from robokudo.core.types import CameraInfo, CameraIntrinsics, CasType, ColorImage, DepthImage, PointCloud, QueryView
 
 DEFAULT_KITCHEN_VIEW = "table"
+PERSON_VIEW = "person"
+"""The kitchen view of the table with a person behind it (``kitchen_person.person_view``)."""
 KITCHEN_RECORDING = "kitchen"
 """The recording of every view of the built-in kitchen: one simulated world."""
 
@@ -43,7 +45,10 @@ KITCHEN_RECORDING = "kitchen"
 class KitchenSceneReader(Annotator):
     """Renders the built-in kitchen from a named camera view (``"table"`` when ``view`` is None).
 
-    ``seed`` seeds the sensor noise; ``moved`` moves objects (see ``kitchen_scene.kitchen_objects``). The
+    ``seed`` seeds the sensor noise; ``moved`` moves objects (see ``kitchen_scene.kitchen_objects``); ``person``
+    puts a person into the kitchen (a spec of ``kitchen_person.person_spec_pose``: ``stand``, ``wave``,
+    ``point:<target>``, optionally ``@x,y``), seen by default from the ``"person"`` view (table and person); ``extra``
+    adds objects with their albedo (``render_kitchen(extra=...)``, e.g. a storage layout's ``extra()``). The
     optional QueryView input is declared for choosing the view from the query's region (not used yet).
     """
 
@@ -62,12 +67,16 @@ class KitchenSceneReader(Annotator):
         view: str | None = None,
         seed: int = 0,
         moved: Mapping[str, np.ndarray] | None = None,
+        person: str | None = None,
+        extra: Sequence[tuple[kitchen_scene.SceneObject, tuple[int, int, int]]] = (),
         name: str | None = None,
     ) -> None:
         super().__init__(name=name)
+        self.extra = tuple(extra)
         self.scene_view = view
         self.seed = seed
         self.moved = dict(moved) if moved else None
+        self.person = person
         self._rendered: dict[str, kitchen_scene.RenderedScene] = {}
         self._last: kitchen_scene.RenderedScene | None = None
 
@@ -77,8 +86,8 @@ class KitchenSceneReader(Annotator):
         return self._last
 
     def choose_view(self) -> str:
-        """The camera view to render (the configured one, else the default)."""
-        return self.scene_view or DEFAULT_KITCHEN_VIEW
+        """The camera view to render (the configured one, else the person view with a person, else the default)."""
+        return self.scene_view or (PERSON_VIEW if self.person else DEFAULT_KITCHEN_VIEW)
 
     def analyse(self) -> None:
         """Render (once per view) and write the three views."""
@@ -86,7 +95,11 @@ class KitchenSceneReader(Annotator):
         scene = self._rendered.get(view)
         if scene is None:
             try:
-                scene = kitchen_scene.render_kitchen(view, seed=self.seed, moved=self.moved)
+                person = kitchen_person.person_spec_pose(self.person) if self.person else None
+                camera = kitchen_person.person_view() if view == PERSON_VIEW else view
+                scene = kitchen_scene.render_kitchen(
+                    camera, seed=self.seed, moved=self.moved, person=person, extra=self.extra
+                )
             except ValueError as error:
                 self.fail(f"cannot render the kitchen: {error}")
             self._rendered[view] = scene

@@ -434,8 +434,11 @@ class PerceivedFrameReader(Annotator):
     """The first step of a task in a served tree: takes the frame the root's perceive pipeline read this run.
 
     The views are shared by reference (no copy). Fails with the reason when the tree has no such pipeline or it
-    holds no frame.
+    holds no frame. Run again (a continuous task's loop), it stays RUNNING while the pipeline still holds the frame
+    it took last, so no frame is analysed twice.
     """
+
+    WAITING = "waiting for a newly perceived frame"
 
     inputs: ClassVar[tuple[type[CasType], ...]] = ()
     outputs: ClassVar[tuple[type[CasType], ...]] = (ColorImage, DepthImage, CameraInfo)
@@ -449,6 +452,19 @@ class PerceivedFrameReader(Annotator):
     def __init__(self, pipeline: str = PERCEPTION_PIPELINE, name: str | None = None) -> None:
         super().__init__(name=name)
         self.pipeline = pipeline
+        self._taken: CameraInfo | None = None
+
+    def update(self) -> Status:
+        """RUNNING while the perceive pipeline holds the frame taken last; else take it (see the class)."""
+        if self._taken is not None:
+            try:
+                current = self.cas_of(self.pipeline).view(CameraInfo)
+            except StructureError:
+                current = None
+            if current is self._taken:
+                self.feedback_message = self.WAITING
+                return Status.RUNNING
+        return super().update()
 
     def analyse(self) -> None:
         """Write the perceived colour, depth and camera info into this task's CAS."""
@@ -462,3 +478,4 @@ class PerceivedFrameReader(Annotator):
         for view in views:
             assert view is not None
             self.write(view)
+        self._taken = views[2]

@@ -23,7 +23,7 @@ Conventions:
 from __future__ import annotations
 
 import math
-from collections.abc import Mapping
+from collections.abc import Mapping, Sequence
 from dataclasses import dataclass
 
 import cv2
@@ -33,6 +33,7 @@ from numpy.typing import NDArray
 
 from annotators.cloud.size import SIZE_CLASS_THRESHOLDS, size_class_for
 from annotators.simulation.kitchen_map import map_regions
+from annotators.simulation.kitchen_person import PERSON_OBJECT_ID, PersonPose, person_meshes
 from robokudo.core.regions import RegionBox, region_of
 from robokudo.core.types import CameraIntrinsics
 
@@ -46,6 +47,7 @@ __all__ = (
     "SceneObject",
     "camera_looking_at",
     "camera_views",
+    "fridge_shelf",
     "kitchen_objects",
     "kitchen_regions",
     "look_at",
@@ -104,6 +106,8 @@ class RenderedScene:
     object_ids: NDArray[np.int32]
     objects: tuple[SceneObject, ...]
     view: str
+    person: PersonPose | None = None
+    """The person in the scene (ground truth for scoring only), None when there is none."""
 
     def object(self, name: str) -> SceneObject:
         """Return the scene object called ``name`` (KeyError if unknown)."""
@@ -391,9 +395,8 @@ def _furniture_parts() -> list[_Part]:
     )
     for size, centre, col in slabs:
         parts.append(_Part(_transform(_box_mesh(size), _pose(*centre)), col))
-    shelf_size = (wx - 2 * _WALL, wy - _WALL - 0.02, _SHELF)
-    for h in FRIDGE_SHELF_HEIGHTS:
-        centre = (fx, y0 + 0.02 + shelf_size[1] / 2, h - _SHELF / 2)
+    for level in range(len(FRIDGE_SHELF_HEIGHTS)):
+        centre, shelf_size = fridge_shelf(level)
         parts.append(_Part(_transform(_box_mesh(shelf_size), _pose(*centre)), (198, 206, 216)))
     door_t = 0.05
     door = _box_mesh((wx, door_t, wz - 0.02))
@@ -404,11 +407,23 @@ def _furniture_parts() -> list[_Part]:
     return parts
 
 
-def _object_parts(objects: tuple[SceneObject, ...]) -> list[_Part]:
-    specs = {s.name: s for s in _OBJECT_SPECS}
+def fridge_shelf(level: int = 0) -> tuple[tuple[float, float, float], tuple[float, float, float]]:
+    """World centre and size (along the world axes) of a fridge shelf board; level 0 is the upper one (the milk's),
+    whose top surface is at ``FRIDGE_SHELF_HEIGHTS[level]``."""
+    fx, fy = FRIDGE_CENTRE
+    wx, wy, _ = FRIDGE_SIZE
+    size = (wx - 2 * _WALL, wy - _WALL - 0.02, _SHELF)
+    top = FRIDGE_SHELF_HEIGHTS[level]
+    return (fx, fy - wy / 2 + 0.02 + size[1] / 2, top - _SHELF / 2), size
+
+
+def _object_parts(
+    objects: tuple[SceneObject, ...], albedos: Mapping[str, tuple[int, int, int]] | None = None
+) -> list[_Part]:
+    colours = {s.name: s.albedo for s in _OBJECT_SPECS} | dict(albedos or {})
     parts: list[_Part] = []
     for obj in objects:
-        spec = specs[obj.name]
+        albedo = colours[obj.name]
         w, _, h = obj.size
         if obj.shape == "box":
             mesh = _box_mesh(obj.size)
@@ -417,7 +432,7 @@ def _object_parts(objects: tuple[SceneObject, ...]) -> list[_Part]:
         else:
             mesh = _bowl_mesh(w / 2, h)
         pattern = _LABEL if obj.text else _PLAIN
-        parts.append(_Part(_transform(mesh, obj.pose), spec.albedo, obj.object_id, pattern))
+        parts.append(_Part(_transform(mesh, obj.pose), albedo, obj.object_id, pattern))
     return parts
 
 
@@ -572,17 +587,31 @@ def render_kitchen(
     noise: bool = True,
     moved: Mapping[str, NDArray[np.floating]] | None = None,
     intrinsics: CameraIntrinsics = DEFAULT_INTRINSICS,
+    person: PersonPose | None = None,
+    extra: Sequence[tuple[SceneObject, tuple[int, int, int]]] = (),
 ) -> RenderedScene:
     """Render one RGB-D frame of the kitchen.
 
     ``view`` is a named view (see :func:`camera_views`) or a 4x4 cam_to_world.
     ``noise`` toggles the seeded colour (sigma ``COLOR_NOISE_SIGMA``) and depth
     (sigma ``DEPTH_NOISE_SIGMA``) noise; without noise the output does not
-    depend on ``seed``.  ``moved`` is passed to :func:`kitchen_objects`.
+    depend on ``seed``.  ``moved`` is passed to :func:`kitchen_objects`.  ``person`` adds the articulated
+    figure of :mod:`annotators.simulation.kitchen_person` in that pose (pixels of id ``PERSON_OBJECT_ID``).
+    ``extra`` adds objects (box, cylinder or bowl shapes) with their RGB albedo to the
+    scene and its ground truth, e.g. a storage layout (``annotators.simulation.storage``);
+    their names and ids must differ from the kitchen's.
     """
     view_name, cam_to_world = _resolve_view(view)
     objects = kitchen_objects(moved)
-    parts = _furniture_parts() + _object_parts(objects)
+    added = tuple(obj for obj, _ in extra)
+    taken = {o.name for o in objects} | {o.object_id for o in objects}
+    clashes = [o.name for o in added if o.name in taken or o.object_id in taken or o.object_id <= 0]
+    if clashes or len({o.name for o in added}) < len(added) or len({o.object_id for o in added}) < len(added):
+        raise ValueError(f"extra objects need names and positive ids of their own; clashing: {clashes or 'each other'}")
+    objects += added
+    parts = _furniture_parts() + _object_parts(objects, {obj.name: albedo for obj, albedo in extra})
+    if person is not None:
+        parts += [_Part(mesh, color, PERSON_OBJECT_ID) for mesh, color in person_meshes(person)]
 
     scene = o3d.t.geometry.RaycastingScene()
     for part in parts:
@@ -641,4 +670,5 @@ def render_kitchen(
         object_ids=np.ascontiguousarray(object_ids.reshape(shape2)),
         objects=objects,
         view=view_name,
+        person=person,
     )

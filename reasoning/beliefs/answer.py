@@ -9,6 +9,7 @@ a list of them; both turn into JSON-ready dicts. The tree leaf that answers from
 
 from __future__ import annotations
 
+import functools
 import json
 import re
 from collections.abc import Callable
@@ -30,8 +31,10 @@ def class_iri(class_name: str) -> str:
     return class_name if "://" in class_name or class_name.startswith("urn:") else ONTOLOGY_NAMESPACE + class_name
 
 
+@functools.lru_cache(maxsize=1024)
 def class_label(class_name: str) -> str:
-    """A readable label: the IRI's local name split at case changes, lower case (``lactose free milk``)."""
+    """A readable label: the IRI's local name split at case changes, lower case (``lactose free milk``); the
+    labels of the few classes answers name are made once."""
     local = re.split(r"[#/]", class_name)[-1]
     words = re.findall(r"[A-Z]+(?=[A-Z][a-z])|[A-Z]?[a-z]+|[A-Z]+|\d+", local)
     return " ".join(words).lower() if words else local
@@ -125,8 +128,82 @@ class ObjectDesignator:
         }
 
 
+@dataclass(frozen=True, slots=True)
+class TrackDesignator:
+    """A continuous task's target in this frame: the tracked class, whether it was seen, the filtered position and
+    velocity in ``frame`` (None before it was first seen), its image position, the estimate's spread (metres),
+    the seconds since it was last seen, the belief it was associated with (None when not seen) and the tracker."""
+
+    target: str
+    seen: bool
+    position: tuple[float, float, float] | None
+    velocity: tuple[float, float, float] | None
+    frame: str
+    pixel: tuple[float, float] | None
+    spread: float | None
+    unseen_for: float
+    object_id: int | None
+    tracker: str
+
+    def to_dict(self) -> dict[str, Any]:
+        """A JSON-ready dict (numbers rounded to 6 decimals)."""
+        return {
+            "target": self.target,
+            "seen": self.seen,
+            "position": None if self.position is None else _rounded(self.position),
+            "velocity": None if self.velocity is None else _rounded(self.velocity),
+            "frame": self.frame,
+            "pixel": None if self.pixel is None else _rounded(self.pixel),
+            "spread": None if self.spread is None else round(self.spread, 6),
+            "unseen_for": round(self.unseen_for, 6),
+            "object_id": self.object_id,
+            "tracker": self.tracker,
+        }
+
+
+@dataclass(frozen=True, slots=True)
+class PlacementDesignator:
+    """A free place on a surface: its centre ``pose`` on the surface (x along ``size[0]``, z the surface normal),
+    the free ``size`` (metres), the ``footprint`` asked for, how many such footprints ``fits``, the ``region`` and
+    how much of it was measured (``confidence``: the share of its surface the sensor saw)."""
+
+    pose: PoseDesignator
+    size: tuple[float, float]
+    footprint: tuple[float, float]
+    fits: int
+    region: str | None
+    confidence: float
+    experts: tuple[str, ...] = ()
+
+    def to_dict(self) -> dict[str, Any]:
+        """A JSON-ready dict (numbers rounded to 6 decimals)."""
+        return {
+            "pose": {
+                "position": _rounded(self.pose.position),
+                "orientation": _rounded(self.pose.orientation),
+                "frame": self.pose.frame,
+            },
+            "size": _rounded(self.size),
+            "footprint": _rounded(self.footprint),
+            "fits": self.fits,
+            "region": self.region,
+            "confidence": round(self.confidence, 6),
+            "experts": list(self.experts),
+        }
+
+    def summary(self) -> str:
+        """One line for people."""
+        p = self.pose.position
+        where = f"({p[0]:.3f}, {p[1]:.3f}, {p[2]:.3f}) [{self.pose.frame}]"
+        return (
+            f"free {self.size[0]:.2f} x {self.size[1]:.2f} m at {where}"
+            + (f" in {self.region}" if self.region else "")
+            + f", fits {self.fits} x {self.footprint[0]:.2f} x {self.footprint[1]:.2f} m, seen {self.confidence:.2f}"
+        )
+
+
 def _local(class_name: str) -> str:
-    return re.split(r"[#/]", class_name)[-1]
+    return class_name.replace("#", "/").rsplit("/", 1)[-1]
 
 
 def _rounded(values: tuple[float, ...]) -> list[float]:
@@ -134,8 +211,43 @@ def _rounded(values: tuple[float, ...]) -> list[float]:
 
 
 @dataclass(frozen=True, slots=True)
+class PointingAnswer:
+    """What a person points at: ``kind`` (``object`` or ``region``), the object's belief id or the region's name,
+    the angle between the arm's ray and the target, the angle between the ray's two estimates (shoulder-wrist,
+    elbow-wrist), both in degrees, the confidence, and the ray (``origin``, unit ``direction``) in ``frame``."""
+
+    kind: str
+    object_id: int | None
+    region: str
+    angular_error_degrees: float
+    spread_degrees: float
+    confidence: float
+    origin: tuple[float, float, float]
+    direction: tuple[float, float, float]
+    frame: str
+
+    @property
+    def target(self) -> str:
+        """The target in words: ``object #12`` or ``region fridge``."""
+        return f"object #{self.object_id}" if self.kind == "object" else f"region {self.region}"
+
+    def to_dict(self) -> dict[str, Any]:
+        """A JSON-ready dict."""
+        return {
+            "kind": self.kind,
+            "object_id": self.object_id,
+            "region": self.region or None,
+            "angular_error_degrees": round(self.angular_error_degrees, 3),
+            "spread_degrees": round(self.spread_degrees, 3),
+            "confidence": round(self.confidence, 6),
+            "ray": {"origin": _rounded(self.origin), "direction": _rounded(self.direction), "frame": self.frame},
+        }
+
+
+@dataclass(frozen=True, slots=True)
 class Answer:
-    """The answer to one query: the matching objects, best first."""
+    """The answer to one query: the matching objects, best first (for a pointing query: the pointed object, and
+    ``pointing`` says what is pointed at)."""
 
     query: str
     objects: tuple[ObjectDesignator, ...] = ()
@@ -144,15 +256,28 @@ class Answer:
     """The belief id of each object seen in this frame, in the order perception found them (not in the JSON)."""
     timed_out: bool = False
     """True when the query's timeout passed before perception finished (the objects then come from memory)."""
+    track: TrackDesignator | None = None
+    """A continuous task's target in this frame (None for other answers; ``track`` in the JSON only when set)."""
+    pointing: PointingAnswer | None = None
+    """The pointing target of a pointing query (None for other queries, and then absent from the JSON)."""
+    placements: tuple[PlacementDesignator, ...] | None = None
+    """Free places, largest first, when the query asked for free space (None when it did not)."""
 
     def to_dict(self) -> dict[str, Any]:
-        """A JSON-ready dict."""
-        return {
+        """A JSON-ready dict (``placements`` only when the query asked for free space)."""
+        found: dict[str, Any] = {
             "query": self.query,
             "from_memory": self.from_memory,
             "timed_out": self.timed_out,
             "objects": [o.to_dict() for o in self.objects],
         }
+        if self.track is not None:
+            found["track"] = self.track.to_dict()
+        if self.pointing is not None:
+            found["pointing"] = self.pointing.to_dict()
+        if self.placements is not None:
+            found["placements"] = [p.to_dict() for p in self.placements]
+        return found
 
     def to_json(self, indent: int | None = 2) -> str:
         """The answer as JSON text."""
@@ -160,10 +285,23 @@ class Answer:
 
     def summary(self) -> str:
         """One line per object, for people: a class more likely wrong than right is marked ``?``; ``class`` is the
-        probability that the class is right, ``exists`` the confidence that the object is there."""
+        probability that the class is right, ``exists`` the confidence that the object is there; then the free places
+        when the query asked for free space."""
+        lines = self._object_lines()
+        if self.placements is not None:
+            lines += [p.summary() for p in self.placements] or ["no free place for the footprint"]
+        return "\n".join(lines)
+
+    def _object_lines(self) -> list[str]:
+        lines: list[str] = []
+        if self.pointing is not None:
+            p = self.pointing
+            lines.append(
+                f"pointing at {p.target}: {p.angular_error_degrees:.1f}° off the arm's ray, "
+                f"confidence {p.confidence:.2f}"
+            )
         if not self.objects:
-            return "no matching object"
-        lines = []
+            return lines or ["no matching object"]
         for o in self.objects:
             p = o.pose.position
             colour = o.attributes.get(SemanticColor.attribute)
@@ -176,7 +314,7 @@ class Answer:
                 + (f", class {stated.confidence:.2f}" if stated is not None and o.class_label else "")
                 + f", exists {o.confidence:.2f}, by {', '.join(o.experts) or 'nobody'}"
             )
-        return "\n".join(lines)
+        return lines
 
 
 def designator(

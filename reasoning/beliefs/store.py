@@ -3,8 +3,11 @@
 * Embedded, one file, WAL journal: readers (other connections, other processes) read a consistent snapshot
   while the engine writes; every write is one ``BEGIN IMMEDIATE`` ... ``COMMIT`` transaction.
 * ``synchronous=NORMAL`` by default: with WAL, a committed transaction survives a crash of the process
-  (SIGKILL) and the file never corrupts; only a power loss or OS crash may lose the last commits. Pass
-  ``synchronous="FULL"`` to also survive power loss, at the cost of an fsync per commit.
+  (SIGKILL) and the file never corrupts; only a power loss or OS crash may lose the last commits: those since the
+  last checkpoint synced the WAL (at most :data:`WAL_AUTOCHECKPOINT_PAGES` pages, about 16 MB of WAL; a frame of
+  20 hypotheses writes some 60 to 80 pages, so at most the last 50 to 70 frames, about two seconds at 30 Hz). The store
+  rolls back to an earlier consistent state and never corrupts. Pass ``synchronous="FULL"`` to also survive power
+  loss, at the cost of an fsync per commit.
 * A file that is not a valid belief store is never modified: opening it raises :class:`BeliefStoreError`
   naming the file and how to move it aside. A store of schema version 1 (before recordings were stored) is
   migrated in one transaction: its beliefs and sightings get an empty recording, so its camera-frame beliefs are
@@ -19,8 +22,8 @@ with its recording and the experts' statements, bounded per object), ``classes``
 
 from __future__ import annotations
 
+import functools
 import json
-import math
 import operator
 import os
 import shlex
@@ -423,25 +426,32 @@ class BeliefStore:
 
         Also returns how each one was stored, so unchanged R*Tree entries and index columns are not rewritten.
         """
-        columns = ", ".join(f"o.{c.strip()}" for c in _OBJECT_COLUMNS.split(","))
-        query = (
-            f"SELECT {columns}, r.x0, r.x1, r.y0, r.y1, r.z0, r.z1 FROM objects_place r JOIN objects o ON o.id = r.id "
-            "WHERE r.x0 <= ? AND r.x1 >= ? AND r.y0 <= ? AND r.y1 >= ? AND r.z0 <= ? AND r.z1 >= ? "
-            "AND o.frame = ? AND (o.frame = ? OR o.recording = ?) AND o.status = ?"
-        )
         rows: dict[int, tuple] = {}
+        groups: dict[tuple[str, str], list[FrameObject]] = {}
         for item in objects:
-            x, y, z = (float(v) for v in item.position)
-            world = (item.frame, WORLD_FRAME, item.recording)
-            parameters = (x + gate, x - gate, y + gate, y - gate, z + gate, z - gate, *world, PRESENT)
-            for row in conn.execute(query, parameters):
-                if row[0] not in rows and _distance(row, item.position) <= gate:
+            groups.setdefault((item.frame, item.recording), []).append(item)
+        for (frame, recording), members in groups.items():
+            # one statement per world: the union of the R*Tree boxes around its observations
+            centres = np.array([[float(v) for v in item.position[:3]] for item in members], dtype=np.float64)
+            parameters: list[object] = []
+            for x, y, z in centres.tolist():
+                parameters += [x + gate, x - gate, y + gate, y - gate, z + gate, z - gate]
+            found = conn.execute(_candidate_query(len(members)), (*parameters, frame, WORLD_FRAME, recording, PRESENT))
+            found = found.fetchall()
+            if not found:
+                continue
+            positions = np.array([(row[3], row[4], row[5]) for row in found], dtype=np.float64)
+            delta = positions[:, None, :] - centres[None, :, :]
+            near = (np.sqrt(np.einsum("ijk,ijk->ij", delta, delta)) <= gate).any(axis=1)
+            for row, keep in zip(found, near.tolist(), strict=True):
+                if keep:
                     rows[row[0]] = row
         if camera is not None:
             low, high = _frustum_bounds(camera)
             world = (camera.frame, WORLD_FRAME, camera.recording)
-            parameters = (high[0], low[0], high[1], low[1], high[2], low[2], *world, PRESENT)
-            in_frustum = [row for row in conn.execute(query, parameters) if row[0] not in rows]
+            box = (high[0], low[0], high[1], low[1], high[2], low[2])
+            found = conn.execute(_candidate_query(1), (*box, *world, PRESENT))
+            in_frustum = [row for row in found if row[0] not in rows]
             if in_frustum:
                 positions = np.array([(row[3], row[4], row[5]) for row in in_frustum], dtype=np.float64)
                 for row, seen in zip(in_frustum, in_view(positions, camera), strict=True):
@@ -452,7 +462,7 @@ class BeliefStore:
             i: _Loaded(((r[n] + r[n + 1]) / 2, (r[n + 2] + r[n + 3]) / 2, (r[n + 4] + r[n + 5]) / 2), *_labels(r))
             for i, r in rows.items()
         }
-        return [_belief_from_row(row) for row in rows.values()], loaded
+        return [_belief_from_row(rows[i]) for i in sorted(rows)], loaded
 
     def _write_beliefs(
         self,
@@ -489,8 +499,12 @@ class BeliefStore:
         added: list[tuple[str, str, int]] = []
         removed: list[tuple[str, str, int]] = []
         for b in beliefs:
-            new = _index_entries(rows[b.id][_INDEXED])
-            old = _index_entries(loaded[b.id].indexed) if b.id in loaded else set()
+            state = loaded.get(b.id)
+            indexed = rows[b.id][_INDEXED]
+            if state is not None and state.indexed == indexed:
+                continue
+            new = _index_entries(indexed)
+            old = _index_entries(state.indexed) if state is not None else set()
             added.extend((name, value, b.id) for name, value in new - old)
             removed.extend((name, value, b.id) for name, value in old - new)
         if removed:
@@ -499,7 +513,7 @@ class BeliefStore:
             conn.executemany("INSERT OR IGNORE INTO attribute_index VALUES (?, ?, ?)", added)
         moved = []
         for b in beliefs:
-            x, y, z = (float(v) for v in b.position)
+            x, y, z = rows[b.id][3:6]
             state = loaded.get(b.id)
             centre = state.place if state is not None else None
             if centre is None or max(abs(x - centre[0]), abs(y - centre[1]), abs(z - centre[2])) > RTREE_SLACK / 2:
@@ -519,17 +533,16 @@ class BeliefStore:
         time: float,
     ) -> None:
         """Record each object's sighting under (belief id, its sighting number)."""
+        cache: dict[frozenset[str], str] = {}
         rows = [
             (
                 object_id,
                 seq,
                 time,
                 item.frame,
-                float(item.position[0]),
-                float(item.position[1]),
-                float(item.position[2]),
+                *_floats(item.position, 3),
                 _roi_text(item.roi),
-                json.dumps(sorted(item.sources)),
+                _encoded_sources(item.sources, cache),
                 json.dumps([[e.attribute, e.value, round(e.confidence, 6), e.source] for e in item.evidence]),
                 item.recording,
             )
@@ -620,9 +633,13 @@ class BeliefStore:
                         )
                     )
             selects, values = [], []
-            for extra, extra_parameters in branches:
+            for number, (extra, extra_parameters) in enumerate(branches):
                 where = " AND ".join(clauses + extra)
-                selects.append(f"SELECT {_OBJECT_COLUMNS} FROM objects" + (f" WHERE {where}" if where else ""))
+                # without statistics SQLite may pick the region index and filter the class row by row; the class
+                # index (class, region) answers both at once (a box branch starts from the R*Tree's ids instead)
+                by_class = f.object_class and f.ids is None and number == 0
+                table = "objects INDEXED BY objects_class" if by_class else "objects"
+                selects.append(f"SELECT {_OBJECT_COLUMNS} FROM {table}" + (f" WHERE {where}" if where else ""))
                 values.extend(parameters + extra_parameters)
             rows = conn.execute(" UNION ".join(selects) + " ORDER BY id", values).fetchall()
             if f.region and f.region_boxes:
@@ -674,6 +691,19 @@ class BeliefStore:
 # ---------------------------------------------------------------------------------------- row mapping
 
 
+@functools.lru_cache(maxsize=64)
+def _candidate_query(boxes: int) -> str:
+    """The present beliefs of one world whose R*Tree entries meet any of ``boxes`` boxes (one statement; its
+    parameters: x1, x0, y1, y0, z1, z0 of each box, then the frame, the world frame, the recording, the status)."""
+    box = "SELECT * FROM objects_place WHERE x0 <= ? AND x1 >= ? AND y0 <= ? AND y1 >= ? AND z0 <= ? AND z1 >= ?"
+    columns = ", ".join(f"o.{c.strip()}" for c in _OBJECT_COLUMNS.split(","))
+    return (
+        f"WITH hit AS ({' UNION '.join([box] * boxes)}) "
+        f"SELECT {columns}, hit.x0, hit.x1, hit.y0, hit.y1, hit.z0, hit.z1 FROM hit JOIN objects o ON o.id = hit.id "
+        "WHERE o.frame = ? AND (o.frame = ? OR o.recording = ?) AND o.status = ?"
+    )
+
+
 def _roi_text(roi: tuple[int, int, int, int] | None) -> str | None:
     return None if roi is None else ",".join(str(int(v)) for v in roi)
 
@@ -687,23 +717,25 @@ def _roi_from_text(text: str | None) -> tuple[int, int, int, int] | None:
 
 def _object_row(b: ObjectBelief, class_test: ClassTest | None, sources: dict[frozenset[str], str]) -> tuple:
     """The ``objects`` row of a belief (columns as in ``_OBJECT_COLUMNS``); ``sources`` caches encodings."""
-    dims = b.dimensions if b.dimensions is not None else (None, None, None)
+    x, y, z = _floats(b.position, 3)
+    qx, qy, qz, qw = _floats(b.orientation, 4)
+    sx, sy, sz = (None, None, None) if b.dimensions is None else _floats(b.dimensions, 3)
     appearance = None if b.appearance is None else np.asarray(b.appearance, dtype=np.float32).tobytes()
     encoded, indexed = _encode_attributes(b.attributes, class_test)
     return (
         b.id,
         b.class_name,
         b.frame,
-        float(b.position[0]),
-        float(b.position[1]),
-        float(b.position[2]),
-        float(b.orientation[0]),
-        float(b.orientation[1]),
-        float(b.orientation[2]),
-        float(b.orientation[3]),
-        None if dims[0] is None else float(dims[0]),
-        None if dims[1] is None else float(dims[1]),
-        None if dims[2] is None else float(dims[2]),
+        x,
+        y,
+        z,
+        qx,
+        qy,
+        qz,
+        qw,
+        sx,
+        sy,
+        sz,
         float(b.position_variance),
         appearance,
         float(b.existence),
@@ -720,6 +752,11 @@ def _object_row(b: ObjectBelief, class_test: ClassTest | None, sources: dict[fro
         encoded,
         indexed,
     )
+
+
+def _floats(values: np.ndarray | Sequence[float], count: int) -> list[float]:
+    """The first ``count`` values as Python floats (one conversion of the array, not one per element)."""
+    return [float(v) for v in np.asarray(values).tolist()[:count]]
 
 
 _COLUMN_COUNT = len(_OBJECT_COLUMNS.split(","))
@@ -771,7 +808,17 @@ def _encode_attributes(attributes: Mapping[str, AttributeBelief], class_test: Cl
             continue
         fused = fuse_values(name, attribute.values, class_test if name == CLASS_ATTRIBUTE else None)
         entries.extend(f"{name}={s.value}" for s in fused.support if s.value == fused.value or s.confidence > 0.5)
-    return json.dumps(encoded, separators=(",", ":")), _INDEX_SEPARATOR.join(sorted(entries))
+    return _COMPACT_JSON.encode(encoded), _INDEX_SEPARATOR.join(sorted(entries))
+
+
+_COMPACT_JSON = json.JSONEncoder(separators=(",", ":"))
+"""The encoder of the attribute column (made once: ``json.dumps`` with options builds one per call)."""
+
+
+@functools.lru_cache(maxsize=256)
+def _decoded_sources(text: str) -> tuple[str, ...]:
+    """The experts of a ``sources`` column (few distinct texts recur on every row)."""
+    return tuple(json.loads(text))
 
 
 def _index_entries(indexed: str) -> set[tuple[str, str]]:
@@ -838,15 +885,11 @@ def _belief_from_row(row: tuple) -> ObjectBelief:
         region=region,
         region_class=region_class,
         roi=_roi_from_text(roi),
-        sources=set(json.loads(sources)),
+        sources=set(_decoded_sources(sources)),
         observations=observations,
         class_name=class_name,
         recording=recording,
     )
-
-
-def _distance(row: tuple, position: np.ndarray) -> float:
-    return math.dist((row[3], row[4], row[5]), (float(position[0]), float(position[1]), float(position[2])))
 
 
 def _box_bounds(pose: np.ndarray, size: Sequence[float]) -> tuple[np.ndarray, np.ndarray]:

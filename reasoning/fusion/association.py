@@ -15,8 +15,11 @@ The cost of pairing an observation with a belief is a sum of squared normalised 
 Only positions of one world are compared (:func:`same_world`): the same fixed frame (``world``, known when the
 camera pose is), or the same camera frame of the same recording.
 
-The assignment minimising the total cost is found with ``scipy.optimize.linear_sum_assignment`` on the gated
-matrix (infeasible pairs get a prohibitive cost and are rejected afterwards). Observations left over become new
+:func:`pair_cost` states the rule for one pair; :func:`geometric_costs` computes its position, size and appearance
+terms for a whole frame at once (numpy distance matrix as the pre-gate, then the gated pairs only), which is what
+the tracker uses. The assignment minimising the total cost is found with one
+``scipy.optimize.linear_sum_assignment`` per frame on the gated matrix (infeasible pairs get a prohibitive cost and
+are rejected afterwards). Observations left over become new
 objects. :func:`visible_from` predicts whether a belief should have been seen (in the image, in range, and not
 hidden behind a nearer surface in the depth image), which is what lets unseen objects lose confidence.
 """
@@ -145,6 +148,76 @@ def typical_size(dimensions: np.ndarray) -> float:
     return float(np.exp(np.mean(np.log(extents)))) if extents.size else 0.0
 
 
+def typical_sizes(items: Sequence[Trackable]) -> np.ndarray:
+    """:func:`typical_size` of every item's dimensions (0 when it has none), computed for all at once."""
+    sizes = np.zeros(len(items))
+    full = [k for k, item in enumerate(items) if item.dimensions is not None and len(item.dimensions) == 3]
+    if full:
+        extents = np.array([items[k].dimensions for k in full], dtype=np.float64)
+        positive = (extents > 0).all(axis=1)
+        logs = np.log(np.where(positive[:, None], extents, 1.0))
+        sizes[np.asarray(full)[positive]] = np.exp(logs[positive].sum(axis=1) / 3.0)
+        for k in np.asarray(full)[~positive].tolist():
+            sizes[k] = typical_size(items[k].dimensions)  # type: ignore[arg-type]
+    for k, item in enumerate(items):
+        if item.dimensions is not None and len(item.dimensions) != 3 and len(item.dimensions):
+            sizes[k] = typical_size(item.dimensions)
+    return sizes
+
+
+def geometric_costs(
+    observations: Sequence[Trackable], beliefs: Sequence[Trackable], config: AssociationConfig
+) -> tuple[np.ndarray, np.ndarray]:
+    """The position, size and appearance terms of :func:`pair_cost` for every (observation, belief) pair at once.
+
+    Returns the cost matrix (:data:`INFEASIBLE` where a gate fails) and where both histograms were compared (there
+    the colour penalty does not apply). Only the pairs within the distance gate are costed further.
+    """
+    cost = np.full((len(observations), len(beliefs)), INFEASIBLE)
+    compared = np.zeros(cost.shape, dtype=bool)
+    rows, cols, distance = _near_pairs(observations, beliefs, config.gate_distance)
+    if rows.size == 0:
+        return cost, compared
+    total = (distance / config.position_sigma) ** 2
+    size_a, size_b = typical_sizes(observations)[rows], typical_sizes(beliefs)[cols]
+    sized = (size_a > 0) & (size_b > 0)
+    ratio = np.maximum(size_a, size_b) / np.where(sized, np.minimum(size_a, size_b), 1.0)
+    feasible = ~sized | (ratio <= config.size_ratio_gate)
+    total += np.where(sized, (np.log(np.where(sized, ratio, 1.0)) / config.size_sigma) ** 2, 0.0)
+    for k, (i, j) in enumerate(zip(rows.tolist(), cols.tolist(), strict=True)):
+        ha, hb = observations[i].appearance, beliefs[j].appearance
+        if ha is None or hb is None or ha.shape != hb.shape or not feasible[k]:
+            continue
+        appearance = bhattacharyya_distance(ha, hb)
+        compared[i, j] = True
+        if appearance > config.appearance_gate:
+            feasible[k] = False
+        else:
+            total[k] += (appearance / config.appearance_sigma) ** 2
+    cost[rows[feasible], cols[feasible]] = total[feasible]
+    return cost, compared
+
+
+def _near_pairs(
+    observations: Sequence[Trackable], beliefs: Sequence[Trackable], gate: float
+) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """Row and column indices of the pairs of one world within ``gate`` metres, and their distances."""
+    if not observations or not beliefs:
+        empty = np.empty(0, dtype=np.int64)
+        return empty, empty, np.empty(0)
+    a = np.array([o.position[:3] for o in observations], dtype=np.float64)
+    b = np.array([x.position[:3] for x in beliefs], dtype=np.float64)
+    delta = a[:, None, :] - b[None, :, :]
+    distance = np.sqrt(np.einsum("ijk,ijk->ij", delta, delta))
+    near = distance <= gate
+    keys_a = [world_key(o.frame, o.recording) for o in observations]
+    keys_b = [world_key(x.frame, x.recording) for x in beliefs]
+    if len(set(keys_a) | set(keys_b)) > 1:
+        near &= np.array(keys_a, dtype=object)[:, None] == np.array(keys_b, dtype=object)[None, :]
+    rows, cols = np.nonzero(near)
+    return rows, cols, distance[rows, cols]
+
+
 def _triple(position: np.ndarray) -> tuple[float, float, float]:
     return float(position[0]), float(position[1]), float(position[2])
 
@@ -184,24 +257,18 @@ def associate(
 ) -> Association:
     """Match observations to beliefs; ``cost_of`` overrides :func:`pair_cost` (e.g. to add colours, classes)."""
     config = config or AssociationConfig()
-    cost_fn = cost_of or (lambda o, b: pair_cost(o, b, config))
+    if cost_of is None:
+        return assign(geometric_costs(observations, beliefs, config)[0])
     cost = np.full((len(observations), len(beliefs)), INFEASIBLE)
     for i, j in gated_pairs(observations, beliefs, config.gate_distance):
-        cost[i, j] = cost_fn(observations[i], beliefs[j])
+        cost[i, j] = cost_of(observations[i], beliefs[j])
     return assign(cost)
 
 
 def gated_pairs(observations: Sequence[Trackable], beliefs: Sequence[Trackable], gate: float) -> np.ndarray:
     """The (observation, belief) index pairs of one world within ``gate`` metres (vectorised pre-gate)."""
-    if not observations or not beliefs:
-        return np.empty((0, 2), dtype=np.int64)
-    a = np.stack([np.asarray(o.position, dtype=np.float64) for o in observations])
-    b = np.stack([np.asarray(x.position, dtype=np.float64) for x in beliefs])
-    near = np.linalg.norm(a[:, None, :] - b[None, :, :], axis=2) <= gate
-    frames_a = np.array([world_key(o.frame, o.recording) for o in observations], dtype=object)
-    frames_b = np.array([world_key(x.frame, x.recording) for x in beliefs], dtype=object)
-    near &= frames_a[:, None] == frames_b[None, :]
-    return np.argwhere(near)
+    rows, cols, _ = _near_pairs(observations, beliefs, gate)
+    return np.column_stack((rows, cols))
 
 
 @dataclass(frozen=True, slots=True)

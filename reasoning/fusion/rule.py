@@ -147,6 +147,14 @@ class AttributeBelief:
             mine.add(theirs.log_odds, theirs.sources, theirs.first_seen, theirs.count)
             mine.last_seen = max(mine.last_seen, theirs.last_seen)
 
+    def supported_value(self, class_test: ClassTest | None = None) -> str | None:
+        """The fused value when evidence supports it (``fuse(...).supported``), else None."""
+        if len(self.values) == 1:  # the fast path of fuse_values, without building the summary
+            ((only, support),) = self.values.items()
+            return only if support.log_odds > 0 else None
+        fused = self.fuse(class_test)
+        return fused.value if fused is not None and fused.supported else None
+
     def fuse(self, class_test: ClassTest | None = None) -> FusedAttribute | None:
         """The fused value (see the module docstring); None when nothing was said."""
         if not self.values:

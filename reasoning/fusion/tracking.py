@@ -28,8 +28,7 @@ from reasoning.fusion.association import (
     AssociationConfig,
     CameraModel,
     assign,
-    gated_pairs,
-    pair_cost,
+    geometric_costs,
     same_world,
     visible_from,
 )
@@ -94,6 +93,8 @@ class ObjectBelief:
     def value(self, attribute: str, class_test: ClassTest | None = None) -> str | None:
         """The fused value of one attribute, or None."""
         belief = self.attributes.get(attribute)
+        if belief is not None and len(belief.values) == 1:  # the common case: the only value said is the fused one
+            return next(iter(belief.values))
         fused = belief.fuse(class_test if attribute == CLASS_ATTRIBUTE else None) if belief else None
         return fused.value if fused else None
 
@@ -122,6 +123,10 @@ class TrackStep:
     missed: tuple[int, ...]
     gone: tuple[int, ...]
     association: Association
+
+
+def _same_class(a: str, b: str) -> bool:
+    return a == b
 
 
 class BeliefTracker:
@@ -183,26 +188,29 @@ class BeliefTracker:
     # ------------------------------------------------------------------ internals
 
     def _associate(self, observations: Sequence[FrameObject], beliefs: Sequence[ObjectBelief]) -> Association:
+        """One cost matrix for the frame (:func:`geometric_costs`), the colour and class penalties of
+        :func:`pair_cost` added on the feasible pairs, then one optimal assignment."""
         config = self.config.association
-        cost = np.full((len(observations), len(beliefs)), INFEASIBLE)
+        cost, compared = geometric_costs(observations, beliefs, config)
         colors: dict[int, str | None] = {}
         stated: dict[int, tuple[set[str], set[str]]] = {}
-        for i, j in gated_pairs(observations, beliefs, config.gate_distance).tolist():
-            observation, belief = observations[i], beliefs[j]
-            if j not in colors:
-                colors[j] = belief.value(SemanticColor.attribute)
+        test = self.class_test or _same_class
+        for i, j in np.argwhere(cost < INFEASIBLE).tolist():
             if i not in stated:
-                stated[i] = (observation.values(SemanticColor.attribute), observation.values(CLASS_ATTRIBUTE))
-            cost[i, j] = pair_cost(
-                observation,
-                belief,
-                config,
-                observation_colors=stated[i][0],
-                belief_color=colors[j],
-                observation_classes=stated[i][1],
-                belief_class=belief.class_name,
-                class_test=self.class_test,
-            )
+                stated[i] = (observations[i].values(SemanticColor.attribute), observations[i].values(CLASS_ATTRIBUTE))
+            observation_colors, observation_classes = stated[i]
+            if observation_colors and not compared[i, j]:
+                if j not in colors:
+                    colors[j] = beliefs[j].value(SemanticColor.attribute)
+                if colors[j] and colors[j] not in observation_colors:
+                    cost[i, j] += config.color_penalty
+            belief_class = beliefs[j].class_name
+            if (
+                observation_classes
+                and belief_class
+                and not any(test(c, belief_class) or test(belief_class, c) for c in observation_classes)
+            ):
+                cost[i, j] += config.class_penalty
         return assign(cost)
 
     def _create(self, observation: FrameObject, time: float, belief_id: int) -> ObjectBelief:
@@ -268,8 +276,7 @@ class BeliefTracker:
     def _refresh(self, belief: ObjectBelief) -> None:
         """Recompute the cached class and the region after a change."""
         known = belief.attributes.get(CLASS_ATTRIBUTE)
-        fused = known.fuse(self.class_test) if known is not None else None
-        belief.class_name = fused.value if fused is not None and fused.supported else None
+        belief.class_name = known.supported_value(self.class_test) if known is not None else None
         region = region_of(belief.position, self.regions) if belief.frame == WORLD_FRAME and self.regions else None
         if region is not None:
             belief.region = region.name

@@ -9,8 +9,8 @@ ranked providers per CAS type.
 from __future__ import annotations
 
 from collections import defaultdict, deque
-from collections.abc import Container, Mapping
-from dataclasses import dataclass
+from collections.abc import Container, Iterable, Mapping
+from dataclasses import dataclass, field
 from decimal import Decimal
 from pathlib import Path
 
@@ -108,6 +108,11 @@ class OntologyIndex:
     ``words`` maps a word key (:func:`~reasoning.knowledge.words.word_key`) to the terms it names, preferred first;
     ``providers`` maps a CAS type to the annotators writing it or a subtype, ranked; ``names`` holds every
     ``rk:`` local name in use and ``name_keys`` their word keys (for clash checks).
+
+    For planning many queries fast: ``ranked`` holds every annotator in rank order; ``type_bits`` gives each CAS type
+    a bit and ``port_masks`` each annotator its (inputs, outputs, outputs with their supertypes) as bit masks;
+    ``needing`` maps a condition key to the annotators with a precondition on it and ``class_domain`` lists the
+    annotators with a class domain; ``look_alikes`` groups the object classes by (colours, shape, size class).
     """
 
     labels: Mapping[str, str]
@@ -136,6 +141,23 @@ class OntologyIndex:
     defined_in: Mapping[str, Path]
     names: frozenset[str]
     name_keys: Mapping[str, str]
+    ranked: tuple[AnnotatorSpec, ...]
+    type_bits: Mapping[str, int]
+    port_masks: Mapping[str, tuple[int, int, int]]
+    needing: Mapping[str, frozenset[str]]
+    class_domain: tuple[AnnotatorSpec, ...]
+    look_alikes: Mapping[tuple[frozenset[str], str | None, str | None], tuple[str, ...]]
+
+    size_bounds: Mapping[str, float] = field(default_factory=dict)
+    """Size class -> the bound on its objects' largest extent in metres (``rk:largestExtentBelow``)."""
+
+    def mask(self, types: Iterable[str]) -> int:
+        """The bit mask of CAS types (names that are no CAS type are left out)."""
+        bits = self.type_bits
+        found = 0
+        for name in types:
+            found |= bits.get(name, 0)
+        return found
 
     def of_kind(self, kind: Kind) -> list[str]:
         """All names of ``kind``, sorted."""
@@ -182,11 +204,20 @@ class _Builder:
         preconditions = self._preconditions()
         annotators = self._annotators(preconditions)
         words, word_labels = self._words(regions)
+        size_bounds = self._size_bounds()
         if self.problems:
             raise OntologyError(sorted(set(self.problems)))
         annotator_conditions = {
             spec.name: frozenset(preconditions[p] for p in spec.preconditions) for spec in annotators.values()
         }
+        cas_types = frozenset(self.down.get("CasType", frozenset()))
+        providers = self._providers(annotators)
+        ranked = tuple(sorted(annotators.values(), key=lambda s: (-s.reliability, s.cost_ms, s.name)))
+        type_bits = {name: 1 << i for i, name in enumerate(sorted(cas_types))}
+        needing: dict[str, set[str]] = defaultdict(set)
+        for name, keys in annotator_conditions.items():
+            for key in keys:
+                needing[key].add(name)
         return OntologyIndex(
             labels=self.labels,
             synonyms={name: tuple(values) for name, values in self.alt_labels.items()},
@@ -199,7 +230,7 @@ class _Builder:
             up=self.up,
             down=self.down,
             disjoint=self.disjoint,
-            cas_types=frozenset(self.down.get("CasType", frozenset())),
+            cas_types=cas_types,
             value_domains=value_domains,
             profiles=profiles,
             hypothesis_types=hypothesis_types,
@@ -208,13 +239,47 @@ class _Builder:
             regions_by_class=self._regions_by_class(regions),
             query_keys=query_keys,
             annotators=annotators,
-            providers=self._providers(annotators),
+            providers=providers,
             precondition_keys=preconditions,
             annotator_conditions=annotator_conditions,
             defined_in=dict(self.defined_in),
             names=frozenset(self.all_names),
             name_keys=self._name_keys(),
+            ranked=ranked,
+            type_bits=type_bits,
+            port_masks=self._port_masks(annotators, providers, type_bits),
+            needing={key: frozenset(names) for key, names in needing.items()},
+            class_domain=tuple(spec for spec in ranked if spec.classes),
+            look_alikes=self._look_alikes(profiles),
+            size_bounds=size_bounds,
         )
+
+    @staticmethod
+    def _port_masks(
+        annotators: Mapping[str, AnnotatorSpec],
+        providers: Mapping[str, tuple[AnnotatorSpec, ...]],
+        type_bits: Mapping[str, int],
+    ) -> dict[str, tuple[int, int, int]]:
+        """Per annotator: its inputs, its outputs, and the types it provides (outputs and supertypes) as bit masks."""
+        written = dict.fromkeys(annotators, 0)
+        for type_name, specs in providers.items():
+            for spec in specs:
+                written[spec.name] |= type_bits[type_name]
+
+        def mask(types: Iterable[str]) -> int:
+            return sum({type_bits.get(t, 0) for t in types})
+
+        return {name: (mask(spec.inputs), mask(spec.outputs), written[name]) for name, spec in annotators.items()}
+
+    def _look_alikes(
+        self, profiles: Mapping[str, ObjectProfile]
+    ) -> dict[tuple[frozenset[str], str | None, str | None], tuple[str, ...]]:
+        """Object classes grouped by how they look (colours, shape, size class), each group sorted."""
+        groups: dict[tuple[frozenset[str], str | None, str | None], list[str]] = defaultdict(list)
+        for name in sorted(n for n in profiles if self.kind_of.get(n) == "class"):
+            profile = profiles[name]
+            groups[(frozenset(profile.colors), profile.shape, profile.size_class)].append(name)
+        return {look: tuple(names) for look, names in groups.items()}
 
     # ------------------------------------------------------------------ labels and names
 
@@ -331,6 +396,22 @@ class _Builder:
         self.disjoint = {name: frozenset(values) for name, values in pairs.items()}
 
     # ------------------------------------------------------------------ object profiles
+
+    def _size_bounds(self) -> dict[str, float]:
+        """Each size class's ``rk:largestExtentBelow`` (a positive number of metres)."""
+        bounds: dict[str, float] = {}
+        for subject, value in self.graph.subject_objects(RK["largestExtentBelow"]):
+            name = local_name(subject) if is_rk(subject) else str(subject)
+            number = value.toPython() if isinstance(value, Literal) else None
+            if self.kind_of.get(name) != "size":
+                self.problems.append(f"{name}: rk:largestExtentBelow is said only of size classes")
+            elif isinstance(number, bool) or not isinstance(number, int | float | Decimal) or not number > 0:
+                self.problems.append(
+                    f"{name}: rk:largestExtentBelow must be a positive number of metres, not {value!s}"
+                )
+            else:
+                bounds[name] = float(number)
+        return bounds
 
     def _own_properties(self, name: str) -> dict[str, list[object]]:
         """The profile values a class declares itself (restrictions on its superclass list)."""

@@ -333,6 +333,20 @@ class KnowledgeBase:
         """The region class objects of this class are typically kept in (inherited), or None."""
         return self.object_profile(name).stored_in
 
+    def largest_extent(self, name: str) -> float | None:
+        """The bound on the largest extent (metres) of objects of this class, from its size class's
+        ``rk:largestExtentBelow`` (None when the class has no size class or its size class has no bound)."""
+        size_class = self.object_profile(name).size_class
+        if size_class is None:
+            return None
+        return self._index.size_bounds.get(size_class)
+
+    def look_alikes(self, name: str) -> tuple[str, ...]:
+        """The object classes that look like this one (same typical colours, shape and size class), itself
+        included, sorted."""
+        profile = self.object_profile(name)
+        return self._index.look_alikes[(frozenset(profile.colors), profile.shape, profile.size_class)]
+
     def variants_differ_by_text(self, name: str) -> bool:
         """True when a sibling class looks the same and only printed text or brand tells them apart."""
         return self._name(name, ("class",)) in self._index.text_variants
@@ -460,3 +474,30 @@ class KnowledgeBase:
                 continue
             chosen.append(spec)
         return chosen
+
+    def provider_exclusions(
+        self, object_class: str | None = None, conditions: Conditions | None = None
+    ) -> tuple[frozenset[str], frozenset[str]]:
+        """What :meth:`providers` leaves out whatever the type, for one object class and conditions, in one pass:
+        the annotators it drops for every type (a class domain unrelated to ``object_class``, preconditions that do
+        not hold), and those it keeps only for the types they write themselves, not for supertypes (a class domain
+        that does not name ``object_class`` or a superclass of it). No value is asked."""
+        index = self._index
+        conditions = conditions or _ALL_CONDITIONS
+        transparent = conditions.transparent
+        object_up = object_down = None
+        if object_class is not None:
+            object_name = self._name(object_class, ("class",))
+            object_up, object_down = index.up[object_name], index.down[object_name]
+            transparent = transparent or index.profiles[object_name].transparent is True
+        holds = {"depth": conditions.depth, "region": conditions.region, "model": conditions.model}
+        holds["opaque"] = not transparent
+        unmet = [key for key, held in holds.items() if not held]
+        everywhere: set[str] = set().union(*(index.needing.get(key, ()) for key in unmet))
+        own_types: set[str] = set()
+        for spec in index.class_domain:
+            if object_up is None or spec.classes.isdisjoint(object_up):
+                own_types.add(spec.name)
+                if object_down is not None and spec.classes.isdisjoint(object_down):
+                    everywhere.add(spec.name)
+        return frozenset(everywhere), frozenset(own_types - everywhere)

@@ -12,7 +12,22 @@ from __future__ import annotations
 
 from dataclasses import dataclass
 
-from queries.model import ANYWHERE, HUMAN_KEY, Asked, Block, Field, ListValue, Number, Query, String, Symbol, Value
+from queries.model import (
+    ANYWHERE,
+    CONTINUOUS_KINDS,
+    FREE_SPACE_KEY,
+    HUMAN_KEY,
+    POINTING_KEY,
+    Asked,
+    Block,
+    Field,
+    ListValue,
+    Number,
+    Query,
+    String,
+    Symbol,
+    Value,
+)
 from reasoning.errors import TermError
 from reasoning.knowledge.knowledge_base import KnowledgeBase
 from reasoning.planning.plan import Constraint, Task
@@ -23,6 +38,11 @@ _RELATIONS = ("in", "inside", "on", "at", "near")
 _STRUCTURAL_KEYS = frozenset({"type", "location", "id", "transparent", "confidence"})
 _TRUTH = {"true": True, "yes": True, "false": False, "no": False}
 _KINDS_WITH_OBJECTS = ("detect", "inspect", "track")
+TRACK_TYPE = "TargetTrack"
+"""What a continuous query needs in every frame: the estimate of its one target (a tracker's output)."""
+
+DEFAULT_FOOTPRINT = (0.1, 0.1)
+"""The footprint (width, depth in metres) a free-space scan looks for when it names neither a class nor a size."""
 
 
 @dataclass(frozen=True)
@@ -47,6 +67,9 @@ def interpret(query: Query, kb: KnowledgeBase, depth: bool = True, camera_pose: 
         raise PlanningError("a stop query cancels a running task; there is no perception tree to plan for it")
     if query.kind == "scan":
         return _interpret_scan(query, kb, camera_pose)
+    pointing = query.get(POINTING_KEY)
+    if isinstance(pointing, Block):
+        return _interpret_pointing(query, pointing, depth, camera_pose)
     obj = _target(query)
     object_class = _object_class(obj.get("type"), kb)
     hypothesis = kb.hypothesis_type(object_class) if object_class is not None else "ObjectHypothesis"
@@ -97,7 +120,7 @@ def interpret(query: Query, kb: KnowledgeBase, depth: bool = True, camera_pose: 
         object_id=_whole(obj.get("id")),
         min_confidence=min_confidence,
     )
-    return Interpretation(task, tuple(requirements), region_box, transparent)
+    return Interpretation(task, (*requirements, *_tracking(query)), region_box, transparent)
 
 
 def _interpret_specialised(query: Query, obj: Block, object_class: str, hypothesis: str) -> Interpretation:
@@ -122,7 +145,46 @@ def _interpret_specialised(query: Query, obj: Block, object_class: str, hypothes
         object_id=_whole(obj.get("id")),
         min_confidence=_confidence(obj.get("confidence"), []),
     )
-    return Interpretation(task, (Requirement(hypothesis, None, why),), None)
+    return Interpretation(task, (Requirement(hypothesis, None, why), *_tracking(query)), None)
+
+
+def _tracking(query: Query) -> tuple[Requirement, ...]:
+    """The tracker a continuous query needs (none for a one-shot query)."""
+    if query.kind not in CONTINUOUS_KINDS:
+        return ()
+    why = f"a {query.kind} query follows its target from frame to frame"
+    return (Requirement(TRACK_TYPE, None, why),)
+
+
+def _interpret_pointing(query: Query, pointing: Block, depth: bool, camera_pose: bool) -> Interpretation:
+    """``detect { pointing: { target: object | region } }``: a person's pointing target, so its body keypoints,
+    its activity and the pointing ray are required; an object target needs the frame's object hypotheses (with
+    their poses), a region target the semantic map, which needs the camera pose."""
+    if query.kind != "detect":
+        raise PlanningError(f"pointing is detected (detect {{ {POINTING_KEY}: ... }}), not asked by {query.kind}")
+    others = [f.key for f in query.body.fields if f.key != POINTING_KEY]
+    if others:
+        raise PlanningError(f"a pointing query asks only what is pointed at; {', '.join(others)} cannot be added")
+    target_value = pointing.get("target")
+    target = target_value.name.lower() if isinstance(target_value, Symbol) else "object"
+    if not depth:
+        raise PlanningError("a pointing ray needs 3-D body keypoints, and the input has no depth")
+    requirements = [
+        Requirement("PointingTarget", None, f"the query asks which {target} the person points at"),
+    ]
+    inferences = ["the pointing person is found with body keypoints; the arm's 3-D ray picks the target"]
+    if target == "object":
+        requirements.append(Requirement("ObjectHypothesis", None, "the objects the person may point at"))
+        requirements.append(Requirement("Pose", None, "the answer reports the pointed object's pose"))
+    elif not camera_pose:
+        raise PlanningError(
+            "a region target needs the camera pose to place the semantic map's regions, and this input has none; "
+            "ask for target: object instead"
+        )
+    else:
+        inferences.append("the semantic map's regions are the candidate targets")
+    task = Task(kind=query.kind, inferences=tuple(inferences), pointing=target)
+    return Interpretation(task, tuple(requirements), None)
 
 
 def _target(query: Query) -> Block:
@@ -177,12 +239,8 @@ def _why_text_matters(object_class: str, kb: KnowledgeBase) -> str:
     profile = kb.object_profile(object_class)
     if not profile.texts:
         return ""
-    looks = (frozenset(profile.colors), profile.shape, profile.size_class)
-    for other in kb.names_of_kind("class"):
-        if kb.is_subclass(other, object_class) or kb.is_subclass(object_class, other):
-            continue
-        seen = kb.object_profile(other)
-        if (frozenset(seen.colors), seen.shape, seen.size_class) == looks:
+    for other in kb.look_alikes(object_class):
+        if not (kb.is_subclass(other, object_class) or kb.is_subclass(object_class, other)):
             texts = ", ".join(repr(t) for t in profile.texts)
             return (
                 f"{object_class} looks like {other} (same colour, shape and size); the text printed on it "
@@ -192,13 +250,63 @@ def _why_text_matters(object_class: str, kb: KnowledgeBase) -> str:
 
 
 def _interpret_scan(query: Query, kb: KnowledgeBase, camera_pose: bool) -> Interpretation:
-    region_box = _region(query.get("region"), kb, camera_pose)
-    requirements = (
-        Requirement("Plane", None, "a scan for free space needs the supporting surface"),
-        Requirement("ObjectHypothesis", None, "a scan for free space needs the objects occupying the surface"),
+    """A scan lists the objects on a region's supporting surface; asked for free space (``free_space: {...}``, or
+    ``for: free_space``) it also finds where a footprint fits."""
+    block = query.get(FREE_SPACE_KEY)
+    wanted = query.get("for")
+    free_space = isinstance(block, Block) or any(
+        isinstance(v, Symbol | String) and _word(v, "for").lower() == FREE_SPACE_KEY for v in _values(wanted or Block())
     )
-    task = Task(kind="scan", region=region_box.name if region_box else None)
-    return Interpretation(task, requirements, region_box)
+    inner = block if isinstance(block, Block) else Block()
+    region_box = _region(inner.get("region") or query.get("region"), kb, camera_pose)
+    requirements = [
+        Requirement("Plane", None, "a scan needs the supporting surface"),
+        Requirement("ObjectHypothesis", None, "a scan needs the objects occupying the surface"),
+    ]
+    if not free_space:
+        task = Task(kind="scan", region=region_box.name if region_box else None)
+        return Interpretation(task, tuple(requirements), region_box)
+    footprint, why = _footprint(inner, kb)
+    requirements.append(Requirement(kb.annotation_type_for_key(FREE_SPACE_KEY), None, why))
+    task = Task(
+        kind="scan",
+        object_class=None,
+        region=region_box.name if region_box else None,
+        inferences=(why,),
+        max_results=_whole(query.get("max_results")),
+        footprint=footprint,
+    )
+    return Interpretation(task, tuple(requirements), region_box)
+
+
+def _footprint(block: Block, kb: KnowledgeBase) -> tuple[tuple[float, float], str]:
+    """The footprint a free-space block asks room for (given, else its class's size bound, else the default), and
+    the sentence saying where it came from."""
+    given = block.get("footprint")
+    if given is not None:
+        lengths = [v.value for v in _values(given) if isinstance(v, Number)]
+        width, depth = (lengths[0], lengths[-1]) if lengths else DEFAULT_FOOTPRINT
+        return (width, depth), f"the query asks room for a {width:g} m x {depth:g} m footprint"
+    target = block.get("for")
+    object_class = _object_class(target, kb)
+    if object_class is None:
+        width, depth = DEFAULT_FOOTPRINT
+        return (
+            DEFAULT_FOOTPRINT,
+            f"the query names no object or footprint, so room for {width:g} m x {depth:g} m is asked",
+        )
+    bound = kb.largest_extent(object_class)
+    if bound is None:
+        size_class = kb.object_profile(object_class).size_class
+        said = f"its size class {size_class} has no upper bound" if size_class else "it has no size class"
+        raise PlanningError(
+            f"the ontology gives no size for {object_class} ({said}); give its footprint: "
+            f"scan {{ free_space: {{ for: {object_class}, footprint: [30cm, 20cm] }} }}"
+        )
+    size_class = kb.object_profile(object_class).size_class
+    return (bound, bound), (
+        f"{object_class} is {size_class} (largest extent below {bound:g} m), so room for a {bound:g} m square is asked"
+    )
 
 
 def _word(value: Value, what: str) -> str:

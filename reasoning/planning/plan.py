@@ -32,6 +32,10 @@ class Task:
     max_results: int | None = None
     object_id: int | None = None
     min_confidence: float = 0.0
+    pointing: str | None = None
+    """What a pointing query asks for (``object`` or ``region``), None for other queries."""
+    footprint: tuple[float, float] | None = None
+    """Width and depth (metres) of what a free-space scan looks for room for; None when it looks for none."""
 
     def constraint(self, key: str) -> Constraint | None:
         """The constraint on ``key``, or None."""

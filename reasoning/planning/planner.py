@@ -98,61 +98,113 @@ def plan_requirements(
 
 
 class _Catalog:
-    """Candidate providers (memoised per type and value) and what can be produced from the sensors."""
+    """Candidate providers (memoised per type and value) and what can be produced from the sensors.
+
+    Type sets of the fixpoints are bit masks over the ontology's CAS types (``OntologyIndex.type_bits``): each
+    usable provider is one rule, its inputs -> the types it provides; a fixpoint makes a type known once a rule
+    providing it has all its inputs known. Nothing here is kept between plans: a catalog is built per plan (unless
+    the caller keeps catalogs), from the index's per-annotator masks and one pass over the annotators.
+    """
 
     def __init__(
         self, index: KnowledgeBase, sensors: frozenset[str], object_class: str | None, conditions: Conditions
     ) -> None:
         self.index = index
+        self.ontology = index.index
         self._supertypes: dict[str, frozenset[str]] = {}
+        self._written: dict[str, frozenset[str]] = {}
         # a type is present when it or a subtype of it is: track each written type together with its supertypes
         self.sensors = self.with_supertypes(sensors)
         self.object_class = object_class
         self.conditions = conditions
         self._providers: dict[tuple[str, str | None], tuple[AnnotatorSpec, ...]] = {}
         self._refiners: dict[str, list[AnnotatorSpec]] = {}
-        self._without: dict[frozenset[str], frozenset[str]] = {}
-        outputs = sorted({t for spec in index.annotators() for t in self.with_supertypes(spec.outputs)})
-        self.edges = [(spec, t) for t in outputs for spec in self.providers(t)]
-        self._waiting: dict[str, list[int]] = {}
-        for index, (spec, _) in enumerate(self.edges):
-            for needed in set(spec.inputs) - self.sensors:
-                self._waiting.setdefault(needed, []).append(index)
-        self._missing_at_start = [len(set(spec.inputs) - self.sensors) for spec, _ in self.edges]
-        self._ready_at_start = [i for i, count in enumerate(self._missing_at_start) if count == 0]
-        self.rounds = self._rounds()
+        self._without: dict[int, int] = {}
+        self._producing: list[tuple[int, tuple[int, ...]]] | None = None
+        self._excluded, self._own_types_only = index.provider_exclusions(object_class, conditions)
+        masks = self.ontology.port_masks
+        rules: list[tuple[int, int]] = []
+        for spec in self.ontology.ranked:
+            # annotators without inputs are sensor readers; a provider does not provide what it reads (a refiner)
+            if not spec.inputs or spec.name in self._excluded:
+                continue
+            inputs, outputs, written = masks[spec.name]
+            provided = (outputs if spec.name in self._own_types_only else written) & ~inputs
+            if provided:
+                rules.append((inputs, provided))
+        self._sensor_mask = self.ontology.mask(self.sensors)
+        self.rounds, self._rules = self._rounds(rules)
         self.producible = frozenset(self.rounds)
+        # forbidding a sensor type or one nothing produces changes no fixpoint: such types are left out of the key
+        self._forbiddable = self.ontology.mask(self.producible) & ~self._sensor_mask
 
-    def _rounds(self) -> dict[str, int]:
-        """The fixpoint round in which each producible type first becomes producible (sensors: 0)."""
+    def _rounds(self, rules: list[tuple[int, int]]) -> tuple[dict[str, int], list[tuple[int, int]]]:
+        """The fixpoint round in which each producible type first becomes producible (sensors: 0), and the rules
+        that can fire at all, merged per inputs and in the order they fire (later fixpoints, which forbid types,
+        fire a subset of them)."""
         rounds = dict.fromkeys(self.sensors, 0)
+        known = self._sensor_mask
+        merged: dict[int, int] = {}
+        for inputs, provided in rules:
+            merged[inputs] = merged.get(inputs, 0) | provided
+        pending = list(merged.items())
+        fired: list[tuple[int, int]] = []
         current = 0
         while True:
             current += 1
-            known = set(rounds)
-            new = {t for spec, t in self.edges if t not in known and known.issuperset(spec.inputs)}
+            new = 0
+            waiting = []
+            for rule in pending:
+                if rule[0] & known == rule[0]:
+                    new |= rule[1]
+                    fired.append(rule)
+                else:
+                    waiting.append(rule)
+            new &= ~known
             if not new:
-                return rounds
-            rounds.update(dict.fromkeys(new, current))
+                return rounds, fired
+            rounds.update(dict.fromkeys((t for t, bit in self.ontology.type_bits.items() if bit & new), current))
+            known |= new
+            pending = waiting
 
     def with_supertypes(self, types: Iterable[str]) -> frozenset[str]:
         """The types and all their supertypes."""
         found: set[str] = set()
         for type_name in types:
-            if type_name not in self._supertypes:
-                self._supertypes[type_name] = frozenset({type_name, *self.index.superclasses(type_name)})
-            found |= self._supertypes[type_name]
+            known = self._supertypes.get(type_name)
+            if known is None:
+                # the index holds each class with its superclasses; anything else is resolved (or rejected) by name
+                known = self.ontology.up.get(type_name) or frozenset({type_name, *self.index.superclasses(type_name)})
+                self._supertypes[type_name] = known
+            found |= known
         return frozenset(found)
 
     def written(self, spec: AnnotatorSpec) -> frozenset[str]:
         """What an annotator makes present for others: its outputs and their supertypes, minus what it reads."""
-        return self.with_supertypes(spec.outputs) - self.with_supertypes(spec.inputs)
+        found = self._written.get(spec.name)
+        if found is None:
+            found = self._written[spec.name] = self.with_supertypes(spec.outputs) - self.with_supertypes(spec.inputs)
+        return found
+
+    def _admitted(self, type_name: str) -> list[AnnotatorSpec]:
+        """``index.providers(type_name)`` for this catalog's object class and conditions (no value asked)."""
+        if type_name not in self.ontology.cas_types:
+            return self.index.providers(type_name, None, self.object_class, self.conditions)  # says what is wrong
+        excluded, own_types_only = self._excluded, self._own_types_only
+        return [
+            s
+            for s in self.ontology.providers[type_name]
+            if s.name not in excluded and (s.name not in own_types_only or type_name in s.outputs)
+        ]
 
     def providers(self, type_name: str, value: str | None = None) -> tuple[AnnotatorSpec, ...]:
         """Ranked providers of ``type_name`` for ``value`` (refiners of the type excluded)."""
         key = (type_name, value)
         if key not in self._providers:
-            found = self.index.providers(type_name, value, self.object_class, self.conditions)
+            if value is None:
+                found = self._admitted(type_name)
+            else:
+                found = self.index.providers(type_name, value, self.object_class, self.conditions)
             # annotators without inputs are sensor readers: the plan's source is chosen by its input, not here
             self._providers[key] = tuple(s for s in found if s.inputs and type_name not in s.inputs)
         return self._providers[key]
@@ -160,33 +212,46 @@ class _Catalog:
     def refiners(self, type_name: str) -> list[AnnotatorSpec]:
         """Annotators that read and write ``type_name`` and whose preconditions hold, cheapest first."""
         if type_name not in self._refiners:
-            found = self.index.providers(type_name, None, self.object_class, self.conditions)
             self._refiners[type_name] = sorted(
-                (s for s in found if type_name in s.inputs), key=lambda s: (s.cost_ms, s.name)
+                (s for s in self._admitted(type_name) if type_name in s.inputs), key=lambda s: (s.cost_ms, s.name)
             )
         return self._refiners[type_name]
 
-    def _fixpoint(self, forbidden: frozenset[str]) -> frozenset[str]:
-        """Worklist closure: each provider fires once all its inputs are known (linear in the ports)."""
-        known = set(self.sensors)
-        missing = list(self._missing_at_start)
-        queue = list(self._ready_at_start)
-        while queue:
-            produced = self.edges[queue.pop()][1]
-            if produced in known or produced in forbidden:
-                continue
-            known.add(produced)
-            for index in self._waiting.get(produced, ()):
-                missing[index] -= 1
-                if missing[index] == 0:
-                    queue.append(index)
-        return frozenset(known)
+    def _fixpoint(self, forbidden: int) -> int:
+        """Make each type known once one of its producing rules has all its inputs known, until none becomes so.
 
-    def producible_without(self, forbidden: frozenset[str]) -> frozenset[str]:
-        """What can be produced when the ``forbidden`` types may not be used."""
-        if forbidden not in self._without:
-            self._without[forbidden] = self._fixpoint(forbidden)
-        return self._without[forbidden]
+        The rules are regrouped per type (the distinct input masks of the rules providing it) at the first call.
+        """
+        if self._producing is None:
+            rules = self._rules
+            self._producing = [
+                (bit, masks)
+                for bit in self.ontology.type_bits.values()
+                if (masks := tuple({inputs: None for inputs, provided in rules if provided & bit}))
+            ]
+        known = self._sensor_mask
+        skip = known | forbidden
+        pending = [entry for entry in self._producing if not entry[0] & skip]
+        while True:
+            waiting = []
+            for bit, masks in pending:
+                for inputs in masks:
+                    if inputs & known == inputs:
+                        known |= bit
+                        break
+                else:
+                    waiting.append((bit, masks))
+            if len(waiting) == len(pending):
+                return known
+            pending = waiting
+
+    def producible_without(self, forbidden: frozenset[str]) -> int:
+        """What can be produced when the ``forbidden`` types may not be used, as a mask of types."""
+        key = self.ontology.mask(forbidden) & self._forbiddable
+        found = self._without.get(key)
+        if found is None:
+            found = self._without[key] = self._fixpoint(key)
+        return found
 
     def valid(
         self, type_name: str, value: str | None, above: frozenset[str] = frozenset(), by_rounds: bool = False
@@ -195,7 +260,8 @@ class _Catalog:
         (those that need it), so that choosing them cannot create a cycle; ``by_rounds`` keeps only those whose
         inputs are derived earliest."""
         usable = self.producible_without(above | {type_name})
-        found = [s for s in self.providers(type_name, value) if usable.issuperset(s.inputs)]
+        masks = self.ontology.port_masks
+        found = [s for s in self.providers(type_name, value) if masks[s.name][0] & usable == masks[s.name][0]]
         if by_rounds and found:
             depth = {s.name: max((self.rounds.get(t, 0) for t in s.inputs), default=0) for s in found}
             limit = min(depth.values())
@@ -213,7 +279,8 @@ class _Catalog:
         ]
         producible = self.producible_without(frozenset({type_name}))
         for spec in self.providers(type_name, value):
-            missing = sorted(set(spec.inputs) - producible)
+            bits = self.ontology.type_bits
+            missing = sorted(t for t in set(spec.inputs) if not bits[t] & producible)
             details.append(f"{spec.name} needs {', '.join(missing)}, which cannot be produced")
         if not details:
             return f"no annotator in the ontology provides {asked}"
@@ -240,6 +307,7 @@ class _UnitChoice:
     def providers(self, providers: list[AnnotatorSpec]) -> None:
         self._providers = providers
         self._guaranteed = frozenset.intersection(*(self._written(s) for s in providers))
+        self.guaranteed_sorted = tuple(sorted(self._guaranteed))
 
     def guaranteed(self) -> frozenset[str]:
         """Types the unit produces for others: outputs every provider writes without having read them."""
@@ -264,7 +332,12 @@ class _Assignment:
         self.units: dict[str, _UnitChoice] = {}
         self.above: dict[str, set[str]] = {}
         self._guaranteed: dict[str, str] | None = None
-        self._dependencies: dict[str, set[str]] | None = None
+        self._last_guaranteed: dict[str, str] | None = None
+        self._owner: dict[str, str] | None = None
+        self._version = 0  # counts changes of the units
+        self._clean_below: dict[str, set[str]] = {}  # unit -> the units below it, while they are unchanged
+        self._inputs_for: dict[str, str] | None = None
+        self._input_units_of: dict[str, tuple[str, ...]] = {}
         self.pinned: dict[str, str] = {}  # type -> unit chosen for it when several units write it
         self._check_feasible()
         self._assign()
@@ -286,12 +359,16 @@ class _Assignment:
                 )
 
     def owner(self) -> dict[str, str]:
-        """Annotator name -> the type of the unit it belongs to."""
-        return {s.name: key for key, unit in self.units.items() for s in unit.providers}
+        """Annotator name -> the type of the unit it belongs to (cached until the units change; read only)."""
+        if self._owner is None:
+            self._owner = {s.name: key for key, unit in self.units.items() for s in unit.providers}
+        return self._owner
 
     def _invalidate(self) -> None:
+        self._version += 1
+        self._clean_below = {}
         self._guaranteed = None
-        self._dependencies = None
+        self._owner = None
 
     def _set_providers(self, key: str, providers: list[AnnotatorSpec]) -> None:
         self.units[key].providers = providers
@@ -300,7 +377,12 @@ class _Assignment:
     def guaranteed_by(self) -> dict[str, str]:
         """Type -> the unit (by its type) that guarantees it (cached until the units change)."""
         if self._guaranteed is None:
-            self._guaranteed = self._compute_guaranteed()
+            found = self._compute_guaranteed()
+            previous = self._last_guaranteed
+            # the same mapping as before (most changes of providers keep it) is the same object, so that what was
+            # derived from it stays valid
+            same = previous is not None and list(found.items()) == list(previous.items())
+            self._guaranteed = self._last_guaranteed = previous if same else found
         return self._guaranteed
 
     def _compute_guaranteed(self) -> dict[str, str]:
@@ -309,7 +391,9 @@ class _Assignment:
         # by-products come from the unit derived earliest, the one least likely to depend on their readers
         for key in sorted(self.units, key=lambda k: (rounds.get(k, 0), k)):
             providers = self.units[key].providers
-            for type_name in sorted(self.units[key].guaranteed()):
+            for type_name in self.units[key].guaranteed_sorted:
+                if type_name in found:
+                    continue
                 if self.by_rounds and any(
                     max((rounds.get(t, 0) for t in s.inputs), default=0) >= rounds.get(type_name, 0) for s in providers
                 ):
@@ -322,39 +406,62 @@ class _Assignment:
             found[key] = key
         return found
 
-    def dependencies(self) -> dict[str, set[str]]:
-        """Unit -> the units its providers' required inputs come from (cached until the units change)."""
-        if self._dependencies is None:
-            self._dependencies = self._compute_dependencies()
-        return self._dependencies
-
-    def _compute_dependencies(self) -> dict[str, set[str]]:
-        guaranteed = self.guaranteed_by()
-        return {
-            key: {guaranteed[t] for s in unit.providers for t in s.inputs if t in guaranteed} - {key}
-            for key, unit in self.units.items()
-        }
+    def _input_units(self, spec: AnnotatorSpec, guaranteed: dict[str, str]) -> tuple[str, ...]:
+        """The units (sorted) that guarantee the required inputs of ``spec`` by ``guaranteed`` (a result of
+        :meth:`guaranteed_by`; memoised while it is the current one)."""
+        if guaranteed is not self._inputs_for:
+            if guaranteed is not self._guaranteed:
+                return tuple(sorted({guaranteed[t] for t in spec.inputs if t in guaranteed}))
+            self._inputs_for = guaranteed
+            self._input_units_of = {}
+        found = self._input_units_of.get(spec.name)
+        if found is None:
+            found = tuple(sorted({guaranteed[t] for t in spec.inputs if t in guaranteed}))
+            self._input_units_of[spec.name] = found
+        return found
 
     def _below(self, key: str) -> set[str]:
-        """The unit and every unit it (transitively) needs."""
-        graph = self.dependencies()
+        """The unit and every unit it (transitively) needs (through its providers' required inputs)."""
+        guaranteed = self.guaranteed_by()
         seen = {key}
         frontier = [key]
         while frontier:
-            for dep in graph.get(frontier.pop(), ()):
-                if dep not in seen:
-                    seen.add(dep)
-                    frontier.append(dep)
+            node = frontier.pop()
+            for spec in self.units[node].providers:
+                for dep in self._input_units(spec, guaranteed):
+                    if dep not in seen:
+                        seen.add(dep)
+                        frontier.append(dep)
         return seen
 
-    def _reuse(self, key: str, above: set[str]) -> bool:
-        """Let the types ``above`` use unit ``key`` when that makes no cycle."""
-        below = self._below(key)
+    def _reuse(self, key: str, above: set[str], below: set[str] | None = None) -> bool:
+        """Let the types ``above`` use unit ``key`` when that makes no cycle (``below``: :meth:`_below` of ``key``,
+        when known)."""
+        below = self._below(key) if below is None else below
         if below & above:
             return False
         for unit in below:
             self.above.setdefault(unit, set()).update(above)
         return True
+
+    def _cut_and_reuse(self, key: str, above: set[str]) -> bool:
+        """:meth:`_cut`, then :meth:`_reuse` when the cut kept some alternatives.
+
+        A cut that changed nothing has visited exactly the units below ``key``: they are not searched again.
+        """
+        below = self._clean_below.get(key)
+        if below is not None and below.isdisjoint(above):
+            # the units are as when a cut from ``key`` found no cycle and changed nothing: none of them is above,
+            # so this cut too would visit exactly them and change nothing
+            return self._reuse(key, above, below)
+        memo: dict[str, bool] = {}
+        version = self._version
+        if not self._cut_below(key, above, frozenset(), memo):
+            return False
+        if self._version != version:
+            return self._reuse(key, above)
+        self._clean_below[key] = below = set(memo)
+        return self._reuse(key, above, below)
 
     def _cut(self, key: str, above: set[str]) -> bool:
         """Drop the alternatives below unit ``key`` that need a type in ``above``; False when none can remain."""
@@ -363,14 +470,26 @@ class _Assignment:
     def _cut_below(self, key: str, above: set[str], path: frozenset[str], memo: dict[str, bool]) -> bool:
         if key in above or key in path:
             return False
-        if key in memo:
-            return memo[key]
+        known = memo.get(key)
+        if known is not None:
+            return known
         unit = self.units[key]
-        guaranteed = self.guaranteed_by()
+        guaranteed = self.guaranteed_by()  # as it is now: cuts further down do not change what this level reads
+        inner: frozenset[str] | None = None
         keep = []
         for spec in unit.providers:
-            inputs = {guaranteed[t] for t in spec.inputs if t in guaranteed} - {key}
-            if all(self._cut_below(dep, above, path | {key}, memo) for dep in sorted(inputs)):
+            for dep in self._input_units(spec, guaranteed):
+                if dep == key:
+                    continue
+                if dep in above or dep in path:  # what the call for ``dep`` would answer first
+                    break
+                done = memo.get(dep)
+                if done is None:
+                    inner = path | {key} if inner is None else inner
+                    done = self._cut_below(dep, above, inner, memo)
+                if not done:
+                    break
+            else:
                 keep.append(spec)
         memo[key] = bool(keep)
         if keep and len(keep) < len(unit.providers):
@@ -398,7 +517,7 @@ class _Assignment:
                 continue
             previous = list(self.units[key].providers)
             self._set_providers(key, [spec])
-            if self._cut(key, above) and self._reuse(key, above):
+            if self._cut_and_reuse(key, above):
                 self._note(type_name, f"{spec.name} also provides it")
                 self.pinned[type_name] = key
                 self._invalidate()
@@ -418,7 +537,7 @@ class _Assignment:
                 continue  # the consumer's alternatives that needed it were dropped
             above = set() if consumer is None else self.above.get(consumer, set()) | {consumer}
             existing = self.guaranteed_by().get(type_name)
-            if existing is not None and self._cut(existing, above) and self._reuse(existing, above):
+            if existing is not None and self._cut_and_reuse(existing, above):
                 continue
             if existing is not None and consumer is not None and self._drop_needing(consumer, type_name):
                 continue
@@ -519,6 +638,7 @@ class _Layout:
         self.units = assignment.units
         self.source = source
         self.parameters = parameters
+        self._labels: dict[str, str] = {}
         self.branches = self._branches()
         absorbed = {t for owned in self.branches.values() for types in owned.values() for t in types}
         self.final: dict[str, str] = dict.fromkeys(catalog.sensors, "reader")
@@ -531,6 +651,7 @@ class _Layout:
                     self.final[type_name] = f"type:{owner_type}"
         self.unrefined = dict(self.final)
         self.refinements = self._refinements()
+        self._unit_inputs = self._branch_inputs()
         while True:
             self._connect()
             cycle = self._required_cycle()
@@ -545,7 +666,6 @@ class _Layout:
 
     def _connect(self) -> None:
         """Compute the final producer of each type and every unit's dependencies for the current refinements."""
-        absorbed = {t for owned in self.branches.values() for types in owned.values() for t in types}
         self.final = dict(self.unrefined)
         for type_name, specs in self.refinements.items():
             self.final[type_name] = f"refine:{specs[-1].name}"
@@ -562,19 +682,31 @@ class _Layout:
                 self.optional_edges |= {(key, dep) for dep in optional}
                 self.dependencies[key] = (required | optional) - {key}
                 previous = key
+        final = self.final
+        for type_name, (required_types, optional_types) in self._unit_inputs.items():
+            key = f"type:{type_name}"
+            deps = {final[t] for t in required_types if t in final}
+            optional = {final[t] for t in optional_types if t in final}
+            self.optional_edges |= {(key, dep) for dep in optional - deps}
+            self.dependencies[key] = (deps | optional) - {key}
+
+    def _branch_inputs(self) -> dict[str, tuple[tuple[str, ...], tuple[str, ...]]]:
+        """Per provider unit not absorbed into a branch (sorted): the required and the optional input types its
+        branches read from outside themselves (they do not change with the refinements)."""
+        absorbed = {t for owned in self.branches.values() for types in owned.values() for t in types}
+        found: dict[str, tuple[tuple[str, ...], tuple[str, ...]]] = {}
         for type_name in sorted(self.units):
             if type_name in absorbed:
                 continue
-            key = f"type:{type_name}"
-            deps: set[str] = set()
-            optional: set[str] = set()
+            required: dict[str, None] = {}
+            optional: dict[str, None] = {}
             for spec in self.units[type_name].providers:
                 members = self._members(type_name, spec)
                 inside = set(self.branches.get(type_name, {}).get(spec.name, []))
-                deps |= self._producers([t for m in members for t in m.inputs if t not in inside])
-                optional |= self._producers([t for m in members for t in m.optional_inputs if t not in inside])
-            self.optional_edges |= {(key, dep) for dep in optional - deps}
-            self.dependencies[key] = (deps | optional) - {key}
+                required.update(dict.fromkeys(t for m in members for t in m.inputs if t not in inside))
+                optional.update(dict.fromkeys(t for m in members for t in m.optional_inputs if t not in inside))
+            found[type_name] = (tuple(required), tuple(optional))
+        return found
 
     def _refinements(self) -> dict[str, list[AnnotatorSpec]]:
         """Refiners of planned types whose other inputs are planned too and that are not otherwise used."""
@@ -624,6 +756,9 @@ class _Layout:
                 for needed in (*spec.inputs, *spec.optional_inputs):
                     consumers.setdefault(needed, set()).add(spec.name)
         guaranteed = self.assignment.guaranteed_by()
+        guarantees: dict[str, list[str]] = {}
+        for type_name, key in guaranteed.items():
+            guarantees.setdefault(key, []).append(type_name)
         branches: dict[str, dict[str, list[str]]] = {}
         for type_name in sorted(self.units):
             unit = self.units[type_name]
@@ -639,8 +774,7 @@ class _Layout:
                     key = guaranteed.get(needed)
                     if key is None or key in owned or key == type_name or len(self.units[key].providers) != 1:
                         continue
-                    outputs = [t for t, k in guaranteed.items() if k == key]
-                    if any(not consumers.get(t, set()) <= members for t in outputs):
+                    if any(not consumers.get(t, set()) <= members for t in guarantees[key]):
                         continue
                     owned.append(key)
                     inner = self.units[key].providers[0]
@@ -677,6 +811,12 @@ class _Layout:
         return tuple(tuple(self._unit(key) for key in sorted(keys)) for _, keys in sorted(by_level.items()))
 
     def _label(self, key: str) -> str:
+        found = self._labels.get(key)
+        if found is None:
+            found = self._labels[key] = self._make_label(key)
+        return found
+
+    def _make_label(self, key: str) -> str:
         if key == "reader":
             return self.source.step.annotator
         kind, name = key.split(":", 1)
@@ -727,11 +867,12 @@ class _Layout:
         if len(unit.providers) == 1:
             return self._step(unit.providers[0], self._why(name), provides=name)
         branches = []
+        why = self._why(name)
         for spec in unit.providers:
             members = self._members(name, spec)
             owned = self.branches[name][spec.name]
             inner = tuple(self._step(m, f"needed only by {spec.name}", inside=owned) for m in members[:-1])
-            branches.append((*inner, self._step(spec, self._why(name), provides=name, inside=owned)))
+            branches.append((*inner, self._step(spec, why, provides=name, inside=owned)))
         ranking = ", ".join(f"{s.name} (reliability {s.reliability:g}, {s.cost_ms:g} ms)" for s in unit.providers)
         return Alternatives(
             provides=name,

@@ -2,15 +2,17 @@
 
 from __future__ import annotations
 
+from collections.abc import Iterable
 from dataclasses import dataclass
 
-from queries.model import Query
+from queries.model import FREE_SPACE_KEY, Query
 from reasoning.knowledge.knowledge_base import KnowledgeBase
-from reasoning.knowledge.model import Conditions
-from reasoning.planning.interpretation import Interpretation, interpret
-from reasoning.planning.plan import Plan
+from reasoning.knowledge.model import AnnotatorSpec, Conditions
+from reasoning.planning.interpretation import TRACK_TYPE, Interpretation, interpret
+from reasoning.planning.plan import Plan, Task
 from reasoning.planning.planner import SensorSource, plan_requirements
 from robokudo.core.regions import RegionBox
+from robokudo.core.types import type_by_name
 
 DEPTH_TYPES = frozenset({"DepthImage", "PointCloud"})
 REGION_PRECONDITION = "NeedsRegion"
@@ -65,17 +67,27 @@ def annotator_parameters(
     box: RegionBox | None,
     profiles: tuple[dict[str, object], ...] | None = None,
     expected: str | None = None,
+    task: Task | None = None,
+    annotators: Iterable[AnnotatorSpec] | None = None,
 ) -> dict[str, dict[str, object]]:
-    """Constructor arguments the plan hands to annotators, from the ontology.
+    """Constructor arguments the plan hands to annotators, from the ontology and the task.
 
     An annotator that needs a region gets the region box; one that can report any object class (its class
     domain is the root class) is a classifier by knowledge and gets the profiles of the classes and the class
-    the query asks for (``expected``).
+    the query asks for (``expected``). A provider of free placements gets the task's footprint, the region box
+    when there is one and the task's result limit. ``annotators`` limits the search (default: all; see
+    :func:`parameterised_annotators`).
     """
     parameters: dict[str, dict[str, object]] = {}
-    for spec in kb.annotators():
+    region = region_parameters(box) if box is not None else {}
+    free_space_type = kb.annotation_type_for_key(FREE_SPACE_KEY)
+    for spec in kb.annotators() if annotators is None else annotators:
+        if task is not None and task.footprint is not None and free_space_type in spec.outputs:
+            parameters[spec.name] = {"footprint": task.footprint, **region}
+            if task.max_results is not None:
+                parameters[spec.name]["max_placements"] = task.max_results
         if box is not None and REGION_PRECONDITION in spec.preconditions:
-            parameters[spec.name] = region_parameters(box)
+            parameters.setdefault(spec.name, {}).update(region)
         if "Classification" in spec.outputs and ROOT_CLASS in spec.classes:
             profiles = profiles if profiles is not None else class_profiles(kb)
             parameters.setdefault(spec.name, {})["profiles"] = profiles
@@ -84,13 +96,61 @@ def annotator_parameters(
     return parameters
 
 
-class QueryPlanner:
-    """Plans queries against one knowledge base, keeping what only changes with the ontology (class profiles)."""
+def parameterised_annotators(kb: KnowledgeBase) -> tuple[AnnotatorSpec, ...]:
+    """The annotators :func:`annotator_parameters` may give arguments to (those needing a region, classifiers by
+    knowledge, providers of free placements), sorted by name."""
+    free_space_type = kb.annotation_type_for_key(FREE_SPACE_KEY)
+    return tuple(
+        spec
+        for spec in kb.annotators()
+        if REGION_PRECONDITION in spec.preconditions
+        or ("Classification" in spec.outputs and ROOT_CLASS in spec.classes)
+        or free_space_type in spec.outputs
+    )
 
-    def __init__(self, kb: KnowledgeBase) -> None:
+
+def target_parameters(kb: KnowledgeBase, task: Task) -> dict[str, object]:
+    """Constructor arguments telling an object tracker which object to follow: the asked class and its subclasses,
+    and the asked attribute values (``{"color": ("blue",)}``), as plain names."""
+    classes: tuple[str, ...] = ()
+    if task.object_class is not None:
+        classes = (task.object_class, *kb.subclasses(task.object_class))
+    values: dict[str, list[str]] = {}
+    for constraint in task.constraints:
+        if constraint.annotation_type == "Classification" or constraint.value is None:
+            continue
+        attribute = getattr(type_by_name(constraint.annotation_type), "attribute", "")
+        if attribute:
+            values.setdefault(attribute, []).append(constraint.value)
+    return {"target_classes": classes, "target_values": tuple((k, tuple(v)) for k, v in sorted(values.items()))}
+
+
+POINTING_OUTPUT = "PointingTarget"
+
+
+def pointing_parameters(kb: KnowledgeBase, target: str) -> dict[str, dict[str, object]]:
+    """Constructor arguments of the annotators that say what a person points at: the kind of target and, for
+    regions, every region box of the semantic map (plain data)."""
+    regions = tuple(region_parameters(box) for box in kb.regions()) if target == "region" else ()
+    return {
+        spec.name: {"target": target, "regions": regions} for spec in kb.annotators() if POINTING_OUTPUT in spec.outputs
+    }
+
+
+class QueryPlanner:
+    """Plans queries against one knowledge base, keeping what only changes with the ontology (class profiles, the
+    annotators that take parameters).
+
+    With ``keep_catalogs`` (the default) the requirement-independent work of a plan (providers and fixpoints per
+    object class, conditions and sensor types) is kept for later queries; without it every plan starts cold.
+    """
+
+    def __init__(self, kb: KnowledgeBase, keep_catalogs: bool = True) -> None:
         self.kb = kb
+        self.keep_catalogs = keep_catalogs
         self._index: object | None = None
         self._profiles: tuple[dict[str, object], ...] = ()
+        self._parameterised: tuple[AnnotatorSpec, ...] = ()
         self._catalogs: dict[tuple[object, ...], object] = {}
 
     def _refresh(self) -> None:
@@ -98,6 +158,7 @@ class QueryPlanner:
         if self._index is not self.kb.index:
             self._index = self.kb.index
             self._profiles = class_profiles(self.kb)
+            self._parameterised = parameterised_annotators(self.kb)
             self._catalogs = {}
 
     def profiles(self) -> tuple[dict[str, object], ...]:
@@ -111,7 +172,13 @@ class QueryPlanner:
         interpretation = interpret(query, self.kb, depth=depth, camera_pose=source.camera_pose)
         box = interpretation.region_box
         conditions = Conditions(depth=depth, region=box is not None, transparent=interpretation.transparent)
-        parameters = annotator_parameters(self.kb, box, self.profiles(), interpretation.task.object_class)
+        task = interpretation.task
+        parameters = annotator_parameters(self.kb, box, self.profiles(), task.object_class, task, self._parameterised)
+        for spec in self.kb.annotators():
+            if TRACK_TYPE in spec.outputs:  # a tracker of any object: told which one to follow
+                parameters.setdefault(spec.name, {}).update(target_parameters(self.kb, task))
+        if task.pointing is not None:
+            parameters.update(pointing_parameters(self.kb, task.pointing))
         plan = plan_requirements(
             interpretation.task,
             interpretation.requirements,
@@ -119,7 +186,7 @@ class QueryPlanner:
             source,
             conditions=conditions,
             parameters=parameters,
-            catalogs=self._catalogs,
+            catalogs=self._catalogs if self.keep_catalogs else None,
         )
         return QueryPlan(plan, interpretation)
 

@@ -16,15 +16,16 @@ def plan_for_input(
     *,
     look_at: str | None = None,
     intrinsics: CameraIntrinsics | None = None,
+    person: str | None = None,
 ) -> QueryPlan:
     """Plan ``query`` to run on ``input_path`` (the built-in kitchen when None).
 
     For the kitchen the simulated camera is pointed at the region the query names, else at ``look_at`` (e.g.
     where the object a query names by id was last seen), so the plan is made twice only when the reader
-    depends on that region.
+    depends on that region. ``person`` puts a person into the kitchen (see ``sensor_source``).
     """
-    draft = planner.plan(query, sensor_source(planner.kb, input_path, frame, intrinsics=intrinsics))
+    draft = planner.plan(query, sensor_source(planner.kb, input_path, frame, intrinsics=intrinsics, person=person))
     region = draft.interpretation.task.region or look_at
     if input_path is None and region is not None:
-        return planner.plan(query, sensor_source(planner.kb, input_path, frame, region))
+        return planner.plan(query, sensor_source(planner.kb, input_path, frame, region, person=person))
     return draft

@@ -3,7 +3,9 @@
 from __future__ import annotations
 
 from annotators.readers.choice import reader_choice
+from annotators.readers.frame_readers import PERSON_VIEW
 from annotators.readers.streams import FrameStream, KitchenCameraStream, PerceivedFrameReader
+from annotators.simulation.kitchen_person import person_spec_pose
 from annotators.simulation.kitchen_scene import camera_looking_at
 from reasoning.knowledge.knowledge_base import KnowledgeBase
 from reasoning.planning.plan import Step
@@ -45,9 +47,12 @@ def sensor_source(
     frame: int = 0,
     region: str | None = None,
     intrinsics: CameraIntrinsics | None = None,
+    person: str | None = None,
 ) -> SensorSource:
     """The reader for ``input_path`` (the built-in kitchen when None, looking at ``region`` if given; the camera
-    ``intrinsics`` of a point-cloud input when given).
+    ``intrinsics`` of a point-cloud input when given). ``person`` puts a person into the kitchen (a spec such as
+    ``point:red_cup@0.2,0.7``, see ``annotators.simulation.kitchen_person``); the camera then looks at the table
+    and the person unless a region is named.
 
     The source says whether the reader's frames carry the camera pose, which regions of the map need. The reader is
     picked from the path's layout (``annotators.readers.choice.reader_choice``); a path of no known
@@ -60,6 +65,13 @@ def sensor_source(
             reason += f" (the robot looks at region {region!r})"
         spec = kb.annotator("KitchenSceneReader")
         parameters: tuple[tuple[str, object], ...] = (("view", view),)
+        if person is not None:
+            person_spec_pose(person)  # a bad spec is refused here, with the reason, before anything runs
+            view = view if region is not None else PERSON_VIEW
+            parameters = (("person", person), ("view", view))
+            reason = f"renders the built-in kitchen with a person ({person}) from the {view!r} camera"
+    elif person is not None:
+        raise ValueError("a person can be put only into the built-in kitchen, not into a recorded input")
     else:
         choice = reader_choice(input_path, frame, intrinsics)
         spec = kb.annotator(choice.name)

@@ -4,8 +4,11 @@ Everything that only changes with the ontology or the mission is made once and k
 reload picks up ontology edits), the QueryPlanner with its caches, the BeliefStore, and one Engine whose root
 holds a task slot. Each query is parsed, planned and synthesized into a Pipeline that ends in the answer step;
 the Pipeline goes into the task slot between ticks, and how it runs follows from the query's kind
-(:data:`EXECUTION_MODES`): a one-shot task runs until its tree finishes and has one Answer; a continuous task runs
-again on every run of the root, one Answer per run, until cancelled or until a run fails. One task runs at a
+(:data:`EXECUTION_MODES`): a one-shot task runs until its tree finishes and has one Answer; a continuous task's
+tree is a Loop (the paper's ↻) around the Pipeline that analyses one frame, one Answer per successful run, until
+it is cancelled or its target is lost: not seen for longer than the query's ``lost_after`` (``track { human: {},
+lost_after: 2s }``) or the service's default (:data:`DEFAULT_LOST_AFTER`), which ends it with the reason
+"target lost: ... not seen for X s" (:mod:`robokudo.application.target_watch`). One task runs at a
 time: a new task replaces the one in the slot. Without a task the slot holds an idle subtree.
 
 Over a live stream (``stream=``, as ``robokudo serve`` runs it) the root is the paper's Fig. 4 shape: a perceive
@@ -46,7 +49,7 @@ from py_trees.common import Status
 
 from annotators.catalog import AnnotatorCatalog
 from annotators.readers.streams import PERCEPTION_PIPELINE, FrameStream, KitchenCameraStream, StreamReader
-from queries import Number, Query, parse_query
+from queries import CONTINUOUS_KINDS, LOST_AFTER_KEY, Number, Query, parse_query
 from reasoning.beliefs.answer import Answer, answer_from_memory
 from reasoning.beliefs.filters import belief_filter, kb_class_test
 from reasoning.beliefs.store import BeliefStore
@@ -56,18 +59,20 @@ from reasoning.planning.query_planner import QueryPlan, QueryPlanner
 from robokudo.application.knowledge import load_knowledge_base
 from robokudo.application.planning import plan_for_input
 from robokudo.application.sensor_sources import kitchen_view_for, served_source
+from robokudo.application.target_watch import TargetWatch
 from robokudo.core.composites import Sequence
 from robokudo.core.engine import Engine
+from robokudo.core.loop import Loop, frame_pipeline
 from robokudo.core.pipeline import Pipeline
 from robokudo.core.placement import Placement
 from robokudo.core.remote import place_remote
 from robokudo.core.resources import SharedResources
-from robokudo.core.slot import Idle, TaskSlot
+from robokudo.core.slot import Idle, PerceiveThenTask, TaskSlot
 from robokudo.core.structure import running_leaves
 from robokudo.core.threaded import has_workers, stop_workers
-from robokudo.core.types import CameraIntrinsics, QueryAnswer
+from robokudo.core.types import CameraInfo, CameraIntrinsics, QueryAnswer
 from trees.answer_step import AnswerStep
-from trees.synthesis import build_tree
+from trees.synthesis import build_task_tree
 
 TASK_SLOT = "task"
 """The name of the engine's task slot."""
@@ -86,14 +91,15 @@ class ExecutionMode(Enum):
 
 EXECUTION_MODES: Mapping[str, ExecutionMode] = MappingProxyType(
     {
-        "detect": ExecutionMode.ONCE,
-        "inspect": ExecutionMode.ONCE,
-        "scan": ExecutionMode.ONCE,
-        "track": ExecutionMode.CONTINUOUS,
+        kind: ExecutionMode.CONTINUOUS if kind in CONTINUOUS_KINDS else ExecutionMode.ONCE
+        for kind in ("detect", "inspect", "scan", "track")
     }
 )
-"""Query kind -> execution mode: the one place that says which kinds end with one result. A ``stop`` query
-plans no tree: it cancels the running task (:meth:`AnsweringService.cancel`)."""
+"""Query kind -> execution mode (continuous for ``queries.CONTINUOUS_KINDS``, whose trees synthesis builds as a
+Loop). A ``stop`` query plans no tree: it cancels the running task (:meth:`AnsweringService.cancel`)."""
+
+DEFAULT_LOST_AFTER = 5.0
+"""How long (seconds) a continuous task's target may go unseen when neither the query nor the service says."""
 
 
 TIMEOUT_KEY = "timeout"
@@ -149,19 +155,25 @@ class TaskHandle:
         self,
         query: Query,
         mode: ExecutionMode,
-        tree: Pipeline,
+        tree: Pipeline | Loop,
         plan: QueryPlan,
         service: AnsweringService,
         *,
         timeout: float | None = None,
         started: float = 0.0,
+        watch: TargetWatch | None = None,
     ) -> None:
         self.query = query
         self.kind = query.kind
         self.mode = mode
         self.tree = tree
+        """The task's tree: a one-shot task's Pipeline, or a continuous task's Loop around its frame Pipeline."""
         self.plan = plan
         self.timeout = timeout
+        self.watch = watch
+        """When a continuous task's target counts as lost (None for a one-shot task)."""
+        self.runs = 0
+        """Finished runs of a continuous task's loop seen so far."""
         self._deadline = None if timeout is None else started + timeout
         self._service = service
         self._answers: queue.SimpleQueue[Answer | None] = queue.SimpleQueue()
@@ -178,6 +190,14 @@ class TaskHandle:
         """When the first tick that ran its tree began (None before)."""
         self.ended_at: float | None = None
         """When the task ended (None while it runs)."""
+
+    @property
+    def pipeline(self) -> Pipeline:
+        """The Pipeline that analyses one frame (the tree itself for a one-shot task)."""
+        found = frame_pipeline(self.tree)
+        if found is None:
+            raise TypeError(f"the task's tree {self.tree.name!r} holds no frame Pipeline")
+        return found
 
     @property
     def done(self) -> bool:
@@ -279,9 +299,16 @@ class AnsweringService:
         stream: FrameStream | None = None,
         remote: Collection[str] = (),
         remote_hints: Placement | None = None,
+        lost_after: float = DEFAULT_LOST_AFTER,
+        person: str | None = None,
     ) -> None:
+        TargetWatch(lost_after)  # checks the default now rather than at the first continuous task
+        self.lost_after = lost_after
+        """How long (seconds) a continuous task's target may go unseen when its query does not say."""
         self.kb = kb
         self.intrinsics = intrinsics
+        self.person = person
+        """A person put into the built-in kitchen (a ``kitchen_person`` spec), None for none."""
         self.store = store
         self.catalog = catalog if catalog is not None else AnnotatorCatalog.discover()
         self.input_path = input_path
@@ -304,7 +331,9 @@ class AnsweringService:
             self._reader = StreamReader(stream, wait=False, name="read frame")
             self._reader.reason = f"reads the newest frame of {stream.name}"
             self._perception = Pipeline(PERCEPTION_PIPELINE, [self._reader], reason="perceives: the newest frame")
-            root = Sequence("robot", [self._perception, self._slot], reason="perceive, then the current task")
+            root = PerceiveThenTask(
+                "robot", self._perception, self._slot, reason="perceive every frame, then the current task"
+            )
         self.engine = Engine(root, hz=hz)
         self.engine.tree.add_post_tick_handler(self._after_tick)
         self._lock = threading.Lock()
@@ -326,6 +355,8 @@ class AnsweringService:
         stream: FrameStream | None = None,
         remote: Collection[str] = (),
         remote_hints: Placement | None = None,
+        lost_after: float = DEFAULT_LOST_AFTER,
+        person: str | None = None,
     ) -> AnsweringService:
         """A service over the shipped and user ontology and the belief store at ``store_path`` (default store
         when None), with the annotators of ``catalog`` (default: this project's); the annotators named in
@@ -352,6 +383,8 @@ class AnsweringService:
             intrinsics=intrinsics,
             remote=remote,
             remote_hints=remote_hints,
+            lost_after=lost_after,
+            person=person,
         )
 
     # ------------------------------------------------------------------ planning
@@ -370,6 +403,7 @@ class AnsweringService:
             self.frame,
             look_at=self._remembered_region(parsed),
             intrinsics=self.intrinsics,
+            person=self.person,
         )
 
     def _remembered_region(self, query: Query) -> str | None:
@@ -388,18 +422,20 @@ class AnsweringService:
                 raise UnknownObjectError(f"no object {object_id}")
         return ids
 
-    def tree(self, query: Query, query_plan: QueryPlan) -> Pipeline:
-        """The Pipeline answering ``query``: the synthesized experts (those to run remotely placed on their
-        actors), then the answer step into this store."""
+    def tree(self, query: Query, query_plan: QueryPlan) -> Pipeline | Loop:
+        """The tree answering ``query``: the synthesized experts (those to run remotely placed on their actors),
+        then the answer step into this store (a Pipeline; for a continuous kind that Pipeline in a Loop,
+        :func:`trees.synthesis.build_task_tree`)."""
         step = AnswerStep(
             self.store,
             tracker=BeliefTracker(class_test=kb_class_test(self.kb), regions=self.kb.regions()),
             filter_for=lambda q: belief_filter(q, self.kb),
             label_of=self.kb.label,
             on_integrated=self._beliefs_changed,
+            free_space=query_plan.plan.task.footprint is not None,
         )
         step.reason = ANSWER_REASON
-        tree = build_tree(
+        tree = build_task_tree(
             query_plan.plan, final_steps=[step], query=query, catalog=self.catalog, resources=self.resources
         )
         place_remote(tree, self.remote, self.remote_hints)
@@ -424,7 +460,13 @@ class AnsweringService:
         self.object_ids(parsed)  # an id that is not stored is refused before anything runs
         query_plan = self.plan(parsed)
         pipeline = self.tree(parsed, query_plan)
-        handle = TaskHandle(parsed, mode, pipeline, query_plan, self, timeout=query_timeout(parsed), started=started)
+        watch = None
+        if mode is ExecutionMode.CONTINUOUS:
+            lost_after = query_duration(parsed, LOST_AFTER_KEY)
+            watch = TargetWatch(self.lost_after if lost_after is None else lost_after, self.target_label(query_plan))
+        handle = TaskHandle(
+            parsed, mode, pipeline, query_plan, self, timeout=query_timeout(parsed), started=started, watch=watch
+        )
         handle.planned = time.monotonic()
         handle.on_tick(on_tick)
         if isinstance(self.stream, KitchenCameraStream):
@@ -436,6 +478,13 @@ class AnsweringService:
             previous._end("replaced by another task")
         self._retire(self.engine.tasks.replace(TASK_SLOT, pipeline, restart=True))
         return handle
+
+    def target_label(self, query_plan: QueryPlan) -> str:
+        """How a reason names the query's target: ``the blue cup``, ``the human``, ``the object``."""
+        task = query_plan.plan.task
+        words = [c.value.lower() for c in task.constraints if c.annotation_type != "Classification" and c.value]
+        words.append(self.kb.label(task.object_class) if task.object_class else "object")
+        return "the " + " ".join(words)
 
     def answer(
         self,
@@ -464,7 +513,7 @@ class AnsweringService:
         handle = self.submit(parsed, on_tick=on_tick)
         if timeout is not None and time.monotonic() - started >= timeout:
             self.cancel(handle)  # the deadline passed while planning: answer from memory without running
-            return Outcome(self._remembered(parsed, timed_out=True), handle.tree, handle.plan)
+            return Outcome(self._remembered(parsed, timed_out=True), handle.pipeline, handle.plan)
 
         def stopped() -> bool:
             return stop is not None and stop()
@@ -480,10 +529,10 @@ class AnsweringService:
             self.cancel(handle)
             raise QueryCancelledError("stopped before the tree finished")
         if handle.timed_out:
-            return Outcome(self._remembered(parsed, timed_out=True), handle.tree, handle.plan, handle.timing())
+            return Outcome(self._remembered(parsed, timed_out=True), handle.pipeline, handle.plan, handle.timing())
         if handle.result is None:
             raise PerceptionFailedError(f"perception failed: {handle.reason}")
-        return Outcome(handle.result, handle.tree, handle.plan, handle.timing())
+        return Outcome(handle.result, handle.pipeline, handle.plan, handle.timing())
 
     def recall(self, query: str | Query) -> Answer:
         """The stored beliefs matching ``query``, answered from memory (nothing runs)."""
@@ -496,9 +545,9 @@ class AnsweringService:
         return replace(answer, timed_out=timed_out)
 
     def start(self, query: str | Query, *, on_tick: Callable[[TickProgress], None] | None = None) -> TaskHandle:
-        """Start a continuous query (track): the engine ticks in the background and every run of the tree
-        yields an answer on the returned handle until it is cancelled or a run fails; ``on_tick`` hears every tick
-        that ran it (:meth:`TaskHandle.on_tick`)."""
+        """Start a continuous query (track): the engine ticks in the background and every successful run of the
+        tree's loop yields an answer on the returned handle until it is cancelled or its target is lost; ``on_tick``
+        hears every tick that ran it (:meth:`TaskHandle.on_tick`)."""
         parsed = parse_query(query) if isinstance(query, str) else query
         if self.mode_of(parsed) is not ExecutionMode.CONTINUOUS:
             raise ValueError(f"a {parsed.kind} query ends with one answer; ask it with answer()")
@@ -597,9 +646,11 @@ class AnsweringService:
             if handle.first_tick is None:
                 handle.first_tick = self.engine.tick_started
             handle._ticked(self.engine.tick_count)
-        pipeline = handle.tree
+        pipeline = handle.pipeline
         if perception_failure is not None:
             self._finish(handle, f"perception failed: {perception_failure}")
+        elif isinstance(handle.tree, Loop):
+            self._after_run(handle, handle.tree, pipeline)
         elif pipeline.status is Status.SUCCESS:
             found = pipeline.cas.view(QueryAnswer)
             answer = found.answer if found is not None and isinstance(found.answer, Answer) else None
@@ -612,6 +663,31 @@ class AnsweringService:
             self._finish(handle, reason if handle.mode is ExecutionMode.ONCE else f"a run failed: {reason}")
         if not handle.done and handle._expired():
             self._finish(handle, f"timed out after {handle.timeout:g} s", timed_out=True)
+
+    def _after_run(self, handle: TaskHandle, loop: Loop, pipeline: Pipeline) -> None:
+        """A continuous task after a tick: when its loop finished a run, publish the run's answer and end the task
+        when its target is lost (or when the loop itself ended)."""
+        if loop.completed > handle.runs:
+            handle.runs = loop.completed
+            answer = None
+            if pipeline.status is Status.SUCCESS:
+                found = pipeline.cas.view(QueryAnswer)
+                answer = found.answer if found is not None and isinstance(found.answer, Answer) else None
+            if answer is not None:
+                handle._publish(answer)
+            info = pipeline.cas.view(CameraInfo)
+            stamp = info.timestamp if info is not None and info.timestamp > 0 else time.monotonic()
+            seen = answer is not None and (answer.track.seen if answer.track is not None else bool(answer.objects))
+            lost = handle.watch.observe(stamp, seen) if handle.watch is not None else None
+            if lost is not None:
+                if loop.last_failure and not seen:
+                    lost += f"; the last run failed: {loop.last_failure}"
+                self._finish(handle, lost)
+                return
+        if loop.status is Status.FAILURE:
+            self._finish(handle, f"a run failed: {loop.last_failure or failure_reason(pipeline)}")
+        elif loop.status is Status.SUCCESS:
+            self._finish(handle, f"finished after {loop.succeeded} runs")
 
     def _finish(
         self, handle: TaskHandle, reason: str, *, result: Answer | None = None, timed_out: bool = False
@@ -639,7 +715,12 @@ class AnsweringService:
 
 def query_timeout(query: Query) -> float | None:
     """The query's ``timeout`` in seconds (None when it sets none)."""
-    value = query.get(TIMEOUT_KEY)
+    return query_duration(query, TIMEOUT_KEY)
+
+
+def query_duration(query: Query, key: str) -> float | None:
+    """The duration (seconds; the parser converts units) the query gives under ``key``, None when it gives none."""
+    value = query.get(key)
     return float(value.value) if isinstance(value, Number) else None
 
 

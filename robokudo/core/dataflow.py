@@ -4,7 +4,9 @@ The analysis walks the tree with the set of CAS types guaranteed to be present:
 
 * Sequence: children in order, each seeing what the earlier ones produced.
 * Fallback (Selector): each child sees only what was present before the Fallback (earlier children failed,
-  and a failed annotator commits nothing); afterwards only what *every* child guarantees is present.
+  and a failed annotator commits nothing); afterwards only what *every* child guarantees is present, where a
+  child that writes a subtype guarantees its supertypes too (one branch writing PersonHypothesis, another
+  ObjectHypothesis guarantee ObjectHypothesis).
 * ThresholdParallel: each child sees only what was present before it (children interleave); afterwards a
   type is guaranteed when every set of children large enough to make the parallel succeed contains a
   producer of it.
@@ -87,13 +89,13 @@ class _Walker:
             self.sequence(children, frozenset({QueryView}) if node.query is not None else frozenset())
             return available
         if isinstance(node, py_trees.composites.Selector):
-            results = [self.flow(child, available) for child in children]
+            results = [_with_supertypes(self.flow(child, available)) for child in children]
             return frozenset.intersection(*results) if results else available
         if isinstance(node, ThresholdParallel):
-            results = [self.flow(child, available) for child in children]
-            return available | self.parallel_guarantees(results, available, node.n_success + 1)
+            results = [_with_supertypes(self.flow(child, available)) for child in children]
+            return available | self.parallel_guarantees(results, _with_supertypes(available), node.n_success + 1)
         if isinstance(node, py_trees.composites.Parallel):
-            results = [self.flow(child, available) for child in children]
+            results = [_with_supertypes(self.flow(child, available)) for child in children]
             if isinstance(node.policy, ParallelPolicy.SuccessOnOne):
                 return frozenset.intersection(*results) if results else available
             return frozenset().union(available, *results)
@@ -140,6 +142,11 @@ class _Walker:
                 f"have finished or succeeded {where}"
             )
         return f"{head} its producer {producer.name} does not run before it on every path {where}"
+
+
+def _with_supertypes(types: TypeSet) -> TypeSet:
+    """The types and every CAS type they derive from (what their presence satisfies, made explicit)."""
+    return frozenset(c for t in types for c in t.__mro__ if isinstance(c, type) and issubclass(c, CasType))
 
 
 def _pipeline_name(node: py_trees.behaviour.Behaviour) -> str:

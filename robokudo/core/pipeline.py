@@ -75,7 +75,10 @@ def pipelines(root: py_trees.behaviour.Behaviour) -> Iterator[Pipeline]:
 
 def finished_run_cas(node: py_trees.behaviour.Behaviour | None) -> CAS | None:
     """The CAS of ``node``'s last run when ``node`` is a Pipeline whose run ended (SUCCESS or FAILURE), else None
-    (how a server finds the frame a task just analysed)."""
+    (how a server finds the frame a task just analysed). A decorated pipeline (a continuous task's loop) counts as
+    the pipeline it decorates."""
+    while isinstance(node, py_trees.decorators.Decorator):
+        node = node.decorated
     if isinstance(node, Pipeline) and node.status in (Status.SUCCESS, Status.FAILURE):
         return node.cas
     return None

@@ -10,9 +10,10 @@ from py_trees.common import Status
 
 from robokudo.core.annotator import Annotator
 from robokudo.core.explained import reason_of
+from robokudo.core.loop import Loop
 from robokudo.core.parallel import ThresholdParallel
 from robokudo.core.pipeline import Pipeline
-from robokudo.core.slot import TaskSlot
+from robokudo.core.slot import PerceiveThenTask, TaskSlot
 
 _STATUS_MARK = {Status.SUCCESS: "✔", Status.FAILURE: "✘", Status.RUNNING: "…", Status.INVALID: " "}
 
@@ -27,10 +28,12 @@ def node_kind(node: py_trees.behaviour.Behaviour) -> str:
         return "Parallel"
     if isinstance(node, py_trees.composites.Selector):
         return "Fallback"
-    if isinstance(node, py_trees.composites.Sequence):
+    if isinstance(node, py_trees.composites.Sequence | PerceiveThenTask):
         return "Sequence"
     if isinstance(node, Annotator):
         return "Annotator"
+    if isinstance(node, Loop):
+        return "Loop"
     if isinstance(node, py_trees.decorators.Decorator):
         return "Decorator"
     return "Behaviour"
@@ -44,6 +47,9 @@ def _label(node: py_trees.behaviour.Behaviour) -> str:
         return node.name
     if isinstance(node, ThresholdParallel):
         return f"{kind} {node.name} (success > {node.n_success}, failure > {node.n_failure})"
+    if isinstance(node, Loop):
+        until = "until stopped" if node.runs is None else f"{node.runs} runs"
+        return f"↻ {node.name} ({until})"
     return f"{kind} {node.name}"
 
 
@@ -85,6 +91,7 @@ _DOT_SHAPES = {
     "Slot": ("box", "#eeeeee"),
     "Annotator": ("ellipse", "#ffffff"),
     "Decorator": ("house", "#dddddd"),
+    "Loop": ("house", "#cde8f7"),
     "Behaviour": ("ellipse", "#ffffff"),
 }
 
@@ -153,6 +160,9 @@ def tree_to_dict(root: py_trees.behaviour.Behaviour) -> dict[str, object]:
     if isinstance(root, ThresholdParallel):
         node["n_success"] = root.n_success
         node["n_failure"] = root.n_failure
+    if isinstance(root, Loop):
+        node["runs"] = root.runs
+        node["max_failures"] = root.max_failures
     node["reason"] = reason_of(root)
     if root.children:
         node["children"] = [tree_to_dict(child) for child in root.children]

@@ -73,3 +73,41 @@ class Idle(Explained, py_trees.behaviour.Behaviour):
     def update(self) -> Status:
         """Nothing to do."""
         return Status.SUCCESS
+
+
+class PerceiveThenTask(Explained, py_trees.composites.Composite):
+    """The served root (the paper's Fig. 4): perceive, then the task; perception runs on every tick.
+
+    Each tick the ``perception`` child runs (it stays RUNNING while no new frame is due); the ``task`` child (the
+    slot) runs when perception just delivered a frame, or when the task is already running (a task in the middle of
+    a run, or a continuous task's loop, goes on every tick). So a task starts on a freshly perceived frame, and a
+    continuous task's loop sees every new frame. Fails when perception fails (the task is left to its owner to end);
+    otherwise its status is the task's (RUNNING while perception waits and no task runs).
+    """
+
+    def __init__(self, name: str, perception: py_trees.behaviour.Behaviour, task: py_trees.behaviour.Behaviour,
+                 reason: str = "") -> None:  # fmt: skip
+        super().__init__(name=name, children=[perception, task])
+        self.reason = reason
+
+    def tick(self) -> Iterator[py_trees.behaviour.Behaviour]:
+        """Tick perception, then the task when it has a frame to work on or is running."""
+        if self.status is not Status.RUNNING:
+            self.initialise()
+        perception, task = self.children
+        self.current_child = perception
+        yield from perception.tick()
+        if perception.status is Status.FAILURE:
+            self.stop(Status.FAILURE)
+            yield self
+            return
+        if perception.status is Status.SUCCESS or task.status is Status.RUNNING:
+            self.current_child = task
+            yield from task.tick()
+            status = task.status
+        else:
+            status = Status.RUNNING
+        if status is not Status.RUNNING:
+            self.stop(status)
+        self.status = status
+        yield self

@@ -229,6 +229,36 @@ class BodyKeypoints(Annotation):
 
 
 @dataclass(eq=False, kw_only=True)
+class Activity(Annotation):
+    """What a person is doing: ``activity`` (``pointing``, ``standing``, ``waving``) with the score of every
+    activity considered (``scores``, 0..1) and, for pointing, the arm (``left`` / ``right``)."""
+
+    activity: str
+    scores: tuple[tuple[str, float], ...] = ()
+    arm: str = ""
+
+
+@dataclass(eq=False, kw_only=True)
+class PointingTarget(Annotation):
+    """What a person points at: ``kind`` (``object`` or ``region``), the ray (camera frame: ``origin``,
+    unit ``direction``; ``second_direction`` the elbow-to-wrist estimate), the pointed object hypothesis' image
+    box ``roi`` (objects) or the region's ``name`` (regions), the ``point`` aimed at (camera frame), the angle
+    between the ray and that target (``angular_error``, radians), the angle between the two ray estimates
+    (``spread``, radians) and the ``margin`` to the next-best candidate (radians)."""
+
+    kind: str
+    origin: np.ndarray
+    direction: np.ndarray
+    second_direction: np.ndarray
+    point: np.ndarray
+    angular_error: float
+    spread: float
+    margin: float
+    name: str = ""
+    roi: tuple[int, int, int, int] | None = None
+
+
+@dataclass(eq=False, kw_only=True)
 class SemanticColor(Annotation):
     """A colour name (an ontology colour class, lower case) with its share of the object's pixels."""
 
@@ -342,6 +372,50 @@ class Location(Annotation):
     def attribute_value(self) -> str:
         """The region name, lower case."""
         return self.region.strip().lower()
+
+
+@dataclass(eq=False, kw_only=True)
+class TargetTrack(Annotation):
+    """A continuous task's estimate of its one target in this frame (camera frame, metres).
+
+    ``seen`` says whether a detection was associated with the target in this frame (``hypothesis``, None when
+    not); ``position`` and ``velocity`` are the filtered estimate, ``pixel`` its image position (None when it
+    is behind the camera), ``spread`` the estimate's standard deviation in metres, ``unseen_for`` the seconds
+    since the target was last seen (0 when seen now) and ``target`` the class tracked ("" for any object).
+    """
+
+    target: str
+    seen: bool
+    position: np.ndarray
+    velocity: np.ndarray
+    pixel: tuple[float, float] | None
+    spread: float
+    unseen_for: float = 0.0
+    hypothesis: ObjectHypothesis | None = None
+    frame: str = "camera"
+
+
+@dataclass(eq=False, kw_only=True)
+class PersonTrack(TargetTrack):
+    """The track of a person (from a people tracker)."""
+
+
+@dataclass(eq=False, kw_only=True)
+class FreePlacement(Annotation):
+    """A free rectangle on a supporting surface where an object of the asked footprint can be put.
+
+    ``position`` is the rectangle's centre on the surface and ``orientation`` (x, y, z, w) turns ``frame`` into
+    the rectangle's axes (x along ``size[0]``, y along ``size[1]``, z the surface normal); ``size`` is the free
+    extent (metres) and ``footprint`` the footprint asked for; ``fits`` is how many such footprints fit side by side.
+    """
+
+    position: np.ndarray
+    orientation: np.ndarray
+    size: tuple[float, float]
+    footprint: tuple[float, float]
+    frame: str = "camera"
+    region: str = ""
+    fits: int = 1
 
 
 def _declared(root: type[T]) -> tuple[type[T], ...]:

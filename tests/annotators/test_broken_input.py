@@ -24,6 +24,7 @@ from annotators.cloud.clusters import ClusterExtractor
 from annotators.cloud.clutter import ClutterSegmenter
 from annotators.cloud.filters import CropBoxFilter, RangeFilter, RegionFilter
 from annotators.cloud.form import FormAnnotator
+from annotators.cloud.free_space import FreeSpaceEstimator
 from annotators.cloud.normals import NormalEstimator
 from annotators.cloud.people import DepthPeopleDetector
 from annotators.cloud.plane import SupportPlaneSegmenter
@@ -33,9 +34,11 @@ from annotators.cloud.shape import ShapeAnnotator
 from annotators.cloud.size import SizeAnnotator
 from annotators.image.color import SemanticColorAnnotator
 from annotators.image.histogram import ColorHistogramAnnotator
-from annotators.image.human_pose import HumanPoseDetector
+from annotators.image.human_pose import LANDMARKS, HumanPoseDetector
 from annotators.image.image_regions import ImageRegionSegmenter
 from annotators.image.onnx_detector import OnnxDetector
+from annotators.people.activity import ActivityRecognizer
+from annotators.people.pointing import PointingEstimator
 from annotators.readers.frame_io import Frame
 from annotators.readers.frame_readers import (
     BagCloudReader,
@@ -49,18 +52,23 @@ from annotators.readers.frame_readers import (
 )
 from annotators.readers.streams import FrameStream, PerceivedFrameReader, StreamReader, recorded_stream
 from annotators.text.reader import TextReader
+from annotators.tracking.human_tracker import HumanTracker
+from annotators.tracking.object_tracker import ObjectTracker
 from robokudo.core.annotator import Annotator
 from robokudo.core.pipeline import Pipeline
 from robokudo.core.types import (
     ANNOTATION_TYPES,
     VIEW_TYPES,
+    Activity,
     Annotation,
+    BodyKeypoints,
     CameraInfo,
     CameraIntrinsics,
     ColorImage,
     DepthImage,
     Normals,
     ObjectHypothesis,
+    PersonHypothesis,
     Plane,
     PointCloud,
     SemanticColor,
@@ -133,6 +141,22 @@ def line_cloud() -> PointCloud:
     return cloud
 
 
+def keypoints(depth: float = np.nan) -> BodyKeypoints:
+    """33 keypoints in the image middle, all at ``depth`` (NaN: no depth)."""
+    return BodyKeypoints(
+        names=LANDMARKS,
+        pixels=np.full((len(LANDMARKS), 2), 20.0),
+        points=np.full((len(LANDMARKS), 3), depth),
+        visibility=np.ones(len(LANDMARKS)),
+    )
+
+
+def person(*attached: Annotation) -> PersonHypothesis:
+    mask = np.zeros((H, W), dtype=bool)
+    mask[5:40, 20:30] = True
+    return PersonHypothesis(point_indices=np.flatnonzero(mask), mask=mask, roi=(20, 5, 30, 40), annotations=[*attached])
+
+
 Seeds = list[View | Annotation]
 
 # name -> (what the CAS holds, the experts this case is meant to break while their inputs are present)
@@ -175,6 +199,7 @@ BROKEN_CASES: dict[str, tuple[Callable[[], Seeds], tuple[type[Annotator], ...]]]
             SupportPlaneSegmenter,
             ClusterExtractor,
             ClutterSegmenter,
+            FreeSpaceEstimator,
             SemanticColorAnnotator,
             ColorHistogramAnnotator,
             PoseAnnotator,
@@ -198,6 +223,7 @@ BROKEN_CASES: dict[str, tuple[Callable[[], Seeds], tuple[type[Annotator], ...]]]
             SupportPlaneSegmenter,
             ClusterExtractor,
             ClutterSegmenter,
+            FreeSpaceEstimator,
             PoseAnnotator,
             ShapeAnnotator,
             SizeAnnotator,
@@ -214,6 +240,7 @@ BROKEN_CASES: dict[str, tuple[Callable[[], Seeds], tuple[type[Annotator], ...]]]
             SupportPlaneSegmenter,
             ClusterExtractor,
             ClutterSegmenter,
+            FreeSpaceEstimator,
             PoseAnnotator,
             ShapeAnnotator,
             SizeAnnotator,
@@ -225,6 +252,13 @@ BROKEN_CASES: dict[str, tuple[Callable[[], Seeds], tuple[type[Annotator], ...]]]
         (NormalEstimator,),
     ),
     "collinear cloud": (lambda: [line_cloud()], (SupportPlaneSegmenter, DepthPeopleDetector)),
+    "hypotheses beyond the cloud": (
+        lambda: [
+            flat_cloud(),
+            PersonHypothesis(point_indices=np.array([H * W + 5]), mask=np.zeros((H, W), bool), roi=(0, 0, 1, 1)),
+        ],
+        (HumanTracker, ObjectTracker),
+    ),
     "a wall, no ground": (lambda: [flat_cloud()], (DepthPeopleDetector,)),
     "cloud out of range": (
         lambda: [PointCloud(points=flat_cloud().points * 10, mask=np.ones((H, W), bool))],
@@ -234,11 +268,11 @@ BROKEN_CASES: dict[str, tuple[Callable[[], Seeds], tuple[type[Annotator], ...]]]
     "no point inside the region": (lambda: [flat_cloud(), posed_camera(x=50.0)], (RegionFilter,)),
     "degenerate plane": (
         lambda: [flat_cloud(), Plane(model=np.array([0.0, 0.0, 0.0, np.nan]), inlier_indices=np.arange(10))],
-        (ClusterExtractor, ClutterSegmenter),
+        (ClusterExtractor, ClutterSegmenter, FreeSpaceEstimator),
     ),
     "plane indices outside the grid": (
         lambda: [flat_cloud(), Plane(model=np.array([0.0, 0.0, -1.0, 1.0]), inlier_indices=np.array([0, H * W]))],
-        (ClusterExtractor, ClutterSegmenter),
+        (ClusterExtractor, ClutterSegmenter, FreeSpaceEstimator),
     ),
     "nothing stands on the plane": (lambda: [flat_cloud(), wall_plane()], (ClusterExtractor, ClutterSegmenter)),
     "no hypotheses": (
@@ -280,6 +314,20 @@ BROKEN_CASES: dict[str, tuple[Callable[[], Seeds], tuple[type[Annotator], ...]]]
     "uniform colour image": (lambda: [color()], (ImageRegionSegmenter, HumanPoseDetector)),
     "tiny colour image": (lambda: [color(4, 4)], (ImageRegionSegmenter, HumanPoseDetector)),
     "hypothesis without evidence": (lambda: [hypothesis(), *evidence_types()], (KnowledgeClassifier,)),
+    "a person without keypoints": (
+        lambda: [person(), keypoints(), Activity(activity="pointing"), flat_cloud(), posed_camera()],
+        (ActivityRecognizer, PointingEstimator),
+    ),
+    "a pointing person's arm without depth": (
+        lambda: [
+            person(keypoints(), Activity(activity="pointing", arm="right")),
+            keypoints(),
+            Activity(activity="pointing"),
+            flat_cloud(),
+            posed_camera(),
+        ],
+        (PointingEstimator,),
+    ),
 }
 
 PROFILES = ({"class": "Milk", "colors": ("white",), "shape": "box", "size": "medium", "texts": ("milk",)},)
@@ -289,11 +337,16 @@ FACTORIES: dict[type[Annotator], Callable[[Path], Annotator]] = {
     RegionFilter: lambda tmp: RegionFilter("table", np.eye(4).ravel(), (4.0, 4.0, 4.0)),
     KnowledgeClassifier: lambda tmp: KnowledgeClassifier(PROFILES),
     OnnxDetector: lambda tmp: OnnxDetector(str(one_box_model(tmp / "model.onnx"))),
+    FreeSpaceEstimator: lambda tmp: FreeSpaceEstimator((0.1, 0.1)),
 }
 
 # experts broken through their configuration: class -> {case: factory(tmp_path)}
 BROKEN_CONFIGURATIONS: dict[type[Annotator], dict[str, Callable[[Path], Annotator]]] = {
     KnowledgeClassifier: {"no profiles": lambda tmp: KnowledgeClassifier([])},
+    ActivityRecognizer: {
+        "missing image-text model": lambda tmp: ActivityRecognizer(model_path=tmp / "nowhere.onnx"),
+        "malformed image-text model": lambda tmp: ActivityRecognizer(model_path=junk_file(tmp / "junk.onnx")),
+    },
     OnnxDetector: {
         "missing model file": lambda tmp: OnnxDetector(str(tmp / "nowhere.onnx")),
         "malformed model file": lambda tmp: OnnxDetector(str(junk_file(tmp / "junk.onnx"))),
@@ -556,7 +609,15 @@ def test_experts_fail_with_a_reason_on_broken_input(expert: type[Annotator], cas
     ids=lambda value: value.__name__ if isinstance(value, type) else value,
 )
 def test_experts_fail_with_a_reason_on_broken_configuration(expert: type[Annotator], case: str, tmp_path) -> None:
-    seeds = [color(), flat_cloud(), up_normals(), CameraInfo(K), hypothesis(), *evidence_types()]
+    seeds = [
+        color(),
+        flat_cloud(),
+        up_normals(),
+        CameraInfo(K),
+        hypothesis(),
+        *evidence_types(),
+        person(keypoints(1.0)),
+    ]
     assert_fails_with_a_reason(BROKEN_CONFIGURATIONS[expert][case](tmp_path), seeds)
 
 

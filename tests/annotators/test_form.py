@@ -58,8 +58,11 @@ def test_a_mug_has_a_handle_and_is_open_a_can_has_neither(seed: int) -> None:
     assert mug.height_to_width < cup.height_to_width  # the handle widens it
 
 
-@pytest.mark.xfail(strict=True, reason="open top: the far half is taken beyond the footprint's median, which a "
-                   "closed cylinder's lateral sides reach too (a known limit of the open-top cue)")
+@pytest.mark.xfail(
+    strict=True,
+    reason="open top: the far half is taken beyond the footprint's median, which a "
+    "closed cylinder's lateral sides reach too (a known limit of the open-top cue)",
+)
 def test_a_closed_can_is_not_open() -> None:
     rng = np.random.default_rng(3)
     can = measure_form(np.vstack([side(0.035, 0.1, rng), lid(0.035, 0.1, rng)]), FRAME)

@@ -6,6 +6,8 @@ import math
 
 import numpy as np
 import pytest
+from hypothesis import given
+from hypothesis import strategies as st
 
 from reasoning.fusion.frame import FrameContext, duplicate_groups, frame_objects
 from reasoning.fusion.rule import MAX_LOG_ODDS, AttributeBelief, Evidence, accumulate, fuse_evidence, logit
@@ -171,3 +173,19 @@ def test_frame_objects_use_pose_and_size_annotations_in_the_world_frame() -> Non
 def test_hypotheses_without_any_position_are_left_out() -> None:
     shape = (10, 10)
     assert frame_objects([_hypothesis(_block(shape, 2, 5, 2, 5), shape, "Seg")]) == []
+
+
+STATEMENTS = st.lists(
+    st.tuples(st.sampled_from(["Milk", "LactoseFreeMilk", "Drink", "Cup"]), st.floats(0.0, 1.0)), max_size=6
+)
+
+
+@given(statements=STATEMENTS)
+def test_supported_value_is_the_fused_value_when_evidence_supports_it(statements: list[tuple[str, float]]) -> None:
+    belief = AttributeBelief("class")
+    for value, confidence in statements:
+        belief.add(Evidence("class", value, confidence, "Expert"))
+    for class_test in (None, is_subclass):
+        fused = belief.fuse(class_test)
+        expected = fused.value if fused is not None and fused.supported else None
+        assert belief.supported_value(class_test) == expected

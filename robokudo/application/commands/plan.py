@@ -20,7 +20,7 @@ from robokudo.application.commands.input_options import (
 from robokudo.application.knowledge import load_knowledge_base
 from robokudo.application.planning import plan_for_input
 from robokudo.core.render import tree_to_dict, unicode_tree
-from trees.synthesis import SynthesisError, build_tree
+from trees.synthesis import SynthesisError, build_task_tree
 
 HELP = "synthesize the perception tree for a query and print it"
 
@@ -58,7 +58,7 @@ def run(args: argparse.Namespace) -> int:
         query_plan = plan_for_input(
             planner, parse_query(text), args.input, frame_number(args), intrinsics=intrinsics_of(args)
         )
-        tree = build_tree(query_plan.plan, catalog=catalog)
+        tree = build_task_tree(query_plan.plan, catalog=catalog)
     except QueryError as error:
         print(error, file=sys.stderr)
         return 2

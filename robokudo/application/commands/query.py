@@ -62,6 +62,12 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
         metavar="PATH",
         help="write the analysed frame with the answer's objects boxed and labelled",
     )
+    parser.add_argument(
+        "--person",
+        metavar="SPEC",
+        help="put a person into the built-in kitchen: stand, wave or point:<object or region>, optionally @x,y "
+        "(where it stands, metres), e.g. point:red_cup@0.2,0.7",
+    )
     add_rerun_arguments(parser)
     add_remote_arguments(parser)
 
@@ -93,6 +99,7 @@ def run(args: argparse.Namespace) -> int:
                 catalog=catalog,
                 remote=args.remote,
                 remote_hints=hints,
+                person=args.person,
             ) as service,
         ):
             outcome = answer(service, query, rerun_log)

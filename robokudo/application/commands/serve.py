@@ -41,7 +41,7 @@ from robokudo.application.commands.remote_options import (
 )
 from robokudo.application.commands.rerun_options import RerunOptionError, add_rerun_arguments, open_rerun_log
 from robokudo.application.server.runner import ServerConfig, is_loopback, serve
-from robokudo.application.service import AnsweringService
+from robokudo.application.service import DEFAULT_LOST_AFTER, AnsweringService
 from robokudo.core.placement import Placement
 
 if TYPE_CHECKING:
@@ -73,6 +73,13 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
     parser.add_argument("--port", type=int, default=9090, help="port to listen on (default 9090)")
     parser.add_argument("--token", help=f"token clients must send in the 'auth' op (default: ${TOKEN_VARIABLE})")
     parser.add_argument("--db", help="belief store file (default: $ROBOKUDO_BELIEF_STORE or the user data dir)")
+    parser.add_argument(
+        "--lost-after",
+        type=float,
+        default=DEFAULT_LOST_AFTER,
+        help="seconds a continuous goal's target may go unseen before the goal ends, when the query gives no "
+        f"lost_after (default {DEFAULT_LOST_AFTER:g})",
+    )
     add_rerun_arguments(parser)
     add_remote_arguments(parser)
 
@@ -100,6 +107,8 @@ def run(args: argparse.Namespace) -> int:
         problem = f"--rate must be positive, got {args.rate:g}"
     elif args.sensor_rate is not None and args.sensor_rate <= 0:
         problem = f"--sensor-rate must be positive, got {args.sensor_rate:g}"
+    elif not args.lost_after >= 0 or args.lost_after == float("inf"):
+        problem = f"--lost-after must be a number of seconds >= 0, got {args.lost_after:g}"
     elif token is None and not is_loopback(args.host):
         problem = f"binding {args.host} (not a loopback address) needs a token: --token or ${TOKEN_VARIABLE}"
     if problem is not None:
@@ -132,7 +141,13 @@ def _serve(args: argparse.Namespace, token: str | None, rerun_log: RerunLog | No
         return 2
     try:
         service = AnsweringService.open(
-            args.db, input_path=args.input, hz=args.rate, stream=stream, remote=args.remote, remote_hints=hints
+            args.db,
+            input_path=args.input,
+            hz=args.rate,
+            stream=stream,
+            remote=args.remote,
+            remote_hints=hints,
+            lost_after=args.lost_after,
         )
     except (BeliefStoreError, OntologyError) as error:
         stream.close()
