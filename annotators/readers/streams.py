@@ -36,6 +36,8 @@ from annotators.readers.choice import recorded_frames
 from annotators.readers.frame_io import Frame, FrameError
 from annotators.readers.frame_readers import DEFAULT_KITCHEN_VIEW, KITCHEN_RECORDING, FileFrameReader
 from annotators.simulation import kitchen_scene
+from annotators.simulation.kitchen_person import PERSON_VIEWS, PersonPose, PersonScript, person_view
+from annotators.simulation.kitchen_scene import SceneObject
 from robokudo.core.annotator import Annotator
 from robokudo.core.capability import Capability
 from robokudo.core.pipeline import StructureError
@@ -135,29 +137,73 @@ def _check_rate(rate_hz: float) -> float:
     return float(rate_hz)
 
 
+MAX_REMEMBERED_POSES = 1000
+"""How many delivered frames' person poses a scripted kitchen stream keeps for :meth:`pose_at_stamp`."""
+
+
 class KitchenCameraStream(FrameStream):
     """The built-in kitchen as a simulated camera producing a frame every ``1 / rate_hz`` seconds.
 
     Each view is rendered once (``seed`` seeds its sensor noise) and delivered with a fresh time stamp; the view
     can be changed while the stream runs (:meth:`set_view`, :meth:`look_at`).
+
+    With a ``person`` script (:class:`~annotators.simulation.kitchen_person.PersonScript`) the kitchen holds the
+    scripted figure: every frame is rendered anew with the figure posed at the script's time (seconds since the
+    stream was made or :meth:`restart_script`), the views of ``PERSON_VIEWS`` (``person``, ``room``) can be chosen
+    too, and :meth:`pose_at_stamp` gives the ground-truth pose of a delivered frame (for scoring only). ``extra``
+    adds objects to the scene (a storage layout's ``extra()``). Without either, nothing changes.
     """
 
-    def __init__(self, rate_hz: float = DEFAULT_RATE_HZ, view: str = DEFAULT_KITCHEN_VIEW, seed: int = 0) -> None:
+    def __init__(
+        self,
+        rate_hz: float = DEFAULT_RATE_HZ,
+        view: str = DEFAULT_KITCHEN_VIEW,
+        seed: int = 0,
+        person: PersonScript | None = None,
+        extra: tuple[tuple[SceneObject, tuple[int, int, int]], ...] = (),
+    ) -> None:
         super().__init__(name="kitchen camera")
         self.rate_hz = _check_rate(rate_hz)
         self.seed = seed
+        self.person = person
+        self.extra = tuple(extra)
         self._view = self._checked_view(view)
         self._rendered: dict[str, kitchen_scene.RenderedScene] = {}
         self._start = time.monotonic()
+        self._script_start = self._start
+        self._poses: dict[float, PersonPose] = {}
         self._last_slot = -1
         self._last_view: str | None = None
+        self._delivered_pose: PersonPose | None = None
 
-    @staticmethod
-    def _checked_view(view: str) -> str:
-        views = kitchen_scene.camera_views()
+    @property
+    def live(self) -> bool:
+        """True when frames are rendered anew (a scripted person or added objects)."""
+        return self.person is not None or bool(self.extra)
+
+    def _checked_view(self, view: str) -> str:
+        views = list(kitchen_scene.camera_views())
+        if self.person is not None:
+            views += list(PERSON_VIEWS)
         if view not in views:
             raise ValueError(f"unknown kitchen camera view {view!r}; known: {', '.join(views)}")
         return view
+
+    def restart_script(self) -> None:
+        """Play the person's script from its start with the next frame."""
+        with self._lock:
+            self._script_start = time.monotonic()
+            self._poses.clear()
+
+    def script_time(self) -> float:
+        """Seconds since the person's script started."""
+        with self._lock:
+            return time.monotonic() - self._script_start
+
+    def pose_at_stamp(self, timestamp: float) -> PersonPose | None:
+        """The person's pose in the frame stamped ``timestamp`` (None when no such frame was delivered)."""
+        with self._lock:
+            return self._poses.get(timestamp)
 
     @property
     def view(self) -> str:
@@ -184,12 +230,23 @@ class KitchenCameraStream(FrameStream):
             self._scene(view)
 
     def _scene(self, view: str) -> kitchen_scene.RenderedScene:
+        if self.live:
+            return self._live_scene(view)
         with self._lock:
             scene = self._rendered.get(view)
         if scene is None:
             scene = kitchen_scene.render_kitchen(view, seed=self.seed)
             with self._lock:
                 scene = self._rendered.setdefault(view, scene)
+        return scene
+
+    def _live_scene(self, view: str) -> kitchen_scene.RenderedScene:
+        pose = None if self.person is None else self.person.pose_at(self.script_time())
+        where = person_view(view) if view in PERSON_VIEWS else view
+        self._delivered_pose = pose
+        scene = kitchen_scene.render_kitchen(where, seed=self.seed, person=pose, extra=self.extra)
+        with self._lock:
+            self._rendered[view] = scene
         return scene
 
     @property
@@ -219,6 +276,11 @@ class KitchenCameraStream(FrameStream):
             recording=KITCHEN_RECORDING,
         )
         frame = Frame(scene.color, scene.depth, scene.intrinsics, source=f"kitchen/{view}", timestamp=camera.timestamp)
+        if self.person is not None and self._delivered_pose is not None:
+            with self._lock:
+                self._poses[camera.timestamp] = self._delivered_pose
+                while len(self._poses) > MAX_REMEMBERED_POSES:
+                    del self._poses[next(iter(self._poses))]
         self._last_slot = slot
         self._last_view = view
         delivered = StreamFrame(frame, camera, index=slot, sequence=self._delivered)

@@ -194,3 +194,24 @@ def test_a_grabber_sequence_plays_in_time_order_at_its_recorded_rate(shared_data
     assert {f.camera.recording for f in played if f} == {str(folder.resolve())}
     with pytest.raises(SourceEndedError, match="all 3 frames played"):
         stream.next_frame()
+
+
+def test_a_scripted_person_walks_through_the_kitchen_stream_and_each_frame_has_its_ground_truth() -> None:
+    from annotators.simulation.kitchen_person import PERSON_OBJECT_ID, Motion, PersonScript
+
+    walk = PersonScript((Motion("walk", 0.6, ((-0.6, 0.8), (0.6, 0.8))),))
+    stream = KitchenCameraStream(rate_hz=20.0, view="person", person=walk)
+    first = stream.next_frame()
+    time.sleep(0.4)
+    later = stream.next_frame()
+    assert first is not None and later is not None
+    poses = [stream.pose_at_stamp(f.camera.timestamp) for f in (first, later)]
+    assert all(p is not None for p in poses)
+    assert poses[1].position[0] > poses[0].position[0] + 0.3  # the figure walked between the frames
+    assert np.any(stream.last_scene.object_ids == PERSON_OBJECT_ID)  # and is in the picture
+    assert not np.array_equal(first.frame.depth, later.frame.depth)
+
+
+def test_without_a_person_the_kitchen_stream_has_no_person_views() -> None:
+    with pytest.raises(ValueError, match="person"):
+        KitchenCameraStream(view="person")

@@ -1,0 +1,94 @@
+"""Track a person walking a path in the built-in kitchen (the articulated figure of
+``annotators.simulation.kitchen_person``): the planner's tree for "track the person", with its kitchen reader
+replaced by one that renders the walk frame by frame (10 frames/s), runs in its Loop; the HumanTracker's 3-D
+position is compared with the figure's ground truth (the middle of hips and shoulders): median error <= 10 cm,
+and the person is never lost (seen in every frame after the first)."""
+
+from __future__ import annotations
+
+from typing import ClassVar
+
+import numpy as np
+import pytest
+
+from annotators.catalog import AnnotatorCatalog
+from annotators.readers.frame_readers import KITCHEN_RECORDING
+from annotators.simulation.kitchen_person import Motion, PersonPose, PersonScript, person_view
+from annotators.simulation.kitchen_scene import render_kitchen
+from queries import parse_query
+from reasoning.planning.plan import Step
+from reasoning.planning.query_planner import plan_query
+from robokudo.application.knowledge import load_knowledge_base
+from robokudo.application.sensor_sources import sensor_source
+from robokudo.core.annotator import Annotator
+from robokudo.core.loop import Loop
+from robokudo.core.types import CameraInfo, CasType, ColorImage, DepthImage, PersonTrack
+from trees.synthesis import build_task_tree, instantiate
+
+RATE = 10.0
+WALK = PersonScript((Motion("walk", 3.0, ((-0.9, 0.9), (0.9, 0.6))),))
+
+
+class WalkReader(Annotator):
+    """Renders the kitchen with the walking figure at the next frame time (writes what the kitchen reader writes)."""
+
+    inputs: ClassVar[tuple[type[CasType], ...]] = ()
+    outputs: ClassVar[tuple[type[CasType], ...]] = (ColorImage, DepthImage, CameraInfo)
+
+    def __init__(self, script: PersonScript, frames: int) -> None:
+        super().__init__(name="KitchenSceneReader")
+        self.script, self.frames, self.index = script, frames, 0
+        self.poses: list[PersonPose] = []
+
+    def analyse(self) -> None:
+        t = self.index / RATE
+        self.index += 1
+        pose = self.script.pose_at(t)
+        self.poses.append(pose)
+        scene = render_kitchen(person_view(), seed=self.index, person=pose)
+        self.write(ColorImage(scene.color))
+        self.write(DepthImage(scene.depth))
+        self.write(CameraInfo(intrinsics=scene.intrinsics, cam_to_world=scene.cam_to_world, frame_id="kitchen/person",
+                              timestamp=1000.0 + t, recording=KITCHEN_RECORDING))  # fmt: skip
+
+
+def body_centre(pose: PersonPose) -> np.ndarray:
+    names = ("left_hip", "right_hip", "left_shoulder", "right_shoulder")
+    return np.mean([pose.joint(n) for n in names], axis=0)
+
+
+@pytest.mark.slow
+@pytest.mark.xfail(
+    strict=True,
+    reason="known gap: the track follows the detections (never lost), but the HumanPoseDetector's 3-D position is "
+    "the depth column's centroid (the body's visible front, plus what stands before it): median 21 cm from the "
+    "body's centre on this walk",
+)
+def test_a_person_walking_a_path_is_tracked_within_10_cm_and_never_lost() -> None:
+    kb = load_knowledge_base()
+    query = parse_query("track the person")
+    query_plan = plan_query(query, kb, sensor_source(kb, None))
+    frames = int(WALK.duration * RATE) + 1
+    reader = WalkReader(WALK, frames)
+    catalog = AnnotatorCatalog.discover()
+
+    def make(step: Step) -> Annotator:
+        return reader if step.annotator == "KitchenSceneReader" else instantiate(step, catalog)
+
+    loop = build_task_tree(query_plan.plan, make=make, query=query)
+    assert isinstance(loop, Loop)
+    tracks: list[PersonTrack] = []
+    while reader.index < frames:
+        loop.tick_once()
+        pipeline = loop.decorated
+        if pipeline.status.name in ("SUCCESS", "FAILURE"):
+            found = pipeline.cas.annotations(PersonTrack)
+            assert found, f"frame {reader.index}: {loop.last_failure}"
+            tracks.append(found[0])
+    errors = [np.linalg.norm(t.position - body_centre(p)) for t, p in zip(tracks, reader.poses, strict=True)]
+    median, worst = np.median(errors) * 100, max(errors) * 100
+    print(f"median 3-D error {median:.1f} cm, max {worst:.1f} cm over {len(errors)} frames")
+    assert all(t.seen for t in tracks), [i for i, t in enumerate(tracks) if not t.seen]
+    assert np.median(errors) <= 0.10
+    walked = np.linalg.norm(tracks[-1].position[:2] - tracks[0].position[:2])
+    assert walked > 1.5  # it followed the walk (1.83 m), not a standing estimate
