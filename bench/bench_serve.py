@@ -264,7 +264,7 @@ class FeedbackFigures:
     answers: int
     answer_step_runs: int | None
     feedback_per_second: float
-    """Every feedback message of the goal: one per tick that ran its tree, plus its answers."""
+    """The goal's progress feedback (phase ``running``): one per tick that ran its tree."""
 
 
 def feedback_rate(
@@ -285,8 +285,9 @@ def feedback_rate(
                 status = message["msg"]
                 ticks.append((now, int(status["tick"]), node_runs(status["tree"], ANSWER_STEP)))
             elif message["op"] == "action_feedback":
-                feedback.append(now)
-                if message["values"].get("phase") == "answer":
+                if message["values"].get("phase") == "running":
+                    feedback.append(now)
+                elif message["values"].get("phase") == "answer":
                     answers.append(now)
                     started = started if started is not None else now  # the window opens after the first answer
             elif message["op"] == "action_result":
@@ -305,8 +306,8 @@ def feedback_rate(
 
 def feedback_part(args: argparse.Namespace, environment: dict[str, str]) -> None:
     print(
-        "feedback: a running track goal's feedback messages (one per tick that ran its tree, and its answers) and "
-        f"answers per second vs the engine's ticks per second (--rate {args.rate:g})"
+        "feedback: a running track goal's progress feedback (one per tick that ran its tree) and answers (one per "
+        f"run) per second vs the engine's ticks per second (--rate {args.rate:g})"
     )
     for query in args.track_query:
         figures = feedback_rate(query, args.rate, args.warmup, args.feedback_seconds, environment)
