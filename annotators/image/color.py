@@ -118,15 +118,11 @@ def _shade_groups(labs: list[np.ndarray], max_difference: float) -> list[list[in
     return groups
 
 
-def _pool_shades(
-    surfaces: list[Surface], names: list[SurfaceName], parameters: NamingParameters
-) -> list[SurfaceName]:
+def _pool_shades(surfaces: list[Surface], names: list[SurfaceName], parameters: NamingParameters) -> list[SurfaceName]:
     """The names with the lit saturated surfaces that are shades of one colour (:func:`_shade_groups` with
     ``shade_delta_e``) named together, by their pixel-weighted term votes: a brown tin whose print and
     shading spread it over reddish, pinkish and orange-brown surfaces is brown, one colour."""
-    chromatic = [
-        i for i, s in enumerate(surfaces) if s.kind != "dark" and names[i].name in CHROMATIC_TERMS
-    ]
+    chromatic = [i for i, s in enumerate(surfaces) if s.kind != "dark" and names[i].name in CHROMATIC_TERMS]
     pooled = list(names)
     for group in _shade_groups([surfaces[i].lab for i in chromatic], parameters.shade_delta_e):
         if len(group) < 2:
