@@ -15,9 +15,10 @@ Each surface is named (:func:`name_surface`):
   counts only when it is a sizeable part of the object or has the name of one of its lit surfaces (shadows are
   dropped).
 
-A name's share is the share of the named pixels its surfaces hold (grey merges into white: an unsaturated
-object's shaded side). The dominant colour is the largest share; a second colour is reported when its share
-and its confidence (share x certainty) are large enough.
+Lit saturated surfaces that are shades of one colour (CIEDE2000 neighbours) are named together by their pooled
+votes (:func:`_pool_shades`). A name's share is the share of the named pixels its surfaces hold (grey merges into
+white: an unsaturated object's shaded side). The dominant colour is the largest share; a second colour is
+reported when its share and its confidence (share x certainty) are large enough.
 
 :data:`COLOR_TERMS` is the one list of names this namer reports: the lower-case labels of the ontology's colour
 classes (``rk:Color`` in ontology/perception.ttl); the annotator's capability is derived from it.
@@ -89,15 +90,50 @@ class NamedColor:
     confidence: float
 
 
-def _chromatic_name(lab: np.ndarray, parameters: NamingParameters) -> SurfaceName:
+def _term_votes(lab: np.ndarray, parameters: NamingParameters) -> np.ndarray:
+    """The chromatic terms' shares of the prototype votes for one CIELAB colour (sums to 1; all on the nearest
+    prototype's term when the colour is far from every prototype)."""
     distances = delta_e_2000(lab[None, :], _PROTOTYPE_LAB)
-    votes = np.exp(-0.5 * (distances / parameters.kernel_width) ** 2)
-    density = votes @ _TERM_AVERAGE
+    density = np.exp(-0.5 * (distances / parameters.kernel_width) ** 2) @ _TERM_AVERAGE
     total = float(density.sum())
-    if total <= 1e-300:  # far from every prototype: the nearest one decides
-        return SurfaceName(_PROTOTYPE_TERMS[int(np.argmin(distances))], 0.0)
-    best = int(np.argmax(density))
-    return SurfaceName(CHROMATIC_TERMS[best], float(density[best] / total))
+    if total <= 1e-300:
+        return np.eye(len(CHROMATIC_TERMS))[_PROTOTYPE_CODES[int(np.argmin(distances))]]
+    return density / total
+
+
+def _chromatic_name(lab: np.ndarray, parameters: NamingParameters) -> SurfaceName:
+    votes = _term_votes(lab, parameters)
+    best = int(np.argmax(votes))
+    return SurfaceName(CHROMATIC_TERMS[best], float(votes[best]))
+
+
+def _shade_groups(labs: list[np.ndarray], max_difference: float) -> list[list[int]]:
+    """The colours (CIELAB) linked by CIEDE2000 differences below ``max_difference`` (single linkage), as
+    lists of indices."""
+    groups: list[list[int]] = []
+    for index, lab in enumerate(labs):
+        linked = [g for g in groups if any(float(delta_e_2000(lab, labs[j])) < max_difference for j in g)]
+        merged = [index] + [j for g in linked for j in g]
+        groups = [g for g in groups if g not in linked] + [sorted(merged)]
+    return groups
+
+
+def _pool_shades(surfaces: list[Surface], names: list[SurfaceName], parameters: NamingParameters) -> list[SurfaceName]:
+    """The names with the lit saturated surfaces that are shades of one colour (:func:`_shade_groups` with
+    ``shade_delta_e``) named together, by their pixel-weighted term votes: a brown tin whose print and
+    shading spread it over reddish, pinkish and orange-brown surfaces is brown, one colour."""
+    chromatic = [i for i, s in enumerate(surfaces) if s.kind != "dark" and names[i].name in CHROMATIC_TERMS]
+    pooled = list(names)
+    for group in _shade_groups([surfaces[i].lab for i in chromatic], parameters.shade_delta_e):
+        if len(group) < 2:
+            continue
+        members = [chromatic[g] for g in group]
+        votes = sum(surfaces[i].pixels * _term_votes(surfaces[i].lab, parameters) for i in members)
+        votes = votes / float(votes.sum())
+        best = int(np.argmax(votes))
+        for i in members:
+            pooled[i] = SurfaceName(CHROMATIC_TERMS[best], float(votes[best]))
+    return pooled
 
 
 def name_surface(surface: Surface, surround: float, parameters: NamingParameters = DEFAULT_PARAMETERS) -> SurfaceName:
@@ -134,7 +170,7 @@ def name_colors(
     object has two; ``edges`` (N, from :func:`~annotators.image.color_surfaces.edge_strength`) lets pixels on
     colour edges be left out."""
     surfaces, count = object_surfaces(pixels, light, edges, parameters)
-    names = [name_surface(surface, light.surround, parameters) for surface in surfaces]
+    names = _pool_shades(surfaces, [name_surface(s, light.surround, parameters) for s in surfaces], parameters)
     weights: dict[str, float] = {}
     certainties: dict[str, float] = {}
     lit_names = {n.name for s, n in zip(surfaces, names, strict=True) if s.kind != "dark"}

@@ -84,6 +84,9 @@ class NamingParameters:
     """An unsaturated surface darker than this lit L* ..."""
     black_surround_ratio: float = 0.5
     """... and than this fraction of the surround's luminance is black (else grey)."""
+    shade_delta_e: float = 15.0
+    """Lit saturated surfaces less than this CIEDE2000 apart (linked in a chain) are shades of one colour and
+    are named together."""
     kernel_width: float = 8.0
     """Width (CIEDE2000 units) of each prototype's vote."""
     second_share: float = 0.3

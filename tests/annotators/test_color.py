@@ -115,6 +115,15 @@ def test_a_small_print_is_not_a_second_colour() -> None:
     assert names(mug) == ["white"]
 
 
+def test_shades_of_one_colour_are_named_together() -> None:
+    # a brown tin in dim light: its print and shading spread it over a reddish, a pinkish and an orange-brown
+    # surface (each named red, pink and brown alone, a few CIEDE2000 units apart); a person calls it brown
+    reddish, pinkish, brownish = (144, 93, 78), (156, 105, 108), (165, 120, 81)
+    assert [names(patch(rgb, 1.0, 300)) for rgb in (reddish, pinkish, brownish)] == [["red"], ["pink"], ["brown"]]
+    tin = np.vstack([patch(reddish, 1.0, 410), patch(pinkish, 1.0, 180, seed=1), patch(brownish, 1.0, 160, seed=2)])
+    assert names(tin) == ["brown"]
+
+
 def test_confidence_is_share_times_certainty() -> None:
     red, yellow, white = patch((205, 28, 30), 1, 600), patch((240, 224, 28), 1, 300), patch((232, 232, 230), 1, 100)
     named = name_colors(np.vstack([red, yellow, white]))
