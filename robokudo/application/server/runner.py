@@ -81,7 +81,8 @@ def keep_startup_objects_out_of_collections() -> None:
     last full collection reach a quarter of those that survived it. With ~150,000 startup objects counted, that
     took hundreds of goals and the server's memory grew by ~0.2 MiB per goal meanwhile. With them frozen, a full
     collection costs well under a millisecond, and the goal manager runs one after every goal (the second
-    collection here resets the count to the few objects left outside the frozen ones).
+    collection here resets the count to the few objects left outside the frozen ones). Called once the socket is
+    bound; :func:`serve` unfreezes when it returns.
     """
     gc.collect()
     gc.freeze()
@@ -102,7 +103,6 @@ async def serve(
     for signum in (signal.SIGINT, signal.SIGTERM):
         reason = f"the server is shutting down ({signal.Signals(signum).name})"
         loop.add_signal_handler(signum, lambda r=reason: stopping.done() or stopping.set_result(r))
-    keep_startup_objects_out_of_collections()
     goals = GoalManager(service, collect_after_goals=True)
     sessions: set[Session] = set()
     subscribers = Subscribers()
@@ -166,6 +166,7 @@ async def serve(
         async with websocket_server(
             connect, config.host, config.port, max_size=FRAME_LIMIT, process_request=page_handler(config.token)
         ) as server:
+            keep_startup_objects_out_of_collections()
             if on_ready is not None:
                 on_ready(f"ws://{config.host}:{config.port}")
             reason = await stopping
@@ -176,6 +177,7 @@ async def serve(
                     await asyncio.wait_for(session.flush(), FLUSH_SECONDS)
             server.close()
     finally:
+        gc.unfreeze()  # a caller in the same process (tests, an embedding program) gets its collector back
         if not closed:  # the server could not start (address in use, ...): still close the store
             await loop.run_in_executor(None, goals.close, "the server stopped")
         for signum in (signal.SIGINT, signal.SIGTERM):
