@@ -169,8 +169,14 @@ def test_the_beliefs_topic_publishes_what_a_goal_changed_in_the_store(ros: rosli
 
 def test_roslibpy_authenticates_with_the_token_on_a_guarded_server(guarded_server: Served) -> None:
     client = roslibpy.Ros(host=guarded_server.host, port=guarded_server.port)
-    client.authenticate(mac=TOKEN, client="", dest="", rand="", t=0, level="", end=0)
     client.run()
+    # Sent as the first message once connected; roslibpy's authenticate() sends on its "ready" event, which can come
+    # after a request made right after run() returns, and the server refuses any op before auth.
+    client.send_on_ready(
+        roslibpy.Message(
+            {"op": "auth", "mac": TOKEN, "client": "", "dest": "", "rand": "", "t": 0, "level": "", "end": 0}
+        )
+    )
     try:
         service = roslibpy.Service(client, "/robokudo/plan", "robokudo_msgs/srv/Plan")
         response = service.call(roslibpy.ServiceRequest({"query": "find milk in fridge"}), timeout=WAIT)
