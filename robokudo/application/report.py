@@ -1,4 +1,4 @@
-"""Human-readable results of a CAS: a table of the object hypotheses and an annotated colour image.
+"""Human-readable results of a CAS: a table of the object hypotheses (pictures: ``annotated_image``).
 
 Sizes come from a Size annotation when an expert attached one, else from the oriented box of the hypothesis
 points: upright in the world when the camera pose is known, upright on the supporting plane when there is one,
@@ -8,27 +8,20 @@ was known).
 
 from __future__ import annotations
 
-from collections.abc import Mapping
 from dataclasses import dataclass
-from pathlib import Path
-from types import MappingProxyType
 
-import cv2
 import numpy as np
 
 from annotators.cloud.plane import plane_basis
 from annotators.cloud.pose import hypothesis_points
 from annotators.geometry.boxes import object_box
-from reasoning.beliefs.answer import Answer
 from robokudo.core.cas import CAS
 from robokudo.core.types import (
     CameraInfo,
-    ColorImage,
     ObjectHypothesis,
     Plane,
     PointCloud,
     Pose,
-    QueryAnswer,
     SemanticColor,
     Size,
 )
@@ -112,107 +105,3 @@ def describe_hypotheses(cas: CAS) -> str:
     return "\n".join(
         "  ".join(cell.ljust(width) for cell, width in zip(row, widths, strict=True)).rstrip() for row in rows
     )
-
-
-_DRAW_COLORS: Mapping[str, tuple[int, int, int]] = MappingProxyType(
-    {
-        "red": (230, 40, 40),
-        "orange": (255, 150, 20),
-        "yellow": (250, 230, 40),
-        "green": (40, 200, 60),
-        "blue": (40, 110, 255),
-        "purple": (160, 60, 220),
-        "pink": (255, 120, 200),
-        "brown": (150, 90, 40),
-        "white": (255, 255, 255),
-        "grey": (160, 160, 160),
-        "black": (20, 20, 20),
-    }
-)
-
-
-def draw_hypotheses(cas: CAS) -> np.ndarray:
-    """The colour image (a new RGB array) with every hypothesis outlined, boxed and labelled."""
-    color_view = cas.view(ColorImage)
-    if color_view is None:
-        raise ValueError("the CAS has no ColorImage to draw on")
-    canvas = np.ascontiguousarray(color_view.image).copy()
-    hypotheses = cas.annotations(ObjectHypothesis)
-    for summary, hypothesis in zip(summarize(cas), hypotheses, strict=True):
-        rgb = _DRAW_COLORS.get(summary.color, (0, 255, 255))
-        x0, y0, x1, y1 = summary.roi
-        local = np.ascontiguousarray(hypothesis.mask[y0:y1, x0:x1]).view(np.uint8)
-        contours, _ = cv2.findContours(local, cv2.RETR_EXTERNAL, cv2.CHAIN_APPROX_SIMPLE, offset=(x0, y0))
-        cv2.drawContours(canvas, contours, -1, rgb, 1, cv2.LINE_AA)
-        cv2.rectangle(canvas, (x0, y0), (x1 - 1, y1 - 1), rgb, 2)
-        label = f"{summary.number} {summary.color}"
-        if summary.size is not None:
-            label += f" {100 * summary.size[0]:.0f}cm"
-        (width, height), _ = cv2.getTextSize(label, cv2.FONT_HERSHEY_SIMPLEX, 0.45, 1)
-        top = max(y0 - height - 6, 0)
-        cv2.rectangle(canvas, (x0, top), (x0 + width + 6, top + height + 6), (0, 0, 0), -1)
-        cv2.putText(canvas, label, (x0 + 3, top + height + 2), cv2.FONT_HERSHEY_SIMPLEX, 0.45, rgb, 1, cv2.LINE_AA)
-    return canvas
-
-
-@dataclass(frozen=True)
-class Box:
-    """A hypothesis' image box and its label."""
-
-    roi: tuple[int, int, int, int]
-    label: str
-
-
-def answer_boxes(cas: CAS) -> tuple[Box, ...]:
-    """The answer's objects seen in this frame (``#id label``), or else every hypothesis, with their boxes."""
-    found = cas.view(QueryAnswer)
-    if found is not None and isinstance(found.answer, Answer):
-        labelled = tuple(
-            Box(tuple(int(v) for v in o.roi), f"#{o.id} {o.shown_label()}")  # type: ignore[arg-type]
-            for o in found.answer.objects
-            if o.roi is not None
-        )
-        if labelled:
-            return labelled
-    hypotheses = cas.annotations(ObjectHypothesis)
-    return tuple(Box(tuple(int(v) for v in h.roi), f"hypothesis {i}") for i, h in enumerate(hypotheses, 1))  # type: ignore[arg-type]
-
-
-def draw_answer(cas: CAS) -> np.ndarray:
-    """The colour image (a new RGB array) with the hypotheses outlined and the answer's objects boxed with their
-    id and class (every hypothesis numbered when the CAS holds no answer)."""
-    color_view = cas.view(ColorImage)
-    if color_view is None:
-        raise ValueError("the CAS has no ColorImage to draw on")
-    canvas = np.ascontiguousarray(color_view.image).copy()
-    for hypothesis in cas.annotations(ObjectHypothesis):
-        x0, y0, x1, y1 = hypothesis.roi
-        local = np.ascontiguousarray(hypothesis.mask[y0:y1, x0:x1]).view(np.uint8)
-        contours, _ = cv2.findContours(local, cv2.RETR_EXTERNAL, cv2.CHAIN_APPROX_SIMPLE, offset=(x0, y0))
-        cv2.drawContours(canvas, contours, -1, (160, 160, 160), 1, cv2.LINE_AA)
-    for box in answer_boxes(cas):
-        _draw_box(canvas, box.roi, box.label, (0, 229, 255))
-    return canvas
-
-
-def _draw_box(canvas: np.ndarray, roi: tuple[int, int, int, int], label: str, rgb: tuple[int, int, int]) -> None:
-    x0, y0, x1, y1 = roi
-    cv2.rectangle(canvas, (x0, y0), (x1 - 1, y1 - 1), rgb, 2)
-    (width, height), _ = cv2.getTextSize(label, cv2.FONT_HERSHEY_SIMPLEX, 0.45, 1)
-    top = max(y0 - height - 6, 0)
-    cv2.rectangle(canvas, (x0, top), (x0 + width + 6, top + height + 6), (0, 0, 0), -1)
-    cv2.putText(canvas, label, (x0 + 3, top + height + 2), cv2.FONT_HERSHEY_SIMPLEX, 0.45, rgb, 1, cv2.LINE_AA)
-
-
-def write_image(picture: np.ndarray, path: str | Path) -> Path:
-    """Write an RGB picture to ``path`` (format from the suffix); returns the path."""
-    path = Path(path)
-    path.parent.mkdir(parents=True, exist_ok=True)
-    if not cv2.imwrite(str(path), cv2.cvtColor(picture, cv2.COLOR_RGB2BGR)):
-        raise OSError(f"could not write an image to {path}")
-    return path
-
-
-def write_annotated_image(cas: CAS, path: str | Path) -> Path:
-    """Draw the hypotheses and write the picture to ``path`` (format from the suffix); returns the path."""
-    return write_image(draw_hypotheses(cas), path)

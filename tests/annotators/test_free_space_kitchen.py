@@ -23,6 +23,7 @@ from reasoning.planning.query_planner import QueryPlanner
 from robokudo.application.knowledge import load_knowledge_base
 from robokudo.application.sensor_sources import sensor_source
 from robokudo.application.service import AnsweringService
+from robokudo.core.cas import CAS
 from robokudo.core.engine import Engine
 from robokudo.core.geometry import rotation_matrix
 from robokudo.core.types import QueryAnswer
@@ -41,6 +42,13 @@ def placements_on(
     kb: KnowledgeBase, layout: StorageLayout, store_path: Path, seed: int = 0
 ) -> list[PlacementDesignator]:
     """The placements the planned tree of QUERY answers on the kitchen with ``layout`` on the fridge shelf."""
+    return placements_tree(kb, layout, store_path, seed)[1]
+
+
+def placements_tree(
+    kb: KnowledgeBase, layout: StorageLayout, store_path: Path, seed: int = 0
+) -> tuple[CAS, list[PlacementDesignator]]:
+    """The CAS the planned tree of QUERY analysed (kitchen with ``layout`` on the fridge shelf) and its placements."""
     base = sensor_source(kb, None, region="fridge").step
     parameters = (*base.parameters, ("extra", layout.extra()), ("seed", seed))
     step = Step(base.annotator, base.implemented_by, base.inputs, base.outputs, parameters, base.reason)
@@ -53,7 +61,7 @@ def placements_on(
         found = tree.cas.view(QueryAnswer)
     assert found is not None and isinstance(found.answer, Answer)
     assert found.answer.placements is not None
-    return list(found.answer.placements)
+    return tree.cas, list(found.answer.placements)
 
 
 def rectangle(placement: PlacementDesignator) -> tuple[np.ndarray, np.ndarray, tuple[float, float]]:

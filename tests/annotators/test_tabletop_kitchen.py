@@ -9,7 +9,8 @@ from py_trees.common import Status
 import trees
 from annotators.readers.frame_readers import KitchenSceneReader
 from annotators.simulation.kitchen_scene import RenderedScene
-from robokudo.application.report import describe_hypotheses, draw_hypotheses, write_annotated_image
+from robokudo.application.annotated_image import draw_answer, write_annotated_image
+from robokudo.application.report import describe_hypotheses
 from robokudo.core.engine import Engine
 from robokudo.core.pipeline import Pipeline
 from robokudo.core.types import ColorImage, ObjectHypothesis, Plane, Pose, SemanticColor
@@ -112,7 +113,7 @@ def test_annotated_image_is_drawn_on_a_copy(table: tuple[Pipeline, RenderedScene
     root, _ = table
     original = root.cas.view(ColorImage).image
     before = original.copy()
-    drawn = draw_hypotheses(root.cas)
+    drawn = draw_answer(root.cas)
     assert drawn.shape == original.shape and drawn.dtype == np.uint8
     assert np.array_equal(original, before)
     assert np.count_nonzero(np.any(drawn != original, axis=2)) > 500

@@ -20,6 +20,7 @@ from queries import Query, QueryError, parse_query
 from reasoning.beliefs.store import BeliefStoreError
 from reasoning.errors import OntologyError
 from reasoning.planning.planner import PlanningError
+from robokudo.application.annotated_image import write_annotated_image
 from robokudo.application.cluster import ClusterError
 from robokudo.application.commands.input_options import (
     add_input_arguments,
@@ -35,7 +36,6 @@ from robokudo.application.commands.remote_options import (
     unknown_names,
 )
 from robokudo.application.commands.rerun_options import RerunOptionError, add_rerun_arguments, open_rerun_log
-from robokudo.application.report import draw_answer, write_image
 from robokudo.application.service import AnsweringService, Outcome, PerceptionFailedError, UnknownObjectError
 from robokudo.core.remote import PlacementError
 from robokudo.core.render import unicode_tree
@@ -103,6 +103,7 @@ def run(args: argparse.Namespace) -> int:
             ) as service,
         ):
             outcome = answer(service, query, rerun_log)
+            regions = service.kb.regions()  # to outline a pointed region in the picture
     except QueryError as error:
         print(error, file=sys.stderr)
         return 2
@@ -119,7 +120,8 @@ def run(args: argparse.Namespace) -> int:
         print(unicode_tree(outcome.tree, show_status=True, show_reasons=True))
         print()
     if args.annotated_image and outcome.tree.cas.view(ColorImage) is not None:
-        print(f"annotated image: {write_image(draw_answer(outcome.tree.cas), args.annotated_image)}", file=sys.stderr)
+        path = write_annotated_image(outcome.tree.cas, args.annotated_image, regions=regions)
+        print(f"annotated image: {path}", file=sys.stderr)
     if outcome.answer.timed_out:
         print(f"robokudo query: {TIMED_OUT_NOTE}", file=sys.stderr)
     print(outcome.answer.to_json() if args.json else outcome.answer.summary())

@@ -8,6 +8,7 @@ import sys
 from py_trees.behaviour import Behaviour
 from py_trees.common import Status
 
+from robokudo.application.annotated_image import write_annotated_image
 from robokudo.application.cluster import ClusterError
 from robokudo.application.commands.input_options import (
     add_input_arguments,
@@ -23,7 +24,7 @@ from robokudo.application.commands.remote_options import (
     unknown_names,
 )
 from robokudo.application.commands.rerun_options import RerunOptionError, add_rerun_arguments, open_rerun_log
-from robokudo.application.report import describe_hypotheses, write_annotated_image
+from robokudo.application.report import describe_hypotheses
 from robokudo.core.annotator import Annotator
 from robokudo.core.engine import Engine
 from robokudo.core.pipeline import pipelines
@@ -40,7 +41,7 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
     add_input_arguments(parser, "input path")
     parser.add_argument("--ticks", type=int, default=None, help="tick this many times (default: until it finishes)")
     parser.add_argument("--hz", type=float, default=30.0, help="tick frequency")
-    parser.add_argument("--annotated-image", metavar="PATH", help="write the colour image with the hypotheses drawn")
+    parser.add_argument("--annotated-image", metavar="PATH", help="write the frame with what was found drawn")
     add_rerun_arguments(parser)
     add_remote_arguments(parser)
 

@@ -22,7 +22,7 @@ from typing import Any
 import cv2
 import numpy as np
 
-from robokudo.application.report import Box, answer_boxes
+from robokudo.application.annotated_image import Box, answer_boxes
 from robokudo.core.cas import CAS
 from robokudo.core.types import CameraInfo, ColorImage, DepthImage
 
