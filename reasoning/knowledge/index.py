@@ -150,6 +150,8 @@ class OntologyIndex:
 
     size_bounds: Mapping[str, float] = field(default_factory=dict)
     """Size class -> the bound on its objects' largest extent in metres (``rk:largestExtentBelow``)."""
+    inspected_types: tuple[str, ...] = ()
+    """The annotation types answering the query keys marked ``rk:refinedByInspection true``, sorted."""
 
     def mask(self, types: Iterable[str]) -> int:
         """The bit mask of CAS types (names that are no CAS type are left out)."""
@@ -205,6 +207,7 @@ class _Builder:
         annotators = self._annotators(preconditions)
         words, word_labels = self._words(regions)
         size_bounds = self._size_bounds()
+        inspected_types = self._inspected_types()
         if self.problems:
             raise OntologyError(sorted(set(self.problems)))
         annotator_conditions = {
@@ -252,6 +255,7 @@ class _Builder:
             class_domain=tuple(spec for spec in ranked if spec.classes),
             look_alikes=self._look_alikes(profiles),
             size_bounds=size_bounds,
+            inspected_types=inspected_types,
         )
 
     @staticmethod
@@ -396,6 +400,18 @@ class _Builder:
         self.disjoint = {name: frozenset(values) for name, values in pairs.items()}
 
     # ------------------------------------------------------------------ object profiles
+
+    def _inspected_types(self) -> tuple[str, ...]:
+        """The annotation types of the query keys an inspection refines (``rk:refinedByInspection true``)."""
+        found = set()
+        for subject, value in self.graph.subject_objects(RK["refinedByInspection"]):
+            name = local_name(subject) if is_rk(subject) else str(subject)
+            answers = [local_name(v) for v in self.graph.objects(subject, RK.answeredBy)]
+            if not (isinstance(value, Literal) and isinstance(value.toPython(), bool)) or len(answers) != 1:
+                self.problems.append(f"{name}: rk:refinedByInspection is a boolean said of query keys")
+            elif value.toPython():
+                found.add(answers[0])
+        return tuple(sorted(found))
 
     def _size_bounds(self) -> dict[str, float]:
         """Each size class's ``rk:largestExtentBelow`` (a positive number of metres)."""

@@ -385,6 +385,11 @@ class KnowledgeBase:
         ``rk:valueDomain``; None for types without one (free text, poses, ...)."""
         return self._index.value_domains.get(annotation_type)
 
+    def inspected_types(self) -> tuple[str, ...]:
+        """The annotation types an inspect query of one object by id refines (their query keys are marked
+        ``rk:refinedByInspection``), sorted."""
+        return self._index.inspected_types
+
     def query_keys(self) -> dict[str, str]:
         """Every query key word (normalised) -> the annotation type that answers it."""
         return dict(self._index.query_keys)

@@ -95,6 +95,9 @@ def interpret(query: Query, kb: KnowledgeBase, depth: bool = True, camera_pose: 
             asked = f"query asks {field.key} = {name}" if name is not None else f"query asks for {field.key}"
             domain_value = name if kb.value_kind(annotation_type) is not None else None
             requirements.append(Requirement(annotation_type, domain_value, asked))
+    object_id = _whole(obj.get("id"))
+    if query.kind == "inspect" and object_id is not None and all(f.key in _STRUCTURAL_KEYS for f in obj.fields):
+        requirements += _inspection(object_id, {r.annotation_type for r in requirements}, kb)
     transparent = _transparency(obj.get("transparent"), object_class, kb, inferences)
     min_confidence = _confidence(obj.get("confidence"), inferences)
     if object_class is not None and not obj.get("text"):
@@ -117,10 +120,21 @@ def interpret(query: Query, kb: KnowledgeBase, depth: bool = True, camera_pose: 
         constraints=tuple(constraints),
         inferences=tuple(inferences),
         max_results=_whole(query.get("max_results")),
-        object_id=_whole(obj.get("id")),
+        object_id=object_id,
         min_confidence=min_confidence,
     )
     return Interpretation(task, (*requirements, *_tracking(query)), region_box, transparent)
+
+
+def _inspection(object_id: int, required: set[str], kb: KnowledgeBase) -> list[Requirement]:
+    """What inspecting object ``object_id`` refines when the query asks for no attribute in particular (``inspect
+    object 3``; ``inspect { obj: { id: 3, color: ? } }`` refines the colour only): every annotation type the
+    ontology marks as refined by inspection."""
+    return [
+        Requirement(t, None, f"inspecting object {object_id} refines its {kb.label(t)}")
+        for t in kb.inspected_types()
+        if t not in required
+    ]
 
 
 def _interpret_specialised(query: Query, obj: Block, object_class: str, hypothesis: str) -> Interpretation:

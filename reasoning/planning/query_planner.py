@@ -3,7 +3,7 @@
 from __future__ import annotations
 
 from collections.abc import Iterable
-from dataclasses import dataclass
+from dataclasses import dataclass, replace
 
 from queries.model import FREE_SPACE_KEY, Query
 from reasoning.knowledge.knowledge_base import KnowledgeBase
@@ -166,10 +166,14 @@ class QueryPlanner:
         self._refresh()
         return self._profiles
 
-    def plan(self, query: Query, source: SensorSource) -> QueryPlan:
-        """Interpret ``query`` and synthesize the plan that answers it from ``source``'s sensor types."""
+    def plan(self, query: Query, source: SensorSource, focus: RegionBox | None = None) -> QueryPlan:
+        """Interpret ``query`` and synthesize the plan that answers it from ``source``'s sensor types; ``focus`` is
+        the box around the object an ``inspect`` query names by id (:func:`reasoning.planning.focus.object_focus`),
+        which then takes the place of a region."""
         depth = bool(source.types & DEPTH_TYPES)
         interpretation = interpret(query, self.kb, depth=depth, camera_pose=source.camera_pose)
+        if focus is not None and query.kind == "inspect":
+            interpretation = focused(interpretation, focus, depth and source.camera_pose)
         box = interpretation.region_box
         conditions = Conditions(depth=depth, region=box is not None, transparent=interpretation.transparent)
         task = interpretation.task
@@ -189,6 +193,17 @@ class QueryPlanner:
             catalogs=self._catalogs if self.keep_catalogs else None,
         )
         return QueryPlan(plan, interpretation)
+
+
+def focused(interpretation: Interpretation, focus: RegionBox, applicable: bool) -> Interpretation:
+    """An inspection's interpretation narrowed to the box around its object (``applicable``: the input has depth
+    and the camera pose, which the region filter needs; else the note says the whole view is searched)."""
+    task = interpretation.task
+    if not applicable:
+        note = f"the input has no depth or camera pose to look only at {focus.label}, so the whole view is searched"
+        return replace(interpretation, task=replace(task, inferences=(*task.inferences, note)))
+    note = f"only the points {focus.label} are searched: the box where the belief store holds it"
+    return replace(interpretation, region_box=focus, task=replace(task, inferences=(*task.inferences, note)))
 
 
 def plan_query(query: Query, kb: KnowledgeBase, source: SensorSource) -> QueryPlan:

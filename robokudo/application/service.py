@@ -55,6 +55,7 @@ from reasoning.beliefs.filters import belief_filter, kb_class_test
 from reasoning.beliefs.store import BeliefStore
 from reasoning.fusion.tracking import BeliefTracker, TrackStep
 from reasoning.knowledge.knowledge_base import KnowledgeBase
+from reasoning.planning.focus import object_focus
 from reasoning.planning.query_planner import QueryPlan, QueryPlanner
 from robokudo.application.knowledge import load_knowledge_base
 from robokudo.application.planning import plan_for_input
@@ -65,6 +66,7 @@ from robokudo.core.engine import Engine
 from robokudo.core.loop import Loop, frame_pipeline
 from robokudo.core.pipeline import Pipeline
 from robokudo.core.placement import Placement
+from robokudo.core.regions import RegionBox
 from robokudo.core.remote import place_remote
 from robokudo.core.resources import SharedResources
 from robokudo.core.slot import Idle, PerceiveThenTask, TaskSlot
@@ -391,11 +393,13 @@ class AnsweringService:
 
     def plan(self, query: str | Query) -> QueryPlan:
         """Interpret and plan ``query`` for this service's input (the kitchen camera looks at the query's region,
-        else at the region of the object the query names by id)."""
+        else at the region of the object the query names by id; an ``inspect`` of one object by id searches only
+        the box around where that object is believed to be)."""
         self.kb.reload_if_changed()
         parsed = parse_query(query) if isinstance(query, str) else query
+        focus = self._focus(parsed)
         if self.stream is not None:
-            return self.planner.plan(parsed, served_source(self.kb, self.stream))
+            return self.planner.plan(parsed, served_source(self.kb, self.stream), focus)
         return plan_for_input(
             self.planner,
             parsed,
@@ -404,7 +408,19 @@ class AnsweringService:
             look_at=self._remembered_region(parsed),
             intrinsics=self.intrinsics,
             person=self.person,
+            focus=focus,
         )
+
+    def _focus(self, query: Query) -> RegionBox | None:
+        """The box around the one object an ``inspect`` query names by id, where the store believes it is (None
+        for other queries, and when the belief is not in the world frame)."""
+        ids = belief_filter(query).ids if query.kind == "inspect" else None
+        if not ids or len(ids) != 1:
+            return None
+        known = self.store.get(ids[0])
+        if known is None:
+            return None
+        return object_focus(known.id, known.position, known.dimensions, known.frame)
 
     def _remembered_region(self, query: Query) -> str | None:
         """Where the last object the query names by id was last seen (None when it names none, or no region)."""
