@@ -53,7 +53,7 @@ def test_each_form_plans_a_clean_tree_narrowed_to_the_object(kb: KnowledgeBase, 
     parameters = dict(region_filter.parameters)
     assert parameters["region"] == "object 3"
     assert np.allclose(np.reshape(parameters["box_pose"], (4, 4))[:2, 3], CUP_POSITION[:2])
-    assert np.allclose(parameters["box_size"][:2], 0.07 + 2 * FOCUS_MARGIN)
+    assert np.allclose(parameters["box_size"][:2], 0.11 + 2 * FOCUS_MARGIN)
     tree = build_task_tree(query_plan.plan, query=query)
     assert isinstance(tree, Pipeline)
     validate_data_flow(tree)
@@ -64,6 +64,8 @@ def test_the_box_holds_the_object_and_the_surface_it_stands_on() -> None:
     assert box is not None and box.frame == "world" and box.name == "object 3"
     bottom = CUP_POSITION[2] - CUP_SIZE[2] / 2
     assert box.contains((CUP_POSITION[0], CUP_POSITION[1], bottom - SUPPORT_DEPTH + 0.01))  # the table under it
+    tall = object_focus(1, (1.3, 0.8, 1.055), (0.2, 0.068, 0.056), "world")  # extents largest first: a milk carton
+    assert tall is not None and tall.contains((1.3, 0.8, 1.055 - 0.1 - 0.01))  # the shelf under it
     assert box.contains((CUP_POSITION[0] + 0.07, CUP_POSITION[1] - 0.07, CUP_POSITION[2]))  # a pose a bit off
     assert not box.contains((CUP_POSITION[0] + 0.25, CUP_POSITION[1], CUP_POSITION[2]))  # the bowl beside it
     assert object_focus(3, CUP_POSITION, CUP_SIZE, "camera") is None  # no camera pose to place the points
