@@ -152,6 +152,10 @@ class KitchenCameraStream(FrameStream):
     stream was made or :meth:`restart_script`), the views of ``PERSON_VIEWS`` (``person``, ``room``) can be chosen
     too, and :meth:`pose_at_stamp` gives the ground-truth pose of a delivered frame (for scoring only). ``extra``
     adds objects to the scene (a storage layout's ``extra()``). Without either, nothing changes.
+
+    The scene can change while the stream runs: :meth:`stage` sets up a new scene (script, added objects),
+    :meth:`play` starts another script, and the events :meth:`grasp` (an object is taken away) and :meth:`place`
+    (an object is put down) change what the next frames show. :meth:`ground_truth` is the scene as it is now.
     """
 
     def __init__(
@@ -167,6 +171,8 @@ class KitchenCameraStream(FrameStream):
         self.seed = seed
         self.person = person
         self.extra = tuple(extra)
+        self.hidden: frozenset[str] = frozenset()
+        """Kitchen objects taken out of the scene (grasped)."""
         self._view = self._checked_view(view)
         self._rendered: dict[str, kitchen_scene.RenderedScene] = {}
         self._start = time.monotonic()
@@ -178,8 +184,62 @@ class KitchenCameraStream(FrameStream):
 
     @property
     def live(self) -> bool:
-        """True when frames are rendered anew (a scripted person or added objects)."""
-        return self.person is not None or bool(self.extra)
+        """True when frames are rendered anew (a scripted person, added or taken objects)."""
+        return self.person is not None or bool(self.extra) or bool(self.hidden)
+
+    def stage(
+        self,
+        person: PersonScript | None = None,
+        extra: tuple[tuple[SceneObject, tuple[int, int, int]], ...] = (),
+    ) -> None:
+        """Set the scene up anew from the next frame on: the kitchen's own objects all back in place, ``extra``
+        added, and ``person``'s script played from its start (None: nobody)."""
+        extra = tuple(extra)
+        taken = [o.name for o in kitchen_scene.kitchen_objects()] + [o.name for o, _ in extra]
+        if len(set(taken)) < len(taken):
+            clashing = sorted({n for n in taken if taken.count(n) > 1})
+            raise ValueError(f"added objects need names of their own, not {clashing}")
+        with self._lock:
+            self.person, self.extra, self.hidden = person, extra, frozenset()
+            self._script_start = time.monotonic()
+            self._poses.clear()
+
+    def play(self, person: PersonScript) -> None:
+        """Play ``person``'s script from its start with the next frame (the person's next motions)."""
+        with self._lock:
+            self.person = person
+            self._script_start = time.monotonic()
+
+    def grasp(self, name: str) -> SceneObject:
+        """A grasp event: the object called ``name`` (a kitchen object or an added one) is gone from the next frame
+        on; the object as it stood. ValueError when no such object is in the scene."""
+        with self._lock:
+            for index, (obj, _) in enumerate(self.extra):
+                if obj.name == name:
+                    self.extra = self.extra[:index] + self.extra[index + 1 :]
+                    return obj
+            present = {o.name: o for o in kitchen_scene.kitchen_objects() if o.name not in self.hidden}
+            if name not in present:
+                names = sorted(present) + [o.name for o, _ in self.extra]
+                raise ValueError(f"no object {name!r} in the scene to grasp; there are: {', '.join(names)}")
+            self.hidden = self.hidden | {name}
+            return present[name]
+
+    def place(self, obj: SceneObject, albedo: tuple[int, int, int]) -> None:
+        """A place event: ``obj`` (rendered with ``albedo``) stands in the scene from the next frame on. A grasped
+        kitchen object may be put down under its own name; ValueError when an object of that name or id is there."""
+        with self._lock:
+            present = [o for o in kitchen_scene.kitchen_objects() if o.name not in self.hidden]
+            present += [o for o, _ in self.extra]
+            if any(o.name == obj.name or o.object_id == obj.object_id for o in present):
+                raise ValueError(f"an object called {obj.name!r} or with id {obj.object_id} is in the scene already")
+            self.extra = (*self.extra, (obj, albedo))
+
+    def ground_truth(self) -> tuple[SceneObject, ...]:
+        """The objects in the scene now (kitchen objects not taken, then the added ones); for scoring only."""
+        with self._lock:
+            kept = tuple(o for o in kitchen_scene.kitchen_objects() if o.name not in self.hidden)
+            return kept + tuple(o for o, _ in self.extra)
 
     def _checked_view(self, view: str) -> str:
         views = list(kitchen_scene.camera_views())
@@ -241,10 +301,13 @@ class KitchenCameraStream(FrameStream):
         return scene
 
     def _live_scene(self, view: str) -> kitchen_scene.RenderedScene:
-        pose = None if self.person is None else self.person.pose_at(self.script_time())
+        with self._lock:
+            person, extra, hidden = self.person, self.extra, self.hidden
+            elapsed = time.monotonic() - self._script_start
+        pose = None if person is None else person.pose_at(elapsed)
         where = person_view(view) if view in PERSON_VIEWS else view
         self._delivered_pose = pose
-        scene = kitchen_scene.render_kitchen(where, seed=self.seed, person=pose, extra=self.extra)
+        scene = kitchen_scene.render_kitchen(where, seed=self.seed, person=pose, extra=extra, hidden=hidden)
         with self._lock:
             self._rendered[view] = scene
         return scene

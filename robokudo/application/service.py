@@ -471,7 +471,9 @@ class AnsweringService:
         handle.on_tick(on_tick)
         if isinstance(self.stream, KitchenCameraStream):
             region = query_plan.interpretation.task.region or self._remembered_region(parsed)
-            self.stream.set_view(kitchen_view_for(region))
+            task = query_plan.plan.task
+            people = self.stream.person is not None and (task.pointing is not None or task.object_class == "Human")
+            self.stream.set_view(kitchen_view_for(region, people=people))
         with self._lock:
             previous, self._current = self._current, handle
         if previous is not None:
