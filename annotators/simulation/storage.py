@@ -17,6 +17,7 @@ import numpy as np
 from annotators.cloud.size import size_class_for
 from annotators.simulation.kitchen_scene import (
     FRIDGE_SHELF_HEIGHTS,
+    RenderedScene,
     SceneObject,
     fridge_shelf,
     kitchen_objects,
@@ -194,3 +195,19 @@ def random_layout(seed: int, count: int | None = None, gap: float = 0.02) -> Sto
     if len(placed) < wanted:
         raise ValueError(f"could not put {wanted} objects on the shelf without touching (seed {seed})")
     return _layout(placed)
+
+
+def footprint_in_view(spot: np.ndarray, footprint: tuple[float, float], scene: RenderedScene) -> bool:
+    """Ground truth: True when the camera of ``scene`` sees the surface under the whole axis-aligned ``footprint``
+    at ``spot`` (the rendered depth there is the surface's, within 1 cm, at every sample)."""
+    samples = rectangle_samples(spot, np.eye(3), footprint, 0.01)
+    world_to_cam = scene.world_to_cam
+    camera = samples @ world_to_cam[:3, :3].T + world_to_cam[:3, 3]
+    if np.any(camera[:, 2] <= 0):
+        return False
+    pixels = np.rint(scene.intrinsics.project(camera)).astype(int)
+    height, width = scene.depth.shape
+    if np.any((pixels < 0) | (pixels >= (width, height))):
+        return False
+    depth = scene.depth[pixels[:, 1], pixels[:, 0]]
+    return bool(np.all(np.abs(depth - camera[:, 2]) < 0.01))

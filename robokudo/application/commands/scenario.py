@@ -16,20 +16,13 @@ from __future__ import annotations
 import argparse
 import json
 import sys
-import tempfile
 from pathlib import Path
 
-from annotators.readers.streams import KitchenCameraStream
-from robokudo.application.scenario.mission import StorageMission
+from robokudo.application.scenario.campaign import run_storage_scenario
 from robokudo.application.scenario.report import expert_stats, expert_table, plot_expert_times, success_table
-from robokudo.application.scenario.scoring import DEFAULT_FOLLOW_TOLERANCE, score_run, success_counts
-from robokudo.application.scenario.setup import RunSetup
-from robokudo.application.service import AnsweringService
+from robokudo.application.scenario.scoring import DEFAULT_FOLLOW_TOLERANCE, success_counts
 
 HELP = "run the paper's storage scenario on one running engine and score it"
-
-CAMERA_RATE_HZ = 15.0
-ENGINE_HZ = 30.0
 
 
 def add_arguments(parser: argparse.ArgumentParser) -> None:
@@ -68,34 +61,9 @@ def run(args: argparse.Namespace) -> int:
         if not args.quiet:
             print(line, file=sys.stderr, flush=True)
 
-    first = RunSetup.draw(args.seed)
-    stream = KitchenCameraStream(CAMERA_RATE_HZ, view="table", person=first.standing())
-    scores, records = [], []
-    with (
-        tempfile.TemporaryDirectory() as folder,
-        AnsweringService.open(Path(folder) / "beliefs.sqlite", hz=ENGINE_HZ, stream=stream) as service,
-    ):
-        service.run_in_background()
-        mission = StorageMission(service, stream)
-        for index in range(args.runs):
-            setup = first if index == 0 else RunSetup.draw(args.seed + index)
-            log(f"run {index + 1}/{args.runs} (seed {setup.seed}): she points at {setup.target}")
-            record = mission.run(setup, log)
-            score = score_run(record, args.follow_tolerance)
-            scores.append(score)
-            records.append(record)
-            verdict = " ".join(
-                f"{name}={'ok' if ok else 'FAIL'}"
-                for name, ok in zip(
-                    ("pointing", "following", "free-space", "process"),
-                    (score.pointing, score.following, score.free_space, score.process),
-                    strict=True,
-                )
-            )
-            log(f"  {verdict}" + "".join(f"\n    {why}" for why in score.why))
-        if service.perception is not None:
-            mission.times.add_tree(service.perception)
-    samples = mission.times.samples
+    result = run_storage_scenario(args.runs, args.seed, args.follow_tolerance, log)
+    records, scores = list(result.records), list(result.scores)
+    samples = result.expert_ms
     if args.plot is not None:
         plot_expert_times(samples, args.plot, f"storage scenario, {args.runs} runs: per-expert run times")
     if args.json:

@@ -37,7 +37,7 @@ from py_trees.common import Status
 from annotators.readers.streams import KitchenCameraStream
 from annotators.simulation.kitchen_person import PersonPose
 from annotators.simulation.kitchen_scene import FRIDGE_SHELF_HEIGHTS, kitchen_albedos, kitchen_objects
-from annotators.simulation.storage import shelf_occupants
+from annotators.simulation.storage import footprint_in_view, free_spots, shelf_occupants
 from reasoning.beliefs.answer import Answer
 from robokudo.application.scenario.scoring import (
     FollowSample,
@@ -257,7 +257,11 @@ class StorageMission:
             )
             for p in (answer.placements or () if answer is not None else ())
         )
-        record.free_space.append(FreeSpaceRecord(placements, occupants, footprint, answer is not None))
+        scene = self.stream.last_scene  # ground truth of the view the scan looked from, for scoring only
+        room = 0
+        if scene is not None:
+            room = sum(footprint_in_view(spot, footprint, scene) for spot in free_spots(occupants, footprint))
+        record.free_space.append(FreeSpaceRecord(placements, occupants, footprint, answer is not None, room))
         return placements
 
 

@@ -1,8 +1,9 @@
 """What one run of the storage scenario looks like: where the person stands, what she points at, what blocks the
 storage shelf, and her scripted motions per phase (seeded, so a run is reproducible).
 
-The person stands behind the table, points at one of the table objects, grasps it, walks to a spot in front of
-the fridge (the kitchen's storage region, its upper shelf the storage place) and points at the fridge. A random
+The person stands behind the table, points at one of the table objects, grasps it, walks to a spot towards the
+fridge (the kitchen's storage region, its upper shelf the storage place) and points at the fridge, sideways, her
+face to the robot (an arm pointing away from the camera would hide behind her body). A random
 storage layout (``annotators.simulation.storage.random_layout``) blocks places on the shelf. Everything here is
 ground truth for staging and scoring; the robot's perception sees only the rendered frames.
 """
@@ -23,15 +24,16 @@ TABLE_OBJECTS: tuple[str, ...] = ("cereal_box", "red_cup", "bowl")
 STORAGE_REGION = "fridge"
 """The storage region she points at (its upper shelf holds the storage layout)."""
 
-START_X: tuple[float, float] = (-0.35, 0.35)
+START_X: tuple[float, float] = (-0.55, -0.1)
 START_Y: tuple[float, float] = (0.6, 0.8)
 """Where she may start: behind the table (x, y ranges in metres, world frame)."""
 
-SPOT_X: tuple[float, float] = (0.75, 0.9)
-SPOT_Y: tuple[float, float] = (0.2, 0.4)
-"""Where she may stop to point at the fridge: between the table's right edge and the fridge's front."""
+SPOT_X: tuple[float, float] = (0.25, 0.45)
+SPOT_Y: tuple[float, float] = (0.7, 0.85)
+"""Where she may stop to point at the fridge: behind the table's right half, the fridge to her left at an arm's
+raise of about 45 degrees (a nearer fridge would have her arm hang nearly down, which is no pointing)."""
 
-WALK_SPEED = 0.45
+WALK_SPEED = 0.35
 """Her walking speed (m/s)."""
 
 HOLD_S = 600.0
