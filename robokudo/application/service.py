@@ -15,7 +15,8 @@ Over a live stream (``stream=``, as ``robokudo serve`` runs it) the root is the 
 pipeline reads the stream's newest frame, then the task slot; the engine ticks at its fixed rate in the
 background for the service's lifetime (:meth:`AnsweringService.run_in_background`), every task starts on a freshly
 perceived frame (:class:`~annotators.readers.streams.PerceivedFrameReader` is its first step), and the kitchen
-camera is pointed at the task's region. When perception fails (the source ended, a frame cannot be read) the
+camera is pointed at the task's region (at the table and the person behind it for a query about a person, when the
+kitchen holds one). When perception fails (the source ended, a frame cannot be read) the
 running task ends with that reason; once the source ended, new tasks are refused with it
 (:class:`SourceEndedError`). Without a stream (``robokudo query``), each task's tree reads its own frame and the
 engine ticks on the calling thread while :meth:`AnsweringService.answer` waits.
