@@ -23,6 +23,7 @@ from robokudo.application.scenario.scoring import (
     score_run,
 )
 from robokudo.application.scenario.setup import TABLE_OBJECTS, RunSetup
+from robokudo.application.service import AnsweringService
 
 IDENTITY = ((1.0, 0.0, 0.0), (0.0, 1.0, 0.0), (0.0, 0.0, 1.0))
 FOOTPRINT = (0.12, 0.12)
@@ -159,3 +160,20 @@ def test_the_storage_scenario_completes_five_runs_with_every_goal_handled(capsys
     for criterion in ("pointing", "following", "free"):
         assert criterion in rows
     assert "HumanPoseDetector" in out and "FreeSpaceEstimator" in out and "p90 ms" in out
+
+
+def test_a_query_about_the_person_looks_at_her_and_a_region_query_at_the_region(tmp_path) -> None:
+    stream = KitchenCameraStream(view="table", person=RunSetup.draw(0).standing())
+    with AnsweringService.open(tmp_path / "beliefs.sqlite", stream=stream) as service:  # the engine does not tick
+        for query, view in (
+            ("which object is the person pointing at", "person"),
+            ("find objects on the table", "table"),
+            ("track the person", "person"),
+            ("scan { free_space: { region: fridge, for: Cup } }", "fridge"),
+        ):
+            service.submit(query)
+            assert stream.view == view, query
+    without = KitchenCameraStream(view="table")
+    with AnsweringService.open(tmp_path / "other.sqlite", stream=without) as service:
+        service.submit("find the person")  # nobody in this kitchen: the camera stays on the table
+        assert without.view == "table"
