@@ -13,6 +13,7 @@ Run: ``.venv/bin/python bench/bench_scenario.py [--runs 50] [--seed 0] [--plot b
 from __future__ import annotations
 
 import argparse
+import os
 import sys
 import time
 from pathlib import Path
@@ -21,12 +22,21 @@ ROOT = Path(__file__).resolve().parents[1]
 if str(ROOT) not in sys.path:
     sys.path.insert(0, str(ROOT))
 
-from robokudo.application.scenario.campaign import run_storage_scenario  # noqa: E402
+from annotators.readers.streams import CLOCKS  # noqa: E402
+from robokudo.application.scenario.campaign import DEFAULT_CLOCK, run_storage_scenario  # noqa: E402
 from robokudo.application.scenario.report import expert_table, plot_expert_times, success_table  # noqa: E402
 from robokudo.application.scenario.scoring import DEFAULT_FOLLOW_TOLERANCE, success_counts  # noqa: E402
 
 GOALS = {"pointing": 0.95, "following": 0.95, "free space": 1.0, "process handling": 1.0}
 """Issue 16's goals: the share of runs that must succeed per criterion."""
+
+
+def _load() -> str:
+    """The machine's 1-minute load average at the end (the runs share the machine)."""
+    try:
+        return f"{os.getloadavg()[0]:.1f}"
+    except OSError:
+        return "unknown"
 
 
 def main() -> None:
@@ -35,6 +45,7 @@ def main() -> None:
     parser.add_argument("--seed", type=int, default=0)
     parser.add_argument("--tolerance", type=float, default=DEFAULT_FOLLOW_TOLERANCE)
     parser.add_argument("--plot", type=Path)
+    parser.add_argument("--clock", choices=CLOCKS, default=DEFAULT_CLOCK)
     parser.add_argument("--verbose", action="store_true", help="per-run progress on stderr")
     args = parser.parse_args()
     started = time.perf_counter()
@@ -43,9 +54,10 @@ def main() -> None:
         if args.verbose:
             print(line, file=sys.stderr, flush=True)
 
-    result = run_storage_scenario(args.runs, args.seed, args.tolerance, log)
+    result = run_storage_scenario(args.runs, args.seed, args.tolerance, log, args.clock)
     elapsed = time.perf_counter() - started
-    print(f"storage scenario: {args.runs} runs (seeds {args.seed}..{args.seed + args.runs - 1}), {elapsed:.0f} s")
+    seeds = f"seeds {args.seed}..{args.seed + args.runs - 1}"
+    print(f"storage scenario: {args.runs} runs ({seeds}, {args.clock} clock), {elapsed:.0f} s, load {_load()}")
     print(success_table(result.scores))
     print()
     counts = success_counts(result.scores)

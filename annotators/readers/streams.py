@@ -137,6 +137,11 @@ def _check_rate(rate_hz: float) -> float:
     return float(rate_hz)
 
 
+CLOCKS: tuple[str, ...] = ("wall", "frames")
+"""How a simulated camera's scene advances: with the wall clock (a slow consumer misses frames and sees the scene
+jump), or one camera period per delivered frame (the world waits for a slow consumer; frame time stamps are
+world time)."""
+
 MAX_REMEMBERED_POSES = 1000
 """How many delivered frames' person poses a scripted kitchen stream keeps for :meth:`pose_at_stamp`."""
 
@@ -151,7 +156,8 @@ class KitchenCameraStream(FrameStream):
     scripted figure: every frame is rendered anew with the figure posed at the script's time (seconds since the
     stream was made or :meth:`restart_script`), the views of ``PERSON_VIEWS`` (``person``, ``room``) can be chosen
     too, and :meth:`pose_at_stamp` gives the ground-truth pose of a delivered frame (for scoring only). ``extra``
-    adds objects to the scene (a storage layout's ``extra()``). Without either, nothing changes.
+    adds objects to the scene (a storage layout's ``extra()``). Without either, nothing changes. The script's time
+    is the wall clock, or with ``clock="frames"`` one camera period per delivered frame (:data:`CLOCKS`).
 
     The scene can change while the stream runs: :meth:`stage` sets up a new scene (script, added objects),
     :meth:`play` starts another script, and the events :meth:`grasp` (an object is taken away) and :meth:`place`
@@ -165,9 +171,16 @@ class KitchenCameraStream(FrameStream):
         seed: int = 0,
         person: PersonScript | None = None,
         extra: tuple[tuple[SceneObject, tuple[int, int, int]], ...] = (),
+        clock: str = "wall",
     ) -> None:
         super().__init__(name="kitchen camera")
         self.rate_hz = _check_rate(rate_hz)
+        if clock not in CLOCKS:
+            raise ValueError(f"unknown clock {clock!r}; known: {', '.join(CLOCKS)}")
+        self.clock = clock
+        """``wall``: the scene's time is the wall clock; ``frames``: it advances one camera period per frame."""
+        self._world = 0.0
+        self._epoch = time.time()
         self.seed = seed
         self.person = person
         self.extra = tuple(extra)
@@ -181,6 +194,10 @@ class KitchenCameraStream(FrameStream):
         self._last_slot = -1
         self._last_view: str | None = None
         self._delivered_pose: PersonPose | None = None
+
+    def _now(self) -> float:
+        """The scene's time now (monotonic seconds; with the frames clock, the next frame's world time)."""
+        return time.monotonic() if self.clock == "wall" else self._start + self._world
 
     @property
     def live(self) -> bool:
@@ -201,14 +218,14 @@ class KitchenCameraStream(FrameStream):
             raise ValueError(f"added objects need names of their own, not {clashing}")
         with self._lock:
             self.person, self.extra, self.hidden = person, extra, frozenset()
-            self._script_start = time.monotonic()
+            self._script_start = self._now()
             self._poses.clear()
 
     def play(self, person: PersonScript) -> None:
         """Play ``person``'s script from its start with the next frame (the person's next motions)."""
         with self._lock:
             self.person = person
-            self._script_start = time.monotonic()
+            self._script_start = self._now()
 
     def grasp(self, name: str) -> SceneObject:
         """A grasp event: the object called ``name`` (a kitchen object or an added one) is gone from the next frame
@@ -252,13 +269,13 @@ class KitchenCameraStream(FrameStream):
     def restart_script(self) -> None:
         """Play the person's script from its start with the next frame."""
         with self._lock:
-            self._script_start = time.monotonic()
+            self._script_start = self._now()
             self._poses.clear()
 
     def script_time(self) -> float:
         """Seconds since the person's script started."""
         with self._lock:
-            return time.monotonic() - self._script_start
+            return self._now() - self._script_start
 
     def pose_at_stamp(self, timestamp: float) -> PersonPose | None:
         """The person's pose in the frame stamped ``timestamp`` (None when no such frame was delivered)."""
@@ -303,7 +320,7 @@ class KitchenCameraStream(FrameStream):
     def _live_scene(self, view: str) -> kitchen_scene.RenderedScene:
         with self._lock:
             person, extra, hidden = self.person, self.extra, self.hidden
-            elapsed = time.monotonic() - self._script_start
+            elapsed = self._now() - self._script_start
         pose = None if person is None else person.pose_at(elapsed)
         where = person_view(view) if view in PERSON_VIEWS else view
         self._delivered_pose = pose
@@ -335,7 +352,7 @@ class KitchenCameraStream(FrameStream):
             intrinsics=scene.intrinsics,
             cam_to_world=scene.cam_to_world,
             frame_id=f"kitchen/{view}",
-            timestamp=time.time(),
+            timestamp=time.time() if self.clock == "wall" else self._epoch + self._world,
             recording=KITCHEN_RECORDING,
         )
         frame = Frame(scene.color, scene.depth, scene.intrinsics, source=f"kitchen/{view}", timestamp=camera.timestamp)
@@ -346,6 +363,9 @@ class KitchenCameraStream(FrameStream):
                     del self._poses[next(iter(self._poses))]
         self._last_slot = slot
         self._last_view = view
+        if self.clock == "frames":
+            with self._lock:
+                self._world += period
         delivered = StreamFrame(frame, camera, index=slot, sequence=self._delivered)
         self._delivered += 1
         return delivered

@@ -18,7 +18,8 @@ import json
 import sys
 from pathlib import Path
 
-from robokudo.application.scenario.campaign import run_storage_scenario
+from annotators.readers.streams import CLOCKS
+from robokudo.application.scenario.campaign import DEFAULT_CLOCK, run_storage_scenario
 from robokudo.application.scenario.report import expert_stats, expert_table, plot_expert_times, success_table
 from robokudo.application.scenario.scoring import DEFAULT_FOLLOW_TOLERANCE, success_counts
 
@@ -38,6 +39,13 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
         default=DEFAULT_FOLLOW_TOLERANCE,
         metavar="M",
         help=f"metres a tracked position may be from her body's centre (default {DEFAULT_FOLLOW_TOLERANCE:g})",
+    )
+    storage.add_argument(
+        "--clock",
+        choices=CLOCKS,
+        default=DEFAULT_CLOCK,
+        help="how the scene advances: one camera period per frame (frames, default: the runs do not depend on how "
+        "busy the machine is) or with the wall clock (wall: a slow tracking loop misses frames of her walk)",
     )
     storage.add_argument("--json", action="store_true", help="print the runs and results as JSON")
     storage.add_argument("--quiet", action="store_true", help="no per-phase progress on stderr")
@@ -61,7 +69,7 @@ def run(args: argparse.Namespace) -> int:
         if not args.quiet:
             print(line, file=sys.stderr, flush=True)
 
-    result = run_storage_scenario(args.runs, args.seed, args.follow_tolerance, log)
+    result = run_storage_scenario(args.runs, args.seed, args.follow_tolerance, log, args.clock)
     records, scores = list(result.records), list(result.scores)
     samples = result.expert_ms
     if args.plot is not None:
@@ -69,7 +77,9 @@ def run(args: argparse.Namespace) -> int:
     if args.json:
         print(json.dumps(_as_json(records, scores, samples), indent=2))
     else:
-        print(f"storage scenario: {args.runs} runs (seeds {args.seed}..{args.seed + args.runs - 1})")
+        print(
+            f"storage scenario: {args.runs} runs (seeds {args.seed}..{args.seed + args.runs - 1}, {args.clock} clock)"
+        )
         print(success_table(scores))
         print()
         print(expert_table(samples))

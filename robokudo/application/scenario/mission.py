@@ -32,11 +32,12 @@ from collections.abc import Callable
 from dataclasses import dataclass, field, replace
 
 import numpy as np
+import py_trees
 from py_trees.common import Status
 
 from annotators.readers.streams import KitchenCameraStream
 from annotators.simulation.kitchen_person import PersonPose
-from annotators.simulation.kitchen_scene import FRIDGE_SHELF_HEIGHTS, kitchen_albedos, kitchen_objects
+from annotators.simulation.kitchen_scene import FRIDGE_SHELF_HEIGHTS, SceneObject, kitchen_albedos, kitchen_objects
 from annotators.simulation.storage import footprint_in_view, free_spots, shelf_occupants
 from reasoning.beliefs.answer import Answer
 from robokudo.application.scenario.scoring import (
@@ -89,9 +90,9 @@ class ExpertTimes:
 
     samples: dict[str, list[float]] = field(default_factory=lambda: defaultdict(list))
 
-    def add_tree(self, tree: object) -> None:
+    def add_tree(self, tree: py_trees.behaviour.Behaviour) -> None:
         """Add the runs of every annotator in a finished goal's tree (by class)."""
-        for node in tree.iterate():  # type: ignore[attr-defined]
+        for node in tree.iterate():
             if isinstance(node, Annotator):
                 self.samples[type(node).__name__].extend(s * 1e3 for s in node.stats.samples)
 
@@ -218,7 +219,7 @@ class StorageMission:
         record.goals.append(GoalRecord("follow", TRACK_QUERY, handle.reason, expected, _ran(handle)))
         self.times.add_tree(handle.tree)
 
-    def _free_space(self, record: RunRecord, grasped: object) -> None:
+    def _free_space(self, record: RunRecord, grasped: SceneObject) -> None:
         """Scan the pointed region for room for the pointed object, put the object on the largest placement and
         scan again."""
         region = record.pointed_region
@@ -233,15 +234,14 @@ class StorageMission:
         if not first:
             return
         obj = grasped
-        best = first[0]
+        best = first[0]  # the largest
         axes = np.asarray(best.axes)
         yaw = math.atan2(axes[1, 0], axes[0, 0])
         pose = np.eye(4)
         c, s = math.cos(yaw), math.sin(yaw)
         pose[:3, :3] = [[c, -s, 0.0], [s, c, 0.0], [0.0, 0.0, 1.0]]
-        pose[:3, 3] = (best.centre[0], best.centre[1], FRIDGE_SHELF_HEIGHTS[0] + obj.size[2] / 2)  # type: ignore[attr-defined]
-        placed = replace(obj, pose=pose, region=region)  # type: ignore[type-var]
-        self.stream.place(placed, kitchen_albedos()[obj.name])  # type: ignore[attr-defined]
+        pose[:3, 3] = (best.centre[0], best.centre[1], FRIDGE_SHELF_HEIGHTS[0] + obj.size[2] / 2)
+        self.stream.place(replace(obj, pose=pose, region=region), kitchen_albedos()[obj.name])
         self._scan(record, query, footprint, phase="free space (after placing)")
 
     def _scan(
