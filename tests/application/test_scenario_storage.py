@@ -177,3 +177,20 @@ def test_a_query_about_the_person_looks_at_her_and_a_region_query_at_the_region(
     with AnsweringService.open(tmp_path / "other.sqlite", stream=without) as service:
         service.submit("find the person")  # nobody in this kitchen: the camera stays on the table
         assert without.view == "table"
+
+
+def test_the_frames_clock_advances_the_scene_one_camera_period_per_frame() -> None:
+    setup = RunSetup.draw(2)
+    script = setup.walking_to_storage()
+    with KitchenCameraStream(rate_hz=10.0, view="person", person=script, clock="frames") as stream:
+        frames = [stream.next_frame() for _ in range(3)]
+        stamps = [f.camera.timestamp for f in frames]
+        assert np.allclose(np.diff(stamps), 0.1)
+        for index, stamp in enumerate(stamps):
+            pose = stream.pose_at_stamp(stamp)
+            assert pose is not None
+            assert np.allclose(pose.position, script.pose_at(0.1 * index).position)
+        stream.play(setup.standing())  # a new script starts at the next frame's time
+        assert np.allclose(stream.pose_at_stamp(stream.next_frame().camera.timestamp).position, (*setup.start, 0.0))
+    with pytest.raises(ValueError, match="unknown clock"):
+        KitchenCameraStream(clock="sundial")
