@@ -145,7 +145,8 @@ class StorageMission:
         reason = handle.reason if ended else f"hung for {GOAL_TIMEOUT_S:g} s"
         failed_with_reason = reason not in NOT_A_PERCEPTION_FAILURE and not reason.startswith("timed out")
         expected = ended and (answer is not None or (may_fail and failed_with_reason))
-        record.goals.append(GoalRecord(phase, query, "answered" if answer else reason, expected, _ran(handle)))
+        ended_as = "answered" if answer is not None else reason
+        record.goals.append(GoalRecord(phase, query, ended_as, expected, _ran(handle)))
         self.times.add_tree(handle.tree)
         return answer
 
