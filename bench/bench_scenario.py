@@ -46,6 +46,7 @@ def main() -> None:
     parser.add_argument("--tolerance", type=float, default=DEFAULT_FOLLOW_TOLERANCE)
     parser.add_argument("--plot", type=Path)
     parser.add_argument("--clock", choices=CLOCKS, default=DEFAULT_CLOCK)
+    parser.add_argument("--minutes", type=float, help="start no run after this many minutes (as many runs as fit)")
     parser.add_argument("--verbose", action="store_true", help="per-run progress on stderr")
     args = parser.parse_args()
     started = time.perf_counter()
@@ -54,15 +55,17 @@ def main() -> None:
         if args.verbose:
             print(line, file=sys.stderr, flush=True)
 
-    result = run_storage_scenario(args.runs, args.seed, args.tolerance, log, args.clock)
+    budget = None if args.minutes is None else 60.0 * args.minutes
+    result = run_storage_scenario(args.runs, args.seed, args.tolerance, log, args.clock, budget)
     elapsed = time.perf_counter() - started
-    seeds = f"seeds {args.seed}..{args.seed + args.runs - 1}"
-    print(f"storage scenario: {args.runs} runs ({seeds}, {args.clock} clock), {elapsed:.0f} s, load {_load()}")
+    runs = len(result.scores)
+    seeds = f"seeds {args.seed}..{args.seed + runs - 1}"
+    print(f"storage scenario: {runs} runs ({seeds}, {args.clock} clock), {elapsed:.0f} s, load {_load()}")
     print(success_table(result.scores))
     print()
     counts = success_counts(result.scores)
     for name, share in GOALS.items():
-        got = counts[name] / args.runs
+        got = counts[name] / runs
         print(f"goal {name} >= {share:.0%}: {got:.1%} {'met' if got >= share else 'NOT met'}")
     if any(score.why for score in result.scores):
         print("\nwhy runs failed:")
@@ -73,7 +76,7 @@ def main() -> None:
     print(expert_table(result.expert_ms))
     if args.plot is not None:
         args.plot.parent.mkdir(parents=True, exist_ok=True)
-        plot_expert_times(result.expert_ms, args.plot, f"storage scenario, {args.runs} runs: per-expert run times")
+        plot_expert_times(result.expert_ms, args.plot, f"storage scenario, {runs} runs: per-expert run times")
         print(f"\nbox plot: {args.plot}")
 
 

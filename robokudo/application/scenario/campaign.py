@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import tempfile
+import time
 from collections.abc import Callable
 from dataclasses import dataclass
 from pathlib import Path
@@ -44,10 +45,12 @@ def run_storage_scenario(
     tolerance: float = DEFAULT_FOLLOW_TOLERANCE,
     log: Callable[[str], None] = lambda _: None,
     clock: str = DEFAULT_CLOCK,
+    budget_s: float | None = None,
 ) -> ScenarioResult:
     """Play ``runs`` runs (seeds ``seed``, ``seed + 1``, ...) of the storage mission on one answering service
     serving the kitchen camera (its own temporary belief store; the scene's ``clock``, see
-    ``annotators.readers.streams.CLOCKS``), score each, and collect the experts' times."""
+    ``annotators.readers.streams.CLOCKS``), score each, and collect the experts' times. With ``budget_s``, no run
+    starts once that many seconds have passed (the result holds the runs done, at least one)."""
     if runs < 1:
         raise ValueError(f"the scenario needs at least one run, not {runs}")
     first = RunSetup.draw(seed)
@@ -60,7 +63,11 @@ def run_storage_scenario(
     ):
         service.run_in_background()
         mission = StorageMission(service, stream)
+        started = time.monotonic()
         for index in range(runs):
+            if index and budget_s is not None and time.monotonic() - started >= budget_s:
+                log(f"time budget of {budget_s:g} s spent after {index} runs")
+                break
             setup = first if index == 0 else RunSetup.draw(seed + index)
             log(f"run {index + 1}/{runs} (seed {setup.seed}): she points at {setup.target}")
             record = mission.run(setup, log)
