@@ -19,7 +19,14 @@ from pathlib import Path
 import numpy as np
 
 from annotators.simulation.kitchen_scene import FRIDGE_SHELF_HEIGHTS
-from annotators.simulation.storage import StorageLayout, covers, on_shelf, random_layout, rectangle_samples
+from annotators.simulation.storage import (
+    StorageLayout,
+    covers,
+    footprint_in_view,
+    on_shelf,
+    random_layout,
+    rectangle_samples,
+)
 from queries import parse_query
 from reasoning.beliefs.store import BeliefStore
 from reasoning.planning.plan import Step
@@ -49,22 +56,6 @@ def true_free_spots(layout: StorageLayout, footprint: tuple[float, float], box: 
         blocked |= covers(obj, samples)
     free = ~blocked.reshape(len(centres), -1).any(axis=1)
     return list(centres[free])
-
-
-def visible(spot: np.ndarray, footprint: tuple[float, float], scene: object) -> bool:
-    """True when the camera sees the shelf under the whole footprint at ``spot`` (the rendered depth there is the
-    shelf's, within 1 cm, at every sample)."""
-    samples = rectangle_samples(spot, np.eye(3), footprint, 0.01)
-    world_to_cam = scene.world_to_cam  # type: ignore[attr-defined]
-    camera = samples @ world_to_cam[:3, :3].T + world_to_cam[:3, 3]
-    if np.any(camera[:, 2] <= 0):
-        return False
-    pixels = np.rint(scene.intrinsics.project(camera)).astype(int)  # type: ignore[attr-defined]
-    height, width = scene.depth.shape  # type: ignore[attr-defined]
-    if np.any((pixels < 0) | (pixels >= (width, height))):
-        return False
-    depth = scene.depth[pixels[:, 1], pixels[:, 0]]  # type: ignore[attr-defined]
-    return bool(np.all(np.abs(depth - camera[:, 2]) < 0.01))
 
 
 def covered(spot: np.ndarray, footprint: tuple[float, float], placements: list[tuple]) -> bool:
@@ -115,7 +106,7 @@ def main() -> None:
         spots_total += len(spots)
         hits = [covered(s, footprint, rectangles) for s in spots]
         spots_covered += sum(hits)
-        seen = [visible(s, footprint, scene) for s in spots]
+        seen = [footprint_in_view(s, footprint, scene) for s in spots]
         seen_total += sum(seen)
         seen_covered += sum(h for h, v in zip(hits, seen, strict=True) if v)
     precision = correct / reported if reported else 1.0

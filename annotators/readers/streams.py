@@ -137,6 +137,11 @@ def _check_rate(rate_hz: float) -> float:
     return float(rate_hz)
 
 
+CLOCKS: tuple[str, ...] = ("wall", "frames")
+"""How a simulated camera's scene advances: with the wall clock (a slow consumer misses frames and sees the scene
+jump), or one camera period per delivered frame (the world waits for a slow consumer; frame time stamps are
+world time)."""
+
 MAX_REMEMBERED_POSES = 1000
 """How many delivered frames' person poses a scripted kitchen stream keeps for :meth:`pose_at_stamp`."""
 
@@ -151,7 +156,12 @@ class KitchenCameraStream(FrameStream):
     scripted figure: every frame is rendered anew with the figure posed at the script's time (seconds since the
     stream was made or :meth:`restart_script`), the views of ``PERSON_VIEWS`` (``person``, ``room``) can be chosen
     too, and :meth:`pose_at_stamp` gives the ground-truth pose of a delivered frame (for scoring only). ``extra``
-    adds objects to the scene (a storage layout's ``extra()``). Without either, nothing changes.
+    adds objects to the scene (a storage layout's ``extra()``). Without either, nothing changes. The script's time
+    is the wall clock, or with ``clock="frames"`` one camera period per delivered frame (:data:`CLOCKS`).
+
+    The scene can change while the stream runs: :meth:`stage` sets up a new scene (script, added objects),
+    :meth:`play` starts another script, and the events :meth:`grasp` (an object is taken away) and :meth:`place`
+    (an object is put down) change what the next frames show. :meth:`ground_truth` is the scene as it is now.
     """
 
     def __init__(
@@ -161,12 +171,21 @@ class KitchenCameraStream(FrameStream):
         seed: int = 0,
         person: PersonScript | None = None,
         extra: tuple[tuple[SceneObject, tuple[int, int, int]], ...] = (),
+        clock: str = "wall",
     ) -> None:
         super().__init__(name="kitchen camera")
         self.rate_hz = _check_rate(rate_hz)
+        if clock not in CLOCKS:
+            raise ValueError(f"unknown clock {clock!r}; known: {', '.join(CLOCKS)}")
+        self.clock = clock
+        """``wall``: the scene's time is the wall clock; ``frames``: it advances one camera period per frame."""
+        self._world = 0.0
+        self._epoch = time.time()
         self.seed = seed
         self.person = person
         self.extra = tuple(extra)
+        self.hidden: frozenset[str] = frozenset()
+        """Kitchen objects taken out of the scene (grasped)."""
         self._view = self._checked_view(view)
         self._rendered: dict[str, kitchen_scene.RenderedScene] = {}
         self._start = time.monotonic()
@@ -176,10 +195,68 @@ class KitchenCameraStream(FrameStream):
         self._last_view: str | None = None
         self._delivered_pose: PersonPose | None = None
 
+    def _now(self) -> float:
+        """The scene's time now (monotonic seconds; with the frames clock, the next frame's world time)."""
+        return time.monotonic() if self.clock == "wall" else self._start + self._world
+
     @property
     def live(self) -> bool:
-        """True when frames are rendered anew (a scripted person or added objects)."""
-        return self.person is not None or bool(self.extra)
+        """True when frames are rendered anew (a scripted person, added or taken objects)."""
+        return self.person is not None or bool(self.extra) or bool(self.hidden)
+
+    def stage(
+        self,
+        person: PersonScript | None = None,
+        extra: tuple[tuple[SceneObject, tuple[int, int, int]], ...] = (),
+    ) -> None:
+        """Set the scene up anew from the next frame on: the kitchen's own objects all back in place, ``extra``
+        added, and ``person``'s script played from its start (None: nobody)."""
+        extra = tuple(extra)
+        taken = [o.name for o in kitchen_scene.kitchen_objects()] + [o.name for o, _ in extra]
+        if len(set(taken)) < len(taken):
+            clashing = sorted({n for n in taken if taken.count(n) > 1})
+            raise ValueError(f"added objects need names of their own, not {clashing}")
+        with self._lock:
+            self.person, self.extra, self.hidden = person, extra, frozenset()
+            self._script_start = self._now()
+            self._poses.clear()
+
+    def play(self, person: PersonScript) -> None:
+        """Play ``person``'s script from its start with the next frame (the person's next motions)."""
+        with self._lock:
+            self.person = person
+            self._script_start = self._now()
+
+    def grasp(self, name: str) -> SceneObject:
+        """A grasp event: the object called ``name`` (a kitchen object or an added one) is gone from the next frame
+        on; the object as it stood. ValueError when no such object is in the scene."""
+        with self._lock:
+            for index, (obj, _) in enumerate(self.extra):
+                if obj.name == name:
+                    self.extra = self.extra[:index] + self.extra[index + 1 :]
+                    return obj
+            present = {o.name: o for o in kitchen_scene.kitchen_objects() if o.name not in self.hidden}
+            if name not in present:
+                names = sorted(present) + [o.name for o, _ in self.extra]
+                raise ValueError(f"no object {name!r} in the scene to grasp; there are: {', '.join(names)}")
+            self.hidden = self.hidden | {name}
+            return present[name]
+
+    def place(self, obj: SceneObject, albedo: tuple[int, int, int]) -> None:
+        """A place event: ``obj`` (rendered with ``albedo``) stands in the scene from the next frame on. A grasped
+        kitchen object may be put down under its own name; ValueError when an object of that name or id is there."""
+        with self._lock:
+            present = [o for o in kitchen_scene.kitchen_objects() if o.name not in self.hidden]
+            present += [o for o, _ in self.extra]
+            if any(o.name == obj.name or o.object_id == obj.object_id for o in present):
+                raise ValueError(f"an object called {obj.name!r} or with id {obj.object_id} is in the scene already")
+            self.extra = (*self.extra, (obj, albedo))
+
+    def ground_truth(self) -> tuple[SceneObject, ...]:
+        """The objects in the scene now (kitchen objects not taken, then the added ones); for scoring only."""
+        with self._lock:
+            kept = tuple(o for o in kitchen_scene.kitchen_objects() if o.name not in self.hidden)
+            return kept + tuple(o for o, _ in self.extra)
 
     def _checked_view(self, view: str) -> str:
         views = list(kitchen_scene.camera_views())
@@ -192,13 +269,13 @@ class KitchenCameraStream(FrameStream):
     def restart_script(self) -> None:
         """Play the person's script from its start with the next frame."""
         with self._lock:
-            self._script_start = time.monotonic()
+            self._script_start = self._now()
             self._poses.clear()
 
     def script_time(self) -> float:
         """Seconds since the person's script started."""
         with self._lock:
-            return time.monotonic() - self._script_start
+            return self._now() - self._script_start
 
     def pose_at_stamp(self, timestamp: float) -> PersonPose | None:
         """The person's pose in the frame stamped ``timestamp`` (None when no such frame was delivered)."""
@@ -241,10 +318,13 @@ class KitchenCameraStream(FrameStream):
         return scene
 
     def _live_scene(self, view: str) -> kitchen_scene.RenderedScene:
-        pose = None if self.person is None else self.person.pose_at(self.script_time())
+        with self._lock:
+            person, extra, hidden = self.person, self.extra, self.hidden
+            elapsed = self._now() - self._script_start
+        pose = None if person is None else person.pose_at(elapsed)
         where = person_view(view) if view in PERSON_VIEWS else view
         self._delivered_pose = pose
-        scene = kitchen_scene.render_kitchen(where, seed=self.seed, person=pose, extra=self.extra)
+        scene = kitchen_scene.render_kitchen(where, seed=self.seed, person=pose, extra=extra, hidden=hidden)
         with self._lock:
             self._rendered[view] = scene
         return scene
@@ -272,7 +352,7 @@ class KitchenCameraStream(FrameStream):
             intrinsics=scene.intrinsics,
             cam_to_world=scene.cam_to_world,
             frame_id=f"kitchen/{view}",
-            timestamp=time.time(),
+            timestamp=time.time() if self.clock == "wall" else self._epoch + self._world,
             recording=KITCHEN_RECORDING,
         )
         frame = Frame(scene.color, scene.depth, scene.intrinsics, source=f"kitchen/{view}", timestamp=camera.timestamp)
@@ -283,6 +363,9 @@ class KitchenCameraStream(FrameStream):
                     del self._poses[next(iter(self._poses))]
         self._last_slot = slot
         self._last_view = view
+        if self.clock == "frames":
+            with self._lock:
+                self._world += period
         delivered = StreamFrame(frame, camera, index=slot, sequence=self._delivered)
         self._delivered += 1
         return delivered

@@ -23,7 +23,7 @@ Conventions:
 from __future__ import annotations
 
 import math
-from collections.abc import Mapping, Sequence
+from collections.abc import Collection, Mapping, Sequence
 from dataclasses import dataclass
 
 import cv2
@@ -48,6 +48,7 @@ __all__ = (
     "camera_looking_at",
     "camera_views",
     "fridge_shelf",
+    "kitchen_albedos",
     "kitchen_objects",
     "kitchen_regions",
     "look_at",
@@ -297,6 +298,11 @@ _PLAIN, _CHECKER, _WOOD, _LABEL = 0, 1, 2, 3
 _BACKGROUND_RGB = (28, 30, 36)
 _LIGHT_DIR: tuple[float, float, float] = (0.35, -0.6, 1.0)  # towards the key light (normalised on use)
 _AMBIENT, _KEY, _HEAD = 0.5, 0.35, 0.2
+
+
+def kitchen_albedos() -> dict[str, tuple[int, int, int]]:
+    """The RGB albedo each kitchen object is rendered with, by name (to put a grasped object down again)."""
+    return {spec.name: spec.albedo for spec in _OBJECT_SPECS}
 
 
 def kitchen_regions() -> tuple[RegionBox, ...]:
@@ -589,6 +595,7 @@ def render_kitchen(
     intrinsics: CameraIntrinsics = DEFAULT_INTRINSICS,
     person: PersonPose | None = None,
     extra: Sequence[tuple[SceneObject, tuple[int, int, int]]] = (),
+    hidden: Collection[str] = (),
 ) -> RenderedScene:
     """Render one RGB-D frame of the kitchen.
 
@@ -599,10 +606,15 @@ def render_kitchen(
     figure of :mod:`annotators.simulation.kitchen_person` in that pose (pixels of id ``PERSON_OBJECT_ID``).
     ``extra`` adds objects (box, cylinder or bowl shapes) with their RGB albedo to the
     scene and its ground truth, e.g. a storage layout (``annotators.simulation.storage``);
-    their names and ids must differ from the kitchen's.
+    their names and ids must differ from the kitchen's. ``hidden`` names kitchen objects left out of the scene and
+    its ground truth (taken away, e.g. grasped).
     """
     view_name, cam_to_world = _resolve_view(view)
     objects = kitchen_objects(moved)
+    unknown = set(hidden) - {o.name for o in objects}
+    if unknown:
+        raise ValueError(f"cannot hide unknown object(s) {sorted(unknown)}; known: {[o.name for o in objects]}")
+    objects = tuple(o for o in objects if o.name not in hidden)
     added = tuple(obj for obj, _ in extra)
     taken = {o.name for o in objects} | {o.object_id for o in objects}
     clashes = [o.name for o in added if o.name in taken or o.object_id in taken or o.object_id <= 0]

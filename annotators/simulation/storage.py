@@ -9,6 +9,7 @@ Ground truth (:meth:`StorageLayout.is_free`) is for scoring only: perception see
 from __future__ import annotations
 
 import math
+from collections.abc import Sequence
 from dataclasses import dataclass
 
 import numpy as np
@@ -16,6 +17,7 @@ import numpy as np
 from annotators.cloud.size import size_class_for
 from annotators.simulation.kitchen_scene import (
     FRIDGE_SHELF_HEIGHTS,
+    RenderedScene,
     SceneObject,
     fridge_shelf,
     kitchen_objects,
@@ -54,11 +56,54 @@ class StorageLayout:
     def is_free(self, centre: np.ndarray, rotation: np.ndarray, size: tuple[float, float], step: float = 0.005) -> bool:
         """Ground truth: True when the rectangle (world ``centre`` on the shelf, axes the columns of ``rotation``,
         ``size`` along its x and y) lies on the upper shelf between the fridge walls and touches no object."""
-        centre = np.asarray(centre, dtype=np.float64)
-        if abs(centre[2] - FRIDGE_SHELF_HEIGHTS[0]) > 0.02:
-            return False
-        samples = rectangle_samples(centre, rotation, size, step)
-        return bool(on_shelf(samples).all() and not any(covers(o, samples).any() for o in self.occupants()))
+        return free_on_shelf(self.occupants(), centre, rotation, size, step)
+
+
+def shelf_occupants(objects: Sequence[SceneObject]) -> tuple[SceneObject, ...]:
+    """The objects of ``objects`` standing on the fridge's upper shelf (their bottom on its top surface)."""
+    (cx, cy, _), (sx, sy, _) = fridge_shelf(0)
+    return tuple(
+        o
+        for o in objects
+        if abs(o.position[2] - o.size[2] / 2 - FRIDGE_SHELF_HEIGHTS[0]) < 0.01
+        and abs(o.position[0] - cx) <= sx / 2
+        and abs(o.position[1] - cy) <= sy / 2
+    )
+
+
+def free_on_shelf(
+    occupants: Sequence[SceneObject],
+    centre: np.ndarray,
+    rotation: np.ndarray,
+    size: tuple[float, float],
+    step: float = 0.005,
+) -> bool:
+    """Ground truth: True when the rectangle (world ``centre`` on the upper shelf, axes the columns of
+    ``rotation``, ``size`` along its x and y) lies on the shelf between the fridge walls and touches none of
+    ``occupants``."""
+    centre = np.asarray(centre, dtype=np.float64)
+    if abs(centre[2] - FRIDGE_SHELF_HEIGHTS[0]) > 0.02:
+        return False
+    samples = rectangle_samples(centre, rotation, size, step)
+    return bool(on_shelf(samples).all() and not any(covers(o, samples).any() for o in occupants))
+
+
+def free_spots(occupants: Sequence[SceneObject], footprint: tuple[float, float], step: float = 0.01) -> np.ndarray:
+    """Ground truth: the centres (``step`` apart, world axes; N x 3) where an axis-aligned ``footprint`` lies on the
+    upper shelf touching none of ``occupants``."""
+    (cx, cy, _), (sx, sy, _) = fridge_shelf(0)
+    half = np.asarray(footprint, dtype=np.float64) / 2
+    xs = np.arange(cx - sx / 2 + half[0], cx + sx / 2 - half[0] + 1e-9, step)
+    ys = np.arange(cy - sy / 2 + half[1], cy + sy / 2 - half[1] + 1e-9, step)
+    centres = np.array([[x, y, FRIDGE_SHELF_HEIGHTS[0]] for x in xs for y in ys]).reshape(-1, 3)
+    if not len(centres):
+        return centres
+    offsets = rectangle_samples(np.zeros(3), np.eye(3), footprint, 0.005)
+    samples = (centres[:, None, :] + offsets[None, :, :]).reshape(-1, 3)
+    blocked = ~on_shelf(samples)
+    for obj in occupants:
+        blocked |= covers(obj, samples)
+    return centres[~blocked.reshape(len(centres), -1).any(axis=1)]
 
 
 def rectangle_samples(centre: np.ndarray, rotation: np.ndarray, size: tuple[float, float], step: float) -> np.ndarray:
@@ -150,3 +195,19 @@ def random_layout(seed: int, count: int | None = None, gap: float = 0.02) -> Sto
     if len(placed) < wanted:
         raise ValueError(f"could not put {wanted} objects on the shelf without touching (seed {seed})")
     return _layout(placed)
+
+
+def footprint_in_view(spot: np.ndarray, footprint: tuple[float, float], scene: RenderedScene) -> bool:
+    """Ground truth: True when the camera of ``scene`` sees the surface under the whole axis-aligned ``footprint``
+    at ``spot`` (the rendered depth there is the surface's, within 1 cm, at every sample)."""
+    samples = rectangle_samples(spot, np.eye(3), footprint, 0.01)
+    world_to_cam = scene.world_to_cam
+    camera = samples @ world_to_cam[:3, :3].T + world_to_cam[:3, 3]
+    if np.any(camera[:, 2] <= 0):
+        return False
+    pixels = np.rint(scene.intrinsics.project(camera)).astype(int)
+    height, width = scene.depth.shape
+    if np.any((pixels < 0) | (pixels >= (width, height))):
+        return False
+    depth = scene.depth[pixels[:, 1], pixels[:, 0]]
+    return bool(np.all(np.abs(depth - camera[:, 2]) < 0.01))

@@ -13,7 +13,7 @@ import sys
 from collections.abc import Mapping, Sequence
 from types import MappingProxyType, ModuleType
 
-from robokudo.application.commands import ask, beliefs, ontology, parse, plan, query, run, serve, tree
+from robokudo.application.commands import ask, beliefs, ontology, parse, plan, query, run, scenario, serve, tree
 from robokudo.application.commands import eval as evaluation
 from robokudo.application.interrupts import InterruptHandling
 
@@ -29,6 +29,7 @@ COMMANDS: Mapping[str, ModuleType] = MappingProxyType(
         "serve": serve,
         "ask": ask,
         "eval": evaluation,
+        "scenario": scenario,
     }
 )
 """Subcommand name -> the module implementing it."""

@@ -16,10 +16,12 @@ READERS_WITH_CAMERA_POSE: frozenset[str] = frozenset({"KitchenSceneReader"})
 """The readers whose frames carry the camera pose (``CameraInfo.cam_to_world``); recorded inputs have none."""
 
 
-def kitchen_view_for(region: str | None) -> str:
-    """The kitchen camera view that looks at ``region`` ("table" for None, "overview" when no view looks at it)."""
+def kitchen_view_for(region: str | None, people: bool = False) -> str:
+    """The kitchen camera view that looks at ``region`` ("table" for None, "overview" when no view looks at it);
+    with ``people`` (a query about a person in a kitchen that holds one) and no region, the view that sees the
+    table and the person behind it."""
     if region is None:
-        return "table"
+        return PERSON_VIEW if people else "table"
     try:
         return camera_looking_at(region)
     except ValueError:

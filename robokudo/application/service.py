@@ -15,7 +15,8 @@ Over a live stream (``stream=``, as ``robokudo serve`` runs it) the root is the 
 pipeline reads the stream's newest frame, then the task slot; the engine ticks at its fixed rate in the
 background for the service's lifetime (:meth:`AnsweringService.run_in_background`), every task starts on a freshly
 perceived frame (:class:`~annotators.readers.streams.PerceivedFrameReader` is its first step), and the kitchen
-camera is pointed at the task's region. When perception fails (the source ended, a frame cannot be read) the
+camera is pointed at the task's region (at the table and the person behind it for a query about a person, when the
+kitchen holds one). When perception fails (the source ended, a frame cannot be read) the
 running task ends with that reason; once the source ended, new tasks are refused with it
 (:class:`SourceEndedError`). Without a stream (``robokudo query``), each task's tree reads its own frame and the
 engine ticks on the calling thread while :meth:`AnsweringService.answer` waits.
@@ -487,7 +488,9 @@ class AnsweringService:
         handle.on_tick(on_tick)
         if isinstance(self.stream, KitchenCameraStream):
             region = query_plan.interpretation.task.region or self._remembered_region(parsed)
-            self.stream.set_view(kitchen_view_for(region))
+            task = query_plan.plan.task
+            people = self.stream.person is not None and (task.pointing is not None or task.object_class == "Human")
+            self.stream.set_view(kitchen_view_for(region, people=people))
         with self._lock:
             previous, self._current = self._current, handle
         if previous is not None:

@@ -37,6 +37,11 @@ class RunStats:
             self._oldest = (self._oldest + 1) % len(recent)
 
     @property
+    def samples(self) -> tuple[float, ...]:
+        """The recent runs' durations in seconds (at most ``window``; once it is full, not in run order)."""
+        return tuple(self._recent)
+
+    @property
     def median_seconds(self) -> float:
         """Median of the recent runs (0 when there were none)."""
         return statistics.median(self._recent) if self._recent else 0.0
