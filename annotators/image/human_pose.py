@@ -5,8 +5,9 @@ is fetched). It finds one person per image, so with a point cloud it runs on a c
 the depth people detector (:func:`annotators.cloud.people.find_people`) finds, and reads each keypoint's 3-D
 point from the organized cloud (the median of the person's points in a small window around the pixel); without
 a cloud it runs once on the whole image and reports 2-D keypoints only; when the cloud shows no ground to stand
-on (a close view of a person's upper body) it runs on the whole image and the person is where its torso
-keypoints are. With a cloud, a skeleton counts only when
+on (a close view of a person's upper body) it runs on the whole image. A person's points are those connected in
+depth to its shoulders and head (:mod:`annotators.people.body_points`), and its Pose is their centroid, the
+person's 3-D position as robokudo defines it. With a cloud, a skeleton counts only when
 at least ``min_on_person`` of its keypoints fall on the candidate's points (the model, given a crop without a
 person, may still draw one on whatever is there).
 
@@ -20,8 +21,9 @@ from typing import Any, ClassVar
 
 import numpy as np
 
-from annotators.cloud.people import HUMAN, IMAGE_UP, PeopleParameters, PersonSegment, find_people, person_hypothesis
+from annotators.cloud.people import HUMAN, IMAGE_UP, PeopleParameters, PersonSegment, find_people
 from annotators.cloud.plane import up_in_camera
+from annotators.people.body_points import body_mask, centroid
 from robokudo.core.annotator import Annotator
 from robokudo.core.capability import Capability
 from robokudo.core.resources import Guarded
@@ -252,46 +254,45 @@ class HumanPoseDetector(Annotator):
         candidate: PersonSegment | None,
         points: np.ndarray | None = None,
     ) -> PersonHypothesis:
+        """The hypothesis of one seen person: its own points (see :mod:`annotators.people.body_points`), the Pose
+        at their centroid, the class Human and the keypoints."""
         confidence = float(np.mean(visibility[list(TORSO)]))
-        if candidate is not None and xyz is not None:
-            hypothesis = person_hypothesis(candidate, self.name, confidence)
-            if points is not None:
-                # the candidate's column may hold what stands in front of the person (a table's objects): keep
-                # the points near its skeleton
-                near = near_skeleton(points.reshape(-1, 3)[candidate.indices], xyz, self.body_reach)
-                if near is not None and near.any():
-                    hypothesis.point_indices = candidate.indices[near]
-                    hypothesis.mask = np.zeros(candidate.mask.size, dtype=bool)
-                    hypothesis.mask[hypothesis.point_indices] = True
-                    hypothesis.mask = hypothesis.mask.reshape(candidate.mask.shape)
+        height, width = self.view(ColorImage).image.shape[:2]
+        if candidate is not None:
+            region, roi = candidate.mask, candidate.roi
         else:
-            height, width = self.view(ColorImage).image.shape[:2]
             x0, y0 = np.clip(np.floor(pixels.min(axis=0)).astype(int), 0, (width - 1, height - 1))
             x1, y1 = np.clip(np.ceil(pixels.max(axis=0)).astype(int) + 1, 1, (width, height))
-            mask = np.zeros((height, width), dtype=bool)
-            mask[y0:y1, x0:x1] = True
-            if points is not None and xyz is not None:
-                # the person's pixels in the box: those near its skeleton (not a table and the objects in front)
-                near = near_skeleton(points[y0:y1, x0:x1].reshape(-1, 3), xyz, self.body_reach)
+            region = np.zeros((height, width), dtype=bool)
+            region[y0:y1, x0:x1] = True
+            roi = (int(x0), int(y0), int(x1), int(y1))
+        mask = region
+        position = None
+        if points is not None and xyz is not None:
+            body = body_mask(points, region, pixels, _unoccluded(xyz))
+            if body is None or not body.any():
+                # no seed joint lands on the body: the points near the skeleton's bones (not a table and the
+                # objects in front)
+                body = np.zeros((height, width), dtype=bool)
+                flat = np.flatnonzero(region)
+                near = near_skeleton(points.reshape(-1, 3)[flat], xyz, self.body_reach)
                 if near is not None:
-                    mask[y0:y1, x0:x1] = near.reshape(y1 - y0, x1 - x0)
-            hypothesis = PersonHypothesis(
-                point_indices=np.flatnonzero(mask),
-                mask=mask,
-                roi=(int(x0), int(y0), int(x1), int(y1)),
-                source=self.name,
-                confidence=confidence,
+                    body.reshape(-1)[flat[near]] = True
+            if body.any():
+                mask = body
+            position = centroid(points, mask)
+        hypothesis = PersonHypothesis(
+            point_indices=np.flatnonzero(mask), mask=mask, roi=roi, source=self.name, confidence=confidence
+        )
+        if position is None and candidate is not None:
+            position = candidate.centroid
+        if position is not None:
+            hypothesis.annotations.append(
+                Pose(position=position, orientation=np.array([0.0, 0.0, 0.0, 1.0]), source=self.name)
             )
-            hypothesis.annotations.append(Classification(class_name=HUMAN, source=self.name, confidence=confidence))
-            if xyz is None:
-                xyz = np.full((pixels.shape[0], 3), np.nan)
-            torso = xyz[list(TORSO)]
-            torso = torso[np.isfinite(torso[:, 2])]
-            if torso.shape[0]:
-                position = np.median(torso, axis=0)
-                hypothesis.annotations.append(
-                    Pose(position=position, orientation=np.array([0.0, 0.0, 0.0, 1.0]), source=self.name)
-                )
+        hypothesis.annotations.append(Classification(class_name=HUMAN, source=self.name, confidence=confidence))
+        if xyz is None:
+            xyz = np.full((pixels.shape[0], 3), np.nan)
         hypothesis.annotations.append(
             BodyKeypoints(
                 names=LANDMARKS, pixels=pixels, points=xyz, visibility=visibility, source=self.name,
