@@ -471,7 +471,8 @@ class AnsweringService:
         handle.on_tick(on_tick)
         if isinstance(self.stream, KitchenCameraStream):
             region = query_plan.interpretation.task.region or self._remembered_region(parsed)
-            self.stream.set_view(kitchen_view_for(region))
+            if region is not None or self.stream.person is None:  # a scripted person stays in the view it is in
+                self.stream.set_view(kitchen_view_for(region))
         with self._lock:
             previous, self._current = self._current, handle
         if previous is not None:
