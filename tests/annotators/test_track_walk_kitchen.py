@@ -95,6 +95,9 @@ def test_a_person_walking_a_path_is_tracked_within_10_cm_and_never_lost(script: 
     print(f"median 3-D error {median:.1f} cm, max {worst:.1f} cm over {len(errors)} frames")
     assert all(t.seen for t in tracks), [i for i, t in enumerate(tracks) if not t.seen]
     assert np.median(errors) <= 0.10
+    (detector,) = [n for n in loop.iterate() if n.name == "HumanPoseDetector"]
+    print(f"the pose detector searched {detector.searches} of {frames} frames and followed the person in the others")
+    assert detector.searches < frames / 2  # the person was followed in a crop, not searched for, in most frames
     walked = np.linalg.norm(tracks[-1].position[:2] - tracks[0].position[:2])
     truly = np.linalg.norm(reader.truth[-1][:2] - reader.truth[0][:2])
     assert walked > 0.8 * truly  # it followed the walk, not a standing estimate
