@@ -314,6 +314,7 @@ class _PhraseParser:
         elif kind == "scan":
             body = self.scan()
         else:
+            watch = self.pointing_watch() if kind == "track" else None
             phrase = self.object_phrase()
             if asked_key is not None:
                 phrase.extras.append(Field(asked_key, Asked(), kind_span))
@@ -324,6 +325,8 @@ class _PhraseParser:
                 body = self.scan_body(None, phrase)
             else:
                 body = self.object_body(kind, phrase)
+            if watch is not None:
+                body = Block((*body.fields, watch))
         query = Query(kind, body, self.text, kind_span)
         validate_query(query)
         return query
@@ -344,6 +347,22 @@ class _PhraseParser:
         query = Query("detect", Block((Field(POINTING_KEY, block, span),)), self.text, first)
         validate_query(query)
         return query
+
+    def pointing_watch(self) -> Field | None:
+        """``... and watch where she points`` after what a track follows (``... what she points at`` for an
+        object target): the pointing block of ``track { human: {}, pointing: { target: ... } }``, its tokens
+        cut off the phrase; None without such a tail."""
+        for start in range(self.index, len(self.tokens) - 1):
+            if self.tokens[start].text != "and" or self.tokens[start + 1].text not in WATCH_VERBS:
+                continue
+            tail = [t.text for t in self.tokens[start + 2 :] if t.kind == "word"]
+            if not tail or tail[0] not in POINTING_QUESTION_WORDS or not POINTING_VERBS & set(tail):
+                continue
+            target = "region" if tail[0] == "where" or REGION_WORDS & set(tail) else "object"
+            span = _join_span(self.tokens[start + 1].span, self.tokens[-1].span)
+            self.tokens = self.tokens[:start]
+            return Field(POINTING_KEY, Block((Field("target", Symbol(target), span),)), span)
+        return None
 
     def expect_end(self) -> None:
         token = self.current()
@@ -595,6 +614,8 @@ POINTING_QUESTION_WORDS = frozenset({"which", "what", "where"})
 POINTING_VERBS = frozenset({"pointing", "point", "points", "pointed", "gesturing"})
 PERSON_WORDS = frozenset({"person", "human", "man", "woman", "someone", "somebody", "she", "he", "they", "people"})
 REGION_WORDS = frozenset({"region", "place", "area", "storage", "location", "shelf", "counter"})
+WATCH_VERBS = frozenset({"watch", "see", "check", "notice", "tell"})
+"""Verbs joining a pointing question to a track phrase (``follow the person and watch where she points``)."""
 
 
 def parse_natural(text: str) -> Query:

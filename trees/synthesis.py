@@ -113,15 +113,17 @@ def build_tree(
     query: object | None = None,
     catalog: AnnotatorCatalog | None = None,
     resources: SharedResources | None = None,
+    body: Ordered[py_trees.behaviour.Behaviour] | None = None,
 ) -> Pipeline:
     """The Pipeline for ``plan`` (stages in order, then ``final_steps`` such as the answer step), validated.
 
     ``make`` turns a step into a node; by default each step becomes an instance of the ``catalog``'s class of
     that name (default catalog: :meth:`AnnotatorCatalog.discover`), sharing the ``resources`` pool (loaded
-    models) when given. ``query`` is put into every new CAS of the pipeline. SynthesisError when a step names no
+    models) when given. ``query`` is put into every new CAS of the pipeline. ``body``, when given, is the plan's
+    stages already built (a tree shape other than one node per stage). SynthesisError when a step names no
     class of the catalog.
     """
-    children = stage_nodes(plan, make=make, catalog=catalog, resources=resources)
+    children = list(body) if body is not None else stage_nodes(plan, make=make, catalog=catalog, resources=resources)
     pipeline = Pipeline(name, [*children, *final_steps], query=query, reason=f"answers the {plan.task.kind} query")
     validate_data_flow(pipeline)
     return pipeline
@@ -137,8 +139,15 @@ def build_task_tree(
     resources: SharedResources | None = None,
 ) -> Pipeline | Loop:
     """The tree running ``plan`` as its task: :func:`build_tree`'s Pipeline for a one-shot kind; for a continuous
-    kind that Pipeline (named "every frame") in a Loop that repeats it until stopped, tolerating failed runs."""
+    kind that Pipeline (named "every frame") in a Loop that repeats it until stopped, tolerating failed runs. A
+    continuous plan that also watches pointing runs its tracker and the pointing unit side by side in a Parallel
+    (:func:`trees.pointing.track_and_detect_nodes`)."""
     continuous = plan.task.kind in CONTINUOUS_KINDS
+    body = None
+    if continuous and plan.task.pointing is not None:
+        from trees.pointing import track_and_detect_nodes  # the pointing unit is built on this module
+
+        body = track_and_detect_nodes(plan, make=make, catalog=catalog, resources=resources)
     pipeline = build_tree(
         plan,
         name="every frame" if continuous else name,
@@ -147,6 +156,7 @@ def build_task_tree(
         query=query,
         catalog=catalog,
         resources=resources,
+        body=body,
     )
     if not continuous:
         return pipeline

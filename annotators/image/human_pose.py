@@ -5,8 +5,9 @@ is fetched). It finds one person per image, so with a point cloud it runs on a c
 the depth people detector (:func:`annotators.cloud.people.find_people`) finds, and reads each keypoint's 3-D
 point from the organized cloud (the median of the person's points in a small window around the pixel); without
 a cloud it runs once on the whole image and reports 2-D keypoints only; when the cloud shows no ground to stand
-on (a close view of a person's upper body) it runs on the whole image and the person is where its torso
-keypoints are. With a cloud, a skeleton counts only when
+on (a close view of a person's upper body) it runs on the whole image. A person's points are those connected in
+depth to its shoulders and head (:mod:`annotators.people.body_points`), and its Pose is their centroid, the
+person's 3-D position as robokudo defines it. With a cloud, a skeleton counts only when
 at least ``min_on_person`` of its keypoints fall on the candidate's points (the model, given a crop without a
 person, may still draw one on whatever is there).
 
@@ -16,12 +17,14 @@ score thresholds (the graph's are cleared) and keeps a person only when its tors
 
 from __future__ import annotations
 
+from dataclasses import dataclass
 from typing import Any, ClassVar
 
 import numpy as np
 
-from annotators.cloud.people import HUMAN, IMAGE_UP, PeopleParameters, PersonSegment, find_people, person_hypothesis
-from annotators.cloud.plane import up_in_camera
+from annotators.cloud.people import HUMAN, IMAGE_UP, PeopleParameters, PersonSegment, find_people, ground_plane
+from annotators.cloud.plane import plane_distances, up_in_camera
+from annotators.people.body_points import body_mask, centroid
 from robokudo.core.annotator import Annotator
 from robokudo.core.capability import Capability
 from robokudo.core.resources import Guarded
@@ -53,13 +56,19 @@ class PoseModelError(RuntimeError):
     """The pose model cannot be loaded (mediapipe missing or broken)."""
 
 
-def load_pose_model() -> Any:
-    """mediapipe's legacy pose solution for single images (complexity 1); raises PoseModelError."""
+def load_pose_model(video: bool = False) -> Any:
+    """mediapipe's legacy pose solution (complexity 1); raises PoseModelError. For single images by default; with
+    ``video`` for consecutive images of one person: it finds the person once and then runs only the landmark
+    model on the region its previous landmarks give (a third of the time)."""
     try:
         import mediapipe as mp
 
         return mp.solutions.pose.Pose(
-            static_image_mode=True, model_complexity=1, min_detection_confidence=None, min_tracking_confidence=None
+            static_image_mode=not video,
+            model_complexity=1,
+            smooth_landmarks=False,  # smoothing lags behind a walking person; the trackers filter over time
+            min_detection_confidence=None,
+            min_tracking_confidence=None,
         )
     except Exception as error:  # ImportError, or mediapipe's own errors when its graph cannot start
         raise PoseModelError(f"the mediapipe pose model cannot be loaded: {error}") from None
@@ -159,8 +168,36 @@ def near_skeleton(points: np.ndarray, keypoints: np.ndarray, reach: float) -> np
     return near if used else None
 
 
+@dataclass
+class _Followed:
+    """A person seen in the previous frame of a sequence: its image box and the video-mode model following it."""
+
+    roi: tuple[int, int, int, int]
+    model: Guarded[Any]
+    position: np.ndarray | None = None
+    """Where the person was (camera frame), the centre of the column its points are looked for in."""
+    standing: bool = False
+    """Whether the search found the person standing on the ground (a depth candidate), not in the whole image."""
+
+
+def _position(person: PersonHypothesis) -> np.ndarray | None:
+    pose = person.first(Pose)
+    return None if pose is None else np.asarray(pose.position, dtype=np.float64)
+
+
 class HumanPoseDetector(Annotator):
-    """Finds people with 2-D and 3-D body keypoints (mediapipe pose on crops around depth person candidates)."""
+    """Finds people with 2-D and 3-D body keypoints (mediapipe pose on crops around depth person candidates).
+
+    Run on consecutive frames of one recording (a continuous task's loop), it follows the people it saw: each is
+    looked for only in a crop around where it was in the previous frame (its box grown by ``follow_margin`` of
+    its height), by a video-mode model of its own that runs just the landmark model there; a person the search
+    found standing on the ground has its points looked for as the search did, among those above the ground
+    within a column around its previous position (``column_radius`` plus ``follow_reach`` metres, a step
+    between frames). The full search (the
+    depth candidates, each through the single-image model) runs on the first frame, when a followed person is
+    not found again, when the sequence breaks (another recording, time going back or a gap over ``max_gap``
+    seconds) and every ``search_every`` frames, so people who walk in are found too.
+    """
 
     inputs: ClassVar[tuple[type[CasType], ...]] = (ColorImage,)
     optional_inputs: ClassVar[tuple[type[CasType], ...]] = (PointCloud, CameraInfo)
@@ -180,15 +217,34 @@ class HumanPoseDetector(Annotator):
         min_on_person: float = 0.5,
         parameters: PeopleParameters | None = None,
         body_reach: float = 0.15,
+        follow_margin: float = 0.2,
+        follow_reach: float = 0.2,
+        search_every: int = 30,
+        max_gap: float = 1.0,
         name: str | None = None,
     ) -> None:
         super().__init__(name=name)
+        if isinstance(search_every, bool) or not isinstance(search_every, int) or search_every < 1:
+            raise ValueError(f"search_every must be a whole number >= 1, not {search_every!r}")
+        for label, value in (("follow_margin", follow_margin), ("follow_reach", follow_reach), ("max_gap", max_gap)):
+            if not np.isfinite(value) or value < 0:
+                raise ValueError(f"{label} must be a number >= 0, not {value!r}")
         self.body_reach = body_reach
         """Without a depth candidate, how far (m) from its skeleton's bones a point counts as the person's."""
         self.min_torso_visibility = min_torso_visibility
         self.crop_margin = crop_margin
         self.min_on_person = min_on_person
         self.parameters = parameters or PeopleParameters()
+        self.follow_margin = follow_margin
+        self.follow_reach = follow_reach
+        self.search_every = search_every
+        self.max_gap = max_gap
+        self.searches = 0
+        """How many frames had the full search (the others followed the people of the previous frame)."""
+        self._followed: list[_Followed] = []
+        self._video_models: list[Guarded[Any]] = []
+        self._sequence: tuple[str, str, float] | None = None
+        self._since_search = 0
 
     def model(self) -> Guarded[Any]:
         """The pose model, loaded on first use and shared through this annotator's resources."""
@@ -205,17 +261,105 @@ class HumanPoseDetector(Annotator):
             self.fail(str(error))
         cloud = self.optional_view(PointCloud)
         points = cloud.points if cloud is not None and cloud.points.shape[:2] == image.shape[:2] else None
+        if self._continues(self.optional_view(CameraInfo)) and self._followed:
+            people = self._follow(image, points)
+            if people is not None:
+                self._since_search += 1
+                for person in people:
+                    self.write(person)
+                return
+        self._since_search = 0
+        self.searches += 1
+        people, standing = self._search(model, image, points, cloud)
+        self._remember(people, standing)
+        for person in people:
+            self.write(person)
+
+    def _search(
+        self, model: Guarded[Any], image: np.ndarray, points: np.ndarray | None, cloud: PointCloud | None
+    ) -> tuple[list[PersonHypothesis], bool]:
+        """The full search: the pose model on a crop around every depth candidate, else on the whole image; the
+        people, and whether they were found standing on the ground (as depth candidates)."""
         whole_image = [((0, 0, image.shape[1], image.shape[0]), None)]
         crops: list[tuple[tuple[int, int, int, int], PersonSegment | None]] = []
         if cloud is not None and points is not None and cloud.mask.any():
             up = up_in_camera(self.optional_view(CameraInfo))
             candidates = find_people(points, cloud.mask, IMAGE_UP if up is None else up, self.parameters)
             crops = [(crop_box(c.roi, image.shape[:2], self.crop_margin), c) for c in candidates]
-        found = self._look(model, image, points, crops)
-        if not found:  # no cloud, no ground in view (a close view of the upper body) or no candidate was a person
-            found = self._look(model, image, points, whole_image)
-        if not found:
+        people = self._look(model, image, points, crops)
+        if people:
+            return people, True
+        # no cloud, no ground in view (a close view of the upper body) or no candidate was a person
+        people = self._look(model, image, points, whole_image)
+        if not people:
+            self._followed = []
             self.fail(f"the pose model saw no person's torso in {len(crops)} candidate region(s) nor the whole image")
+        return people, False
+
+    def _continues(self, info: CameraInfo | None) -> bool:
+        """True when this frame follows the previous one of the same sequence and no periodic search is due."""
+        key = ("", "", 0.0) if info is None else (info.recording, info.frame_id, float(info.timestamp))
+        previous, self._sequence = self._sequence, key
+        if previous is None or info is None or key[2] <= 0 or self._since_search + 1 >= self.search_every:
+            return False
+        return previous[:2] == key[:2] and 0 < key[2] - previous[2] <= self.max_gap
+
+    def _follow(self, image: np.ndarray, points: np.ndarray | None) -> list[PersonHypothesis] | None:
+        """Each followed person in a crop around its previous box; None when one of them is not found there.
+        A person's points are looked for above the ground (when the cloud shows it), as the search does."""
+        ground = None
+        if points is not None and any(f.standing for f in self._followed):
+            up = up_in_camera(self.optional_view(CameraInfo))
+            ground = ground_plane(points, np.isfinite(points[..., 2]), IMAGE_UP if up is None else up, self.parameters)
+        people = []
+        for followed in self._followed:
+            crop = crop_box(followed.roi, image.shape[:2], self.follow_margin)
+            allowed = np.zeros(image.shape[:2], dtype=bool)
+            x0, y0, x1, y1 = crop
+            allowed[y0:y1, x0:x1] = True
+            if points is not None and ground is not None and followed.standing:
+                allowed[y0:y1, x0:x1] = self._column(points[y0:y1, x0:x1], ground, followed.position)
+            found = self._look(followed.model, image, points, [(crop, None)], allowed)
+            if len(found) != 1 or not self._near(followed.position, _position(found[0])):
+                return None  # lost, or the model drew a person elsewhere: the search decides
+            people.append(found[0])
+        for followed, person in zip(self._followed, people, strict=True):
+            followed.roi, followed.position = person.roi, _position(person)
+        return people
+
+    def _near(self, before: np.ndarray | None, now: np.ndarray | None) -> bool:
+        """Whether a followed person's position moved at most a step (``follow_reach``) between frames (True when
+        either position is unknown); a farther one is left to the search, so following never drifts away."""
+        if before is None or now is None:
+            return True
+        return bool(np.linalg.norm(now - before) <= self.follow_reach)
+
+    def _column(self, points: np.ndarray, ground: np.ndarray, centre: np.ndarray | None) -> np.ndarray:
+        """Which points stand above the ground (``min_height``) within the column (``column_radius`` plus a
+        step's reach, ``follow_reach``) around where the person was, as the search's depth candidates do."""
+        normal = ground[:3].astype(np.float32)
+        with np.errstate(invalid="ignore"):
+            keep = np.isfinite(points[..., 2]) & (plane_distances(points, ground) > self.parameters.min_height)
+            if centre is not None:
+                offset = points - centre.astype(np.float32)
+                across = offset - (offset @ normal)[..., None] * normal
+                reach = self.parameters.column_radius + self.follow_reach
+                keep &= np.einsum("...i,...i->...", across, across) < reach * reach
+        return keep
+
+    def _remember(self, people: list[PersonHypothesis], standing: bool) -> None:
+        """Follow these people from the next frame on, each with a video-mode model of this node (``standing``:
+        they were found as depth candidates standing on the ground, and are looked for there)."""
+        while len(self._video_models) < len(people):
+            try:
+                self._video_models.append(Guarded(load_pose_model(video=True)))
+            except PoseModelError:
+                break
+        self._followed = [
+            _Followed(p.roi, m, _position(p), standing) for p, m in zip(people, self._video_models, strict=False)
+        ]
+        if len(self._followed) < len(people):
+            self._followed = []
 
     def _look(
         self,
@@ -223,9 +367,10 @@ class HumanPoseDetector(Annotator):
         image: np.ndarray,
         points: np.ndarray | None,
         crops: list[tuple[tuple[int, int, int, int], PersonSegment | None]],
-    ) -> int:
-        """Run the model on each crop and write the people it sees there; returns how many."""
-        found = 0
+        allowed: np.ndarray | None = None,
+    ) -> list[PersonHypothesis]:
+        """Run the model on each crop; the people it sees there."""
+        found: list[PersonHypothesis] = []
         for (x0, y0, x1, y1), candidate in crops:
             with model.lock:
                 landmarks = detect_landmarks(model.value, image[y0:y1, x0:x1])
@@ -240,8 +385,7 @@ class HumanPoseDetector(Annotator):
                 xyz = keypoint_points(pixels, points, None if candidate is None else candidate.mask)
                 if np.count_nonzero(np.isfinite(xyz[:, 2])) < self.min_on_person * len(LANDMARKS):
                     continue  # the skeleton does not lie on the candidate's points: something else was seen
-            found += 1
-            self.write(self._person(pixels, visibility, xyz, candidate, points))
+            found.append(self._person(pixels, visibility, xyz, candidate, points, allowed))
         return found
 
     def _person(
@@ -251,47 +395,52 @@ class HumanPoseDetector(Annotator):
         xyz: np.ndarray | None,
         candidate: PersonSegment | None,
         points: np.ndarray | None = None,
+        allowed: np.ndarray | None = None,
     ) -> PersonHypothesis:
+        """The hypothesis of one seen person: its own points (see :mod:`annotators.people.body_points`), the Pose
+        at their centroid, the class Human and the keypoints."""
         confidence = float(np.mean(visibility[list(TORSO)]))
-        if candidate is not None and xyz is not None:
-            hypothesis = person_hypothesis(candidate, self.name, confidence)
-            if points is not None:
-                # the candidate's column may hold what stands in front of the person (a table's objects): keep
-                # the points near its skeleton
-                near = near_skeleton(points.reshape(-1, 3)[candidate.indices], xyz, self.body_reach)
-                if near is not None and near.any():
-                    hypothesis.point_indices = candidate.indices[near]
-                    hypothesis.mask = np.zeros(candidate.mask.size, dtype=bool)
-                    hypothesis.mask[hypothesis.point_indices] = True
-                    hypothesis.mask = hypothesis.mask.reshape(candidate.mask.shape)
+        height, width = self.view(ColorImage).image.shape[:2]
+        if candidate is not None:
+            region, roi = candidate.mask, candidate.roi
         else:
-            height, width = self.view(ColorImage).image.shape[:2]
             x0, y0 = np.clip(np.floor(pixels.min(axis=0)).astype(int), 0, (width - 1, height - 1))
             x1, y1 = np.clip(np.ceil(pixels.max(axis=0)).astype(int) + 1, 1, (width, height))
-            mask = np.zeros((height, width), dtype=bool)
-            mask[y0:y1, x0:x1] = True
-            if points is not None and xyz is not None:
-                # the person's pixels in the box: those near its skeleton (not a table and the objects in front)
-                near = near_skeleton(points[y0:y1, x0:x1].reshape(-1, 3), xyz, self.body_reach)
+            region = np.zeros((height, width), dtype=bool)
+            region[y0:y1, x0:x1] = True
+            if allowed is not None:  # the region the person was looked for in (the skeleton may not span it)
+                region = allowed
+            roi = (int(x0), int(y0), int(x1), int(y1))
+        mask = region
+        position = None
+        if points is not None and xyz is not None:
+            body = body_mask(points, region, pixels, _unoccluded(xyz))
+            if body is None or not body.any():
+                # no seed joint lands on the body: the points near the skeleton's bones (not a table and the
+                # objects in front)
+                body = np.zeros((height, width), dtype=bool)
+                flat = np.flatnonzero(region)
+                near = near_skeleton(points.reshape(-1, 3)[flat], xyz, self.body_reach)
                 if near is not None:
-                    mask[y0:y1, x0:x1] = near.reshape(y1 - y0, x1 - x0)
-            hypothesis = PersonHypothesis(
-                point_indices=np.flatnonzero(mask),
-                mask=mask,
-                roi=(int(x0), int(y0), int(x1), int(y1)),
-                source=self.name,
-                confidence=confidence,
+                    body.reshape(-1)[flat[near]] = True
+            if body.any():
+                mask = body
+                if allowed is not None:  # a followed person's box is where its points are
+                    rows, cols = np.nonzero(mask)
+                    roi = (int(cols.min()), int(rows.min()), int(cols.max()) + 1, int(rows.max()) + 1)
+            position = centroid(points, mask)
+        hypothesis = PersonHypothesis(
+            point_indices=np.flatnonzero(mask), mask=mask, roi=roi, source=self.name, confidence=confidence
+        )
+        if position is None and candidate is not None:
+            position = candidate.centroid
+        if position is not None:
+            hypothesis.annotations.append(
+                Pose(position=position, orientation=np.array([0.0, 0.0, 0.0, 1.0]), source=self.name)
             )
-            hypothesis.annotations.append(Classification(class_name=HUMAN, source=self.name, confidence=confidence))
-            if xyz is None:
-                xyz = np.full((pixels.shape[0], 3), np.nan)
-            torso = xyz[list(TORSO)]
-            torso = torso[np.isfinite(torso[:, 2])]
-            if torso.shape[0]:
-                position = np.median(torso, axis=0)
-                hypothesis.annotations.append(
-                    Pose(position=position, orientation=np.array([0.0, 0.0, 0.0, 1.0]), source=self.name)
-                )
+        hypothesis.annotations.append(Classification(class_name=HUMAN, source=self.name, confidence=confidence))
+        if xyz is None:
+            xyz = np.full((pixels.shape[0], 3), np.nan)
         hypothesis.annotations.append(
             BodyKeypoints(
                 names=LANDMARKS, pixels=pixels, points=xyz, visibility=visibility, source=self.name,

@@ -138,6 +138,19 @@ class RenderedScene:
         p[:3] = self.object(name).pose[:3, 3]
         return (self.world_to_cam @ p)[:3]
 
+    def person_position(self) -> FloatArray | None:
+        """The person's 3-D position (world frame) as robokudo defines it (see
+        :mod:`annotators.people.body_points`): the centroid of the figure's surface visible in this frame,
+        from the rendered person pixels and their depth. None without a person in view. Ground truth for
+        scoring only."""
+        rows, cols = np.nonzero((self.object_ids == PERSON_OBJECT_ID) & (self.depth > 0))
+        if rows.size == 0:
+            return None
+        k = self.intrinsics
+        z = self.depth[rows, cols].astype(np.float64)
+        camera = np.column_stack(((cols - k.cx) * z / k.fx, (rows - k.cy) * z / k.fy, z)).mean(axis=0)
+        return self.cam_to_world[:3, :3] @ camera + self.cam_to_world[:3, 3]
+
 
 # --------------------------------------------------------------------------
 # Geometry helpers

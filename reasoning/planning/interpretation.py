@@ -10,7 +10,7 @@ requirement carries the sentence that explains it.
 
 from __future__ import annotations
 
-from dataclasses import dataclass
+from dataclasses import dataclass, replace
 
 from queries.model import (
     ANYWHERE,
@@ -69,7 +69,7 @@ def interpret(query: Query, kb: KnowledgeBase, depth: bool = True, camera_pose: 
         return _interpret_scan(query, kb, camera_pose)
     pointing = query.get(POINTING_KEY)
     if isinstance(pointing, Block):
-        return _interpret_pointing(query, pointing, depth, camera_pose)
+        return _interpret_pointing(query, pointing, depth, camera_pose, kb)
     obj = _target(query)
     object_class = _object_class(obj.get("type"), kb)
     hypothesis = kb.hypothesis_type(object_class) if object_class is not None else "ObjectHypothesis"
@@ -170,12 +170,19 @@ def _tracking(query: Query) -> tuple[Requirement, ...]:
     return (Requirement(TRACK_TYPE, None, why),)
 
 
-def _interpret_pointing(query: Query, pointing: Block, depth: bool, camera_pose: bool) -> Interpretation:
+def _interpret_pointing(
+    query: Query, pointing: Block, depth: bool, camera_pose: bool, kb: KnowledgeBase
+) -> Interpretation:
     """``detect { pointing: { target: object | region } }``: a person's pointing target, so its body keypoints,
     its activity and the pointing ray are required; an object target needs the frame's object hypotheses (with
     their poses), a region target the semantic map, which needs the camera pose."""
+    if query.kind == "track" and any(isinstance(query.get(key), Block) for key in ("human", "obj")):
+        return _interpret_track_and_point(query, pointing, kb, depth, camera_pose)
     if query.kind != "detect":
-        raise PlanningError(f"pointing is detected (detect {{ {POINTING_KEY}: ... }}), not asked by {query.kind}")
+        raise PlanningError(
+            f"pointing is detected (detect {{ {POINTING_KEY}: ... }}) or watched while tracking a person "
+            f"(track {{ human: {{}}, {POINTING_KEY}: ... }}), not asked by {query.kind}"
+        )
     others = [f.key for f in query.body.fields if f.key != POINTING_KEY]
     if others:
         raise PlanningError(f"a pointing query asks only what is pointed at; {', '.join(others)} cannot be added")
@@ -199,6 +206,30 @@ def _interpret_pointing(query: Query, pointing: Block, depth: bool, camera_pose:
         inferences.append("the semantic map's regions are the candidate targets")
     task = Task(kind=query.kind, inferences=tuple(inferences), pointing=target)
     return Interpretation(task, tuple(requirements), None)
+
+
+def _interpret_track_and_point(
+    query: Query, pointing: Block, kb: KnowledgeBase, depth: bool, camera_pose: bool
+) -> Interpretation:
+    """``track { human: {}, pointing: { target: ... } }`` ("track and detect"): follow the person and watch what
+    she points at, so the tracking requirements and the pointing requirements together."""
+    others = [f.key for f in query.body.fields if f.key not in ("human", "obj", "max_results", POINTING_KEY)]
+    if others:
+        raise PlanningError(
+            f"track and watch pointing asks for a human and pointing; {', '.join(others)} cannot be added"
+        )
+    human = Query(query.kind, Block(tuple(f for f in query.body.fields if f.key != POINTING_KEY)), query.source)
+    tracked = interpret(human, kb, depth, camera_pose)
+    if tracked.task.object_class is None or kb.hypothesis_type(tracked.task.object_class) == "ObjectHypothesis":
+        raise PlanningError("pointing is watched while tracking a person (track { human: {}, pointing: ... })")
+    asked = Query("detect", Block((Field(POINTING_KEY, pointing),)), query.source)
+    watched = _interpret_pointing(asked, pointing, depth, camera_pose, kb)
+    task = replace(
+        tracked.task,
+        pointing=watched.task.pointing,
+        inferences=(*tracked.task.inferences, *watched.task.inferences),
+    )
+    return Interpretation(task, (*tracked.requirements, *watched.requirements), tracked.region_box)
 
 
 def _target(query: Query) -> Block:
