@@ -98,7 +98,7 @@ class Replay(Annotator):
         self.hypotheses = hypotheses
 
     def analyse(self) -> None:
-        self.write(self.image)
+        self.write(ColorImage(self.image.image))  # a new frame's view (sharing the array): put anew by remote experts
         for hypothesis in self.hypotheses:
             fresh = copy.copy(hypothesis)  # shares its arrays
             fresh.annotations = []
