@@ -325,9 +325,10 @@ class MaskIndices:
 
     dtype: str
 
-    def of(self, mask: np.ndarray) -> np.ndarray:
-        """The indices again."""
-        return np.flatnonzero(mask).astype(self.dtype, copy=False)
+    def of(self, mask: CroppedMask, roi: tuple[int, int, int, int]) -> np.ndarray:
+        """The indices again, from the mask as it was sent."""
+        rows, columns = np.nonzero(mask.inside)
+        return ((rows + roi[1]) * mask.shape[1] + (columns + roi[0])).astype(self.dtype, copy=False)
 
 
 def in_transit(annotation: Annotation, declared: tuple[type[CasType], ...]) -> Annotation:
@@ -354,9 +355,9 @@ def restored(annotation: Annotation) -> Annotation:
     """An annotation as it was before :func:`in_transit` (a hypothesis gets its full-frame mask and its point
     indices back)."""
     if isinstance(annotation, ObjectHypothesis) and isinstance(annotation.mask, CroppedMask):
-        annotation.mask = annotation.mask.full(annotation.roi)
         if isinstance(annotation.point_indices, MaskIndices):
-            annotation.point_indices = annotation.point_indices.of(annotation.mask)
+            annotation.point_indices = annotation.point_indices.of(annotation.mask, annotation.roi)
+        annotation.mask = annotation.mask.full(annotation.roi)
     return annotation
 
 
