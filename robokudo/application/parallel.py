@@ -19,6 +19,10 @@ from tqdm import tqdm
 
 from robokudo.application.cluster import ray_cluster
 
+RETRIES = 3
+"""How often a task whose worker process died (e.g. killed by Ray's memory monitor when the machine runs low on
+memory) is run again; an exception the function raises is not retried."""
+
 T = TypeVar("T")
 R = TypeVar("R")
 
@@ -61,7 +65,7 @@ def map_on_cluster(
         try:
             ray.get(group.ready())
             task = ray.remote(function).options(
-                num_cpus=1, max_retries=0, scheduling_strategy=PlacementGroupSchedulingStrategy(group)
+                num_cpus=1, max_retries=RETRIES, scheduling_strategy=PlacementGroupSchedulingStrategy(group)
             )
             return _in_order(ray, task, items, [ray.put(value) for value in extra], 2 * workers, label)
         finally:
