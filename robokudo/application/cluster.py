@@ -2,7 +2,8 @@
 
 :func:`ray_cluster` connects to the cluster at an address (``ray://HOST:10001`` through the Ray client, or
 ``HOST:6379`` / ``auto`` for a node of the cluster), or starts a local one on this machine (the default) with
-the given number of CPUs, and disconnects (stopping a local one) afterwards. When this process is connected
+the given number of CPUs (its workers at this process's priority: :data:`LOCAL_SYSTEM_CONFIG`), and
+disconnects (stopping a local one) afterwards. When this process is connected
 already (a program or a test that called ``ray.init``), that connection is used and left open.
 
 Ray is an optional extra (``pip install 'robokudo[ray]'``); without it :class:`ClusterError` says so.
@@ -16,6 +17,10 @@ from contextlib import contextmanager
 from types import ModuleType
 
 from robokudo.core.remote import INSTALL_HINT, PlacementError, require_ray
+
+LOCAL_SYSTEM_CONFIG = {"worker_niceness": 0}
+"""Ray's settings for a local cluster: its workers run at this process's priority (Ray's default lowers them by
+15, so on a busy machine every other program would go before the scenes and experts this command waits for)."""
 
 
 class ClusterError(Exception):
@@ -42,6 +47,7 @@ def ray_cluster(address: str | None = None, num_cpus: int | None = None, purpose
     options: dict[str, object] = {"include_dashboard": False, "log_to_driver": False, "logging_level": logging.ERROR}
     if address is None:
         options["num_cpus"] = num_cpus
+        options["_system_config"] = LOCAL_SYSTEM_CONFIG
     try:
         ray.init(address=address, **options)
     except (ConnectionError, RuntimeError, ValueError) as error:

@@ -3,6 +3,10 @@
 Used by ``robokudo eval ... --workers N [--address ...]``: each scene is a Ray task (one CPU), run on a local
 cluster (default) or the one at the address, with a progress bar on a terminal. The tasks run the same code as
 the sequential loop, so the figures are the same. An exception a task raises is raised here as itself.
+
+The tasks run in a placement group of N one-CPU bundles, so at most N run at once on any cluster, and twice as
+many are handed to Ray as run: the next item is waiting on a worker's node when its task ends (no round trip
+to this process between two items). Ray reuses its worker processes, so each loads the code once.
 """
 
 from __future__ import annotations
@@ -14,6 +18,10 @@ from typing import Any, TypeVar
 from tqdm import tqdm
 
 from robokudo.application.cluster import ray_cluster
+
+RETRIES = 3
+"""How often a task whose worker process died (e.g. killed by Ray's memory monitor when the machine runs low on
+memory) is run again; an exception the function raises is not retried."""
 
 T = TypeVar("T")
 R = TypeVar("R")
@@ -43,35 +51,51 @@ def map_on_cluster(
     label: str = "",
     purpose: str = "running tasks on a cluster",
 ) -> list[R]:
-    """``function(item, *extra)`` for each item as Ray tasks, at most ``workers`` at once, on the cluster at
+    """``function(item, *extra)`` for each item as Ray tasks, at most ``workers`` at once (a placement group of
+    ``workers`` one-CPU bundles), on the cluster at
     ``address`` (None: a local one with ``workers`` CPUs); the results in the items' order. The task's own
     exception when one fails; ClusterError without Ray (``PURPOSE needs Ray``) or a cluster."""
     if workers < 1:
         raise ValueError(f"workers must be at least 1, got {workers}")
     with ray_cluster(address, num_cpus=workers, purpose=purpose) as ray:
-        task = ray.remote(num_cpus=1, max_retries=0)(function)
-        shared = [ray.put(value) for value in extra]
-        results: list[Any] = [None] * len(items)
-        running: dict[Any, int] = {}
-        upcoming = iter(enumerate(items))
-        with progress(len(items), label) as bar:
-            try:
-                while True:
-                    while len(running) < workers:
-                        index, item = next(upcoming, (-1, None))
-                        if index < 0:
-                            break
-                        running[task.remote(item, *shared)] = index
-                    if not running:
+        from ray.util.placement_group import placement_group, remove_placement_group
+        from ray.util.scheduling_strategies import PlacementGroupSchedulingStrategy
+
+        group = placement_group([{"CPU": 1}] * workers)
+        try:
+            ray.get(group.ready())
+            task = ray.remote(function).options(
+                num_cpus=1, max_retries=RETRIES, scheduling_strategy=PlacementGroupSchedulingStrategy(group)
+            )
+            return _in_order(ray, task, items, [ray.put(value) for value in extra], 2 * workers, label)
+        finally:
+            remove_placement_group(group)
+
+
+def _in_order(ray: Any, task: Any, items: Sequence[T], shared: list[Any], in_flight: int, label: str) -> list[Any]:
+    """``task`` on each item with the ``shared`` arguments, ``in_flight`` handed to Ray at a time; the results in
+    the items' order."""
+    results: list[Any] = [None] * len(items)
+    running: dict[Any, int] = {}
+    upcoming = iter(enumerate(items))
+    with progress(len(items), label) as bar:
+        try:
+            while True:
+                while len(running) < in_flight:
+                    index, item = next(upcoming, (-1, None))
+                    if index < 0:
                         break
-                    done, _ = ray.wait(list(running), num_returns=1)
-                    for reference in done:
-                        results[running.pop(reference)] = _result(ray, reference)
-                        bar.update()
-            finally:
-                for reference in running:
-                    ray.cancel(reference)
-        return results
+                    running[task.remote(item, *shared)] = index
+                if not running:
+                    break
+                done, _ = ray.wait(list(running), num_returns=1)
+                for reference in done:
+                    results[running.pop(reference)] = _result(ray, reference)
+                    bar.update()
+        finally:
+            for reference in running:
+                ray.cancel(reference)
+    return results
 
 
 def _result(ray: Any, reference: Any) -> Any:

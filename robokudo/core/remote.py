@@ -6,10 +6,13 @@ annotator's name, reason, ports and capability; on each run its worker thread
 
 1. takes the annotator's *declared* inputs from the CAS (the views of its input types, the annotations of its
    input types; a hypothesis goes without the annotations other experts attached to it unless they are of a
-   declared input type too, as a shallow copy that shares its arrays),
-2. sends them to the actor in one call: Ray serialises numpy arrays out of band into its object store (the
-   one copy the transfer needs; nothing else is copied here), and on the actor's node they are read in place,
-   read-only,
+   declared input type too, as a shallow copy that shares its arrays, and with its mask cut to its ``roi``
+   when nothing of the mask lies outside: the actor restores the full-frame mask, so the expert sees what
+   it would see locally),
+2. puts each view into Ray's object store once per frame (:class:`FrameStore`: every remote expert of a
+   resource pool that reads the frame's image sends the same reference; the put is the one copy the transfer
+   needs, nothing else is copied here) and calls the actor with the references and the (small) annotations;
+   on the actor's node the arrays are read in place, read-only,
 3. waits (the node is RUNNING, the tick loop goes on), polling its cancel flag: a cancelled or timed-out run
    asks Ray to cancel the call and discards its result, as a local threaded annotator does,
 4. commits what the actor's annotator wrote through its own port checks (attachments go to the local
@@ -32,12 +35,15 @@ import contextlib
 import copy
 import functools
 import os
+import threading
 import time
+from collections import OrderedDict
 from collections.abc import Collection, Hashable
 from dataclasses import dataclass, replace
 from types import ModuleType
 from typing import Any, ClassVar
 
+import numpy as np
 import py_trees
 
 from robokudo.core.annotator import Annotator, PortError, RunCancelledError, _Run
@@ -131,19 +137,20 @@ class ExpertHost:
         """The actor's process id (to watch or stop it)."""
         return os.getpid()
 
-    def analyse(self, inputs: tuple[list[View], list[Annotation]]) -> tuple[str, str, list[Write]]:
-        """Run the annotator on ``inputs`` (views, annotations); its status name, message and writes, each
-        attachment naming its hypothesis by its index among the annotations sent."""
-        views, annotations = inputs
+    def analyse(self, annotations: list[Annotation], *views: View) -> tuple[str, str, list[Write], float]:
+        """Run the annotator on the ``annotations`` (as :func:`in_transit` made them) and ``views``; its status
+        name, message, writes (each attachment naming its hypothesis by its index among the annotations) and
+        run time in seconds."""
+        annotations = [restored(annotation) for annotation in annotations]
         cas = CAS()
         for view in views:
             cas.set_view(view)
         for annotation in annotations:
             cas.add(annotation)
         run = _Run(cas, thread_ident=None)
-        status, message, _ = self._annotator._execute(run)
+        status, message, seconds = self._annotator._execute(run)
         if status.name != "SUCCESS":
-            return status.name, message, []
+            return status.name, message, [], seconds
         position = {id(annotation): index for index, annotation in enumerate(annotations)}
         writes: list[Write] = []
         for write in run.writes:
@@ -154,8 +161,8 @@ class ExpertHost:
             elif id(write.hypothesis) in position:
                 writes.append(("attach", position[id(write.hypothesis)], write.annotation))
             else:
-                return "FAILURE", "attached an annotation to a hypothesis it was not sent", []
-        return status.name, message, writes
+                return "FAILURE", "attached an annotation to a hypothesis it was not sent", [], seconds
+        return status.name, message, writes, seconds
 
 
 @functools.cache
@@ -179,6 +186,8 @@ class RemoteAnnotator(ThreadedAnnotator):
         self.where = placement
         self._actor: Any = None
         self._actor_failed = False
+        self.remote_seconds = 0.0
+        """The expert's own run time on the actor in the last run that got an answer (seconds)."""
 
     def actor(self) -> Any:
         """The Ray actor handle (started on first use; shared through this node's resources)."""
@@ -223,8 +232,12 @@ class RemoteAnnotator(ThreadedAnnotator):
                         seen.add(id(annotation))
                         local.append(annotation)
         annotation_types = tuple(t for t in declared if issubclass(t, Annotation))
-        sent = [_only_declared(annotation, annotation_types) for annotation in local]
+        sent = [in_transit(annotation, annotation_types) for annotation in local]
         return views, sent, local
+
+    def frames(self) -> FrameStore:
+        """The object-store references of the frames' views, shared by the remote experts of this node's pool."""
+        return self.resources.get(FrameStore.KEY, FrameStore)
 
     def analyse(self) -> None:
         """Send the declared inputs, wait for the actor's answer, commit its writes."""
@@ -234,7 +247,8 @@ class RemoteAnnotator(ThreadedAnnotator):
         if self._actor_failed:
             self._await_restart(ray, actor)
         try:
-            status, message, writes = self._wait(ray, actor.analyse.remote((views, sent)))
+            references = self.frames().references(ray, views)
+            status, message, writes, self.remote_seconds = self._wait(ray, actor.analyse.remote(sent, *references))
         except ray.exceptions.RayTaskError as error:
             cause = getattr(error, "cause", None)
             if isinstance(cause, PortError | StructureError | NotImplementedError):
@@ -260,13 +274,15 @@ class RemoteAnnotator(ThreadedAnnotator):
         """The result of the call ``pending``, polling this run's cancel flag meanwhile (a cancelled run asks Ray
         to cancel the call and ends with RunCancelledError)."""
         try:
-            while not ray.wait([pending], timeout=POLL_SECONDS)[0]:
-                if self.cancelled:  # raises RunCancelledError once the run is cancelled
-                    break
+            while True:
+                try:
+                    return ray.get(pending, timeout=POLL_SECONDS)
+                except ray.exceptions.GetTimeoutError:
+                    if self.cancelled:  # (reading it raises RunCancelledError once the run is cancelled)
+                        raise RunCancelledError() from None
         except RunCancelledError:
             _cancel(ray, pending)
             raise
-        return ray.get(pending)
 
     def _await_restart(self, ray: ModuleType, actor: Any) -> None:
         """After the actor died: wait until Ray has restarted it (a call sent while it restarts would fail)."""
@@ -288,17 +304,122 @@ class RemoteAnnotator(ThreadedAnnotator):
             self._actor = None
 
 
-def _only_declared(annotation: Annotation, declared: tuple[type[CasType], ...]) -> Annotation:
-    """``annotation``, or for a hypothesis a shallow copy (arrays shared) whose attached annotations are those of
-    the declared types only."""
+@dataclass(frozen=True, slots=True)
+class CroppedMask:
+    """A hypothesis mask in transit: its part inside the hypothesis' ``roi`` and the full frame's shape."""
+
+    inside: np.ndarray
+    shape: tuple[int, ...]
+
+    def full(self, roi: tuple[int, int, int, int]) -> np.ndarray:
+        """The full-frame mask again (False outside ``roi``)."""
+        x0, y0, x1, y1 = roi
+        mask = np.zeros(self.shape, dtype=self.inside.dtype)
+        mask[y0:y1, x0:x1] = self.inside
+        return mask
+
+
+@dataclass(frozen=True, slots=True)
+class MaskIndices:
+    """Hypothesis point indices in transit that are exactly the flat indices of its mask (of this dtype)."""
+
+    dtype: str
+
+    def of(self, mask: CroppedMask, roi: tuple[int, int, int, int]) -> np.ndarray:
+        """The indices again, from the mask as it was sent."""
+        rows, columns = np.nonzero(mask.inside)
+        return ((rows + roi[1]) * mask.shape[1] + (columns + roi[0])).astype(self.dtype, copy=False)
+
+
+def in_transit(annotation: Annotation, declared: tuple[type[CasType], ...]) -> Annotation:
+    """What is sent for ``annotation``: itself, or for a hypothesis a shallow copy (arrays shared) whose
+    attached annotations are those of the ``declared`` types only, whose mask is a :class:`CroppedMask` when
+    no pixel of it lies outside the hypothesis' ``roi``, and whose point indices are a :class:`MaskIndices` when
+    they are the mask's flat indices (the actor restores both: :func:`restored`)."""
     if not isinstance(annotation, ObjectHypothesis):
         return annotation
     kept = [a for a in annotation.annotations if isinstance(a, declared)]
-    if len(kept) == len(annotation.annotations):
+    inside = _inside_roi(annotation.mask, annotation.roi)
+    if len(kept) == len(annotation.annotations) and inside is None:
         return annotation
-    stripped = copy.copy(annotation)
-    stripped.annotations = kept
-    return stripped
+    sent = copy.copy(annotation)
+    sent.annotations = kept
+    if inside is not None:
+        if _are_mask_indices(annotation.point_indices, inside, annotation.roi, annotation.mask.shape):
+            sent.point_indices = MaskIndices(annotation.point_indices.dtype.str)  # type: ignore[assignment]
+        sent.mask = CroppedMask(inside, annotation.mask.shape)  # type: ignore[assignment]
+    return sent
+
+
+def restored(annotation: Annotation) -> Annotation:
+    """An annotation as it was before :func:`in_transit` (a hypothesis gets its full-frame mask and its point
+    indices back)."""
+    if isinstance(annotation, ObjectHypothesis) and isinstance(annotation.mask, CroppedMask):
+        if isinstance(annotation.point_indices, MaskIndices):
+            annotation.point_indices = annotation.point_indices.of(annotation.mask, annotation.roi)
+        annotation.mask = annotation.mask.full(annotation.roi)
+    return annotation
+
+
+def _are_mask_indices(indices: Any, inside: np.ndarray, roi: tuple[int, int, int, int], shape: tuple[int, ...]) -> bool:
+    """True when ``indices`` (an integer array) are the flat indices, in order, of the mask whose part inside
+    ``roi`` is ``inside`` (and nothing outside)."""
+    if not isinstance(indices, np.ndarray) or indices.ndim != 1 or indices.dtype.kind not in "iu":
+        return False
+    rows, columns = np.nonzero(inside)
+    if indices.shape[0] != rows.shape[0]:
+        return False
+    x0, y0 = roi[0], roi[1]
+    return bool(np.array_equal((rows + y0) * shape[1] + (columns + x0), indices))
+
+
+def _inside_roi(mask: Any, roi: Any) -> np.ndarray | None:
+    """The part of a 2-D ``mask`` inside ``roi`` (x0, y0, x1, y1) when that is all of it and smaller, else None."""
+    if not isinstance(mask, np.ndarray) or mask.ndim != 2 or not isinstance(roi, tuple) or len(roi) != 4:
+        return None
+    x0, y0, x1, y1 = (int(v) for v in roi)
+    height, width = mask.shape
+    if not (0 <= x0 <= x1 <= width and 0 <= y0 <= y1 <= height) or (x1 - x0) * (y1 - y0) == mask.size:
+        return None
+    inside = mask[y0:y1, x0:x1]
+    if np.count_nonzero(inside) != np.count_nonzero(mask):
+        return None
+    return inside
+
+
+class FrameStore:
+    """The object-store references of the views remote experts sent lately, one ``ray.put`` per view object.
+
+    A frame's views are new objects (a reader writes new ones for every frame), so the references are kept per
+    view object, the view held with its reference so its id stays its own; the ``size`` latest are kept
+    (several trees of one pool may work on a few frames at once). Thread-safe: the workers of several remote
+    experts call it at once.
+    """
+
+    KEY: ClassVar[Hashable] = ("remote expert frames",)
+
+    def __init__(self, size: int = 8) -> None:
+        self.size = size
+        self._lock = threading.Lock()
+        self._references: OrderedDict[int, tuple[View, Any]] = OrderedDict()
+
+    def references(self, ray: ModuleType, views: list[View]) -> list[Any]:
+        """The object references of ``views`` (put into the object store on first request)."""
+        return [self._reference(ray, view) for view in views]
+
+    def _reference(self, ray: ModuleType, view: View) -> Any:
+        with self._lock:
+            known = self._references.get(id(view))
+            if known is not None and known[0] is view:
+                self._references.move_to_end(id(view))
+                return known[1]
+        reference = ray.put(view)
+        with self._lock:
+            self._references[id(view)] = (view, reference)
+            self._references.move_to_end(id(view))
+            while len(self._references) > self.size:
+                self._references.popitem(last=False)
+        return reference
 
 
 def _cancel(ray: ModuleType, pending: Any) -> None:

@@ -22,6 +22,9 @@ from types import ModuleType
 
 import numpy as np
 import pytest
+from hypothesis import given
+from hypothesis import strategies as st
+from hypothesis.extra.numpy import arrays
 from py_trees.common import Status
 
 from annotators.image.color import SemanticColorAnnotator
@@ -30,7 +33,18 @@ from robokudo.core.cas import CAS
 from robokudo.core.engine import Engine
 from robokudo.core.pipeline import pipelines
 from robokudo.core.placement import Placement
-from robokudo.core.remote import ExpertHost, PlacementError, Recipe, RemoteAnnotator, place_remote
+from robokudo.core.remote import (
+    CroppedMask,
+    ExpertHost,
+    FrameStore,
+    MaskIndices,
+    PlacementError,
+    Recipe,
+    RemoteAnnotator,
+    in_transit,
+    place_remote,
+    restored,
+)
 from robokudo.core.types import ColorImage, DepthImage, ObjectHypothesis, Pose, SemanticColor
 from tests.annotators.conftest import SHARED_DATA, require_folder
 from trees import tabletop
@@ -177,12 +191,12 @@ def test_the_actor_side_runs_the_expert_on_the_declared_inputs_alone() -> None:
     hypothesis = ObjectHypothesis(point_indices=np.flatnonzero(mask), mask=mask, roi=(35, 10, 55, 30))
     require_ray()  # the recipe checks with Ray's pickler that the parameters can be sent
     host = ExpertHost(Recipe.of(SemanticColorAnnotator(name="colour", max_pixels=500)))
-    status, message, writes = host.analyse(([ColorImage(image)], [hypothesis]))
-    assert (status, message) == ("SUCCESS", "")
+    status, message, writes, seconds = host.analyse([hypothesis], ColorImage(image))
+    assert (status, message) == ("SUCCESS", "") and seconds > 0
     [(kind, index, colour)] = writes
     assert (kind, index, colour.color, colour.source) == ("attach", 0, "red", "colour")
     assert not hypothesis.annotations  # the actor's writes are returned, not applied
-    status, message, writes = host.analyse(([], [hypothesis]))
+    status, message, writes, _ = host.analyse([hypothesis])
     assert (status, message, writes) == ("FAILURE", "no ColorImage in the CAS", [])
 
 
@@ -204,6 +218,53 @@ def test_only_declared_inputs_are_sent() -> None:
     assert local == [hypothesis] and sent[0] is not hypothesis
     assert sent[0].annotations == [] and sent[0].mask is hypothesis.mask  # shares its arrays, drops the pose
     assert hypothesis.annotations and isinstance(hypothesis.annotations[0], Pose)
+
+
+@given(
+    mask=arrays(bool, st.tuples(st.integers(1, 12), st.integers(1, 12))),
+    corners=st.tuples(*(st.floats(0, 1) for _ in range(4))),
+)
+def test_a_mask_in_transit_comes_back_as_it_was(mask: np.ndarray, corners: tuple[float, ...]) -> None:
+    """For any mask and box: the mask goes cut to the box only when nothing of it lies outside, and the actor's
+    side restores exactly the full-frame mask."""
+    height, width = mask.shape
+    xs = sorted(round(c * width) for c in corners[:2])
+    ys = sorted(round(c * height) for c in corners[2:])
+    roi = (xs[0], ys[0], xs[1], ys[1])
+    hypothesis = ObjectHypothesis(point_indices=np.flatnonzero(mask), mask=mask, roi=roi)
+    sent = in_transit(hypothesis, (ObjectHypothesis,))
+    outside = np.count_nonzero(mask) - np.count_nonzero(mask[roi[1] : roi[3], roi[0] : roi[2]])
+    assert isinstance(sent.mask, CroppedMask) == (outside == 0 and (roi[2] - roi[0]) * (roi[3] - roi[1]) < mask.size)
+    back = restored(sent)
+    assert back.mask.shape == mask.shape and back.mask.dtype == mask.dtype and np.array_equal(back.mask, mask)
+    indices = hypothesis.point_indices
+    assert back.point_indices.dtype == indices.dtype and np.array_equal(back.point_indices, indices)
+    assert hypothesis.mask is mask and hypothesis.point_indices is indices  # the local one unchanged
+
+
+@given(indices=arrays(np.int64, st.integers(0, 30), elements=st.integers(0, 47)), dtype=st.sampled_from(["<i4", "<i8"]))
+def test_point_indices_in_transit_come_back_as_they_were(indices: np.ndarray, dtype: str) -> None:
+    """Indices that are not the mask's own (any order, repeats, other points) go as they are."""
+    mask = np.zeros((6, 8), bool)
+    mask[1:4, 2:5] = True
+    hypothesis = ObjectHypothesis(point_indices=indices.astype(dtype), mask=mask, roi=(2, 1, 5, 4))
+    back = restored(in_transit(hypothesis, (ObjectHypothesis,)))
+    assert back.point_indices.dtype == np.dtype(dtype) and np.array_equal(back.point_indices, indices)
+    own = ObjectHypothesis(point_indices=np.flatnonzero(mask).astype(dtype), mask=mask, roi=(2, 1, 5, 4))
+    sent = in_transit(own, (ObjectHypothesis,))
+    assert isinstance(sent.point_indices, MaskIndices)
+    back = restored(sent)
+    assert back.point_indices.dtype == np.dtype(dtype) and np.array_equal(back.point_indices, own.point_indices)
+
+
+def test_a_frame_goes_into_the_object_store_once(cluster: ModuleType) -> None:
+    frames = FrameStore(size=2)
+    first, second, third = (ColorImage(np.full((4, 4, 3), n, np.uint8)) for n in (1, 2, 3))
+    [reference] = frames.references(cluster, [first])
+    assert frames.references(cluster, [first]) == [reference]  # a second expert on the frame: the same object
+    assert cluster.get(reference).image[0, 0, 0] == 1
+    frames.references(cluster, [second, third])  # two newer frames push the first out
+    assert frames.references(cluster, [first]) != [reference]
 
 
 def place_remote_probe() -> RemoteAnnotator:
