@@ -29,6 +29,7 @@ import os
 import shlex
 import sqlite3
 import threading
+from collections import OrderedDict
 from collections.abc import Callable, Iterator, Mapping, Sequence
 from contextlib import contextmanager
 from dataclasses import dataclass, field
@@ -61,6 +62,10 @@ RTREE_SLACK = 0.05
 """Half-width (metres) of a belief's R*Tree entry around its position."""
 WAL_AUTOCHECKPOINT_PAGES = 4000
 """Checkpoint the WAL into the file every ~16 MB (fewer fsyncs than SQLite's default of 1000 pages)."""
+WORKING_SET = 8192
+"""Beliefs :meth:`BeliefStore.integrate` keeps decoded between frames (the least recently used are dropped)."""
+CACHE_KIB = 32768
+"""SQLite page cache of the store's connection (KiB): the candidate look-ups of a frame read from it."""
 
 
 class BeliefStoreError(Exception):
@@ -201,13 +206,21 @@ class BeliefStore:
         busy_timeout: float = 10.0,
         check: bool = True,
         history_limit: int = 100,
+        working_set: int = WORKING_SET,
     ) -> None:
         self.path = Path(path).expanduser()
         if synchronous.upper() not in SYNCHRONOUS_MODES:
             raise ValueError(f"synchronous must be one of {', '.join(SYNCHRONOUS_MODES)}, not {synchronous!r}")
+        if working_set < 0:
+            raise ValueError(f"working_set must be >= 0, not {working_set}")
         self.tracker = tracker or BeliefTracker()
         self.history_limit = history_limit
+        self.write_log: list[list[tuple[str, list[tuple]]]] | None = None
+        """When a list, each :meth:`integrate` appends the statements it wrote, with their rows (benchmarks)."""
         self._lock = threading.RLock()
+        self._working: OrderedDict[int, tuple[ObjectBelief, _Loaded]] = OrderedDict()
+        self._working_limit = working_set
+        self._data_version: int | None = None
         self._conn = self._open(synchronous.upper(), busy_timeout, check)
 
     # ------------------------------------------------------------------ opening
@@ -242,6 +255,7 @@ class BeliefStore:
                 raise BeliefStoreError(f"belief store {path}: cannot use WAL journal mode (got {mode})")
             conn.execute(f"PRAGMA synchronous = {synchronous}")
             conn.execute(f"PRAGMA wal_autocheckpoint = {WAL_AUTOCHECKPOINT_PAGES}")
+            conn.execute(f"PRAGMA cache_size = -{CACHE_KIB}")
             if not ready:  # a store in use is opened without writing, so readers never wait for the writer
                 conn.execute("BEGIN IMMEDIATE")
                 self._migrate(conn)
@@ -356,34 +370,70 @@ class BeliefStore:
         missed earlier and not seen for the tracker's ``gone_after`` seconds are marked gone, wherever they are.
         """
         tracker = tracker or self.tracker
-        with self._transaction() as conn:
-            beliefs, loaded = self._candidates(conn, objects, camera, tracker.config.association.gate_distance)
-            next_id = int(conn.execute("SELECT value FROM meta WHERE key = 'next_id'").fetchone()[0])
-            allocated = [next_id]
+        time = float(time)
+        writes: list[tuple[str, list[tuple]]] = []
+        try:
+            with self._transaction() as conn:
+                self._check_working_set(conn)
+                beliefs, loaded = self._candidates(conn, objects, camera, tracker.config.association.gate_distance)
+                next_id = int(conn.execute("SELECT value FROM meta WHERE key = 'next_id'").fetchone()[0])
+                allocated = [next_id]
 
-            def new_id() -> int:
-                value = allocated[0]
-                allocated[0] += 1
-                return value
+                def new_id() -> int:
+                    value = allocated[0]
+                    allocated[0] += 1
+                    return value
 
-            step = tracker.step(beliefs, objects, time, new_id, camera)
-            self._write_beliefs(conn, step.changed, tracker.class_test, loaded)
-            counts = {b.id: b.observations for b in step.changed}
-            self._write_observations(conn, objects, [(i, counts.get(i, 0)) for i in step.assigned], time)
-            if allocated[0] != next_id:
-                conn.execute("UPDATE meta SET value = ? WHERE key = 'next_id'", (str(allocated[0]),))
-            seen = set(step.assigned)
-            self._prune_history(conn, [b for b in step.changed if b.id in seen])
-            # beliefs missed earlier and not seen since, wherever they are, are gone after gone_after seconds
-            conn.execute(
-                "UPDATE objects SET status = 'gone' WHERE misses > 0 AND status = 'present' AND last_seen <= ?",
-                (time - tracker.config.gone_after,),
-            )
+                step = tracker.step(beliefs, objects, time, new_id, camera)
+                rows, places = self._write_beliefs(conn, step.changed, tracker.class_test, loaded, writes)
+                counts = {b.id: b.observations for b in step.changed}
+                self._write_observations(conn, objects, [(i, counts.get(i, 0)) for i in step.assigned], time, writes)
+                if allocated[0] != next_id:
+                    _write(conn, writes, "UPDATE meta SET value = ? WHERE key = 'next_id'", [(str(allocated[0]),)])
+                seen = set(step.assigned)
+                self._prune_history(conn, [b for b in step.changed if b.id in seen], writes)
+                # beliefs missed earlier and not seen since, wherever they are, are gone after gone_after seconds
+                cutoff = (time - tracker.config.gone_after,)
+                gone = conn.execute(_MARK_GONE, cutoff).fetchall()
+                writes.append((_MARK_GONE, [cutoff]))
+        except BaseException:
+            self._working.clear()  # the tracker changed loaded beliefs in place; the file has them as they were
+            raise
+        for (belief_id,) in gone:
+            self._working.pop(belief_id, None)
+        for b in step.changed:
+            row = rows[b.id]
+            _settle(b, row)
+            self._remember(b, _Loaded(places[b.id], *_labels(row)))
+        if self.write_log is not None:
+            self.write_log.append(writes)
         return step
+
+    # ------------------------------------------------------------------ working set
+
+    def _check_working_set(self, conn: sqlite3.Connection) -> None:
+        """Drop the working set when another connection committed since this one last looked (inside the
+        write transaction, so nobody else commits until it ends)."""
+        version = conn.execute("PRAGMA data_version").fetchone()[0]
+        if version != self._data_version:
+            self._working.clear()
+            self._data_version = version
+
+    def _remember(self, belief: ObjectBelief, stored: _Loaded) -> None:
+        """Keep a belief exactly as the file now holds it (equal to decoding its row), most recent last."""
+        if not self._working_limit:
+            return
+        working = self._working
+        working[belief.id] = (belief, stored)
+        working.move_to_end(belief.id)
+        while len(working) > self._working_limit:
+            working.popitem(last=False)
 
     def put(self, beliefs: Sequence[ObjectBelief], class_test: ClassTest | None = None) -> None:
         """Write beliefs as they are (insert or replace, attributes included) in one transaction."""
         with self._transaction() as conn:
+            for b in beliefs:
+                self._working.pop(b.id, None)
             self._write_beliefs(conn, beliefs, class_test)
             top = max((b.id for b in beliefs), default=0) + 1
             conn.execute(
@@ -401,6 +451,7 @@ class BeliefStore:
         """Forget every belief and its history; returns how many beliefs there were."""
         with self._transaction() as conn:
             count = int(conn.execute("SELECT COUNT(*) FROM objects").fetchone()[0])
+            self._working.clear()
             for table in ("objects", "objects_place", "attribute_index", "observations", "classes"):
                 conn.execute(f"DELETE FROM {table}")
         return count
@@ -409,6 +460,8 @@ class BeliefStore:
         """Forget the beliefs ``ids`` and their history (unknown ids are skipped); returns how many were forgotten."""
         rows = [(int(i),) for i in set(ids)]
         with self._transaction() as conn:
+            for (object_id,) in rows:
+                self._working.pop(object_id, None)
             count = conn.executemany("DELETE FROM objects WHERE id = ?", rows).rowcount
             conn.executemany("DELETE FROM objects_place WHERE id = ?", rows)
             conn.executemany("DELETE FROM attribute_index WHERE object_id = ?", rows)
@@ -425,8 +478,10 @@ class BeliefStore:
         """Present beliefs within ``gate`` of an observation or in view of ``camera`` (R*Tree look-ups).
 
         Also returns how each one was stored, so unchanged R*Tree entries and index columns are not rewritten.
+        The look-ups return ids, positions and R*Tree entries only; beliefs of the working set are taken from
+        it, the others are read and decoded with one more statement.
         """
-        rows: dict[int, tuple] = {}
+        hits: dict[int, tuple] = {}
         groups: dict[tuple[str, str], list[FrameObject]] = {}
         for item in objects:
             groups.setdefault((item.frame, item.recording), []).append(item)
@@ -440,29 +495,43 @@ class BeliefStore:
             found = found.fetchall()
             if not found:
                 continue
-            positions = np.array([(row[3], row[4], row[5]) for row in found], dtype=np.float64)
+            positions = np.array([row[1:4] for row in found], dtype=np.float64)
             delta = positions[:, None, :] - centres[None, :, :]
             near = (np.sqrt(np.einsum("ijk,ijk->ij", delta, delta)) <= gate).any(axis=1)
             for row, keep in zip(found, near.tolist(), strict=True):
                 if keep:
-                    rows[row[0]] = row
+                    hits[row[0]] = row
         if camera is not None:
             low, high = _frustum_bounds(camera)
             world = (camera.frame, WORLD_FRAME, camera.recording)
             box = (high[0], low[0], high[1], low[1], high[2], low[2])
             found = conn.execute(_candidate_query(1), (*box, *world, PRESENT))
-            in_frustum = [row for row in found if row[0] not in rows]
+            in_frustum = [row for row in found if row[0] not in hits]
             if in_frustum:
-                positions = np.array([(row[3], row[4], row[5]) for row in in_frustum], dtype=np.float64)
+                positions = np.array([row[1:4] for row in in_frustum], dtype=np.float64)
                 for row, seen in zip(in_frustum, in_view(positions, camera), strict=True):
                     if seen:
-                        rows[row[0]] = row
-        n = _COLUMN_COUNT
-        loaded = {
-            i: _Loaded(((r[n] + r[n + 1]) / 2, (r[n + 2] + r[n + 3]) / 2, (r[n + 4] + r[n + 5]) / 2), *_labels(r))
-            for i, r in rows.items()
-        }
-        return [_belief_from_row(rows[i]) for i in sorted(rows)], loaded
+                        hits[row[0]] = row
+        working = self._working
+        chosen: dict[int, tuple[ObjectBelief, _Loaded]] = {}
+        missing = []
+        for i in hits:
+            known = working.get(i)
+            if known is None:
+                missing.append(i)
+            else:
+                chosen[i] = known
+        for start in range(0, len(missing), 900):  # SQLite's default limit of 999 parameters per statement
+            part = missing[start : start + 900]
+            rows = conn.execute(
+                f"SELECT {_OBJECT_COLUMNS} FROM objects WHERE id IN ({', '.join('?' * len(part))})", part
+            )
+            for row in rows:
+                r = hits[row[0]]
+                place = ((r[4] + r[5]) / 2, (r[6] + r[7]) / 2, (r[8] + r[9]) / 2)
+                chosen[row[0]] = (_belief_from_row(row), _Loaded(place, *_labels(row)))
+        order = sorted(chosen)
+        return [chosen[i][0] for i in order], {i: chosen[i][1] for i in order}
 
     def _write_beliefs(
         self,
@@ -470,8 +539,10 @@ class BeliefStore:
         beliefs: Sequence[ObjectBelief],
         class_test: ClassTest | None,
         loaded: Mapping[int, _Loaded] | None = None,
-    ) -> None:
-        """Write object rows, their R*Tree entries and attribute-index entries.
+        writes: list[tuple[str, list[tuple]]] | None = None,
+    ) -> tuple[dict[int, tuple], dict[int, tuple[float, float, float]]]:
+        """Write object rows, their R*Tree entries and attribute-index entries; returns the rows written and the
+        centre of each belief's R*Tree entry afterwards.
 
         Beliefs in ``loaded`` are updated in place; their indexed columns and index entries are touched only
         when they changed. The R*Tree entry of a belief is a box of half-width ``RTREE_SLACK`` around a recent
@@ -479,20 +550,23 @@ class BeliefStore:
         so the true position always lies inside the entry and look-ups by position miss nothing.
         """
         if not beliefs:
-            return
+            return {}, {}
+        log = [] if writes is None else writes
         loaded = loaded or {}
         cache: dict[frozenset[str], str] = {}
         rows = {b.id: _object_row(b, class_test, cache) for b in beliefs}
         fresh = [rows[b.id] for b in beliefs if b.id not in loaded]
         if fresh:
-            conn.executemany("DELETE FROM attribute_index WHERE object_id = ?", [(row[0],) for row in fresh])
-            conn.executemany(f"INSERT OR REPLACE INTO objects ({_OBJECT_COLUMNS}) VALUES ({_PLACEHOLDERS})", fresh)
+            _write(conn, log, "DELETE FROM attribute_index WHERE object_id = ?", [(row[0],) for row in fresh])
+            _write(conn, log, f"INSERT OR REPLACE INTO objects ({_OBJECT_COLUMNS}) VALUES ({_PLACEHOLDERS})", fresh)
         known = [b for b in beliefs if b.id in loaded]
         if known:
-            conn.executemany(_UPDATE_VOLATILE, [_volatile(rows[b.id]) for b in known])
+            _write(conn, log, _UPDATE_VOLATILE, [_volatile(rows[b.id]) for b in known])
             relabelled = [(*_labels(rows[b.id]), b.id) for b in known if _labels(rows[b.id]) != _state(loaded[b.id])]
             if relabelled:
-                conn.executemany(
+                _write(
+                    conn,
+                    log,
                     "UPDATE objects SET class_name = ?, region = ?, region_class = ?, indexed = ? WHERE id = ?",
                     relabelled,
                 )
@@ -508,10 +582,11 @@ class BeliefStore:
             added.extend((name, value, b.id) for name, value in new - old)
             removed.extend((name, value, b.id) for name, value in old - new)
         if removed:
-            conn.executemany("DELETE FROM attribute_index WHERE name = ? AND value = ? AND object_id = ?", removed)
+            _write(conn, log, "DELETE FROM attribute_index WHERE name = ? AND value = ? AND object_id = ?", removed)
         if added:
-            conn.executemany("INSERT OR IGNORE INTO attribute_index VALUES (?, ?, ?)", added)
+            _write(conn, log, "INSERT OR IGNORE INTO attribute_index VALUES (?, ?, ?)", added)
         moved = []
+        places: dict[int, tuple[float, float, float]] = {}
         for b in beliefs:
             x, y, z = rows[b.id][3:6]
             state = loaded.get(b.id)
@@ -519,11 +594,20 @@ class BeliefStore:
             if centre is None or max(abs(x - centre[0]), abs(y - centre[1]), abs(z - centre[2])) > RTREE_SLACK / 2:
                 r = RTREE_SLACK
                 moved.append((b.id, x - r, x + r, y - r, y + r, z - r, z + r))
+            else:
+                places[b.id] = centre
         if moved:
-            conn.executemany("INSERT OR REPLACE INTO objects_place VALUES (?, ?, ?, ?, ?, ?, ?)", moved)
-        classes = {(b.class_name,) for b in beliefs if b.class_name and b.class_name != _loaded_class(loaded, b.id)}
+            _write(conn, log, "INSERT OR REPLACE INTO objects_place VALUES (?, ?, ?, ?, ?, ?, ?)", moved)
+            # the centre as the R*Tree stores it (32-bit floats), read back as the look-ups will read it
+            for i, x0, x1, y0, y1, z0, z1 in _rtree_boxes(conn, [m[0] for m in moved]):
+                places[i] = ((x0 + x1) / 2, (y0 + y1) / 2, (z0 + z1) / 2)
+        classes = [
+            (c,)
+            for c in {b.class_name for b in beliefs if b.class_name and b.class_name != _loaded_class(loaded, b.id)}
+        ]
         if classes:
-            conn.executemany("INSERT OR IGNORE INTO classes VALUES (?)", classes)
+            _write(conn, log, "INSERT OR IGNORE INTO classes VALUES (?)", classes)
+        return rows, places
 
     def _write_observations(
         self,
@@ -531,6 +615,7 @@ class BeliefStore:
         objects: Sequence[FrameObject],
         assigned: Sequence[tuple[int, int]],
         time: float,
+        writes: list[tuple[str, list[tuple]]],
     ) -> None:
         """Record each object's sighting under (belief id, its sighting number)."""
         cache: dict[frozenset[str], str] = {}
@@ -550,17 +635,21 @@ class BeliefStore:
             if object_id
         ]
         if rows:
-            conn.executemany(
+            _write(
+                conn,
+                writes,
                 "INSERT OR REPLACE INTO observations (object_id, seq, time, frame, px, py, pz, roi, sources, evidence, "
                 "recording) VALUES (?, ?, ?, ?, ?, ?, ?, ?, ?, ?, ?)",
                 rows,
             )
 
-    def _prune_history(self, conn: sqlite3.Connection, beliefs: Sequence[ObjectBelief]) -> None:
+    def _prune_history(
+        self, conn: sqlite3.Connection, beliefs: Sequence[ObjectBelief], writes: list[tuple[str, list[tuple]]]
+    ) -> None:
         limit = self.history_limit
         due = [(b.id, b.observations - limit) for b in beliefs if b.observations > limit and b.observations % 16 == 0]
         if due:
-            conn.executemany("DELETE FROM observations WHERE object_id = ? AND seq <= ?", due)
+            _write(conn, writes, "DELETE FROM observations WHERE object_id = ? AND seq <= ?", due)
 
     # ------------------------------------------------------------------ reading
 
@@ -691,17 +780,34 @@ class BeliefStore:
 # ---------------------------------------------------------------------------------------- row mapping
 
 
+_MARK_GONE = (
+    "UPDATE objects SET status = 'gone' WHERE misses > 0 AND status = 'present' AND last_seen <= ? RETURNING id"
+)
+
+
+def _write(conn: sqlite3.Connection, log: list[tuple[str, list[tuple]]], statement: str, rows: list[tuple]) -> None:
+    """Run one write statement over ``rows`` and note it in ``log`` (what the benchmark's reference replays)."""
+    conn.executemany(statement, rows)
+    log.append((statement, rows))
+
+
 @functools.lru_cache(maxsize=64)
 def _candidate_query(boxes: int) -> str:
-    """The present beliefs of one world whose R*Tree entries meet any of ``boxes`` boxes (one statement; its
-    parameters: x1, x0, y1, y0, z1, z0 of each box, then the frame, the world frame, the recording, the status)."""
+    """Id, position and R*Tree entry of the present beliefs of one world whose entries meet any of ``boxes`` boxes
+    (one statement; its parameters: x1, x0, y1, y0, z1, z0 of each box, then the frame, the world frame, the
+    recording, the status)."""
     box = "SELECT * FROM objects_place WHERE x0 <= ? AND x1 >= ? AND y0 <= ? AND y1 >= ? AND z0 <= ? AND z1 >= ?"
-    columns = ", ".join(f"o.{c.strip()}" for c in _OBJECT_COLUMNS.split(","))
     return (
         f"WITH hit AS ({' UNION '.join([box] * boxes)}) "
-        f"SELECT {columns}, hit.x0, hit.x1, hit.y0, hit.y1, hit.z0, hit.z1 FROM hit JOIN objects o ON o.id = hit.id "
+        "SELECT o.id, o.px, o.py, o.pz, hit.x0, hit.x1, hit.y0, hit.y1, hit.z0, hit.z1 "
+        "FROM hit JOIN objects o ON o.id = hit.id "
         "WHERE o.frame = ? AND (o.frame = ? OR o.recording = ?) AND o.status = ?"
     )
+
+
+def _rtree_boxes(conn: sqlite3.Connection, ids: list[int]) -> list[tuple]:
+    """The R*Tree entries of ``ids`` as stored (SQLite rounds them outwards to 32-bit floats)."""
+    return conn.execute(f"SELECT * FROM objects_place WHERE id IN ({', '.join('?' * len(ids))})", ids).fetchall()
 
 
 def _roi_text(roi: tuple[int, int, int, int] | None) -> str | None:
@@ -756,7 +862,7 @@ def _object_row(b: ObjectBelief, class_test: ClassTest | None, sources: dict[fro
 
 def _floats(values: np.ndarray | Sequence[float], count: int) -> list[float]:
     """The first ``count`` values as Python floats (one conversion of the array, not one per element)."""
-    return [float(v) for v in np.asarray(values).tolist()[:count]]
+    return np.asarray(values, dtype=np.float64)[:count].tolist()
 
 
 _COLUMN_COUNT = len(_OBJECT_COLUMNS.split(","))
@@ -836,6 +942,24 @@ def _decode_attributes(text: str) -> dict[str, AttributeBelief]:
     }
 
 
+def _settle(belief: ObjectBelief, row: tuple) -> None:
+    """Make ``belief`` (just written as ``row``) equal to what decoding ``row`` gives, in place and without parsing
+    it: log-odds rounded as :func:`_encode_attributes` writes them, arrays and numbers as the columns hold them."""
+    for attribute in belief.attributes.values():
+        for support in attribute.values.values():
+            support.log_odds = round(support.log_odds, 9)
+    if not all(attribute.values for attribute in belief.attributes.values()):
+        belief.attributes = {name: a for name, a in belief.attributes.items() if a.values}
+    belief.position = np.array(row[3:6])
+    belief.orientation = np.array(row[6:10])
+    belief.dimensions = None if row[10] is None else np.array(row[10:13])
+    belief.position_variance = row[13]
+    belief.appearance = None if row[14] is None else np.frombuffer(row[14], dtype=np.float32).astype(np.float64)
+    belief.existence = row[15]
+    belief.first_seen, belief.last_seen, belief.misses, belief.observations = row[17:21]
+    belief.roi = _roi_from_text(row[24])
+
+
 def _belief_from_row(row: tuple) -> ObjectBelief:
     """The belief of an ``objects`` row (extra trailing columns are ignored)."""
     (
@@ -865,7 +989,7 @@ def _belief_from_row(row: tuple) -> ObjectBelief:
         recording,
         roi,
         sources,
-        attributes,
+        encoded,
         _indexed,
     ) = row[:_COLUMN_COUNT]
     return ObjectBelief(
@@ -875,7 +999,7 @@ def _belief_from_row(row: tuple) -> ObjectBelief:
         orientation=np.array([qx, qy, qz, qw]),
         dimensions=None if sx is None else np.array([sx, sy, sz]),
         appearance=None if appearance is None else np.frombuffer(appearance, dtype=np.float32).astype(np.float64),
-        attributes=_decode_attributes(attributes),
+        attributes=_decode_attributes(encoded),
         position_variance=variance,
         existence=existence,
         status=status,
