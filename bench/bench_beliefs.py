@@ -440,29 +440,37 @@ def serve_idle_rss(folder: Path) -> float | None:
         return None
 
 
-def profile_updates(size: int, frames: int, per_frame: int, folder: Path, out: Path) -> None:
-    """cProfile of ``store.integrate`` over ``frames`` frames into a store of ``size``; the top entries by own time
-    and by cumulative time are written to ``out``."""
+def profile_updates(size: int, frames: int, per_frame: int, cameras: int, folder: Path, out: Path) -> None:
+    """cProfile of ``store.integrate`` over ``frames`` frames into a store of ``size``, frames at random places and
+    then from ``cameras`` fixed cameras; the top entries by own and by cumulative time are written to ``out``."""
     import cProfile
     import io
     import pstats
 
     path = folder / f"profile-{size}.sqlite"
-    seeded = seed_file(path, size, np.random.default_rng(size))
-    rng = np.random.default_rng(1)
-    objects = [frame_objects(hypotheses_near(seeded, rng, per_frame)) for _ in range(frames + 1)]
-    store = BeliefStore(path, tracker=BeliefTracker(class_test=is_subclass))
-    store.integrate(objects[0], 999.0)
-    profiler = cProfile.Profile()
-    profiler.enable()
-    for index, frame in enumerate(objects[1:]):
-        store.integrate(frame, 1000.0 + index)
-    profiler.disable()
-    store.close()
+    seeded = seed_file(path, size, np.random.default_rng(size), named_regions=False)
     text = io.StringIO()
-    text.write(f"store.integrate, {frames} frames x {per_frame} hypotheses into {size} stored objects\n")
-    pstats.Stats(profiler, stream=text).sort_stats("tottime").print_stats(25)
-    pstats.Stats(profiler, stream=text).sort_stats("cumulative").print_stats(25)
+    for scenario in (0, cameras):
+        copy = folder / f"profile-{size}-{scenario}.sqlite"
+        shutil.copy(path, copy)
+        rng = np.random.default_rng(1)
+        views = fixed_views(seeded, rng, scenario, per_frame) if scenario else []
+        objects = [
+            frame_objects(hypotheses_near(seeded, rng, per_frame, views[k % len(views)] if views else None))
+            for k in range(frames + 1)
+        ]
+        store = BeliefStore(copy, tracker=BeliefTracker(class_test=is_subclass))
+        store.integrate(objects[0], 999.0)
+        profiler = cProfile.Profile()
+        profiler.enable()
+        for index, frame in enumerate(objects[1:]):
+            store.integrate(frame, 1000.0 + index)
+        profiler.disable()
+        store.close()
+        where = f"from {scenario} fixed cameras in turn" if scenario else "each at a random place"
+        text.write(f"store.integrate, {frames} frames x {per_frame} hypotheses {where}, {size} stored objects\n")
+        pstats.Stats(profiler, stream=text).sort_stats("tottime").print_stats(25)
+        pstats.Stats(profiler, stream=text).sort_stats("cumulative").print_stats(25)
     out.parent.mkdir(parents=True, exist_ok=True)
     out.write_text(text.getvalue().replace(str(ROOT) + "/", ""))
     print(f"profile written to {out}")
@@ -493,7 +501,7 @@ def main() -> int:
         return 0
     if args.profile:
         with tempfile.TemporaryDirectory() as name:
-            profile_updates(10_000, args.frames, args.per_frame, Path(name), args.profile)
+            profile_updates(10_000, args.frames, args.per_frame, args.cameras, Path(name), args.profile)
         return 0
     print(f"load average before: {os.getloadavg()[0]:.2f} on {os.cpu_count()} CPUs")
     met: list[bool] = []

@@ -8,6 +8,11 @@
   20 hypotheses writes some 60 to 80 pages, so at most the last 50 to 70 frames, about two seconds at 30 Hz). The store
   rolls back to an earlier consistent state and never corrupts. Pass ``synchronous="FULL"`` to also survive power
   loss, at the cost of an fsync per commit.
+* A working set of decoded beliefs (up to :data:`WORKING_SET`, least recently used dropped) is kept between
+  frames, so a camera that sees the same objects again does not read and decode them again. It is write-through,
+  not write-behind: every frame is committed before :meth:`BeliefStore.integrate` returns, so the working set adds
+  nothing to what a crash can lose. It equals the file exactly (a belief is settled to what decoding its row
+  gives when it is written); another connection's commit (``PRAGMA data_version``) and a failed frame drop it.
 * A file that is not a valid belief store is never modified: opening it raises :class:`BeliefStoreError`
   naming the file and how to move it aside. A store of schema version 1 (before recordings were stored) is
   migrated in one transaction: its beliefs and sightings get an empty recording, so its camera-frame beliefs are
@@ -368,6 +373,8 @@ class BeliefStore:
         Beliefs near the observations (and, with ``camera``, in front of it) are loaded, associated and
         updated by the tracker; new objects get new ids; the changes and the sightings are written. Beliefs
         missed earlier and not seen for the tracker's ``gone_after`` seconds are marked gone, wherever they are.
+        The beliefs in the returned step are as the file now holds them, and are the store's working copies:
+        read them, do not change them (the next frame may update them in place).
         """
         tracker = tracker or self.tracker
         time = float(time)
@@ -385,7 +392,7 @@ class BeliefStore:
                     return value
 
                 step = tracker.step(beliefs, objects, time, new_id, camera)
-                rows, places = self._write_beliefs(conn, step.changed, tracker.class_test, loaded, writes)
+                rows, places = self._write_beliefs(conn, step.changed, tracker.class_test, loaded, writes, settle=True)
                 counts = {b.id: b.observations for b in step.changed}
                 self._write_observations(conn, objects, [(i, counts.get(i, 0)) for i in step.assigned], time, writes)
                 if allocated[0] != next_id:
@@ -540,9 +547,11 @@ class BeliefStore:
         class_test: ClassTest | None,
         loaded: Mapping[int, _Loaded] | None = None,
         writes: list[tuple[str, list[tuple]]] | None = None,
+        settle: bool = False,
     ) -> tuple[dict[int, tuple], dict[int, tuple[float, float, float]]]:
         """Write object rows, their R*Tree entries and attribute-index entries; returns the rows written and the
-        centre of each belief's R*Tree entry afterwards.
+        centre of each belief's R*Tree entry afterwards. With ``settle`` the beliefs' log-odds are set to the
+        values written (:func:`_encode_attributes`).
 
         Beliefs in ``loaded`` are updated in place; their indexed columns and index entries are touched only
         when they changed. The R*Tree entry of a belief is a box of half-width ``RTREE_SLACK`` around a recent
@@ -554,7 +563,7 @@ class BeliefStore:
         log = [] if writes is None else writes
         loaded = loaded or {}
         cache: dict[frozenset[str], str] = {}
-        rows = {b.id: _object_row(b, class_test, cache) for b in beliefs}
+        rows = {b.id: _object_row(b, class_test, cache, settle) for b in beliefs}
         fresh = [rows[b.id] for b in beliefs if b.id not in loaded]
         if fresh:
             _write(conn, log, "DELETE FROM attribute_index WHERE object_id = ?", [(row[0],) for row in fresh])
@@ -821,13 +830,16 @@ def _roi_from_text(text: str | None) -> tuple[int, int, int, int] | None:
     return x0, y0, x1, y1
 
 
-def _object_row(b: ObjectBelief, class_test: ClassTest | None, sources: dict[frozenset[str], str]) -> tuple:
-    """The ``objects`` row of a belief (columns as in ``_OBJECT_COLUMNS``); ``sources`` caches encodings."""
+def _object_row(
+    b: ObjectBelief, class_test: ClassTest | None, sources: dict[frozenset[str], str], settle: bool = False
+) -> tuple:
+    """The ``objects`` row of a belief (columns as in ``_OBJECT_COLUMNS``); ``sources`` caches encodings;
+    ``settle`` as in :func:`_encode_attributes`."""
     x, y, z = _floats(b.position, 3)
     qx, qy, qz, qw = _floats(b.orientation, 4)
     sx, sy, sz = (None, None, None) if b.dimensions is None else _floats(b.dimensions, 3)
     appearance = None if b.appearance is None else np.asarray(b.appearance, dtype=np.float32).tobytes()
-    encoded, indexed = _encode_attributes(b.attributes, class_test)
+    encoded, indexed = _encode_attributes(b.attributes, class_test, settle)
     return (
         b.id,
         b.class_name,
@@ -898,8 +910,11 @@ def _encoded_sources(experts: set[str], cache: dict[frozenset[str], str]) -> str
     return found
 
 
-def _encode_attributes(attributes: Mapping[str, AttributeBelief], class_test: ClassTest | None) -> tuple[str, str]:
-    """JSON of every value's support, and the attribute-index entries (values more likely than not, or fused)."""
+def _encode_attributes(
+    attributes: Mapping[str, AttributeBelief], class_test: ClassTest | None, settle: bool = False
+) -> tuple[str, str]:
+    """JSON of every value's support, and the attribute-index entries (values more likely than not, or fused);
+    with ``settle``, the log-odds are then set to the values written (rounded), as decoding would give them."""
     encoded: dict[str, dict[str, list]] = {}
     entries: list[str] = []
     for name, attribute in attributes.items():
@@ -914,6 +929,11 @@ def _encode_attributes(attributes: Mapping[str, AttributeBelief], class_test: Cl
             continue
         fused = fuse_values(name, attribute.values, class_test if name == CLASS_ATTRIBUTE else None)
         entries.extend(f"{name}={s.value}" for s in fused.support if s.value == fused.value or s.confidence > 0.5)
+    if settle:
+        for name, values in encoded.items():
+            supports = attributes[name].values
+            for value, written in values.items():
+                supports[value].log_odds = written[0]
     return _COMPACT_JSON.encode(encoded), _INDEX_SEPARATOR.join(sorted(entries))
 
 
@@ -943,21 +963,29 @@ def _decode_attributes(text: str) -> dict[str, AttributeBelief]:
 
 
 def _settle(belief: ObjectBelief, row: tuple) -> None:
-    """Make ``belief`` (just written as ``row``) equal to what decoding ``row`` gives, in place and without parsing
-    it: log-odds rounded as :func:`_encode_attributes` writes them, arrays and numbers as the columns hold them."""
-    for attribute in belief.attributes.values():
-        for support in attribute.values.values():
-            support.log_odds = round(support.log_odds, 9)
+    """Make ``belief`` (just written as ``row``, its log-odds settled by :func:`_encode_attributes`) equal to what
+    decoding ``row`` gives, in place and without parsing it: arrays and numbers as the columns hold them."""
     if not all(attribute.values for attribute in belief.attributes.values()):
         belief.attributes = {name: a for name, a in belief.attributes.items() if a.values}
-    belief.position = np.array(row[3:6])
-    belief.orientation = np.array(row[6:10])
-    belief.dimensions = None if row[10] is None else np.array(row[10:13])
+    if not _is_vector(belief.position, 3):
+        belief.position = np.array(row[3:6])
+    if not _is_vector(belief.orientation, 4):
+        belief.orientation = np.array(row[6:10])
+    if belief.dimensions is not None and not _is_vector(belief.dimensions, 3):
+        belief.dimensions = None if row[10] is None else np.array(row[10:13])
+    if belief.appearance is not None:  # stored as 32-bit floats
+        belief.appearance = np.frombuffer(row[14], dtype=np.float32).astype(np.float64)
     belief.position_variance = row[13]
-    belief.appearance = None if row[14] is None else np.frombuffer(row[14], dtype=np.float32).astype(np.float64)
     belief.existence = row[15]
     belief.first_seen, belief.last_seen, belief.misses, belief.observations = row[17:21]
-    belief.roi = _roi_from_text(row[24])
+    roi = belief.roi
+    if roi is not None and not (type(roi) is tuple and len(roi) == 4 and all(type(v) is int for v in roi)):
+        belief.roi = _roi_from_text(row[24])
+
+
+def _is_vector(values: object, size: int) -> bool:
+    """True for a 64-bit float array of shape (size,) (what decoding a row gives)."""
+    return isinstance(values, np.ndarray) and values.dtype == np.float64 and values.shape == (size,)
 
 
 def _belief_from_row(row: tuple) -> ObjectBelief:
