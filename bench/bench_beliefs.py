@@ -49,7 +49,6 @@ for folder in (ROOT, Path(__file__).resolve().parent):
 from reasoning.beliefs.answer import answer_from_memory  # noqa: E402
 from reasoning.beliefs.store import (  # noqa: E402
     _OBJECT_COLUMNS,
-    CACHE_KIB,
     WAL_AUTOCHECKPOINT_PAGES,
     BeliefFilter,
     BeliefStore,
@@ -261,12 +260,11 @@ def bench_store(
 
 def bench_reference(path: Path, recorded: list[Recorded], per_frame: int) -> Rates:
     """Hypotheses/s of writing the recorded statements and rows with plain sqlite3 ``executemany``, one
-    transaction per frame (the store's journal mode, synchronous setting, checkpoint interval and page cache)."""
+    transaction per frame (the store's journal mode, synchronous setting and checkpoint interval)."""
     conn = sqlite3.connect(path, isolation_level=None)
     conn.execute("PRAGMA journal_mode = WAL")
     conn.execute(f"PRAGMA synchronous = {SYNCHRONOUS}")
     conn.execute(f"PRAGMA wal_autocheckpoint = {WAL_AUTOCHECKPOINT_PAGES}")
-    conn.execute(f"PRAGMA cache_size = -{CACHE_KIB}")
     start = time.perf_counter()
     cpu = time.process_time()
     for frame in recorded:
@@ -312,7 +310,7 @@ def bench_updates(
         ]
         warm = folder / "warm.sqlite"
         shutil.copy(template, warm)
-        bench_store(warm, prepared[:1], record=False)  # lazy imports, statement cache (not the working set)
+        bench_store(warm, prepared[:1], record=False)  # lazy imports, statement cache
         for suffix in ("", "-wal", "-shm"):
             Path(f"{warm}{suffix}").unlink(missing_ok=True)
         trial_path = folder / f"trial-{size}.sqlite"

@@ -8,11 +8,6 @@
   20 hypotheses writes some 60 to 80 pages, so at most the last 50 to 70 frames, about two seconds at 30 Hz). The store
   rolls back to an earlier consistent state and never corrupts. Pass ``synchronous="FULL"`` to also survive power
   loss, at the cost of an fsync per commit.
-* A working set of decoded beliefs (up to :data:`WORKING_SET`, least recently used dropped) is kept between
-  frames, so a camera that sees the same objects again does not read and decode them again. It is write-through,
-  not write-behind: every frame is committed before :meth:`BeliefStore.integrate` returns, so the working set adds
-  nothing to what a crash can lose. It equals the file exactly (a belief is settled to what decoding its row
-  gives when it is written); another connection's commit (``PRAGMA data_version``) and a failed frame drop it.
 * A file that is not a valid belief store is never modified: opening it raises :class:`BeliefStoreError`
   naming the file and how to move it aside. A store of schema version 1 (before recordings were stored) is
   migrated in one transaction: its beliefs and sightings get an empty recording, so its camera-frame beliefs are
@@ -34,7 +29,6 @@ import os
 import shlex
 import sqlite3
 import threading
-from collections import OrderedDict
 from collections.abc import Callable, Iterator, Mapping, Sequence
 from contextlib import contextmanager
 from dataclasses import dataclass, field
@@ -67,10 +61,6 @@ RTREE_SLACK = 0.05
 """Half-width (metres) of a belief's R*Tree entry around its position."""
 WAL_AUTOCHECKPOINT_PAGES = 4000
 """Checkpoint the WAL into the file every ~16 MB (fewer fsyncs than SQLite's default of 1000 pages)."""
-WORKING_SET = 8192
-"""Beliefs :meth:`BeliefStore.integrate` keeps decoded between frames (the least recently used are dropped)."""
-CACHE_KIB = 32768
-"""SQLite page cache of the store's connection (KiB): the candidate look-ups of a frame read from it."""
 
 
 class BeliefStoreError(Exception):
@@ -211,21 +201,15 @@ class BeliefStore:
         busy_timeout: float = 10.0,
         check: bool = True,
         history_limit: int = 100,
-        working_set: int = WORKING_SET,
     ) -> None:
         self.path = Path(path).expanduser()
         if synchronous.upper() not in SYNCHRONOUS_MODES:
             raise ValueError(f"synchronous must be one of {', '.join(SYNCHRONOUS_MODES)}, not {synchronous!r}")
-        if working_set < 0:
-            raise ValueError(f"working_set must be >= 0, not {working_set}")
         self.tracker = tracker or BeliefTracker()
         self.history_limit = history_limit
         self.write_log: list[list[tuple[str, list[tuple]]]] | None = None
         """When a list, each :meth:`integrate` appends the statements it wrote, with their rows (benchmarks)."""
         self._lock = threading.RLock()
-        self._working: OrderedDict[int, tuple[ObjectBelief, _Loaded]] = OrderedDict()
-        self._working_limit = working_set
-        self._data_version: int | None = None
         self._conn = self._open(synchronous.upper(), busy_timeout, check)
 
     # ------------------------------------------------------------------ opening
@@ -260,7 +244,6 @@ class BeliefStore:
                 raise BeliefStoreError(f"belief store {path}: cannot use WAL journal mode (got {mode})")
             conn.execute(f"PRAGMA synchronous = {synchronous}")
             conn.execute(f"PRAGMA wal_autocheckpoint = {WAL_AUTOCHECKPOINT_PAGES}")
-            conn.execute(f"PRAGMA cache_size = -{CACHE_KIB}")
             if not ready:  # a store in use is opened without writing, so readers never wait for the writer
                 conn.execute("BEGIN IMMEDIATE")
                 self._migrate(conn)
@@ -373,74 +356,36 @@ class BeliefStore:
         Beliefs near the observations (and, with ``camera``, in front of it) are loaded, associated and
         updated by the tracker; new objects get new ids; the changes and the sightings are written. Beliefs
         missed earlier and not seen for the tracker's ``gone_after`` seconds are marked gone, wherever they are.
-        The beliefs in the returned step are as the file now holds them, and are the store's working copies:
-        read them, do not change them (the next frame may update them in place).
         """
         tracker = tracker or self.tracker
-        time = float(time)
         writes: list[tuple[str, list[tuple]]] = []
-        try:
-            with self._transaction() as conn:
-                self._check_working_set(conn)
-                beliefs, loaded = self._candidates(conn, objects, camera, tracker.config.association.gate_distance)
-                next_id = int(conn.execute("SELECT value FROM meta WHERE key = 'next_id'").fetchone()[0])
-                allocated = [next_id]
+        with self._transaction() as conn:
+            beliefs, loaded = self._candidates(conn, objects, camera, tracker.config.association.gate_distance)
+            next_id = int(conn.execute("SELECT value FROM meta WHERE key = 'next_id'").fetchone()[0])
+            allocated = [next_id]
 
-                def new_id() -> int:
-                    value = allocated[0]
-                    allocated[0] += 1
-                    return value
+            def new_id() -> int:
+                value = allocated[0]
+                allocated[0] += 1
+                return value
 
-                step = tracker.step(beliefs, objects, time, new_id, camera)
-                rows, places = self._write_beliefs(conn, step.changed, tracker.class_test, loaded, writes, settle=True)
-                counts = {b.id: b.observations for b in step.changed}
-                self._write_observations(conn, objects, [(i, counts.get(i, 0)) for i in step.assigned], time, writes)
-                if allocated[0] != next_id:
-                    _write(conn, writes, "UPDATE meta SET value = ? WHERE key = 'next_id'", [(str(allocated[0]),)])
-                seen = set(step.assigned)
-                self._prune_history(conn, [b for b in step.changed if b.id in seen], writes)
-                # beliefs missed earlier and not seen since, wherever they are, are gone after gone_after seconds
-                cutoff = (time - tracker.config.gone_after,)
-                gone = conn.execute(_MARK_GONE, cutoff).fetchall()
-                writes.append((_MARK_GONE, [cutoff]))
-        except BaseException:
-            self._working.clear()  # the tracker changed loaded beliefs in place; the file has them as they were
-            raise
-        for (belief_id,) in gone:
-            self._working.pop(belief_id, None)
-        for b in step.changed:
-            row = rows[b.id]
-            _settle(b, row)
-            self._remember(b, _Loaded(places[b.id], *_labels(row)))
+            step = tracker.step(beliefs, objects, time, new_id, camera)
+            self._write_beliefs(conn, step.changed, tracker.class_test, loaded, writes)
+            counts = {b.id: b.observations for b in step.changed}
+            self._write_observations(conn, objects, [(i, counts.get(i, 0)) for i in step.assigned], time, writes)
+            if allocated[0] != next_id:
+                _write(conn, writes, "UPDATE meta SET value = ? WHERE key = 'next_id'", [(str(allocated[0]),)])
+            seen = set(step.assigned)
+            self._prune_history(conn, [b for b in step.changed if b.id in seen], writes)
+            # beliefs missed earlier and not seen since, wherever they are, are gone after gone_after seconds
+            _write(conn, writes, _MARK_GONE, [(time - tracker.config.gone_after,)])
         if self.write_log is not None:
             self.write_log.append(writes)
         return step
 
-    # ------------------------------------------------------------------ working set
-
-    def _check_working_set(self, conn: sqlite3.Connection) -> None:
-        """Drop the working set when another connection committed since this one last looked (inside the
-        write transaction, so nobody else commits until it ends)."""
-        version = conn.execute("PRAGMA data_version").fetchone()[0]
-        if version != self._data_version:
-            self._working.clear()
-            self._data_version = version
-
-    def _remember(self, belief: ObjectBelief, stored: _Loaded) -> None:
-        """Keep a belief exactly as the file now holds it (equal to decoding its row), most recent last."""
-        if not self._working_limit:
-            return
-        working = self._working
-        working[belief.id] = (belief, stored)
-        working.move_to_end(belief.id)
-        while len(working) > self._working_limit:
-            working.popitem(last=False)
-
     def put(self, beliefs: Sequence[ObjectBelief], class_test: ClassTest | None = None) -> None:
         """Write beliefs as they are (insert or replace, attributes included) in one transaction."""
         with self._transaction() as conn:
-            for b in beliefs:
-                self._working.pop(b.id, None)
             self._write_beliefs(conn, beliefs, class_test)
             top = max((b.id for b in beliefs), default=0) + 1
             conn.execute(
@@ -458,7 +403,6 @@ class BeliefStore:
         """Forget every belief and its history; returns how many beliefs there were."""
         with self._transaction() as conn:
             count = int(conn.execute("SELECT COUNT(*) FROM objects").fetchone()[0])
-            self._working.clear()
             for table in ("objects", "objects_place", "attribute_index", "observations", "classes"):
                 conn.execute(f"DELETE FROM {table}")
         return count
@@ -467,8 +411,6 @@ class BeliefStore:
         """Forget the beliefs ``ids`` and their history (unknown ids are skipped); returns how many were forgotten."""
         rows = [(int(i),) for i in set(ids)]
         with self._transaction() as conn:
-            for (object_id,) in rows:
-                self._working.pop(object_id, None)
             count = conn.executemany("DELETE FROM objects WHERE id = ?", rows).rowcount
             conn.executemany("DELETE FROM objects_place WHERE id = ?", rows)
             conn.executemany("DELETE FROM attribute_index WHERE object_id = ?", rows)
@@ -485,10 +427,8 @@ class BeliefStore:
         """Present beliefs within ``gate`` of an observation or in view of ``camera`` (R*Tree look-ups).
 
         Also returns how each one was stored, so unchanged R*Tree entries and index columns are not rewritten.
-        The look-ups return ids, positions and R*Tree entries only; beliefs of the working set are taken from
-        it, the others are read and decoded with one more statement.
         """
-        hits: dict[int, tuple] = {}
+        rows: dict[int, tuple] = {}
         groups: dict[tuple[str, str], list[FrameObject]] = {}
         for item in objects:
             groups.setdefault((item.frame, item.recording), []).append(item)
@@ -502,43 +442,29 @@ class BeliefStore:
             found = found.fetchall()
             if not found:
                 continue
-            positions = np.array([row[1:4] for row in found], dtype=np.float64)
+            positions = np.array([(row[3], row[4], row[5]) for row in found], dtype=np.float64)
             delta = positions[:, None, :] - centres[None, :, :]
             near = (np.sqrt(np.einsum("ijk,ijk->ij", delta, delta)) <= gate).any(axis=1)
             for row, keep in zip(found, near.tolist(), strict=True):
                 if keep:
-                    hits[row[0]] = row
+                    rows[row[0]] = row
         if camera is not None:
             low, high = _frustum_bounds(camera)
             world = (camera.frame, WORLD_FRAME, camera.recording)
             box = (high[0], low[0], high[1], low[1], high[2], low[2])
             found = conn.execute(_candidate_query(1), (*box, *world, PRESENT))
-            in_frustum = [row for row in found if row[0] not in hits]
+            in_frustum = [row for row in found if row[0] not in rows]
             if in_frustum:
-                positions = np.array([row[1:4] for row in in_frustum], dtype=np.float64)
+                positions = np.array([(row[3], row[4], row[5]) for row in in_frustum], dtype=np.float64)
                 for row, seen in zip(in_frustum, in_view(positions, camera), strict=True):
                     if seen:
-                        hits[row[0]] = row
-        working = self._working
-        chosen: dict[int, tuple[ObjectBelief, _Loaded]] = {}
-        missing = []
-        for i in hits:
-            known = working.get(i)
-            if known is None:
-                missing.append(i)
-            else:
-                chosen[i] = known
-        for start in range(0, len(missing), 900):  # SQLite's default limit of 999 parameters per statement
-            part = missing[start : start + 900]
-            rows = conn.execute(
-                f"SELECT {_OBJECT_COLUMNS} FROM objects WHERE id IN ({', '.join('?' * len(part))})", part
-            )
-            for row in rows:
-                r = hits[row[0]]
-                place = ((r[4] + r[5]) / 2, (r[6] + r[7]) / 2, (r[8] + r[9]) / 2)
-                chosen[row[0]] = (_belief_from_row(row), _Loaded(place, *_labels(row)))
-        order = sorted(chosen)
-        return [chosen[i][0] for i in order], {i: chosen[i][1] for i in order}
+                        rows[row[0]] = row
+        n = _COLUMN_COUNT
+        loaded = {
+            i: _Loaded(((r[n] + r[n + 1]) / 2, (r[n + 2] + r[n + 3]) / 2, (r[n + 4] + r[n + 5]) / 2), *_labels(r))
+            for i, r in rows.items()
+        }
+        return [_belief_from_row(rows[i]) for i in sorted(rows)], loaded
 
     def _write_beliefs(
         self,
@@ -547,11 +473,8 @@ class BeliefStore:
         class_test: ClassTest | None,
         loaded: Mapping[int, _Loaded] | None = None,
         writes: list[tuple[str, list[tuple]]] | None = None,
-        settle: bool = False,
-    ) -> tuple[dict[int, tuple], dict[int, tuple[float, float, float]]]:
-        """Write object rows, their R*Tree entries and attribute-index entries; returns the rows written and the
-        centre of each belief's R*Tree entry afterwards. With ``settle`` the beliefs' log-odds are set to the
-        values written (:func:`_encode_attributes`).
+    ) -> None:
+        """Write object rows, their R*Tree entries and attribute-index entries (noted in ``writes``).
 
         Beliefs in ``loaded`` are updated in place; their indexed columns and index entries are touched only
         when they changed. The R*Tree entry of a belief is a box of half-width ``RTREE_SLACK`` around a recent
@@ -559,11 +482,11 @@ class BeliefStore:
         so the true position always lies inside the entry and look-ups by position miss nothing.
         """
         if not beliefs:
-            return {}, {}
+            return
         log = [] if writes is None else writes
         loaded = loaded or {}
         cache: dict[frozenset[str], str] = {}
-        rows = {b.id: _object_row(b, class_test, cache, settle) for b in beliefs}
+        rows = {b.id: _object_row(b, class_test, cache) for b in beliefs}
         fresh = [rows[b.id] for b in beliefs if b.id not in loaded]
         if fresh:
             _write(conn, log, "DELETE FROM attribute_index WHERE object_id = ?", [(row[0],) for row in fresh])
@@ -595,7 +518,6 @@ class BeliefStore:
         if added:
             _write(conn, log, "INSERT OR IGNORE INTO attribute_index VALUES (?, ?, ?)", added)
         moved = []
-        places: dict[int, tuple[float, float, float]] = {}
         for b in beliefs:
             x, y, z = rows[b.id][3:6]
             state = loaded.get(b.id)
@@ -603,20 +525,11 @@ class BeliefStore:
             if centre is None or max(abs(x - centre[0]), abs(y - centre[1]), abs(z - centre[2])) > RTREE_SLACK / 2:
                 r = RTREE_SLACK
                 moved.append((b.id, x - r, x + r, y - r, y + r, z - r, z + r))
-            else:
-                places[b.id] = centre
         if moved:
             _write(conn, log, "INSERT OR REPLACE INTO objects_place VALUES (?, ?, ?, ?, ?, ?, ?)", moved)
-            # the centre as the R*Tree stores it (32-bit floats), read back as the look-ups will read it
-            for i, x0, x1, y0, y1, z0, z1 in _rtree_boxes(conn, [m[0] for m in moved]):
-                places[i] = ((x0 + x1) / 2, (y0 + y1) / 2, (z0 + z1) / 2)
-        classes = [
-            (c,)
-            for c in {b.class_name for b in beliefs if b.class_name and b.class_name != _loaded_class(loaded, b.id)}
-        ]
+        classes = {(b.class_name,) for b in beliefs if b.class_name and b.class_name != _loaded_class(loaded, b.id)}
         if classes:
-            _write(conn, log, "INSERT OR IGNORE INTO classes VALUES (?)", classes)
-        return rows, places
+            _write(conn, log, "INSERT OR IGNORE INTO classes VALUES (?)", list(classes))
 
     def _write_observations(
         self,
@@ -789,9 +702,7 @@ class BeliefStore:
 # ---------------------------------------------------------------------------------------- row mapping
 
 
-_MARK_GONE = (
-    "UPDATE objects SET status = 'gone' WHERE misses > 0 AND status = 'present' AND last_seen <= ? RETURNING id"
-)
+_MARK_GONE = "UPDATE objects SET status = 'gone' WHERE misses > 0 AND status = 'present' AND last_seen <= ?"
 
 
 def _write(conn: sqlite3.Connection, log: list[tuple[str, list[tuple]]], statement: str, rows: list[tuple]) -> None:
@@ -802,21 +713,15 @@ def _write(conn: sqlite3.Connection, log: list[tuple[str, list[tuple]]], stateme
 
 @functools.lru_cache(maxsize=64)
 def _candidate_query(boxes: int) -> str:
-    """Id, position and R*Tree entry of the present beliefs of one world whose entries meet any of ``boxes`` boxes
-    (one statement; its parameters: x1, x0, y1, y0, z1, z0 of each box, then the frame, the world frame, the
-    recording, the status)."""
+    """The present beliefs of one world whose R*Tree entries meet any of ``boxes`` boxes (one statement; its
+    parameters: x1, x0, y1, y0, z1, z0 of each box, then the frame, the world frame, the recording, the status)."""
     box = "SELECT * FROM objects_place WHERE x0 <= ? AND x1 >= ? AND y0 <= ? AND y1 >= ? AND z0 <= ? AND z1 >= ?"
+    columns = ", ".join(f"o.{c.strip()}" for c in _OBJECT_COLUMNS.split(","))
     return (
         f"WITH hit AS ({' UNION '.join([box] * boxes)}) "
-        "SELECT o.id, o.px, o.py, o.pz, hit.x0, hit.x1, hit.y0, hit.y1, hit.z0, hit.z1 "
-        "FROM hit JOIN objects o ON o.id = hit.id "
+        f"SELECT {columns}, hit.x0, hit.x1, hit.y0, hit.y1, hit.z0, hit.z1 FROM hit JOIN objects o ON o.id = hit.id "
         "WHERE o.frame = ? AND (o.frame = ? OR o.recording = ?) AND o.status = ?"
     )
-
-
-def _rtree_boxes(conn: sqlite3.Connection, ids: list[int]) -> list[tuple]:
-    """The R*Tree entries of ``ids`` as stored (SQLite rounds them outwards to 32-bit floats)."""
-    return conn.execute(f"SELECT * FROM objects_place WHERE id IN ({', '.join('?' * len(ids))})", ids).fetchall()
 
 
 def _roi_text(roi: tuple[int, int, int, int] | None) -> str | None:
@@ -830,16 +735,13 @@ def _roi_from_text(text: str | None) -> tuple[int, int, int, int] | None:
     return x0, y0, x1, y1
 
 
-def _object_row(
-    b: ObjectBelief, class_test: ClassTest | None, sources: dict[frozenset[str], str], settle: bool = False
-) -> tuple:
-    """The ``objects`` row of a belief (columns as in ``_OBJECT_COLUMNS``); ``sources`` caches encodings;
-    ``settle`` as in :func:`_encode_attributes`."""
+def _object_row(b: ObjectBelief, class_test: ClassTest | None, sources: dict[frozenset[str], str]) -> tuple:
+    """The ``objects`` row of a belief (columns as in ``_OBJECT_COLUMNS``); ``sources`` caches encodings."""
     x, y, z = _floats(b.position, 3)
     qx, qy, qz, qw = _floats(b.orientation, 4)
     sx, sy, sz = (None, None, None) if b.dimensions is None else _floats(b.dimensions, 3)
     appearance = None if b.appearance is None else np.asarray(b.appearance, dtype=np.float32).tobytes()
-    encoded, indexed = _encode_attributes(b.attributes, class_test, settle)
+    encoded, indexed = _encode_attributes(b.attributes, class_test)
     return (
         b.id,
         b.class_name,
@@ -910,11 +812,8 @@ def _encoded_sources(experts: set[str], cache: dict[frozenset[str], str]) -> str
     return found
 
 
-def _encode_attributes(
-    attributes: Mapping[str, AttributeBelief], class_test: ClassTest | None, settle: bool = False
-) -> tuple[str, str]:
-    """JSON of every value's support, and the attribute-index entries (values more likely than not, or fused);
-    with ``settle``, the log-odds are then set to the values written (rounded), as decoding would give them."""
+def _encode_attributes(attributes: Mapping[str, AttributeBelief], class_test: ClassTest | None) -> tuple[str, str]:
+    """JSON of every value's support, and the attribute-index entries (values more likely than not, or fused)."""
     encoded: dict[str, dict[str, list]] = {}
     entries: list[str] = []
     for name, attribute in attributes.items():
@@ -929,11 +828,6 @@ def _encode_attributes(
             continue
         fused = fuse_values(name, attribute.values, class_test if name == CLASS_ATTRIBUTE else None)
         entries.extend(f"{name}={s.value}" for s in fused.support if s.value == fused.value or s.confidence > 0.5)
-    if settle:
-        for name, values in encoded.items():
-            supports = attributes[name].values
-            for value, written in values.items():
-                supports[value].log_odds = written[0]
     return _COMPACT_JSON.encode(encoded), _INDEX_SEPARATOR.join(sorted(entries))
 
 
@@ -960,32 +854,6 @@ def _decode_attributes(text: str) -> dict[str, AttributeBelief]:
         )
         for name, values in json.loads(text).items()
     }
-
-
-def _settle(belief: ObjectBelief, row: tuple) -> None:
-    """Make ``belief`` (just written as ``row``, its log-odds settled by :func:`_encode_attributes`) equal to what
-    decoding ``row`` gives, in place and without parsing it: arrays and numbers as the columns hold them."""
-    if not all(attribute.values for attribute in belief.attributes.values()):
-        belief.attributes = {name: a for name, a in belief.attributes.items() if a.values}
-    if not _is_vector(belief.position, 3):
-        belief.position = np.array(row[3:6])
-    if not _is_vector(belief.orientation, 4):
-        belief.orientation = np.array(row[6:10])
-    if belief.dimensions is not None and not _is_vector(belief.dimensions, 3):
-        belief.dimensions = None if row[10] is None else np.array(row[10:13])
-    if belief.appearance is not None:  # stored as 32-bit floats
-        belief.appearance = np.frombuffer(row[14], dtype=np.float32).astype(np.float64)
-    belief.position_variance = row[13]
-    belief.existence = row[15]
-    belief.first_seen, belief.last_seen, belief.misses, belief.observations = row[17:21]
-    roi = belief.roi
-    if roi is not None and not (type(roi) is tuple and len(roi) == 4 and all(type(v) is int for v in roi)):
-        belief.roi = _roi_from_text(row[24])
-
-
-def _is_vector(values: object, size: int) -> bool:
-    """True for a 64-bit float array of shape (size,) (what decoding a row gives)."""
-    return isinstance(values, np.ndarray) and values.dtype == np.float64 and values.shape == (size,)
 
 
 def _belief_from_row(row: tuple) -> ObjectBelief:
@@ -1017,7 +885,7 @@ def _belief_from_row(row: tuple) -> ObjectBelief:
         recording,
         roi,
         sources,
-        encoded,
+        attributes,
         _indexed,
     ) = row[:_COLUMN_COUNT]
     return ObjectBelief(
@@ -1027,7 +895,7 @@ def _belief_from_row(row: tuple) -> ObjectBelief:
         orientation=np.array([qx, qy, qz, qw]),
         dimensions=None if sx is None else np.array([sx, sy, sz]),
         appearance=None if appearance is None else np.frombuffer(appearance, dtype=np.float32).astype(np.float64),
-        attributes=_decode_attributes(encoded),
+        attributes=_decode_attributes(attributes),
         position_variance=variance,
         existence=existence,
         status=status,
