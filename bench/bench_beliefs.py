@@ -474,6 +474,60 @@ def profile_updates(size: int, frames: int, per_frame: int, cameras: int, folder
     print(f"profile written to {out}")
 
 
+FLOOR_VARIANTS: dict[str, tuple[tuple[str, ...], str, str]] = {
+    "as designed (the reference)": ((), "", "NORMAL"),
+    "synchronous = OFF": ((), "", "OFF"),
+    "no sightings written (observations)": ((), "INSERT OR REPLACE INTO observations", "NORMAL"),
+    "sightings without their (object_id, seq) index": (("DROP INDEX observations_object",), "", "NORMAL"),
+    "no class and region indexes on objects": (("DROP INDEX objects_class", "DROP INDEX objects_region"), "", "NORMAL"),
+    "no updates of known objects": ((), "UPDATE objects SET frame", "NORMAL"),
+    "no R*Tree writes": ((), "INSERT OR REPLACE INTO objects_place", "NORMAL"),
+}
+"""Variants of the storage design for ``--floor-variants``: statements run first, statements left out (prefix),
+``synchronous``."""
+
+
+def floor_variants(size: int, frames: int, per_frame: int, folder: Path) -> None:
+    """Where the floor's time and pages go: the store's write log of ``frames`` frames (random places) replayed
+    per variant of the design (:data:`FLOOR_VARIANTS`); hypotheses/s in wall and CPU time, WAL pages per frame."""
+    template = folder / f"floor-{size}.sqlite"
+    seeded = seed_file(template, size, np.random.default_rng(size), named_regions=False)
+    rng = np.random.default_rng(1)
+    prepared = [hypotheses_near(seeded, rng, per_frame) for _ in range(frames)]
+    run = folder / "floor-run.sqlite"
+    shutil.copy(template, run)
+    rates, _, _, log = bench_store(run, prepared, record=True)
+    print(f"floor variants, {size} stored, {frames} frames x {per_frame} hypotheses at random places:")
+    print(f"  {'store.integrate':52s} wall {rates.wall:7.0f}/s  cpu {rates.cpu:7.0f}/s")
+    variants = [("warm-up (not printed)", FLOOR_VARIANTS["as designed (the reference)"]), *FLOOR_VARIANTS.items()]
+    for label, (setup, left_out, synchronous) in variants:
+        path = folder / "floor-variant.sqlite"
+        for suffix in ("", "-wal", "-shm"):
+            Path(f"{path}{suffix}").unlink(missing_ok=True)
+        shutil.copy(template, path)
+        conn = sqlite3.connect(path, isolation_level=None)
+        conn.execute("PRAGMA journal_mode = WAL")
+        conn.execute(f"PRAGMA synchronous = {synchronous}")
+        conn.execute("PRAGMA wal_autocheckpoint = 0")  # the WAL's size counts the pages written
+        for statement in setup:
+            conn.execute(statement)
+        conn.execute("PRAGMA wal_checkpoint(TRUNCATE)")
+        start, cpu = time.perf_counter(), time.process_time()
+        for frame in log:
+            conn.execute("BEGIN IMMEDIATE")
+            for statement, rows in frame:
+                if not (left_out and statement.startswith(left_out)):
+                    conn.executemany(statement, rows)
+            conn.execute("COMMIT")
+        wall, used = time.perf_counter() - start, time.process_time() - cpu
+        pages = (Path(f"{path}-wal").stat().st_size - 32) / (4096 + 24) / len(log)
+        conn.close()
+        count = len(log) * per_frame
+        if label.startswith("warm-up"):
+            continue
+        print(f"  {label:52s} wall {count / wall:7.0f}/s  cpu {count / used:7.0f}/s  WAL pages/frame {pages:5.1f}")
+
+
 def goal_for(size: int) -> float:
     return next((goal for limit, goal in sorted(QUERY_GOALS.items()) if size <= limit), max(QUERY_GOALS.values()))
 
@@ -490,12 +544,19 @@ def main() -> int:
     parser.add_argument("--repeats", type=int, default=300)
     parser.add_argument("--trials", type=int, default=3)
     parser.add_argument("--no-serve", action="store_true", help="skip the RSS of robokudo serve")
+    parser.add_argument(
+        "--floor-variants", action="store_true", help="only replay the write log per variant of the storage design"
+    )
     parser.add_argument("--profile", type=Path, help="only write a cProfile of integrate (10,000 stored) to PROFILE")
     parser.add_argument("--rss-child", type=Path, help=argparse.SUPPRESS)
     parser.add_argument("--rss-count", type=int, help=argparse.SUPPRESS)
     args = parser.parse_args()
     if args.rss_child:
         rss_child(args.rss_child, args.rss_count)
+        return 0
+    if args.floor_variants:
+        with tempfile.TemporaryDirectory() as name:
+            floor_variants(10_000, args.frames, args.per_frame, Path(name))
         return 0
     if args.profile:
         with tempfile.TemporaryDirectory() as name:
