@@ -4,11 +4,16 @@ Parts, each printing its goal and whether it is met:
 
 * updates: hypotheses per second integrated (``BeliefStore.integrate``: candidate search, association, attribute
   fusion, one transaction per frame; 20 hypotheses per frame) into stores of 10,000 and 100,000 objects, side by
-  side with the floor of this storage design: the same rows (the changed objects, their R*Tree and index
-  entries, the sightings) written by plain ``sqlite3`` ``executemany`` in one transaction per frame on a copy of
-  the same store. Trials alternate store / reference; the median trial is the figure. Goal: >= 20,000
-  hypotheses/s; the ratio to the reference is printed beside it. ``frame_objects`` + integrate (from the
-  experts' hypotheses) is printed too.
+  side with the floor of this storage design: the very statements and rows the store wrote for each frame
+  (``BeliefStore.write_log``: the changed columns of known objects, new objects, moved R*Tree entries,
+  attribute-index changes, sightings, the next id, gone marks) replayed by plain ``sqlite3`` ``executemany`` in
+  one transaction per frame on a copy of the same store; when the store's design changes, the floor changes with
+  it. Trials alternate store / reference; the median trial is the figure. Goal: >= 20,000 hypotheses/s; the
+  ratio to the reference is printed beside it, and both rates in CPU time of the process too (on a shared,
+  loaded machine wall time mostly measures waiting for a core). ``frame_objects`` + integrate (from the
+  experts' hypotheses) is printed too. The update stores are seeded without region names, as this tracker
+  (which has no regions) stores its beliefs; with them, the first sighting of each seeded belief would rename its
+  region (an index rewrite that only seeding causes).
 * queries: median and p95 latency of memory queries, to beliefs and to designators, with 10,000 and 1,000,000
   objects stored. The world grows with the store (one object per square metre, rooms of about 500 objects), so
   a query's answer stays about the same size. Goals: median to designators <= 1 ms (10,000) and <= 10 ms
@@ -42,7 +47,13 @@ for folder in (ROOT, Path(__file__).resolve().parent):
         sys.path.insert(0, str(folder))
 
 from reasoning.beliefs.answer import answer_from_memory  # noqa: E402
-from reasoning.beliefs.store import _OBJECT_COLUMNS, BeliefFilter, BeliefStore, _object_row  # noqa: E402
+from reasoning.beliefs.store import (  # noqa: E402
+    _OBJECT_COLUMNS,
+    WAL_AUTOCHECKPOINT_PAGES,
+    BeliefFilter,
+    BeliefStore,
+    _object_row,
+)
 from reasoning.fusion.frame import FrameContext, FrameObject, frame_objects  # noqa: E402
 from reasoning.fusion.rule import AttributeBelief, ValueSupport  # noqa: E402
 from reasoning.fusion.tracking import BeliefTracker, ObjectBelief  # noqa: E402
@@ -50,6 +61,8 @@ from robokudo.core.regions import RegionBox  # noqa: E402
 from robokudo.core.types import Classification, ObjectHypothesis, Pose, SemanticColor, Shape, Size  # noqa: E402
 
 UPDATE_GOAL = 20_000.0
+SYNCHRONOUS = "NORMAL"
+"""The store's default ``synchronous`` setting, which the reference uses too."""
 QUERY_GOALS = {10_000: 1.0, 1_000_000: 10.0}
 """Median ms to designators, by stored objects (sizes not listed here get the goal of the next larger one)."""
 BYTES_PER_BELIEF_GOAL = 1024.0
@@ -111,9 +124,10 @@ def template_belief(cls: str, color: str, shape: str) -> ObjectBelief:
     )
 
 
-def seed_file(path: Path, count: int, rng: np.random.Generator) -> Seeded:
+def seed_file(path: Path, count: int, rng: np.random.Generator, named_regions: bool = True) -> Seeded:
     """A belief store of ``count`` objects, written with ``executemany`` of rows the store's own encoder made for
-    each (class, colour, shape) and placed per object (50,000 rows per transaction)."""
+    each (class, colour, shape) and placed per object (50,000 rows per transaction); each object's region is its
+    room's name when ``named_regions``, else empty."""
     BeliefStore(path).close()  # the schema
     side = world_side(count)
     positions = np.column_stack([rng.uniform(0, side, count), rng.uniform(0, side, count), np.full(count, 0.8)])
@@ -132,7 +146,7 @@ def seed_file(path: Path, count: int, rng: np.random.Generator) -> Seeded:
     for index_name, _ in indexes:
         conn.execute(f"DROP INDEX {index_name}")
     xs, ys, zs = positions.T.tolist()
-    room_names = [f"room{r}" for r in rooms.tolist()]
+    room_names = [f"room{r}" if named_regions else "" for r in rooms.tolist()]
     keys = list(zip(class_index.tolist(), color_index.tolist(), [i % len(SHAPES) for i in range(count)], strict=True))
     for begin in range(0, count, 50_000):
         objects, places, entries = [], [], []
@@ -166,16 +180,22 @@ def seed_file(path: Path, count: int, rng: np.random.Generator) -> Seeded:
     return Seeded(positions, [CLASSES[k] for k in class_index.tolist()], [COLORS[k] for k in color_index.tolist()])
 
 
-def hypotheses_near(seeded: Seeded, rng: np.random.Generator, per_frame: int) -> list[ObjectHypothesis]:
-    """One frame around a random place: re-observations of stored objects (1 cm noise) and two new objects.
+def hypotheses_near(
+    seeded: Seeded, rng: np.random.Generator, per_frame: int, view: tuple[int, list[int]] | None = None
+) -> list[ObjectHypothesis]:
+    """One frame around a random place (or the fixed ``view``: a place and the stored objects a camera there
+    sees): re-observations of stored objects (1 cm noise) and two new objects.
 
     Every hypothesis carries a pose, a size, a colour, a shape and a class, like the output of a tabletop tree.
     """
     positions = seeded.positions
-    centre = positions[int(rng.integers(len(positions)))]
-    near = np.flatnonzero(np.abs(positions[:, :2] - centre[:2]).max(axis=1) < 4.0)
-    near = near[np.linalg.norm(positions[near, :2] - centre[:2], axis=1) < 4.0]
-    chosen = [int(i) for i in rng.choice(near, size=min(len(near), per_frame - 2), replace=False)]
+    if view is None:
+        centre = positions[int(rng.integers(len(positions)))]
+        near = np.flatnonzero(np.abs(positions[:, :2] - centre[:2]).max(axis=1) < 4.0)
+        near = near[np.linalg.norm(positions[near, :2] - centre[:2], axis=1) < 4.0]
+        chosen = [int(i) for i in rng.choice(near, size=min(len(near), per_frame - 2), replace=False)]
+    else:
+        centre, chosen = positions[view[0]], view[1]
     seen = [
         (positions[i] + rng.normal(0, 0.01, 3), seeded.classes[i], seeded.colors[i], SHAPES[i % len(SHAPES)])
         for i in chosen
@@ -199,93 +219,95 @@ def hypotheses_near(seeded: Seeded, rng: np.random.Generator, per_frame: int) ->
     return hypotheses
 
 
-@dataclass
-class Recorded:
-    """The rows one frame's integration wrote, for the reference to write again."""
+Recorded = list[tuple[str, list[tuple]]]
+"""The write statements of one frame's integration with their rows (``BeliefStore.write_log``)."""
 
-    updated: list[tuple]
-    created: list[tuple]
-    places: list[tuple]
-    entries: list[tuple]
-    sightings: list[tuple]
+
+@dataclass(frozen=True)
+class Rates:
+    """Hypotheses/s of one run, in wall time and in CPU time of the process."""
+
+    wall: float
+    cpu: float
 
 
 def bench_store(
     path: Path, prepared: list[list[ObjectHypothesis]], record: bool
-) -> tuple[float, float, int, list[Recorded]]:
+) -> tuple[Rates, float, int, list[Recorded]]:
     """Integrate the prepared frames; hypotheses/s of integrate, of frame_objects + integrate, objects created, and
-    (when ``record``) the rows each frame wrote (read back outside the timing)."""
+    (when ``record``) the statements and rows each frame wrote."""
     store = BeliefStore(path, tracker=BeliefTracker(class_test=is_subclass))
-    reader = sqlite3.connect(path)
-    columns = _OBJECT_COLUMNS
-    recorded: list[Recorded] = []
-    t_fuse = t_integrate = 0.0
+    if record:
+        store.write_log = []
+    t_fuse = t_integrate = c_integrate = 0.0
     count = created = 0
     for index, hypotheses in enumerate(prepared):
         start = time.perf_counter()
         objects: list[FrameObject] = frame_objects(hypotheses, FrameContext(time=float(index)))
         middle = time.perf_counter()
+        cpu = time.process_time()
         step = store.integrate(objects, 1000.0 + index)
+        c_integrate += time.process_time() - cpu
         end = time.perf_counter()
         t_fuse += middle - start
         t_integrate += end - middle
         count += len(hypotheses)
         created += len(step.created)
-        if record:
-            ids = [b.id for b in step.changed]
-            marks = ", ".join("?" * len(ids))
-            rows = reader.execute(f"SELECT {columns} FROM objects WHERE id IN ({marks})", ids).fetchall()
-            new = set(step.created)
-            recorded.append(
-                Recorded(
-                    updated=[(*row[1:], row[0]) for row in rows if row[0] not in new],
-                    created=[row for row in rows if row[0] in new],
-                    places=reader.execute(
-                        f"SELECT * FROM objects_place WHERE id IN ({', '.join('?' * len(new))})", list(new)
-                    ).fetchall(),
-                    entries=reader.execute(
-                        f"SELECT * FROM attribute_index WHERE object_id IN ({', '.join('?' * len(new))})", list(new)
-                    ).fetchall(),
-                    sightings=reader.execute("SELECT * FROM observations WHERE time = ?", (1000.0 + index,)).fetchall(),
-                )
-            )
-    reader.close()
+    recorded = store.write_log or []
     store.close()
-    return count / t_integrate, count / (t_fuse + t_integrate), created, recorded
+    return Rates(count / t_integrate, count / c_integrate), count / (t_fuse + t_integrate), created, recorded
 
 
-def bench_reference(path: Path, recorded: list[Recorded], per_frame: int) -> float:
-    """Hypotheses/s of writing the recorded rows with plain sqlite3 ``executemany``, one transaction per frame
-    (the store's journal mode and synchronous setting)."""
-    columns = _OBJECT_COLUMNS.split(", ")
-    update = f"UPDATE objects SET {', '.join(c + ' = ?' for c in columns[1:])} WHERE id = ?"
-    insert = f"INSERT INTO objects ({_OBJECT_COLUMNS}) VALUES ({', '.join('?' * len(columns))})"
+def bench_reference(path: Path, recorded: list[Recorded], per_frame: int) -> Rates:
+    """Hypotheses/s of writing the recorded statements and rows with plain sqlite3 ``executemany``, one
+    transaction per frame (the store's journal mode, synchronous setting and checkpoint interval)."""
     conn = sqlite3.connect(path, isolation_level=None)
     conn.execute("PRAGMA journal_mode = WAL")
-    conn.execute("PRAGMA synchronous = NORMAL")
-    conn.execute("PRAGMA wal_autocheckpoint = 4000")
+    conn.execute(f"PRAGMA synchronous = {SYNCHRONOUS}")
+    conn.execute(f"PRAGMA wal_autocheckpoint = {WAL_AUTOCHECKPOINT_PAGES}")
     start = time.perf_counter()
+    cpu = time.process_time()
     for frame in recorded:
         conn.execute("BEGIN IMMEDIATE")
-        conn.executemany(update, frame.updated)
-        conn.executemany(insert, frame.created)
-        conn.executemany("INSERT OR REPLACE INTO objects_place VALUES (?, ?, ?, ?, ?, ?, ?)", frame.places)
-        conn.executemany("INSERT OR IGNORE INTO attribute_index VALUES (?, ?, ?)", frame.entries)
-        conn.executemany(f"INSERT INTO observations VALUES ({', '.join('?' * 11)})", frame.sightings)
+        for statement, rows in frame:
+            conn.executemany(statement, rows)
         conn.execute("COMMIT")
     elapsed = time.perf_counter() - start
+    used = time.process_time() - cpu
     conn.close()
-    return len(recorded) * per_frame / elapsed
+    return Rates(len(recorded) * per_frame / elapsed, len(recorded) * per_frame / used)
 
 
-def bench_updates(size: int, frames: int, per_frame: int, trials: int, folder: Path) -> dict[str, float]:
-    """Median over trials (each on a fresh copy of one seeded store) of the store's and the reference's rates."""
+def fixed_views(seeded: Seeded, rng: np.random.Generator, cameras: int, per_frame: int) -> list[tuple[int, list[int]]]:
+    """``cameras`` fixed cameras: each a random place and the stored objects within 4 m it sees every frame."""
+    positions = seeded.positions
+    views = []
+    for _ in range(cameras):
+        place = int(rng.integers(len(positions)))
+        near = np.flatnonzero(np.linalg.norm(positions[:, :2] - positions[place, :2], axis=1) < 4.0)
+        views.append((place, [int(i) for i in rng.choice(near, size=min(len(near), per_frame - 2), replace=False)]))
+    return views
+
+
+def bench_updates(
+    size: int, frames: int, per_frame: int, trials: int, folder: Path, cameras: int = 0
+) -> dict[str, float]:
+    """Median over trials (each on a fresh copy of one seeded store) of the store's and the reference's rates;
+    frames anywhere in the world, or (``cameras`` > 0) from that many fixed cameras in turn."""
     template = folder / f"seed-{size}.sqlite"
-    seeded = seed_file(template, size, np.random.default_rng(size))
-    store_rates, end_to_end, reference_rates, created = [], [], [], 0
+    for suffix in ("", "-wal", "-shm"):
+        Path(f"{template}{suffix}").unlink(missing_ok=True)
+    seeded = seed_file(template, size, np.random.default_rng(size), named_regions=False)
+    store_rates: list[Rates] = []
+    reference_rates: list[Rates] = []
+    end_to_end: list[float] = []
+    created = 0
     for trial in range(trials):
         rng = np.random.default_rng(trial + 1)
-        prepared = [hypotheses_near(seeded, rng, per_frame) for _ in range(frames + 1)]
+        views = fixed_views(seeded, rng, cameras, per_frame) if cameras else []
+        prepared = [
+            hypotheses_near(seeded, rng, per_frame, views[k % len(views)] if views else None) for k in range(frames + 1)
+        ]
         warm = folder / "warm.sqlite"
         shutil.copy(template, warm)
         bench_store(warm, prepared[:1], record=False)  # lazy imports, statement cache
@@ -297,21 +319,27 @@ def bench_updates(size: int, frames: int, per_frame: int, trials: int, folder: P
         reference_path = folder / f"reference-{size}.sqlite"
         shutil.copy(template, reference_path)
         reference_rates.append(bench_reference(reference_path, recorded, per_frame))
+        written = [(len(frame), sum(len(rows) for _, rows in frame)) for frame in recorded]
         store_rates.append(rate)
         end_to_end.append(full)
         created = made
         for path in (trial_path, reference_path):
             for suffix in ("", "-wal", "-shm"):
                 Path(f"{path}{suffix}").unlink(missing_ok=True)
-    middle = trials // 2
+    pairs = list(zip(store_rates, reference_rates, strict=True))
     return {
-        "integrate": sorted(store_rates)[middle],
-        "integrate best": max(store_rates),
-        "end to end": sorted(end_to_end)[middle],
-        "reference": sorted(reference_rates)[middle],
-        "ratio": statistics.median(s / r for s, r in zip(store_rates, reference_rates, strict=True)),
+        "integrate": statistics.median(s.wall for s in store_rates),
+        "integrate best": max(s.wall for s in store_rates),
+        "integrate cpu": statistics.median(s.cpu for s in store_rates),
+        "end to end": statistics.median(end_to_end),
+        "reference": statistics.median(r.wall for r in reference_rates),
+        "reference cpu": statistics.median(r.cpu for r in reference_rates),
+        "ratio": statistics.median(s.wall / r.wall for s, r in pairs),
+        "ratio cpu": statistics.median(s.cpu / r.cpu for s, r in pairs),
         "created": created,
         "hypotheses": frames * per_frame,
+        "statements": statistics.mean(n for n, _ in written),
+        "rows": statistics.mean(m for _, m in written),
     }
 
 
@@ -410,32 +438,94 @@ def serve_idle_rss(folder: Path) -> float | None:
         return None
 
 
-def profile_updates(size: int, frames: int, per_frame: int, folder: Path, out: Path) -> None:
-    """cProfile of ``store.integrate`` over ``frames`` frames into a store of ``size``; the top entries by own time
-    and by cumulative time are written to ``out``."""
+def profile_updates(size: int, frames: int, per_frame: int, cameras: int, folder: Path, out: Path) -> None:
+    """cProfile of ``store.integrate`` over ``frames`` frames into a store of ``size``, frames at random places and
+    then from ``cameras`` fixed cameras; the top entries by own and by cumulative time are written to ``out``."""
     import cProfile
     import io
     import pstats
 
     path = folder / f"profile-{size}.sqlite"
-    seeded = seed_file(path, size, np.random.default_rng(size))
-    rng = np.random.default_rng(1)
-    objects = [frame_objects(hypotheses_near(seeded, rng, per_frame)) for _ in range(frames + 1)]
-    store = BeliefStore(path, tracker=BeliefTracker(class_test=is_subclass))
-    store.integrate(objects[0], 999.0)
-    profiler = cProfile.Profile()
-    profiler.enable()
-    for index, frame in enumerate(objects[1:]):
-        store.integrate(frame, 1000.0 + index)
-    profiler.disable()
-    store.close()
+    seeded = seed_file(path, size, np.random.default_rng(size), named_regions=False)
     text = io.StringIO()
-    text.write(f"store.integrate, {frames} frames x {per_frame} hypotheses into {size} stored objects\n")
-    pstats.Stats(profiler, stream=text).sort_stats("tottime").print_stats(25)
-    pstats.Stats(profiler, stream=text).sort_stats("cumulative").print_stats(25)
+    for scenario in (0, cameras):
+        copy = folder / f"profile-{size}-{scenario}.sqlite"
+        shutil.copy(path, copy)
+        rng = np.random.default_rng(1)
+        views = fixed_views(seeded, rng, scenario, per_frame) if scenario else []
+        objects = [
+            frame_objects(hypotheses_near(seeded, rng, per_frame, views[k % len(views)] if views else None))
+            for k in range(frames + 1)
+        ]
+        store = BeliefStore(copy, tracker=BeliefTracker(class_test=is_subclass))
+        store.integrate(objects[0], 999.0)
+        profiler = cProfile.Profile()
+        profiler.enable()
+        for index, frame in enumerate(objects[1:]):
+            store.integrate(frame, 1000.0 + index)
+        profiler.disable()
+        store.close()
+        where = f"from {scenario} fixed cameras in turn" if scenario else "each at a random place"
+        text.write(f"store.integrate, {frames} frames x {per_frame} hypotheses {where}, {size} stored objects\n")
+        pstats.Stats(profiler, stream=text).sort_stats("tottime").print_stats(25)
+        pstats.Stats(profiler, stream=text).sort_stats("cumulative").print_stats(25)
     out.parent.mkdir(parents=True, exist_ok=True)
     out.write_text(text.getvalue().replace(str(ROOT) + "/", ""))
     print(f"profile written to {out}")
+
+
+FLOOR_VARIANTS: dict[str, tuple[tuple[str, ...], str, str]] = {
+    "as designed (the reference)": ((), "", "NORMAL"),
+    "synchronous = OFF": ((), "", "OFF"),
+    "no sightings written (observations)": ((), "INSERT OR REPLACE INTO observations", "NORMAL"),
+    "sightings without their (object_id, seq) index": (("DROP INDEX observations_object",), "", "NORMAL"),
+    "no class and region indexes on objects": (("DROP INDEX objects_class", "DROP INDEX objects_region"), "", "NORMAL"),
+    "no updates of known objects": ((), "UPDATE objects SET frame", "NORMAL"),
+    "no R*Tree writes": ((), "INSERT OR REPLACE INTO objects_place", "NORMAL"),
+}
+"""Variants of the storage design for ``--floor-variants``: statements run first, statements left out (prefix),
+``synchronous``."""
+
+
+def floor_variants(size: int, frames: int, per_frame: int, folder: Path) -> None:
+    """Where the floor's time and pages go: the store's write log of ``frames`` frames (random places) replayed
+    per variant of the design (:data:`FLOOR_VARIANTS`); hypotheses/s in wall and CPU time, WAL pages per frame."""
+    template = folder / f"floor-{size}.sqlite"
+    seeded = seed_file(template, size, np.random.default_rng(size), named_regions=False)
+    rng = np.random.default_rng(1)
+    prepared = [hypotheses_near(seeded, rng, per_frame) for _ in range(frames)]
+    run = folder / "floor-run.sqlite"
+    shutil.copy(template, run)
+    rates, _, _, log = bench_store(run, prepared, record=True)
+    print(f"floor variants, {size} stored, {frames} frames x {per_frame} hypotheses at random places:")
+    print(f"  {'store.integrate':52s} wall {rates.wall:7.0f}/s  cpu {rates.cpu:7.0f}/s")
+    variants = [("warm-up (not printed)", FLOOR_VARIANTS["as designed (the reference)"]), *FLOOR_VARIANTS.items()]
+    for label, (setup, left_out, synchronous) in variants:
+        path = folder / "floor-variant.sqlite"
+        for suffix in ("", "-wal", "-shm"):
+            Path(f"{path}{suffix}").unlink(missing_ok=True)
+        shutil.copy(template, path)
+        conn = sqlite3.connect(path, isolation_level=None)
+        conn.execute("PRAGMA journal_mode = WAL")
+        conn.execute(f"PRAGMA synchronous = {synchronous}")
+        conn.execute("PRAGMA wal_autocheckpoint = 0")  # the WAL's size counts the pages written
+        for statement in setup:
+            conn.execute(statement)
+        conn.execute("PRAGMA wal_checkpoint(TRUNCATE)")
+        start, cpu = time.perf_counter(), time.process_time()
+        for frame in log:
+            conn.execute("BEGIN IMMEDIATE")
+            for statement, rows in frame:
+                if not (left_out and statement.startswith(left_out)):
+                    conn.executemany(statement, rows)
+            conn.execute("COMMIT")
+        wall, used = time.perf_counter() - start, time.process_time() - cpu
+        pages = (Path(f"{path}-wal").stat().st_size - 32) / (4096 + 24) / len(log)
+        conn.close()
+        count = len(log) * per_frame
+        if label.startswith("warm-up"):
+            continue
+        print(f"  {label:52s} wall {count / wall:7.0f}/s  cpu {count / used:7.0f}/s  WAL pages/frame {pages:5.1f}")
 
 
 def goal_for(size: int) -> float:
@@ -450,9 +540,13 @@ def main() -> int:
     parser.add_argument("--memory-size", type=int, default=100_000)
     parser.add_argument("--frames", type=int, default=300)
     parser.add_argument("--per-frame", type=int, default=20)
+    parser.add_argument("--cameras", type=int, default=30, help="fixed cameras of the second update scenario")
     parser.add_argument("--repeats", type=int, default=300)
     parser.add_argument("--trials", type=int, default=3)
     parser.add_argument("--no-serve", action="store_true", help="skip the RSS of robokudo serve")
+    parser.add_argument(
+        "--floor-variants", action="store_true", help="only replay the write log per variant of the storage design"
+    )
     parser.add_argument("--profile", type=Path, help="only write a cProfile of integrate (10,000 stored) to PROFILE")
     parser.add_argument("--rss-child", type=Path, help=argparse.SUPPRESS)
     parser.add_argument("--rss-count", type=int, help=argparse.SUPPRESS)
@@ -460,29 +554,44 @@ def main() -> int:
     if args.rss_child:
         rss_child(args.rss_child, args.rss_count)
         return 0
+    if args.floor_variants:
+        with tempfile.TemporaryDirectory() as name:
+            floor_variants(10_000, args.frames, args.per_frame, Path(name))
+        return 0
     if args.profile:
         with tempfile.TemporaryDirectory() as name:
-            profile_updates(10_000, args.frames, args.per_frame, Path(name), args.profile)
+            profile_updates(10_000, args.frames, args.per_frame, args.cameras, Path(name), args.profile)
         return 0
     print(f"load average before: {os.getloadavg()[0]:.2f} on {os.cpu_count()} CPUs")
     met: list[bool] = []
     with tempfile.TemporaryDirectory() as name:
         folder = Path(name)
         for size in args.update_sizes:
-            r = bench_updates(size, args.frames, args.per_frame, args.trials, folder)
-            ok = r["integrate"] >= UPDATE_GOAL
-            met.append(ok)
-            print(
-                f"updates, {size} stored ({args.trials} trials of {args.frames} frames x {args.per_frame} hypotheses, "
-                f"{r['created']:.0f} new objects in {r['hypotheses']:.0f} hypotheses):"
-            )
-            print(
-                f"  store.integrate (association + fusion + transaction) {r['integrate']:8.0f} hypotheses/s median "
-                f"(best {r['integrate best']:.0f})   goal >= {UPDATE_GOAL:.0f}: {'met' if ok else 'NOT met'}"
-            )
-            print(f"  plain sqlite3 executemany, same rows (reference)   {r['reference']:8.0f} hypotheses/s median")
-            print(f"  ratio store / reference                            {r['ratio']:8.2f}")
-            print(f"  frame_objects + integrate                          {r['end to end']:8.0f} hypotheses/s median")
+            for cameras in (0, args.cameras):
+                r = bench_updates(size, args.frames, args.per_frame, args.trials, folder, cameras)
+                ok = r["integrate"] >= UPDATE_GOAL
+                met.append(ok)
+                where = f"from {cameras} fixed cameras in turn" if cameras else "each at a random place"
+                print(
+                    f"updates, {size} stored, frames {where} ({args.trials} trials of {args.frames} frames x "
+                    f"{args.per_frame} hypotheses, {r['created']:.0f} new objects in {r['hypotheses']:.0f} hypotheses):"
+                )
+                print(
+                    f"  store.integrate (association + fusion + transaction) {r['integrate']:8.0f} hypotheses/s median "
+                    f"(best {r['integrate best']:.0f})   goal >= {UPDATE_GOAL:.0f}: {'met' if ok else 'NOT met'}"
+                )
+                print(
+                    f"  plain sqlite3 executemany, same rows (reference)   {r['reference']:8.0f} hypotheses/s median   "
+                    f"(the store's own {r['statements']:.1f} write statements, {r['rows']:.1f} rows per frame)"
+                )
+                print(f"  ratio store / reference                            {r['ratio']:8.2f}")
+                print(
+                    f"  in CPU time of the process: store {r['integrate cpu']:.0f}, reference "
+                    f"{r['reference cpu']:.0f} hypotheses/s, ratio {r['ratio cpu']:.2f}"
+                )
+                print(
+                    f"  frame_objects + integrate                          {r['end to end']:8.0f} hypotheses/s median"
+                )
         for size in args.query_sizes:
             path = folder / f"query-{size}.sqlite"
             start = time.perf_counter()

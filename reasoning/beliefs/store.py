@@ -207,6 +207,8 @@ class BeliefStore:
             raise ValueError(f"synchronous must be one of {', '.join(SYNCHRONOUS_MODES)}, not {synchronous!r}")
         self.tracker = tracker or BeliefTracker()
         self.history_limit = history_limit
+        self.write_log: list[list[tuple[str, list[tuple]]]] | None = None
+        """When a list, each :meth:`integrate` appends the statements it wrote, with their rows (benchmarks)."""
         self._lock = threading.RLock()
         self._conn = self._open(synchronous.upper(), busy_timeout, check)
 
@@ -356,6 +358,7 @@ class BeliefStore:
         missed earlier and not seen for the tracker's ``gone_after`` seconds are marked gone, wherever they are.
         """
         tracker = tracker or self.tracker
+        writes: list[tuple[str, list[tuple]]] = []
         with self._transaction() as conn:
             beliefs, loaded = self._candidates(conn, objects, camera, tracker.config.association.gate_distance)
             next_id = int(conn.execute("SELECT value FROM meta WHERE key = 'next_id'").fetchone()[0])
@@ -367,18 +370,17 @@ class BeliefStore:
                 return value
 
             step = tracker.step(beliefs, objects, time, new_id, camera)
-            self._write_beliefs(conn, step.changed, tracker.class_test, loaded)
+            self._write_beliefs(conn, step.changed, tracker.class_test, loaded, writes)
             counts = {b.id: b.observations for b in step.changed}
-            self._write_observations(conn, objects, [(i, counts.get(i, 0)) for i in step.assigned], time)
+            self._write_observations(conn, objects, [(i, counts.get(i, 0)) for i in step.assigned], time, writes)
             if allocated[0] != next_id:
-                conn.execute("UPDATE meta SET value = ? WHERE key = 'next_id'", (str(allocated[0]),))
+                _write(conn, writes, "UPDATE meta SET value = ? WHERE key = 'next_id'", [(str(allocated[0]),)])
             seen = set(step.assigned)
-            self._prune_history(conn, [b for b in step.changed if b.id in seen])
+            self._prune_history(conn, [b for b in step.changed if b.id in seen], writes)
             # beliefs missed earlier and not seen since, wherever they are, are gone after gone_after seconds
-            conn.execute(
-                "UPDATE objects SET status = 'gone' WHERE misses > 0 AND status = 'present' AND last_seen <= ?",
-                (time - tracker.config.gone_after,),
-            )
+            _write(conn, writes, _MARK_GONE, [(time - tracker.config.gone_after,)])
+        if self.write_log is not None:
+            self.write_log.append(writes)
         return step
 
     def put(self, beliefs: Sequence[ObjectBelief], class_test: ClassTest | None = None) -> None:
@@ -470,8 +472,9 @@ class BeliefStore:
         beliefs: Sequence[ObjectBelief],
         class_test: ClassTest | None,
         loaded: Mapping[int, _Loaded] | None = None,
+        writes: list[tuple[str, list[tuple]]] | None = None,
     ) -> None:
-        """Write object rows, their R*Tree entries and attribute-index entries.
+        """Write object rows, their R*Tree entries and attribute-index entries (noted in ``writes``).
 
         Beliefs in ``loaded`` are updated in place; their indexed columns and index entries are touched only
         when they changed. The R*Tree entry of a belief is a box of half-width ``RTREE_SLACK`` around a recent
@@ -480,19 +483,22 @@ class BeliefStore:
         """
         if not beliefs:
             return
+        log = [] if writes is None else writes
         loaded = loaded or {}
         cache: dict[frozenset[str], str] = {}
         rows = {b.id: _object_row(b, class_test, cache) for b in beliefs}
         fresh = [rows[b.id] for b in beliefs if b.id not in loaded]
         if fresh:
-            conn.executemany("DELETE FROM attribute_index WHERE object_id = ?", [(row[0],) for row in fresh])
-            conn.executemany(f"INSERT OR REPLACE INTO objects ({_OBJECT_COLUMNS}) VALUES ({_PLACEHOLDERS})", fresh)
+            _write(conn, log, "DELETE FROM attribute_index WHERE object_id = ?", [(row[0],) for row in fresh])
+            _write(conn, log, f"INSERT OR REPLACE INTO objects ({_OBJECT_COLUMNS}) VALUES ({_PLACEHOLDERS})", fresh)
         known = [b for b in beliefs if b.id in loaded]
         if known:
-            conn.executemany(_UPDATE_VOLATILE, [_volatile(rows[b.id]) for b in known])
+            _write(conn, log, _UPDATE_VOLATILE, [_volatile(rows[b.id]) for b in known])
             relabelled = [(*_labels(rows[b.id]), b.id) for b in known if _labels(rows[b.id]) != _state(loaded[b.id])]
             if relabelled:
-                conn.executemany(
+                _write(
+                    conn,
+                    log,
                     "UPDATE objects SET class_name = ?, region = ?, region_class = ?, indexed = ? WHERE id = ?",
                     relabelled,
                 )
@@ -508,9 +514,9 @@ class BeliefStore:
             added.extend((name, value, b.id) for name, value in new - old)
             removed.extend((name, value, b.id) for name, value in old - new)
         if removed:
-            conn.executemany("DELETE FROM attribute_index WHERE name = ? AND value = ? AND object_id = ?", removed)
+            _write(conn, log, "DELETE FROM attribute_index WHERE name = ? AND value = ? AND object_id = ?", removed)
         if added:
-            conn.executemany("INSERT OR IGNORE INTO attribute_index VALUES (?, ?, ?)", added)
+            _write(conn, log, "INSERT OR IGNORE INTO attribute_index VALUES (?, ?, ?)", added)
         moved = []
         for b in beliefs:
             x, y, z = rows[b.id][3:6]
@@ -520,10 +526,10 @@ class BeliefStore:
                 r = RTREE_SLACK
                 moved.append((b.id, x - r, x + r, y - r, y + r, z - r, z + r))
         if moved:
-            conn.executemany("INSERT OR REPLACE INTO objects_place VALUES (?, ?, ?, ?, ?, ?, ?)", moved)
+            _write(conn, log, "INSERT OR REPLACE INTO objects_place VALUES (?, ?, ?, ?, ?, ?, ?)", moved)
         classes = {(b.class_name,) for b in beliefs if b.class_name and b.class_name != _loaded_class(loaded, b.id)}
         if classes:
-            conn.executemany("INSERT OR IGNORE INTO classes VALUES (?)", classes)
+            _write(conn, log, "INSERT OR IGNORE INTO classes VALUES (?)", list(classes))
 
     def _write_observations(
         self,
@@ -531,6 +537,7 @@ class BeliefStore:
         objects: Sequence[FrameObject],
         assigned: Sequence[tuple[int, int]],
         time: float,
+        writes: list[tuple[str, list[tuple]]],
     ) -> None:
         """Record each object's sighting under (belief id, its sighting number)."""
         cache: dict[frozenset[str], str] = {}
@@ -550,17 +557,21 @@ class BeliefStore:
             if object_id
         ]
         if rows:
-            conn.executemany(
+            _write(
+                conn,
+                writes,
                 "INSERT OR REPLACE INTO observations (object_id, seq, time, frame, px, py, pz, roi, sources, evidence, "
                 "recording) VALUES (?, ?, ?, ?, ?, ?, ?, ?, ?, ?, ?)",
                 rows,
             )
 
-    def _prune_history(self, conn: sqlite3.Connection, beliefs: Sequence[ObjectBelief]) -> None:
+    def _prune_history(
+        self, conn: sqlite3.Connection, beliefs: Sequence[ObjectBelief], writes: list[tuple[str, list[tuple]]]
+    ) -> None:
         limit = self.history_limit
         due = [(b.id, b.observations - limit) for b in beliefs if b.observations > limit and b.observations % 16 == 0]
         if due:
-            conn.executemany("DELETE FROM observations WHERE object_id = ? AND seq <= ?", due)
+            _write(conn, writes, "DELETE FROM observations WHERE object_id = ? AND seq <= ?", due)
 
     # ------------------------------------------------------------------ reading
 
@@ -691,6 +702,15 @@ class BeliefStore:
 # ---------------------------------------------------------------------------------------- row mapping
 
 
+_MARK_GONE = "UPDATE objects SET status = 'gone' WHERE misses > 0 AND status = 'present' AND last_seen <= ?"
+
+
+def _write(conn: sqlite3.Connection, log: list[tuple[str, list[tuple]]], statement: str, rows: list[tuple]) -> None:
+    """Run one write statement over ``rows`` and note it in ``log`` (what the benchmark's reference replays)."""
+    conn.executemany(statement, rows)
+    log.append((statement, rows))
+
+
 @functools.lru_cache(maxsize=64)
 def _candidate_query(boxes: int) -> str:
     """The present beliefs of one world whose R*Tree entries meet any of ``boxes`` boxes (one statement; its
@@ -756,7 +776,7 @@ def _object_row(b: ObjectBelief, class_test: ClassTest | None, sources: dict[fro
 
 def _floats(values: np.ndarray | Sequence[float], count: int) -> list[float]:
     """The first ``count`` values as Python floats (one conversion of the array, not one per element)."""
-    return [float(v) for v in np.asarray(values).tolist()[:count]]
+    return np.asarray(values, dtype=np.float64)[:count].tolist()
 
 
 _COLUMN_COUNT = len(_OBJECT_COLUMNS.split(","))
