@@ -743,17 +743,20 @@ class _Layout:
     def _branches(self) -> dict[str, dict[str, list[str]]]:
         """For each unit with alternatives: the units only one alternative needs, moved into its branch.
 
-        A unit moves when it has a single provider, guarantees nothing else that is used, and is needed
-        only inside that branch.
+        A unit moves when it has a single provider, guarantees nothing else that is required elsewhere, and is
+        needed only inside that branch or by other alternatives of the same type (then it goes into each of
+        theirs); optional readers elsewhere do not hold it back.
         """
+        # only required inputs bind a unit to the stage: an optional reader (size or shape using the plane when
+        # there is one) runs after the Fallback that may have made it and does without when no branch did
         consumers: dict[str, set[str]] = {}
         for unit in self.units.values():
             for spec in unit.providers:
-                for needed in (*spec.inputs, *spec.optional_inputs):
+                for needed in spec.inputs:
                     consumers.setdefault(needed, set()).add(spec.name)
         for type_name in sorted(set(self.units) | set(self.catalog.sensors)):
             for spec in self.catalog.refiners(type_name):
-                for needed in (*spec.inputs, *spec.optional_inputs):
+                for needed in spec.inputs:
                     consumers.setdefault(needed, set()).add(spec.name)
         guaranteed = self.assignment.guaranteed_by()
         guarantees: dict[str, list[str]] = {}
@@ -765,6 +768,7 @@ class _Layout:
             if len(unit.providers) < 2:
                 continue
             branches[type_name] = {}
+            rivals = {s.name for s in unit.providers}
             for spec in unit.providers:
                 owned: list[str] = []
                 members = {spec.name}
@@ -774,7 +778,9 @@ class _Layout:
                     key = guaranteed.get(needed)
                     if key is None or key in owned or key == type_name or len(self.units[key].providers) != 1:
                         continue
-                    if any(not consumers.get(t, set()) <= members for t in guarantees[key]):
+                    # a unit only alternatives of this type need goes into each of their branches: a branch
+                    # that fails (its plane not found) then hands over to the next, which makes its own
+                    if any(not consumers.get(t, set()) <= members | rivals for t in guarantees[key]):
                         continue
                     owned.append(key)
                     inner = self.units[key].providers[0]
