@@ -74,27 +74,30 @@ def join_occluded(
     kernel = np.ones((2 * rules.band + 1, 2 * rules.band + 1), np.uint8)
     wide = np.ones((6 * rules.band + 1, 6 * rules.band + 1), np.uint8)
     pixels, starts = label_groups(labels)
-    touching = _touching(labels)
+    measured = np.isfinite(depth.reshape(-1)) & (flat_labels > 0)
+    sums = np.bincount(flat_labels[measured], depth.reshape(-1)[measured], minlength=count + 1)
+    mean_depth = sums / np.maximum(np.bincount(flat_labels[measured], minlength=count + 1), 1)
+    touching: set[tuple[int, int]] | None = None
     joined: list[tuple[int, int]] = []
     for occluder in range(1, count + 1):
         own = pixels[starts[occluder] : starts[occluder + 1]]
-        if own.size < rules.min_points:
+        # what an occluder hides lies farther than it as a whole: at least two such objects or nothing to join
+        farther = np.flatnonzero(mean_depth > mean_depth[occluder])
+        if own.size < rules.min_points or farther.size < 2:
             continue
         x0, y0, x1, y1 = _box(own, labels.shape[1], labels.shape, 3 * rules.band + 1)
         window = labels[y0:y1, x0:x1]
         near = cv2.dilate(_with_shadow(window == occluder, depth[y0:y1, x0:x1], wide).view(np.uint8), kernel) > 0
         behind = []
-        for piece in np.unique(window[near]).tolist():
-            if piece in (0, occluder):
-                continue
+        for piece in np.intersect1d(np.unique(window[near]), farther).tolist():
             band = near & (window == piece)
             if np.count_nonzero(band) < rules.min_points:
                 continue
             facing = (cv2.dilate(band.view(np.uint8), wide) > 0) & (window == occluder)
             if np.count_nonzero(facing) < rules.min_points:
                 continue
-            piece_depth = np.nanmedian(depth[y0:y1, x0:x1][band])
-            occluder_depth = np.nanmedian(depth[y0:y1, x0:x1][facing])
+            piece_depth = _finite_mean(depth[y0:y1, x0:x1][band])
+            occluder_depth = _finite_mean(depth[y0:y1, x0:x1][facing])
             if not depth_jump(np.float32(piece_depth), np.float32(occluder_depth), absolute, relative):
                 continue
             if piece_depth <= occluder_depth:
@@ -107,10 +110,12 @@ def join_occluded(
                 continue
             pixel = np.array([rows.mean() + y0, cols.mean() + x0])
             behind.append(_Piece(piece, flat, xyz.mean(axis=0), pixel))
+        if len(behind) >= 2 and touching is None:
+            touching = _touching(labels)
         for index, first in enumerate(behind):
             for second in behind[index + 1 :]:
                 key = (min(first.label, second.label), max(first.label, second.label))
-                if key in touching:
+                if touching is None or key in touching:
                     continue
                 if (
                     _continues(first, second, normals, rules)
@@ -119,6 +124,12 @@ def join_occluded(
                 ):
                     joined.append(key)
     return join_labels(labels, joined) if joined else labels
+
+
+def _finite_mean(values: np.ndarray) -> float:
+    """The mean of the finite values (NaN when there is none)."""
+    finite = values[np.isfinite(values)]
+    return float(finite.mean()) if finite.size else float("nan")
 
 
 def _with_shadow(occluder: np.ndarray, depth: np.ndarray, reach: np.ndarray) -> np.ndarray:
