@@ -13,7 +13,9 @@ behind an occluder):
   both ends (the line runs along its axis, across which all its normals lie) - for any surface extruded along
   the hidden stretch;
 * the cross-sections agree: seen along that line, both pieces reach the same height above the support plane
-  and span the same width across it (within ``rules.tolerance`` metres or ``rules.relative`` of the larger);
+  (within ``rules.tolerance`` metres or ``rules.relative`` of the larger) and, unless they lie on one plane
+  (``rules.flat`` metres RMS: a flat top may have any outline behind the occluder), the narrower one spans no
+  more than the wider one across it (a box turned across the line shows a corner on one side);
 * the straight image line between them runs mostly through the occluder (they face each other across it), and
   the occluder is nearer there than the surface joining them would be.
 """
@@ -37,16 +39,19 @@ class OcclusionRules:
     tangent_share: float = 0.6
     tolerance: float = 0.015
     relative: float = 0.15
+    flat: float = 0.005
     through_occluder: float = 0.5
     min_points: int = 20
 
 
 @dataclass(frozen=True, eq=False)
 class _Piece:
-    """A piece near an occluder: its pixels there (flat indices), their 3-D centroid and image centroid."""
+    """A piece near an occluder: its pixels there (flat indices), their finite 3-D points and centroid, and their
+    image centroid."""
 
     label: int
     band: np.ndarray
+    points: np.ndarray
     centre: np.ndarray
     pixel: np.ndarray
 
@@ -109,7 +114,7 @@ def join_occluded(
             if xyz.shape[0] < rules.min_points:
                 continue
             pixel = np.array([rows.mean() + y0, cols.mean() + x0])
-            behind.append(_Piece(piece, flat, xyz.mean(axis=0), pixel))
+            behind.append(_Piece(piece, flat, xyz, xyz.mean(axis=0), pixel))
         if len(behind) >= 2 and touching is None:
             touching = _touching(labels)
         for index, first in enumerate(behind):
@@ -124,6 +129,14 @@ def join_occluded(
                 ):
                     joined.append(key)
     return join_labels(labels, joined) if joined else labels
+
+
+def _coplanar(first: _Piece, second: _Piece, flat: float) -> bool:
+    """Do the two pieces' points near the occluder lie on one plane (RMS distance at most ``flat`` metres)?"""
+    xyz = np.concatenate([first.points, second.points]).astype(np.float64)
+    centred = xyz - xyz.mean(axis=0)
+    smallest = np.linalg.eigvalsh(centred.T @ centred / xyz.shape[0])[0]
+    return bool(np.sqrt(max(smallest, 0.0)) <= flat)
 
 
 def _finite_mean(values: np.ndarray) -> float:
@@ -195,10 +208,15 @@ def _same_section(first: _Piece, second: _Piece, on_plane: np.ndarray, rules: Oc
     low_b, high_b = np.quantile(b[:, 2], (0.05, 0.95))
     if abs(high_a - high_b) > slack(low_a, high_a, low_b, high_b):
         return False  # one reaches higher than the other
+    if _coplanar(first, second, rules.flat):
+        return True  # one plane going on behind the occluder: any outline of it may continue there
     low_a, high_a = np.quantile(a[:, :2] @ across, (0.05, 0.95))
     low_b, high_b = np.quantile(b[:, :2] @ across, (0.05, 0.95))
     width = slack(low_a, high_a, low_b, high_b)
-    return abs(low_a - low_b) <= width and abs(high_a - high_b) <= width
+    # the narrower cross-section lies within the wider (a corner of a box turned across the line is narrower)
+    if high_a - low_a > high_b - low_b:
+        low_a, high_a, low_b, high_b = low_b, high_b, low_a, high_a
+    return low_a >= low_b - width and high_a <= high_b + width
 
 
 def _touching(labels: np.ndarray) -> set[tuple[int, int]]:
