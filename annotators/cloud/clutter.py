@@ -112,7 +112,7 @@ def segment_clutter(
     normals = grid_normals(grid, p.normal_step, p.normal_smoothing, p.jump_absolute, p.jump_relative)
     surfaces = label_parts(region & ~seams, 1)
     patches = split_by_normals(grid_patches(surfaces, p.cell), normals, p.normal_spread)
-    labels, faces = convex_groups(patches, grid, p.convexity_rules(), region & ~seams)
+    labels, _ = convex_groups(patches, grid, p.convexity_rules(), region & ~seams)
     # patches without a trustworthy plane (a face seen edge-on, a few points) go with the object beside them
     labels = grow_labels(labels, region & ~seams, max(2.0 * p.cell, p.grow_distance / step))
     labels = grow_on_surface(labels, region, depth, p.jump_absolute, p.jump_relative)
@@ -126,7 +126,8 @@ def segment_clutter(
         colors_crop = np.ascontiguousarray(colors[::step, ::step][y0:y1, x0:x1])
         labels = split_by_color(labels, grid, normals, colors_crop, p)
     if p.complete_occluded:
-        labels = join_occluded(labels, faces, grid, p.jump_absolute, p.jump_relative, OcclusionRules())
+        plane_grid = on_plane(np.arange(crop_points.shape[0])).reshape(grid.shape)
+        labels = join_occluded(labels, grid, normals, plane_grid, p.jump_absolute, p.jump_relative, OcclusionRules())
     return full_resolution_segments(labels, depth, (x0, y0, x1, y1), step, points, mask, model, p)
 
 

@@ -1,12 +1,21 @@
 """Occlusion completion on the organized grid: the pieces of one object that a nearer object cuts apart.
 
-A box lying across another splits the view of the lower one into two disjoint pieces. They are one object when
-(the Gestalt rule of good continuation behind an occluder):
+A box lying across another splits the view of the lower one into two disjoint pieces; a box standing in front of
+a can lying on the table leaves its two ends. They are one object when (the Gestalt rule of good continuation
+behind an occluder):
 
-* both border a common occluder across depth jumps, on the far side of the jump;
+* both lie behind a common occluder: near it (within ``rules.band`` pixels, which also bridges the sensor's
+  shadow beside an occluding edge, where no depth is measured) they are farther than it by a depth jump;
 * they do not touch each other;
-* near the occluder each piece is flat, and the two surfaces continue one another: their normals agree and the
-  line between them lies in both planes (within ``rules.degrees``);
+* the surface goes on from one to the other along the line between them: that line lies in the tangent planes
+  of both pieces near the occluder (within ``rules.degrees`` for most of their pixels). This holds for one plane
+  continuing behind the occluder, for a box's top and front together, and for a can lying on its side seen at
+  both ends (the line runs along its axis, across which all its normals lie) - for any surface extruded along
+  the hidden stretch;
+* the cross-sections agree: seen along that line, both pieces reach the same height above the support plane
+  (within ``rules.tolerance`` metres or ``rules.relative`` of the larger) and, unless they lie on one plane
+  (``rules.flat`` metres RMS: a flat top may have any outline behind the occluder), the narrower one spans no
+  more than the wider one across it (a box turned across the line shows a corner on one side);
 * the straight image line between them runs mostly through the occluder (they face each other across it), and
   the occluder is nearer there than the surface joining them would be.
 """
@@ -18,130 +27,196 @@ from dataclasses import dataclass
 import cv2
 import numpy as np
 
-from annotators.geometry.grid_segmentation import depth_jump, join_labels
+from annotators.geometry.grid_segmentation import depth_jump, join_labels, label_groups
 
 
 @dataclass(frozen=True)
 class OcclusionRules:
-    """Thresholds of :func:`join_occluded` (pixels, shares, degrees)."""
+    """Thresholds of :func:`join_occluded` (pixels, shares, degrees, metres)."""
 
     band: int = 6
-    occluded_share: float = 0.5
     degrees: float = 20.0
-    flatness: float = 0.05
+    tangent_share: float = 0.6
+    tolerance: float = 0.015
+    relative: float = 0.15
+    flat: float = 0.005
     through_occluder: float = 0.5
     min_points: int = 20
 
 
-def occluded_pairs(
-    labels: np.ndarray, depth: np.ndarray, absolute: float, relative: float, share: float
-) -> set[tuple[int, int]]:
-    """``(far, near)`` label pairs that touch as 4-neighbours, across depth jumps on at least ``share`` of their
-    shared boundary, with ``near`` in front."""
-    base = int(labels.max(initial=0)) + 1
-    keys, jumps = [], []
-    for first, second, z_first, z_second in (
-        (labels[:, :-1], labels[:, 1:], depth[:, :-1], depth[:, 1:]),
-        (labels[:-1, :], labels[1:, :], depth[:-1, :], depth[1:, :]),
-    ):
-        touching = (first != second) & (first > 0) & (second > 0)
-        a, b = first[touching].astype(np.int64), second[touching].astype(np.int64)
-        za, zb = z_first[touching], z_second[touching]
-        a_farther = za > zb
-        keys.append(np.where(a_farther, a * base + b, b * base + a))
-        jumps.append(depth_jump(za, zb, absolute, relative))
-    key = np.concatenate(keys)
-    if key.size == 0:
-        return set()
-    unique, inverse = np.unique(key, return_inverse=True)
-    total = np.bincount(inverse, minlength=unique.size)
-    jumped = np.bincount(inverse, weights=np.concatenate(jumps), minlength=unique.size)
-    found = unique[jumped >= share * total]
-    return set(zip((found // base).tolist(), (found % base).tolist(), strict=True))
+@dataclass(frozen=True, eq=False)
+class _Piece:
+    """A piece near an occluder: its pixels there (flat indices), their finite 3-D points and centroid, and their
+    image centroid."""
+
+    label: int
+    band: np.ndarray
+    points: np.ndarray
+    centre: np.ndarray
+    pixel: np.ndarray
 
 
 def join_occluded(
     labels: np.ndarray,
-    faces: np.ndarray,
     points: np.ndarray,
+    normals: np.ndarray,
+    on_plane: np.ndarray,
     absolute: float,
     relative: float,
     rules: OcclusionRules,
 ) -> np.ndarray:
     """Labels with the pieces of occluded objects joined (see the module docstring), renumbered 1..n.
 
-    ``faces`` labels the smooth surfaces the pieces are made of; the surfaces of two pieces that border the
-    occluder are compared face by face (near the occluder), so a piece showing a box's top and side continues
-    the other piece's top.
+    ``points`` and ``normals`` are the HxWx3 grid and its unit normals (NaN where unknown); ``on_plane`` the HxWx3
+    coordinates ``(u, v, height)`` of every grid point on the support plane.
     """
+    count = int(labels.max(initial=0))
+    if count < 3:
+        return labels
     depth = points[..., 2]
-    behind = occluded_pairs(labels, depth, absolute, relative, rules.occluded_share)
-    hidden_by: dict[int, list[int]] = {}
-    for far, near in behind:
-        hidden_by.setdefault(near, []).append(far)
-    touching = _touching(labels)
+    flat_points = points.reshape(-1, 3)
+    flat_labels = labels.reshape(-1)
     kernel = np.ones((2 * rules.band + 1, 2 * rules.band + 1), np.uint8)
+    wide = np.ones((6 * rules.band + 1, 6 * rules.band + 1), np.uint8)
+    pixels, starts = label_groups(labels)
+    measured = np.isfinite(depth.reshape(-1)) & (flat_labels > 0)
+    sums = np.bincount(flat_labels[measured], depth.reshape(-1)[measured], minlength=count + 1)
+    mean_depth = sums / np.maximum(np.bincount(flat_labels[measured], minlength=count + 1), 1)
+    touching: set[tuple[int, int]] | None = None
     joined: list[tuple[int, int]] = []
-    for occluder, pieces in hidden_by.items():
-        if len(pieces) < 2:
+    for occluder in range(1, count + 1):
+        own = pixels[starts[occluder] : starts[occluder + 1]]
+        # what an occluder hides lies farther than it as a whole: at least two such objects or nothing to join
+        farther = np.flatnonzero(mean_depth > mean_depth[occluder])
+        if own.size < rules.min_points or farther.size < 2:
             continue
-        near_occluder = cv2.dilate((labels == occluder).view(np.uint8), kernel) > 0
-        planes = {piece: _face_planes(points, faces, near_occluder & (labels == piece), rules) for piece in pieces}
-        for index, first in enumerate(pieces):
-            for second in pieces[index + 1 :]:
-                if (min(first, second), max(first, second)) in touching:
+        x0, y0, x1, y1 = _box(own, labels.shape[1], labels.shape, 3 * rules.band + 1)
+        window = labels[y0:y1, x0:x1]
+        near = cv2.dilate(_with_shadow(window == occluder, depth[y0:y1, x0:x1], wide).view(np.uint8), kernel) > 0
+        behind = []
+        for piece in np.intersect1d(np.unique(window[near]), farther).tolist():
+            band = near & (window == piece)
+            if np.count_nonzero(band) < rules.min_points:
+                continue
+            facing = (cv2.dilate(band.view(np.uint8), wide) > 0) & (window == occluder)
+            if np.count_nonzero(facing) < rules.min_points:
+                continue
+            piece_depth = _finite_mean(depth[y0:y1, x0:x1][band])
+            occluder_depth = _finite_mean(depth[y0:y1, x0:x1][facing])
+            if not depth_jump(np.float32(piece_depth), np.float32(occluder_depth), absolute, relative):
+                continue
+            if piece_depth <= occluder_depth:
+                continue
+            rows, cols = np.nonzero(band)
+            flat = (rows + y0) * labels.shape[1] + cols + x0
+            xyz = flat_points[flat]
+            xyz = xyz[np.isfinite(xyz).all(axis=1)]
+            if xyz.shape[0] < rules.min_points:
+                continue
+            pixel = np.array([rows.mean() + y0, cols.mean() + x0])
+            behind.append(_Piece(piece, flat, xyz, xyz.mean(axis=0), pixel))
+        if len(behind) >= 2 and touching is None:
+            touching = _touching(labels)
+        for index, first in enumerate(behind):
+            for second in behind[index + 1 :]:
+                key = (min(first.label, second.label), max(first.label, second.label))
+                if touching is None or key in touching:
                     continue
-                if any(
-                    _continues(a, b, rules.degrees)
-                    and _across(labels, points, occluder, first, second, a.band, b.band, a.centre, b.centre)
-                    >= rules.through_occluder
-                    for a in planes[first]
-                    for b in planes[second]
+                if (
+                    _continues(first, second, normals, rules)
+                    and _same_section(first, second, on_plane, rules)
+                    and _across(flat_labels, depth, labels.shape, occluder, first, second) >= rules.through_occluder
                 ):
-                    joined.append((first, second))
+                    joined.append(key)
     return join_labels(labels, joined) if joined else labels
 
 
-@dataclass(frozen=True, eq=False)
-class _BandPlane:
-    """A flat face of a piece near the occluder: its pixels there, their centroid and unit normal."""
-
-    band: np.ndarray
-    centre: np.ndarray
-    normal: np.ndarray
-
-
-def _face_planes(points: np.ndarray, faces: np.ndarray, band: np.ndarray, rules: OcclusionRules) -> list[_BandPlane]:
-    """The flat faces (flatness <= ``rules.flatness``) with at least ``rules.min_points`` pixels in ``band``."""
-    found = []
-    for face in np.unique(faces[band]).tolist():
-        if face == 0:
-            continue
-        own = band & (faces == face)
-        xyz = points[own]
-        xyz = xyz[np.isfinite(xyz).all(axis=1)].astype(np.float64)
-        if xyz.shape[0] < rules.min_points:
-            continue
-        centre = xyz.mean(axis=0)
-        values, vectors = np.linalg.eigh(np.cov((xyz - centre).T))
-        if values[0] / max(values.sum(), 1e-12) > rules.flatness:
-            continue
-        normal = vectors[:, 0] * (-1.0 if vectors[:, 0] @ centre > 0 else 1.0)
-        found.append(_BandPlane(own, centre, normal))
-    return found
+def _coplanar(first: _Piece, second: _Piece, flat: float) -> bool:
+    """Do the two pieces' points near the occluder lie on one plane (RMS distance at most ``flat`` metres)?"""
+    xyz = np.concatenate([first.points, second.points]).astype(np.float64)
+    centred = xyz - xyz.mean(axis=0)
+    smallest = np.linalg.eigvalsh(centred.T @ centred / xyz.shape[0])[0]
+    return bool(np.sqrt(max(smallest, 0.0)) <= flat)
 
 
-def _continues(first: _BandPlane, second: _BandPlane, degrees: float) -> bool:
-    """Do the two faces continue one surface: normals within ``degrees``, the line between their centroids within
-    ``degrees`` of both planes?"""
-    offset = second.centre - first.centre
-    direction = offset / max(float(np.linalg.norm(offset)), 1e-9)
-    sine = np.sin(np.radians(degrees))
-    return bool(
-        first.normal @ second.normal >= np.cos(np.radians(degrees))
-        and abs(direction @ first.normal) <= sine
-        and abs(direction @ second.normal) <= sine
+def _finite_mean(values: np.ndarray) -> float:
+    """The mean of the finite values (NaN when there is none)."""
+    finite = values[np.isfinite(values)]
+    return float(finite.mean()) if finite.size else float("nan")
+
+
+def _with_shadow(occluder: np.ndarray, depth: np.ndarray, reach: np.ndarray) -> np.ndarray:
+    """The occluder's mask and the unmeasured pixels (no depth) beside it, within ``reach`` (a kernel) of it:
+    a depth sensor sees no depth in the shadow an occluding edge casts on what is behind it."""
+    unmeasured = ~np.isfinite(depth)
+    if not unmeasured.any():
+        return occluder
+    count, parts = cv2.connectedComponents(unmeasured.view(np.uint8), connectivity=4)
+    beside = cv2.dilate(occluder.view(np.uint8), np.ones((3, 3), np.uint8)) > 0
+    touching = np.zeros(count, dtype=bool)
+    touching[parts[beside & unmeasured]] = True
+    touching[0] = False
+    within = cv2.dilate(occluder.view(np.uint8), reach) > 0
+    return occluder | (touching[parts] & within)
+
+
+def _box(flat: np.ndarray, width: int, shape: tuple[int, int], margin: int) -> tuple[int, int, int, int]:
+    """``(x0, y0, x1, y1)`` (exclusive) of flat pixel indices, grown by ``margin`` and clipped to ``shape``."""
+    rows, cols = flat // width, flat % width
+    return (
+        max(int(cols.min()) - margin, 0),
+        max(int(rows.min()) - margin, 0),
+        min(int(cols.max()) + 1 + margin, shape[1]),
+        min(int(rows.max()) + 1 + margin, shape[0]),
     )
+
+
+def _continues(first: _Piece, second: _Piece, normals: np.ndarray, rules: OcclusionRules) -> bool:
+    """Does the line between the pieces' centroids lie in the tangent planes of both (for at least
+    ``rules.tangent_share`` of the pixels with a normal of each)?"""
+    offset = second.centre - first.centre
+    length = float(np.linalg.norm(offset))
+    if length < 1e-6:
+        return False
+    direction = offset / length
+    sine = np.sin(np.radians(rules.degrees))
+    flat_normals = normals.reshape(-1, 3)
+    for piece in (first, second):
+        known = flat_normals[piece.band]
+        known = known[np.isfinite(known).all(axis=1)]
+        if known.shape[0] < rules.min_points:
+            return False
+        if np.count_nonzero(np.abs(known @ direction) <= sine) < rules.tangent_share * known.shape[0]:
+            return False
+    return True
+
+
+def _same_section(first: _Piece, second: _Piece, on_plane: np.ndarray, rules: OcclusionRules) -> bool:
+    """Seen along the line between them, do the pieces reach the same height and span the same width?"""
+    flat = on_plane.reshape(-1, 3)
+    a, b = flat[first.band], flat[second.band]
+    a, b = a[np.isfinite(a).all(axis=1)], b[np.isfinite(b).all(axis=1)]
+    along = np.median(b[:, :2], axis=0) - np.median(a[:, :2], axis=0)
+    norm = float(np.linalg.norm(along))
+    if norm < 1e-6:
+        return False
+    across = np.array([-along[1], along[0]]) / norm
+    slack = lambda low_a, high_a, low_b, high_b: max(  # noqa: E731
+        rules.tolerance, rules.relative * max(high_a - low_a, high_b - low_b)
+    )
+    low_a, high_a = np.quantile(a[:, 2], (0.05, 0.95))
+    low_b, high_b = np.quantile(b[:, 2], (0.05, 0.95))
+    if abs(high_a - high_b) > slack(low_a, high_a, low_b, high_b):
+        return False  # one reaches higher than the other
+    if _coplanar(first, second, rules.flat):
+        return True  # one plane going on behind the occluder: any outline of it may continue there
+    low_a, high_a = np.quantile(a[:, :2] @ across, (0.05, 0.95))
+    low_b, high_b = np.quantile(b[:, :2] @ across, (0.05, 0.95))
+    width = slack(low_a, high_a, low_b, high_b)
+    # the narrower cross-section lies within the wider (a corner of a box turned across the line is narrower)
+    if high_a - low_a > high_b - low_b:
+        low_a, high_a, low_b, high_b = low_b, high_b, low_a, high_a
+    return low_a >= low_b - width and high_a <= high_b + width
 
 
 def _touching(labels: np.ndarray) -> set[tuple[int, int]]:
@@ -154,26 +229,25 @@ def _touching(labels: np.ndarray) -> set[tuple[int, int]]:
 
 
 def _across(
-    labels: np.ndarray,
-    points: np.ndarray,
+    flat_labels: np.ndarray,
+    depth: np.ndarray,
+    shape: tuple[int, int],
     occluder: int,
-    first: int,
-    second: int,
-    first_band: np.ndarray,
-    second_band: np.ndarray,
-    start: np.ndarray,
-    end: np.ndarray,
+    first: _Piece,
+    second: _Piece,
 ) -> float:
-    """The share of the image line between the two bands (their pixel centroids), outside the two pieces, that the
-    occluder covers in front of the straight 3-D line from ``start`` to ``end`` (the hidden surface)."""
-    (r0, c0), (r1, c1) = (np.argwhere(band).mean(axis=0) for band in (first_band, second_band))
+    """The share of the image line between the two pieces' band centroids, outside the two pieces and where depth
+    is measured, that the occluder covers in front of the straight 3-D line between their centroids (the hidden
+    surface)."""
+    (r0, c0), (r1, c1) = first.pixel, second.pixel
     steps = int(max(abs(r1 - r0), abs(c1 - c0))) + 1
     t = np.linspace(0.0, 1.0, steps)
-    rows = np.round(r0 + t * (r1 - r0)).astype(int)
-    cols = np.round(c0 + t * (c1 - c0)).astype(int)
-    hidden_depth = start[2] + t * (end[2] - start[2])
-    on_line = labels[rows, cols]
+    rows = np.clip(np.round(r0 + t * (r1 - r0)).astype(int), 0, shape[0] - 1)
+    cols = np.clip(np.round(c0 + t * (c1 - c0)).astype(int), 0, shape[1] - 1)
+    hidden_depth = first.centre[2] + t * (second.centre[2] - first.centre[2])
+    on_line = flat_labels[rows * shape[1] + cols]
+    line_depth = depth[rows, cols]
     with np.errstate(invalid="ignore"):
-        covered = (on_line == occluder) & (points[rows, cols, 2] < hidden_depth)
-    between = (on_line != first) & (on_line != second)
+        covered = (on_line == occluder) & (line_depth < hidden_depth)
+    between = (on_line != first.label) & (on_line != second.label) & np.isfinite(line_depth)
     return float(np.count_nonzero(covered) / max(np.count_nonzero(between), 1))

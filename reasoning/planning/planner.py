@@ -743,17 +743,20 @@ class _Layout:
     def _branches(self) -> dict[str, dict[str, list[str]]]:
         """For each unit with alternatives: the units only one alternative needs, moved into its branch.
 
-        A unit moves when it has a single provider, guarantees nothing else that is used, and is needed
-        only inside that branch.
+        A unit moves when it has a single provider, guarantees nothing else that is required elsewhere, and is
+        needed only inside that branch or by other alternatives of the same type (then it goes into each of
+        theirs); optional readers elsewhere do not hold it back.
         """
+        # only required inputs bind a unit to the stage: an optional reader (size or shape using the plane when
+        # there is one) runs after the Fallback that may have made it and does without when no branch did
         consumers: dict[str, set[str]] = {}
         for unit in self.units.values():
             for spec in unit.providers:
-                for needed in (*spec.inputs, *spec.optional_inputs):
+                for needed in spec.inputs:
                     consumers.setdefault(needed, set()).add(spec.name)
         for type_name in sorted(set(self.units) | set(self.catalog.sensors)):
             for spec in self.catalog.refiners(type_name):
-                for needed in (*spec.inputs, *spec.optional_inputs):
+                for needed in spec.inputs:
                     consumers.setdefault(needed, set()).add(spec.name)
         guaranteed = self.assignment.guaranteed_by()
         guarantees: dict[str, list[str]] = {}
@@ -764,24 +767,50 @@ class _Layout:
             unit = self.units[type_name]
             if len(unit.providers) < 2:
                 continue
-            branches[type_name] = {}
-            for spec in unit.providers:
-                owned: list[str] = []
-                members = {spec.name}
-                frontier = list(spec.inputs)
-                while frontier:
-                    needed = frontier.pop(0)
-                    key = guaranteed.get(needed)
-                    if key is None or key in owned or key == type_name or len(self.units[key].providers) != 1:
-                        continue
-                    if any(not consumers.get(t, set()) <= members for t in guarantees[key]):
-                        continue
-                    owned.append(key)
-                    inner = self.units[key].providers[0]
-                    members.add(inner.name)
-                    frontier.extend(inner.inputs)
-                branches[type_name][spec.name] = owned
+            rivals = {s.name for s in unit.providers}
+            # a unit only alternatives of this type need goes into each of their branches: a branch that fails
+            # (its plane not found) then hands over to the next, which makes its own - unless some alternative
+            # needing it would not own it, then units go into a branch only when that branch alone needs them
+            shared = {spec.name: self._owned(spec, type_name, consumers, guaranteed, guarantees, rivals)
+                      for spec in unit.providers}  # fmt: skip
+            if not all(
+                consumer in members or (consumer in rivals and key in shared[consumer][0])
+                for owned, members in shared.values()
+                for key in owned
+                for t in guarantees[key]
+                for consumer in consumers.get(t, set())
+            ):
+                shared = {spec.name: self._owned(spec, type_name, consumers, guaranteed, guarantees, set())
+                          for spec in unit.providers}  # fmt: skip
+            branches[type_name] = {name: owned for name, (owned, _) in shared.items()}
         return branches
+
+    def _owned(
+        self,
+        spec: AnnotatorSpec,
+        type_name: str,
+        consumers: dict[str, set[str]],
+        guaranteed: dict[str, str],
+        guarantees: dict[str, list[str]],
+        rivals: set[str],
+    ) -> tuple[list[str], set[str]]:
+        """The units that move into the branch of alternative ``spec`` of ``type_name`` (and the branch's
+        annotators): single-provider units whose outputs only the branch (or the ``rivals``) read."""
+        owned: list[str] = []
+        members = {spec.name}
+        frontier = list(spec.inputs)
+        while frontier:
+            needed = frontier.pop(0)
+            key = guaranteed.get(needed)
+            if key is None or key in owned or key == type_name or len(self.units[key].providers) != 1:
+                continue
+            if any(not consumers.get(t, set()) <= members | rivals for t in guarantees[key]):
+                continue
+            owned.append(key)
+            inner = self.units[key].providers[0]
+            members.add(inner.name)
+            frontier.extend(inner.inputs)
+        return owned, members
 
     def _required_cycle(self) -> list[str] | None:
         """Drop optional ordering edges that close cycles; return a cycle of required edges, if any."""

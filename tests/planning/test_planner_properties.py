@@ -79,8 +79,20 @@ def test_random_capability_ontologies(seed: int, annotators: int, types: int) ->
 
 
 def check_each_annotator_once(plan: Plan) -> None:
-    names = plan.annotator_names()
-    assert len(names) == len(set(names)), names
+    """Each annotator runs at most once on any path: it appears once in the plan, or (a unit that only the
+    alternatives of one Fallback need) once in each of several branches of one Alternatives."""
+    outside = [unit.annotator for unit in plan.units() if isinstance(unit, Step)]
+    inside: dict[str, int] = {}
+    for unit in plan.units():
+        if isinstance(unit, Alternatives):
+            for branch in unit.branches:
+                names = [step.annotator for step in branch]
+                assert len(names) == len(set(names)), names
+            for name in {step.annotator for branch in unit.branches for step in branch}:
+                inside[name] = inside.get(name, 0) + 1
+    assert len(outside) == len(set(outside)), outside
+    assert all(count == 1 for count in inside.values()), inside  # never in two Fallbacks
+    assert not set(outside) & set(inside), set(outside) & set(inside)
 
 
 def check_minimal(plan: Plan, wanted: list[str]) -> None:
