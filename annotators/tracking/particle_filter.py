@@ -115,15 +115,34 @@ class ParticleFilter:
         return best if distances[best] <= self.gate() else None
 
     def update(self, detection: np.ndarray) -> None:
-        """Weight the particles by a detection's likelihood and resample when the weights degenerate."""
+        """Weight the particles by a detection's likelihood and resample when the weights degenerate.
+
+        When the predicted particles hardly cover the detection (a long step spread them far wider than the
+        detection noise), a share of them is drawn afresh around the detection, keeping the velocities of the
+        particles nearest to it: otherwise the few particles that happen to lie near the detection decide the
+        estimate and a still target's estimate wanders by centimetres.
+        """
         self._require_started()
-        squared = np.sum((self.states[:, :3] - _point(detection)) ** 2, axis=1)
-        log_w = np.log(np.maximum(self.weights, 1e-300)) - 0.5 * squared / self.settings.measurement_noise**2
+        point = _point(detection)
+        squared = np.sum((self.states[:, :3] - point) ** 2, axis=1)
+        log_likelihood = -0.5 * squared / self.settings.measurement_noise**2
+        coverage = float(self.weights @ np.exp(log_likelihood))
+        log_w = np.log(np.maximum(self.weights, 1e-300)) + log_likelihood
         log_w -= log_w.max()
         weights = np.exp(log_w)
         self.weights = weights / weights.sum()
-        if 1.0 / float(self.weights @ self.weights) < 0.5 * self.weights.size:
+        if coverage < _WELL_COVERED:
+            self._reset_around(point, share=1.0 - coverage / _WELL_COVERED)
+        elif 1.0 / float(self.weights @ self.weights) < 0.5 * self.weights.size:
             self.resample()
+
+    def _reset_around(self, detection: np.ndarray, share: float) -> None:
+        """Resample, then move ``share`` of the particles to draws around ``detection`` (velocities kept)."""
+        self.resample()
+        count = self.weights.size
+        fresh = self.rng.random(count) < share
+        noise = self.rng.normal(0.0, self.settings.measurement_noise, (int(fresh.sum()), 3))
+        self.states[fresh, :3] = detection + noise
 
     def resample(self) -> None:
         """Systematic resampling: particles drawn in proportion to their weights, weights made equal."""
@@ -138,6 +157,11 @@ class ParticleFilter:
     def _require_started(self) -> None:
         if not self.started:
             raise RuntimeError("the particle filter has no target yet: call start() with a first detection")
+
+
+_WELL_COVERED = 0.2
+"""The mean likelihood of the predicted particles (1 at the detection, e^-0.5 one noise sigma away per axis) below
+which particles are drawn afresh around the detection."""
 
 
 def _point(value: np.ndarray) -> np.ndarray:

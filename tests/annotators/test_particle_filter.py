@@ -82,6 +82,22 @@ def test_the_gate_widens_while_the_target_is_unseen_and_no_gap_predicts_wildly()
     assert np.linalg.norm(pf.estimate().position - [0.0, 0.0, 3.0]) < 3.0
 
 
+@pytest.mark.parametrize("seed", range(8))
+def test_a_still_target_seen_once_a_second_stays_put(seed: int) -> None:
+    """Frames a second apart (a loaded machine, a slow tree) spread the predicted particles far wider than the
+    detection noise; the estimate still follows the detections of a target that does not move."""
+    rng = np.random.default_rng(100 + seed)
+    target = np.array([0.4, -0.2, 1.1])
+    pf = ParticleFilter(FilterSettings(), np.random.default_rng(seed))
+    pf.start(target + rng.normal(0.0, 0.005, 3), 0.0)
+    errors = []
+    for step in range(1, 30):
+        pf.predict(step * 1.0 + rng.uniform(-0.2, 0.2))
+        pf.update(target + rng.normal(0.0, 0.005, 3))
+        errors.append(float(np.linalg.norm(pf.estimate().position - target)))
+    assert max(errors) < 0.02, errors
+
+
 def test_resampling_keeps_the_particle_count_and_equal_weights() -> None:
     pf = ParticleFilter(FilterSettings(particles=100), np.random.default_rng(2))
     pf.start(np.zeros(3), 0.0)
