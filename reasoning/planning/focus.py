@@ -3,8 +3,9 @@
 ``inspect object 3`` refines one believed object. Its plan keeps only the points of a box around where the object
 is believed to be (:func:`object_focus`): a cube of the object's largest believed extent (a belief's extents are
 not along the world axes) grown by :data:`FOCUS_MARGIN` on every side, reaching :data:`SUPPORT_DEPTH` further down
-so that the surface it stands on is inside (the segmentation finds the object as what stands on that surface). The box is a :class:`~robokudo.core.regions.RegionBox` in the
-belief's frame, so the region filter the planner adds for regions applies it.
+so that the surface it stands on is inside (the segmentation finds the object as what stands on that surface).
+The box is a :class:`~robokudo.core.regions.RegionBox` in the belief's frame, so the region filter the planner adds
+for regions applies it.
 """
 
 from __future__ import annotations
@@ -35,8 +36,8 @@ def object_focus(
     object_id: int, position: Sequence[float], dimensions: Sequence[float] | None, frame: str
 ) -> RegionBox | None:
     """The box to inspect object ``object_id`` in: upright (z up) around its believed ``position``, sized by its
-    largest believed extent (``dimensions`` None: :data:`DEFAULT_EXTENT`); None when the belief is not in the world frame (then
-    no camera pose places the points, and the whole view is searched)."""
+    largest believed extent (``dimensions`` None: :data:`DEFAULT_EXTENT`); None when the belief is not in the world
+    frame (then no camera pose places the points, and the whole view is searched)."""
     if frame != FOCUS_FRAME:
         return None
     centre = np.asarray(position, dtype=np.float64).reshape(3)
