@@ -8,9 +8,9 @@ from collections.abc import Iterator
 import numpy as np
 import pytest
 
-from annotators.image.human_pose import PoseModelError, load_pose_model
 from annotators.simulation.kitchen_scene import kitchen_objects
 from robokudo.application.service import AnsweringService, Outcome, PerceptionFailedError
+from tests.kitchen_service import kitchen_service_with_pose
 
 POSITIONS = ((-0.35, 0.7), (0.05, 0.75), (0.4, 0.65))
 TABLE_OBJECTS = ("cereal_box", "red_cup", "bowl")
@@ -18,16 +18,8 @@ TABLE_OBJECTS = ("cereal_box", "red_cup", "bowl")
 
 @pytest.fixture(scope="module")
 def service(tmp_path_factory: pytest.TempPathFactory) -> Iterator[AnsweringService]:
-    """One answering service for the module (its own user ontology and store); each test puts its person in."""
-    try:
-        load_pose_model()
-    except PoseModelError as error:
-        pytest.skip(str(error))
-    folder = tmp_path_factory.mktemp("pointing")
-    with pytest.MonkeyPatch.context() as env:
-        env.setenv("ROBOKUDO_USER_ONTOLOGY", str(folder / "user.ttl"))
-        with AnsweringService.open(folder / "beliefs.sqlite") as opened:
-            yield opened
+    """One answering service on the kitchen for the module; each test puts its person in."""
+    yield from kitchen_service_with_pose(tmp_path_factory, "pointing")
 
 
 def _answer(service: AnsweringService, person: str, text: str) -> Outcome:

@@ -14,7 +14,6 @@ import cv2
 import numpy as np
 import pytest
 
-from annotators.image.human_pose import PoseModelError, load_pose_model
 from annotators.readers.streams import KitchenCameraStream
 from annotators.simulation.kitchen_person import person_spec_pose, person_view
 from annotators.simulation.kitchen_scene import DEFAULT_INTRINSICS, FRIDGE_SHELF_HEIGHTS, kitchen_objects
@@ -36,6 +35,7 @@ from robokudo.core.types import BodyKeypoints, CameraInfo, ColorImage, PersonHyp
 from tests.annotators.test_free_space_kitchen import placements_tree
 from tests.application.server.conftest import REPO
 from tests.application.test_cli_query import query
+from tests.kitchen_service import kitchen_service_with_pose, require_pose_model
 
 ARTIFACTS = REPO / "test-artifacts" / "annotated_image"
 POINT_AT_BOWL = "point:bowl@0.3,0.7"
@@ -85,15 +85,7 @@ def distance_to_line(points: np.ndarray, a: np.ndarray, b: np.ndarray) -> np.nda
 @pytest.fixture(scope="module")
 def service(tmp_path_factory: pytest.TempPathFactory) -> Iterator[AnsweringService]:
     """One answering service on the kitchen for the module; each test puts its person in."""
-    try:
-        load_pose_model()
-    except PoseModelError as error:
-        pytest.skip(str(error))
-    folder = tmp_path_factory.mktemp("pictures")
-    with pytest.MonkeyPatch.context() as env:
-        env.setenv("ROBOKUDO_USER_ONTOLOGY", str(folder / "user.ttl"))
-        with AnsweringService.open(folder / "beliefs.sqlite") as opened:
-            yield opened
+    yield from kitchen_service_with_pose(tmp_path_factory, "pictures")
 
 
 def test_run_numbers_every_hypothesis_of_a_hand_authored_tree(capsys: pytest.CaptureFixture[str]) -> None:
@@ -109,10 +101,7 @@ def test_run_numbers_every_hypothesis_of_a_hand_authored_tree(capsys: pytest.Cap
 def test_pointing_at_an_object_draws_the_ray_from_the_hand_to_the_object(
     capsys: pytest.CaptureFixture[str], tmp_path: Path
 ) -> None:
-    try:
-        load_pose_model()
-    except PoseModelError as error:
-        pytest.skip(str(error))
+    require_pose_model()
     path = ARTIFACTS / "pointing_object.png"
     status, out, err = query(
         capsys, "which object is the person pointing at", "--person", POINT_AT_BOWL, "--json",
