@@ -185,7 +185,11 @@ def _rg(linear: np.ndarray) -> np.ndarray:
 
 def _mixture_target(surface: Surface, larger: list[Surface], tolerance: float) -> int | None:
     """The index (in ``larger``) of the surface that ``surface`` is mostly made of when its chromaticity lies
-    on the segment between two larger surfaces (a blend of the two), else None."""
+    on the segment between two larger surfaces (a blend of the two), else None.
+
+    A blend's place on the segment weighs each part by its intensity (R + G + B in linear light): a pixel half
+    covered by a dark purple print and half by white paper lies near the white end. The share of the blend
+    that is each part's area undoes that weighting."""
     point = _rg(surface.linear)
     for i, first in enumerate(larger):
         for j in range(i + 1, len(larger)):
@@ -196,7 +200,9 @@ def _mixture_target(surface: Surface, larger: list[Surface], tolerance: float) -
                 continue
             t = float((point - a) @ segment) / length
             if 0.1 <= t <= 0.9 and np.linalg.norm(a + t * segment - point) <= tolerance:
-                return i if t < 0.5 else j
+                first_intensity, second_intensity = float(first.linear.sum()), float(larger[j].linear.sum())
+                second_area = t * first_intensity / (t * first_intensity + (1.0 - t) * second_intensity)
+                return i if second_area < 0.5 else j
     return None
 
 
