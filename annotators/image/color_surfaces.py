@@ -22,7 +22,7 @@ import cv2
 import numpy as np
 
 from annotators.image.color_space import linear_to_lab, srgb_to_linear
-from annotators.image.white_balance import NEUTRAL_LIGHT, FrameLight
+from annotators.image.white_balance import LUMINANCE, NEUTRAL_LIGHT, FrameLight
 from robokudo.core.types import ObjectHypothesis
 
 WHITE_LAB = np.array([100.0, 0.0, 0.0])
@@ -222,9 +222,6 @@ def _merge_mixtures(surfaces: list[Surface], tolerance: float) -> list[Surface]:
 
 NEUTRAL_RG = np.array([1.0 / 3.0, 1.0 / 3.0])
 """The rg chromaticity of a neutral (white-balanced) colour."""
-
-LUMINANCE = np.array([0.2126, 0.7152, 0.0722])
-"""Relative luminance Y of linear sRGB."""
 
 
 def _white_blend(host: Surface, surface: Surface, parameters: NamingParameters) -> tuple[float, np.ndarray] | None:
