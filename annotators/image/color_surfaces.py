@@ -258,13 +258,14 @@ def _merge_white_blends(surfaces: list[Surface], parameters: NamingParameters) -
     ``min_white_blend`` white are left alone (shading and noise move a colour that little)."""
     result = list(surfaces)
     merged: set[int] = set()
+    whitened: set[int] = set()
     for index, surface in enumerate(surfaces):
         if surface.kind == "dark" or is_unsaturated(surface.lab, parameters):
             continue
         for host_index, host in enumerate(surfaces):
             if (
                 host_index == index
-                or host_index in merged
+                or host_index in merged | whitened
                 or host.kind == "dark"
                 or is_unsaturated(host.lab, parameters)
                 or _saturation(host.lab) <= _saturation(surface.lab)
@@ -277,6 +278,7 @@ def _merge_white_blends(surfaces: list[Surface], parameters: NamingParameters) -
             share, white_lab = blend
             if share >= 0.5:
                 result[index] = Surface(white_lab, surface.linear, surface.pixels, surface.kind)
+                whitened.add(index)
             else:
                 target = result[host_index]
                 result[host_index] = Surface(target.lab, target.linear, target.pixels + surface.pixels, target.kind)
