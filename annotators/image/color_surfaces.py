@@ -8,8 +8,10 @@ where the lit and the shaded side of a surface stay together. A surface's colour
 ``(a*, b*) / (L* + 16)`` (unchanged by a uniform change of light where L* > 8) at its lit lightness (a high
 percentile of its L*): people name the lit side. An unsaturated group (:func:`is_unsaturated`) is split into
 black and the rest; a group whose colour is a blend of two larger ones (pixels mixing a red and a white print)
-joins the nearer of the two, and a darker group of nearly the same hue and saturation as a larger one is its
-shaded side.
+joins the nearer of the two; a lighter, paler group that is a blend of a saturated one with white (a specular
+highlight on it, or a white part its colour bleeds into on a small or blurred object) is the saturated surface's
+highlight when it is mostly that colour, else the white it is mixed with (:func:`_merge_white_blends`); and a
+darker group of nearly the same hue and saturation as a larger one is its shaded side.
 """
 
 from __future__ import annotations
@@ -20,7 +22,7 @@ import cv2
 import numpy as np
 
 from annotators.image.color_space import linear_to_lab, srgb_to_linear
-from annotators.image.white_balance import NEUTRAL_LIGHT, FrameLight
+from annotators.image.white_balance import LUMINANCE, NEUTRAL_LIGHT, FrameLight
 from robokudo.core.types import ObjectHypothesis
 
 WHITE_LAB = np.array([100.0, 0.0, 0.0])
@@ -61,6 +63,9 @@ class NamingParameters:
     max_groups: int = 5
     mixture_tolerance: float = 0.02
     """A group whose rg-chromaticity lies this close to the segment between two larger groups is their mixture."""
+    min_white_blend: float = 0.1
+    """A paler, lighter surface on the line from a saturated one to white is a blend of the two (a highlight, or
+    a white bleeding into the colour) when at least this share of it is white."""
     shade_hue: float = 30.0
     """A saturated surface within this many degrees of hue of a larger one ..."""
     shade_lightness: float = 8.0
@@ -180,7 +185,11 @@ def _rg(linear: np.ndarray) -> np.ndarray:
 
 def _mixture_target(surface: Surface, larger: list[Surface], tolerance: float) -> int | None:
     """The index (in ``larger``) of the surface that ``surface`` is mostly made of when its chromaticity lies
-    on the segment between two larger surfaces (a blend of the two), else None."""
+    on the segment between two larger surfaces (a blend of the two), else None.
+
+    A blend's place on the segment weighs each part by its intensity (R + G + B in linear light): a pixel half
+    covered by a dark purple print and half by white paper lies near the white end. The share of the blend
+    that is each part's area undoes that weighting."""
     point = _rg(surface.linear)
     for i, first in enumerate(larger):
         for j in range(i + 1, len(larger)):
@@ -191,7 +200,9 @@ def _mixture_target(surface: Surface, larger: list[Surface], tolerance: float) -
                 continue
             t = float((point - a) @ segment) / length
             if 0.1 <= t <= 0.9 and np.linalg.norm(a + t * segment - point) <= tolerance:
-                return i if t < 0.5 else j
+                first_intensity, second_intensity = float(first.linear.sum()), float(larger[j].linear.sum())
+                second_area = t * first_intensity / (t * first_intensity + (1.0 - t) * second_intensity)
+                return i if second_area < 0.5 else j
     return None
 
 
@@ -207,6 +218,73 @@ def _merge_mixtures(surfaces: list[Surface], tolerance: float) -> list[Surface]:
             host = kept[target]
             kept[target] = Surface(host.lab, host.linear, host.pixels + surface.pixels, host.kind)
     return kept
+
+
+NEUTRAL_RG = np.array([1.0 / 3.0, 1.0 / 3.0])
+"""The rg chromaticity of a neutral (white-balanced) colour."""
+
+
+def _white_blend(host: Surface, surface: Surface, parameters: NamingParameters) -> tuple[float, np.ndarray] | None:
+    """How much of ``surface`` is white (0..1) and that white's CIELAB, when ``surface`` is an additive blend of
+    ``host`` and an unsaturated colour, else None.
+
+    Blends in linear light lie on straight lines in rg chromaticity (the dichromatic reflection model puts a
+    highlight on the line from the body colour to the light's). The line from the host through the surface is
+    followed to where it passes nearest to neutral; that point is the white when it is unsaturated
+    (:func:`is_unsaturated`, at the surface's lightness) and the surface lies between it and the host."""
+    start, through = _rg(host.linear), _rg(surface.linear)
+    direction = through - start
+    length = float(direction @ direction)
+    if length < 1e-8:
+        return None
+    reach = float((NEUTRAL_RG - start) @ direction) / length  # the nearest point to neutral, in units of direction
+    if reach <= 1.0:
+        return None
+    end = start + reach * direction
+    white = np.array([end[0], end[1], 1.0 - end[0] - end[1]])
+    if white.min() <= 0.0:
+        return None
+    white_lab = linear_to_lab(white * float(surface.linear @ LUMINANCE) / float(white @ LUMINANCE))
+    white_lab[0] = surface.lab[0]
+    if not is_unsaturated(white_lab, parameters):
+        return None
+    return 1.0 / reach, white_lab
+
+
+def _merge_white_blends(surfaces: list[Surface], parameters: NamingParameters) -> list[Surface]:
+    """Surfaces with every saturated surface that is a lighter, paler blend of a more saturated one with white
+    (:func:`_white_blend`) resolved: mostly white (at least half) it becomes that white (a white part the
+    colour bleeds into), else it joins the saturated surface (its highlight). Blends with less than
+    ``min_white_blend`` white are left alone (shading and noise move a colour that little)."""
+    result = list(surfaces)
+    merged: set[int] = set()
+    whitened: set[int] = set()
+    for index, surface in enumerate(surfaces):
+        if surface.kind == "dark" or is_unsaturated(surface.lab, parameters):
+            continue
+        for host_index, host in enumerate(surfaces):
+            if (
+                host_index == index
+                or host_index in merged | whitened
+                or host.kind == "dark"
+                or is_unsaturated(host.lab, parameters)
+                or _saturation(host.lab) <= _saturation(surface.lab)
+                or host.lab[0] >= surface.lab[0]
+            ):
+                continue
+            blend = _white_blend(host, surface, parameters)
+            if blend is None or blend[0] < parameters.min_white_blend:
+                continue
+            share, white_lab = blend
+            if share >= 0.5:
+                result[index] = Surface(white_lab, surface.linear, surface.pixels, surface.kind)
+                whitened.add(index)
+            else:
+                target = result[host_index]
+                result[host_index] = Surface(target.lab, target.linear, target.pixels + surface.pixels, target.kind)
+                merged.add(index)
+            break
+    return [surface for index, surface in enumerate(result) if index not in merged]
 
 
 def _hue(lab: np.ndarray) -> float:
@@ -296,7 +374,8 @@ def object_surfaces(
                         )
     if not surfaces and np.count_nonzero(regular):  # too few pixels for a group: they are one surface
         surfaces.append(_surface(lab[regular], linear[regular], parameters.lit_percentile, "regular"))
-    surfaces = _merge_shaded(_merge_mixtures(surfaces, parameters.mixture_tolerance), parameters)
+    surfaces = _merge_mixtures(surfaces, parameters.mixture_tolerance)
+    surfaces = _merge_shaded(_merge_white_blends(surfaces, parameters), parameters)
     if np.count_nonzero(dark):
         surfaces.append(_surface(lab[dark], linear[dark], 50.0, "dark"))
     if not surfaces:  # only highlights, too few of them to count as a white surface otherwise

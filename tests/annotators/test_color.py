@@ -110,6 +110,33 @@ def test_a_black_bag_with_a_blue_print_is_black_and_blue() -> None:
     assert dominant.confidence > second.confidence
 
 
+def blend(first: np.ndarray, second: np.ndarray, first_area: float) -> np.ndarray:
+    """Pixels that each cover ``first_area`` of one surface and the rest of another, mixed in linear light (as
+    a camera's blur or a pixel on a fine print mixes them)."""
+    linear = first_area * srgb_to_linear(first) + (1.0 - first_area) * srgb_to_linear(second)
+    return np.clip(np.rint(255.0 * linear_to_srgb(linear)), 0, 255).astype(np.uint8)
+
+
+def test_a_dark_print_blended_with_white_paper_counts_by_the_area_it_covers() -> None:
+    """A purple cover with a white photo, seen blurred: many pixels are part purple, part white. A pixel two
+    thirds purple lies nearer white than purple in chromaticity (white is brighter), but it is mostly purple."""
+    purple, white = patch((120, 30, 110), 1.0, 300), patch((235, 232, 228), 1.0, 250, seed=1)
+    mostly_purple = blend(patch((120, 30, 110), 1.0, 200, seed=2), patch((235, 232, 228), 1.0, 200, seed=3), 0.7)
+    named = name_colors(np.vstack([purple, white, mostly_purple]))
+    assert [c.name for c in named] == ["purple", "white"]
+    assert named[0].share == pytest.approx(500 / 750, abs=0.05)
+
+
+@pytest.mark.parametrize("white_area", [0.3, 0.5])
+def test_a_colour_blended_with_white_is_that_white_not_a_third_colour(white_area: float) -> None:
+    """A small red and white toy, blurred: its white body takes on the red and, named alone, is pink; beside the
+    red it is a blend of red and white nearer white in chromaticity, so the toy is red and white."""
+    red, white = patch((200, 25, 20), 1.0, 300), patch((240, 238, 232), 1.0, 300, seed=1)
+    pale = blend(white, red, white_area)
+    assert names(pale) == ["pink"]
+    assert names(np.vstack([red, pale])) == ["red", "white"]
+
+
 def test_a_small_print_is_not_a_second_colour() -> None:
     mug = np.vstack([patch((248, 248, 246), 1.0, 370), patch((200, 30, 35), 1.0, 30, seed=1)])
     assert names(mug) == ["white"]
