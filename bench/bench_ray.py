@@ -30,6 +30,7 @@ THREADS = ("OMP_NUM_THREADS", "OPENBLAS_NUM_THREADS", "MKL_NUM_THREADS", "OPENCV
 for _variable in THREADS:  # before numpy, OpenCV and Open3D load
     os.environ[_variable] = "1"
 
+import argparse  # noqa: E402
 import copy  # noqa: E402
 import statistics  # noqa: E402
 import sys  # noqa: E402
@@ -198,6 +199,7 @@ def bench_overhead(ray: ModuleType) -> None:
         one_run(local_engine)
         one_run(remote_engine)
     local_ms, latency_ms, actor_ms, added_ms, local_wall, remote_wall = [], [], [], [], [], []
+    stages: dict[str, list[float]] = {}
     for _ in range(CALLS):
         start = time.perf_counter()
         one_run(local_engine)
@@ -209,6 +211,8 @@ def bench_overhead(ray: ModuleType) -> None:
         latency_ms.append(1000 * remote.stats.last_seconds)
         actor_ms.append(1000 * remote.remote_seconds)
         added_ms.append(latency_ms[-1] - actor_ms[-1])
+        for stage, seconds in remote.call_times.stages().items():
+            stages.setdefault(stage, []).append(1000 * seconds)
     remote.stop_actor()
     empty_ms, image_ms = ray_floor(ray, image.image)
     median = statistics.median
@@ -221,6 +225,10 @@ def bench_overhead(ray: ModuleType) -> None:
         f"   Ray's floor here: an empty actor call {empty_ms:.2f} ms, "
         f"one with a reference to a 640x480 image put for it {image_ms:.2f} ms"
     )
+    print(
+        "   stages of a remote call (medians, ms): "
+        + ", ".join(f"{stage} {median(values):.2f}" for stage, values in stages.items())
+    )
     print(f"   remote latency - local run (medians) {median(latency_ms) - median(local_ms):6.2f} ms")
     overhead = median(added_ms)
     print(
@@ -230,14 +238,19 @@ def bench_overhead(ray: ModuleType) -> None:
 
 
 def main() -> None:
+    parser = argparse.ArgumentParser(description=__doc__.split("\n", 1)[0])
+    parser.add_argument("--only", choices=("eval", "overhead"), help="run one of the two benchmarks")
+    args = parser.parse_args()
     if not LEARN.is_dir():
         sys.exit(f"no scenes at {LEARN}")
     print(f"one thread per process on both sides ({', '.join(f'{name}=1' for name in THREADS)}); {load()}")
     start = time.perf_counter()
     with ray_cluster(num_cpus=2) as ray:
         print(f"local Ray cluster of 2 CPUs started in {time.perf_counter() - start:.1f} s (not counted below)")
-        bench_eval()
-        bench_overhead(ray)
+        if args.only != "overhead":
+            bench_eval()
+        if args.only != "eval":
+            bench_overhead(ray)
 
 
 if __name__ == "__main__":

@@ -137,10 +137,11 @@ class ExpertHost:
         """The actor's process id (to watch or stop it)."""
         return os.getpid()
 
-    def analyse(self, annotations: list[Annotation], *views: View) -> tuple[str, str, list[Write], float]:
+    def analyse(self, annotations: list[Annotation], *views: View) -> tuple[str, str, list[Write], float, float]:
         """Run the annotator on the ``annotations`` (as :func:`in_transit` made them) and ``views``; its status
-        name, message, writes (each attachment naming its hypothesis by its index among the annotations) and
-        run time in seconds."""
+        name, message, writes (each attachment naming its hypothesis by its index among the annotations), its
+        run time and the time spent in this method, in seconds."""
+        entered = time.perf_counter()
         annotations = [restored(annotation) for annotation in annotations]
         cas = CAS()
         for view in views:
@@ -150,7 +151,7 @@ class ExpertHost:
         run = _Run(cas, thread_ident=None)
         status, message, seconds = self._annotator._execute(run)
         if status.name != "SUCCESS":
-            return status.name, message, [], seconds
+            return status.name, message, [], seconds, time.perf_counter() - entered
         position = {id(annotation): index for index, annotation in enumerate(annotations)}
         writes: list[Write] = []
         for write in run.writes:
@@ -161,8 +162,8 @@ class ExpertHost:
             elif id(write.hypothesis) in position:
                 writes.append(("attach", position[id(write.hypothesis)], write.annotation))
             else:
-                return "FAILURE", "attached an annotation to a hypothesis it was not sent", [], seconds
-        return status.name, message, writes, seconds
+                return "FAILURE", "attached an annotation to a hypothesis it was not sent", [], seconds, 0.0
+        return status.name, message, writes, seconds, time.perf_counter() - entered
 
 
 @functools.cache
@@ -188,6 +189,8 @@ class RemoteAnnotator(ThreadedAnnotator):
         self._actor_failed = False
         self.remote_seconds = 0.0
         """The expert's own run time on the actor in the last run that got an answer (seconds)."""
+        self.call_times = CallTimes()
+        """Where the time of the last successful run went."""
 
     def actor(self) -> Any:
         """The Ray actor handle (started on first use; shared through this node's resources)."""
@@ -242,13 +245,22 @@ class RemoteAnnotator(ThreadedAnnotator):
     def analyse(self) -> None:
         """Send the declared inputs, wait for the actor's answer, commit its writes."""
         ray = require_ray()
+        times = CallTimes()
+        start = time.perf_counter()
         views, sent, local = self._inputs()
         actor = self.actor()
         if self._actor_failed:
             self._await_restart(ray, actor)
         try:
+            stamp = time.perf_counter()
+            times.inputs = stamp - start
             references = self.frames().references(ray, views)
-            status, message, writes, self.remote_seconds = self._wait(ray, actor.analyse.remote(sent, *references))
+            stamp, times.put = _lap(stamp)
+            pending = actor.analyse.remote(sent, *references)
+            stamp, times.call = _lap(stamp)
+            status, message, writes, times.expert, times.actor = self._wait(ray, pending)
+            stamp, times.answer = _lap(stamp)
+            self.remote_seconds = times.expert
         except ray.exceptions.RayTaskError as error:
             cause = getattr(error, "cause", None)
             if isinstance(cause, PortError | StructureError | NotImplementedError):
@@ -269,6 +281,8 @@ class RemoteAnnotator(ThreadedAnnotator):
                 if not 0 <= index < len(local) or not isinstance(local[index], ObjectHypothesis):
                     self.fail(f"remote {self.name} attached to hypothesis {index}, which it was not sent")
                 self.attach(local[index], annotation)  # type: ignore[arg-type]
+        _, times.commit = _lap(stamp)
+        self.call_times = times
 
     def _wait(self, ray: ModuleType, pending: Any) -> Any:
         """The result of the call ``pending``, polling this run's cancel flag meanwhile (a cancelled run asks Ray
@@ -302,6 +316,44 @@ class RemoteAnnotator(ThreadedAnnotator):
         if self._actor is not None:
             require_ray().kill(self._actor, no_restart=True)
             self._actor = None
+
+
+@dataclass(slots=True)
+class CallTimes:
+    """Where one remote call's time went, in seconds, stage by stage (a few clock reads per call)."""
+
+    inputs: float = 0.0
+    """Declared inputs gathered from the CAS and packed for transit."""
+    put: float = 0.0
+    """The frame's views put into the object store (nothing when another expert of the pool put them)."""
+    call: float = 0.0
+    """The actor call handed to Ray (its small arguments serialised)."""
+    answer: float = 0.0
+    """From the call handed over to the answer in hand (the actor's time included)."""
+    actor: float = 0.0
+    """In the actor's method: inputs restored, the expert's run, its writes packed."""
+    expert: float = 0.0
+    """The expert's own run on the actor."""
+    commit: float = 0.0
+    """The answer's writes checked and queued."""
+
+    def stages(self) -> dict[str, float]:
+        """The stages that make up the node's latency (they add up to it, but for the thread's own start)."""
+        return {
+            "inputs": self.inputs,
+            "put": self.put,
+            "call": self.call,
+            "transport": self.answer - self.actor,
+            "actor unpack/pack": self.actor - self.expert,
+            "expert": self.expert,
+            "commit": self.commit,
+        }
+
+
+def _lap(since: float) -> tuple[float, float]:
+    """Now, and the seconds since ``since``."""
+    now = time.perf_counter()
+    return now, now - since
 
 
 @dataclass(frozen=True, slots=True)

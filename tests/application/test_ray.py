@@ -191,12 +191,12 @@ def test_the_actor_side_runs_the_expert_on_the_declared_inputs_alone() -> None:
     hypothesis = ObjectHypothesis(point_indices=np.flatnonzero(mask), mask=mask, roi=(35, 10, 55, 30))
     require_ray()  # the recipe checks with Ray's pickler that the parameters can be sent
     host = ExpertHost(Recipe.of(SemanticColorAnnotator(name="colour", max_pixels=500)))
-    status, message, writes, seconds = host.analyse([hypothesis], ColorImage(image))
+    status, message, writes, seconds, _ = host.analyse([hypothesis], ColorImage(image))
     assert (status, message) == ("SUCCESS", "") and seconds > 0
     [(kind, index, colour)] = writes
     assert (kind, index, colour.color, colour.source) == ("attach", 0, "red", "colour")
     assert not hypothesis.annotations  # the actor's writes are returned, not applied
-    status, message, writes, _ = host.analyse([hypothesis])
+    status, message, writes, _, _ = host.analyse([hypothesis])
     assert (status, message, writes) == ("FAILURE", "no ColorImage in the CAS", [])
 
 
