@@ -137,10 +137,12 @@ class ExpertHost:
         """The actor's process id (to watch or stop it)."""
         return os.getpid()
 
-    def analyse(self, annotations: list[Annotation], *views: View) -> tuple[str, str, list[Write], float, float]:
+    def analyse(
+        self, annotations: list[Annotation], *views: View
+    ) -> tuple[str, str, list[Write], float, tuple[float, float]]:
         """Run the annotator on the ``annotations`` (as :func:`in_transit` made them) and ``views``; its status
         name, message, writes (each attachment naming its hypothesis by its index among the annotations), its
-        run time and the time spent in this method, in seconds."""
+        run time in seconds and when this method was entered and left (``time.perf_counter()`` here)."""
         entered = time.perf_counter()
         annotations = [restored(annotation) for annotation in annotations]
         cas = CAS()
@@ -151,7 +153,7 @@ class ExpertHost:
         run = _Run(cas, thread_ident=None)
         status, message, seconds = self._annotator._execute(run)
         if status.name != "SUCCESS":
-            return status.name, message, [], seconds, time.perf_counter() - entered
+            return status.name, message, [], seconds, (entered, time.perf_counter())
         position = {id(annotation): index for index, annotation in enumerate(annotations)}
         writes: list[Write] = []
         for write in run.writes:
@@ -162,8 +164,9 @@ class ExpertHost:
             elif id(write.hypothesis) in position:
                 writes.append(("attach", position[id(write.hypothesis)], write.annotation))
             else:
-                return "FAILURE", "attached an annotation to a hypothesis it was not sent", [], seconds, 0.0
-        return status.name, message, writes, seconds, time.perf_counter() - entered
+                message = "attached an annotation to a hypothesis it was not sent"
+                return "FAILURE", message, [], seconds, (entered, time.perf_counter())
+        return status.name, message, writes, seconds, (entered, time.perf_counter())
 
 
 @functools.cache
@@ -258,8 +261,10 @@ class RemoteAnnotator(ThreadedAnnotator):
             stamp, times.put = _lap(stamp)
             pending = actor.analyse.remote(sent, *references)
             stamp, times.call = _lap(stamp)
-            status, message, writes, times.expert, times.actor = self._wait(ray, pending)
-            stamp, times.answer = _lap(stamp)
+            status, message, writes, times.expert, (entered, left) = self._wait(ray, pending)
+            called, (stamp, times.answer) = stamp, _lap(stamp)
+            times.actor = left - entered
+            times.to_actor, times.from_actor = entered - called, stamp - left
             self.remote_seconds = times.expert
         except ray.exceptions.RayTaskError as error:
             cause = getattr(error, "cause", None)
@@ -330,6 +335,11 @@ class CallTimes:
     """The actor call handed to Ray (its small arguments serialised)."""
     answer: float = 0.0
     """From the call handed over to the answer in hand (the actor's time included)."""
+    to_actor: float = 0.0
+    """From the call handed over to the actor's method entered (its inputs in hand). Only meaningful when the
+    actor runs on this machine (the clocks of two machines differ), as are ``from_actor``."""
+    from_actor: float = 0.0
+    """From the actor's method left to the answer in hand here."""
     actor: float = 0.0
     """In the actor's method: inputs restored, the expert's run, its writes packed."""
     expert: float = 0.0
@@ -343,7 +353,8 @@ class CallTimes:
             "inputs": self.inputs,
             "put": self.put,
             "call": self.call,
-            "transport": self.answer - self.actor,
+            "to actor": self.to_actor,
+            "from actor": self.from_actor,
             "actor unpack/pack": self.actor - self.expert,
             "expert": self.expert,
             "commit": self.commit,
@@ -379,8 +390,11 @@ class MaskIndices:
 
     def of(self, mask: CroppedMask, roi: tuple[int, int, int, int]) -> np.ndarray:
         """The indices again, from the mask as it was sent."""
-        rows, columns = np.nonzero(mask.inside)
-        return ((rows + roi[1]) * mask.shape[1] + (columns + roi[0])).astype(self.dtype, copy=False)
+        inside = np.ascontiguousarray(mask.inside)
+        width, frame_width = inside.shape[1], mask.shape[1]
+        flat = np.flatnonzero(inside)  # row * width + column inside the roi
+        indices = flat + (flat // max(width, 1)) * (frame_width - width) + (roi[1] * frame_width + roi[0])
+        return indices.astype(self.dtype, copy=False)
 
 
 def in_transit(annotation: Annotation, declared: tuple[type[CasType], ...]) -> Annotation:
@@ -391,13 +405,14 @@ def in_transit(annotation: Annotation, declared: tuple[type[CasType], ...]) -> A
     if not isinstance(annotation, ObjectHypothesis):
         return annotation
     kept = [a for a in annotation.annotations if isinstance(a, declared)]
-    inside = _inside_roi(annotation.mask, annotation.roi)
-    if len(kept) == len(annotation.annotations) and inside is None:
+    cut = _inside_roi(annotation.mask, annotation.roi)
+    if len(kept) == len(annotation.annotations) and cut is None:
         return annotation
     sent = copy.copy(annotation)
     sent.annotations = kept
-    if inside is not None:
-        if _are_mask_indices(annotation.point_indices, inside, annotation.roi, annotation.mask.shape):
+    if cut is not None:
+        inside, count = cut
+        if _are_mask_indices(annotation.point_indices, annotation.mask, count):
             sent.point_indices = MaskIndices(annotation.point_indices.dtype.str)  # type: ignore[assignment]
         sent.mask = CroppedMask(inside, annotation.mask.shape)  # type: ignore[assignment]
     return sent
@@ -413,20 +428,23 @@ def restored(annotation: Annotation) -> Annotation:
     return annotation
 
 
-def _are_mask_indices(indices: Any, inside: np.ndarray, roi: tuple[int, int, int, int], shape: tuple[int, ...]) -> bool:
-    """True when ``indices`` (an integer array) are the flat indices, in order, of the mask whose part inside
-    ``roi`` is ``inside`` (and nothing outside)."""
+def _are_mask_indices(indices: Any, mask: np.ndarray, count: int) -> bool:
+    """True when ``indices`` (an integer array) are the flat indices, in order, of the ``count`` set pixels of
+    ``mask``: as many, strictly increasing, in range and all on set pixels (no scan of the whole mask)."""
     if not isinstance(indices, np.ndarray) or indices.ndim != 1 or indices.dtype.kind not in "iu":
         return False
-    rows, columns = np.nonzero(inside)
-    if indices.shape[0] != rows.shape[0]:
+    if indices.shape[0] != count:
         return False
-    x0, y0 = roi[0], roi[1]
-    return bool(np.array_equal((rows + y0) * shape[1] + (columns + x0), indices))
+    if count == 0:
+        return True
+    if indices[0] < 0 or indices[-1] >= mask.size or not np.all(indices[1:] > indices[:-1]):
+        return False
+    return bool(mask.reshape(-1)[indices].all())
 
 
-def _inside_roi(mask: Any, roi: Any) -> np.ndarray | None:
-    """The part of a 2-D ``mask`` inside ``roi`` (x0, y0, x1, y1) when that is all of it and smaller, else None."""
+def _inside_roi(mask: Any, roi: Any) -> tuple[np.ndarray, int] | None:
+    """The part of a 2-D ``mask`` inside ``roi`` (x0, y0, x1, y1) and the mask's number of set pixels, when that
+    part holds all of them and is smaller than the mask; else None."""
     if not isinstance(mask, np.ndarray) or mask.ndim != 2 or not isinstance(roi, tuple) or len(roi) != 4:
         return None
     x0, y0, x1, y1 = (int(v) for v in roi)
@@ -434,9 +452,10 @@ def _inside_roi(mask: Any, roi: Any) -> np.ndarray | None:
     if not (0 <= x0 <= x1 <= width and 0 <= y0 <= y1 <= height) or (x1 - x0) * (y1 - y0) == mask.size:
         return None
     inside = mask[y0:y1, x0:x1]
-    if np.count_nonzero(inside) != np.count_nonzero(mask):
+    count = np.count_nonzero(mask)
+    if np.count_nonzero(inside) != count:
         return None
-    return inside
+    return inside, count
 
 
 class FrameStore:
