@@ -178,18 +178,24 @@ class Busy:
 def shaped_call(ray: ModuleType, actor: Any, annotations: list[Any], image: np.ndarray, seconds: float) -> float:
     """Ms beyond ``seconds`` that a call shaped like the expert's takes, waited for in a worker thread while this
     one ticks: the frame's image put, the call with its reference and ``annotations``, the answer in hand."""
-    elapsed: list[float] = []
+    outcome: list[Any] = []
 
     def work() -> None:
         start = time.perf_counter()
-        ray.get(actor.call.remote(annotations, ray.put(ColorImage(image)), seconds))
-        elapsed.append(time.perf_counter() - start)
+        try:
+            ray.get(actor.call.remote(annotations, ray.put(ColorImage(image)), seconds))
+        except Exception as error:  # handed to the ticking thread
+            outcome.append(error)
+        else:
+            outcome.append(time.perf_counter() - start)
 
     worker = threading.Thread(target=work, name="shaped call")
     worker.start()
     while worker.is_alive():
         time.sleep(0.0002)
-    return 1000 * (elapsed[0] - seconds)
+    if isinstance(outcome[0], Exception):
+        raise outcome[0]
+    return 1000 * (outcome[0] - seconds)
 
 
 def ray_floor(ray: ModuleType, image: np.ndarray) -> tuple[float, float]:
