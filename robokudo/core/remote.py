@@ -251,18 +251,19 @@ class RemoteAnnotator(ThreadedAnnotator):
         times = CallTimes()
         start = time.perf_counter()
         views, sent, local = self._inputs()
+        _, times.inputs = _lap(start)
         actor = self.actor()
         if self._actor_failed:
             self._await_restart(ray, actor)
         try:
             stamp = time.perf_counter()
-            times.inputs = stamp - start
             references = self.frames().references(ray, views)
             stamp, times.put = _lap(stamp)
             pending = actor.analyse.remote(sent, *references)
             stamp, times.call = _lap(stamp)
             status, message, writes, times.expert, (entered, left) = self._wait(ray, pending)
-            called, (stamp, times.answer) = stamp, _lap(stamp)
+            called = stamp
+            stamp, times.answer = _lap(called)
             times.actor = left - entered
             times.to_actor, times.from_actor = entered - called, stamp - left
             self.remote_seconds = times.expert
@@ -348,7 +349,7 @@ class CallTimes:
     """The answer's writes checked and queued."""
 
     def stages(self) -> dict[str, float]:
-        """The stages that make up the node's latency (they add up to it, but for the thread's own start)."""
+        """The stages of the node's latency, in order (they add up to it, but for a wait for a restarted actor)."""
         return {
             "inputs": self.inputs,
             "put": self.put,
