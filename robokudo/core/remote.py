@@ -137,10 +137,13 @@ class ExpertHost:
         """The actor's process id (to watch or stop it)."""
         return os.getpid()
 
-    def analyse(self, annotations: list[Annotation], *views: View) -> tuple[str, str, list[Write], float]:
+    def analyse(
+        self, annotations: list[Annotation], *views: View
+    ) -> tuple[str, str, list[Write], float, tuple[float, float]]:
         """Run the annotator on the ``annotations`` (as :func:`in_transit` made them) and ``views``; its status
-        name, message, writes (each attachment naming its hypothesis by its index among the annotations) and
-        run time in seconds."""
+        name, message, writes (each attachment naming its hypothesis by its index among the annotations), its
+        run time in seconds and when this method was entered and left (``time.perf_counter()`` here)."""
+        entered = time.perf_counter()
         annotations = [restored(annotation) for annotation in annotations]
         cas = CAS()
         for view in views:
@@ -150,7 +153,7 @@ class ExpertHost:
         run = _Run(cas, thread_ident=None)
         status, message, seconds = self._annotator._execute(run)
         if status.name != "SUCCESS":
-            return status.name, message, [], seconds
+            return status.name, message, [], seconds, (entered, time.perf_counter())
         position = {id(annotation): index for index, annotation in enumerate(annotations)}
         writes: list[Write] = []
         for write in run.writes:
@@ -161,8 +164,9 @@ class ExpertHost:
             elif id(write.hypothesis) in position:
                 writes.append(("attach", position[id(write.hypothesis)], write.annotation))
             else:
-                return "FAILURE", "attached an annotation to a hypothesis it was not sent", [], seconds
-        return status.name, message, writes, seconds
+                message = "attached an annotation to a hypothesis it was not sent"
+                return "FAILURE", message, [], seconds, (entered, time.perf_counter())
+        return status.name, message, writes, seconds, (entered, time.perf_counter())
 
 
 @functools.cache
@@ -188,6 +192,8 @@ class RemoteAnnotator(ThreadedAnnotator):
         self._actor_failed = False
         self.remote_seconds = 0.0
         """The expert's own run time on the actor in the last run that got an answer (seconds)."""
+        self.call_times = CallTimes()
+        """Where the time of the last successful run went."""
 
     def actor(self) -> Any:
         """The Ray actor handle (started on first use; shared through this node's resources)."""
@@ -242,13 +248,25 @@ class RemoteAnnotator(ThreadedAnnotator):
     def analyse(self) -> None:
         """Send the declared inputs, wait for the actor's answer, commit its writes."""
         ray = require_ray()
+        times = CallTimes()
+        start = time.perf_counter()
         views, sent, local = self._inputs()
+        _, times.inputs = _lap(start)
         actor = self.actor()
         if self._actor_failed:
             self._await_restart(ray, actor)
         try:
+            stamp = time.perf_counter()
             references = self.frames().references(ray, views)
-            status, message, writes, self.remote_seconds = self._wait(ray, actor.analyse.remote(sent, *references))
+            stamp, times.put = _lap(stamp)
+            pending = actor.analyse.remote(sent, *references)
+            stamp, times.call = _lap(stamp)
+            status, message, writes, times.expert, (entered, left) = self._wait(ray, pending)
+            called = stamp
+            stamp, times.answer = _lap(called)
+            times.actor = left - entered
+            times.to_actor, times.from_actor = entered - called, stamp - left
+            self.remote_seconds = times.expert
         except ray.exceptions.RayTaskError as error:
             cause = getattr(error, "cause", None)
             if isinstance(cause, PortError | StructureError | NotImplementedError):
@@ -269,6 +287,8 @@ class RemoteAnnotator(ThreadedAnnotator):
                 if not 0 <= index < len(local) or not isinstance(local[index], ObjectHypothesis):
                     self.fail(f"remote {self.name} attached to hypothesis {index}, which it was not sent")
                 self.attach(local[index], annotation)  # type: ignore[arg-type]
+        _, times.commit = _lap(stamp)
+        self.call_times = times
 
     def _wait(self, ray: ModuleType, pending: Any) -> Any:
         """The result of the call ``pending``, polling this run's cancel flag meanwhile (a cancelled run asks Ray
@@ -304,6 +324,50 @@ class RemoteAnnotator(ThreadedAnnotator):
             self._actor = None
 
 
+@dataclass(slots=True)
+class CallTimes:
+    """Where one remote call's time went, in seconds, stage by stage (a few clock reads per call)."""
+
+    inputs: float = 0.0
+    """Declared inputs gathered from the CAS and packed for transit."""
+    put: float = 0.0
+    """The frame's views put into the object store (nothing when another expert of the pool put them)."""
+    call: float = 0.0
+    """The actor call handed to Ray (its small arguments serialised)."""
+    answer: float = 0.0
+    """From the call handed over to the answer in hand (the actor's time included)."""
+    to_actor: float = 0.0
+    """From the call handed over to the actor's method entered (its inputs in hand). Only meaningful when the
+    actor runs on this machine (the clocks of two machines differ), as are ``from_actor``."""
+    from_actor: float = 0.0
+    """From the actor's method left to the answer in hand here."""
+    actor: float = 0.0
+    """In the actor's method: inputs restored, the expert's run, its writes packed."""
+    expert: float = 0.0
+    """The expert's own run on the actor."""
+    commit: float = 0.0
+    """The answer's writes checked and queued."""
+
+    def stages(self) -> dict[str, float]:
+        """The stages of the node's latency, in order (they add up to it, but for a wait for a restarted actor)."""
+        return {
+            "inputs": self.inputs,
+            "put": self.put,
+            "call": self.call,
+            "to actor": self.to_actor,
+            "from actor": self.from_actor,
+            "actor unpack/pack": self.actor - self.expert,
+            "expert": self.expert,
+            "commit": self.commit,
+        }
+
+
+def _lap(since: float) -> tuple[float, float]:
+    """Now, and the seconds since ``since``."""
+    now = time.perf_counter()
+    return now, now - since
+
+
 @dataclass(frozen=True, slots=True)
 class CroppedMask:
     """A hypothesis mask in transit: its part inside the hypothesis' ``roi`` and the full frame's shape."""
@@ -327,8 +391,11 @@ class MaskIndices:
 
     def of(self, mask: CroppedMask, roi: tuple[int, int, int, int]) -> np.ndarray:
         """The indices again, from the mask as it was sent."""
-        rows, columns = np.nonzero(mask.inside)
-        return ((rows + roi[1]) * mask.shape[1] + (columns + roi[0])).astype(self.dtype, copy=False)
+        inside = np.ascontiguousarray(mask.inside)
+        width, frame_width = inside.shape[1], mask.shape[1]
+        flat = np.flatnonzero(inside)  # row * width + column inside the roi
+        indices = flat + (flat // max(width, 1)) * (frame_width - width) + (roi[1] * frame_width + roi[0])
+        return indices.astype(self.dtype, copy=False)
 
 
 def in_transit(annotation: Annotation, declared: tuple[type[CasType], ...]) -> Annotation:
@@ -339,13 +406,14 @@ def in_transit(annotation: Annotation, declared: tuple[type[CasType], ...]) -> A
     if not isinstance(annotation, ObjectHypothesis):
         return annotation
     kept = [a for a in annotation.annotations if isinstance(a, declared)]
-    inside = _inside_roi(annotation.mask, annotation.roi)
-    if len(kept) == len(annotation.annotations) and inside is None:
+    cut = _inside_roi(annotation.mask, annotation.roi)
+    if len(kept) == len(annotation.annotations) and cut is None:
         return annotation
     sent = copy.copy(annotation)
     sent.annotations = kept
-    if inside is not None:
-        if _are_mask_indices(annotation.point_indices, inside, annotation.roi, annotation.mask.shape):
+    if cut is not None:
+        inside, count = cut
+        if _are_mask_indices(annotation.point_indices, annotation.mask, count):
             sent.point_indices = MaskIndices(annotation.point_indices.dtype.str)  # type: ignore[assignment]
         sent.mask = CroppedMask(inside, annotation.mask.shape)  # type: ignore[assignment]
     return sent
@@ -361,20 +429,23 @@ def restored(annotation: Annotation) -> Annotation:
     return annotation
 
 
-def _are_mask_indices(indices: Any, inside: np.ndarray, roi: tuple[int, int, int, int], shape: tuple[int, ...]) -> bool:
-    """True when ``indices`` (an integer array) are the flat indices, in order, of the mask whose part inside
-    ``roi`` is ``inside`` (and nothing outside)."""
+def _are_mask_indices(indices: Any, mask: np.ndarray, count: int) -> bool:
+    """True when ``indices`` (an integer array) are the flat indices, in order, of the ``count`` set pixels of
+    ``mask``: as many, strictly increasing, in range and all on set pixels (no scan of the whole mask)."""
     if not isinstance(indices, np.ndarray) or indices.ndim != 1 or indices.dtype.kind not in "iu":
         return False
-    rows, columns = np.nonzero(inside)
-    if indices.shape[0] != rows.shape[0]:
+    if indices.shape[0] != count:
         return False
-    x0, y0 = roi[0], roi[1]
-    return bool(np.array_equal((rows + y0) * shape[1] + (columns + x0), indices))
+    if count == 0:
+        return True
+    if indices[0] < 0 or indices[-1] >= mask.size or not np.all(indices[1:] > indices[:-1]):
+        return False
+    return bool(mask.reshape(-1)[indices].all())
 
 
-def _inside_roi(mask: Any, roi: Any) -> np.ndarray | None:
-    """The part of a 2-D ``mask`` inside ``roi`` (x0, y0, x1, y1) when that is all of it and smaller, else None."""
+def _inside_roi(mask: Any, roi: Any) -> tuple[np.ndarray, int] | None:
+    """The part of a 2-D ``mask`` inside ``roi`` (x0, y0, x1, y1) and the mask's number of set pixels, when that
+    part holds all of them and is smaller than the mask; else None."""
     if not isinstance(mask, np.ndarray) or mask.ndim != 2 or not isinstance(roi, tuple) or len(roi) != 4:
         return None
     x0, y0, x1, y1 = (int(v) for v in roi)
@@ -382,9 +453,10 @@ def _inside_roi(mask: Any, roi: Any) -> np.ndarray | None:
     if not (0 <= x0 <= x1 <= width and 0 <= y0 <= y1 <= height) or (x1 - x0) * (y1 - y0) == mask.size:
         return None
     inside = mask[y0:y1, x0:x1]
-    if np.count_nonzero(inside) != np.count_nonzero(mask):
+    count = np.count_nonzero(mask)
+    if np.count_nonzero(inside) != count:
         return None
-    return inside
+    return inside, count
 
 
 class FrameStore:

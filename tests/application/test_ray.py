@@ -191,12 +191,12 @@ def test_the_actor_side_runs_the_expert_on_the_declared_inputs_alone() -> None:
     hypothesis = ObjectHypothesis(point_indices=np.flatnonzero(mask), mask=mask, roi=(35, 10, 55, 30))
     require_ray()  # the recipe checks with Ray's pickler that the parameters can be sent
     host = ExpertHost(Recipe.of(SemanticColorAnnotator(name="colour", max_pixels=500)))
-    status, message, writes, seconds = host.analyse([hypothesis], ColorImage(image))
-    assert (status, message) == ("SUCCESS", "") and seconds > 0
+    status, message, writes, seconds, (entered, left) = host.analyse([hypothesis], ColorImage(image))
+    assert (status, message) == ("SUCCESS", "") and 0 < seconds <= left - entered
     [(kind, index, colour)] = writes
     assert (kind, index, colour.color, colour.source) == ("attach", 0, "red", "colour")
     assert not hypothesis.annotations  # the actor's writes are returned, not applied
-    status, message, writes, _ = host.analyse([hypothesis])
+    status, message, writes, _, _ = host.analyse([hypothesis])
     assert (status, message, writes) == ("FAILURE", "no ColorImage in the CAS", [])
 
 
@@ -255,6 +255,10 @@ def test_point_indices_in_transit_come_back_as_they_were(indices: np.ndarray, dt
     assert isinstance(sent.point_indices, MaskIndices)
     back = restored(sent)
     assert back.point_indices.dtype == np.dtype(dtype) and np.array_equal(back.point_indices, own.point_indices)
+    for others in (own.point_indices[::-1], np.repeat(own.point_indices[:1], len(own.point_indices))):
+        hypothesis = ObjectHypothesis(point_indices=others.copy(), mask=mask, roi=(2, 1, 5, 4))  # as many, not its
+        back = restored(in_transit(hypothesis, (ObjectHypothesis,)))
+        assert np.array_equal(back.point_indices, others)
 
 
 def test_a_frame_goes_into_the_object_store_once(cluster: ModuleType) -> None:
