@@ -189,15 +189,27 @@ def _range(values: np.ndarray, low: float, high: float) -> tuple[float, float]:
     return float(ordered[round(low * last)]), float(ordered[round(high * last)])
 
 
+RIM_BAND = 0.5
+"""A part spanning at most this share of another's heights, in their upper part, lies in the band of a rim: a
+handle, or an inner wall seen over the rim of a cup or bowl. It is measured against the other's top (99 %), since
+the rim is a container's highest point and reaches above the body's 95 % height."""
+
+
 def heights_nest(first: np.ndarray, second: np.ndarray, tolerance: float) -> bool:
     """Does the 5 %-95 % range of one set of heights above the plane lie within the other's (``tolerance`` metres
     of slack)? A container's inside or handle lies within its body's heights; an object standing on another lies
-    above it."""
-    low_a, high_a = _range(first, 0.05, 0.95)
-    low_b, high_b = _range(second, 0.05, 0.95)
-    return (low_a >= low_b - tolerance and high_a <= high_b + tolerance) or (
-        low_b >= low_a - tolerance and high_b <= high_a + tolerance
-    )
+    above it. A part in the rim band (:data:`RIM_BAND`) may reach up to the other's top instead of its 95 % height;
+    a neighbour of about the same height never counts as in the rim band, so its top must nest strictly.
+    """
+    ranges = [_range(heights, 0.05, 0.95) for heights in (first, second)]
+    tops = [_range(heights, 0.05, 0.99)[1] for heights in (first, second)]
+    for inner, outer in ((0, 1), (1, 0)):
+        (low_in, high_in), (low_out, high_out) = ranges[inner], ranges[outer]
+        in_band = high_in - low_in <= RIM_BAND * (high_out - low_out)
+        top = tops[outer] if in_band else high_out
+        if low_in >= low_out - tolerance and high_in <= top + tolerance:
+            return True
+    return False
 
 
 INNER_SPREAD = 0.1
