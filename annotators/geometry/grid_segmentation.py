@@ -23,7 +23,14 @@ def _neighbour_views(array: np.ndarray) -> list[tuple[np.ndarray, np.ndarray]]:
 def depth_jump(z_a: np.ndarray, z_b: np.ndarray, absolute: float, relative: float) -> np.ndarray:
     """True where two neighbouring depths differ by more than ``absolute + relative * nearer depth``."""
     with np.errstate(invalid="ignore"):
-        return np.abs(z_a - z_b) > absolute + relative * np.fmin(z_a, z_b)
+        if np.ndim(z_a) == 0 or np.ndim(z_b) == 0:
+            return np.abs(z_a - z_b) > absolute + relative * np.fmin(z_a, z_b)
+        difference = np.subtract(z_a, z_b)  # the same arithmetic as above, in place on two temporaries
+        np.abs(difference, out=difference)
+        limit = np.fmin(z_a, z_b)
+        np.multiply(limit, relative, out=limit)
+        np.add(limit, absolute, out=limit)
+        return np.greater(difference, limit, out=np.empty(difference.shape, dtype=bool))
 
 
 def depth_seams(depth: np.ndarray, candidates: np.ndarray, absolute: float, relative: float) -> np.ndarray:
@@ -542,7 +549,12 @@ def join_unless_apart(count: int, pairs: np.ndarray, apart: np.ndarray) -> np.nd
             continue
         parent[rb] = ra
         keep_apart[ra] = against_a | against_b
-    return np.array([root(node) for node in range(count)], dtype=np.int64)
+    roots = np.array(parent, dtype=np.int64)
+    while True:  # follow the parent pointers to the roots, all nodes at once
+        above = roots[roots]
+        if np.array_equal(above, roots):
+            return roots
+        roots = above
 
 
 def bounding_box(mask: np.ndarray, margin: int = 0) -> tuple[int, int, int, int]:
