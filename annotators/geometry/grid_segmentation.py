@@ -163,15 +163,31 @@ def footprint_overlap(first: np.ndarray, second: np.ndarray, cell: float) -> flo
     if np.any(shared_box < -cell):
         return 0.0  # the footprints' bounding boxes are apart: nothing to rasterize
     low = np.minimum(first.min(axis=0), second.min(axis=0))
-    high = np.maximum(first.max(axis=0), second.max(axis=0))
-    shape = tuple(int(v) for v in (np.ceil((high - low) / cell) + 2)[::-1])
-    rasters = []
-    for hull in (first, second):
-        raster = np.zeros(shape, dtype=np.uint8)
-        cv2.fillConvexPoly(raster, np.round((hull - low) / cell).astype(np.int32), 1)
-        rasters.append(raster.view(bool))
-    shared = np.count_nonzero(rasters[0] & rasters[1])
+    vertices = [np.round((hull - low) / cell).astype(np.int32) for hull in (first, second)]
+    # each polygon on the raster of its own bounding cells; the shared cells where the two rasters overlap
+    corners = [vertex.min(axis=0) for vertex in vertices]
+    rasters = [_filled(vertex, corner) for vertex, corner in zip(vertices, corners, strict=True)]
+    window_low = np.maximum(corners[0], corners[1])
+    window_high = np.minimum(corners[0] + rasters[0].shape[::-1], corners[1] + rasters[1].shape[::-1])
+    shared = 0
+    if np.all(window_high > window_low):
+        windows = [
+            raster[
+                window_low[1] - corner[1] : window_high[1] - corner[1],
+                window_low[0] - corner[0] : window_high[0] - corner[0],
+            ]
+            for raster, corner in zip(rasters, corners, strict=True)
+        ]
+        shared = np.count_nonzero(windows[0] & windows[1])
     return shared / max(1, min(np.count_nonzero(rasters[0]), np.count_nonzero(rasters[1])))
+
+
+def _filled(vertices: np.ndarray, corner: np.ndarray) -> np.ndarray:
+    """The cells a convex polygon with integer ``vertices`` covers, on a raster whose first cell is ``corner``."""
+    local = np.ascontiguousarray(vertices - corner)
+    raster = np.zeros((int(local[:, 1].max()) + 1, int(local[:, 0].max()) + 1), dtype=np.uint8)
+    cv2.fillConvexPoly(raster, local, 1)
+    return raster.view(bool)
 
 
 def join_labels(labels: np.ndarray, pairs: list[tuple[int, int]]) -> np.ndarray:
