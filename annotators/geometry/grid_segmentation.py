@@ -235,6 +235,52 @@ def heights_nest(first: np.ndarray, second: np.ndarray, tolerance: float) -> boo
     return False
 
 
+FLOOR_FLATNESS = 0.1
+"""A part is a horizontal surface when its heights (5 %-95 %) spread over at most this share of its width."""
+
+FLOOR_INSIDE = 0.9
+"""The share of a floor's footprint that must lie within the hull of the part around it."""
+
+
+def is_floor_within(
+    first: np.ndarray, second: np.ndarray, hull_first: np.ndarray, hull_second: np.ndarray, rules: MergeRules
+) -> bool:
+    """Is one of two parts (Nx3 plane coordinates, hulls Kx2) the floor of a container whose walls are the other?
+
+    A horizontal surface seen from above inside the footprint of a part standing higher is not covered by it -
+    what rests on a surface covers it - so the higher part surrounds it: the floor of a bowl or cup seen through
+    its opening, below its walls' visible heights, not an object the walls stand on. The floor is flat
+    (:data:`FLOOR_FLATNESS`), lies within the other's hull (:data:`FLOOR_INSIDE` of its footprint) and no higher
+    than the other's lowest heights (5 %, with ``rules.nest_tolerance``).
+    """
+    for floor, walls, floor_hull, walls_hull in (
+        (first, second, hull_first, hull_second),
+        (second, first, hull_second, hull_first),
+    ):
+        low, high = _range(floor[:, 2], 0.05, 0.95)
+        if high > _range(walls[:, 2], 0.05, 0.95)[0] + rules.nest_tolerance:
+            continue
+        width = float(np.max([np.subtract(*_range(floor[:, axis], 0.95, 0.05)) for axis in (0, 1)]))
+        if high - low > FLOOR_FLATNESS * width:
+            continue
+        if _inside_share(floor_hull, walls_hull, rules.cell) >= FLOOR_INSIDE:
+            return True
+    return False
+
+
+def _inside_share(inner: np.ndarray, outer: np.ndarray, cell: float) -> float:
+    """The share of convex polygon ``inner``'s cells (Nx2, metres, on a ``cell`` raster) inside ``outer``."""
+    low = np.minimum(inner.min(axis=0), outer.min(axis=0))
+    vertices = [np.round((hull - low) / cell).astype(np.int32) for hull in (inner, outer)]
+    size = np.maximum(vertices[0].max(axis=0), vertices[1].max(axis=0)) + 1
+    rasters = []
+    for vertex in vertices:
+        raster = np.zeros((int(size[1]), int(size[0])), dtype=np.uint8)
+        cv2.fillConvexPoly(raster, vertex, 1)
+        rasters.append(raster.view(bool))
+    return np.count_nonzero(rasters[0] & rasters[1]) / max(1, np.count_nonzero(rasters[0]))
+
+
 INNER_SPREAD = 0.1
 """An inner surface of a container falls away from the rim: its 50 %-95 % height spread is at least this share of
 the rim height (or it lies in the lower half); the flat top of an object standing behind does not."""
@@ -513,7 +559,13 @@ def merge_parts(
             and footprint_overlap(parts.hull(first), parts.hull(second), rules.cell) > rules.overlap
         ):
             heights = (parts.coordinates(first)[:, 2], parts.coordinates(second)[:, 2])
-            if not rules.nested or heights_nest(*heights, rules.nest_tolerance):
+            if (
+                not rules.nested
+                or heights_nest(*heights, rules.nest_tolerance)
+                or is_floor_within(
+                    parts.coordinates(first), parts.coordinates(second), parts.hull(first), parts.hull(second), rules
+                )
+            ):
                 allowed.append((first, second))
                 continue
             stacked = True
