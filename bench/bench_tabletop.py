@@ -9,7 +9,10 @@ Three measurements in one run, on frame 000003 of ../shared/data/uoc_tabletop_re
 * reference: a common Open3D recipe for the same job (5 mm voxel grid, ``segment_plane``, DBSCAN above the plane),
   to put the numbers in context;
 * segmentation recall on the labelled mOSD scenes (../shared/data/pcl_mosd_tabletop): the share of ground-truth
-  objects matched by a hypothesis with point IoU >= 0.5.
+  objects matched by a hypothesis with point IoU >= 0.5;
+* with ``--reference REV`` (a git revision, e.g. the commit before a change): this checkout's tree and the tree of
+  REV (exported with ``git archive``) ticked side by side, each in its own worker process
+  (:mod:`bench.tick_tree`), rounds alternating; ms, Hz and the ratio (goal: >= 30 Hz).
 
 Tree and bare rounds alternate so machine noise hits both alike. The reader decodes the PNGs once and then
 serves the cached frame (as it does on repeated ticks of the same frame); decoding is reported separately.
@@ -17,8 +20,14 @@ serves the cached frame (as it does on repeated ticks of the same frame); decodi
 
 from __future__ import annotations
 
+import argparse
+import io
+import json
 import statistics
+import subprocess
 import sys
+import tarfile
+import tempfile
 import time
 from collections.abc import Callable
 from pathlib import Path
@@ -131,9 +140,65 @@ def mosd_recall(scene: str) -> tuple[int, int, list[float], float]:
     return sum(iou >= MIN_IOU for iou in ious), len(ious), ious, statistics.median(times) * 1e3
 
 
+def side_by_side(reference: str, rounds: int = 8, ticks: int = 10) -> None:
+    """This checkout's tree vs the tree of git revision ``reference`` on the same frame, rounds alternating."""
+    with tempfile.TemporaryDirectory() as folder:
+        archive = subprocess.run(["git", "-C", str(ROOT), "archive", reference], check=True, capture_output=True)
+        with tarfile.open(fileobj=io.BytesIO(archive.stdout)) as tar:
+            tar.extractall(folder, filter="data")
+        checkouts = {"this checkout": str(ROOT), f"reference {reference}": folder}
+        workers = {
+            name: subprocess.Popen(
+                [sys.executable, str(ROOT / "bench" / "tick_tree.py"), path, str(DATA), str(FRAME)],
+                stdin=subprocess.PIPE,
+                stdout=subprocess.PIPE,
+                text=True,
+            )
+            for name, path in checkouts.items()
+        }
+        for worker in workers.values():
+            if worker.stdout is None or worker.stdout.readline().strip() != "ready":
+                raise RuntimeError("a tree worker did not start")
+        wall: dict[str, list[float]] = {name: [] for name in workers}
+        cpu: dict[str, list[float]] = {name: [] for name in workers}
+        found: dict[str, int] = {}
+        for _ in range(rounds):
+            for name, worker in workers.items():
+                assert worker.stdin is not None and worker.stdout is not None
+                worker.stdin.write(f"{ticks}\n")
+                worker.stdin.flush()
+                answer = json.loads(worker.stdout.readline())
+                wall[name] += answer["wall"]
+                cpu[name] += answer["cpu"]
+                found[name] = answer["hypotheses"]
+        for worker in workers.values():
+            assert worker.stdin is not None
+            worker.stdin.close()
+            worker.wait()
+    print(f"\nside by side on {DATA.name}/{FRAME:06d}, {rounds} alternating rounds of {ticks} ticks, median per tick:")
+    ms = {name: statistics.median(values) * 1e3 for name, values in wall.items()}
+    cpu_ms = {name: statistics.median(values) * 1e3 for name, values in cpu.items()}
+    for name in workers:
+        print(
+            f"  {name:28s} {ms[name]:7.1f} ms = {1e3 / ms[name]:5.1f} Hz  ({cpu_ms[name]:.1f} ms CPU)"
+            f"  {found[name]} hypotheses"
+        )
+    ours, theirs = ms["this checkout"], ms[f"reference {reference}"]
+    ours_cpu, theirs_cpu = cpu_ms["this checkout"], cpu_ms[f"reference {reference}"]
+    print(f"  speed-up over the reference: {theirs / ours:.2f}x wall, {theirs_cpu / ours_cpu:.2f}x CPU")
+    print(f"  goal >= 30 Hz: {'met' if 1e3 / ours >= 30 else 'NOT met'} ({1e3 / ours:.1f} Hz on this machine now)")
+
+
 def main() -> None:
+    parser = argparse.ArgumentParser(description=__doc__.split("\n")[0])
+    parser.add_argument("--reference", help="git revision whose tree is timed side by side with this checkout's")
+    parser.add_argument("--only-side-by-side", action="store_true", help="with --reference: skip the other parts")
+    arguments = parser.parse_args()
     if not DATA.is_dir():
         print(f"bench_tabletop: no data at {DATA}; skipped")
+        return
+    if arguments.reference and arguments.only_side_by_side:
+        side_by_side(arguments.reference)
         return
     o3d.utility.random.seed(0)
     start = time.perf_counter()
@@ -190,6 +255,8 @@ def main() -> None:
             listed = ", ".join(f"{iou:.2f}" for iou in ious)
             recall = f"recall {found}/{total} = {found / total:.2f}"
             print(f"  {scene:8s} {recall}   IoU per object: {listed}   tree {ms:.1f} ms")
+    if arguments.reference:
+        side_by_side(arguments.reference)
 
 
 if __name__ == "__main__":

@@ -210,13 +210,12 @@ def full_resolution_segments(
     same_surface = ~depth_jump(fine_points[..., 2], sampled_depth, p.jump_absolute, p.jump_relative)
     fine = fine * (_candidates(fine_points, mask[fy0:fy1, fx0:fx1], model, p) & same_surface)
     pixels, starts = label_groups(fine)
+    kept = [label for label in range(1, starts.size - 1) if starts[label + 1] - starts[label] >= p.min_points]
+    masks = np.zeros((len(kept), rows, cols), dtype=bool)  # one allocation for all masks
     segments = []
-    for label in range(1, starts.size - 1):
+    for object_mask, label in zip(masks, kept, strict=True):
         own = pixels[starts[label] : starts[label + 1]]
-        if own.size < p.min_points:
-            continue
         r, c = own // width + fy0, own % width + fx0
-        object_mask = np.zeros((rows, cols), dtype=bool)
         object_mask[r, c] = True
         roi = (int(c.min()), int(r.min()), int(c.max()) + 1, int(r.max()) + 1)
         segments.append(Segment(indices=r * cols + c, mask=object_mask, roi=roi))

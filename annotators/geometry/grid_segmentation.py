@@ -23,7 +23,14 @@ def _neighbour_views(array: np.ndarray) -> list[tuple[np.ndarray, np.ndarray]]:
 def depth_jump(z_a: np.ndarray, z_b: np.ndarray, absolute: float, relative: float) -> np.ndarray:
     """True where two neighbouring depths differ by more than ``absolute + relative * nearer depth``."""
     with np.errstate(invalid="ignore"):
-        return np.abs(z_a - z_b) > absolute + relative * np.fmin(z_a, z_b)
+        if np.ndim(z_a) == 0 or np.ndim(z_b) == 0:
+            return np.abs(z_a - z_b) > absolute + relative * np.fmin(z_a, z_b)
+        difference = np.subtract(z_a, z_b)  # the same arithmetic as above, in place on two temporaries
+        np.abs(difference, out=difference)
+        limit = np.fmin(z_a, z_b)
+        np.multiply(limit, relative, out=limit)
+        np.add(limit, absolute, out=limit)
+        return np.greater(difference, limit, out=np.empty(difference.shape, dtype=bool))
 
 
 def depth_seams(depth: np.ndarray, candidates: np.ndarray, absolute: float, relative: float) -> np.ndarray:
@@ -156,15 +163,31 @@ def footprint_overlap(first: np.ndarray, second: np.ndarray, cell: float) -> flo
     if np.any(shared_box < -cell):
         return 0.0  # the footprints' bounding boxes are apart: nothing to rasterize
     low = np.minimum(first.min(axis=0), second.min(axis=0))
-    high = np.maximum(first.max(axis=0), second.max(axis=0))
-    shape = tuple(int(v) for v in (np.ceil((high - low) / cell) + 2)[::-1])
-    rasters = []
-    for hull in (first, second):
-        raster = np.zeros(shape, dtype=np.uint8)
-        cv2.fillConvexPoly(raster, np.round((hull - low) / cell).astype(np.int32), 1)
-        rasters.append(raster.view(bool))
-    shared = np.count_nonzero(rasters[0] & rasters[1])
+    vertices = [np.round((hull - low) / cell).astype(np.int32) for hull in (first, second)]
+    # each polygon on the raster of its own bounding cells; the shared cells where the two rasters overlap
+    corners = [vertex.min(axis=0) for vertex in vertices]
+    rasters = [_filled(vertex, corner) for vertex, corner in zip(vertices, corners, strict=True)]
+    window_low = np.maximum(corners[0], corners[1])
+    window_high = np.minimum(corners[0] + rasters[0].shape[::-1], corners[1] + rasters[1].shape[::-1])
+    shared = 0
+    if np.all(window_high > window_low):
+        windows = [
+            raster[
+                window_low[1] - corner[1] : window_high[1] - corner[1],
+                window_low[0] - corner[0] : window_high[0] - corner[0],
+            ]
+            for raster, corner in zip(rasters, corners, strict=True)
+        ]
+        shared = np.count_nonzero(windows[0] & windows[1])
     return shared / max(1, min(np.count_nonzero(rasters[0]), np.count_nonzero(rasters[1])))
+
+
+def _filled(vertices: np.ndarray, corner: np.ndarray) -> np.ndarray:
+    """The cells a convex polygon with integer ``vertices`` covers, on a raster whose first cell is ``corner``."""
+    local = np.ascontiguousarray(vertices - corner)
+    raster = np.zeros((int(local[:, 1].max()) + 1, int(local[:, 0].max()) + 1), dtype=np.uint8)
+    cv2.fillConvexPoly(raster, local, 1)
+    return raster.view(bool)
 
 
 def join_labels(labels: np.ndarray, pairs: list[tuple[int, int]]) -> np.ndarray:
@@ -189,15 +212,73 @@ def _range(values: np.ndarray, low: float, high: float) -> tuple[float, float]:
     return float(ordered[round(low * last)]), float(ordered[round(high * last)])
 
 
+RIM_BAND = 0.5
+"""A part spanning at most this share of another's heights, in their upper part, lies in the band of a rim: a
+handle, or an inner wall seen over the rim of a cup or bowl. It is measured against the other's top (99 %), since
+the rim is a container's highest point and reaches above the body's 95 % height."""
+
+
 def heights_nest(first: np.ndarray, second: np.ndarray, tolerance: float) -> bool:
     """Does the 5 %-95 % range of one set of heights above the plane lie within the other's (``tolerance`` metres
     of slack)? A container's inside or handle lies within its body's heights; an object standing on another lies
-    above it."""
-    low_a, high_a = _range(first, 0.05, 0.95)
-    low_b, high_b = _range(second, 0.05, 0.95)
-    return (low_a >= low_b - tolerance and high_a <= high_b + tolerance) or (
-        low_b >= low_a - tolerance and high_b <= high_a + tolerance
-    )
+    above it. A part in the rim band (:data:`RIM_BAND`) may reach up to the other's top instead of its 95 % height;
+    a neighbour of about the same height never counts as in the rim band, so its top must nest strictly.
+    """
+    ranges = [_range(heights, 0.05, 0.95) for heights in (first, second)]
+    tops = [_range(heights, 0.05, 0.99)[1] for heights in (first, second)]
+    for inner, outer in ((0, 1), (1, 0)):
+        (low_in, high_in), (low_out, high_out) = ranges[inner], ranges[outer]
+        in_band = high_in - low_in <= RIM_BAND * (high_out - low_out)
+        top = tops[outer] if in_band else high_out
+        if low_in >= low_out - tolerance and high_in <= top + tolerance:
+            return True
+    return False
+
+
+FLOOR_FLATNESS = 0.1
+"""A part is a horizontal surface when its heights (5 %-95 %) spread over at most this share of its width."""
+
+FLOOR_INSIDE = 0.9
+"""The share of a floor's footprint that must lie within the hull of the part around it."""
+
+
+def is_floor_within(
+    first: np.ndarray, second: np.ndarray, hull_first: np.ndarray, hull_second: np.ndarray, rules: MergeRules
+) -> bool:
+    """Is one of two parts (Nx3 plane coordinates, hulls Kx2) the floor of a container whose walls are the other?
+
+    A horizontal surface seen from above inside the footprint of a part standing higher is not covered by it -
+    what rests on a surface covers it - so the higher part surrounds it: the floor of a bowl or cup seen through
+    its opening, below its walls' visible heights, not an object the walls stand on. The floor is flat
+    (:data:`FLOOR_FLATNESS`), lies within the other's hull (:data:`FLOOR_INSIDE` of its footprint) and no higher
+    than the other's lowest heights (5 %, with ``rules.nest_tolerance``).
+    """
+    for floor, walls, floor_hull, walls_hull in (
+        (first, second, hull_first, hull_second),
+        (second, first, hull_second, hull_first),
+    ):
+        low, high = _range(floor[:, 2], 0.05, 0.95)
+        if high > _range(walls[:, 2], 0.05, 0.95)[0] + rules.nest_tolerance:
+            continue
+        width = float(np.max([np.subtract(*_range(floor[:, axis], 0.95, 0.05)) for axis in (0, 1)]))
+        if high - low > FLOOR_FLATNESS * width:
+            continue
+        if _inside_share(floor_hull, walls_hull, rules.cell) >= FLOOR_INSIDE:
+            return True
+    return False
+
+
+def _inside_share(inner: np.ndarray, outer: np.ndarray, cell: float) -> float:
+    """The share of convex polygon ``inner``'s cells (Nx2, metres, on a ``cell`` raster) inside ``outer``."""
+    low = np.minimum(inner.min(axis=0), outer.min(axis=0))
+    vertices = [np.round((hull - low) / cell).astype(np.int32) for hull in (inner, outer)]
+    size = np.maximum(vertices[0].max(axis=0), vertices[1].max(axis=0)) + 1
+    rasters = []
+    for vertex in vertices:
+        raster = np.zeros((int(size[1]), int(size[0])), dtype=np.uint8)
+        cv2.fillConvexPoly(raster, vertex, 1)
+        rasters.append(raster.view(bool))
+    return np.count_nonzero(rasters[0] & rasters[1]) / max(1, np.count_nonzero(rasters[0]))
 
 
 INNER_SPREAD = 0.1
@@ -478,7 +559,13 @@ def merge_parts(
             and footprint_overlap(parts.hull(first), parts.hull(second), rules.cell) > rules.overlap
         ):
             heights = (parts.coordinates(first)[:, 2], parts.coordinates(second)[:, 2])
-            if not rules.nested or heights_nest(*heights, rules.nest_tolerance):
+            if (
+                not rules.nested
+                or heights_nest(*heights, rules.nest_tolerance)
+                or is_floor_within(
+                    parts.coordinates(first), parts.coordinates(second), parts.hull(first), parts.hull(second), rules
+                )
+            ):
                 allowed.append((first, second))
                 continue
             stacked = True
@@ -530,7 +617,12 @@ def join_unless_apart(count: int, pairs: np.ndarray, apart: np.ndarray) -> np.nd
             continue
         parent[rb] = ra
         keep_apart[ra] = against_a | against_b
-    return np.array([root(node) for node in range(count)], dtype=np.int64)
+    roots = np.array(parent, dtype=np.int64)
+    while True:  # follow the parent pointers to the roots, all nodes at once
+        above = roots[roots]
+        if np.array_equal(above, roots):
+            return roots
+        roots = above
 
 
 def bounding_box(mask: np.ndarray, margin: int = 0) -> tuple[int, int, int, int]:

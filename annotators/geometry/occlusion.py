@@ -27,7 +27,7 @@ from dataclasses import dataclass
 import cv2
 import numpy as np
 
-from annotators.geometry.grid_segmentation import depth_jump, join_labels, label_groups
+from annotators.geometry.grid_segmentation import depth_jump, join_labels, label_groups, touching_pairs
 
 
 @dataclass(frozen=True)
@@ -92,6 +92,13 @@ def join_occluded(
             continue
         x0, y0, x1, y1 = _box(own, labels.shape[1], labels.shape, 3 * rules.band + 1)
         window = labels[y0:y1, x0:x1]
+        present = np.bincount(window.reshape(-1), minlength=count + 1)[farther] > 0
+        if np.count_nonzero(present) < 2:
+            continue  # fewer than two farther objects anywhere near this one
+        if touching is None:
+            touching = _touching(labels)
+        if not _some_apart(farther[present].tolist(), touching):
+            continue  # the farther objects near it all touch one another: nothing to join
         near = cv2.dilate(_with_shadow(window == occluder, depth[y0:y1, x0:x1], wide).view(np.uint8), kernel) > 0
         behind = []
         for piece in np.intersect1d(np.unique(window[near]), farther).tolist():
@@ -115,12 +122,10 @@ def join_occluded(
                 continue
             pixel = np.array([rows.mean() + y0, cols.mean() + x0])
             behind.append(_Piece(piece, flat, xyz, xyz.mean(axis=0), pixel))
-        if len(behind) >= 2 and touching is None:
-            touching = _touching(labels)
         for index, first in enumerate(behind):
             for second in behind[index + 1 :]:
                 key = (min(first.label, second.label), max(first.label, second.label))
-                if touching is None or key in touching:
+                if key in touching:
                     continue
                 if (
                     _continues(first, second, normals, rules)
@@ -219,13 +224,14 @@ def _same_section(first: _Piece, second: _Piece, on_plane: np.ndarray, rules: Oc
     return low_a >= low_b - width and high_a <= high_b + width
 
 
+def _some_apart(labels: list[int], touching: set[tuple[int, int]]) -> bool:
+    """Are two of the (increasing) ``labels`` not touching each other?"""
+    return any((a, b) not in touching for index, a in enumerate(labels) for b in labels[index + 1 :])
+
+
 def _touching(labels: np.ndarray) -> set[tuple[int, int]]:
-    found = set()
-    for first, second in ((labels[:, :-1], labels[:, 1:]), (labels[:-1, :], labels[1:, :])):
-        touching = (first != second) & (first > 0) & (second > 0)
-        a, b = first[touching], second[touching]
-        found.update(zip(np.minimum(a, b).tolist(), np.maximum(a, b).tolist(), strict=True))
-    return found
+    """The pairs ``(a, b)``, ``a < b``, of labels that touch as 4-neighbours."""
+    return {(a, b) for a, b in touching_pairs(labels).tolist()}
 
 
 def _across(

@@ -2,12 +2,13 @@
 
 from __future__ import annotations
 
+import cv2
 import numpy as np
 import pytest
 
 from annotators.cloud.plane import ransac_support_plane, up_in_camera
 from annotators.geometry.boxes import object_box, principal_box, upright_box
-from annotators.geometry.grid_segmentation import looks_like_inside
+from annotators.geometry.grid_segmentation import MergeRules, heights_nest, is_floor_within, looks_like_inside
 from robokudo.core.types import CameraInfo, CameraIntrinsics
 
 
@@ -104,3 +105,42 @@ def test_the_inside_of_a_cup_is_recognised_and_a_neighbour_is_not() -> None:
     assert not looks_like_inside(front, beside, 0.01, 1.5)
     assert not looks_like_inside(front, taller_behind, 0.01, 1.5)
     assert not looks_like_inside(front, flat_top_behind, 0.01, 1.5)
+
+
+def _heights(low: float, high: float, count: int = 200) -> np.ndarray:
+    return np.linspace(low, high, count)
+
+
+def test_a_handle_reaching_the_rim_nests_in_its_body_and_what_stands_on_it_does_not() -> None:
+    # a mug body seen from above: many points low on its wall, few up to its rim at 0.095 m
+    body = np.concatenate([_heights(0.015, 0.085, 380), _heights(0.085, 0.095, 20)])
+    handle = _heights(0.070, 0.095)  # hangs from the rim: above the body's 95 % height, not above its top
+    assert heights_nest(handle, body, 0.003)
+    lid = _heights(0.095, 0.105)  # a flat lid lying on top
+    assert not heights_nest(lid, body, 0.003)
+    # a neighbour as tall, seen from higher up, is measured against the 95 % height, not the top
+    neighbour = _heights(0.030, 0.0965)
+    assert not heights_nest(neighbour, body, 0.003)
+
+
+def _disk(centre: tuple[float, float], radius: float, height: np.ndarray) -> np.ndarray:
+    angles = np.linspace(0, 2 * np.pi, height.size, endpoint=False)
+    radii = radius * np.sqrt(np.linspace(0.05, 1.0, height.size))
+    return np.column_stack([centre[0] + radii * np.cos(angles), centre[1] + radii * np.sin(angles), height])
+
+
+def _hull(points: np.ndarray) -> np.ndarray:
+    return cv2.convexHull(points[:, :2].astype(np.float32)).reshape(-1, 2)
+
+
+def test_a_bowls_floor_joins_its_walls_and_a_box_under_another_does_not() -> None:
+    rules = MergeRules(nested=True)
+    walls = _disk((0.0, 0.6), 0.08, _heights(0.02, 0.085, 400))
+    floor = _disk((0.0, 0.6), 0.03, np.full(200, 0.012))
+    assert is_floor_within(walls, floor, _hull(walls), _hull(floor), rules)
+    # the side of a narrower box under a wider one: inside its footprint and below it, but not a flat floor
+    side = _disk((0.0, 0.6), 0.03, _heights(0.0, 0.018))
+    assert not is_floor_within(walls, side, _hull(walls), _hull(side), rules)
+    # a flat object beside the bowl (a coaster partly outside its footprint) is not its floor
+    coaster = _disk((0.08, 0.6), 0.04, np.full(200, 0.005))
+    assert not is_floor_within(walls, coaster, _hull(walls), _hull(coaster), rules)
