@@ -835,15 +835,18 @@ def _encode_attributes(attributes: Mapping[str, AttributeBelief], class_test: Cl
     encoded: dict[str, dict[str, list]] = {}
     entries: list[str] = []
     for name, attribute in attributes.items():
-        if not attribute.values:
+        values = attribute.values
+        if len(values) == 1:  # the common case: one value said, indexed
+            ((value, s),) = values.items()
+            encoded[name] = {value: [round(s.log_odds, 9), s.count, sorted(s.sources), s.first_seen, s.last_seen]}
+            entries.append(f"{name}={value}")
+            continue
+        if not values:
             continue
         encoded[name] = {
             value: [round(s.log_odds, 9), s.count, sorted(s.sources), s.first_seen, s.last_seen]
-            for value, s in attribute.values.items()
+            for value, s in values.items()
         }
-        if len(attribute.values) == 1:
-            entries.append(f"{name}={next(iter(attribute.values))}")
-            continue
         fused = fuse_values(name, attribute.values, class_test if name == CLASS_ATTRIBUTE else None)
         entries.extend(f"{name}={s.value}" for s in fused.support if s.value == fused.value or s.confidence > 0.5)
     return _COMPACT_JSON.encode(encoded), _INDEX_SEPARATOR.join(sorted(entries))
