@@ -19,9 +19,10 @@ camera pose is), or the same camera frame of the same recording.
 terms for a whole frame at once (numpy distance matrix as the pre-gate, then the gated pairs only), which is what
 the tracker uses. The assignment minimising the total cost is found with one
 ``scipy.optimize.linear_sum_assignment`` per frame on the gated matrix (infeasible pairs get a prohibitive cost and
-are rejected afterwards). Observations left over become new
-objects. :func:`visible_from` predicts whether a belief should have been seen (in the image, in range, and not
-hidden behind a nearer surface in the depth image), which is what lets unseen objects lose confidence.
+are rejected afterwards); when no two feasible pairs share an observation or a belief (a sparse frame, the common
+case) that assignment is all of them, and the solver is not called. Observations left over become new objects.
+:func:`visible_from` predicts whether a belief should have been seen (in the image, in range, and not hidden behind
+a nearer surface in the depth image), which is what lets unseen objects lose confidence.
 """
 
 from __future__ import annotations
