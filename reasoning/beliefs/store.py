@@ -558,7 +558,7 @@ class BeliefStore:
                 _roi_text(item.roi),
                 _encoded_sources(item.sources, cache),
                 _EVIDENCE_JSON.encode(
-                    [[e.attribute, e.value, round(e.confidence, 6), e.source] for e in item.evidence]
+                    [[e.attribute, e.value, _rounded(e.confidence, 6), e.source] for e in item.evidence]
                 ),
                 item.recording,
             )
@@ -838,18 +838,29 @@ def _encode_attributes(attributes: Mapping[str, AttributeBelief], class_test: Cl
         values = attribute.values
         if len(values) == 1:  # the common case: one value said, indexed
             ((value, s),) = values.items()
-            encoded[name] = {value: [round(s.log_odds, 9), s.count, sorted(s.sources), s.first_seen, s.last_seen]}
+            encoded[name] = {value: [_rounded(s.log_odds, 9), s.count, sorted(s.sources), s.first_seen, s.last_seen]}
             entries.append(f"{name}={value}")
             continue
         if not values:
             continue
         encoded[name] = {
-            value: [round(s.log_odds, 9), s.count, sorted(s.sources), s.first_seen, s.last_seen]
+            value: [_rounded(s.log_odds, 9), s.count, sorted(s.sources), s.first_seen, s.last_seen]
             for value, s in values.items()
         }
         fused = fuse_values(name, attribute.values, class_test if name == CLASS_ATTRIBUTE else None)
         entries.extend(f"{name}={s.value}" for s in fused.support if s.value == fused.value or s.confidence > 0.5)
     return _COMPACT_JSON.encode(encoded), _INDEX_SEPARATOR.join(sorted(entries))
+
+
+@functools.lru_cache(maxsize=4096, typed=True)
+def _rounded_cached(value: float, digits: int) -> float:
+    return round(value, digits)
+
+
+def _rounded(value: float, digits: int) -> float:
+    """``round(value, digits)``, remembered for the values that recur on every row (accumulated log-odds, the
+    experts' confidences); zero is rounded afresh, as the cache would not tell -0.0 from 0.0."""
+    return _rounded_cached(value, digits) if value else round(value, digits)
 
 
 _COMPACT_JSON = JsonText(",", ":")

@@ -12,6 +12,7 @@ from hypothesis import strategies as st
 from scipy.optimize import linear_sum_assignment
 
 from reasoning.beliefs.json_text import JsonText
+from reasoning.beliefs.store import _rounded
 from reasoning.fusion.association import INFEASIBLE, assign
 from reasoning.fusion.rule import AttributeBelief, Evidence, accumulate_into
 
@@ -89,3 +90,18 @@ def test_assignment_equals_the_hungarian_on_random_sparse_frames(
     assert sorted((i, j) for i, j, _ in found.matches) == hungarian(cost)
     assert [i for i, _, _ in found.matches] == sorted(i for i, _, _ in found.matches)  # by observation
     assert all(c == cost[i, j] for i, j, c in found.matches)
+
+
+@settings(max_examples=300, deadline=None)
+@given(
+    values=st.lists(
+        st.floats(allow_nan=True, allow_infinity=True) | st.integers(-5, 5) | st.sampled_from([0.0, -0.0, 0.8, 1.4]),
+        max_size=20,
+    ),
+    digits=st.sampled_from([6, 9]),
+)
+def test_remembered_rounding_gives_the_text_of_round(values: list[float], digits: int) -> None:
+    numpy = [np.float64(v) for v in values if abs(v) < 1e6]  # (numpy warns of overflow rounding huge ones)
+    for value in values + values + numpy:  # the second time answered from the cache
+        assert json.dumps(_rounded(value, digits)) == json.dumps(round(value, digits))
+        assert type(_rounded(value, digits)) is type(round(value, digits))
