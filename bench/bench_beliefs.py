@@ -40,6 +40,7 @@ from dataclasses import dataclass
 from pathlib import Path
 
 import numpy as np
+import scipy.optimize  # noqa: F401 - the assignment imports it on first use: not what the parts measure
 
 ROOT = Path(__file__).resolve().parents[1]
 for folder in (ROOT, Path(__file__).resolve().parent):
@@ -389,8 +390,6 @@ def rss_kib(pid: int | str = "self") -> int:
 
 def rss_child(path: Path, count: int) -> None:
     """In a fresh process: RSS before opening the store of ``count`` beliefs and after using it (prints KiB)."""
-    import scipy.optimize  # noqa: F401 - code the first integration imports, not memory per belief
-
     seeded = Seeded(np.load(f"{path}.positions.npy"), ["Milk"] * count, ["red"] * count)
     rng = np.random.default_rng(5)
     prepared = [frame_objects(hypotheses_near(seeded, rng, 20)) for _ in range(50)]

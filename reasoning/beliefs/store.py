@@ -33,10 +33,12 @@ from collections.abc import Callable, Iterator, Mapping, Sequence
 from contextlib import contextmanager
 from dataclasses import dataclass, field
 from pathlib import Path
+from typing import NamedTuple
 
 import numpy as np
 import platformdirs
 
+from reasoning.beliefs.json_text import JsonText
 from reasoning.fusion.association import CameraModel, in_view
 from reasoning.fusion.frame import WORLD_FRAME, FrameObject
 from reasoning.fusion.rule import CLASS_ATTRIBUTE, AttributeBelief, ClassTest, ValueSupport, fuse_values, sigmoid
@@ -59,6 +61,8 @@ SYNCHRONOUS_MODES = ("OFF", "NORMAL", "FULL", "EXTRA")
 _CORRUPT_ERRORS = {"SQLITE_CORRUPT", "SQLITE_NOTADB"}
 RTREE_SLACK = 0.05
 """Half-width (metres) of a belief's R*Tree entry around its position."""
+SOURCES_CACHE_LIMIT = 4096
+"""Distinct expert sets a store keeps the JSON of (beyond that the cache starts afresh)."""
 WAL_AUTOCHECKPOINT_PAGES = 4000
 """Checkpoint the WAL into the file every ~16 MB (fewer fsyncs than SQLite's default of 1000 pages)."""
 
@@ -174,9 +178,9 @@ _SCHEMA = (
 _TABLES = {"meta", "objects", "objects_place", "attribute_index", "observations", "classes"}
 
 
-@dataclass(frozen=True, slots=True)
-class _Loaded:
-    """What a belief looked like in the store when loaded: its R*Tree entry centre and its indexed columns."""
+class _Loaded(NamedTuple):
+    """What a belief looked like in the store when loaded: its R*Tree entry centre and its indexed columns (a named
+    tuple: made for every candidate of every frame)."""
 
     place: tuple[float, float, float]
     class_name: str | None
@@ -209,6 +213,8 @@ class BeliefStore:
         self.history_limit = history_limit
         self.write_log: list[list[tuple[str, list[tuple]]]] | None = None
         """When a list, each :meth:`integrate` appends the statements it wrote, with their rows (benchmarks)."""
+        self._sources_text: dict[frozenset[str], str] = {}
+        """JSON of the expert sets written (few distinct sets recur on every row)."""
         self._lock = threading.RLock()
         self._conn = self._open(synchronous.upper(), busy_timeout, check)
 
@@ -434,15 +440,16 @@ class BeliefStore:
             groups.setdefault((item.frame, item.recording), []).append(item)
         for (frame, recording), members in groups.items():
             # one statement per world: the union of the R*Tree boxes around its observations
-            centres = np.array([[float(v) for v in item.position[:3]] for item in members], dtype=np.float64)
-            parameters: list[object] = []
-            for x, y, z in centres.tolist():
-                parameters += [x + gate, x - gate, y + gate, y - gate, z + gate, z - gate]
+            centres = np.array([item.position[:3] for item in members], dtype=np.float64)
+            bounds = np.empty((len(members), 6))
+            bounds[:, 0::2] = centres + gate  # x1, y1, z1 of each box, then x0, y0, z0 in between
+            bounds[:, 1::2] = centres - gate
+            parameters = bounds.ravel().tolist()
             found = conn.execute(_candidate_query(len(members)), (*parameters, frame, WORLD_FRAME, recording, PRESENT))
             found = found.fetchall()
             if not found:
                 continue
-            positions = np.array([(row[3], row[4], row[5]) for row in found], dtype=np.float64)
+            positions = np.array([row[3:6] for row in found], dtype=np.float64)
             delta = positions[:, None, :] - centres[None, :, :]
             near = (np.sqrt(np.einsum("ijk,ijk->ij", delta, delta)) <= gate).any(axis=1)
             for row, keep in zip(found, near.tolist(), strict=True):
@@ -485,7 +492,7 @@ class BeliefStore:
             return
         log = [] if writes is None else writes
         loaded = loaded or {}
-        cache: dict[frozenset[str], str] = {}
+        cache = self._sources_cache()
         rows = {b.id: _object_row(b, class_test, cache) for b in beliefs}
         fresh = [rows[b.id] for b in beliefs if b.id not in loaded]
         if fresh:
@@ -540,7 +547,7 @@ class BeliefStore:
         writes: list[tuple[str, list[tuple]]],
     ) -> None:
         """Record each object's sighting under (belief id, its sighting number)."""
-        cache: dict[frozenset[str], str] = {}
+        cache = self._sources_cache()
         rows = [
             (
                 object_id,
@@ -550,7 +557,9 @@ class BeliefStore:
                 *_floats(item.position, 3),
                 _roi_text(item.roi),
                 _encoded_sources(item.sources, cache),
-                json.dumps([[e.attribute, e.value, round(e.confidence, 6), e.source] for e in item.evidence]),
+                _EVIDENCE_JSON.encode(
+                    [[e.attribute, e.value, _rounded(e.confidence, 6), e.source] for e in item.evidence]
+                ),
                 item.recording,
             )
             for item, (object_id, seq) in zip(objects, assigned, strict=True)
@@ -564,6 +573,12 @@ class BeliefStore:
                 "recording) VALUES (?, ?, ?, ?, ?, ?, ?, ?, ?, ?, ?)",
                 rows,
             )
+
+    def _sources_cache(self) -> dict[frozenset[str], str]:
+        """The cache of encoded expert sets, emptied when it grows past :data:`SOURCES_CACHE_LIMIT` entries."""
+        if len(self._sources_text) > SOURCES_CACHE_LIMIT:
+            self._sources_text.clear()
+        return self._sources_text
 
     def _prune_history(
         self, conn: sqlite3.Connection, beliefs: Sequence[ObjectBelief], writes: list[tuple[str, list[tuple]]]
@@ -725,7 +740,10 @@ def _candidate_query(boxes: int) -> str:
 
 
 def _roi_text(roi: tuple[int, int, int, int] | None) -> str | None:
-    return None if roi is None else ",".join(str(int(v)) for v in roi)
+    if roi is None:
+        return None
+    x0, y0, x1, y1 = roi
+    return f"{int(x0)},{int(y0)},{int(x1)},{int(y1)}"
 
 
 def _roi_from_text(text: str | None) -> tuple[int, int, int, int] | None:
@@ -817,22 +835,38 @@ def _encode_attributes(attributes: Mapping[str, AttributeBelief], class_test: Cl
     encoded: dict[str, dict[str, list]] = {}
     entries: list[str] = []
     for name, attribute in attributes.items():
-        if not attribute.values:
+        values = attribute.values
+        if len(values) == 1:  # the common case: one value said, indexed
+            ((value, s),) = values.items()
+            encoded[name] = {value: [_rounded(s.log_odds, 9), s.count, sorted(s.sources), s.first_seen, s.last_seen]}
+            entries.append(f"{name}={value}")
+            continue
+        if not values:
             continue
         encoded[name] = {
-            value: [round(s.log_odds, 9), s.count, sorted(s.sources), s.first_seen, s.last_seen]
-            for value, s in attribute.values.items()
+            value: [_rounded(s.log_odds, 9), s.count, sorted(s.sources), s.first_seen, s.last_seen]
+            for value, s in values.items()
         }
-        if len(attribute.values) == 1:
-            entries.append(f"{name}={next(iter(attribute.values))}")
-            continue
         fused = fuse_values(name, attribute.values, class_test if name == CLASS_ATTRIBUTE else None)
         entries.extend(f"{name}={s.value}" for s in fused.support if s.value == fused.value or s.confidence > 0.5)
     return _COMPACT_JSON.encode(encoded), _INDEX_SEPARATOR.join(sorted(entries))
 
 
-_COMPACT_JSON = json.JSONEncoder(separators=(",", ":"))
-"""The encoder of the attribute column (made once: ``json.dumps`` with options builds one per call)."""
+@functools.lru_cache(maxsize=4096, typed=True)
+def _rounded_cached(value: float, digits: int) -> float:
+    return round(value, digits)
+
+
+def _rounded(value: float, digits: int) -> float:
+    """``round(value, digits)``, remembered for the values that recur on every row (accumulated log-odds, the
+    experts' confidences); zero is rounded afresh, as the cache would not tell -0.0 from 0.0."""
+    return _rounded_cached(value, digits) if value else round(value, digits)
+
+
+_COMPACT_JSON = JsonText(",", ":")
+"""The encoder of the attribute column."""
+_EVIDENCE_JSON = JsonText()
+"""The encoder of a sighting's statements (``json.dumps``'s format)."""
 
 
 @functools.lru_cache(maxsize=256)

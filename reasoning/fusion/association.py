@@ -19,9 +19,10 @@ camera pose is), or the same camera frame of the same recording.
 terms for a whole frame at once (numpy distance matrix as the pre-gate, then the gated pairs only), which is what
 the tracker uses. The assignment minimising the total cost is found with one
 ``scipy.optimize.linear_sum_assignment`` per frame on the gated matrix (infeasible pairs get a prohibitive cost and
-are rejected afterwards). Observations left over become new
-objects. :func:`visible_from` predicts whether a belief should have been seen (in the image, in range, and not
-hidden behind a nearer surface in the depth image), which is what lets unseen objects lose confidence.
+are rejected afterwards); when no two feasible pairs share an observation or a belief (a sparse frame, the common
+case) that assignment is all of them, and the solver is not called. Observations left over become new objects.
+:func:`visible_from` predicts whether a belief should have been seen (in the image, in range, and not hidden behind
+a nearer surface in the depth image), which is what lets unseen objects lose confidence.
 """
 
 from __future__ import annotations
@@ -184,7 +185,9 @@ def geometric_costs(
     ratio = np.maximum(size_a, size_b) / np.where(sized, np.minimum(size_a, size_b), 1.0)
     feasible = ~sized | (ratio <= config.size_ratio_gate)
     total += np.where(sized, (np.log(np.where(sized, ratio, 1.0)) / config.size_sigma) ** 2, 0.0)
-    for k, (i, j) in enumerate(zip(rows.tolist(), cols.tolist(), strict=True)):
+    histograms = any(o.appearance is not None for o in observations) and any(b.appearance is not None for b in beliefs)
+    pairs = list(zip(rows.tolist(), cols.tolist(), strict=True)) if histograms else []  # else nothing to compare
+    for k, (i, j) in enumerate(pairs):
         ha, hb = observations[i].appearance, beliefs[j].appearance
         if ha is None or hb is None or ha.shape != hb.shape or not feasible[k]:
             continue
@@ -210,8 +213,11 @@ def _near_pairs(
     delta = a[:, None, :] - b[None, :, :]
     distance = np.sqrt(np.einsum("ijk,ijk->ij", delta, delta))
     near = distance <= gate
-    keys_a = [world_key(o.frame, o.recording) for o in observations]
-    keys_b = [world_key(x.frame, x.recording) for x in beliefs]
+    if {o.frame for o in observations} | {x.frame for x in beliefs} == {WORLD_FRAME}:
+        keys_a = keys_b = [WORLD_FRAME]  # one world: every pair is comparable
+    else:
+        keys_a = [world_key(o.frame, o.recording) for o in observations]
+        keys_b = [world_key(x.frame, x.recording) for x in beliefs]
     if len(set(keys_a) | set(keys_b)) > 1:
         near &= np.array(keys_a, dtype=object)[:, None] == np.array(keys_b, dtype=object)[None, :]
     rows, cols = np.nonzero(near)
@@ -234,6 +240,10 @@ def assign(cost: np.ndarray) -> Association:
     elif rows == 1 or cols == 1:
         i, j = np.unravel_index(int(np.argmin(cost)), cost.shape)
         pairs = [(int(i), int(j))]
+    elif _disjoint(feasible):
+        # no two feasible pairs share an observation or a belief: the optimal assignment takes them all (leaving
+        # one out would put a prohibitive cost in its place), so there is nothing to choose
+        pairs = [(int(i), int(j)) for i, j in zip(*np.nonzero(feasible), strict=True)]
     else:
         from scipy.optimize import linear_sum_assignment
 
@@ -247,6 +257,11 @@ def assign(cost: np.ndarray) -> Association:
         tuple(i for i in range(rows) if i not in matched_rows),
         tuple(j for j in range(cols) if j not in matched_cols),
     )
+
+
+def _disjoint(feasible: np.ndarray) -> bool:
+    """True when every row and every column of the boolean matrix holds at most one True."""
+    return bool((feasible.sum(axis=0) <= 1).all() and (feasible.sum(axis=1) <= 1).all())
 
 
 def associate(

@@ -40,6 +40,7 @@ from reasoning.fusion.rule import (
     ClassTest,
     FusedAttribute,
     accumulate,
+    accumulate_into,
     logit,
     sigmoid,
 )
@@ -192,25 +193,34 @@ class BeliefTracker:
         :func:`pair_cost` added on the feasible pairs, then one optimal assignment."""
         config = self.config.association
         cost, compared = geometric_costs(observations, beliefs, config)
+        rows, cols = np.nonzero(cost < INFEASIBLE)
+        if not rows.size:
+            return assign(cost)
         colors: dict[int, str | None] = {}
         stated: dict[int, tuple[set[str], set[str]]] = {}
         test = self.class_test or _same_class
-        for i, j in np.argwhere(cost < INFEASIBLE).tolist():
+        color_added = [0.0] * rows.size
+        class_added = [0.0] * rows.size
+        pairs = zip(rows.tolist(), cols.tolist(), compared[rows, cols].tolist(), strict=True)
+        for k, (i, j, histograms_compared) in enumerate(pairs):
             if i not in stated:
                 stated[i] = (observations[i].values(SemanticColor.attribute), observations[i].values(CLASS_ATTRIBUTE))
             observation_colors, observation_classes = stated[i]
-            if observation_colors and not compared[i, j]:
+            if observation_colors and not histograms_compared:
                 if j not in colors:
                     colors[j] = beliefs[j].value(SemanticColor.attribute)
                 if colors[j] and colors[j] not in observation_colors:
-                    cost[i, j] += config.color_penalty
+                    color_added[k] = config.color_penalty
             belief_class = beliefs[j].class_name
-            if (
-                observation_classes
-                and belief_class
-                and not any(test(c, belief_class) or test(belief_class, c) for c in observation_classes)
-            ):
-                cost[i, j] += config.class_penalty
+            if observation_classes and belief_class:
+                for c in observation_classes:
+                    if test(c, belief_class) or test(belief_class, c):
+                        break
+                else:
+                    class_added[k] = config.class_penalty
+        # the colour penalty first, then the class penalty, as pair_cost adds them (adding 0.0 changes nothing)
+        cost[rows, cols] += np.array(color_added)
+        cost[rows, cols] += np.array(class_added)
         return assign(cost)
 
     def _create(self, observation: FrameObject, time: float, belief_id: int) -> ObjectBelief:
@@ -258,12 +268,7 @@ class BeliefTracker:
             else:
                 blended = (1.0 - rate) * belief.appearance + rate * observation.appearance
                 belief.appearance = blended / max(float(blended.sum()), 1e-12)
-        attributes = belief.attributes
-        for evidence in observation.evidence:
-            known = attributes.get(evidence.attribute)
-            if known is None:
-                known = attributes[evidence.attribute] = AttributeBelief(evidence.attribute)
-            known.add(evidence, time)
+        accumulate_into(belief.attributes, observation.evidence, time)
         belief.existence = min(belief.existence + config.hit_log_odds, MAX_LOG_ODDS)
         belief.misses = 0
         belief.status = PRESENT
