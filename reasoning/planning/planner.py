@@ -754,11 +754,12 @@ class _Layout:
             for spec in unit.providers:
                 for needed in spec.inputs:
                     consumers.setdefault(needed, set()).add(spec.name)
-        for type_name in sorted(set(self.units) | set(self.catalog.sensors)):
+        guaranteed = self.assignment.guaranteed_by()
+        # refiners of every type a unit makes (by-products too: a refiner of one may be planned) read their inputs
+        for type_name in sorted(set(guaranteed) | set(self.catalog.sensors)):
             for spec in self.catalog.refiners(type_name):
                 for needed in spec.inputs:
                     consumers.setdefault(needed, set()).add(spec.name)
-        guaranteed = self.assignment.guaranteed_by()
         guarantees: dict[str, list[str]] = {}
         for type_name, key in guaranteed.items():
             guarantees.setdefault(key, []).append(type_name)
