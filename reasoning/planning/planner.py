@@ -23,7 +23,7 @@ The algorithm, polynomial in annotators x types:
 from __future__ import annotations
 
 from collections import deque
-from collections.abc import Callable, Iterable, Mapping, Sequence
+from collections.abc import Iterable, Mapping, Sequence
 from dataclasses import dataclass
 
 from reasoning.knowledge.knowledge_base import KnowledgeBase
@@ -324,12 +324,11 @@ class _Catalog:
 class _UnitChoice:
     """The providers chosen for one needed type (one unit of the plan)."""
 
-    def __init__(
-        self, type_name: str, providers: list[AnnotatorSpec], value: str | None, written: Callable[..., frozenset[str]]
-    ) -> None:
+    def __init__(self, type_name: str, providers: list[AnnotatorSpec], value: str | None, catalog: _Catalog) -> None:
         self.type_name = type_name
         self.value = value
-        self._written = written
+        self._written = catalog.written
+        self._input_round = catalog.input_round
         self.providers = providers
 
     @property
@@ -342,6 +341,8 @@ class _UnitChoice:
         self._providers = providers
         self._guaranteed = frozenset.intersection(*(self._written(s) for s in providers))
         self.guaranteed_sorted = tuple(sorted(self._guaranteed))
+        self.latest_round = max(map(self._input_round, providers))
+        """The latest fixpoint round among the inputs of any provider."""
 
     def guaranteed(self) -> frozenset[str]:
         """Types the unit produces for others: outputs every provider writes without having read them."""
@@ -430,8 +431,7 @@ class _Assignment:
             self._order = sorted(units, key=lambda k: (rounds.get(k, 0), k))
         for key in self._order:
             unit = units[key]
-            # the latest round among the inputs of any provider of the unit
-            latest = max(map(self.catalog.input_round, unit.providers)) if by_rounds else 0
+            latest = unit.latest_round
             for type_name in unit.guaranteed_sorted:
                 if type_name in found:
                     continue
@@ -462,12 +462,16 @@ class _Assignment:
     def _below(self, key: str) -> set[str]:
         """The unit and every unit it (transitively) needs (through its providers' required inputs)."""
         guaranteed = self.guaranteed_by()
+        table = self._input_units_of if guaranteed is self._inputs_for else {}
         seen = {key}
         frontier = [key]
         while frontier:
             node = frontier.pop()
             for spec in self.units[node].providers:
-                for dep in self._input_units(spec, guaranteed):
+                deps = table.get(spec.name)
+                if deps is None:
+                    deps = self._input_units(spec, guaranteed)
+                for dep in deps:
                     if dep not in seen:
                         seen.add(dep)
                         frontier.append(dep)
@@ -520,10 +524,15 @@ class _Assignment:
             return known
         unit = self.units[key]
         guaranteed = self.guaranteed_by()  # as it is now: cuts further down do not change what this level reads
+        # the memo of _input_units for this mapping (a cut further down may start another one: this one stays right)
+        table = self._input_units_of if guaranteed is self._inputs_for else {}
         inner: frozenset[str] | None = None
         keep = []
         for spec in unit.providers:
-            for dep in self._input_units(spec, guaranteed):
+            deps = table.get(spec.name)
+            if deps is None:
+                deps = self._input_units(spec, guaranteed)
+            for dep in deps:
                 if dep == key:
                     continue
                 if dep in above or dep in path:  # what the call for ``dep`` would answer first
@@ -612,7 +621,7 @@ class _Assignment:
                 if not self._take_over(type_name, valid, consumer, above):
                     raise _OrderingError(f"cannot produce {type_name}: {self.catalog.why_not(type_name, value)}")
                 continue
-            self.units[type_name] = _UnitChoice(type_name, free, value, self.catalog.written)
+            self.units[type_name] = _UnitChoice(type_name, free, value, self.catalog)
             self._order = None
             self._invalidate()
             self.above[type_name] = set(above)
