@@ -450,13 +450,12 @@ class _Assignment:
         :meth:`guaranteed_by`; memoised while it is the current one)."""
         if guaranteed is not self._inputs_for:
             if guaranteed is not self._guaranteed:
-                return tuple(sorted({guaranteed[t] for t in spec.inputs if t in guaranteed}))
+                return _units_of(spec.inputs, guaranteed)
             self._inputs_for = guaranteed
             self._input_units_of = {}
         found = self._input_units_of.get(spec.name)
         if found is None:
-            found = tuple(sorted({guaranteed[t] for t in spec.inputs if t in guaranteed}))
-            self._input_units_of[spec.name] = found
+            found = self._input_units_of[spec.name] = _units_of(spec.inputs, guaranteed)
         return found
 
     def _below(self, key: str) -> set[str]:
@@ -650,6 +649,14 @@ class _Assignment:
                 del self.units[key]
             self._order = None
             self._invalidate()
+
+
+def _units_of(types: tuple[str, ...], guaranteed: Mapping[str, str]) -> tuple[str, ...]:
+    """The units (sorted, each once) that guarantee ``types`` by ``guaranteed``."""
+    if len(types) == 1:
+        key = guaranteed.get(types[0])
+        return () if key is None else (key,)
+    return tuple(sorted({guaranteed[t] for t in types if t in guaranteed}))
 
 
 def _find_cycle(graph: Mapping[str, set[str]]) -> list[str] | None:
