@@ -328,6 +328,7 @@ class _UnitChoice:
         self.type_name = type_name
         self.value = value
         self._written = catalog.written
+        self._written_types = catalog.ontology.written_types
         self._input_round = catalog.input_round
         self.providers = providers
 
@@ -339,10 +340,17 @@ class _UnitChoice:
     @providers.setter
     def providers(self, providers: list[AnnotatorSpec]) -> None:
         self._providers = providers
-        self._guaranteed = frozenset.intersection(*(self._written(s) for s in providers))
+        known = self._written_types
+        self._guaranteed = frozenset.intersection(*[known.get(s.name) or self._written(s) for s in providers])
         self.guaranteed_sorted = tuple(sorted(self._guaranteed))
-        self.latest_round = max(map(self._input_round, providers))
+        self._latest_round: int | None = None
+
+    @property
+    def latest_round(self) -> int:
         """The latest fixpoint round among the inputs of any provider."""
+        if self._latest_round is None:
+            self._latest_round = max(map(self._input_round, self._providers))
+        return self._latest_round
 
     def guaranteed(self) -> frozenset[str]:
         """Types the unit produces for others: outputs every provider writes without having read them."""
@@ -624,9 +632,15 @@ class _Assignment:
             self._order = None
             self._invalidate()
             self.above[type_name] = set(above)
+            reasons = self.reasons
             for spec in free:
+                why = f"needed by {spec.name}"
                 for needed in spec.inputs:
-                    self._note(needed, f"needed by {spec.name}")
+                    noted = reasons.get(needed)
+                    if noted is None:
+                        reasons[needed] = [why]
+                    elif why not in noted:
+                        noted.append(why)
                     queue.append((needed, type_name))
 
     def _prune(self) -> None:
