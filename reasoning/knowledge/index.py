@@ -150,6 +150,13 @@ class OntologyIndex:
 
     size_bounds: Mapping[str, float] = field(default_factory=dict)
     """Size class -> the bound on its objects' largest extent in metres (``rk:largestExtentBelow``)."""
+    written_types: Mapping[str, frozenset[str]] = field(default_factory=dict)
+    """Annotator -> what it makes present for others: its outputs and their supertypes minus its inputs and theirs
+    (annotators with a port type outside the class closure are left out)."""
+    makers: Mapping[str, tuple[AnnotatorSpec, ...]] = field(default_factory=dict)
+    """CAS type -> its ranked providers that have inputs and do not read it (not sensor readers, not refiners)."""
+    refiners: Mapping[str, tuple[AnnotatorSpec, ...]] = field(default_factory=dict)
+    """CAS type -> its providers that read it too (refiners), cheapest first (by cost, then name)."""
     inspected_types: tuple[str, ...] = ()
     """The annotation types answering the query keys marked ``rk:refinedByInspection true``, sorted."""
 
@@ -256,7 +263,24 @@ class _Builder:
             look_alikes=self._look_alikes(profiles),
             size_bounds=size_bounds,
             inspected_types=inspected_types,
+            written_types=self._written_types(annotators),
+            makers={t: tuple(s for s in specs if s.inputs and t not in s.inputs) for t, specs in providers.items()},
+            refiners={
+                t: tuple(sorted((s for s in specs if t in s.inputs), key=lambda s: (s.cost_ms, s.name)))
+                for t, specs in providers.items()
+            },
         )
+
+    def _written_types(self, annotators: Mapping[str, AnnotatorSpec]) -> dict[str, frozenset[str]]:
+        """Per annotator whose port types are all classes: its outputs and their supertypes, minus its inputs and
+        theirs."""
+        up = self.up
+        found: dict[str, frozenset[str]] = {}
+        for name, spec in annotators.items():
+            if all(t in up for t in (*spec.inputs, *spec.outputs)):
+                made = frozenset().union(*(up[t] for t in spec.outputs))
+                found[name] = made - frozenset().union(*(up[t] for t in spec.inputs))
+        return found
 
     @staticmethod
     def _port_masks(

@@ -23,7 +23,7 @@ The algorithm, polynomial in annotators x types:
 from __future__ import annotations
 
 from collections import deque
-from collections.abc import Callable, Iterable, Mapping, Sequence
+from collections.abc import Iterable, Mapping, Sequence
 from dataclasses import dataclass
 
 from reasoning.knowledge.knowledge_base import KnowledgeBase
@@ -120,6 +120,7 @@ class _Catalog:
         self._providers: dict[tuple[str, str | None], tuple[AnnotatorSpec, ...]] = {}
         self._refiners: dict[str, list[AnnotatorSpec]] = {}
         self._without: dict[int, int] = {}
+        self._input_rounds: dict[str, int] = {}
         self._producing: list[tuple[int, tuple[int, ...]]] | None = None
         self._excluded, self._own_types_only = index.provider_exclusions(object_class, conditions)
         masks = self.ontology.port_masks
@@ -179,9 +180,17 @@ class _Catalog:
             found |= known
         return frozenset(found)
 
+    def input_round(self, spec: AnnotatorSpec) -> int:
+        """The latest fixpoint round among the inputs of ``spec`` (0 without inputs)."""
+        found = self._input_rounds.get(spec.name)
+        if found is None:
+            rounds = self.rounds
+            found = self._input_rounds[spec.name] = max((rounds.get(t, 0) for t in spec.inputs), default=0)
+        return found
+
     def written(self, spec: AnnotatorSpec) -> frozenset[str]:
         """What an annotator makes present for others: its outputs and their supertypes, minus what it reads."""
-        found = self._written.get(spec.name)
+        found = self.ontology.written_types.get(spec.name) or self._written.get(spec.name)
         if found is None:
             found = self._written[spec.name] = self.with_supertypes(spec.outputs) - self.with_supertypes(spec.inputs)
         return found
@@ -200,22 +209,45 @@ class _Catalog:
     def providers(self, type_name: str, value: str | None = None) -> tuple[AnnotatorSpec, ...]:
         """Ranked providers of ``type_name`` for ``value`` (refiners of the type excluded)."""
         key = (type_name, value)
-        if key not in self._providers:
-            if value is None:
-                found = self._admitted(type_name)
+        found = self._providers.get(key)
+        if found is None:
+            makers = self.ontology.makers.get(type_name)
+            if value is None and makers is not None:
+                excluded, own_types_only = self._excluded, self._own_types_only
+                found = tuple(
+                    s
+                    for s in makers
+                    if s.name not in excluded and (s.name not in own_types_only or type_name in s.outputs)
+                )
             else:
-                found = self.index.providers(type_name, value, self.object_class, self.conditions)
-            # annotators without inputs are sensor readers: the plan's source is chosen by its input, not here
-            self._providers[key] = tuple(s for s in found if s.inputs and type_name not in s.inputs)
-        return self._providers[key]
+                admitted = (
+                    self._admitted(type_name)
+                    if value is None
+                    else self.index.providers(type_name, value, self.object_class, self.conditions)
+                )
+                # annotators without inputs are sensor readers: the plan's source is chosen by its input, not here
+                found = tuple(s for s in admitted if s.inputs and type_name not in s.inputs)
+            self._providers[key] = found
+        return found
 
     def refiners(self, type_name: str) -> list[AnnotatorSpec]:
         """Annotators that read and write ``type_name`` and whose preconditions hold, cheapest first."""
-        if type_name not in self._refiners:
-            self._refiners[type_name] = sorted(
-                (s for s in self._admitted(type_name) if type_name in s.inputs), key=lambda s: (s.cost_ms, s.name)
-            )
-        return self._refiners[type_name]
+        found = self._refiners.get(type_name)
+        if found is None:
+            candidates = self.ontology.refiners.get(type_name)
+            if candidates is None or type_name not in self.ontology.cas_types:
+                found = sorted(
+                    (s for s in self._admitted(type_name) if type_name in s.inputs), key=lambda s: (s.cost_ms, s.name)
+                )
+            else:
+                excluded, own_types_only = self._excluded, self._own_types_only
+                found = [
+                    s
+                    for s in candidates
+                    if s.name not in excluded and (s.name not in own_types_only or type_name in s.outputs)
+                ]
+            self._refiners[type_name] = found
+        return found
 
     def _fixpoint(self, forbidden: int) -> int:
         """Make each type known once one of its producing rules has all its inputs known, until none becomes so.
@@ -223,11 +255,14 @@ class _Catalog:
         The rules are regrouped per type (the distinct input masks of the rules providing it) at the first call.
         """
         if self._producing is None:
-            rules = self._rules
+            inputs_of: dict[int, dict[int, None]] = {}  # type bit -> the input masks of the rules providing it
+            for inputs, provided in self._rules:
+                while provided:
+                    bit = provided & -provided
+                    inputs_of.setdefault(bit, {})[inputs] = None
+                    provided ^= bit
             self._producing = [
-                (bit, masks)
-                for bit in self.ontology.type_bits.values()
-                if (masks := tuple({inputs: None for inputs, provided in rules if provided & bit}))
+                (bit, tuple(inputs_of[bit])) for bit in self.ontology.type_bits.values() if bit in inputs_of
             ]
         known = self._sensor_mask
         skip = known | forbidden
@@ -263,9 +298,8 @@ class _Catalog:
         masks = self.ontology.port_masks
         found = [s for s in self.providers(type_name, value) if masks[s.name][0] & usable == masks[s.name][0]]
         if by_rounds and found:
-            depth = {s.name: max((self.rounds.get(t, 0) for t in s.inputs), default=0) for s in found}
-            limit = min(depth.values())
-            found = [s for s in found if depth[s.name] <= limit]
+            limit = min(map(self.input_round, found))
+            found = [s for s in found if self.input_round(s) <= limit]
         return found
 
     def why_not(self, type_name: str, value: str | None) -> str:
@@ -290,12 +324,12 @@ class _Catalog:
 class _UnitChoice:
     """The providers chosen for one needed type (one unit of the plan)."""
 
-    def __init__(
-        self, type_name: str, providers: list[AnnotatorSpec], value: str | None, written: Callable[..., frozenset[str]]
-    ) -> None:
+    def __init__(self, type_name: str, providers: list[AnnotatorSpec], value: str | None, catalog: _Catalog) -> None:
         self.type_name = type_name
         self.value = value
-        self._written = written
+        self._written = catalog.written
+        self._written_types = catalog.ontology.written_types
+        self._input_round = catalog.input_round
         self.providers = providers
 
     @property
@@ -306,8 +340,17 @@ class _UnitChoice:
     @providers.setter
     def providers(self, providers: list[AnnotatorSpec]) -> None:
         self._providers = providers
-        self._guaranteed = frozenset.intersection(*(self._written(s) for s in providers))
+        known = self._written_types
+        self._guaranteed = frozenset.intersection(*[known.get(s.name) or self._written(s) for s in providers])
         self.guaranteed_sorted = tuple(sorted(self._guaranteed))
+        self._latest_round: int | None = None
+
+    @property
+    def latest_round(self) -> int:
+        """The latest fixpoint round among the inputs of any provider."""
+        if self._latest_round is None:
+            self._latest_round = max(map(self._input_round, self._providers))
+        return self._latest_round
 
     def guaranteed(self) -> frozenset[str]:
         """Types the unit produces for others: outputs every provider writes without having read them."""
@@ -339,6 +382,7 @@ class _Assignment:
         self._inputs_for: dict[str, str] | None = None
         self._input_units_of: dict[str, tuple[str, ...]] = {}
         self.pinned: dict[str, str] = {}  # type -> unit chosen for it when several units write it
+        self._order: list[str] | None = None  # the units' types by fixpoint round, then name (until units come or go)
         self._check_feasible()
         self._assign()
         self._prune()
@@ -389,16 +433,19 @@ class _Assignment:
         found: dict[str, str] = {}
         rounds = self.catalog.rounds
         # by-products come from the unit derived earliest, the one least likely to depend on their readers
-        for key in sorted(self.units, key=lambda k: (rounds.get(k, 0), k)):
-            providers = self.units[key].providers
-            for type_name in self.units[key].guaranteed_sorted:
+        by_rounds = self.by_rounds
+        units = self.units
+        if self._order is None:
+            self._order = sorted(units, key=lambda k: (rounds.get(k, 0), k))
+        for key in self._order:
+            unit = units[key]
+            latest = unit.latest_round
+            for type_name in unit.guaranteed_sorted:
                 if type_name in found:
                     continue
-                if self.by_rounds and any(
-                    max((rounds.get(t, 0) for t in s.inputs), default=0) >= rounds.get(type_name, 0) for s in providers
-                ):
+                if by_rounds and latest >= rounds.get(type_name, 0):
                     continue  # a by-product made from later types could close a cycle in the strict mode
-                found.setdefault(type_name, key)
+                found[type_name] = key
         for type_name, key in self.pinned.items():
             if key in self.units and type_name in self.units[key].guaranteed():
                 found[type_name] = key
@@ -411,24 +458,27 @@ class _Assignment:
         :meth:`guaranteed_by`; memoised while it is the current one)."""
         if guaranteed is not self._inputs_for:
             if guaranteed is not self._guaranteed:
-                return tuple(sorted({guaranteed[t] for t in spec.inputs if t in guaranteed}))
+                return _units_of(spec.inputs, guaranteed)
             self._inputs_for = guaranteed
             self._input_units_of = {}
         found = self._input_units_of.get(spec.name)
         if found is None:
-            found = tuple(sorted({guaranteed[t] for t in spec.inputs if t in guaranteed}))
-            self._input_units_of[spec.name] = found
+            found = self._input_units_of[spec.name] = _units_of(spec.inputs, guaranteed)
         return found
 
     def _below(self, key: str) -> set[str]:
         """The unit and every unit it (transitively) needs (through its providers' required inputs)."""
         guaranteed = self.guaranteed_by()
+        table = self._input_units_of if guaranteed is self._inputs_for else {}
         seen = {key}
         frontier = [key]
         while frontier:
             node = frontier.pop()
             for spec in self.units[node].providers:
-                for dep in self._input_units(spec, guaranteed):
+                deps = table.get(spec.name)
+                if deps is None:
+                    deps = self._input_units(spec, guaranteed)
+                for dep in deps:
                     if dep not in seen:
                         seen.add(dep)
                         frontier.append(dep)
@@ -438,10 +488,16 @@ class _Assignment:
         """Let the types ``above`` use unit ``key`` when that makes no cycle (``below``: :meth:`_below` of ``key``,
         when known)."""
         below = self._below(key) if below is None else below
-        if below & above:
+        if not below.isdisjoint(above):
             return False
-        for unit in below:
-            self.above.setdefault(unit, set()).update(above)
+        if above:
+            known = self.above
+            for unit in below:
+                present = known.get(unit)
+                if present is None:
+                    known[unit] = set(above)
+                elif not above <= present:
+                    present |= above
         return True
 
     def _cut_and_reuse(self, key: str, above: set[str]) -> bool:
@@ -475,10 +531,15 @@ class _Assignment:
             return known
         unit = self.units[key]
         guaranteed = self.guaranteed_by()  # as it is now: cuts further down do not change what this level reads
+        # the memo of _input_units for this mapping (a cut further down may start another one: this one stays right)
+        table = self._input_units_of if guaranteed is self._inputs_for else {}
         inner: frozenset[str] | None = None
         keep = []
         for spec in unit.providers:
-            for dep in self._input_units(spec, guaranteed):
+            deps = table.get(spec.name)
+            if deps is None:
+                deps = self._input_units(spec, guaranteed)
+            for dep in deps:
                 if dep == key:
                     continue
                 if dep in above or dep in path:  # what the call for ``dep`` would answer first
@@ -527,16 +588,19 @@ class _Assignment:
 
     def _assign(self) -> None:
         queue: deque[tuple[str, str | None]] = deque((r.annotation_type, None) for r in self.requirements)
+        sensors, units = self.catalog.sensors, self.units
         while queue:
             type_name, consumer = queue.popleft()
-            if type_name in self.catalog.sensors:
+            if type_name in sensors:
                 continue
-            if consumer is not None and (
-                consumer not in self.units or not any(type_name in s.inputs for s in self.units[consumer].providers)
-            ):
-                continue  # the consumer's alternatives that needed it were dropped
-            above = set() if consumer is None else self.above.get(consumer, set()) | {consumer}
-            existing = self.guaranteed_by().get(type_name)
+            if consumer is None:
+                above: set[str] = set()
+            else:
+                unit = units.get(consumer)
+                if unit is None or not any(type_name in s.inputs for s in unit.providers):
+                    continue  # the consumer's alternatives that needed it were dropped
+                above = self.above.get(consumer, set()) | {consumer}
+            existing = (self._guaranteed or self.guaranteed_by()).get(type_name)
             if existing is not None and self._cut_and_reuse(existing, above):
                 continue
             if existing is not None and consumer is not None and self._drop_needing(consumer, type_name):
@@ -564,12 +628,19 @@ class _Assignment:
                 if not self._take_over(type_name, valid, consumer, above):
                     raise _OrderingError(f"cannot produce {type_name}: {self.catalog.why_not(type_name, value)}")
                 continue
-            self.units[type_name] = _UnitChoice(type_name, free, value, self.catalog.written)
+            self.units[type_name] = _UnitChoice(type_name, free, value, self.catalog)
+            self._order = None
             self._invalidate()
             self.above[type_name] = set(above)
+            reasons = self.reasons
             for spec in free:
+                why = f"needed by {spec.name}"
                 for needed in spec.inputs:
-                    self._note(needed, f"needed by {spec.name}")
+                    noted = reasons.get(needed)
+                    if noted is None:
+                        reasons[needed] = [why]
+                    elif why not in noted:
+                        noted.append(why)
                     queue.append((needed, type_name))
 
     def _prune(self) -> None:
@@ -590,7 +661,16 @@ class _Assignment:
                 return
             for key in unneeded:
                 del self.units[key]
+            self._order = None
             self._invalidate()
+
+
+def _units_of(types: tuple[str, ...], guaranteed: Mapping[str, str]) -> tuple[str, ...]:
+    """The units (sorted, each once) that guarantee ``types`` by ``guaranteed``."""
+    if len(types) == 1:
+        key = guaranteed.get(types[0])
+        return () if key is None else (key,)
+    return tuple(sorted({guaranteed[t] for t in types if t in guaranteed}))
 
 
 def _find_cycle(graph: Mapping[str, set[str]]) -> list[str] | None:
@@ -652,6 +732,16 @@ class _Layout:
         self.unrefined = dict(self.final)
         self.refinements = self._refinements()
         self._unit_inputs = self._branch_inputs()
+        self._settle()
+        # a type whose unit moved into a Fallback's branch exists only when that branch ran: a refiner outside
+        # reading it is left out
+        if any(not absorbed.isdisjoint(s.inputs) for specs in self.refinements.values() for s in specs):
+            kept = {t: [s for s in specs if absorbed.isdisjoint(s.inputs)] for t, specs in self.refinements.items()}
+            self.refinements = {t: specs for t, specs in kept.items() if specs}
+            self._settle()
+
+    def _settle(self) -> None:
+        """Connect the units; leave out refinements that close a cycle until none does."""
         while True:
             self._connect()
             cycle = self._required_cycle()

@@ -139,7 +139,7 @@ def pointing_parameters(kb: KnowledgeBase, target: str) -> dict[str, dict[str, o
 
 class QueryPlanner:
     """Plans queries against one knowledge base, keeping what only changes with the ontology (class profiles, the
-    annotators that take parameters).
+    annotators that take parameters, the trackers).
 
     With ``keep_catalogs`` (the default) the requirement-independent work of a plan (providers and fixpoints per
     object class, conditions and sensor types) is kept for later queries; without it every plan starts cold.
@@ -151,6 +151,7 @@ class QueryPlanner:
         self._index: object | None = None
         self._profiles: tuple[dict[str, object], ...] = ()
         self._parameterised: tuple[AnnotatorSpec, ...] = ()
+        self._trackers: tuple[AnnotatorSpec, ...] = ()
         self._catalogs: dict[tuple[object, ...], object] = {}
 
     def _refresh(self) -> None:
@@ -159,6 +160,7 @@ class QueryPlanner:
             self._index = self.kb.index
             self._profiles = class_profiles(self.kb)
             self._parameterised = parameterised_annotators(self.kb)
+            self._trackers = tuple(spec for spec in self.kb.annotators() if TRACK_TYPE in spec.outputs)
             self._catalogs = {}
 
     def profiles(self) -> tuple[dict[str, object], ...]:
@@ -178,9 +180,8 @@ class QueryPlanner:
         conditions = Conditions(depth=depth, region=box is not None, transparent=interpretation.transparent)
         task = interpretation.task
         parameters = annotator_parameters(self.kb, box, self.profiles(), task.object_class, task, self._parameterised)
-        for spec in self.kb.annotators():
-            if TRACK_TYPE in spec.outputs:  # a tracker of any object: told which one to follow
-                parameters.setdefault(spec.name, {}).update(target_parameters(self.kb, task))
+        for spec in self._trackers:  # a tracker of any object: told which one to follow
+            parameters.setdefault(spec.name, {}).update(target_parameters(self.kb, task))
         if task.pointing is not None:
             parameters.update(pointing_parameters(self.kb, task.pointing))
         plan = plan_requirements(

@@ -6,7 +6,7 @@ import statistics
 from dataclasses import dataclass, field
 
 
-@dataclass
+@dataclass(slots=True)
 class RunStats:
     """Durations of an annotator's runs: count, total, maximum and the last; keeps the most recent ``window``
     samples for the median.

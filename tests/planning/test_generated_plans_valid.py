@@ -1,0 +1,73 @@
+"""Plans on a large generated ontology (bench_ontology: random annotators over the real CAS types, whose type
+hierarchy the small random capability ontologies lack) build trees whose data flow is valid.
+
+A refiner of a by-product (an annotator reading and writing a supertype of what some unit makes) once read a type
+whose unit had moved into one branch of a Fallback: the tree read it where only that branch makes it.
+"""
+
+from __future__ import annotations
+
+import importlib.util
+import random
+import sys
+from pathlib import Path
+from types import ModuleType
+
+import pytest
+
+from queries import parse_query
+from reasoning.knowledge.knowledge_base import KnowledgeBase
+from reasoning.planning.plan import Step
+from reasoning.planning.planner import PlanningError, SensorSource
+from reasoning.planning.query_planner import QueryPlanner
+from robokudo.core.annotator import Annotator
+from robokudo.core.types import type_by_name
+from tests.planning.plan_digests import sources
+from trees.synthesis import build_tree
+
+BENCH = Path(__file__).resolve().parents[2] / "bench"
+
+
+def generator() -> ModuleType:
+    """bench/bench_ontology.py, which generates large ontologies."""
+    spec = importlib.util.spec_from_file_location("bench_ontology", BENCH / "bench_ontology.py")
+    assert spec is not None and spec.loader is not None
+    module = importlib.util.module_from_spec(spec)
+    sys.modules["bench_ontology"] = module
+    spec.loader.exec_module(module)
+    return module
+
+
+@pytest.fixture(scope="module")
+def kb(tmp_path_factory: pytest.TempPathFactory) -> KnowledgeBase:
+    module = generator()
+    folder = tmp_path_factory.mktemp("generated")
+    files, declarations = module.generate(folder, random.Random(7), 1000, 200)
+    return KnowledgeBase.load(folder / "user.ttl", files=files, annotators=module.annotator_classes(declarations))
+
+
+def node(step: Step) -> Annotator:
+    """A port-declaring node for a generated annotator (which has no implementation)."""
+    ports = {"inputs": tuple(map(type_by_name, step.inputs)), "outputs": tuple(map(type_by_name, step.outputs))}
+    return type(step.annotator, (Annotator,), ports)()
+
+
+def test_plans_on_a_generated_ontology_have_valid_data_flow(kb: KnowledgeBase) -> None:
+    rng = random.Random(3)
+    names = [c for c in kb.names_of_kind("class") if c.startswith("GenObject")]
+    texts = [f"detect {{ obj: {{ type: {rng.choice(names)}, color: red }} }}" for _ in range(10)]
+    texts += [f"find {rng.choice(names)} in the fridge" for _ in range(5)]
+    assert "detect { obj: { type: GenObject0133, color: red } }" in texts  # the query whose plan was invalid
+    reader = kb.annotator("KitchenSceneReader")
+    chosen = SensorSource(Step(reader.name, reader.implemented_by, (), reader.outputs, (("view", "table"),), "reads"))
+    planner = QueryPlanner(kb)
+    planned = 0
+    for source in (chosen, *sources(kb).values()):
+        for text in texts:
+            try:
+                result = planner.plan(parse_query(text), source)
+            except PlanningError:
+                continue
+            build_tree(result.plan, make=node)  # runs the data-flow validator, which raises on a violation
+            planned += 1
+    assert planned >= len(texts)
