@@ -6,8 +6,9 @@ the depth people detector (:func:`annotators.cloud.people.find_people`) finds, a
 point from the organized cloud (the median of the person's points in a small window around the pixel); without
 a cloud it runs once on the whole image and reports 2-D keypoints only; when the cloud shows no ground to stand
 on (a close view of a person's upper body) it runs on the whole image. A person's points are those connected in
-depth to its shoulders and head (:mod:`annotators.people.body_points`), and its Pose is their centroid, the
-person's 3-D position as robokudo defines it. With a cloud, a skeleton counts only when
+depth to its shoulders and head (:mod:`annotators.people.body_points`) that lie within ``body_reach`` of its
+skeleton's bones (what touches the person in depth, e.g. a door at the pointing hand, is cut off), and its Pose
+is their centroid, the person's 3-D position as robokudo defines it. With a cloud, a skeleton counts only when
 at least ``min_on_person`` of its keypoints fall on the candidate's points (the model, given a crop without a
 person, may still draw one on whatever is there).
 
@@ -97,21 +98,34 @@ def keypoint_points(pixels: np.ndarray, points: np.ndarray, member: np.ndarray |
     """The 3-D point of each keypoint: the median of the valid cloud points (of ``member`` pixels when given)
     within ``window`` pixels of it; NaN where there are none."""
     rows, cols = points.shape[:2]
-    found = np.full((pixels.shape[0], 3), np.nan)
-    for number, (u, v) in enumerate(pixels):
-        if not (np.isfinite(u) and np.isfinite(v)):
-            continue
-        c, r = round(u), round(v)
-        r0, r1, c0, c1 = max(0, r - window), min(rows, r + window + 1), max(0, c - window), min(cols, c + window + 1)
-        if r0 >= r1 or c0 >= c1:
-            continue
-        patch = points[r0:r1, c0:c1].reshape(-1, 3)
-        keep = np.isfinite(patch[:, 2])
-        if member is not None:
-            keep &= member[r0:r1, c0:c1].reshape(-1)
-        if keep.any():
-            found[number] = np.median(patch[keep], axis=0)
-    return found
+    count = pixels.shape[0]
+    usable = np.isfinite(pixels).all(axis=1)
+    centres = np.zeros((count, 2), dtype=np.int64)
+    centres[usable] = np.round(pixels[usable]).astype(np.int64)  # (column, row) of each keypoint
+    offsets = np.arange(-window, window + 1)
+    r = centres[:, 1, None, None] + offsets[None, :, None]  # keypoint x row offset x 1
+    c = centres[:, 0, None, None] + offsets[None, None, :]  # keypoint x 1 x column offset
+    inside = usable[:, None, None] & (r >= 0) & (r < rows) & (c >= 0) & (c < cols)
+    r, c = np.clip(r, 0, rows - 1), np.clip(c, 0, cols - 1)
+    patches = points[r, c].astype(np.float64)  # keypoint x window x window x 3
+    keep = inside & np.isfinite(patches[..., 2])
+    if member is not None:
+        keep &= member[r, c]
+    patches[~keep] = np.nan
+    return _median_of_valid(patches.reshape(count, -1, 3), keep.reshape(count, -1).sum(axis=1))
+
+
+def _median_of_valid(values: np.ndarray, valid: np.ndarray) -> np.ndarray:
+    """Per row of ``values`` (rows x samples x 3, NaN where not valid), the median of its ``valid`` (per row)
+    samples per coordinate; NaN for a row without any."""
+    ordered = np.sort(values, axis=1)  # NaN sorts last
+    low = np.clip((valid - 1) // 2, 0, None)[:, None, None]
+    high = np.clip(valid // 2, 0, None)[:, None, None]
+    low_values = np.take_along_axis(ordered, np.broadcast_to(low, (values.shape[0], 1, 3)), axis=1)[:, 0]
+    high_values = np.take_along_axis(ordered, np.broadcast_to(high, (values.shape[0], 1, 3)), axis=1)[:, 0]
+    median = (low_values + high_values) / 2.0
+    median[valid == 0] = np.nan
+    return median
 
 
 BONES: tuple[tuple[str, str], ...] = (
@@ -178,6 +192,39 @@ class _Followed:
     """Where the person was (camera frame), the centre of the column its points are looked for in."""
     standing: bool = False
     """Whether the search found the person standing on the ground (a depth candidate), not in the whole image."""
+    velocity: np.ndarray | None = None
+    """How fast (m/s, camera frame) the person moved between the last two frames it was followed in."""
+    box_velocity: np.ndarray | None = None
+    """How fast (pixels/s) its box's centre moved then."""
+
+    def predicted(self, gap: float, shape: tuple[int, int]) -> tuple[tuple[int, int, int, int], np.ndarray | None]:
+        """Where the person is expected ``gap`` seconds later: its box shifted as it moved, and its position."""
+        if self.box_velocity is None or gap <= 0:
+            return self.roi, self.position
+        du, dv = np.round(self.box_velocity * gap).astype(int)
+        x0, y0, x1, y1 = self.roi
+        du = int(np.clip(du, -x0, shape[1] - x1))  # the box stays in the image
+        dv = int(np.clip(dv, -y0, shape[0] - y1))
+        position = self.position
+        if position is not None and self.velocity is not None:
+            position = position + self.velocity * gap
+        return (x0 + du, y0 + dv, x1 + du, y1 + dv), position
+
+    def moved(self, roi: tuple[int, int, int, int], position: np.ndarray | None, gap: float, top_speed: float) -> None:
+        """Remember where it was found now (``gap`` seconds after the previous frame); the velocities from the step,
+        a 3-D speed over ``top_speed`` (a jump of the detection, not a walk) counting as none."""
+        self.velocity = self.box_velocity = None
+        if gap > 0:
+            known = position is not None and self.position is not None
+            velocity = (position - self.position) / gap if known else None  # type: ignore[operator]
+            if velocity is None or float(np.linalg.norm(velocity)) <= top_speed:
+                self.velocity = velocity
+                self.box_velocity = (_box_centre(roi) - _box_centre(self.roi)) / gap
+        self.roi, self.position = roi, position
+
+
+def _box_centre(roi: tuple[int, int, int, int]) -> np.ndarray:
+    return np.array([(roi[0] + roi[2]) / 2.0, (roi[1] + roi[3]) / 2.0])
 
 
 def _position(person: PersonHypothesis) -> np.ndarray | None:
@@ -189,14 +236,14 @@ class HumanPoseDetector(Annotator):
     """Finds people with 2-D and 3-D body keypoints (mediapipe pose on crops around depth person candidates).
 
     Run on consecutive frames of one recording (a continuous task's loop), it follows the people it saw: each is
-    looked for only in a crop around where it was in the previous frame (its box grown by ``follow_margin`` of
-    its height), by a video-mode model of its own that runs just the landmark model there; a person the search
-    found standing on the ground has its points looked for as the search did, among those above the ground
-    within a column around its previous position (``column_radius`` plus ``follow_reach`` metres, a step
-    between frames). The full search (the
-    depth candidates, each through the single-image model) runs on the first frame, when a followed person is
-    not found again, when the sequence breaks (another recording, time going back or a gap over ``max_gap``
-    seconds) and every ``search_every`` frames, so people who walk in are found too.
+    looked for only in a crop around where it is expected (its previous box moved on as it moved between the
+    last two frames, grown by ``follow_margin`` of its height), by a video-mode model of its own that runs just
+    the landmark model there; a person the search found standing on the ground has its points looked for as the
+    search did, among those above the ground within a column around its expected position (``column_radius``
+    plus ``follow_reach`` metres, a step off the prediction; a step faster than ``top_speed`` is not used to
+    predict). The full search (the depth candidates, each through the single-image model) runs on the first
+    frame, when a followed person is not found again, when the sequence breaks (another recording, time going
+    back or a gap over ``max_gap`` seconds) and every ``search_every`` frames, so people who walk in are found.
     """
 
     inputs: ClassVar[tuple[type[CasType], ...]] = (ColorImage,)
@@ -221,16 +268,21 @@ class HumanPoseDetector(Annotator):
         follow_reach: float = 0.2,
         search_every: int = 30,
         max_gap: float = 1.0,
+        top_speed: float = 2.5,
         name: str | None = None,
     ) -> None:
         super().__init__(name=name)
         if isinstance(search_every, bool) or not isinstance(search_every, int) or search_every < 1:
             raise ValueError(f"search_every must be a whole number >= 1, not {search_every!r}")
-        for label, value in (("follow_margin", follow_margin), ("follow_reach", follow_reach), ("max_gap", max_gap)):
+        numbers = (
+            ("follow_margin", follow_margin), ("follow_reach", follow_reach), ("max_gap", max_gap),
+            ("top_speed", top_speed),
+        )  # fmt: skip
+        for label, value in numbers:
             if not np.isfinite(value) or value < 0:
                 raise ValueError(f"{label} must be a number >= 0, not {value!r}")
         self.body_reach = body_reach
-        """Without a depth candidate, how far (m) from its skeleton's bones a point counts as the person's."""
+        """How far (m) from its skeleton's bones (or torso) a point counts as the person's."""
         self.min_torso_visibility = min_torso_visibility
         self.crop_margin = crop_margin
         self.min_on_person = min_on_person
@@ -239,11 +291,16 @@ class HumanPoseDetector(Annotator):
         self.follow_reach = follow_reach
         self.search_every = search_every
         self.max_gap = max_gap
+        self.top_speed = top_speed
+        """The fastest a person moves (m/s): a faster step between two frames is a jump of the detection, and the
+        prediction of where the person is next does not use it."""
         self.searches = 0
         """How many frames had the full search (the others followed the people of the previous frame)."""
         self._followed: list[_Followed] = []
         self._video_models: list[Guarded[Any]] = []
         self._sequence: tuple[str, str, float] | None = None
+        self._gap = 0.0
+        """Seconds between the previous frame and this one (0 when unknown)."""
         self._since_search = 0
 
     def model(self) -> Guarded[Any]:
@@ -300,43 +357,46 @@ class HumanPoseDetector(Annotator):
         """True when this frame follows the previous one of the same sequence and no periodic search is due."""
         key = ("", "", 0.0) if info is None else (info.recording, info.frame_id, float(info.timestamp))
         previous, self._sequence = self._sequence, key
+        self._gap = key[2] - previous[2] if previous is not None and key[2] > 0 and previous[2] > 0 else 0.0
         if previous is None or info is None or key[2] <= 0 or self._since_search + 1 >= self.search_every:
             return False
         return previous[:2] == key[:2] and 0 < key[2] - previous[2] <= self.max_gap
 
     def _follow(self, image: np.ndarray, points: np.ndarray | None) -> list[PersonHypothesis] | None:
-        """Each followed person in a crop around its previous box; None when one of them is not found there.
-        A person's points are looked for above the ground (when the cloud shows it), as the search does."""
+        """Each followed person in a crop around its predicted box (its previous box moved on as it moved between
+        the last two frames); None when one of them is not found there. A person's points are looked for above the
+        ground (when the cloud shows it), as the search does, around its predicted position."""
         ground = None
         if points is not None and any(f.standing for f in self._followed):
             up = up_in_camera(self.optional_view(CameraInfo))
             ground = ground_plane(points, np.isfinite(points[..., 2]), IMAGE_UP if up is None else up, self.parameters)
         people = []
         for followed in self._followed:
-            crop = crop_box(followed.roi, image.shape[:2], self.follow_margin)
+            roi, expected = followed.predicted(self._gap, image.shape[:2])
+            crop = crop_box(roi, image.shape[:2], self.follow_margin)
             allowed = np.zeros(image.shape[:2], dtype=bool)
             x0, y0, x1, y1 = crop
             allowed[y0:y1, x0:x1] = True
             if points is not None and ground is not None and followed.standing:
-                allowed[y0:y1, x0:x1] = self._column(points[y0:y1, x0:x1], ground, followed.position)
+                allowed[y0:y1, x0:x1] = self._column(points[y0:y1, x0:x1], ground, expected)
             found = self._look(followed.model, image, points, [(crop, None)], allowed)
-            if len(found) != 1 or not self._near(followed.position, _position(found[0])):
+            if len(found) != 1 or not self._near(expected, _position(found[0])):
                 return None  # lost, or the model drew a person elsewhere: the search decides
             people.append(found[0])
         for followed, person in zip(self._followed, people, strict=True):
-            followed.roi, followed.position = person.roi, _position(person)
+            followed.moved(person.roi, _position(person), self._gap, self.top_speed)
         return people
 
-    def _near(self, before: np.ndarray | None, now: np.ndarray | None) -> bool:
-        """Whether a followed person's position moved at most a step (``follow_reach``) between frames (True when
-        either position is unknown); a farther one is left to the search, so following never drifts away."""
-        if before is None or now is None:
+    def _near(self, expected: np.ndarray | None, now: np.ndarray | None) -> bool:
+        """Whether a followed person's position lies at most a step (``follow_reach``) from where it was expected
+        (True when either position is unknown); a farther one is left to the search, so following never drifts."""
+        if expected is None or now is None:
             return True
-        return bool(np.linalg.norm(now - before) <= self.follow_reach)
+        return bool(np.linalg.norm(now - expected) <= self.follow_reach)
 
     def _column(self, points: np.ndarray, ground: np.ndarray, centre: np.ndarray | None) -> np.ndarray:
         """Which points stand above the ground (``min_height``) within the column (``column_radius`` plus a
-        step's reach, ``follow_reach``) around where the person was, as the search's depth candidates do."""
+        step's reach, ``follow_reach``) around where the person is expected, as the search's depth candidates do."""
         normal = ground[:3].astype(np.float32)
         with np.errstate(invalid="ignore"):
             keep = np.isfinite(points[..., 2]) & (plane_distances(points, ground) > self.parameters.min_height)
@@ -388,6 +448,18 @@ class HumanPoseDetector(Annotator):
             found.append(self._person(pixels, visibility, xyz, candidate, points, allowed))
         return found
 
+    def _near_bones(self, points: np.ndarray, body: np.ndarray, xyz: np.ndarray) -> np.ndarray:
+        """The body pixels within ``body_reach`` of the skeleton's bones (or the torso): what touches the person
+        in depth (a fridge door at her pointing hand, a wall she leans on) is not the person; all of them when no
+        bone has depth."""
+        flat = np.flatnonzero(body)
+        near = near_skeleton(points.reshape(-1, 3)[flat], xyz, self.body_reach)
+        if near is None:
+            return body
+        kept = np.zeros(body.shape, dtype=bool)
+        kept.reshape(-1)[flat[near]] = True
+        return kept
+
     def _person(
         self,
         pixels: np.ndarray,
@@ -415,6 +487,8 @@ class HumanPoseDetector(Annotator):
         position = None
         if points is not None and xyz is not None:
             body = body_mask(points, region, pixels, _unoccluded(xyz))
+            if body is not None and body.any():
+                body = self._near_bones(points, body, xyz)
             if body is None or not body.any():
                 # no seed joint lands on the body: the points near the skeleton's bones (not a table and the
                 # objects in front)
