@@ -18,6 +18,7 @@ score thresholds (the graph's are cleared) and keeps a person only when its tors
 
 from __future__ import annotations
 
+import weakref
 from dataclasses import dataclass
 from typing import Any, ClassVar
 
@@ -184,10 +185,10 @@ def near_skeleton(points: np.ndarray, keypoints: np.ndarray, reach: float) -> np
 
 @dataclass
 class _Followed:
-    """A person seen in the previous frame of a sequence: its image box and the video-mode model following it."""
+    """A person seen in the previous frame of a sequence: its image box and where it is (its video-mode model is
+    the detector's model of the same number)."""
 
     roi: tuple[int, int, int, int]
-    model: Guarded[Any]
     position: np.ndarray | None = None
     """Where the person was (camera frame), the centre of the column its points are looked for in."""
     standing: bool = False
@@ -225,6 +226,14 @@ class _Followed:
 
 def _box_centre(roi: tuple[int, int, int, int]) -> np.ndarray:
     return np.array([(roi[0] + roi[2]) / 2.0, (roi[1] + roi[3]) / 2.0])
+
+
+def _close_models(models: list[Guarded[Any]]) -> None:
+    """Close mediapipe models (each under its lock) and forget them."""
+    for model in models:
+        with model.lock:
+            model.value.close()
+    models.clear()
 
 
 def _position(person: PersonHypothesis) -> np.ndarray | None:
@@ -298,6 +307,10 @@ class HumanPoseDetector(Annotator):
         """How many frames had the full search (the others followed the people of the previous frame)."""
         self._followed: list[_Followed] = []
         self._video_models: list[Guarded[Any]] = []
+        """The video-mode models following people (loaded on the first frame that follows anyone, so a one-shot
+        run loads none), closed when the node is shut down or dropped: an unclosed mediapipe graph keeps its
+        memory (~100 MB)."""
+        self._close_models = weakref.finalize(self, _close_models, self._video_models)
         self._sequence: tuple[str, str, float] | None = None
         self._gap = 0.0
         """Seconds between the previous frame and this one (0 when unknown)."""
@@ -370,8 +383,13 @@ class HumanPoseDetector(Annotator):
         if points is not None and any(f.standing for f in self._followed):
             up = up_in_camera(self.optional_view(CameraInfo))
             ground = ground_plane(points, np.isfinite(points[..., 2]), IMAGE_UP if up is None else up, self.parameters)
+        while len(self._video_models) < len(self._followed):
+            try:
+                self._video_models.append(Guarded(load_pose_model(video=True)))
+            except PoseModelError:
+                return None  # the search runs with the single-image model instead
         people = []
-        for followed in self._followed:
+        for followed, model in zip(self._followed, self._video_models, strict=False):
             roi, expected = followed.predicted(self._gap, image.shape[:2])
             crop = crop_box(roi, image.shape[:2], self.follow_margin)
             allowed = np.zeros(image.shape[:2], dtype=bool)
@@ -379,7 +397,7 @@ class HumanPoseDetector(Annotator):
             allowed[y0:y1, x0:x1] = True
             if points is not None and ground is not None and followed.standing:
                 allowed[y0:y1, x0:x1] = self._column(points[y0:y1, x0:x1], ground, expected)
-            found = self._look(followed.model, image, points, [(crop, None)], allowed)
+            found = self._look(model, image, points, [(crop, None)], allowed)
             if len(found) != 1 or not self._near(expected, _position(found[0])):
                 return None  # lost, or the model drew a person elsewhere: the search decides
             people.append(found[0])
@@ -410,16 +428,12 @@ class HumanPoseDetector(Annotator):
     def _remember(self, people: list[PersonHypothesis], standing: bool) -> None:
         """Follow these people from the next frame on, each with a video-mode model of this node (``standing``:
         they were found as depth candidates standing on the ground, and are looked for there)."""
-        while len(self._video_models) < len(people):
-            try:
-                self._video_models.append(Guarded(load_pose_model(video=True)))
-            except PoseModelError:
-                break
-        self._followed = [
-            _Followed(p.roi, m, _position(p), standing) for p, m in zip(people, self._video_models, strict=False)
-        ]
-        if len(self._followed) < len(people):
-            self._followed = []
+        self._followed = [_Followed(p.roi, _position(p), standing) for p in people]
+
+    def shutdown(self) -> None:
+        """Close the video-mode models (py_trees calls this when the tree shuts down; dropping the node does too)."""
+        self._followed = []
+        self._close_models()
 
     def _look(
         self,
