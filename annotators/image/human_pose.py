@@ -189,6 +189,9 @@ class _Followed:
     the detector's model of the same number)."""
 
     roi: tuple[int, int, int, int]
+    mask: np.ndarray
+    """Its pixels in the previous frame (HxW): blanked out of the crops the other followed people are looked for
+    in, so that the model, which sees one person per crop, does not draw this one there."""
     position: np.ndarray | None = None
     """Where the person was (camera frame), the centre of the column its points are looked for in."""
     standing: bool = False
@@ -211,17 +214,24 @@ class _Followed:
             position = position + self.velocity * gap
         return (x0 + du, y0 + dv, x1 + du, y1 + dv), position
 
-    def moved(self, roi: tuple[int, int, int, int], position: np.ndarray | None, gap: float, top_speed: float) -> None:
-        """Remember where it was found now (``gap`` seconds after the previous frame); the velocities from the step,
-        a 3-D speed over ``top_speed`` (a jump of the detection, not a walk) counting as none."""
-        self.velocity = self.box_velocity = None
+    def moved(self, person: PersonHypothesis, gap: float, top_speed: float) -> None:
+        """Remember where it was found now (``gap`` seconds after the previous frame); the velocities are the mean
+        of the last two steps' (one step's noise does not carry a standing person off), a 3-D speed over
+        ``top_speed`` (a jump of the detection, not a walk) stopping the prediction."""
+        roi, position = person.roi, _position(person)
+        velocity = box_velocity = None
         if gap > 0:
             known = position is not None and self.position is not None
             velocity = (position - self.position) / gap if known else None  # type: ignore[operator]
-            if velocity is None or float(np.linalg.norm(velocity)) <= top_speed:
-                self.velocity = velocity
-                self.box_velocity = (_box_centre(roi) - _box_centre(self.roi)) / gap
-        self.roi, self.position = roi, position
+            box_velocity = (_box_centre(roi) - _box_centre(self.roi)) / gap
+            if velocity is not None and float(np.linalg.norm(velocity)) > top_speed:
+                velocity = box_velocity = None
+        if velocity is not None and self.velocity is not None:
+            velocity = (velocity + self.velocity) / 2.0
+        if box_velocity is not None and self.box_velocity is not None:
+            box_velocity = (box_velocity + self.box_velocity) / 2.0
+        self.velocity, self.box_velocity = velocity, box_velocity
+        self.roi, self.position, self.mask = roi, position, person.mask
 
 
 def _box_centre(roi: tuple[int, int, int, int]) -> np.ndarray:
@@ -397,20 +407,38 @@ class HumanPoseDetector(Annotator):
             allowed[y0:y1, x0:x1] = True
             if points is not None and ground is not None and followed.standing:
                 allowed[y0:y1, x0:x1] = self._column(points[y0:y1, x0:x1], ground, expected)
-            found = self._look(model, image, points, [(crop, None)], allowed)
-            if len(found) != 1 or not self._near(expected, _position(found[0])):
+            shown = self._without_others(image, crop, followed)
+            found = self._look(model, shown, points, [(crop, None)], allowed)
+            if len(found) != 1 or not self._near(followed, expected, _position(found[0])):
                 return None  # lost, or the model drew a person elsewhere: the search decides
             people.append(found[0])
         for followed, person in zip(self._followed, people, strict=True):
-            followed.moved(person.roi, _position(person), self._gap, self.top_speed)
+            followed.moved(person, self._gap, self.top_speed)
         return people
 
-    def _near(self, expected: np.ndarray | None, now: np.ndarray | None) -> bool:
+    def _without_others(self, image: np.ndarray, crop: tuple[int, int, int, int], followed: _Followed) -> np.ndarray:
+        """The image with the other followed people's pixels (of the previous frame, not this one's) painted over
+        in ``crop`` with the crop's median colour; the image itself when none of them reaches into the crop."""
+        x0, y0, x1, y1 = crop
+        others = np.zeros((y1 - y0, x1 - x0), dtype=bool)
+        for other in self._followed:
+            if other is not followed:
+                others |= other.mask[y0:y1, x0:x1]
+        others &= ~followed.mask[y0:y1, x0:x1]
+        if not others.any():
+            return image
+        shown = image.copy()
+        window = shown[y0:y1, x0:x1]
+        window[others] = np.median(window.reshape(-1, 3), axis=0).astype(np.uint8)
+        return shown
+
+    def _near(self, followed: _Followed, expected: np.ndarray | None, now: np.ndarray | None) -> bool:
         """Whether a followed person's position lies at most a step (``follow_reach``) from where it was expected
-        (True when either position is unknown); a farther one is left to the search, so following never drifts."""
-        if expected is None or now is None:
+        or where it was (True when a position is unknown); a farther one is left to the search, so following never
+        drifts."""
+        if expected is None or now is None or followed.position is None:
             return True
-        return bool(np.linalg.norm(now - expected) <= self.follow_reach)
+        return bool(min(np.linalg.norm(now - expected), np.linalg.norm(now - followed.position)) <= self.follow_reach)
 
     def _column(self, points: np.ndarray, ground: np.ndarray, centre: np.ndarray | None) -> np.ndarray:
         """Which points stand above the ground (``min_height``) within the column (``column_radius`` plus a
@@ -428,7 +456,7 @@ class HumanPoseDetector(Annotator):
     def _remember(self, people: list[PersonHypothesis], standing: bool) -> None:
         """Follow these people from the next frame on, each with a video-mode model of this node (``standing``:
         they were found as depth candidates standing on the ground, and are looked for there)."""
-        self._followed = [_Followed(p.roi, _position(p), standing) for p in people]
+        self._followed = [_Followed(p.roi, p.mask, _position(p), standing) for p in people]
 
     def shutdown(self) -> None:
         """Close the video-mode models (py_trees calls this when the tree shuts down; dropping the node does too)."""
