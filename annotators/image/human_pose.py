@@ -161,25 +161,34 @@ def near_skeleton(points: np.ndarray, keypoints: np.ndarray, reach: float) -> np
     """Which of the Nx3 ``points`` lie within ``reach`` of a bone between keypoints with depth (33x3); the torso
     (between the shoulders and the hips) counts too. None when no bone has depth at both ends."""
     keypoints = _unoccluded(keypoints)
-    near = np.zeros(points.shape[0], dtype=bool)
-    valid = np.isfinite(points[:, 2])
+    cloud = np.asarray(points, dtype=np.float64)
+    near = np.zeros(cloud.shape[0], dtype=bool)
+    open_ = np.flatnonzero(np.isfinite(cloud[:, 2]))  # the valid points not found near yet (each bone tests only these)
+    corners = keypoints[list(TORSO)]
+    if np.all(np.isfinite(corners)):  # the torso first: it holds most of a person's points
+        centre = corners.mean(axis=0)
+        radius = float(np.max(np.linalg.norm(corners - centre, axis=1)))
+        offset = cloud[open_] - centre
+        inside = np.einsum("ij,ij->i", offset, offset) < radius * radius
+        near[open_[inside]] = True
+        open_ = open_[~inside]
     used = 0
     for first, second in BONES:
         a, b = keypoints[LANDMARKS.index(first)], keypoints[LANDMARKS.index(second)]
         if not (np.all(np.isfinite(a)) and np.all(np.isfinite(b))):
             continue
         used += 1
+        if open_.size == 0:
+            continue
         ab = b - a
         length = float(ab @ ab)
-        t = np.zeros(points.shape[0]) if length < 1e-12 else np.clip((points - a) @ ab / length, 0.0, 1.0)
-        with np.errstate(invalid="ignore"):
-            near |= valid & (np.linalg.norm(points - (a + t[:, None] * ab), axis=1) < reach + (first == "nose") * 0.05)
-    corners = keypoints[list(TORSO)]
-    if np.all(np.isfinite(corners)):
-        centre = corners.mean(axis=0)
-        radius = float(np.max(np.linalg.norm(corners - centre, axis=1)))
-        with np.errstate(invalid="ignore"):
-            near |= valid & (np.linalg.norm(points - centre, axis=1) < radius)
+        offset = cloud[open_] - a
+        t = np.zeros(open_.size) if length < 1e-12 else np.clip(offset @ ab / length, 0.0, 1.0)
+        offset -= t[:, None] * ab
+        limit = reach + (first == "nose") * 0.05
+        inside = np.einsum("ij,ij->i", offset, offset) < limit * limit
+        near[open_[inside]] = True
+        open_ = open_[~inside]
     return near if used else None
 
 
@@ -286,7 +295,7 @@ class HumanPoseDetector(Annotator):
         follow_margin: float = 0.2,
         follow_reach: float = 0.2,
         search_every: int = 30,
-        max_gap: float = 1.0,
+        max_gap: float = 5.0,
         top_speed: float = 2.5,
         name: str | None = None,
     ) -> None:
@@ -310,6 +319,9 @@ class HumanPoseDetector(Annotator):
         self.follow_reach = follow_reach
         self.search_every = search_every
         self.max_gap = max_gap
+        """The longest time (s) between two frames of one sequence: more than a search takes on a busy machine (a
+        shorter one made every frame after a search a break, so a slow search never led to following); a person
+        who moved farther than a step meanwhile is searched for anyway."""
         self.top_speed = top_speed
         """The fastest a person moves (m/s): a faster step between two frames is a jump of the detection, and the
         prediction of where the person is next does not use it."""
