@@ -6,8 +6,9 @@ the depth people detector (:func:`annotators.cloud.people.find_people`) finds, a
 point from the organized cloud (the median of the person's points in a small window around the pixel); without
 a cloud it runs once on the whole image and reports 2-D keypoints only; when the cloud shows no ground to stand
 on (a close view of a person's upper body) it runs on the whole image. A person's points are those connected in
-depth to its shoulders and head (:mod:`annotators.people.body_points`), and its Pose is their centroid, the
-person's 3-D position as robokudo defines it. With a cloud, a skeleton counts only when
+depth to its shoulders and head (:mod:`annotators.people.body_points`) that lie within ``body_reach`` of its
+skeleton's bones (what touches the person in depth, e.g. a door at the pointing hand, is cut off), and its Pose
+is their centroid, the person's 3-D position as robokudo defines it. With a cloud, a skeleton counts only when
 at least ``min_on_person`` of its keypoints fall on the candidate's points (the model, given a crop without a
 person, may still draw one on whatever is there).
 
@@ -17,6 +18,7 @@ score thresholds (the graph's are cleared) and keeps a person only when its tors
 
 from __future__ import annotations
 
+import weakref
 from dataclasses import dataclass
 from typing import Any, ClassVar
 
@@ -97,21 +99,34 @@ def keypoint_points(pixels: np.ndarray, points: np.ndarray, member: np.ndarray |
     """The 3-D point of each keypoint: the median of the valid cloud points (of ``member`` pixels when given)
     within ``window`` pixels of it; NaN where there are none."""
     rows, cols = points.shape[:2]
-    found = np.full((pixels.shape[0], 3), np.nan)
-    for number, (u, v) in enumerate(pixels):
-        if not (np.isfinite(u) and np.isfinite(v)):
-            continue
-        c, r = round(u), round(v)
-        r0, r1, c0, c1 = max(0, r - window), min(rows, r + window + 1), max(0, c - window), min(cols, c + window + 1)
-        if r0 >= r1 or c0 >= c1:
-            continue
-        patch = points[r0:r1, c0:c1].reshape(-1, 3)
-        keep = np.isfinite(patch[:, 2])
-        if member is not None:
-            keep &= member[r0:r1, c0:c1].reshape(-1)
-        if keep.any():
-            found[number] = np.median(patch[keep], axis=0)
-    return found
+    count = pixels.shape[0]
+    usable = np.isfinite(pixels).all(axis=1)
+    centres = np.zeros((count, 2), dtype=np.int64)
+    centres[usable] = np.round(pixels[usable]).astype(np.int64)  # (column, row) of each keypoint
+    offsets = np.arange(-window, window + 1)
+    r = centres[:, 1, None, None] + offsets[None, :, None]  # keypoint x row offset x 1
+    c = centres[:, 0, None, None] + offsets[None, None, :]  # keypoint x 1 x column offset
+    inside = usable[:, None, None] & (r >= 0) & (r < rows) & (c >= 0) & (c < cols)
+    r, c = np.clip(r, 0, rows - 1), np.clip(c, 0, cols - 1)
+    patches = points[r, c].astype(np.float64)  # keypoint x window x window x 3
+    keep = inside & np.isfinite(patches[..., 2])
+    if member is not None:
+        keep &= member[r, c]
+    patches[~keep] = np.nan
+    return _median_of_valid(patches.reshape(count, -1, 3), keep.reshape(count, -1).sum(axis=1))
+
+
+def _median_of_valid(values: np.ndarray, valid: np.ndarray) -> np.ndarray:
+    """Per row of ``values`` (rows x samples x 3, NaN where not valid), the median of its ``valid`` (per row)
+    samples per coordinate; NaN for a row without any."""
+    ordered = np.sort(values, axis=1)  # NaN sorts last
+    low = np.clip((valid - 1) // 2, 0, None)[:, None, None]
+    high = np.clip(valid // 2, 0, None)[:, None, None]
+    low_values = np.take_along_axis(ordered, np.broadcast_to(low, (values.shape[0], 1, 3)), axis=1)[:, 0]
+    high_values = np.take_along_axis(ordered, np.broadcast_to(high, (values.shape[0], 1, 3)), axis=1)[:, 0]
+    median = (low_values + high_values) / 2.0
+    median[valid == 0] = np.nan
+    return median
 
 
 BONES: tuple[tuple[str, str], ...] = (
@@ -146,38 +161,98 @@ def near_skeleton(points: np.ndarray, keypoints: np.ndarray, reach: float) -> np
     """Which of the Nx3 ``points`` lie within ``reach`` of a bone between keypoints with depth (33x3); the torso
     (between the shoulders and the hips) counts too. None when no bone has depth at both ends."""
     keypoints = _unoccluded(keypoints)
-    near = np.zeros(points.shape[0], dtype=bool)
-    valid = np.isfinite(points[:, 2])
+    cloud = np.asarray(points, dtype=np.float64)
+    near = np.zeros(cloud.shape[0], dtype=bool)
+    open_ = np.flatnonzero(np.isfinite(cloud[:, 2]))  # the valid points not found near yet (each bone tests only these)
+    corners = keypoints[list(TORSO)]
+    if np.all(np.isfinite(corners)):  # the torso first: it holds most of a person's points
+        centre = corners.mean(axis=0)
+        radius = float(np.max(np.linalg.norm(corners - centre, axis=1)))
+        offset = cloud[open_] - centre
+        inside = np.einsum("ij,ij->i", offset, offset) < radius * radius
+        near[open_[inside]] = True
+        open_ = open_[~inside]
     used = 0
     for first, second in BONES:
         a, b = keypoints[LANDMARKS.index(first)], keypoints[LANDMARKS.index(second)]
         if not (np.all(np.isfinite(a)) and np.all(np.isfinite(b))):
             continue
         used += 1
+        if open_.size == 0:
+            continue
         ab = b - a
         length = float(ab @ ab)
-        t = np.zeros(points.shape[0]) if length < 1e-12 else np.clip((points - a) @ ab / length, 0.0, 1.0)
-        with np.errstate(invalid="ignore"):
-            near |= valid & (np.linalg.norm(points - (a + t[:, None] * ab), axis=1) < reach + (first == "nose") * 0.05)
-    corners = keypoints[list(TORSO)]
-    if np.all(np.isfinite(corners)):
-        centre = corners.mean(axis=0)
-        radius = float(np.max(np.linalg.norm(corners - centre, axis=1)))
-        with np.errstate(invalid="ignore"):
-            near |= valid & (np.linalg.norm(points - centre, axis=1) < radius)
+        offset = cloud[open_] - a
+        t = np.zeros(open_.size) if length < 1e-12 else np.clip(offset @ ab / length, 0.0, 1.0)
+        offset -= t[:, None] * ab
+        limit = reach + (first == "nose") * 0.05
+        inside = np.einsum("ij,ij->i", offset, offset) < limit * limit
+        near[open_[inside]] = True
+        open_ = open_[~inside]
     return near if used else None
 
 
 @dataclass
 class _Followed:
-    """A person seen in the previous frame of a sequence: its image box and the video-mode model following it."""
+    """A person seen in the previous frame of a sequence: its image box and where it is (its video-mode model is
+    the detector's model of the same number)."""
 
     roi: tuple[int, int, int, int]
-    model: Guarded[Any]
+    mask: np.ndarray
+    """Its pixels in the previous frame (HxW): blanked out of the crops the other followed people are looked for
+    in, so that the model, which sees one person per crop, does not draw this one there."""
     position: np.ndarray | None = None
     """Where the person was (camera frame), the centre of the column its points are looked for in."""
     standing: bool = False
     """Whether the search found the person standing on the ground (a depth candidate), not in the whole image."""
+    velocity: np.ndarray | None = None
+    """How fast (m/s, camera frame) the person moved between the last two frames it was followed in."""
+    box_velocity: np.ndarray | None = None
+    """How fast (pixels/s) its box's centre moved then."""
+
+    def predicted(self, gap: float, shape: tuple[int, int]) -> tuple[tuple[int, int, int, int], np.ndarray | None]:
+        """Where the person is expected ``gap`` seconds later: its box shifted as it moved, and its position."""
+        if self.box_velocity is None or gap <= 0:
+            return self.roi, self.position
+        du, dv = np.round(self.box_velocity * gap).astype(int)
+        x0, y0, x1, y1 = self.roi
+        du = int(np.clip(du, -x0, shape[1] - x1))  # the box stays in the image
+        dv = int(np.clip(dv, -y0, shape[0] - y1))
+        position = self.position
+        if position is not None and self.velocity is not None:
+            position = position + self.velocity * gap
+        return (x0 + du, y0 + dv, x1 + du, y1 + dv), position
+
+    def moved(self, person: PersonHypothesis, gap: float, top_speed: float) -> None:
+        """Remember where it was found now (``gap`` seconds after the previous frame); the velocities are the mean
+        of the last two steps' (one step's noise does not carry a standing person off), a 3-D speed over
+        ``top_speed`` (a jump of the detection, not a walk) stopping the prediction."""
+        roi, position = person.roi, _position(person)
+        velocity = box_velocity = None
+        if gap > 0:
+            known = position is not None and self.position is not None
+            velocity = (position - self.position) / gap if known else None  # type: ignore[operator]
+            box_velocity = (_box_centre(roi) - _box_centre(self.roi)) / gap
+            if velocity is not None and float(np.linalg.norm(velocity)) > top_speed:
+                velocity = box_velocity = None
+        if velocity is not None and self.velocity is not None:
+            velocity = (velocity + self.velocity) / 2.0
+        if box_velocity is not None and self.box_velocity is not None:
+            box_velocity = (box_velocity + self.box_velocity) / 2.0
+        self.velocity, self.box_velocity = velocity, box_velocity
+        self.roi, self.position, self.mask = roi, position, person.mask
+
+
+def _box_centre(roi: tuple[int, int, int, int]) -> np.ndarray:
+    return np.array([(roi[0] + roi[2]) / 2.0, (roi[1] + roi[3]) / 2.0])
+
+
+def _close_models(models: list[Guarded[Any]]) -> None:
+    """Close mediapipe models (each under its lock) and forget them."""
+    for model in models:
+        with model.lock:
+            model.value.close()
+    models.clear()
 
 
 def _position(person: PersonHypothesis) -> np.ndarray | None:
@@ -189,14 +264,14 @@ class HumanPoseDetector(Annotator):
     """Finds people with 2-D and 3-D body keypoints (mediapipe pose on crops around depth person candidates).
 
     Run on consecutive frames of one recording (a continuous task's loop), it follows the people it saw: each is
-    looked for only in a crop around where it was in the previous frame (its box grown by ``follow_margin`` of
-    its height), by a video-mode model of its own that runs just the landmark model there; a person the search
-    found standing on the ground has its points looked for as the search did, among those above the ground
-    within a column around its previous position (``column_radius`` plus ``follow_reach`` metres, a step
-    between frames). The full search (the
-    depth candidates, each through the single-image model) runs on the first frame, when a followed person is
-    not found again, when the sequence breaks (another recording, time going back or a gap over ``max_gap``
-    seconds) and every ``search_every`` frames, so people who walk in are found too.
+    looked for only in a crop around where it is expected (its previous box moved on as it moved between the
+    last two frames, grown by ``follow_margin`` of its height), by a video-mode model of its own that runs just
+    the landmark model there; a person the search found standing on the ground has its points looked for as the
+    search did, among those above the ground within a column around its expected position (``column_radius``
+    plus ``follow_reach`` metres, a step off the prediction; a step faster than ``top_speed`` is not used to
+    predict). The full search (the depth candidates, each through the single-image model) runs on the first
+    frame, when a followed person is not found again, when the sequence breaks (another recording, time going
+    back or a gap over ``max_gap`` seconds) and every ``search_every`` frames, so people who walk in are found.
     """
 
     inputs: ClassVar[tuple[type[CasType], ...]] = (ColorImage,)
@@ -220,17 +295,22 @@ class HumanPoseDetector(Annotator):
         follow_margin: float = 0.2,
         follow_reach: float = 0.2,
         search_every: int = 30,
-        max_gap: float = 1.0,
+        max_gap: float = 5.0,
+        top_speed: float = 2.5,
         name: str | None = None,
     ) -> None:
         super().__init__(name=name)
         if isinstance(search_every, bool) or not isinstance(search_every, int) or search_every < 1:
             raise ValueError(f"search_every must be a whole number >= 1, not {search_every!r}")
-        for label, value in (("follow_margin", follow_margin), ("follow_reach", follow_reach), ("max_gap", max_gap)):
+        numbers = (
+            ("follow_margin", follow_margin), ("follow_reach", follow_reach), ("max_gap", max_gap),
+            ("top_speed", top_speed),
+        )  # fmt: skip
+        for label, value in numbers:
             if not np.isfinite(value) or value < 0:
                 raise ValueError(f"{label} must be a number >= 0, not {value!r}")
         self.body_reach = body_reach
-        """Without a depth candidate, how far (m) from its skeleton's bones a point counts as the person's."""
+        """How far (m) from its skeleton's bones (or torso) a point counts as the person's."""
         self.min_torso_visibility = min_torso_visibility
         self.crop_margin = crop_margin
         self.min_on_person = min_on_person
@@ -239,11 +319,23 @@ class HumanPoseDetector(Annotator):
         self.follow_reach = follow_reach
         self.search_every = search_every
         self.max_gap = max_gap
+        """The longest time (s) between two frames of one sequence: more than a search takes on a busy machine (a
+        shorter one made every frame after a search a break, so a slow search never led to following); a person
+        who moved farther than a step meanwhile is searched for anyway."""
+        self.top_speed = top_speed
+        """The fastest a person moves (m/s): a faster step between two frames is a jump of the detection, and the
+        prediction of where the person is next does not use it."""
         self.searches = 0
         """How many frames had the full search (the others followed the people of the previous frame)."""
         self._followed: list[_Followed] = []
         self._video_models: list[Guarded[Any]] = []
+        """The video-mode models following people (loaded on the first frame that follows anyone, so a one-shot
+        run loads none), closed when the node is shut down or dropped: an unclosed mediapipe graph keeps its
+        memory (~100 MB)."""
+        self._close_models = weakref.finalize(self, _close_models, self._video_models)
         self._sequence: tuple[str, str, float] | None = None
+        self._gap = 0.0
+        """Seconds between the previous frame and this one (0 when unknown)."""
         self._since_search = 0
 
     def model(self) -> Guarded[Any]:
@@ -300,43 +392,69 @@ class HumanPoseDetector(Annotator):
         """True when this frame follows the previous one of the same sequence and no periodic search is due."""
         key = ("", "", 0.0) if info is None else (info.recording, info.frame_id, float(info.timestamp))
         previous, self._sequence = self._sequence, key
+        self._gap = key[2] - previous[2] if previous is not None and key[2] > 0 and previous[2] > 0 else 0.0
         if previous is None or info is None or key[2] <= 0 or self._since_search + 1 >= self.search_every:
             return False
         return previous[:2] == key[:2] and 0 < key[2] - previous[2] <= self.max_gap
 
     def _follow(self, image: np.ndarray, points: np.ndarray | None) -> list[PersonHypothesis] | None:
-        """Each followed person in a crop around its previous box; None when one of them is not found there.
-        A person's points are looked for above the ground (when the cloud shows it), as the search does."""
+        """Each followed person in a crop around its predicted box (its previous box moved on as it moved between
+        the last two frames); None when one of them is not found there. A person's points are looked for above the
+        ground (when the cloud shows it), as the search does, around its predicted position."""
         ground = None
         if points is not None and any(f.standing for f in self._followed):
             up = up_in_camera(self.optional_view(CameraInfo))
             ground = ground_plane(points, np.isfinite(points[..., 2]), IMAGE_UP if up is None else up, self.parameters)
+        while len(self._video_models) < len(self._followed):
+            try:
+                self._video_models.append(Guarded(load_pose_model(video=True)))
+            except PoseModelError:
+                return None  # the search runs with the single-image model instead
         people = []
-        for followed in self._followed:
-            crop = crop_box(followed.roi, image.shape[:2], self.follow_margin)
+        for followed, model in zip(self._followed, self._video_models, strict=False):
+            roi, expected = followed.predicted(self._gap, image.shape[:2])
+            crop = crop_box(roi, image.shape[:2], self.follow_margin)
             allowed = np.zeros(image.shape[:2], dtype=bool)
             x0, y0, x1, y1 = crop
             allowed[y0:y1, x0:x1] = True
             if points is not None and ground is not None and followed.standing:
-                allowed[y0:y1, x0:x1] = self._column(points[y0:y1, x0:x1], ground, followed.position)
-            found = self._look(followed.model, image, points, [(crop, None)], allowed)
-            if len(found) != 1 or not self._near(followed.position, _position(found[0])):
+                allowed[y0:y1, x0:x1] = self._column(points[y0:y1, x0:x1], ground, expected)
+            shown = self._without_others(image, crop, followed)
+            found = self._look(model, shown, points, [(crop, None)], allowed)
+            if len(found) != 1 or not self._near(followed, expected, _position(found[0])):
                 return None  # lost, or the model drew a person elsewhere: the search decides
             people.append(found[0])
         for followed, person in zip(self._followed, people, strict=True):
-            followed.roi, followed.position = person.roi, _position(person)
+            followed.moved(person, self._gap, self.top_speed)
         return people
 
-    def _near(self, before: np.ndarray | None, now: np.ndarray | None) -> bool:
-        """Whether a followed person's position moved at most a step (``follow_reach``) between frames (True when
-        either position is unknown); a farther one is left to the search, so following never drifts away."""
-        if before is None or now is None:
+    def _without_others(self, image: np.ndarray, crop: tuple[int, int, int, int], followed: _Followed) -> np.ndarray:
+        """The image with the other followed people's pixels (of the previous frame, not this one's) painted over
+        in ``crop`` with the crop's median colour; the image itself when none of them reaches into the crop."""
+        x0, y0, x1, y1 = crop
+        others = np.zeros((y1 - y0, x1 - x0), dtype=bool)
+        for other in self._followed:
+            if other is not followed:
+                others |= other.mask[y0:y1, x0:x1]
+        others &= ~followed.mask[y0:y1, x0:x1]
+        if not others.any():
+            return image
+        shown = image.copy()
+        window = shown[y0:y1, x0:x1]
+        window[others] = np.median(window.reshape(-1, 3), axis=0).astype(np.uint8)
+        return shown
+
+    def _near(self, followed: _Followed, expected: np.ndarray | None, now: np.ndarray | None) -> bool:
+        """Whether a followed person's position lies at most a step (``follow_reach``) from where it was expected
+        or where it was (True when a position is unknown); a farther one is left to the search, so following never
+        drifts."""
+        if expected is None or now is None or followed.position is None:
             return True
-        return bool(np.linalg.norm(now - before) <= self.follow_reach)
+        return bool(min(np.linalg.norm(now - expected), np.linalg.norm(now - followed.position)) <= self.follow_reach)
 
     def _column(self, points: np.ndarray, ground: np.ndarray, centre: np.ndarray | None) -> np.ndarray:
         """Which points stand above the ground (``min_height``) within the column (``column_radius`` plus a
-        step's reach, ``follow_reach``) around where the person was, as the search's depth candidates do."""
+        step's reach, ``follow_reach``) around where the person is expected, as the search's depth candidates do."""
         normal = ground[:3].astype(np.float32)
         with np.errstate(invalid="ignore"):
             keep = np.isfinite(points[..., 2]) & (plane_distances(points, ground) > self.parameters.min_height)
@@ -350,16 +468,12 @@ class HumanPoseDetector(Annotator):
     def _remember(self, people: list[PersonHypothesis], standing: bool) -> None:
         """Follow these people from the next frame on, each with a video-mode model of this node (``standing``:
         they were found as depth candidates standing on the ground, and are looked for there)."""
-        while len(self._video_models) < len(people):
-            try:
-                self._video_models.append(Guarded(load_pose_model(video=True)))
-            except PoseModelError:
-                break
-        self._followed = [
-            _Followed(p.roi, m, _position(p), standing) for p, m in zip(people, self._video_models, strict=False)
-        ]
-        if len(self._followed) < len(people):
-            self._followed = []
+        self._followed = [_Followed(p.roi, p.mask, _position(p), standing) for p in people]
+
+    def shutdown(self) -> None:
+        """Close the video-mode models (py_trees calls this when the tree shuts down; dropping the node does too)."""
+        self._followed = []
+        self._close_models()
 
     def _look(
         self,
@@ -388,6 +502,18 @@ class HumanPoseDetector(Annotator):
             found.append(self._person(pixels, visibility, xyz, candidate, points, allowed))
         return found
 
+    def _near_bones(self, points: np.ndarray, body: np.ndarray, xyz: np.ndarray) -> np.ndarray:
+        """The body pixels within ``body_reach`` of the skeleton's bones (or the torso): what touches the person
+        in depth (a fridge door at her pointing hand, a wall she leans on) is not the person; all of them when no
+        bone has depth."""
+        flat = np.flatnonzero(body)
+        near = near_skeleton(points.reshape(-1, 3)[flat], xyz, self.body_reach)
+        if near is None:
+            return body
+        kept = np.zeros(body.shape, dtype=bool)
+        kept.reshape(-1)[flat[near]] = True
+        return kept
+
     def _person(
         self,
         pixels: np.ndarray,
@@ -415,6 +541,8 @@ class HumanPoseDetector(Annotator):
         position = None
         if points is not None and xyz is not None:
             body = body_mask(points, region, pixels, _unoccluded(xyz))
+            if body is not None and body.any():
+                body = self._near_bones(points, body, xyz)
             if body is None or not body.any():
                 # no seed joint lands on the body: the points near the skeleton's bones (not a table and the
                 # objects in front)

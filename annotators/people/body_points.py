@@ -19,7 +19,9 @@ filter it. Why this and not a body-model point such as the pelvis:
 skeleton holds the person and whatever is in the same image region. The person's points are those connected in
 depth to the person's shoulders and head: neighbouring pixels are joined when their depths differ by less than
 ``step`` (metres, growing with distance); a depth step (the edge of an object in front, the table's far edge
-below the body) cuts the region there.
+below the body) cuts the region there. The pose detector keeps of them those near the skeleton's bones
+(:func:`annotators.image.human_pose.near_skeleton`): a surface the person touches (a door at her pointing hand)
+is connected in depth but is not the person.
 """
 
 from __future__ import annotations
@@ -47,9 +49,41 @@ def body_mask(
     ``keypoints`` (33x3) the person's landmarks. A seed is the region holding most pixels within ``window`` of
     a seed landmark whose depth is within one depth step of the landmark's 3-D point. None when no seed lands.
     """
-    rows, cols = allowed.shape
-    if points.shape[:2] != (rows, cols) or pixels.shape[0] <= max(SEED_JOINTS):
+    if points.shape[:2] != allowed.shape or pixels.shape[0] <= max(SEED_JOINTS):
         raise ValueError("the cloud, the allowed mask and the keypoints do not describe one image")
+    window_box = _bounding_box(allowed)
+    if window_box is None:
+        return None
+    # regions never join across pixels outside ``allowed``: the work is done in its bounding box only
+    top, left, bottom, right_edge = window_box
+    inside = _region_mask(
+        points[top:bottom, left:right_edge],
+        allowed[top:bottom, left:right_edge],
+        pixels - (left, top),
+        keypoints,
+        window,
+    )
+    if inside is None:
+        return None
+    mask = np.zeros(allowed.shape, dtype=bool)
+    mask[top:bottom, left:right_edge] = inside
+    return mask
+
+
+def _bounding_box(mask: np.ndarray) -> tuple[int, int, int, int] | None:
+    """The rows and columns (top, left, bottom, right; exclusive ends) that hold the mask's pixels, or None."""
+    rows = np.flatnonzero(mask.any(axis=1))
+    if rows.size == 0:
+        return None
+    cols = np.flatnonzero(mask[rows[0] : rows[-1] + 1].any(axis=0))
+    return int(rows[0]), int(cols[0]), int(rows[-1]) + 1, int(cols[-1]) + 1
+
+
+def _region_mask(
+    points: np.ndarray, allowed: np.ndarray, pixels: np.ndarray, keypoints: np.ndarray, window: int
+) -> np.ndarray | None:
+    """:func:`body_mask` within one window of the image (``pixels`` in the window's coordinates)."""
+    rows, cols = allowed.shape
     z = points[..., 2]
     valid = allowed & np.isfinite(z)
     if not valid.any():

@@ -142,6 +142,10 @@ CLOCKS: tuple[str, ...] = ("wall", "frames")
 jump), or one camera period per delivered frame (the world waits for a slow consumer; frame time stamps are
 world time)."""
 
+KEPT_RECORDING_BYTES = 256 * 2**20
+"""A looping recording whose decoded frames take at most this many bytes is decoded once and replayed from
+memory (a single frame played as a sequence is not decoded again every run)."""
+
 MAX_REMEMBERED_POSES = 1000
 """How many delivered frames' person poses a scripted kitchen stream keeps for :meth:`pose_at_stamp`."""
 
@@ -376,10 +380,23 @@ RecordedFrames = Callable[[], Iterator[tuple[Frame, str]]]
 
 
 class PlaybackStream(FrameStream):
-    """Plays a recording frame after frame (see the module docstring); ``rate_hz`` None plays at the recorded rate."""
+    """Plays a recording frame after frame (see the module docstring); ``rate_hz`` None plays at the recorded rate.
+    When looping, a recording whose decoded frames fit in ``keep_bytes`` is replayed from memory after its first
+    play (the frames are read-only for the consumers)."""
 
-    def __init__(self, frames: RecordedFrames, name: str, rate_hz: float | None = None, loop: bool = True) -> None:
+    def __init__(
+        self,
+        frames: RecordedFrames,
+        name: str,
+        rate_hz: float | None = None,
+        loop: bool = True,
+        keep_bytes: int = KEPT_RECORDING_BYTES,
+    ) -> None:
         super().__init__(name=name)
+        self.keep_bytes = keep_bytes
+        self._kept: list[tuple[Frame, str]] | None = [] if loop and keep_bytes > 0 else None
+        self._kept_bytes = 0
+        self._replay: tuple[tuple[Frame, str], ...] | None = None
         self.rate_hz = None if rate_hz is None else _check_rate(rate_hz)
         self.loop = loop
         self._open = frames
@@ -410,11 +427,13 @@ class PlaybackStream(FrameStream):
         """The next frame of the recording (starting over when looping); SourceEndedError after a single play."""
         for attempt in range(2):
             if self._frames is None:
-                self._frames = self._open()
+                self._frames = iter(self._replay) if self._replay is not None else self._open()
             try:
                 frame, recording = next(self._frames)
             except StopIteration:
                 self._frames = None
+                if self._kept is not None and self._index > 0:  # the whole first play fitted: replay it from now on
+                    self._replay, self._kept = tuple(self._kept), None
                 if self._index == 0:
                     raise SourceEndedError(f"{self.name}: the recording holds no frame") from None
                 if not self.loop or attempt == 1:
@@ -425,8 +444,20 @@ class PlaybackStream(FrameStream):
                 self._previous_stamp = None
                 continue
             self._index += 1
+            self._keep(frame, recording)
             return frame, recording, self._index - 1
         raise SourceEndedError(f"{self.name}: the recording holds no frame")
+
+    def _keep(self, frame: Frame, recording: str) -> None:
+        """Keep a frame of the first play while the recording fits in ``keep_bytes``."""
+        if self._kept is None:
+            return
+        arrays = (frame.color, frame.depth, frame.points, frame.labels)
+        self._kept_bytes += sum(a.nbytes for a in arrays if a is not None)
+        if self._kept_bytes > self.keep_bytes:
+            self._kept = None  # too long: decoded again on every play
+        else:
+            self._kept.append((frame, recording))
 
     def _next(self, block: bool) -> StreamFrame | None:
         """The recording's next frame once it is due (frames are never skipped)."""

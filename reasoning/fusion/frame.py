@@ -114,7 +114,10 @@ def _index_set(hypothesis: ObjectHypothesis) -> np.ndarray:
     indices = np.asarray(hypothesis.point_indices).ravel()
     if indices.size == 0 and hypothesis.mask is not None and np.asarray(hypothesis.mask).size > 1:
         indices = np.flatnonzero(hypothesis.mask)
-    return np.unique(indices.astype(np.int64, copy=False))
+    indices = indices.astype(np.int64, copy=False)
+    if indices.size < 2 or bool(np.all(indices[1:] > indices[:-1])):  # already sorted and unique (flatnonzero)
+        return indices
+    return np.unique(indices)
 
 
 def _roi_overlaps(a: tuple[int, int, int, int], b: tuple[int, int, int, int]) -> bool:
