@@ -25,6 +25,12 @@ from robokudo.core.capability import Capability
 from robokudo.core.geometry import quaternion_from_matrix
 from robokudo.core.types import CameraInfo, CasType, FreePlacement, Plane, PointCloud
 
+DEFAULT_CELL_M = 0.01
+"""Side of an occupancy-grid cell on the surface."""
+
+DEFAULT_CLEARANCE_M = 0.01
+"""Distance every reported placement keeps from anything standing on the surface."""
+
 
 def grid_stride(points: np.ndarray, surface: np.ndarray, cell: float, samples: int = 500) -> int:
     """The pixel stride that keeps about two measured points per ``cell`` along the surface: the median distance
@@ -69,10 +75,10 @@ class FreeSpaceEstimator(Annotator):
         region: str = "",
         box_pose: Sequence[float] | None = None,
         box_size: Sequence[float] | None = None,
-        cell: float = 0.01,
+        cell: float = DEFAULT_CELL_M,
         min_height: float = 0.015,
         max_height: float = 0.35,
-        clearance: float = 0.01,
+        clearance: float = DEFAULT_CLEARANCE_M,
         max_placements: int = 10,
         name: str | None = None,
     ) -> None:

@@ -35,6 +35,7 @@ import numpy as np
 import py_trees
 from py_trees.common import Status
 
+from annotators.cloud.free_space import DEFAULT_CLEARANCE_M
 from annotators.readers.streams import KitchenCameraStream
 from annotators.simulation.kitchen_person import PersonPose
 from annotators.simulation.kitchen_scene import FRIDGE_SHELF_HEIGHTS, SceneObject, kitchen_albedos, kitchen_objects
@@ -261,7 +262,10 @@ class StorageMission:
         scene = self.stream.last_scene  # ground truth of the view the scan looked from, for scoring only
         room = 0
         if scene is not None:
-            room = sum(footprint_in_view(spot, footprint, scene) for spot in free_spots(occupants, footprint))
+            # room the estimator promises to find: the footprint with the clearance it keeps from obstacles on
+            # every side, free and wholly in view
+            grown = tuple(side + 2 * DEFAULT_CLEARANCE_M for side in footprint)
+            room = sum(footprint_in_view(spot, grown, scene) for spot in free_spots(occupants, grown))
         record.free_space.append(FreeSpaceRecord(placements, occupants, footprint, answer is not None, room))
         return placements
 

@@ -82,7 +82,8 @@ class FreeSpaceRecord:
     footprint: tuple[float, float]
     answered: bool
     room_in_view: int = 0
-    """Ground truth: how many footprint positions (1 cm apart) on the shelf are free and wholly in view."""
+    """Ground truth: how many positions (1 cm apart) on the shelf hold the footprint with the free-space
+    estimator's clearance around it, free and wholly in view."""
 
 
 @dataclass
