@@ -241,27 +241,10 @@ def accumulate(evidence: Iterable[Evidence], time: float | None = None) -> dict[
 def accumulate_into(
     beliefs: dict[str, AttributeBelief], evidence: Iterable[Evidence], time: float | None = None
 ) -> None:
-    """Accumulate statements into ``beliefs`` (by attribute, created when missing), stamped with ``time`` when given.
-
-    The same as :meth:`AttributeBelief.add` of each statement in turn, with the steps of :meth:`ValueSupport.add`
-    written out (it runs for every statement of every frame).
-    """
-    low, high = CONFIDENCE_CLIP
+    """Accumulate statements into ``beliefs`` (by attribute, created when missing), stamped with ``time`` when given
+    (e.g. one frame's statements straight into a stored belief's attributes)."""
     for item in evidence:
         belief = beliefs.get(item.attribute)
         if belief is None:
             belief = beliefs[item.attribute] = AttributeBelief(item.attribute)
-        values = belief.values
-        support = values.get(item.value)
-        if support is None:
-            support = values[item.value] = ValueSupport()
-        p = min(max(float(item.confidence), low), high)
-        stamp = item.time if time is None else time
-        if support.count == 0:
-            support.first_seen = stamp
-        else:
-            support.first_seen = min(support.first_seen, stamp)
-        support.log_odds = min(max(support.log_odds + math.log(p / (1.0 - p)), -MAX_LOG_ODDS), MAX_LOG_ODDS)
-        support.count += 1
-        support.sources.add(item.source)
-        support.last_seen = max(support.last_seen, stamp)
+        belief.add(item, time)
