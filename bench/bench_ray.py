@@ -150,10 +150,11 @@ class Replay(Annotator):
             self.write(fresh)
 
 
-def one_run(engine: Engine) -> None:
+def one_run(engine: Engine, tick: float = 0.0002) -> None:
+    """One run of the tree, ticked every ``tick`` seconds while it is RUNNING."""
     status = engine.tick()
     while status is Status.RUNNING:
-        time.sleep(0.0002)
+        time.sleep(tick)
         status = engine.tick()
     assert status is Status.SUCCESS, status
 
@@ -175,7 +176,9 @@ class Busy:
             pass
 
 
-def shaped_call(ray: ModuleType, actor: Any, annotations: list[Any], image: np.ndarray, seconds: float) -> float:
+def shaped_call(
+    ray: ModuleType, actor: Any, annotations: list[Any], image: np.ndarray, seconds: float, tick: float = 0.0002
+) -> float:
     """Ms beyond ``seconds`` that a call shaped like the expert's takes, waited for in a worker thread while this
     one ticks: the frame's image put, the call with its reference and ``annotations``, the answer in hand."""
     outcome: list[Any] = []
@@ -192,7 +195,7 @@ def shaped_call(ray: ModuleType, actor: Any, annotations: list[Any], image: np.n
     worker = threading.Thread(target=work, name="shaped call")
     worker.start()
     while worker.is_alive():
-        time.sleep(0.0002)
+        time.sleep(tick)
     if isinstance(outcome[0], Exception):
         raise outcome[0]
     return 1000 * (outcome[0] - seconds)
@@ -214,7 +217,7 @@ def ray_floor(ray: ModuleType, image: np.ndarray) -> tuple[float, float]:
     return statistics.median(empty), statistics.median(with_image)
 
 
-def bench_overhead(ray: ModuleType) -> None:
+def bench_overhead(ray: ModuleType, calls: int = CALLS, tick: float = 0.0002) -> None:
     root = tabletop.create_tree()
     one_run(Engine(root, hz=1000))
     cas = next(pipelines(root)).cas
@@ -237,20 +240,20 @@ def bench_overhead(ray: ModuleType) -> None:
         shaped_call(ray, busy, sent, image.image, 0.001)
     local_ms, latency_ms, actor_ms, added_ms, local_wall, remote_wall, shaped_ms = [], [], [], [], [], [], []
     stages: dict[str, list[float]] = {}
-    for _ in range(CALLS):
+    for _ in range(calls):
         start = time.perf_counter()
-        one_run(local_engine)
+        one_run(local_engine, tick)
         local_wall.append(1000 * (time.perf_counter() - start))
         local_ms.append(1000 * local.stats.last_seconds)
         start = time.perf_counter()
-        one_run(remote_engine)
+        one_run(remote_engine, tick)
         remote_wall.append(1000 * (time.perf_counter() - start))
         latency_ms.append(1000 * remote.stats.last_seconds)
         actor_ms.append(1000 * remote.remote_seconds)
         added_ms.append(latency_ms[-1] - actor_ms[-1])
         for stage, seconds in remote.call_times.stages().items():
             stages.setdefault(stage, []).append(1000 * seconds)
-        shaped_ms.append(shaped_call(ray, busy, sent, image.image, remote.remote_seconds))
+        shaped_ms.append(shaped_call(ray, busy, sent, image.image, remote.remote_seconds, tick))
     remote.stop_actor()
     ray.kill(busy)
     empty_ms, image_ms = ray_floor(ray, image.image)
@@ -258,7 +261,7 @@ def bench_overhead(ray: ModuleType) -> None:
     print(f"   local run of the expert   median {median(local_ms):7.2f} ms   (tree run {median(local_wall):.2f} ms)")
     print(
         f"   remote call latency       median {median(latency_ms):7.2f} ms   (tree run {median(remote_wall):.2f} ms, "
-        f"ticking every 0.2 ms), of which the expert's run on the actor {median(actor_ms):.2f} ms"
+        f"ticking every {1000 * tick:g} ms), of which the expert's run on the actor {median(actor_ms):.2f} ms"
     )
     print(
         f"   Ray's floor here: an empty actor call {empty_ms:.2f} ms, "
@@ -285,6 +288,8 @@ def bench_overhead(ray: ModuleType) -> None:
 def main() -> None:
     parser = argparse.ArgumentParser(description=__doc__.split("\n", 1)[0])
     parser.add_argument("--only", choices=("eval", "overhead"), help="run one of the two benchmarks")
+    parser.add_argument("--calls", type=int, default=CALLS, help="remote calls measured (overhead)")
+    parser.add_argument("--tick-ms", type=float, default=0.2, help="tick period while a run is RUNNING (overhead)")
     args = parser.parse_args()
     if not LEARN.is_dir():
         sys.exit(f"no scenes at {LEARN}")
@@ -295,7 +300,7 @@ def main() -> None:
         if args.only != "overhead":
             bench_eval()
         if args.only != "eval":
-            bench_overhead(ray)
+            bench_overhead(ray, args.calls, args.tick_ms / 1000)
 
 
 if __name__ == "__main__":
