@@ -68,7 +68,7 @@ ACTOR_ENV: dict[str, str] = {
 """Environment of an actor's process: its C allocator (glibc; others ignore these) keeps the memory an expert's
 run freed for the next run. An actor runs one expert over and over; with glibc's defaults its process hands each
 run's large temporaries back to the system and takes them again, page by page, on the next run (the colour expert
-on the kitchen frame: about 800 page faults, 5.0 -> 8.1 ms per run on a 2-core VM, none in the tree's process,
+on the kitchen frame: about 800 page faults, 8 ms per run instead of 5 on a 2-core VM, none in the tree's process,
 whose earlier large frees had raised glibc's adaptive thresholds). Blocks below 32 MB come from the heap, which
 is not trimmed below 1 GB of free memory: the process keeps about its peak use, which every run needs anyway."""
 
