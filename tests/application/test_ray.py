@@ -18,6 +18,7 @@ import sys
 import threading
 import time
 from collections.abc import Iterator
+from pathlib import Path
 from types import ModuleType
 
 import numpy as np
@@ -34,6 +35,7 @@ from robokudo.core.engine import Engine
 from robokudo.core.pipeline import pipelines
 from robokudo.core.placement import Placement
 from robokudo.core.remote import (
+    ACTOR_ENV,
     CroppedMask,
     ExpertHost,
     FrameStore,
@@ -93,6 +95,16 @@ def colours(root: object) -> list[tuple[tuple[int, int, int, int], list[tuple[st
     ]
 
 
+def process_environment(pid: int) -> dict[str, str] | None:
+    """The environment process ``pid`` started with (None where /proc cannot tell)."""
+    try:
+        raw = Path(f"/proc/{pid}/environ").read_bytes()
+    except OSError:
+        return None
+    pairs = (entry.decode(errors="replace").partition("=") for entry in raw.split(b"\0") if entry)
+    return {name: value for name, _, value in pairs}
+
+
 @pytest.fixture(scope="module")
 def local_colours() -> list:
     root = tabletop.create_tree()
@@ -110,6 +122,8 @@ def test_the_colour_expert_on_an_actor_gives_the_local_answer(cluster: ModuleTyp
         assert remote.actor_process_id() != os.getpid()
         assert run_to_end(Engine(root, hz=1000)) is Status.SUCCESS
         assert colours(root) == local_colours
+        environment = process_environment(remote.actor_process_id())
+        assert environment is None or ACTOR_ENV.items() <= environment.items()
     finally:
         remote.stop_actor()
 
@@ -138,6 +152,8 @@ def test_a_killed_actor_fails_its_node_with_the_reason_and_the_next_run_works(
         assert "remote actor of SemanticColorAnnotator died" in remote.feedback_message
         assert run_to_end(engine) is Status.SUCCESS, remote.feedback_message
         assert colours(root) == local_colours
+        restarted = process_environment(remote.actor_process_id())
+        assert restarted is None or ACTOR_ENV.items() <= restarted.items()
         assert remote.actor_process_id() != pid
     finally:
         remote.stop_actor()
