@@ -63,9 +63,6 @@ RTREE_SLACK = 0.05
 """Half-width (metres) of a belief's R*Tree entry around its position."""
 SOURCES_CACHE_LIMIT = 4096
 """Distinct expert sets a store keeps the JSON of (beyond that the cache starts afresh)."""
-WORKING_COPIES_LIMIT = 8192
-"""Beliefs :meth:`BeliefStore.integrate` keeps decoded between frames, with the rows stored for them (the least
-recently kept are dropped beyond that)."""
 VIEW_CACHE_LIMIT = 4096
 """Rows :meth:`BeliefStore.query_views` remembers the views of (beyond that the memo starts afresh)."""
 WAL_AUTOCHECKPOINT_PAGES = 4000
@@ -213,22 +210,16 @@ class BeliefStore:
         busy_timeout: float = 10.0,
         check: bool = True,
         history_limit: int = 100,
-        working_copies: int = WORKING_COPIES_LIMIT,
     ) -> None:
         self.path = Path(path).expanduser()
         if synchronous.upper() not in SYNCHRONOUS_MODES:
             raise ValueError(f"synchronous must be one of {', '.join(SYNCHRONOUS_MODES)}, not {synchronous!r}")
         self.tracker = tracker or BeliefTracker()
         self.history_limit = history_limit
-        self.working_copies = working_copies
-        """How many beliefs :meth:`integrate` keeps decoded between frames (0: every frame decodes its rows)."""
         self.write_log: list[list[tuple[str, list[tuple]]]] | None = None
         """When a list, each :meth:`integrate` appends the statements it wrote, with their rows (benchmarks)."""
         self._sources_text: dict[frozenset[str], str] = {}
         """JSON of the expert sets written (few distinct sets recur on every row)."""
-        self._working: dict[int, tuple[tuple, ObjectBelief, bool]] = {}
-        """Beliefs of recent frames with the ``objects`` rows stored for them and whether they are what reading
-        the row gives already (else :func:`_settle` makes them so), least recently kept first."""
         self._views: dict[tuple[object, tuple], object] = {}
         """What :meth:`query_views` made, by (view, stored row)."""
         self._lock = threading.RLock()
@@ -378,22 +369,11 @@ class BeliefStore:
         Beliefs near the observations (and, with ``camera``, in front of it) are loaded, associated and
         updated by the tracker; new objects get new ids; the changes and the sightings are written. Beliefs
         missed earlier and not seen for the tracker's ``gone_after`` seconds are marked gone, wherever they are.
-
-        The beliefs of the returned step are the store's working copies (see :data:`WORKING_COPIES_LIMIT`): read
-        them, do not change them.
         """
-        try:
-            return self._integrate(objects, time, camera, tracker or self.tracker)
-        except BaseException:
-            self._working.clear()  # the tracker may have changed working copies the store then did not write
-            raise
-
-    def _integrate(
-        self, objects: Sequence[FrameObject], time: float, camera: CameraModel | None, tracker: BeliefTracker
-    ) -> TrackStep:
+        tracker = tracker or self.tracker
         writes: list[tuple[str, list[tuple]]] = []
         with self._transaction() as conn:
-            beliefs, loaded, stored = self._candidates(conn, objects, camera, tracker.config.association.gate_distance)
+            beliefs, loaded = self._candidates(conn, objects, camera, tracker.config.association.gate_distance)
             next_id = int(conn.execute("SELECT value FROM meta WHERE key = 'next_id'").fetchone()[0])
             allocated = [next_id]
 
@@ -403,7 +383,7 @@ class BeliefStore:
                 return value
 
             step = tracker.step(beliefs, objects, time, new_id, camera)
-            written = self._write_beliefs(conn, step.changed, tracker.class_test, loaded, writes)
+            self._write_beliefs(conn, step.changed, tracker.class_test, loaded, writes)
             counts = {b.id: b.observations for b in step.changed}
             self._write_observations(conn, objects, [(i, counts.get(i, 0)) for i in step.assigned], time, writes)
             if allocated[0] != next_id:
@@ -414,29 +394,7 @@ class BeliefStore:
             _write(conn, writes, _MARK_GONE, [(time - tracker.config.gone_after,)])
         if self.write_log is not None:
             self.write_log.append(writes)
-        self._keep_working_copies(beliefs, step.changed, stored, written)
         return step
-
-    def _keep_working_copies(
-        self,
-        candidates: Sequence[ObjectBelief],
-        changed: Sequence[ObjectBelief],
-        stored: Mapping[int, tuple],
-        written: Mapping[int, tuple],
-    ) -> None:
-        """Keep the frame's beliefs with the rows now stored for them, so a later frame that finds a row unchanged
-        reuses its belief (made exactly what reading the row back gives, :func:`_settle`, only then: most kept
-        beliefs are never seen again) and no row this store wrote is decoded again."""
-        working = self._working
-        for belief in changed:
-            working.pop(belief.id, None)
-            working[belief.id] = (written[belief.id], belief, False)
-        for belief in candidates:
-            if belief.id not in written:
-                working.pop(belief.id, None)
-                working[belief.id] = (stored[belief.id], belief, True)
-        while len(working) > self.working_copies:  # the least recently kept go first
-            del working[next(iter(working))]
 
     def put(self, beliefs: Sequence[ObjectBelief], class_test: ClassTest | None = None) -> None:
         """Write beliefs as they are (insert or replace, attributes included) in one transaction."""
@@ -478,12 +436,10 @@ class BeliefStore:
         objects: Sequence[FrameObject],
         camera: CameraModel | None,
         gate: float,
-    ) -> tuple[list[ObjectBelief], dict[int, _Loaded], dict[int, tuple]]:
+    ) -> tuple[list[ObjectBelief], dict[int, _Loaded]]:
         """Present beliefs within ``gate`` of an observation or in view of ``camera`` (R*Tree look-ups).
 
-        Also returns how each one was stored (so unchanged R*Tree entries and index columns are not rewritten) and
-        its ``objects`` row. A belief whose row equals the one kept with its working copy is that copy (the row is
-        the key: a change by any writer makes the belief be read afresh).
+        Also returns how each one was stored, so unchanged R*Tree entries and index columns are not rewritten.
         """
         rows: dict[int, tuple] = {}
         groups: dict[tuple[str, str], list[FrameObject]] = {}
@@ -522,19 +478,7 @@ class BeliefStore:
             i: _Loaded(((r[n] + r[n + 1]) / 2, (r[n + 2] + r[n + 3]) / 2, (r[n + 4] + r[n + 5]) / 2), *_labels(r))
             for i, r in rows.items()
         }
-        working = self._working
-        beliefs = []
-        stored = {}
-        for i in sorted(rows):
-            row = stored[i] = rows[i][:n]
-            kept = working.get(i)
-            if kept is None or kept[0] != row:
-                beliefs.append(_belief_from_row(row))
-                continue
-            if not kept[2]:
-                _settle(kept[1], row)
-            beliefs.append(kept[1])
-        return beliefs, loaded, stored
+        return [_belief_from_row(rows[i]) for i in sorted(rows)], loaded
 
     def _write_beliefs(
         self,
@@ -543,9 +487,8 @@ class BeliefStore:
         class_test: ClassTest | None,
         loaded: Mapping[int, _Loaded] | None = None,
         writes: list[tuple[str, list[tuple]]] | None = None,
-    ) -> dict[int, tuple]:
-        """Write object rows, their R*Tree entries and attribute-index entries (noted in ``writes``); returns the
-        rows written, by id.
+    ) -> None:
+        """Write object rows, their R*Tree entries and attribute-index entries (noted in ``writes``).
 
         Beliefs in ``loaded`` are updated in place; their indexed columns and index entries are touched only
         when they changed. The R*Tree entry of a belief is a box of half-width ``RTREE_SLACK`` around a recent
@@ -553,7 +496,7 @@ class BeliefStore:
         so the true position always lies inside the entry and look-ups by position miss nothing.
         """
         if not beliefs:
-            return {}
+            return
         log = [] if writes is None else writes
         loaded = loaded or {}
         cache = self._sources_cache()
@@ -601,7 +544,6 @@ class BeliefStore:
         classes = {(b.class_name,) for b in beliefs if b.class_name and b.class_name != _loaded_class(loaded, b.id)}
         if classes:
             _write(conn, log, "INSERT OR IGNORE INTO classes VALUES (?)", list(classes))
-        return rows
 
     def _write_observations(
         self,
@@ -1035,65 +977,6 @@ def _belief_from_row(row: tuple) -> ObjectBelief:
         class_name=class_name,
         recording=recording,
     )
-
-
-def _settle(b: ObjectBelief, row: tuple) -> None:
-    """Make a belief exactly what :func:`_belief_from_row` gives for ``row``, the row written for it: the columns'
-    values and arrays from the row, and the attribute supports as stored (log-odds rounded as the encoder rounds
-    them, attributes without values left out), keeping the attribute objects."""
-    (
-        _,
-        b.class_name,
-        b.frame,
-        px,
-        py,
-        pz,
-        qx,
-        qy,
-        qz,
-        qw,
-        sx,
-        sy,
-        sz,
-        b.position_variance,
-        appearance,
-        b.existence,
-        b.status,
-        b.first_seen,
-        b.last_seen,
-        b.misses,
-        b.observations,
-        b.region,
-        b.region_class,
-        b.recording,
-        roi,
-        sources,
-        _attributes,
-        _indexed,
-    ) = row
-    # arrays the tracker made of the same float64 values are kept (the row's values came from them)
-    if not _is_float64(b.position, 3):
-        b.position = np.array([px, py, pz])
-    if not _is_float64(b.orientation, 4):
-        b.orientation = np.array([qx, qy, qz, qw])
-    if sx is None:
-        b.dimensions = None
-    elif not _is_float64(b.dimensions, 3):
-        b.dimensions = np.array([sx, sy, sz])
-    b.appearance = None if appearance is None else np.frombuffer(appearance, dtype=np.float32).astype(np.float64)
-    b.roi = _roi_from_text(roi)
-    b.sources = set(_decoded_sources(sources))
-    attributes = b.attributes
-    for name in [name for name, attribute in attributes.items() if not attribute.values]:
-        del attributes[name]
-    for attribute in attributes.values():
-        for support in attribute.values.values():
-            support.log_odds = _rounded(support.log_odds, 9)
-
-
-def _is_float64(values: object, count: int) -> bool:
-    """True when ``values`` is a float64 array of ``count`` values (what :func:`_belief_from_row` makes)."""
-    return type(values) is np.ndarray and values.dtype == np.float64 and values.shape == (count,)
 
 
 def _box_bounds(pose: np.ndarray, size: Sequence[float]) -> tuple[np.ndarray, np.ndarray]:
