@@ -320,12 +320,17 @@ class Answer:
 @dataclass(frozen=True, slots=True)
 class _BeliefView:
     """What a designator takes from one belief that no class test or naming changes: the belief (read only), its
-    confidence, and each attribute's designator in the belief's order (None for a class attribute of several
-    values, which is fused with the caller's class test)."""
+    pose, size, experts and confidence, and each attribute's designator in the belief's order (None for a class
+    attribute of several values, which is fused with the caller's class test)."""
 
     belief: ObjectBelief
+    pose: PoseDesignator
+    size: tuple[float, float, float] | None
+    experts: tuple[str, ...]
     confidence: float
     attributes: tuple[tuple[str, AttributeDesignator | None], ...]
+    fused_once: bool
+    """True when no attribute waits for the class test (``attributes`` holds every designator)."""
     supported_class: str | None
     """The fused class when evidence supports it and no class test is needed to fuse it."""
 
@@ -354,7 +359,18 @@ def _belief_view(belief: ObjectBelief) -> _BeliefView:
         attributes.append((name, _attribute_designator(fused)))
         if name == CLASS_ATTRIBUTE and fused.supported:
             supported_class = fused.value
-    return _BeliefView(belief, belief.confidence, tuple(attributes), supported_class)
+    x, y, z = belief.position.tolist()
+    qx, qy, qz, qw = belief.orientation.tolist()
+    return _BeliefView(
+        belief=belief,
+        pose=PoseDesignator(position=(x, y, z), orientation=(qx, qy, qz, qw), frame=belief.frame),
+        size=None if belief.dimensions is None else tuple(belief.dimensions.tolist()),  # type: ignore[arg-type]
+        experts=tuple(sorted(belief.sources)),
+        confidence=belief.confidence,
+        attributes=tuple(attributes),
+        fused_once=all(made is not None for _, made in attributes),
+        supported_class=supported_class,
+    )
 
 
 def designator(
@@ -388,30 +404,32 @@ def _designate(
 ) -> ObjectDesignator:
     """The designator of a belief's view (see :func:`designator`)."""
     belief = view.belief
-    attributes: dict[str, AttributeDesignator] = {}
     supported_class = view.supported_class
-    for name, made in view.attributes:
-        if made is None:
-            fused = fuse_values(name, belief.attributes[name].values, class_test)
-            made = _attribute_designator(fused)
-            supported_class = fused.value if fused.supported else None
-        attributes[name] = made
+    attributes: dict[str, AttributeDesignator]
+    if view.fused_once:
+        attributes = dict(view.attributes)  # type: ignore[arg-type]
+    else:
+        attributes = {}
+        for name, made in view.attributes:
+            if made is None:
+                fused = fuse_values(name, belief.attributes[name].values, class_test)
+                made = _attribute_designator(fused)
+                supported_class = fused.value if fused.supported else None
+            attributes[name] = made
     class_name = guessed_class or belief.class_name
     if class_name is None:
         class_name = supported_class
     size_attribute = attributes.get(Size.attribute)
-    x, y, z = belief.position.tolist()
-    qx, qy, qz, qw = belief.orientation.tolist()
     return ObjectDesignator(
         id=belief.id,
         class_iri=iri_of(class_name) if class_name else None,
         class_label=label_of(class_name) if class_name and _local(class_name) != ROOTS["class"] else UNKNOWN_LABEL,
-        pose=PoseDesignator(position=(x, y, z), orientation=(qx, qy, qz, qw), frame=belief.frame),
-        size=None if belief.dimensions is None else tuple(belief.dimensions.tolist()),  # type: ignore[arg-type]
+        pose=view.pose,
+        size=view.size,
         size_class=size_attribute.value if size_attribute else None,
         region=belief.region or None,
         attributes=attributes,
-        experts=tuple(sorted(belief.sources)),
+        experts=view.experts,
         confidence=view.confidence,
         roi=roi,
         first_seen=belief.first_seen,

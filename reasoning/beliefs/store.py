@@ -1009,7 +1009,7 @@ def _in_named_region(rows: list[tuple], f: BeliefFilter) -> list[tuple]:
             kept.append(row)
             continue
         position = np.array([row[3], row[4], row[5]], dtype=np.float64)
-        if any(row[2] == frame and bool(np.all(np.abs(rotation @ (position - centre)) <= half)) for frame, rotation,
+        if any(row[2] == frame and bool((np.abs(rotation @ (position - centre)) <= half).all()) for frame, rotation,
                centre, half in boxes):  # fmt: skip
             kept.append(row)
     return kept

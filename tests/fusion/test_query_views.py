@@ -8,7 +8,7 @@ from pathlib import Path
 
 import numpy as np
 
-from reasoning.beliefs.answer import answer_from_memory, designator
+from reasoning.beliefs.answer import answer_from_memory, class_label, designator
 from reasoning.beliefs.store import BeliefFilter, BeliefStore
 from reasoning.fusion.frame import FrameObject
 from reasoning.fusion.rule import AttributeBelief, Evidence, ValueSupport
@@ -66,8 +66,11 @@ def remembered(store: BeliefStore, belief_filter: BeliefFilter) -> list[dict]:
 
 def seeded(path: Path) -> BeliefStore:
     store = BeliefStore(path, tracker=BeliefTracker(class_test=is_subclass))
+    unnamed = belief(6, 2.0, {"Cup": 1.0, "Bowl": 0.2})  # named by its fused class only
+    unnamed.class_name = None
     store.put(
         [
+            unnamed,
             belief(1, 0.8, {"Milk": 1.4}),
             belief(2, 1.1, {"LactoseFreeMilk": 1.2, "Milk": 0.4}),  # subsumption: the class test decides
             belief(3, 1.3, {"WholeMilk": 0.9, "Cup": 0.9}, "red"),  # a conflict
@@ -118,12 +121,39 @@ def test_a_view_is_made_again_exactly_for_changed_rows(tmp_path: Path) -> None:
         return b.id
 
     everything = BeliefFilter()
-    assert store.query_views(everything, view) == [1, 2, 3, 4, 5]
-    assert sorted(made) == [1, 2, 3, 4, 5]
+    assert store.query_views(everything, view) == [1, 2, 3, 4, 5, 6]
+    assert sorted(made) == [1, 2, 3, 4, 5, 6]
     made.clear()
-    assert store.query_views(everything, view) == [1, 2, 3, 4, 5]
+    assert store.query_views(everything, view) == [1, 2, 3, 4, 5, 6]
     assert made == []
     store.put([belief(3, 1.35, {"WholeMilk": 0.9, "Cup": 0.9}, "red")], is_subclass)
-    assert store.query_views(everything, view) == [1, 2, 3, 4, 5]
+    assert store.query_views(everything, view) == [1, 2, 3, 4, 5, 6]
     assert made == [3]
+    store.close()
+
+
+def test_designators_carry_each_attribute_fused_with_the_query_class_test(tmp_path: Path) -> None:
+    """Against the fusion rule itself (:meth:`ObjectBelief.fused`): the class attribute of several values is fused
+    with the filter's class test, the others as they are; an unnamed belief takes the supported fused class."""
+    store = seeded(tmp_path / "b.sqlite")
+    for class_test in (is_subclass, None):
+        belief_filter = BeliefFilter(class_test=class_test)
+        beliefs = {b.id: b for b in store.query(belief_filter)}
+        for found in answer_from_memory(store, belief_filter).objects:
+            every = beliefs[found.id].fused(class_test)
+            assert {
+                name: (a.value, a.confidence, a.experts, [(x.value, x.confidence, x.experts) for x in a.alternatives])
+                for name, a in found.attributes.items()
+            } == {
+                name: (f.value, f.confidence, f.sources, [(s.value, s.confidence, s.sources) for s in f.support])
+                for name, f in every.items()
+            }
+            assert {name: a.conflict for name, a in found.attributes.items()} == {
+                name: f.conflict for name, f in every.items()
+            }
+            named = beliefs[found.id].class_name
+            fused_class = every.get("class")
+            if named is None and fused_class is not None and fused_class.supported:
+                named = fused_class.value
+            assert found.class_label == (class_label(named) if named else "unknown object")
     store.close()
