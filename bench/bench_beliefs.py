@@ -360,23 +360,28 @@ def memory_queries(count: int) -> dict[str, BeliefFilter]:
     }
 
 
-def bench_queries(store: BeliefStore, count: int, repeats: int) -> list[tuple[str, float, float, float, float, int]]:
-    """Per query: median and p95 ms to beliefs, median and p95 ms to designators, results."""
-    found: list[tuple[str, float, float, float, float, int]] = []
+def bench_queries(
+    store: BeliefStore, count: int, repeats: int
+) -> list[tuple[str, float, float, float, float, float, int]]:
+    """Per query: median and p95 ms to beliefs, median and p95 ms to designators, median CPU ms of the process to
+    designators (on a loaded machine wall time includes waiting for a core), results."""
+    found: list[tuple[str, float, float, float, float, float, int]] = []
     for label, belief_filter in memory_queries(count).items():
         figures: list[float] = []
         results = 0
+        cpu: list[float] = []
         for use_answer in (False, True):
             samples = []
             for _ in range(repeats):
-                start = time.perf_counter()
+                start, used = time.perf_counter(), time.process_time()
                 if use_answer:
                     results = len(answer_from_memory(store, belief_filter).objects)
+                    cpu.append((time.process_time() - used) * 1000.0)
                 else:
                     store.query(belief_filter)
                 samples.append((time.perf_counter() - start) * 1000.0)
             figures += [statistics.median(samples), float(np.percentile(samples, 95))]
-        found.append((label, *figures, results))  # type: ignore[arg-type]
+        found.append((label, *figures, statistics.median(cpu), results))  # type: ignore[arg-type]
     return found
 
 
@@ -473,6 +478,40 @@ def profile_updates(size: int, frames: int, per_frame: int, cameras: int, folder
     print(f"profile written to {out}")
 
 
+def profile_queries(size: int, repeats: int, folder: Path, out: Path) -> None:
+    """cProfile of ``answer_from_memory`` (every memory query ``repeats`` times) on a store of ``size`` objects; the
+    median ms of each query to designators and the top entries by own and by cumulative time are written to
+    ``out``."""
+    import cProfile
+    import io
+    import pstats
+
+    path = folder / f"profile-queries-{size}.sqlite"
+    seed_file(path, size, np.random.default_rng(size + 1))
+    text = io.StringIO()
+    with BeliefStore(path, tracker=BeliefTracker(class_test=is_subclass)) as store:
+        queries = memory_queries(size)
+        for label, belief_filter in queries.items():
+            samples = []
+            for _ in range(repeats):
+                start = time.perf_counter()
+                answer_from_memory(store, belief_filter)
+                samples.append((time.perf_counter() - start) * 1000.0)
+            text.write(f"{label}: {statistics.median(samples):.3f} ms median to designators (unprofiled)\n")
+        profiler = cProfile.Profile()
+        profiler.enable()
+        for _ in range(repeats):
+            for belief_filter in queries.values():
+                answer_from_memory(store, belief_filter)
+        profiler.disable()
+    text.write(f"answer_from_memory, {len(queries)} queries x {repeats}, {size} stored objects\n")
+    pstats.Stats(profiler, stream=text).sort_stats("tottime").print_stats(20)
+    pstats.Stats(profiler, stream=text).sort_stats("cumulative").print_stats(20)
+    out.parent.mkdir(parents=True, exist_ok=True)
+    out.write_text(text.getvalue().replace(str(ROOT) + "/", ""))
+    print(f"profile written to {out}")
+
+
 FLOOR_VARIANTS: dict[str, tuple[tuple[str, ...], str, str]] = {
     "as designed (the reference)": ((), "", "NORMAL"),
     "synchronous = OFF": ((), "", "OFF"),
@@ -547,6 +586,9 @@ def main() -> int:
         "--floor-variants", action="store_true", help="only replay the write log per variant of the storage design"
     )
     parser.add_argument("--profile", type=Path, help="only write a cProfile of integrate (10,000 stored) to PROFILE")
+    parser.add_argument(
+        "--profile-queries", type=Path, help="only write a cProfile of the memory queries (10,000 stored) to PATH"
+    )
     parser.add_argument("--rss-child", type=Path, help=argparse.SUPPRESS)
     parser.add_argument("--rss-count", type=int, help=argparse.SUPPRESS)
     args = parser.parse_args()
@@ -556,6 +598,10 @@ def main() -> int:
     if args.floor_variants:
         with tempfile.TemporaryDirectory() as name:
             floor_variants(10_000, args.frames, args.per_frame, Path(name))
+        return 0
+    if args.profile_queries:
+        with tempfile.TemporaryDirectory() as name:
+            profile_queries(10_000, args.repeats, Path(name), args.profile_queries)
         return 0
     if args.profile:
         with tempfile.TemporaryDirectory() as name:
@@ -599,12 +645,15 @@ def main() -> int:
             goal = goal_for(size)
             with BeliefStore(path, tracker=BeliefTracker(class_test=is_subclass)) as store:
                 print(f"queries, {store.count()} stored (seeded in {seeding:.1f} s), {args.repeats} runs each:")
-                print(f"  {'query':48s} {'beliefs ms p50':>14s} {'p95':>7s} {'designators ms p50':>18s} {'p95':>7s} n")
-                for label, q50, q95, d50, d95, results in bench_queries(store, size, args.repeats):
+                print(
+                    f"  {'query':48s} {'beliefs ms p50':>14s} {'p95':>7s} {'designators ms p50':>18s} {'p95':>7s} "
+                    f"{'cpu p50':>7s} n"
+                )
+                for label, q50, q95, d50, d95, c50, results in bench_queries(store, size, args.repeats):
                     ok = d50 <= goal
                     met.append(ok)
                     print(
-                        f"  {label:48s} {q50:14.3f} {q95:7.3f} {d50:18.3f} {d95:7.3f} {results}   "
+                        f"  {label:48s} {q50:14.3f} {q95:7.3f} {d50:18.3f} {d95:7.3f} {c50:7.3f} {results}   "
                         f"goal median <= {goal:g} ms: {'met' if ok else 'NOT met'}"
                     )
             for suffix in ("", "-wal", "-shm"):

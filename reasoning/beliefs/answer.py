@@ -17,7 +17,7 @@ from dataclasses import dataclass
 from typing import Any
 
 from reasoning.beliefs.store import BeliefFilter, BeliefStore
-from reasoning.fusion.rule import CLASS_ATTRIBUTE, ClassTest
+from reasoning.fusion.rule import CLASS_ATTRIBUTE, ClassTest, FusedAttribute, fuse_values
 from reasoning.fusion.tracking import ObjectBelief
 from reasoning.knowledge.index import ROOTS
 from robokudo.core.types import ONTOLOGY_NAMESPACE, SemanticColor, Size
@@ -317,6 +317,62 @@ class Answer:
         return lines
 
 
+@dataclass(frozen=True, slots=True)
+class _BeliefView:
+    """What a designator takes from one belief that no class test or naming changes: the belief (read only), its
+    pose, size, experts and confidence, and each attribute's designator in the belief's order (None for a class
+    attribute of several values, which is fused with the caller's class test)."""
+
+    belief: ObjectBelief
+    pose: PoseDesignator
+    size: tuple[float, float, float] | None
+    experts: tuple[str, ...]
+    confidence: float
+    attributes: tuple[tuple[str, AttributeDesignator | None], ...]
+    fused_once: bool
+    """True when no attribute waits for the class test (``attributes`` holds every designator)."""
+    supported_class: str | None
+    """The fused class when evidence supports it and no class test is needed to fuse it."""
+
+
+def _attribute_designator(fused: FusedAttribute) -> AttributeDesignator:
+    return AttributeDesignator(
+        value=fused.value,
+        confidence=fused.confidence,
+        experts=fused.sources,
+        alternatives=tuple(Alternative(s.value, s.confidence, s.sources) for s in fused.support),
+        conflict=fused.conflict,
+    )
+
+
+def _belief_view(belief: ObjectBelief) -> _BeliefView:
+    """The class-test-free part of a belief's designator (what :meth:`BeliefStore.query_views` remembers)."""
+    attributes: list[tuple[str, AttributeDesignator | None]] = []
+    supported_class = None
+    for name, attribute in belief.attributes.items():
+        if not attribute.values:
+            continue
+        if name == CLASS_ATTRIBUTE and len(attribute.values) > 1:  # subsumption: fused with the caller's test
+            attributes.append((name, None))
+            continue
+        fused = fuse_values(name, attribute.values)  # one class value: the class test changes nothing
+        attributes.append((name, _attribute_designator(fused)))
+        if name == CLASS_ATTRIBUTE and fused.supported:
+            supported_class = fused.value
+    x, y, z = belief.position.tolist()
+    qx, qy, qz, qw = belief.orientation.tolist()
+    return _BeliefView(
+        belief=belief,
+        pose=PoseDesignator(position=(x, y, z), orientation=(qx, qy, qz, qw), frame=belief.frame),
+        size=None if belief.dimensions is None else tuple(belief.dimensions.tolist()),  # type: ignore[arg-type]
+        experts=tuple(sorted(belief.sources)),
+        confidence=belief.confidence,
+        attributes=tuple(attributes),
+        fused_once=all(made is not None for _, made in attributes),
+        supported_class=supported_class,
+    )
+
+
 def designator(
     belief: ObjectBelief,
     *,
@@ -331,34 +387,50 @@ def designator(
     ``guessed_class`` names the object when this answer offers it as a candidate of that class without evidence
     the belief keeps (its class attribute still shows what the evidence says).
     """
-    attributes: dict[str, AttributeDesignator] = {}
-    every = belief.fused(class_test)
-    for name, fused in every.items():
-        attributes[name] = AttributeDesignator(
-            value=fused.value,
-            confidence=fused.confidence,
-            experts=fused.sources,
-            alternatives=tuple(Alternative(s.value, s.confidence, s.sources) for s in fused.support),
-            conflict=fused.conflict,
-        )
-    fused_class = every.get(CLASS_ATTRIBUTE)
+    return _designate(
+        _belief_view(belief), class_test=class_test, roi=roi, iri_of=iri_of, label_of=label_of,
+        guessed_class=guessed_class,
+    )  # fmt: skip
+
+
+def _designate(
+    view: _BeliefView,
+    *,
+    class_test: ClassTest | None = None,
+    roi: tuple[int, int, int, int] | None = None,
+    iri_of: Callable[[str], str] = class_iri,
+    label_of: Callable[[str], str] = class_label,
+    guessed_class: str | None = None,
+) -> ObjectDesignator:
+    """The designator of a belief's view (see :func:`designator`)."""
+    belief = view.belief
+    supported_class = view.supported_class
+    attributes: dict[str, AttributeDesignator]
+    if view.fused_once:
+        attributes = dict(view.attributes)  # type: ignore[arg-type]
+    else:
+        attributes = {}
+        for name, made in view.attributes:
+            if made is None:
+                fused = fuse_values(name, belief.attributes[name].values, class_test)
+                made = _attribute_designator(fused)
+                supported_class = fused.value if fused.supported else None
+            attributes[name] = made
     class_name = guessed_class or belief.class_name
-    if class_name is None and fused_class is not None and fused_class.supported:
-        class_name = fused_class.value
+    if class_name is None:
+        class_name = supported_class
     size_attribute = attributes.get(Size.attribute)
-    x, y, z = belief.position.tolist()
-    qx, qy, qz, qw = belief.orientation.tolist()
     return ObjectDesignator(
         id=belief.id,
         class_iri=iri_of(class_name) if class_name else None,
         class_label=label_of(class_name) if class_name and _local(class_name) != ROOTS["class"] else UNKNOWN_LABEL,
-        pose=PoseDesignator(position=(x, y, z), orientation=(qx, qy, qz, qw), frame=belief.frame),
-        size=None if belief.dimensions is None else tuple(belief.dimensions.tolist()),  # type: ignore[arg-type]
+        pose=view.pose,
+        size=view.size,
         size_class=size_attribute.value if size_attribute else None,
         region=belief.region or None,
         attributes=attributes,
-        experts=tuple(sorted(belief.sources)),
-        confidence=belief.confidence,
+        experts=view.experts,
+        confidence=view.confidence,
         roi=roi,
         first_seen=belief.first_seen,
         last_seen=belief.last_seen,
@@ -368,7 +440,7 @@ def designator(
 
 def answer_from_memory(store: BeliefStore, belief_filter: BeliefFilter, query: str = "", **options: Any) -> Answer:
     """Answer a query from the store alone (no perception): the matching known objects, most confident first."""
-    beliefs = store.query(belief_filter)
-    beliefs.sort(key=lambda b: (-b.confidence, b.id))
-    designators = tuple(designator(b, class_test=belief_filter.class_test, **options) for b in beliefs)
+    views = store.query_views(belief_filter, _belief_view)
+    views.sort(key=lambda v: (-v.confidence, v.belief.id))
+    designators = tuple(_designate(v, class_test=belief_filter.class_test, **options) for v in views)
     return Answer(query=query, objects=designators, from_memory=True)

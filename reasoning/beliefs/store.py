@@ -33,7 +33,7 @@ from collections.abc import Callable, Iterator, Mapping, Sequence
 from contextlib import contextmanager
 from dataclasses import dataclass, field
 from pathlib import Path
-from typing import NamedTuple
+from typing import NamedTuple, TypeVar
 
 import numpy as np
 import platformdirs
@@ -63,8 +63,13 @@ RTREE_SLACK = 0.05
 """Half-width (metres) of a belief's R*Tree entry around its position."""
 SOURCES_CACHE_LIMIT = 4096
 """Distinct expert sets a store keeps the JSON of (beyond that the cache starts afresh)."""
+VIEW_CACHE_LIMIT = 4096
+"""Rows :meth:`BeliefStore.query_views` remembers the views of (beyond that the memo starts afresh)."""
 WAL_AUTOCHECKPOINT_PAGES = 4000
 """Checkpoint the WAL into the file every ~16 MB (fewer fsyncs than SQLite's default of 1000 pages)."""
+
+
+T = TypeVar("T")
 
 
 class BeliefStoreError(Exception):
@@ -215,6 +220,8 @@ class BeliefStore:
         """When a list, each :meth:`integrate` appends the statements it wrote, with their rows (benchmarks)."""
         self._sources_text: dict[frozenset[str], str] = {}
         """JSON of the expert sets written (few distinct sets recur on every row)."""
+        self._views: dict[tuple[object, tuple], object] = {}
+        """What :meth:`query_views` made, by (view, stored row)."""
         self._lock = threading.RLock()
         self._conn = self._open(synchronous.upper(), busy_timeout, check)
 
@@ -610,6 +617,32 @@ class BeliefStore:
 
     def query(self, belief_filter: BeliefFilter) -> list[ObjectBelief]:
         """The beliefs matching ``belief_filter`` (class subsumption, region, attributes), by id."""
+        return [_belief_from_row(row) for row in self._select(belief_filter)]
+
+    def query_views(self, belief_filter: BeliefFilter, view: Callable[[ObjectBelief], T]) -> list[T]:
+        """``view(belief)`` of each belief :meth:`query` gives, by id, remembered per stored row.
+
+        A row unchanged since an earlier call gives the earlier result (the stored row is the key, so a change by
+        any writer makes a new one). ``view`` must be a pure function of the belief and the same function object
+        on every call (e.g. a module-level function); its results are shared between calls: never change them.
+        At most :data:`VIEW_CACHE_LIMIT` rows are remembered (beyond that the memo starts afresh).
+        """
+        rows = self._select(belief_filter)
+        with self._lock:
+            memo = self._views
+            if len(memo) > VIEW_CACHE_LIMIT:
+                memo.clear()
+            found: list[T] = []
+            for row in rows:
+                key = (view, row)
+                made = memo.get(key)
+                if made is None:
+                    made = memo[key] = view(_belief_from_row(row))
+                found.append(made)  # type: ignore[arg-type]
+            return found
+
+    def _select(self, belief_filter: BeliefFilter) -> list[tuple]:
+        """The ``objects`` rows of the beliefs matching ``belief_filter``, by id (see :meth:`query`)."""
         clauses: list[str] = []
         parameters: list[object] = []
         f = belief_filter
@@ -669,14 +702,14 @@ class BeliefStore:
                 values.extend(parameters + extra_parameters)
             rows = conn.execute(" UNION ".join(selects) + " ORDER BY id", values).fetchall()
             if f.region and f.region_boxes:
-                rows = [row for row in rows if _in_named_region(row, f)]
+                rows = _in_named_region(rows, f)
             for name, value in texts.items():
                 rows = [row for row in rows if any(_reads(row, name, wanted) for wanted in _alternatives(value))]
             if f.min_confidence > 0:
                 rows = [row for row in rows if sigmoid(row[15]) >= f.min_confidence]
             if f.limit is not None:
                 rows = rows[: f.limit]
-            return [_belief_from_row(row) for row in rows]
+            return rows
 
     def history(self, object_id: int, limit: int | None = None) -> list[ObservationRecord]:
         """The recorded sightings of one object, oldest first (the newest ``limit`` when given)."""
@@ -962,12 +995,24 @@ def _reads(row: tuple, name: str, wanted: str) -> bool:
     return any(entry == name and text_matches(wanted, value) for entry, value in _index_entries(row[_INDEXED]))
 
 
-def _in_named_region(row: tuple, f: BeliefFilter) -> bool:
+def _in_named_region(rows: list[tuple], f: BeliefFilter) -> list[tuple]:
+    """The rows whose stored region is one of the filter's names or whose position lies in one of its boxes
+    (:meth:`RegionBox.contains`, with each box's pose made once)."""
     names = {n.lower() for n in [f.region or "", *(box.name for box in f.region_boxes)]}
-    if str(row[21]).lower() in names:
-        return True
-    position = np.array([row[3], row[4], row[5]])
-    return any(row[2] == box.frame and box.contains(position) for box in f.region_boxes)
+    boxes = []
+    for box in f.region_boxes:
+        pose = box.pose
+        boxes.append((box.frame, pose[:3, :3].T, pose[:3, 3], np.asarray(box.size, dtype=np.float64) / 2.0 + 1e-9))
+    kept = []
+    for row in rows:
+        if str(row[21]).lower() in names:
+            kept.append(row)
+            continue
+        position = np.array([row[3], row[4], row[5]], dtype=np.float64)
+        if any(row[2] == frame and bool((np.abs(rotation @ (position - centre)) <= half).all()) for frame, rotation,
+               centre, half in boxes):  # fmt: skip
+            kept.append(row)
+    return kept
 
 
 def _frustum_bounds(camera: CameraModel) -> tuple[np.ndarray, np.ndarray]:
