@@ -587,7 +587,32 @@ class _Assignment:
         return False
 
     def _assign(self) -> None:
+        """Give every needed type a unit, until every required input of every chosen provider is guaranteed.
+
+        Choosing a unit's providers again (when its own unit leads back to a consumer) can take a by-product from
+        a unit that others already read: the needs left without a unit are queued again, a few times at most.
+        """
         queue: deque[tuple[str, str | None]] = deque((r.annotation_type, None) for r in self.requirements)
+        for _ in range(_UNMET_ROUNDS):
+            self._assign_queue(queue)
+            queue.extend(self._unmet())
+            if not queue:
+                return
+        raise _OrderingError("the chosen alternatives keep leaving inputs without a unit")
+
+    def _unmet(self) -> list[tuple[str, str]]:
+        """(type, consumer unit) for the required inputs of chosen providers that no unit guarantees."""
+        guaranteed = self.guaranteed_by()
+        sensors = self.catalog.sensors
+        return [
+            (needed, key)
+            for key, unit in self.units.items()
+            for spec in unit.providers
+            for needed in spec.inputs
+            if needed not in guaranteed and needed not in sensors
+        ]
+
+    def _assign_queue(self, queue: deque[tuple[str, str | None]]) -> None:
         sensors, units = self.catalog.sensors, self.units
         while queue:
             type_name, consumer = queue.popleft()
@@ -663,6 +688,9 @@ class _Assignment:
                 del self.units[key]
             self._order = None
             self._invalidate()
+
+
+_UNMET_ROUNDS = 4  # passes of the assignment over needs left without a unit before the strict mode is asked
 
 
 def _units_of(types: tuple[str, ...], guaranteed: Mapping[str, str]) -> tuple[str, ...]:
