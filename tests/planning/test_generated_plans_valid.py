@@ -64,7 +64,10 @@ def test_plans_on_a_generated_ontology_have_valid_data_flow(kb: KnowledgeBase) -
     tracks = random.Random(5)
     texts += [f"track {{ obj: {{ type: {tracks.choice(names)}, color: {tracks.choice(colors)} }} }}" for _ in range(40)]
     # plans that read PersonTrack and Size made in one alternative of a later Fallback (without depth and pose)
-    texts += ["track { obj: { type: GenObject0298, color: white } }", "track { obj: { type: GenObject0582, color: red } }"]
+    texts += [
+        "track { obj: { type: GenObject0298, color: white } }",
+        "track { obj: { type: GenObject0582, color: red } }",
+    ]
     reader = kb.annotator("KitchenSceneReader")
     chosen = SensorSource(Step(reader.name, reader.implemented_by, (), reader.outputs, (("view", "table"),), "reads"))
     planner = QueryPlanner(kb)
