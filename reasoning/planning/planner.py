@@ -651,7 +651,9 @@ class _Assignment:
             free = [s for s in valid if s.name not in owner]
             if not free:
                 if not self._take_over(type_name, valid, consumer, above):
-                    raise _OrderingError(f"cannot produce {type_name}: {self.catalog.why_not(type_name, value)}")
+                    # the greedy mode's error is never shown (the strict mode runs next): it names no excluded providers
+                    why = self.catalog.why_not(type_name, value) if self.by_rounds else "its providers are taken"
+                    raise _OrderingError(f"cannot produce {type_name}: {why}")
                 continue
             self.units[type_name] = _UnitChoice(type_name, free, value, self.catalog)
             self._order = None
@@ -747,6 +749,7 @@ class _Layout:
         self.source = source
         self.parameters = parameters
         self._labels: dict[str, str] = {}
+        self._branch_members: dict[tuple[str, str], list[AnnotatorSpec]] = {}
         self.branches = self._branches()
         absorbed = {t for owned in self.branches.values() for types in owned.values() for t in types}
         self.final: dict[str, str] = dict.fromkeys(catalog.sensors, "reader")
@@ -855,8 +858,12 @@ class _Layout:
 
     def _members(self, type_name: str, spec: AnnotatorSpec) -> list[AnnotatorSpec]:
         """The annotators of one branch: absorbed providers in dependency order, then the alternative."""
-        owned = self.branches.get(type_name, {}).get(spec.name, [])
-        return [self.units[t].providers[0] for t in _topological(owned, self.units)] + [spec]
+        found = self._branch_members.get((type_name, spec.name))
+        if found is None:
+            owned = self.branches.get(type_name, {}).get(spec.name, [])
+            found = [self.units[t].providers[0] for t in _topological(owned, self.units)] + [spec]
+            self._branch_members[(type_name, spec.name)] = found
+        return found
 
     def _branches(self) -> dict[str, dict[str, list[str]]]:
         """For each unit with alternatives: the units only one alternative needs, moved into its branch.
@@ -1030,17 +1037,20 @@ class _Layout:
 
 def _topological(keys: list[str], units: Mapping[str, _UnitChoice]) -> list[str]:
     """Order units so that each comes after the units of the same list whose types it needs."""
+    if len(keys) < 2:
+        return list(keys)
+    needs = {key: frozenset(units[key].providers[0].inputs) for key in keys}
     ordered: list[str] = []
-    remaining = list(keys)
+    remaining = sorted(keys)
     while remaining:
-        for key in sorted(remaining):
-            needs = set(units[key].providers[0].inputs)
-            if not any(units[other].guaranteed() & needs for other in remaining if other != key):
+        for key in remaining:
+            wanted = needs[key]
+            if all(other == key or wanted.isdisjoint(units[other].guaranteed()) for other in remaining):
                 ordered.append(key)
                 remaining.remove(key)
                 break
         else:
-            ordered.extend(sorted(remaining))
+            ordered.extend(remaining)
             break
     return ordered
 
