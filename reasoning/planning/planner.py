@@ -437,15 +437,19 @@ class _Assignment:
         units = self.units
         if self._order is None:
             self._order = sorted(units, key=lambda k: (rounds.get(k, 0), k))
-        for key in self._order:
-            unit = units[key]
-            latest = unit.latest_round
-            for type_name in unit.guaranteed_sorted:
-                if type_name in found:
-                    continue
-                if by_rounds and latest >= rounds.get(type_name, 0):
-                    continue  # a by-product made from later types could close a cycle in the strict mode
-                found[type_name] = key
+        if by_rounds:
+            for key in self._order:
+                unit = units[key]
+                latest = unit.latest_round
+                for type_name in unit.guaranteed_sorted:
+                    # a by-product made from later types could close a cycle in the strict mode
+                    if type_name not in found and latest < rounds.get(type_name, 0):
+                        found[type_name] = key
+        else:
+            for key in self._order:
+                for type_name in units[key].guaranteed_sorted:
+                    if type_name not in found:
+                        found[type_name] = key
         for type_name, key in self.pinned.items():
             if key in self.units and type_name in self.units[key].guaranteed():
                 found[type_name] = key
