@@ -701,9 +701,17 @@ _UNMET_ROUNDS = 4  # passes of the assignment over needs left without a unit bef
 
 def _units_of(types: tuple[str, ...], guaranteed: Mapping[str, str]) -> tuple[str, ...]:
     """The units (sorted, each once) that guarantee ``types`` by ``guaranteed``."""
-    if len(types) == 1:
+    count = len(types)
+    if count == 1:
         key = guaranteed.get(types[0])
         return () if key is None else (key,)
+    if count == 2:
+        first, second = guaranteed.get(types[0]), guaranteed.get(types[1])
+        if first is None or first == second:
+            return () if second is None else (second,)
+        if second is None:
+            return (first,)
+        return (first, second) if first < second else (second, first)
     return tuple(sorted({guaranteed[t] for t in types if t in guaranteed}))
 
 
