@@ -7,7 +7,11 @@ Measured on the hypothesis' points in the upright support frame (:mod:`annotator
 * **handle**: the body is the circle fitted to the footprint of the lowest part (up to ``BODY_SLICE`` of the
   height), where a handle never is. A handle is a clump of points of the middle part sticking out of that circle
   by more than ``HANDLE_GAP`` of its radius, in a narrow direction (circular spread under ``HANDLE_SPREAD``),
-  while the lowest part does not stick out there (a wider base is no handle);
+  while the lowest part does not stick out there (a wider base is no handle). Its confidence grows with its
+  points up to ``HANDLE_POINTS``; the confidence that there is none grows with how much of the middle part was
+  seen but falls with the share of it that sticks out without forming a handle, to 0 at ``HANDLE_SHARE`` (about
+  what a handle seen from the side holds: a handle seen end-on or cut apart by the segmenter looks like that, a
+  plain cup's or can's side does not);
 * **open top**: by visibility. Every seen point of a closed (convex) object is seen from outside: the line of
   sight from it to the camera leaves the object's convex hull at once. The inside of an open object (a cup's
   far inner wall, a bowl's bottom) is seen through the opening: its line of sight crosses the hull for a good part
@@ -48,6 +52,11 @@ HANDLE_SPREAD = np.radians(40.0)
 """A handle's points point in one direction: their circular standard deviation around the axis is below this."""
 HANDLE_MIN_SHARE = 0.02
 """A handle holds at least this share of the middle part's points (and 8 points)."""
+HANDLE_POINTS = 20
+"""Points of a handle at which it is taken as certain."""
+HANDLE_SHARE = 0.1
+"""Share of the middle part a handle seen from the side holds: sticking out that much, the points leave it open
+whether there is a handle (no confidence that there is none)."""
 THROUGH = 0.15
 """A point is seen through the object when its line of sight crosses the hull for this share of the extent."""
 THROUGH_MIN = 0.01
@@ -102,7 +111,8 @@ def handle_evidence(points: np.ndarray, bottom: float, height: float) -> tuple[b
     reach = radius + max(0.01, HANDLE_GAP * radius)
     offsets = middle - centre
     out = np.linalg.norm(offsets, axis=1) > reach
-    confidence = min(1.0, middle.shape[0] / FULL_EVIDENCE)
+    sticking_out = np.count_nonzero(out) / middle.shape[0]
+    confidence = min(1.0, middle.shape[0] / FULL_EVIDENCE) * max(0.0, 1.0 - sticking_out / HANDLE_SHARE)  # none
     if np.count_nonzero(out) < max(8, HANDLE_MIN_SHARE * middle.shape[0]):
         return False, confidence
     angles = np.arctan2(offsets[out, 1], offsets[out, 0])
@@ -113,7 +123,7 @@ def handle_evidence(points: np.ndarray, bottom: float, height: float) -> tuple[b
     base_out = (np.linalg.norm(below, axis=1) > reach) & (below @ direction > 0.7 * np.linalg.norm(below, axis=1))
     if np.count_nonzero(base_out) > 0.5 * np.count_nonzero(out) * body.shape[0] / middle.shape[0]:
         return False, confidence  # the base reaches out there too: a wider object, no handle
-    return True, min(1.0, np.count_nonzero(out) / 20)
+    return True, min(1.0, np.count_nonzero(out) / HANDLE_POINTS)
 
 
 def lines_of_sight(points: np.ndarray, tested: np.ndarray, camera: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
