@@ -72,8 +72,11 @@ WEIGHTS: Mapping[str, float] = MappingProxyType(
 )
 """How much each cue counts in the score."""
 
-HANDLE_HIDDEN = 0.5
-"""Handle agreement of a class with a handle when none was seen (it may be on the hidden side)."""
+HANDLE_HIDDEN = 0.3
+"""Handle agreement of a class with a handle when none was seen: it may be on the hidden side, but from most
+directions a mug's handle shows (it hides behind the body in roughly a third of the views around it), so not seeing
+one speaks against the class: a handle-less cup does not tie with a mug and the query's class cannot make it one.
+How sure the form expert is that none is in view (``handle_confidence``) weighs this as any cue."""
 
 NO_HANDLE = 0.6
 """Handle agreement of a class without a handle when none was seen (most objects show none)."""

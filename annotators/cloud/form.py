@@ -7,11 +7,25 @@ Measured on the hypothesis' points in the upright support frame (:mod:`annotator
 * **handle**: the body is the circle fitted to the footprint of the lowest part (up to ``BODY_SLICE`` of the
   height), where a handle never is. A handle is a clump of points of the middle part sticking out of that circle
   by more than ``HANDLE_GAP`` of its radius, in a narrow direction (circular spread under ``HANDLE_SPREAD``),
-  while the lowest part does not stick out there (a wider base is no handle);
-* **open top**: seen from the camera, the far half of a closed object shows only its top (a lid, a box's top
-  face); an open one shows its inside wall below the rim. The share of far-half points lower than ``RIM`` of the
-  height says open (more than ``OPEN_SHARE``) or closed; how many far-half points were seen is the confidence
-  (none: the top was not seen, confidence 0).
+  while the lowest part does not stick out there (a wider base is no handle). Its confidence grows with its
+  points up to ``HANDLE_POINTS``; the confidence that there is none grows with how much of the middle part was
+  seen but falls with the share of it that sticks out without forming a handle, to 0 at ``HANDLE_SHARE`` (about
+  what a handle seen from the side holds: a handle seen end-on or cut apart by the segmenter looks like that, a
+  plain cup's or can's side does not);
+* **open top**: by visibility. Every seen point of a closed (convex) object is seen from outside: the line of
+  sight from it to the camera leaves the object's convex hull at once. The inside of an open object (a cup's
+  far inner wall, a bowl's bottom) is seen through the opening: its line of sight crosses the hull for a good part
+  of the object's width and leaves it over the rim, near the top. (Two objects cut as one are not convex either:
+  a line of sight from the one behind runs through their hull too, but leaves it lower, between them.) What is
+  seen through an opening is the far part of the inside: seen from above, it lies within the footprint of the
+  object's top (its points above ``RIM_EXIT`` of the height: the rim), widened by ``THROUGH_MIN``, and beyond
+  the middle of that top as seen from the camera (the near rim hides the near inside). A taller object's face
+  seen over a shorter one cut together with it in front, or a bottle's shoulder below its cap, is seen over the
+  top of the hull too, but in front of the top's middle or beside the top. The share of points seen through the
+  hull for more than ``THROUGH`` of the footprint's extent (and at least ``THROUGH_MIN`` metres), leaving it
+  above ``RIM_EXIT`` of the height, in the far part of the top, says open (more than ``OPEN_SHARE``) or closed;
+  the confidence grows with the distance of that share from ``OPEN_SHARE`` (a share near it says little either
+  way).
 """
 
 from __future__ import annotations
@@ -20,6 +34,7 @@ from dataclasses import dataclass
 from typing import ClassVar
 
 import numpy as np
+from scipy.spatial import ConvexHull, QhullError
 
 from annotators.cloud.cloud_expert import CloudExpert
 from annotators.cloud.shape import circle_fit
@@ -37,14 +52,23 @@ HANDLE_SPREAD = np.radians(40.0)
 """A handle's points point in one direction: their circular standard deviation around the axis is below this."""
 HANDLE_MIN_SHARE = 0.02
 """A handle holds at least this share of the middle part's points (and 8 points)."""
-RIM = 0.8
-"""Points lower than this share of the height, on the far half, are inside an open object."""
-OPEN_SHARE = 0.3
-"""Share of far-half points below the rim from which the object is open at the top."""
-FAR = 0.1
-"""Far-half points lie beyond the footprint's median, seen from the camera, by this share of its extent."""
+HANDLE_POINTS = 20
+"""Points of a handle at which it is taken as certain."""
+HANDLE_SHARE = 0.1
+"""Share of the middle part a handle seen from the side holds: sticking out that much, the points leave it open
+whether there is a handle (no confidence that there is none)."""
+THROUGH = 0.15
+"""A point is seen through the object when its line of sight crosses the hull for this share of the extent."""
+THROUGH_MIN = 0.01
+"""... and for at least this many metres (depth noise puts surface points a few millimetres inside the hull)."""
+RIM_EXIT = 0.85
+"""... leaving the hull over the rim: at least this share of the height up (not between two objects cut as one)."""
+THROUGH_TESTED = 400
+"""At most about this many points (evenly taken) are tested for being seen through the object."""
+OPEN_SHARE = 0.1
+"""Share of points seen through the object from which it is open at the top."""
 FULL_EVIDENCE = 40
-"""Points (far half, or handle) at which the evidence is taken as complete (confidence 1)."""
+"""Points (object, or handle) at which the evidence is taken as complete (confidence 1)."""
 
 
 @dataclass(frozen=True)
@@ -87,7 +111,8 @@ def handle_evidence(points: np.ndarray, bottom: float, height: float) -> tuple[b
     reach = radius + max(0.01, HANDLE_GAP * radius)
     offsets = middle - centre
     out = np.linalg.norm(offsets, axis=1) > reach
-    confidence = min(1.0, middle.shape[0] / FULL_EVIDENCE)
+    sticking_out = np.count_nonzero(out) / middle.shape[0]
+    confidence = min(1.0, middle.shape[0] / FULL_EVIDENCE) * max(0.0, 1.0 - sticking_out / HANDLE_SHARE)  # none
     if np.count_nonzero(out) < max(8, HANDLE_MIN_SHARE * middle.shape[0]):
         return False, confidence
     angles = np.arctan2(offsets[out, 1], offsets[out, 0])
@@ -98,25 +123,62 @@ def handle_evidence(points: np.ndarray, bottom: float, height: float) -> tuple[b
     base_out = (np.linalg.norm(below, axis=1) > reach) & (below @ direction > 0.7 * np.linalg.norm(below, axis=1))
     if np.count_nonzero(base_out) > 0.5 * np.count_nonzero(out) * body.shape[0] / middle.shape[0]:
         return False, confidence  # the base reaches out there too: a wider object, no handle
-    return True, min(1.0, np.count_nonzero(out) / 20)
+    return True, min(1.0, np.count_nonzero(out) / HANDLE_POINTS)
 
 
-def open_evidence(points: np.ndarray, bottom: float, height: float, camera_xy: np.ndarray) -> tuple[bool, float]:
+def lines_of_sight(points: np.ndarray, tested: np.ndarray, camera: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """For each of the Mx3 ``tested`` points (some of the Nx3 ``points``): how far (metres) its line of sight towards
+    ``camera`` runs inside the convex hull of ``points``, and the height (z) at which it leaves the hull. A flat hull
+    (no volume) holds no line of sight: (0, the point's own z)."""
+    try:
+        hull = ConvexHull(points)
+    except QhullError:
+        return np.zeros(tested.shape[0]), tested[:, 2].copy()
+    sight = camera - tested
+    sight /= np.maximum(np.linalg.norm(sight, axis=1, keepdims=True), 1e-12)
+    normals, offsets = hull.equations[:, :3], hull.equations[:, 3]
+    inside = -(tested @ normals.T + offsets)  # distance to each face's plane, >= 0 inside
+    toward = sight @ normals.T  # > 0: the line of sight runs towards that face
+    with np.errstate(divide="ignore", invalid="ignore"):
+        reach = np.where(toward > 1e-12, inside / toward, np.inf)
+    run = np.maximum(reach.min(axis=1), 0.0)
+    return run, tested[:, 2] + run * sight[:, 2]
+
+
+def far_inside_top(points: np.ndarray, tested: np.ndarray, rim_height: float, camera: np.ndarray) -> np.ndarray:
+    """Which of the Mx3 ``tested`` points lie, seen from above, in the far part of the top of the Nx3 ``points``
+    (those at least ``rim_height`` high): inside its footprint (convex hull in x, y, widened by ``THROUGH_MIN``)
+    and beyond its middle (median) as seen from ``camera``; none without such a footprint."""
+    top = points[points[:, 2] >= rim_height, :2]
+    none = np.zeros(tested.shape[0], dtype=bool)
+    if top.shape[0] < 3:
+        return none
+    try:
+        hull = ConvexHull(top)
+    except QhullError:  # the top is a line or a point: it encloses nothing
+        return none
+    outside = tested[:, :2] @ hull.equations[:, :2].T + hull.equations[:, 2]  # > 0: beyond that edge
+    middle = np.median(top, axis=0)
+    away = middle - camera[:2]
+    if np.linalg.norm(away) < 1e-9:  # seen from straight above: no near and far side
+        return outside.max(axis=1) <= THROUGH_MIN
+    return (outside.max(axis=1) <= THROUGH_MIN) & ((tested[:, :2] - middle) @ away > 0.0)
+
+
+def open_evidence(points: np.ndarray, bottom: float, height: float, camera: np.ndarray) -> tuple[bool, float]:
     """Whether the object is open at the top, and the confidence of that (see the module docstring)."""
-    xy = points[:, :2]
-    centre = np.median(xy, axis=0)
-    away = centre - camera_xy
-    distance = float(np.linalg.norm(away))
-    if distance < 1e-6:
+    extent = _extent(points[:, :2])
+    if points.shape[0] < 20 or extent <= 0.0 or height <= 0.0:
         return False, 0.0
-    away /= distance
-    depth = (xy - centre) @ away
-    far = depth > FAR * _extent(xy)
-    if not far.any():
-        return False, 0.0
-    low = (points[far, 2] - bottom) < RIM * height
-    share = float(np.count_nonzero(low)) / np.count_nonzero(far)
-    return share > OPEN_SHARE, min(1.0, np.count_nonzero(far) / FULL_EVIDENCE)
+    tested = points[:: max(1, points.shape[0] // THROUGH_TESTED)]
+    run, leaves_at = lines_of_sight(points, tested, camera)
+    rim = bottom + RIM_EXIT * height
+    through = (
+        (run >= max(THROUGH * extent, THROUGH_MIN)) & (leaves_at >= rim) & far_inside_top(points, tested, rim, camera)
+    )
+    share = float(np.count_nonzero(through)) / tested.shape[0]
+    clearness = min(1.0, abs(share - OPEN_SHARE) / OPEN_SHARE)
+    return share > OPEN_SHARE, clearness * min(1.0, points.shape[0] / FULL_EVIDENCE)
 
 
 def measure_form(points: np.ndarray, frame: SupportFrame) -> Form | None:
@@ -131,8 +193,7 @@ def measure_form(points: np.ndarray, frame: SupportFrame) -> Form | None:
     if height <= 0.0 or width <= 0.0:
         return None
     handle, handle_confidence = handle_evidence(points, bottom, height)
-    camera_xy = frame.camera_to_frame[:2, 3]
-    open_top, open_confidence = open_evidence(points, bottom, height, camera_xy)
+    open_top, open_confidence = open_evidence(points, bottom, height, frame.camera_to_frame[:3, 3])
     return Form(height / width, handle, handle_confidence, open_top, open_confidence)
 
 

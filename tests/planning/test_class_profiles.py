@@ -1,0 +1,75 @@
+"""The class profiles the planner hands the knowledge classifier (issue 15, item 6): every object class says what the
+form experts measure, and with the shipped ontology the form cues tell containers apart without the query's class."""
+
+from __future__ import annotations
+
+import pytest
+
+from annotators.classification.knowledge_classifier import Cues, Profile, best_match, decide, score
+from reasoning.knowledge.knowledge_base import KnowledgeBase
+from reasoning.planning.query_planner import class_profiles
+
+
+@pytest.fixture(scope="module")
+def profiles(tmp_path_factory: pytest.TempPathFactory) -> dict[str, Profile]:
+    kb = KnowledgeBase.load(tmp_path_factory.mktemp("user") / "user.ttl")
+    return {p["class"]: Profile.from_mapping(p) for p in class_profiles(kb)}
+
+
+def stands_or_lies(profile: Profile) -> bool:
+    """Boxes of dry food stand or lie: their height over width may be anything (like a cup's colour)."""
+    return "dryfood" in profile.ancestors
+
+
+def test_every_class_declares_its_form(profiles: dict[str, Profile]) -> None:
+    assert len(profiles) > 50
+    missing = {
+        name: [
+            f
+            for f in ("handle", "open_top", "height_to_width")
+            if getattr(p, f) is None and not (f == "height_to_width" and stands_or_lies(p))
+        ]
+        for name, p in profiles.items()
+    }
+    assert {name: fields for name, fields in missing.items() if fields} == {}
+    assert profiles["DryFood"].height_to_width is None and profiles["CerealBox"].height_to_width is not None
+
+
+def test_containers_differ_in_handle_open_top_and_height_to_width(profiles: dict[str, Profile]) -> None:
+    assert profiles["Mug"].handle and not profiles["Cup"].handle and not profiles["Bowl"].handle
+    assert all(profiles[c].open_top for c in ("Mug", "Cup", "Bowl", "Glass"))
+    assert not any(profiles[c].open_top for c in ("CannedFood", "Bottle", "Milk", "CerealBox", "Crackers"))
+    ratio = {name: p.height_to_width for name, p in profiles.items()}
+    assert ratio["Bowl"][1] <= ratio["Cup"][0] < ratio["Bottle"][0]  # a bowl is squat, a bottle tall
+    assert ratio["Plate"][1] <= ratio["Bowl"][0]  # a plate is flatter than a bowl
+    assert profiles["Cup"].colors == () and profiles["Mug"].colors == ()  # any colour
+
+
+def ranked(profiles: dict[str, Profile], cues: Cues) -> list[str]:
+    matches = sorted((score(p, cues) for p in profiles.values()), key=lambda m: -m.score)
+    return [m.profile.class_name for m in matches]
+
+
+SMALL_CYLINDER = {"shape": ("cylinder", 0.8), "size": ("small", 1.0), "color": ("green", 0.9)}
+
+
+def test_a_green_open_cylinder_with_a_handle_is_ranked_a_mug(profiles: dict[str, Profile]) -> None:
+    cues = Cues(**SMALL_CYLINDER, handle=(True, 1.0), open_top=(True, 1.0), height_to_width=1.0)
+    matches = [score(p, cues) for p in profiles.values()]
+    assert best_match(matches).profile.class_name == "Mug"
+    assert decide(matches, expected="Cup").class_name != "Cup"  # the query cannot make it a cup
+
+
+def test_without_a_handle_seen_the_query_cannot_make_a_cup_a_mug(profiles: dict[str, Profile]) -> None:
+    cues = Cues(**SMALL_CYLINDER, handle=(False, 1.0), open_top=(True, 1.0), height_to_width=1.2)
+    order = ranked(profiles, cues)
+    assert order.index("Cup") < order.index("Mug")
+    matches = [score(p, cues) for p in profiles.values()]
+    assert decide(matches, expected="Mug").class_name != "Mug"
+
+
+def test_a_closed_cylinder_is_no_cup_and_a_squat_open_one_is_a_bowl(profiles: dict[str, Profile]) -> None:
+    can = ranked(profiles, Cues(**SMALL_CYLINDER, handle=(False, 1.0), open_top=(False, 1.0), height_to_width=1.3))
+    assert can.index("CannedFood") < min(can.index("Cup"), can.index("Mug"), can.index("Glass"))
+    bowl = Cues(shape=("sphere", 0.6), size=("medium", 1.0), handle=(False, 1.0), open_top=(True, 1.0))
+    assert ranked(profiles, Cues(**{**bowl.__dict__, "height_to_width": 0.4}))[0] in {"Bowl", "PlasticBowl"}
