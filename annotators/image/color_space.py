@@ -58,51 +58,66 @@ def srgb_to_lab(rgb: np.ndarray) -> np.ndarray:
     return linear_to_lab(srgb_to_linear(rgb))
 
 
+_TWO_PI = 2.0 * np.pi
+_POW25_7 = 25.0**7
+_T_TERMS = tuple((np.cos(np.radians(d)), np.sin(np.radians(d))) for d in (30.0, 6.0, 63.0))
+"""cos and sin of the phase offsets of the hue weighting T: 30, 6 and 63 degrees."""
+
+
+def _seventh_power_ratio(chroma: np.ndarray) -> np.ndarray:
+    """``sqrt(C^7 / (C^7 + 25^7))``, the chroma factor of the G and R_C terms."""
+    squared = chroma * chroma
+    seventh = squared * squared * squared * chroma
+    return np.sqrt(seventh / (seventh + _POW25_7))
+
+
 def delta_e_2000(
     lab1: np.ndarray, lab2: np.ndarray, k_l: float = 1.0, k_c: float = 1.0, k_h: float = 1.0
 ) -> np.ndarray:
     """CIEDE2000 differences between CIELAB colours; the inputs broadcast against each other (``...x3``).
 
     ``k_l``, ``k_c`` and ``k_h`` are the formula's parametric factors (1 for the reference conditions; a larger
-    factor makes differences in lightness, chroma or hue count less)."""
+    factor makes differences in lightness, chroma or hue count less). Hue angles are kept in radians and the
+    hue weighting T's four cosines come from one cosine and sine by multiple-angle identities."""
     lab1, lab2 = np.asarray(lab1, dtype=np.float64), np.asarray(lab2, dtype=np.float64)
     l1, a1, b1 = lab1[..., 0], lab1[..., 1], lab1[..., 2]
     l2, a2, b2 = lab2[..., 0], lab2[..., 1], lab2[..., 2]
-    c_mean = (np.hypot(a1, b1) + np.hypot(a2, b2)) / 2
-    c7 = c_mean**7
-    g = 0.5 * (1 - np.sqrt(c7 / (c7 + 25.0**7)))
-    a1p, a2p = (1 + g) * a1, (1 + g) * a2
+    g1 = 1.5 - 0.5 * _seventh_power_ratio((np.hypot(a1, b1) + np.hypot(a2, b2)) * 0.5)  # 1 + G
+    a1p, a2p = g1 * a1, g1 * a2
     c1p, c2p = np.hypot(a1p, b1), np.hypot(a2p, b2)
-    h1p = np.degrees(np.arctan2(b1, a1p)) % 360
-    h2p = np.degrees(np.arctan2(b2, a2p)) % 360
+    h1p, h2p = np.arctan2(b1, a1p), np.arctan2(b2, a2p)
+    h1p = np.where(h1p < 0.0, h1p + _TWO_PI, h1p)
+    h2p = np.where(h2p < 0.0, h2p + _TWO_PI, h2p)
     chroma_product = c1p * c2p
+    neutral = chroma_product == 0
     dh = h2p - h1p
-    dh = np.where(dh > 180, dh - 360, np.where(dh < -180, dh + 360, dh))
-    dh = np.where(chroma_product == 0, 0.0, dh)
-    d_l = l2 - l1
-    d_c = c2p - c1p
-    d_h = 2 * np.sqrt(chroma_product) * np.sin(np.radians(dh / 2))
-    l_mean = (l1 + l2) / 2
-    cp_mean = (c1p + c2p) / 2
+    dh = np.where(dh > np.pi, dh - _TWO_PI, np.where(dh < -np.pi, dh + _TWO_PI, dh))
+    d_h = 2.0 * np.sqrt(chroma_product) * np.sin(np.where(neutral, 0.0, dh) * 0.5)
     h_sum = h1p + h2p
     h_mean = np.where(
-        chroma_product == 0,
-        h_sum,
-        np.where(np.abs(h1p - h2p) <= 180, h_sum / 2, np.where(h_sum < 360, (h_sum + 360) / 2, (h_sum - 360) / 2)),
+        neutral | (np.abs(h2p - h1p) <= np.pi),
+        np.where(neutral, h_sum, h_sum * 0.5),
+        np.where(h_sum < _TWO_PI, (h_sum + _TWO_PI) * 0.5, (h_sum - _TWO_PI) * 0.5),
     )
+    c, s = np.cos(h_mean), np.sin(h_mean)
+    c2, s2 = 2.0 * c * c - 1.0, 2.0 * s * c
+    c3, s3 = c * (2.0 * c2 - 1.0), s * (2.0 * c2 + 1.0)
+    c4, s4 = 2.0 * c2 * c2 - 1.0, 2.0 * s2 * c2
+    (cos30, sin30), (cos6, sin6), (cos63, sin63) = _T_TERMS
     t = (
-        1
-        - 0.17 * np.cos(np.radians(h_mean - 30))
-        + 0.24 * np.cos(np.radians(2 * h_mean))
-        + 0.32 * np.cos(np.radians(3 * h_mean + 6))
-        - 0.20 * np.cos(np.radians(4 * h_mean - 63))
+        1.0
+        - 0.17 * (c * cos30 + s * sin30)
+        + 0.24 * c2
+        + 0.32 * (c3 * cos6 - s3 * sin6)
+        - 0.20 * (c4 * cos63 + s4 * sin63)
     )
-    s_l = 1 + 0.015 * (l_mean - 50) ** 2 / np.sqrt(20 + (l_mean - 50) ** 2)
-    s_c = 1 + 0.045 * cp_mean
-    s_h = 1 + 0.015 * cp_mean * t
-    cp7 = cp_mean**7
-    r_c = 2 * np.sqrt(cp7 / (cp7 + 25.0**7))
-    d_theta = 30 * np.exp(-(((h_mean - 275) / 25) ** 2))
-    r_t = -np.sin(np.radians(2 * d_theta)) * r_c
-    term_l, term_c, term_h = d_l / (k_l * s_l), d_c / (k_c * s_c), d_h / (k_h * s_h)
-    return np.sqrt(term_l**2 + term_c**2 + term_h**2 + r_t * term_c * term_h)
+    l_offset = (l1 + l2) * 0.5 - 50.0
+    l_offset *= l_offset
+    s_l = 1.0 + 0.015 * l_offset / np.sqrt(20.0 + l_offset)
+    cp_mean = (c1p + c2p) * 0.5
+    s_c = 1.0 + 0.045 * cp_mean
+    s_h = 1.0 + 0.015 * cp_mean * t
+    rotation = (h_mean - np.radians(275.0)) / np.radians(25.0)
+    r_t = -np.sin(np.radians(60.0) * np.exp(-rotation * rotation)) * 2.0 * _seventh_power_ratio(cp_mean)
+    term_l, term_c, term_h = (l2 - l1) / (k_l * s_l), (c2p - c1p) / (k_c * s_c), d_h / (k_h * s_h)
+    return np.sqrt(term_l * term_l + term_c * term_c + term_h * term_h + r_t * term_c * term_h)

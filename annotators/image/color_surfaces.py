@@ -16,6 +16,7 @@ darker group of nearly the same hue and saturation as a larger one is its shaded
 
 from __future__ import annotations
 
+from collections.abc import Sequence
 from dataclasses import dataclass
 
 import cv2
@@ -137,32 +138,32 @@ def chroma_plane(lab: np.ndarray, softness: float) -> np.ndarray:
 
 def _modes(features: np.ndarray, radius: float, min_count: float, max_groups: int) -> np.ndarray:
     """Centres of the densest modes of 2-D features: flat-kernel mean shift from the fullest histogram cell,
-    each mode taking the features within ``radius``; modes with fewer than ``min_count`` members are dropped."""
-    x, y = features[:, 0], features[:, 1]
+    each mode taking the features within ``radius``; modes with fewer than ``min_count`` members are dropped.
+
+    The features are held as complex numbers (one subtraction and one modulus give every distance), and the
+    features a mode took are removed from the arrays, so later modes search only what remains."""
     cells = np.floor(features / (radius / 2)).astype(np.int64)
     cells -= cells.min(axis=0)
     keys = cells[:, 0] * (int(cells[:, 1].max()) + 1) + cells[:, 1]
-    remaining = np.ones(features.shape[0], dtype=bool)
-    limit = radius * radius
-    centres: list[tuple[float, float]] = []
+    points = features[:, 0] + 1j * features[:, 1]
+    tolerance = 1e-6 * radius * radius
+    centres: list[complex] = []
     for _ in range(4 * max_groups):
-        if len(centres) == max_groups or np.count_nonzero(remaining) < min_count:
+        if len(centres) == max_groups or points.size < min_count:
             break
-        fullest = int(np.argmax(np.bincount(keys[remaining])))
-        seed = (remaining & (keys == fullest)).astype(np.float64)
-        cx, cy = float(x @ seed) / seed.sum(), float(y @ seed) / seed.sum()
+        seed = points[keys == int(np.argmax(np.bincount(keys)))]
+        centre = complex(seed.sum()) / seed.size
         for _ in range(10):
-            near = (remaining & ((x - cx) ** 2 + (y - cy) ** 2 < limit)).astype(np.float64)
-            count = near.sum()
-            new_x, new_y = float(x @ near) / count, float(y @ near) / count
-            if (new_x - cx) ** 2 + (new_y - cy) ** 2 < 1e-6 * limit:
+            near = points[np.abs(points - centre) < radius]
+            moved = complex(near.sum()) / near.size
+            if abs(moved - centre) ** 2 < tolerance:
                 break
-            cx, cy = new_x, new_y
-        member = remaining & ((x - cx) ** 2 + (y - cy) ** 2 < limit)
-        remaining &= ~member
-        if np.count_nonzero(member) >= min_count:
-            centres.append((cx, cy))
-    return np.array(centres, dtype=np.float64).reshape(-1, 2)
+            centre = moved
+        outside = np.abs(points - centre) >= radius
+        if points.size - np.count_nonzero(outside) >= min_count:
+            centres.append(centre)
+        points, keys = points[outside], keys[outside]
+    return np.array([(c.real, c.imag) for c in centres], dtype=np.float64).reshape(-1, 2)
 
 
 def _order_statistic(values: np.ndarray, percentile: float) -> float:
@@ -173,10 +174,14 @@ def _order_statistic(values: np.ndarray, percentile: float) -> float:
 
 def _surface(lab: np.ndarray, linear: np.ndarray, percentile: float, kind: str) -> Surface:
     """A surface from its pixels: median chromaticity at the ``percentile`` lightness, mean linear RGB."""
-    lit = _order_statistic(lab[:, 0], percentile)
-    scale = 1.0 / (lab[:, 0] + 16.0)
-    direction = np.array([_order_statistic(lab[:, 1] * scale, 50.0), _order_statistic(lab[:, 2] * scale, 50.0)])
-    return Surface(np.array([lit, *(direction * (lit + 16.0))]), linear.mean(axis=0), lab.shape[0], kind)
+    count = lab.shape[0]
+    lit_rank, middle_rank = round(percentile / 100.0 * (count - 1)), round(0.5 * (count - 1))
+    values = np.empty((3, count))
+    values[0] = lab[:, 0]
+    np.multiply(lab[:, 1:].T, 1.0 / (lab[:, 0] + 16.0), out=values[1:])
+    ranked = np.partition(values, sorted({lit_rank, middle_rank}), axis=1)  # order statistics, exact
+    lit = float(ranked[0, lit_rank])
+    return Surface(np.array([lit, *(ranked[1:, middle_rank] * (lit + 16.0))]), linear.mean(axis=0), count, kind)
 
 
 def _rg(linear: np.ndarray) -> np.ndarray:
@@ -332,36 +337,81 @@ def object_surfaces(
     """The surfaces of an object's RGB pixels (Nx3 uint8) and how many pixels were considered (after edge
     pixels were left out); the dark pool comes last. ``edges`` (N, from :func:`edge_strength`) lets pixels on
     colour edges be left out."""
-    rgb = np.asarray(pixels, dtype=np.uint8).reshape(-1, 3)
-    if rgb.shape[0] == 0:
+    return objects_surfaces([(pixels, edges)], light, parameters)[0]
+
+
+def objects_surfaces(
+    objects: Sequence[tuple[np.ndarray, np.ndarray | None]],
+    light: FrameLight = NEUTRAL_LIGHT,
+    parameters: NamingParameters = DEFAULT_PARAMETERS,
+) -> list[tuple[list[Surface], int]]:
+    """:func:`object_surfaces` of several objects of one frame (each its RGB pixels and their edge strengths or
+    None): the per-pixel steps run once over all the objects' pixels, the grouping per object."""
+    rgb_parts = [np.asarray(pixels, dtype=np.uint8).reshape(-1, 3) for pixels, _ in objects]
+    sizes = np.array([part.shape[0] for part in rgb_parts], dtype=np.int64)
+    if not rgb_parts:
+        return []
+    if sizes.min() == 0:
         raise ValueError("no pixels to name a colour for")
-    if edges is not None:
-        interior = np.asarray(edges).reshape(-1) <= parameters.edge_step
-        if np.count_nonzero(interior) >= parameters.min_interior_share * rgb.shape[0]:
-            rgb = rgb[interior]
-    count = rgb.shape[0]
+    rgb = np.concatenate(rgb_parts)
+    owner = np.repeat(np.arange(len(objects)), sizes)
+    edge_parts = [
+        np.zeros(size, dtype=np.float32) if edges is None else np.asarray(edges).reshape(-1)
+        for (_, edges), size in zip(objects, sizes, strict=True)
+    ]
+    interior = np.concatenate(edge_parts) <= parameters.edge_step
+    interior_counts = np.bincount(owner[interior], minlength=len(objects))
+    keep = interior | (interior_counts < parameters.min_interior_share * sizes)[owner]
+    rgb, owner = rgb[keep], owner[keep]
+    counts = np.bincount(owner, minlength=len(objects))
     linear = srgb_to_linear(rgb) * light.gains
     lab = linear_to_lab(linear)
     highlight = (rgb.max(axis=1) >= parameters.clipped_level) & (rgb.min(axis=1) >= parameters.highlight_floor)
     highlight[highlight] = tints(lab[highlight], parameters) <= parameters.highlight_tint
     dark = ~highlight & (lab[:, 0] < parameters.dark_lightness)
     regular = ~highlight & ~dark
-    if np.count_nonzero(highlight) >= parameters.highlight_keep_share * count:
-        # an over-exposed white surface: its clipped pixels are white, and group with its unclipped ones
-        lab[highlight] = WHITE_LAB
-        regular |= highlight
+    # an over-exposed white surface: its clipped pixels are white, and group with its unclipped ones
+    white = np.bincount(owner[highlight], minlength=len(objects)) >= parameters.highlight_keep_share * counts
+    whitened = highlight & white[owner]
+    lab[whitened] = WHITE_LAB
+    regular |= whitened
+    features = chroma_plane(lab, parameters.chroma_softness)
+    ends = np.cumsum(counts)
+    result = []
+    for index, count in enumerate(counts.tolist()):
+        part = slice(int(ends[index]) - count, int(ends[index]))
+        pixels = _Pixels(lab[part], linear[part], features[part], regular[part], dark[part], highlight[part])
+        result.append((_grouped_surfaces(pixels, count, parameters), count))
+    return result
+
+
+@dataclass(frozen=True)
+class _Pixels:
+    """One object's pixels after edge pixels were left out: CIELAB, linear RGB, log-chroma features, and which
+    are regular, in the dark pool or highlights."""
+
+    lab: np.ndarray
+    linear: np.ndarray
+    features: np.ndarray
+    regular: np.ndarray
+    dark: np.ndarray
+    highlight: np.ndarray
+
+
+def _grouped_surfaces(pixels: _Pixels, count: int, parameters: NamingParameters) -> list[Surface]:
+    """One object's surfaces from its pixels (see the module docstring); the dark pool comes last."""
+    lab, linear, regular, dark = pixels.lab, pixels.linear, pixels.regular, pixels.dark
     min_count = max(3.0, parameters.min_group_share * count)
     surfaces: list[Surface] = []
     if np.count_nonzero(regular) >= min_count:
-        colors, colors_linear = lab[regular], linear[regular]
-        features = chroma_plane(colors, parameters.chroma_softness)
+        colors, colors_linear, features = lab[regular], linear[regular], pixels.features[regular]
         centres = _modes(features, parameters.group_radius, min_count, parameters.max_groups)
         if centres.size:
-            owner = np.argmin(((features[:, None, :] - centres[None]) ** 2).sum(axis=2), axis=1)
-            for group in range(centres.shape[0]):
+            across = (features[:, 0, None] - centres[None, :, 0]) ** 2
+            owner = np.argmin(across + (features[:, 1, None] - centres[None, :, 1]) ** 2, axis=1)
+            sizes = np.bincount(owner, minlength=centres.shape[0])
+            for group in np.flatnonzero(sizes >= min_count).tolist():
                 member = owner == group
-                if np.count_nonzero(member) < min_count:
-                    continue
                 surface = _surface(colors[member], colors_linear[member], parameters.lit_percentile, "regular")
                 if not is_unsaturated(surface.lab, parameters):
                     surfaces.append(surface)
@@ -379,8 +429,9 @@ def object_surfaces(
     if np.count_nonzero(dark):
         surfaces.append(_surface(lab[dark], linear[dark], 50.0, "dark"))
     if not surfaces:  # only highlights, too few of them to count as a white surface otherwise
+        highlight = pixels.highlight
         surfaces.append(Surface(WHITE_LAB, linear[highlight].mean(axis=0), int(np.count_nonzero(highlight)), "regular"))
-    return surfaces, count
+    return surfaces
 
 
 def tints(lab: np.ndarray, parameters: NamingParameters) -> np.ndarray:
