@@ -39,7 +39,7 @@ from annotators.image.color_surfaces import (
     NamingParameters,
     Surface,
     is_unsaturated,
-    object_pixels,
+    objects_pixels,
     objects_surfaces,
     tint,
 )
@@ -279,15 +279,12 @@ class SemanticColorAnnotator(Annotator):
         """Name the colours of each hypothesis with pixels; fail on missing or inconsistent input."""
         image, hypotheses = image_and_hypotheses(self, "name colours for")
         light = estimate_frame_light(image)
-        named: list[ObjectHypothesis] = []
-        objects: list[tuple[np.ndarray, np.ndarray]] = []
         for hypothesis in hypotheses:
             if hypothesis.mask.shape != image.shape[:2]:
                 self.fail(f"hypothesis mask {hypothesis.mask.shape} and colour image {image.shape[:2]} sizes differ")
-            pixels, edges = object_pixels(image, hypothesis, self.max_pixels)
-            if pixels.shape[0]:
-                named.append(hypothesis)
-                objects.append((pixels, edges))
+        picked = objects_pixels(image, hypotheses, self.max_pixels)
+        named = [hypothesis for hypothesis, (pixels, _) in zip(hypotheses, picked, strict=True) if pixels.shape[0]]
+        objects = [(pixels, edges) for pixels, edges in picked if pixels.shape[0]]
         for hypothesis, colors in zip(named, name_objects_colors(objects, light, self.parameters), strict=True):
             for color in colors:
                 self.attach(hypothesis, SemanticColor(color=color.name, ratio=color.share, confidence=color.confidence))
