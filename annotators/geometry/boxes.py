@@ -143,3 +143,44 @@ def object_box(points_camera: np.ndarray, cam_to_world: np.ndarray | None) -> tu
         world = rows.T @ transform[:3, :3].T + transform[:3, 3]
         return upright_box(world), "world"
     return _principal(rows), "camera"
+
+
+def _principal_boxes(parts: list[np.ndarray]) -> list[OrientedBox]:
+    """:func:`principal_box` of several point sets (each finite 3xN float64 rows) at once: the sums, covariances,
+    eigen-decompositions and extents of all the sets in one pass each."""
+    boxes: list[OrientedBox | None] = [None if part.shape[1] >= 3 else _degenerate_box(part.T) for part in parts]
+    sets = [part for part in parts if part.shape[1] >= 3]
+    if not sets:
+        return [box for box in boxes if box is not None]
+    sizes = np.array([part.shape[1] for part in sets])
+    starts = np.cumsum(sizes) - sizes
+    owner = np.repeat(np.arange(sizes.size), sizes)
+    rows = np.concatenate(sets, axis=1)
+    mean = np.add.reduceat(rows, starts, axis=1) / sizes  # 3 x sets
+    centred = rows - mean[:, owner]
+    products = np.add.reduceat(centred[[0, 0, 0, 1, 1, 2]] * centred[[0, 1, 2, 1, 2, 2]], starts, axis=1)
+    covariance = products[[0, 1, 2, 1, 3, 4, 2, 4, 5]].T.reshape(-1, 3, 3)
+    _, vectors = np.linalg.eigh(covariance)
+    rotation = vectors[:, :, ::-1].copy()  # largest spread first
+    rotation[np.linalg.det(rotation) < 0, :, 2] *= -1
+    turn = rotation.reshape(-1, 9).T[:, owner]  # each point's rotation, row-major
+    local = turn[[0, 1, 2]] * centred[0] + turn[[3, 4, 5]] * centred[1] + turn[[6, 7, 8]] * centred[2]
+    low, high = np.minimum.reduceat(local, starts, axis=1), np.maximum.reduceat(local, starts, axis=1)
+    centres = mean.T + np.einsum("sij,sj->si", rotation, ((low + high) / 2).T)
+    extents = (high - low).T
+    fitted = iter(OrientedBox(c, r, e) for c, r, e in zip(centres, rotation, extents, strict=True))
+    return [box if box is not None else next(fitted) for box in boxes]
+
+
+def object_boxes(point_sets: list[np.ndarray], cam_to_world: np.ndarray | None) -> list[tuple[OrientedBox, str]]:
+    """:func:`object_box` of several objects' camera-frame points (each Nx3) at once."""
+    return object_boxes_of_rows([_finite_rows(points) for points in point_sets], cam_to_world)
+
+
+def object_boxes_of_rows(rows: list[np.ndarray], cam_to_world: np.ndarray | None) -> list[tuple[OrientedBox, str]]:
+    """:func:`object_box` of several objects whose finite camera-frame points are given as 3xN float64 rows."""
+    parts = [_compact(part) for part in rows]
+    if cam_to_world is not None:
+        transform = np.asarray(cam_to_world, dtype=np.float64)
+        return [(upright_box(part.T @ transform[:3, :3].T + transform[:3, 3]), "world") for part in parts]
+    return [(box, "camera") for box in _principal_boxes(parts)]
