@@ -140,31 +140,48 @@ def _lightness_name(surface: Surface, surround: float, parameters: NamingParamet
     return SurfaceName("black" if black else "grey", certainty)
 
 
-def _shade_groups(labs: list[np.ndarray], max_difference: float) -> list[list[int]]:
-    """The colours (CIELAB) linked by CIEDE2000 differences below ``max_difference`` (single linkage), as
+def _shade_groups(linked_to: np.ndarray) -> list[list[int]]:
+    """The single-linkage groups of colours given which pairs are linked (``linked_to[i, j]`` for j < i), as
     lists of indices."""
-    if len(labs) < 2:
-        return [[index] for index in range(len(labs))]
-    stacked = np.array(labs)
-    linked_to = delta_e_2000(stacked[:, None, :], stacked[None, :, :]) < max_difference
     groups: list[list[int]] = []
-    for index in range(len(labs)):
+    for index in range(linked_to.shape[0]):
         linked = [g for g in groups if any(linked_to[index, j] for j in g)]
         merged = [index] + [j for g in linked for j in g]
         groups = [g for g in groups if g not in linked] + [sorted(merged)]
     return groups
 
 
+def _lit_chromatic(surfaces: list[Surface], names: list[SurfaceName]) -> list[int]:
+    """The indices of the lit surfaces named by a hue."""
+    return [i for i, s in enumerate(surfaces) if s.kind != "dark" and names[i].name in CHROMATIC_TERMS]
+
+
+def _shade_links(labs_per_object: list[list[np.ndarray]], max_difference: float) -> list[np.ndarray]:
+    """For each object's colours (CIELAB), which pairs are closer than ``max_difference`` in CIEDE2000 (a
+    square boolean matrix per object), from one computation over all the objects' pairs."""
+    links = [np.zeros((len(labs), len(labs)), dtype=bool) for labs in labs_per_object]
+    pairs = [(k, i, j) for k, labs in enumerate(labs_per_object) for i in range(len(labs)) for j in range(i)]
+    if pairs:
+        first = np.array([labs_per_object[k][i] for k, i, _ in pairs])
+        second = np.array([labs_per_object[k][j] for k, _, j in pairs])
+        for (k, i, j), close in zip(pairs, (delta_e_2000(first, second) < max_difference).tolist(), strict=True):
+            links[k][i, j] = close
+    return links
+
+
 def _pool_shades(
-    surfaces: list[Surface], names: list[SurfaceName], votes: list[np.ndarray | None], parameters: NamingParameters
+    surfaces: list[Surface],
+    names: list[SurfaceName],
+    votes: list[np.ndarray | None],
+    links: np.ndarray,
 ) -> list[SurfaceName]:
-    """The names with the lit saturated surfaces that are shades of one colour (:func:`_shade_groups` with
-    ``shade_delta_e``) named together, by their pixel-weighted term votes (``votes``: each surface's, None for
-    the surfaces named by lightness): a brown tin whose print and shading spread it over reddish, pinkish and
-    orange-brown surfaces is brown, one colour."""
-    chromatic = [i for i, s in enumerate(surfaces) if s.kind != "dark" and names[i].name in CHROMATIC_TERMS]
+    """The names with the lit saturated surfaces (:func:`_lit_chromatic`) that are shades of one colour (linked
+    in a chain by ``links``, from :func:`_shade_links` with ``shade_delta_e``) named together, by their
+    pixel-weighted term votes (``votes``: each surface's, None for the surfaces named by lightness): a brown tin
+    whose print and shading spread it over reddish, pinkish and orange-brown surfaces is brown, one colour."""
+    chromatic = _lit_chromatic(surfaces, names)
     pooled = list(names)
-    for group in _shade_groups([surfaces[i].lab for i in chromatic], parameters.shade_delta_e):
+    for group in _shade_groups(links):
         if len(group) < 2:
             continue
         members = [chromatic[g] for g in group]
@@ -223,15 +240,23 @@ def name_objects_colors(
     vote_labs = [[_vote_lab(surface, parameters) for surface in surfaces] for surfaces, _ in found]
     voted = [lab for labs in vote_labs for lab in labs if lab is not None]
     all_votes = iter(_term_votes(np.array(voted), parameters) if voted else ())
-    result = []
-    for (surfaces, count), labs in zip(found, vote_labs, strict=True):
+    named = []
+    for (surfaces, _), labs in zip(found, vote_labs, strict=True):
         votes = [None if lab is None else next(all_votes) for lab in labs]
         names = [
             _lightness_name(surface, light.surround, parameters) if vote is None else _name_of_votes(vote)
             for surface, vote in zip(surfaces, votes, strict=True)
         ]
-        result.append(_object_colors(surfaces, _pool_shades(surfaces, names, votes, parameters), count, parameters))
-    return result
+        named.append((votes, names))
+    lit_labs = [
+        [surfaces[i].lab for i in _lit_chromatic(surfaces, names)]
+        for (surfaces, _), (_, names) in zip(found, named, strict=True)
+    ]
+    links = _shade_links(lit_labs, parameters.shade_delta_e)
+    return [
+        _object_colors(surfaces, _pool_shades(surfaces, names, votes, linked), count, parameters)
+        for (surfaces, count), (votes, names), linked in zip(found, named, links, strict=True)
+    ]
 
 
 def name_colors(

@@ -371,7 +371,9 @@ def objects_surfaces(
     counts = np.bincount(owner, minlength=len(objects))
     linear = srgb_to_linear(rgb) * light.gains
     lab = linear_to_lab(linear)
-    highlight = (rgb.max(axis=1) >= parameters.clipped_level) & (rgb.min(axis=1) >= parameters.highlight_floor)
+    red, green, blue = rgb[:, 0], rgb[:, 1], rgb[:, 2]
+    brightest, darkest = np.maximum(np.maximum(red, green), blue), np.minimum(np.minimum(red, green), blue)
+    highlight = (brightest >= parameters.clipped_level) & (darkest >= parameters.highlight_floor)
     highlight[highlight] = tints(_rows(lab, highlight), parameters) <= parameters.highlight_tint
     dark = ~highlight & (lab[:, 0] < parameters.dark_lightness)
     regular = ~highlight & ~dark
