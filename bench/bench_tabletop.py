@@ -161,6 +161,7 @@ def side_by_side(reference: str, rounds: int = 8, ticks: int = 10) -> None:
                 raise RuntimeError("a tree worker did not start")
         wall: dict[str, list[float]] = {name: [] for name in workers}
         cpu: dict[str, list[float]] = {name: [] for name in workers}
+        runs: dict[str, dict[str, list[float]]] = {name: {} for name in workers}
         found: dict[str, int] = {}
         for _ in range(rounds):
             for name, worker in workers.items():
@@ -170,6 +171,8 @@ def side_by_side(reference: str, rounds: int = 8, ticks: int = 10) -> None:
                 answer = json.loads(worker.stdout.readline())
                 wall[name] += answer["wall"]
                 cpu[name] += answer["cpu"]
+                for node, seconds in answer.get("nodes", {}).items():
+                    runs[name].setdefault(node, []).extend(seconds)
                 found[name] = answer["hypotheses"]
         for worker in workers.values():
             assert worker.stdin is not None
@@ -184,9 +187,19 @@ def side_by_side(reference: str, rounds: int = 8, ticks: int = 10) -> None:
             f"  {found[name]} hypotheses"
         )
     ours, theirs = ms["this checkout"], ms[f"reference {reference}"]
+    print_expert_table(runs["this checkout"], runs[f"reference {reference}"], reference)
     ours_cpu, theirs_cpu = cpu_ms["this checkout"], cpu_ms[f"reference {reference}"]
     print(f"  speed-up over the reference: {theirs / ours:.2f}x wall, {theirs_cpu / ours_cpu:.2f}x CPU")
     print(f"  goal >= 30 Hz: {'met' if 1e3 / ours >= 30 else 'NOT met'} ({1e3 / ours:.1f} Hz on this machine now)")
+
+
+def print_expert_table(ours: dict[str, list[float]], theirs: dict[str, list[float]], reference: str) -> None:
+    """Median ms per run of every annotator in both trees, side by side, and the reference's / ours ratio."""
+    print(f"  {'annotator (median ms per run)':30s} {'ours':>8s} {reference[:10]:>10s} {'speed-up':>9s}")
+    for node in [*ours, *(node for node in theirs if node not in ours)]:
+        mine = statistics.median(ours[node]) * 1e3 if ours.get(node) else float("nan")
+        other = statistics.median(theirs[node]) * 1e3 if theirs.get(node) else float("nan")
+        print(f"  {node:30s} {mine:8.2f} {other:10.2f} {other / mine:8.2f}x")
 
 
 def main() -> None:
