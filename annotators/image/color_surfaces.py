@@ -177,16 +177,21 @@ def _rows(array: np.ndarray, where: np.ndarray) -> np.ndarray:
     return np.compress(where, array, axis=0)
 
 
-def _surface(lab: np.ndarray, linear: np.ndarray, percentile: float, kind: str) -> Surface:
-    """A surface from its pixels: median chromaticity at the ``percentile`` lightness, mean linear RGB."""
-    count = lab.shape[0]
+def _surface(chromaticity: np.ndarray, linear: np.ndarray, percentile: float, kind: str) -> Surface:
+    """A surface from its pixels (``chromaticity``: 3xN rows L*, a*/(L*+16), b*/(L*+16); ``linear``: Nx3):
+    median chromaticity at the ``percentile`` lightness, mean linear RGB."""
+    count = chromaticity.shape[1]
     lit_rank, middle_rank = round(percentile / 100.0 * (count - 1)), round(0.5 * (count - 1))
-    values = np.empty((3, count))
-    values[0] = lab[:, 0]
-    np.multiply(lab[:, 1:].T, 1.0 / (lab[:, 0] + 16.0), out=values[1:])
-    ranked = np.partition(values, sorted({lit_rank, middle_rank}), axis=1)  # order statistics, exact
+    ranked = np.partition(chromaticity, sorted({lit_rank, middle_rank}), axis=1)  # order statistics, exact
     lit = float(ranked[0, lit_rank])
     return Surface(np.array([lit, *(ranked[1:, middle_rank] * (lit + 16.0))]), linear.mean(axis=0), count, kind)
+
+
+def _surface_where(
+    chromaticity: np.ndarray, linear: np.ndarray, where: np.ndarray, percentile: float, kind: str
+) -> Surface:
+    """:func:`_surface` of the pixels ``where`` is set."""
+    return _surface(np.compress(where, chromaticity, axis=1), _rows(linear, where), percentile, kind)
 
 
 def _rg(linear: np.ndarray) -> np.ndarray:
@@ -383,21 +388,26 @@ def objects_surfaces(
     lab[whitened] = WHITE_LAB
     regular |= whitened
     features = chroma_plane(lab, parameters.chroma_softness)
+    chromaticity = np.empty((3, lab.shape[0]))  # L*, and a* and b* over L* + 16 (unchanged by uniform light)
+    chromaticity[0] = lab[:, 0]
+    np.multiply(lab[:, 1:].T, 1.0 / (lab[:, 0] + 16.0), out=chromaticity[1:])
     ends = np.cumsum(counts)
     result = []
     for index, count in enumerate(counts.tolist()):
         part = slice(int(ends[index]) - count, int(ends[index]))
-        pixels = _Pixels(lab[part], linear[part], features[part], regular[part], dark[part], highlight[part])
+        pixels = _Pixels(
+            chromaticity[:, part], linear[part], features[part], regular[part], dark[part], highlight[part]
+        )
         result.append((_grouped_surfaces(pixels, count, parameters), count))
     return result
 
 
 @dataclass(frozen=True)
 class _Pixels:
-    """One object's pixels after edge pixels were left out: CIELAB, linear RGB, log-chroma features, and which
-    are regular, in the dark pool or highlights."""
+    """One object's pixels after edge pixels were left out: L* and chromaticity (3xN rows, see
+    :func:`_surface`), linear RGB, log-chroma features, and which are regular, in the dark pool or highlights."""
 
-    lab: np.ndarray
+    chromaticity: np.ndarray
     linear: np.ndarray
     features: np.ndarray
     regular: np.ndarray
@@ -420,31 +430,29 @@ def _group_members(features: np.ndarray, centres: np.ndarray, min_count: float) 
 
 def _grouped_surfaces(pixels: _Pixels, count: int, parameters: NamingParameters) -> list[Surface]:
     """One object's surfaces from its pixels (see the module docstring); the dark pool comes last."""
-    lab, linear, regular, dark = pixels.lab, pixels.linear, pixels.regular, pixels.dark
+    chromaticity, linear, regular, dark = pixels.chromaticity, pixels.linear, pixels.regular, pixels.dark
     min_count = max(3.0, parameters.min_group_share * count)
     surfaces: list[Surface] = []
+    percentile = parameters.lit_percentile
     if np.count_nonzero(regular) >= min_count:
-        colors, colors_linear, features = _rows(lab, regular), _rows(linear, regular), _rows(pixels.features, regular)
+        colors, colors_linear = np.compress(regular, chromaticity, axis=1), _rows(linear, regular)
+        features = _rows(pixels.features, regular)
         centres = _modes(features, parameters.group_radius, min_count, parameters.max_groups)
         for member in _group_members(features, centres, min_count):
-            surface = _surface(
-                _rows(colors, member), _rows(colors_linear, member), parameters.lit_percentile, "regular"
-            )
+            surface = _surface_where(colors, colors_linear, member, percentile, "regular")
             if not is_unsaturated(surface.lab, parameters):
                 surfaces.append(surface)
                 continue
-            blackish = member & (colors[:, 0] < parameters.black_lightness)
+            blackish = member & (colors[0] < parameters.black_lightness)
             for part in (member & ~blackish, blackish):  # black print on white: two surfaces
                 if np.count_nonzero(part) >= min_count:
-                    surfaces.append(
-                        _surface(_rows(colors, part), _rows(colors_linear, part), parameters.lit_percentile, "regular")
-                    )
+                    surfaces.append(_surface_where(colors, colors_linear, part, percentile, "regular"))
     if not surfaces and np.count_nonzero(regular):  # too few pixels for a group: they are one surface
-        surfaces.append(_surface(_rows(lab, regular), _rows(linear, regular), parameters.lit_percentile, "regular"))
+        surfaces.append(_surface_where(chromaticity, linear, regular, percentile, "regular"))
     surfaces = _merge_mixtures(surfaces, parameters.mixture_tolerance)
     surfaces = _merge_shaded(_merge_white_blends(surfaces, parameters), parameters)
     if np.count_nonzero(dark):
-        surfaces.append(_surface(_rows(lab, dark), _rows(linear, dark), 50.0, "dark"))
+        surfaces.append(_surface_where(chromaticity, linear, dark, 50.0, "dark"))
     if not surfaces:  # only highlights, too few of them to count as a white surface otherwise
         highlight = pixels.highlight
         surfaces.append(
