@@ -177,21 +177,24 @@ def _rows(array: np.ndarray, where: np.ndarray) -> np.ndarray:
     return np.compress(where, array, axis=0)
 
 
-def _surface(chromaticity: np.ndarray, linear: np.ndarray, percentile: float, kind: str) -> Surface:
-    """A surface from its pixels (``chromaticity``: 3xN rows L*, a*/(L*+16), b*/(L*+16); ``linear``: Nx3):
-    median chromaticity at the ``percentile`` lightness, mean linear RGB."""
-    count = chromaticity.shape[1]
+def _surface(rows: np.ndarray, percentile: float, kind: str) -> Surface:
+    """A surface from its pixels given as rows (:func:`_pixel_rows`): median chromaticity at the ``percentile``
+    lightness, mean linear RGB."""
+    count = rows.shape[1]
     lit_rank, middle_rank = round(percentile / 100.0 * (count - 1)), round(0.5 * (count - 1))
-    ranked = np.partition(chromaticity, sorted({lit_rank, middle_rank}), axis=1)  # order statistics, exact
+    ranked = np.partition(rows[:3], sorted({lit_rank, middle_rank}), axis=1)  # order statistics, exact
     lit = float(ranked[0, lit_rank])
-    return Surface(np.array([lit, *(ranked[1:, middle_rank] * (lit + 16.0))]), linear.mean(axis=0), count, kind)
+    return Surface(np.array([lit, *(ranked[1:, middle_rank] * (lit + 16.0))]), rows[3:].mean(axis=1), count, kind)
 
 
-def _surface_where(
-    chromaticity: np.ndarray, linear: np.ndarray, where: np.ndarray, percentile: float, kind: str
-) -> Surface:
-    """:func:`_surface` of the pixels ``where`` is set."""
-    return _surface(np.compress(where, chromaticity, axis=1), _rows(linear, where), percentile, kind)
+def _pixel_rows(lab: np.ndarray, linear: np.ndarray) -> np.ndarray:
+    """Pixels (CIELAB and linear RGB, Nx3 each) as 6xN rows: L*, a*/(L*+16), b*/(L*+16) (a chromaticity that a
+    uniform change of light leaves alone), and linear R, G, B."""
+    rows = np.empty((6, lab.shape[0]))
+    rows[0] = lab[:, 0]
+    np.multiply(lab[:, 1:].T, 1.0 / (lab[:, 0] + 16.0), out=rows[1:3])
+    rows[3:] = linear.T
+    return rows
 
 
 def _rg(linear: np.ndarray) -> np.ndarray:
@@ -388,27 +391,22 @@ def objects_surfaces(
     lab[whitened] = WHITE_LAB
     regular |= whitened
     features = chroma_plane(lab, parameters.chroma_softness)
-    chromaticity = np.empty((3, lab.shape[0]))  # L*, and a* and b* over L* + 16 (unchanged by uniform light)
-    chromaticity[0] = lab[:, 0]
-    np.multiply(lab[:, 1:].T, 1.0 / (lab[:, 0] + 16.0), out=chromaticity[1:])
+    rows = _pixel_rows(lab, linear)
     ends = np.cumsum(counts)
     result = []
     for index, count in enumerate(counts.tolist()):
         part = slice(int(ends[index]) - count, int(ends[index]))
-        pixels = _Pixels(
-            chromaticity[:, part], linear[part], features[part], regular[part], dark[part], highlight[part]
-        )
+        pixels = _Pixels(rows[:, part], features[part], regular[part], dark[part], highlight[part])
         result.append((_grouped_surfaces(pixels, count, parameters), count))
     return result
 
 
 @dataclass(frozen=True)
 class _Pixels:
-    """One object's pixels after edge pixels were left out: L* and chromaticity (3xN rows, see
-    :func:`_surface`), linear RGB, log-chroma features, and which are regular, in the dark pool or highlights."""
+    """One object's pixels after edge pixels were left out: lightness, chromaticity and linear RGB as rows
+    (:func:`_pixel_rows`), log-chroma features, and which are regular, in the dark pool or highlights."""
 
-    chromaticity: np.ndarray
-    linear: np.ndarray
+    rows: np.ndarray
     features: np.ndarray
     regular: np.ndarray
     dark: np.ndarray
@@ -430,34 +428,33 @@ def _group_members(features: np.ndarray, centres: np.ndarray, min_count: float) 
 
 def _grouped_surfaces(pixels: _Pixels, count: int, parameters: NamingParameters) -> list[Surface]:
     """One object's surfaces from its pixels (see the module docstring); the dark pool comes last."""
-    chromaticity, linear, regular, dark = pixels.chromaticity, pixels.linear, pixels.regular, pixels.dark
+    rows, regular, dark = pixels.rows, pixels.regular, pixels.dark
     min_count = max(3.0, parameters.min_group_share * count)
     surfaces: list[Surface] = []
     percentile = parameters.lit_percentile
     if np.count_nonzero(regular) >= min_count:
-        colors, colors_linear = np.compress(regular, chromaticity, axis=1), _rows(linear, regular)
+        colors = np.compress(regular, rows, axis=1)
         features = _rows(pixels.features, regular)
         centres = _modes(features, parameters.group_radius, min_count, parameters.max_groups)
         for member in _group_members(features, centres, min_count):
-            surface = _surface_where(colors, colors_linear, member, percentile, "regular")
+            surface = _surface(np.compress(member, colors, axis=1), percentile, "regular")
             if not is_unsaturated(surface.lab, parameters):
                 surfaces.append(surface)
                 continue
             blackish = member & (colors[0] < parameters.black_lightness)
             for part in (member & ~blackish, blackish):  # black print on white: two surfaces
                 if np.count_nonzero(part) >= min_count:
-                    surfaces.append(_surface_where(colors, colors_linear, part, percentile, "regular"))
+                    surfaces.append(_surface(np.compress(part, colors, axis=1), percentile, "regular"))
     if not surfaces and np.count_nonzero(regular):  # too few pixels for a group: they are one surface
-        surfaces.append(_surface_where(chromaticity, linear, regular, percentile, "regular"))
+        surfaces.append(_surface(np.compress(regular, rows, axis=1), percentile, "regular"))
     surfaces = _merge_mixtures(surfaces, parameters.mixture_tolerance)
     surfaces = _merge_shaded(_merge_white_blends(surfaces, parameters), parameters)
     if np.count_nonzero(dark):
-        surfaces.append(_surface_where(chromaticity, linear, dark, 50.0, "dark"))
+        surfaces.append(_surface(np.compress(dark, rows, axis=1), 50.0, "dark"))
     if not surfaces:  # only highlights, too few of them to count as a white surface otherwise
         highlight = pixels.highlight
-        surfaces.append(
-            Surface(WHITE_LAB, _rows(linear, highlight).mean(axis=0), int(np.count_nonzero(highlight)), "regular")
-        )
+        white_linear = np.compress(highlight, rows[3:], axis=1).mean(axis=1)
+        surfaces.append(Surface(WHITE_LAB, white_linear, int(np.count_nonzero(highlight)), "regular"))
     return surfaces
 
 
