@@ -493,14 +493,29 @@ def _reflected(index: np.ndarray, low: np.ndarray, high: np.ndarray) -> np.ndarr
     return np.where(index >= high, np.maximum(high - 2, low), index)
 
 
+def _box_sobel(
+    image: np.ndarray, rows: np.ndarray, cols: np.ndarray, boxes: tuple[np.ndarray, ...]
+) -> tuple[np.ndarray, np.ndarray]:
+    """The 3x3 Sobel derivatives (x, y; int16, Nx3) of an RGB image at pixels (``rows``, ``cols``) of each one's
+    box (y0, y1, x0, x1 per pixel) cut out of the image, mirrored at the box's border as OpenCV does."""
+    y0, y1, x0, x1 = boxes
+    row_index = np.stack([_reflected(rows - 1, y0, y1), rows, _reflected(rows + 1, y0, y1)]) * image.shape[1]
+    col_index = np.stack([_reflected(cols - 1, x0, x1), cols, _reflected(cols + 1, x0, x1)])
+    neighbourhood = (row_index[:, None, :] + col_index[None, :, :]).reshape(9, -1)  # 3x3, row-major, per pixel
+    p = np.take(image.reshape(-1, 3), neighbourhood, axis=0).astype(np.int16).reshape(3, 3, -1, 3)
+    gx = p[0, 2] + p[2, 2] - p[0, 0] - p[2, 0] + 2 * (p[1, 2] - p[1, 0])
+    gy = p[2, 0] + p[2, 2] - p[0, 0] - p[0, 2] + 2 * (p[2, 1] - p[0, 1])
+    return gx, gy
+
+
 def objects_pixels(
     image: np.ndarray, hypotheses: Sequence[ObjectHypothesis], max_pixels: int
 ) -> list[tuple[np.ndarray, np.ndarray]]:
     """:func:`object_pixels` of several hypotheses of one image: each one's pixels and their edge strengths.
 
-    The edge strength of a pixel is :func:`edge_strength` of the hypothesis' box cut out of the image, computed
-    at the picked pixels only (the 3x3 Sobel sums, mirrored at the box's border as OpenCV does), for all the
-    hypotheses at once."""
+    The edge strength of a pixel is :func:`edge_strength` of the hypothesis' box cut out of the image: the
+    frame's Sobel derivatives, except on the box's border, where they are summed at the pixel with the box
+    mirrored as OpenCV does (:func:`_box_sobel`)."""
     rows_parts, cols_parts, boxes, sizes = [], [], [], []
     for hypothesis in hypotheses:
         x0, y0, x1, y1 = hypothesis.roi
@@ -518,20 +533,16 @@ def objects_pixels(
         return []
     rows, cols = np.concatenate(rows_parts), np.concatenate(cols_parts)
     y0, y1, x0, x1 = np.repeat(np.array(boxes, dtype=np.int64).reshape(-1, 4), sizes, axis=0).T
-    width = image.shape[1]
-    flat = np.asarray(image).reshape(-1, 3)
-    above, below = _reflected(rows - 1, y0, y1) * width, _reflected(rows + 1, y0, y1) * width
-    left, right = _reflected(cols - 1, x0, x1), _reflected(cols + 1, x0, x1)
-    centre_row, here = rows * width, cols
-
-    def at(row: np.ndarray, col: np.ndarray) -> np.ndarray:
-        return np.take(flat, row + col, axis=0).astype(np.int16)
-
-    corners = at(above, left), at(above, right), at(below, left), at(below, right)
-    gx = corners[1] + corners[3] - corners[0] - corners[2] + 2 * (at(centre_row, right) - at(centre_row, left))
-    gy = corners[2] + corners[3] - corners[0] - corners[1] + 2 * (at(below, here) - at(above, here))
+    image = np.ascontiguousarray(image)
+    flat = rows * image.shape[1] + cols
+    gx = np.take(cv2.Sobel(image, cv2.CV_16S, 1, 0, ksize=3).reshape(-1, 3), flat, axis=0)
+    gy = np.take(cv2.Sobel(image, cv2.CV_16S, 0, 1, ksize=3).reshape(-1, 3), flat, axis=0)
+    border = (rows == y0) | (rows == y1 - 1) | (cols == x0) | (cols == x1 - 1)  # the box mirrors, not the frame
+    if np.any(border):
+        at = np.flatnonzero(border)
+        gx[at], gy[at] = _box_sobel(image, rows[at], cols[at], (y0[at], y1[at], x0[at], x1[at]))
     squared = gx.astype(np.float32) ** 2 + gy.astype(np.float32) ** 2
     edges = np.sqrt(np.maximum(np.maximum(squared[:, 0], squared[:, 1]), squared[:, 2])) / 8.0
-    pixels = np.take(flat, centre_row + here, axis=0)
+    pixels = np.take(image.reshape(-1, 3), flat, axis=0)
     ends = np.cumsum(sizes)
     return [(pixels[end - size : end], edges[end - size : end]) for end, size in zip(ends.tolist(), sizes, strict=True)]
