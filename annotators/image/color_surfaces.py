@@ -137,16 +137,13 @@ def chroma_plane(lab: np.ndarray, softness: float) -> np.ndarray:
     return lab[:, 1:] * scale[:, None]
 
 
-def _modes(features: np.ndarray, radius: float, min_count: float, max_groups: int) -> np.ndarray:
-    """Centres of the densest modes of 2-D features: flat-kernel mean shift from the fullest histogram cell,
-    each mode taking the features within ``radius``; modes with fewer than ``min_count`` members are dropped.
-
-    The features are held as complex numbers (one subtraction and one modulus give every distance), and the
-    features a mode took are removed from the arrays, so later modes search only what remains."""
-    cells = np.floor(features / (radius / 2)).astype(np.int64)
-    cells -= cells.min(axis=0)
-    keys = cells[:, 0] * (int(cells[:, 1].max()) + 1) + cells[:, 1]
-    points = features[:, 0] + 1j * features[:, 1]
+def _modes(points: np.ndarray, cells: np.ndarray, radius: float, min_count: float, max_groups: int) -> np.ndarray:
+    """Centres (complex) of the densest modes of 2-D features given as complex ``points`` (one subtraction and
+    one modulus give every distance) with their histogram cells (2xN, cells of radius / 2): flat-kernel mean
+    shift from the fullest cell, each mode taking the points within ``radius``, which are then removed, so later
+    modes search only what remains; modes with fewer than ``min_count`` members are dropped."""
+    x, y = cells[0] - cells[0].min(), cells[1] - cells[1].min()
+    keys = x * (int(y.max()) + 1) + y
     tolerance = 1e-6 * radius * radius
     centres: list[complex] = []
     for _ in range(4 * max_groups):
@@ -154,7 +151,7 @@ def _modes(features: np.ndarray, radius: float, min_count: float, max_groups: in
             break
         seed = points[keys == int(np.argmax(np.bincount(keys)))]
         centre = complex(seed.sum()) / seed.size
-        inside = None  # the features within radius of centre, once known
+        inside = None  # the points within radius of centre, once known
         for _ in range(10):
             within = np.abs(points - centre) < radius
             near = points[within]
@@ -169,7 +166,7 @@ def _modes(features: np.ndarray, radius: float, min_count: float, max_groups: in
             centres.append(centre)
         outside = ~inside
         points, keys = points[outside], keys[outside]
-    return np.array([(c.real, c.imag) for c in centres], dtype=np.float64).reshape(-1, 2)
+    return np.array(centres, dtype=np.complex128)
 
 
 def _rows(array: np.ndarray, where: np.ndarray) -> np.ndarray:
@@ -391,12 +388,14 @@ def objects_surfaces(
     lab[whitened] = WHITE_LAB
     regular |= whitened
     features = chroma_plane(lab, parameters.chroma_softness)
+    points = features[:, 0] + 1j * features[:, 1]
+    cells = np.floor(features.T / (parameters.group_radius / 2)).astype(np.int64)
     rows = _pixel_rows(lab, linear)
     ends = np.cumsum(counts)
     result = []
     for index, count in enumerate(counts.tolist()):
         part = slice(int(ends[index]) - count, int(ends[index]))
-        pixels = _Pixels(rows[:, part], features[part], regular[part], dark[part], highlight[part])
+        pixels = _Pixels(rows[:, part], points[part], cells[:, part], regular[part], dark[part], highlight[part])
         result.append((_grouped_surfaces(pixels, count, parameters), count))
     return result
 
@@ -404,25 +403,27 @@ def objects_surfaces(
 @dataclass(frozen=True)
 class _Pixels:
     """One object's pixels after edge pixels were left out: lightness, chromaticity and linear RGB as rows
-    (:func:`_pixel_rows`), log-chroma features, and which are regular, in the dark pool or highlights."""
+    (:func:`_pixel_rows`), log-chroma features (:func:`chroma_plane`) as complex points and their histogram cells
+    (2xN), and which are regular, in the dark pool or highlights."""
 
     rows: np.ndarray
-    features: np.ndarray
+    points: np.ndarray
+    cells: np.ndarray
     regular: np.ndarray
     dark: np.ndarray
     highlight: np.ndarray
 
 
-def _group_members(features: np.ndarray, centres: np.ndarray, min_count: float) -> list[np.ndarray]:
-    """Which features each mode owns (those nearer its centre than any other's), for the modes owning at
-    least ``min_count``."""
-    if centres.shape[0] == 1:
-        return [np.ones(features.shape[0], dtype=bool)]
-    if centres.shape[0] == 0:
+def _group_members(points: np.ndarray, centres: np.ndarray, min_count: float) -> list[np.ndarray]:
+    """Which points (complex) each mode owns (those nearer its centre than any other's), for the modes owning
+    at least ``min_count``."""
+    if centres.size == 1:
+        return [np.ones(points.size, dtype=bool)]
+    if centres.size == 0:
         return []
-    across = (features[:, 0, None] - centres[None, :, 0]) ** 2
-    owner = np.argmin(across + (features[:, 1, None] - centres[None, :, 1]) ** 2, axis=1)
-    counts = np.bincount(owner, minlength=centres.shape[0])
+    offsets = points[:, None] - centres[None, :]
+    owner = np.argmin(offsets.real**2 + offsets.imag**2, axis=1)
+    counts = np.bincount(owner, minlength=centres.size)
     return [owner == group for group in np.flatnonzero(counts >= min_count).tolist()]
 
 
@@ -434,9 +435,15 @@ def _grouped_surfaces(pixels: _Pixels, count: int, parameters: NamingParameters)
     percentile = parameters.lit_percentile
     if np.count_nonzero(regular) >= min_count:
         colors = np.compress(regular, rows, axis=1)
-        features = _rows(pixels.features, regular)
-        centres = _modes(features, parameters.group_radius, min_count, parameters.max_groups)
-        for member in _group_members(features, centres, min_count):
+        points = pixels.points[regular]
+        centres = _modes(
+            points,
+            np.compress(regular, pixels.cells, axis=1),
+            parameters.group_radius,
+            min_count,
+            parameters.max_groups,
+        )
+        for member in _group_members(points, centres, min_count):
             surface = _surface(np.compress(member, colors, axis=1), percentile, "regular")
             if not is_unsaturated(surface.lab, parameters):
                 surfaces.append(surface)
