@@ -72,7 +72,7 @@ def _compact(rows: np.ndarray) -> np.ndarray:
     offsets *= offsets
     distances = np.sqrt(offsets[0] + offsets[1] + offsets[2])
     q1, q3 = _quartiles(distances)
-    return rows[:, distances <= q3 + STRAY_FENCE * (q3 - q1)]
+    return np.compress(distances <= q3 + STRAY_FENCE * (q3 - q1), rows, axis=1)
 
 
 def compact_points(points: np.ndarray) -> np.ndarray:
@@ -146,8 +146,8 @@ def object_box(points_camera: np.ndarray, cam_to_world: np.ndarray | None) -> tu
 
 
 def _principal_boxes(parts: list[np.ndarray]) -> list[OrientedBox]:
-    """:func:`principal_box` of several point sets (each finite 3xN float64 rows) at once: the sums, covariances,
-    eigen-decompositions and extents of all the sets in one pass each."""
+    """:func:`principal_box` of several point sets (each finite 3xN float64 rows) at once: the means, covariances
+    and eigen-decompositions of all the sets in one pass each, then each set's extents along its axes."""
     boxes: list[OrientedBox | None] = [None if part.shape[1] >= 3 else _degenerate_box(part.T) for part in parts]
     sets = [part for part in parts if part.shape[1] >= 3]
     if not sets:
@@ -163,11 +163,12 @@ def _principal_boxes(parts: list[np.ndarray]) -> list[OrientedBox]:
     _, vectors = np.linalg.eigh(covariance)
     rotation = vectors[:, :, ::-1].copy()  # largest spread first
     rotation[np.linalg.det(rotation) < 0, :, 2] *= -1
-    turn = rotation.reshape(-1, 9).T[:, owner]  # each point's rotation, row-major
-    local = turn[[0, 1, 2]] * centred[0] + turn[[3, 4, 5]] * centred[1] + turn[[6, 7, 8]] * centred[2]
-    low, high = np.minimum.reduceat(local, starts, axis=1), np.maximum.reduceat(local, starts, axis=1)
-    centres = mean.T + np.einsum("sij,sj->si", rotation, ((low + high) / 2).T)
-    extents = (high - low).T
+    low, high = np.empty((sizes.size, 3)), np.empty((sizes.size, 3))
+    for index, (start, size) in enumerate(zip(starts.tolist(), sizes.tolist(), strict=True)):
+        local = rotation[index].T @ centred[:, start : start + size]  # the set in its box's axes
+        low[index], high[index] = local.min(axis=1), local.max(axis=1)
+    centres = mean.T + np.einsum("sij,sj->si", rotation, (low + high) / 2)
+    extents = high - low
     fitted = iter(OrientedBox(c, r, e) for c, r, e in zip(centres, rotation, extents, strict=True))
     return [box if box is not None else next(fitted) for box in boxes]
 
