@@ -48,9 +48,15 @@ def linear_to_lab(linear: np.ndarray) -> np.ndarray:
     """CIELAB (D65) of linear sRGB values, any shape ``...x3`` (values above 1 are allowed: L* above 100)."""
     xyz = np.asarray(linear, dtype=np.float64) @ SRGB_TO_XYZ.T / D65_WHITE
     epsilon, kappa = 216 / 24389, 24389 / 27
-    f = np.where(xyz > epsilon, np.cbrt(xyz), (kappa * xyz + 16) / 116)
-    lightness = 116 * f[..., 1] - 16
-    return np.stack([lightness, 500 * (f[..., 0] - f[..., 1]), 200 * (f[..., 1] - f[..., 2])], axis=-1)
+    f = np.cbrt(xyz)
+    dim = xyz <= epsilon  # the linear segment near black (the cube root elsewhere)
+    if np.any(dim):
+        f[dim] = (kappa * xyz[dim] + 16) / 116
+    lab = np.empty(f.shape)
+    lab[..., 0] = 116 * f[..., 1] - 16
+    lab[..., 1] = 500 * (f[..., 0] - f[..., 1])
+    lab[..., 2] = 200 * (f[..., 1] - f[..., 2])
+    return lab
 
 
 def srgb_to_lab(rgb: np.ndarray) -> np.ndarray:
