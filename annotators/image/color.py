@@ -33,7 +33,7 @@ from typing import ClassVar
 import numpy as np
 
 from annotators.image.color_prototypes import prototypes
-from annotators.image.color_space import delta_e_2000, linear_to_lab, linear_to_srgb
+from annotators.image.color_space import delta_e_2000, linear_to_lab
 from annotators.image.color_surfaces import (
     DEFAULT_PARAMETERS,
     NamingParameters,
@@ -110,13 +110,22 @@ def _name_of_votes(votes: np.ndarray) -> SurfaceName:
     return SurfaceName(CHROMATIC_TERMS[best], float(votes[best]))
 
 
+def _srgb_spread(linear: np.ndarray) -> tuple[float, float]:
+    """The spread of a linear RGB colour's sRGB levels (0..255): max - min, and that over max."""
+    levels = [
+        255.0 * (v * 12.92 if v <= 0.0031308 else 1.055 * v ** (1 / 2.4) - 0.055)
+        for v in (min(max(float(c), 0.0), 1.0) for c in linear)
+    ]
+    span = max(levels) - min(levels)
+    return span, span / max(max(levels), 1e-9)
+
+
 def _vote_lab(surface: Surface, parameters: NamingParameters) -> np.ndarray | None:
     """The CIELAB colour the prototypes name a surface by, or None when it is named by lightness (white, grey or
     black): a saturated surface's own colour, or a saturated dark pool's mean chromaticity a little lighter."""
     if surface.kind == "dark":
-        srgb = 255.0 * linear_to_srgb(surface.linear)
-        span = float(srgb.max() - srgb.min())
-        if span / max(float(srgb.max()), 1e-9) >= parameters.dark_saturation and span >= parameters.dark_span:
+        span, saturation = _srgb_spread(surface.linear)
+        if saturation >= parameters.dark_saturation and span >= parameters.dark_span:
             mean = linear_to_lab(surface.linear)
             lightness = max(float(mean[0]), parameters.dark_lightness * 2.0)
             return np.array([lightness, *(mean[1:] / (mean[0] + 16.0) * (lightness + 16.0))])
@@ -128,8 +137,7 @@ def _lightness_name(surface: Surface, surround: float, parameters: NamingParamet
     """The name of a surface without a hue: a dark pool is black; an unsaturated surface is white, grey or black
     by its lit lightness against the surround (see the module docstring)."""
     if surface.kind == "dark":
-        srgb = 255.0 * linear_to_srgb(surface.linear)
-        saturation = float(srgb.max() - srgb.min()) / max(float(srgb.max()), 1e-9)
+        saturation = _srgb_spread(surface.linear)[1]
         return SurfaceName("black", 0.5 + 0.5 * max(0.0, 1.0 - saturation / parameters.dark_saturation))
     lightness = float(surface.lab[0])
     certainty = 0.5 + 0.5 * (1.0 - tint(surface.lab, parameters))
