@@ -12,7 +12,8 @@ Three measurements in one run, on frame 000003 of ../shared/data/uoc_tabletop_re
   objects matched by a hypothesis with point IoU >= 0.5;
 * with ``--reference REV`` (a git revision, e.g. the commit before a change): this checkout's tree and the tree of
   REV (exported with ``git archive``) ticked side by side, each in its own worker process
-  (:mod:`bench.tick_tree`), rounds alternating; ms, Hz and the ratio (goal: >= 30 Hz).
+  (:mod:`bench.tick_tree`), rounds alternating; ms, Hz and the ratio (goal: >= 30 Hz), and each annotator's
+  median ms per run in both trees with its speed-up and the per-expert budgets (:data:`EXPERT_GOALS_MS`).
 
 Tree and bare rounds alternate so machine noise hits both alike. The reader decodes the PNGs once and then
 serves the cached frame (as it does on repeated ticks of the same frame); decoding is reported separately.
