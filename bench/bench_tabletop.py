@@ -43,10 +43,11 @@ from annotators.cloud.clutter import ClutterParameters, segment_clutter  # noqa:
 from annotators.cloud.filters import range_mask  # noqa: E402
 from annotators.cloud.plane import ransac_support_plane  # noqa: E402
 from annotators.cloud.point_cloud import back_project, pixel_rays  # noqa: E402
-from annotators.cloud.pose import PoseAnnotator, hypothesis_points  # noqa: E402
-from annotators.geometry.boxes import object_box  # noqa: E402
-from annotators.image.color import SemanticColorAnnotator, name_color  # noqa: E402
-from annotators.image.pixel_expert import hypothesis_pixels  # noqa: E402
+from annotators.cloud.pose import PoseAnnotator, hypotheses_rows  # noqa: E402
+from annotators.geometry.boxes import object_boxes_of_rows  # noqa: E402
+from annotators.image.color import SemanticColorAnnotator, name_objects_colors  # noqa: E402
+from annotators.image.color_surfaces import objects_pixels  # noqa: E402
+from annotators.image.white_balance import estimate_frame_light  # noqa: E402
 from annotators.readers.frame_io import read_color_depth_pair  # noqa: E402
 from annotators.readers.frame_readers import PcdReader  # noqa: E402
 from robokudo.core.engine import Engine  # noqa: E402
@@ -96,9 +97,11 @@ def bare_frame(frame, rays, timings: dict[str, list[float]]) -> int:
     cloud = PointCloud(points=points, mask=mask, colors=frame.color)
     timed(
         "SemanticColorAnnotator",
-        lambda: [name_color(hypothesis_pixels(frame.color, h, COLOR_PIXELS)) for h in hypotheses],
+        lambda: name_objects_colors(
+            objects_pixels(frame.color, hypotheses, COLOR_PIXELS), estimate_frame_light(frame.color)
+        ),
     )
-    timed("PoseAnnotator", lambda: [object_box(hypothesis_points(cloud, h, POSE_POINTS), None) for h in hypotheses])
+    timed("PoseAnnotator", lambda: object_boxes_of_rows(hypotheses_rows(cloud, hypotheses, POSE_POINTS), None))
     return len(segments)
 
 

@@ -173,11 +173,6 @@ def _principal_boxes(parts: list[np.ndarray]) -> list[OrientedBox]:
     return [box if box is not None else next(fitted) for box in boxes]
 
 
-def object_boxes(point_sets: list[np.ndarray], cam_to_world: np.ndarray | None) -> list[tuple[OrientedBox, str]]:
-    """:func:`object_box` of several objects' camera-frame points (each Nx3) at once."""
-    return object_boxes_of_rows([_finite_rows(points) for points in point_sets], cam_to_world)
-
-
 def object_boxes_of_rows(rows: list[np.ndarray], cam_to_world: np.ndarray | None) -> list[tuple[OrientedBox, str]]:
     """:func:`object_box` of several objects whose finite camera-frame points are given as 3xN float64 rows."""
     parts = [_compact(part) for part in rows]
