@@ -96,19 +96,34 @@ def _hue_units(ap: np.ndarray, b: np.ndarray, cp: np.ndarray) -> tuple[np.ndarra
         return np.where(chromatic, ap / cp, 0.0), np.where(chromatic, b / cp, 0.0)
 
 
-def _mean_hue_direction(
-    x: np.ndarray, y: np.ndarray, neutral_both: np.ndarray, h_mean: np.ndarray
-) -> tuple[np.ndarray, np.ndarray]:
-    """cos and sin of the mean hue from the sum (x, y) of the two hue unit vectors: its direction is the bisector
-    of the smaller arc, as the mean hue is, and a neutral colour adds nothing (its hue counts as 0 in the sum);
-    ``np.cos``/``np.sin`` of ``h_mean`` only where the two hues are opposite (the sum vanishes)."""
+def _mean_hue(
+    units: tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray],
+    neutral_both: np.ndarray,
+    primes: tuple[np.ndarray, ...],
+) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """The mean hue (radians, 0..2 pi) and its cosine and sine, from the two hue unit vectors ``units`` (x1, y1,
+    x2, y2): the direction of their sum is the bisector of the smaller arc, as the mean hue is, and a neutral
+    colour adds nothing (its hue counts as 0). Where the hues are opposite (the sum vanishes) the mean hue comes
+    from the angles of ``primes`` (a1', b1, a2', b2) by the formula's case analysis."""
+    x1, y1, x2, y2 = units
+    x, y = x1 + x2, y1 + y2
     length = np.sqrt(x * x + y * y)
     with np.errstate(invalid="ignore", divide="ignore"):
         cos, sin = np.where(neutral_both, 1.0, x / length), np.where(neutral_both, 0.0, y / length)
+    mean = np.arctan2(sin, cos)
+    mean = np.where(mean < 0.0, mean + _TWO_PI, mean)
     opposite = ~neutral_both & (length < 1e-6)
     if np.any(opposite):
-        cos[opposite], sin[opposite] = np.cos(h_mean[opposite]), np.sin(h_mean[opposite])
-    return cos, sin
+        a1p, b1, a2p, b2 = (np.broadcast_to(v, opposite.shape)[opposite] for v in primes)
+        h1, h2 = np.arctan2(b1, a1p) % _TWO_PI, np.arctan2(b2, a2p) % _TWO_PI
+        total = h1 + h2
+        fixed = np.where(
+            np.abs(h2 - h1) <= np.pi,
+            total * 0.5,
+            np.where(total < _TWO_PI, (total + _TWO_PI) * 0.5, (total - _TWO_PI) * 0.5),
+        )
+        mean[opposite], cos[opposite], sin[opposite] = fixed, np.cos(fixed), np.sin(fixed)
+    return mean, cos, sin
 
 
 def delta_e_2000(
@@ -118,31 +133,21 @@ def delta_e_2000(
 
     ``k_l``, ``k_c`` and ``k_h`` are the formula's parametric factors (1 for the reference conditions; a larger
     factor makes differences in lightness, chroma or hue count less). Computed with few trigonometric calls
-    (they dominate on many pairs): hue angles in radians, the hue difference term from the chroma vectors'
-    dot and cross products, the mean hue's cosine and sine from the hue unit vectors, T's four cosines from
-    those by multiple-angle identities, and the rotation term's sine by its Taylor series."""
+    (they dominate on many pairs): the hue difference term and the mean hue from the hue unit vectors (radians),
+    T's four cosines from the mean hue's cosine and sine by multiple-angle identities, and the rotation term's
+    sine by its Taylor series."""
     lab1, lab2 = np.asarray(lab1, dtype=np.float64), np.asarray(lab2, dtype=np.float64)
     l1, a1, b1 = lab1[..., 0], lab1[..., 1], lab1[..., 2]
     l2, a2, b2 = lab2[..., 0], lab2[..., 1], lab2[..., 2]
     g1 = 1.5 - 0.5 * _seventh_power_ratio((np.sqrt(a1 * a1 + b1 * b1) + np.sqrt(a2 * a2 + b2 * b2)) * 0.5)  # 1 + G
     a1p, a2p = g1 * a1, g1 * a2
     c1p, c2p = np.sqrt(a1p * a1p + b1 * b1), np.sqrt(a2p * a2p + b2 * b2)
-    h1p, h2p = np.arctan2(b1, a1p), np.arctan2(b2, a2p)
-    h1p = np.where(h1p < 0.0, h1p + _TWO_PI, h1p)
-    h2p = np.where(h2p < 0.0, h2p + _TWO_PI, h2p)
     chroma_product = c1p * c2p
-    neutral = chroma_product == 0
     (x1, y1), (x2, y2) = _hue_units(a1p, b1, c1p), _hue_units(a2p, b2, c2p)
     # 2 sqrt(C1' C2') sin(dh / 2) = sqrt(C1' C2') |u1 - u2|, signed as dh = h2' - h1' wrapped to (-pi, pi]
     dx, dy = x1 - x2, y1 - y2
     d_h = np.copysign(np.sqrt(chroma_product * (dx * dx + dy * dy)), x1 * y2 - y1 * x2)
-    h_sum = h1p + h2p
-    h_mean = np.where(
-        neutral | (np.abs(h2p - h1p) <= np.pi),
-        np.where(neutral, h_sum, h_sum * 0.5),
-        np.where(h_sum < _TWO_PI, (h_sum + _TWO_PI) * 0.5, (h_sum - _TWO_PI) * 0.5),
-    )
-    c, s = _mean_hue_direction(x1 + x2, y1 + y2, (c1p == 0) & (c2p == 0), h_mean)
+    h_mean, c, s = _mean_hue((x1, y1, x2, y2), (c1p == 0) & (c2p == 0), (a1p, b1, a2p, b2))
     c2, s2 = 2.0 * c * c - 1.0, 2.0 * s * c
     c3, s3 = c * (2.0 * c2 - 1.0), s * (2.0 * c2 + 1.0)
     c4, s4 = 2.0 * c2 * c2 - 1.0, 2.0 * s2 * c2
