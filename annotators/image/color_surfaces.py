@@ -274,16 +274,18 @@ def _merge_white_blends(surfaces: list[Surface], parameters: NamingParameters) -
     result = list(surfaces)
     merged: set[int] = set()
     whitened: set[int] = set()
+    lit_saturated = [s.kind != "dark" and not is_unsaturated(s.lab, parameters) for s in surfaces]
+    saturation = [_saturation(s.lab) for s in surfaces]
     for index, surface in enumerate(surfaces):
-        if surface.kind == "dark" or is_unsaturated(surface.lab, parameters):
+        if not lit_saturated[index]:
             continue
         for host_index, host in enumerate(surfaces):
             if (
                 host_index == index
-                or host_index in merged | whitened
-                or host.kind == "dark"
-                or is_unsaturated(host.lab, parameters)
-                or _saturation(host.lab) <= _saturation(surface.lab)
+                or host_index in merged
+                or host_index in whitened
+                or not lit_saturated[host_index]
+                or saturation[host_index] <= saturation[index]
                 or host.lab[0] >= surface.lab[0]
             ):
                 continue
