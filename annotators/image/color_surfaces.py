@@ -150,12 +150,12 @@ def _modes(points: np.ndarray, cells: np.ndarray, radius: float, min_count: floa
         if len(centres) == max_groups or points.size < min_count:
             break
         seed = points[keys == int(np.argmax(np.bincount(keys)))]
-        centre = complex(seed.sum()) / seed.size
+        centre = complex(np.add.reduce(seed)) / seed.size
         inside = None  # the points within radius of centre, once known
         for _ in range(10):
             within = np.abs(points - centre) < radius
             near = points[within]
-            moved = complex(near.sum()) / near.size
+            moved = complex(np.add.reduce(near)) / near.size
             if abs(moved - centre) ** 2 < tolerance:
                 inside = within
                 break
@@ -171,7 +171,7 @@ def _modes(points: np.ndarray, cells: np.ndarray, radius: float, min_count: floa
 
 def _rows(array: np.ndarray, where: np.ndarray) -> np.ndarray:
     """The rows of ``array`` where ``where`` is set (as ``array[where]``, faster for rows of a few values)."""
-    return np.compress(where, array, axis=0)
+    return array.compress(where, axis=0)
 
 
 def _surface(rows: np.ndarray, percentile: float, kind: str) -> Surface:
@@ -179,7 +179,8 @@ def _surface(rows: np.ndarray, percentile: float, kind: str) -> Surface:
     lightness, mean linear RGB."""
     count = rows.shape[1]
     lit_rank, middle_rank = round(percentile / 100.0 * (count - 1)), round(0.5 * (count - 1))
-    ranked = np.partition(rows[:3], sorted({lit_rank, middle_rank}), axis=1)  # order statistics, exact
+    ranked = rows[:3].copy()
+    ranked.partition(sorted({lit_rank, middle_rank}), axis=1)  # order statistics, exact
     lit = float(ranked[0, lit_rank])
     return Surface(np.array([lit, *(ranked[1:, middle_rank] * (lit + 16.0))]), rows[3:].mean(axis=1), count, kind)
 
@@ -436,33 +437,33 @@ def _grouped_surfaces(pixels: _Pixels, count: int, parameters: NamingParameters)
     surfaces: list[Surface] = []
     percentile = parameters.lit_percentile
     if np.count_nonzero(regular) >= min_count:
-        colors = np.compress(regular, rows, axis=1)
+        colors = rows.compress(regular, axis=1)
         points = pixels.points[regular]
         centres = _modes(
             points,
-            np.compress(regular, pixels.cells, axis=1),
+            pixels.cells.compress(regular, axis=1),
             parameters.group_radius,
             min_count,
             parameters.max_groups,
         )
         for member in _group_members(points, centres, min_count):
-            surface = _surface(np.compress(member, colors, axis=1), percentile, "regular")
+            surface = _surface(colors.compress(member, axis=1), percentile, "regular")
             if not is_unsaturated(surface.lab, parameters):
                 surfaces.append(surface)
                 continue
             blackish = member & (colors[0] < parameters.black_lightness)
             for part in (member & ~blackish, blackish):  # black print on white: two surfaces
                 if np.count_nonzero(part) >= min_count:
-                    surfaces.append(_surface(np.compress(part, colors, axis=1), percentile, "regular"))
+                    surfaces.append(_surface(colors.compress(part, axis=1), percentile, "regular"))
     if not surfaces and np.count_nonzero(regular):  # too few pixels for a group: they are one surface
-        surfaces.append(_surface(np.compress(regular, rows, axis=1), percentile, "regular"))
+        surfaces.append(_surface(rows.compress(regular, axis=1), percentile, "regular"))
     surfaces = _merge_mixtures(surfaces, parameters.mixture_tolerance)
     surfaces = _merge_shaded(_merge_white_blends(surfaces, parameters), parameters)
     if np.count_nonzero(dark):
-        surfaces.append(_surface(np.compress(dark, rows, axis=1), 50.0, "dark"))
+        surfaces.append(_surface(rows.compress(dark, axis=1), 50.0, "dark"))
     if not surfaces:  # only highlights, too few of them to count as a white surface otherwise
         highlight = pixels.highlight
-        white_linear = np.compress(highlight, rows[3:], axis=1).mean(axis=1)
+        white_linear = rows[3:].compress(highlight, axis=1).mean(axis=1)
         surfaces.append(Surface(WHITE_LAB, white_linear, int(np.count_nonzero(highlight)), "regular"))
     return surfaces
 
