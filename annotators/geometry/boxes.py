@@ -51,7 +51,8 @@ def _quartiles(values: np.ndarray) -> tuple[float, float]:
     (linear interpolation between order statistics)."""
     positions = [(values.size - 1) * 0.25, (values.size - 1) * 0.75]
     below = [math.floor(position) for position in positions]
-    ranked = np.partition(values, sorted({*below, *(rank + 1 for rank in below)}))
+    ranked = values.copy()
+    ranked.partition(sorted({*below, *(rank + 1 for rank in below)}))
     quartiles = []
     for position, rank in zip(positions, below, strict=True):
         low, high = float(ranked[rank]), float(ranked[rank + 1])
@@ -67,12 +68,13 @@ def _compact(rows: np.ndarray) -> np.ndarray:
     if count < 8:
         return rows
     low, high = (count - 1) // 2, count // 2
-    ranked = np.partition(rows, [low, high] if low != high else low, axis=1)
+    ranked = rows.copy()
+    ranked.partition([low, high] if low != high else low, axis=1)
     offsets = rows - ((ranked[:, low] + ranked[:, high]) / 2.0)[:, None]  # from the median point
     offsets *= offsets
     distances = np.sqrt(offsets[0] + offsets[1] + offsets[2])
     q1, q3 = _quartiles(distances)
-    return np.compress(distances <= q3 + STRAY_FENCE * (q3 - q1), rows, axis=1)
+    return rows.compress(distances <= q3 + STRAY_FENCE * (q3 - q1), axis=1)
 
 
 def compact_points(points: np.ndarray) -> np.ndarray:
