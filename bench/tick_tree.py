@@ -3,7 +3,8 @@
 ``python bench/tick_tree.py CHECKOUT DATA FRAME`` imports ``trees.tabletop`` from CHECKOUT (so another checkout of
 the project - the tree before a change - can be timed against this one in the same run), builds the tree on frame
 FRAME of the recording DATA, ticks it three times to warm up and prints ``ready``. Each line ``N`` read from stdin
-then ticks it N times and answers one JSON line: the wall and CPU seconds of each tick and the hypotheses found.
+then ticks it N times and answers one JSON line: the wall and CPU seconds of each tick, each annotator's seconds
+per run in those ticks (from its RunStats) and the hypotheses found.
 """
 
 from __future__ import annotations
@@ -17,6 +18,7 @@ def main() -> None:
     checkout, data, frame = sys.argv[1], sys.argv[2], int(sys.argv[3])
     sys.path.insert(0, checkout)
     from robokudo.core.engine import Engine
+    from robokudo.core.stats import RunStats
     from robokudo.core.types import ObjectHypothesis
     from trees.tabletop import create_tree
 
@@ -26,6 +28,9 @@ def main() -> None:
         engine.tick()
     print("ready", flush=True)
     for line in sys.stdin:
+        for node in root.iterate():
+            if hasattr(node, "stats"):
+                node.stats = RunStats()  # only this request's runs
         wall, cpu = [], []
         for _ in range(int(line)):
             start, start_cpu = time.perf_counter(), time.process_time()
@@ -33,7 +38,8 @@ def main() -> None:
             wall.append(time.perf_counter() - start)
             cpu.append(time.process_time() - start_cpu)
         found = len(root.cas.annotations(ObjectHypothesis))
-        print(json.dumps({"wall": wall, "cpu": cpu, "hypotheses": found}), flush=True)
+        nodes = {name: list(stats.samples) for name, stats in engine.annotator_stats().items()}
+        print(json.dumps({"wall": wall, "cpu": cpu, "nodes": nodes, "hypotheses": found}), flush=True)
 
 
 if __name__ == "__main__":

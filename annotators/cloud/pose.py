@@ -7,7 +7,7 @@ from typing import ClassVar
 import numpy as np
 
 from annotators.cloud.cloud_expert import CloudExpert
-from annotators.geometry.boxes import finite_points, object_box
+from annotators.geometry.boxes import finite_points, object_boxes_of_rows
 from robokudo.core.capability import Capability
 from robokudo.core.geometry import quaternion_from_matrix
 from robokudo.core.types import CameraInfo, CasType, ObjectHypothesis, PointCloud, Pose
@@ -19,6 +19,24 @@ def hypothesis_points(cloud: PointCloud, hypothesis: ObjectHypothesis, max_point
     indices = indices[:: max(1, indices.size // max_points)]
     indices = indices[(indices >= 0) & (indices < cloud.mask.size)]
     return finite_points(cloud.points.reshape(-1, 3)[indices])
+
+
+def hypotheses_rows(cloud: PointCloud, hypotheses: list[ObjectHypothesis], max_points: int) -> list[np.ndarray]:
+    """:func:`hypothesis_points` of several hypotheses, gathered at once, each as 3xN float64 rows (x, y and z
+    each contiguous)."""
+    picked = []
+    for hypothesis in hypotheses:
+        indices = np.asarray(hypothesis.point_indices)
+        indices = indices[:: max(1, indices.size // max_points)]
+        picked.append(indices[(indices >= 0) & (indices < cloud.mask.size)])
+    sizes = np.array([indices.size for indices in picked])
+    every = np.concatenate(picked) if picked else np.zeros(0, dtype=np.intp)
+    points = np.take(cloud.points.reshape(-1, 3), every, axis=0)
+    finite = np.isfinite(points)
+    finite = finite[:, 0] & finite[:, 1] & finite[:, 2]
+    rows = np.array(np.compress(finite, points, axis=0).T, dtype=np.float64, order="C")
+    kept = np.bincount(np.repeat(np.arange(sizes.size), sizes)[finite], minlength=sizes.size)
+    return np.split(rows, np.cumsum(kept)[:-1], axis=1)
 
 
 class PoseAnnotator(CloudExpert):
@@ -47,14 +65,11 @@ class PoseAnnotator(CloudExpert):
         cam_to_world = camera.cam_to_world if camera is not None else None
         if cam_to_world is not None and (np.shape(cam_to_world) != (4, 4) or not np.all(np.isfinite(cam_to_world))):
             self.fail(f"camera pose must be a finite 4x4 matrix, got shape {np.shape(cam_to_world)}")
-        posed = 0
-        for hypothesis in hypotheses:
-            points = hypothesis_points(cloud, hypothesis, self.max_points)
-            if points.shape[0] == 0:
-                continue
-            box, frame = object_box(points, cam_to_world)
+        rows = hypotheses_rows(cloud, hypotheses, self.max_points)
+        posed = [(h, part) for h, part in zip(hypotheses, rows, strict=True) if part.shape[1]]
+        if not posed:
+            self.fail("no object hypothesis has a valid 3-D point")
+        boxes = object_boxes_of_rows([part for _, part in posed], cam_to_world)
+        for (hypothesis, _), (box, frame) in zip(posed, boxes, strict=True):
             orientation = quaternion_from_matrix(box.rotation)
             self.attach(hypothesis, Pose(position=box.centre, orientation=orientation, frame=frame))
-            posed += 1
-        if posed == 0:
-            self.fail("no object hypothesis has a valid 3-D point")

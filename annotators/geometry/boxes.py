@@ -7,6 +7,7 @@ principal components of the points).
 
 from __future__ import annotations
 
+import math
 from dataclasses import dataclass
 
 import cv2
@@ -30,11 +31,50 @@ class OrientedBox:
 def finite_points(points: np.ndarray) -> np.ndarray:
     """The rows of an Nx3 array that are finite, as float64."""
     points = np.asarray(points).reshape(-1, 3)
-    return points[np.isfinite(points).all(axis=1)].astype(np.float64)
+    finite = np.isfinite(points)
+    return points[finite[:, 0] & finite[:, 1] & finite[:, 2]].astype(np.float64)
 
 
 STRAY_FENCE = 3.0
 """Tukey's far-out fence: a point farther from the median point than Q3 + 3 IQR of all such distances is a stray."""
+
+
+def _finite_rows(points: np.ndarray) -> np.ndarray:
+    """The finite rows of an Nx3 array as a 3xN float64 array (each coordinate contiguous)."""
+    points = np.asarray(points).reshape(-1, 3)
+    finite = np.isfinite(points)
+    return np.array(points[finite[:, 0] & finite[:, 1] & finite[:, 2]].T, dtype=np.float64, order="C")
+
+
+def _quartiles(values: np.ndarray) -> tuple[float, float]:
+    """The first and third quartiles of N >= 2 values, as ``np.percentile(values, [25, 75])`` computes them
+    (linear interpolation between order statistics)."""
+    positions = [(values.size - 1) * 0.25, (values.size - 1) * 0.75]
+    below = [math.floor(position) for position in positions]
+    ranked = values.copy()
+    ranked.partition(sorted({*below, *(rank + 1 for rank in below)}))
+    quartiles = []
+    for position, rank in zip(positions, below, strict=True):
+        low, high = float(ranked[rank]), float(ranked[rank + 1])
+        weight = position - rank
+        step = high - low
+        quartiles.append(high - step * (1.0 - weight) if weight >= 0.5 else low + step * weight)
+    return quartiles[0], quartiles[1]
+
+
+def _compact(rows: np.ndarray) -> np.ndarray:
+    """:func:`compact_points` of finite points given as 3xN float64 rows (returned the same way)."""
+    count = rows.shape[1]
+    if count < 8:
+        return rows
+    low, high = (count - 1) // 2, count // 2
+    ranked = rows.copy()
+    ranked.partition([low, high] if low != high else low, axis=1)
+    offsets = rows - ((ranked[:, low] + ranked[:, high]) / 2.0)[:, None]  # from the median point
+    offsets *= offsets
+    distances = np.sqrt(offsets[0] + offsets[1] + offsets[2])
+    q1, q3 = _quartiles(distances)
+    return rows.compress(distances <= q3 + STRAY_FENCE * (q3 - q1), axis=1)
 
 
 def compact_points(points: np.ndarray) -> np.ndarray:
@@ -46,12 +86,7 @@ def compact_points(points: np.ndarray) -> np.ndarray:
     point is beyond Tukey's far-out fence of those distances; an elongated or hollow object keeps all its points,
     since its distances spread evenly and the fence lies beyond its far end.
     """
-    points = finite_points(points)
-    if points.shape[0] < 8:
-        return points
-    distances = np.linalg.norm(points - np.median(points, axis=0), axis=1)
-    q1, q3 = np.percentile(distances, [25.0, 75.0])
-    return points[distances <= q3 + STRAY_FENCE * (q3 - q1)]
+    return np.ascontiguousarray(_compact(_finite_rows(points)).T)
 
 
 def _degenerate_box(points: np.ndarray) -> OrientedBox:
@@ -74,29 +109,76 @@ def upright_box(points: np.ndarray) -> OrientedBox:
     return OrientedBox(centre, rotation, np.array([width, depth, high - low], dtype=np.float64))
 
 
-def principal_box(points: np.ndarray) -> OrientedBox:
-    """The box aligned with the principal axes of Nx3 points (a right-handed rotation)."""
-    points = finite_points(points)
-    if points.shape[0] < 3:
-        return _degenerate_box(points)
-    mean = points.mean(axis=0)
-    centred = points - mean
-    _, vectors = np.linalg.eigh(centred.T @ centred)
+def _determinant(matrix: np.ndarray) -> float:
+    """The determinant of a 3x3 matrix (the scalar triple product of its rows)."""
+    (a, b, c), (d, e, f), (g, h, i) = matrix.tolist()
+    return a * (e * i - f * h) - b * (d * i - f * g) + c * (d * h - e * g)
+
+
+def _principal(rows: np.ndarray) -> OrientedBox:
+    """:func:`principal_box` of finite points given as 3xN float64 rows."""
+    if rows.shape[1] < 3:
+        return _degenerate_box(rows.T)
+    mean = rows.mean(axis=1)
+    centred = rows - mean[:, None]
+    _, vectors = np.linalg.eigh(centred @ centred.T)
     rotation = vectors[:, ::-1].copy()  # largest spread first
-    if np.linalg.det(rotation) < 0:
+    if _determinant(rotation) < 0:
         rotation[:, 2] *= -1
-    local = centred @ rotation
-    low, high = local.min(axis=0), local.max(axis=0)
+    local = rotation.T @ centred
+    low, high = local.min(axis=1), local.max(axis=1)
     centre = mean + rotation @ ((low + high) / 2)
     return OrientedBox(centre, rotation, high - low)
+
+
+def principal_box(points: np.ndarray) -> OrientedBox:
+    """The box aligned with the principal axes of Nx3 points (a right-handed rotation)."""
+    return _principal(_finite_rows(points))
 
 
 def object_box(points_camera: np.ndarray, cam_to_world: np.ndarray | None) -> tuple[OrientedBox, str]:
     """The box of an object's camera-frame points (strays dropped) and its frame: upright in "world" when the
     camera pose is known."""
-    points = compact_points(points_camera)
+    rows = _compact(_finite_rows(points_camera))
     if cam_to_world is not None:
         transform = np.asarray(cam_to_world, dtype=np.float64)
-        world = points @ transform[:3, :3].T + transform[:3, 3]
+        world = rows.T @ transform[:3, :3].T + transform[:3, 3]
         return upright_box(world), "world"
-    return principal_box(points), "camera"
+    return _principal(rows), "camera"
+
+
+def _principal_boxes(parts: list[np.ndarray]) -> list[OrientedBox]:
+    """:func:`principal_box` of several point sets (each finite 3xN float64 rows) at once: the means, covariances
+    and eigen-decompositions of all the sets in one pass each, then each set's extents along its axes."""
+    boxes: list[OrientedBox | None] = [None if part.shape[1] >= 3 else _degenerate_box(part.T) for part in parts]
+    sets = [part for part in parts if part.shape[1] >= 3]
+    if not sets:
+        return [box for box in boxes if box is not None]
+    sizes = np.array([part.shape[1] for part in sets])
+    starts = np.cumsum(sizes) - sizes
+    owner = np.repeat(np.arange(sizes.size), sizes)
+    rows = np.concatenate(sets, axis=1)
+    mean = np.add.reduceat(rows, starts, axis=1) / sizes  # 3 x sets
+    centred = rows - mean[:, owner]
+    products = np.add.reduceat(centred[[0, 0, 0, 1, 1, 2]] * centred[[0, 1, 2, 1, 2, 2]], starts, axis=1)
+    covariance = products[[0, 1, 2, 1, 3, 4, 2, 4, 5]].T.reshape(-1, 3, 3)
+    _, vectors = np.linalg.eigh(covariance)
+    rotation = vectors[:, :, ::-1].copy()  # largest spread first
+    rotation[np.linalg.det(rotation) < 0, :, 2] *= -1
+    low, high = np.empty((sizes.size, 3)), np.empty((sizes.size, 3))
+    for index, (start, size) in enumerate(zip(starts.tolist(), sizes.tolist(), strict=True)):
+        local = rotation[index].T @ centred[:, start : start + size]  # the set in its box's axes
+        low[index], high[index] = local.min(axis=1), local.max(axis=1)
+    centres = mean.T + np.einsum("sij,sj->si", rotation, (low + high) / 2)
+    extents = high - low
+    fitted = iter(OrientedBox(c, r, e) for c, r, e in zip(centres, rotation, extents, strict=True))
+    return [box if box is not None else next(fitted) for box in boxes]
+
+
+def object_boxes_of_rows(rows: list[np.ndarray], cam_to_world: np.ndarray | None) -> list[tuple[OrientedBox, str]]:
+    """:func:`object_box` of several objects whose finite camera-frame points are given as 3xN float64 rows."""
+    parts = [_compact(part) for part in rows]
+    if cam_to_world is not None:
+        transform = np.asarray(cam_to_world, dtype=np.float64)
+        return [(upright_box(part.T @ transform[:3, :3].T + transform[:3, 3]), "world") for part in parts]
+    return [(box, "camera") for box in _principal_boxes(parts)]

@@ -20,26 +20,31 @@ votes (:func:`_pool_shades`). A name's share is the share of the named pixels it
 white: an unsaturated object's shaded side). The dominant colour is the largest share; a second colour is
 reported when its share and its confidence (share x certainty) are large enough.
 
+The annotator names all the hypotheses of a frame together (:func:`name_objects_colors`): their pixels are
+picked and grouped in one pass over the frame, and every surface's prototype votes and every pair of shades come
+from one CIEDE2000 computation each, with the same results as naming each object alone (:func:`name_colors`).
+
 :data:`COLOR_TERMS` is the one list of names this namer reports: the lower-case labels of the ontology's colour
 classes (``rk:Color`` in ontology/perception.ttl); the annotator's capability is derived from it.
 """
 
 from __future__ import annotations
 
+from collections.abc import Sequence
 from dataclasses import dataclass
 from typing import ClassVar
 
 import numpy as np
 
 from annotators.image.color_prototypes import prototypes
-from annotators.image.color_space import delta_e_2000, linear_to_lab, linear_to_srgb
+from annotators.image.color_space import delta_e_2000, linear_to_lab
 from annotators.image.color_surfaces import (
     DEFAULT_PARAMETERS,
     NamingParameters,
     Surface,
     is_unsaturated,
-    object_pixels,
-    object_surfaces,
+    objects_pixels,
+    objects_surfaces,
     tint,
 )
 from annotators.image.pixel_expert import image_and_hypotheses
@@ -90,67 +95,54 @@ class NamedColor:
     confidence: float
 
 
-def _term_votes(lab: np.ndarray, parameters: NamingParameters) -> np.ndarray:
-    """The chromatic terms' shares of the prototype votes for one CIELAB colour (sums to 1; all on the nearest
-    prototype's term when the colour is far from every prototype)."""
-    distances = delta_e_2000(lab[None, :], _PROTOTYPE_LAB)
+def _term_votes(labs: np.ndarray, parameters: NamingParameters) -> np.ndarray:
+    """The chromatic terms' shares of the prototype votes for CIELAB colours (Sx3 in, S x terms out; each row
+    sums to 1, all on the nearest prototype's term when the colour is far from every prototype)."""
+    labs = np.asarray(labs, dtype=np.float64).reshape(-1, 3)
+    distances = delta_e_2000(labs[:, None, :], _PROTOTYPE_LAB[None, :, :])
     density = np.exp(-0.5 * (distances / parameters.kernel_width) ** 2) @ _TERM_AVERAGE
-    total = float(density.sum())
-    if total <= 1e-300:
-        return np.eye(len(CHROMATIC_TERMS))[_PROTOTYPE_CODES[int(np.argmin(distances))]]
-    return density / total
+    total = density.sum(axis=1)
+    far = total <= 1e-300
+    votes = density / np.where(far, 1.0, total)[:, None]
+    if np.any(far):
+        votes[far] = np.eye(len(CHROMATIC_TERMS))[_PROTOTYPE_CODES[np.argmin(distances[far], axis=1)]]
+    return votes
 
 
-def _chromatic_name(lab: np.ndarray, parameters: NamingParameters) -> SurfaceName:
-    votes = _term_votes(lab, parameters)
+def _name_of_votes(votes: np.ndarray) -> SurfaceName:
     best = int(np.argmax(votes))
     return SurfaceName(CHROMATIC_TERMS[best], float(votes[best]))
 
 
-def _shade_groups(labs: list[np.ndarray], max_difference: float) -> list[list[int]]:
-    """The colours (CIELAB) linked by CIEDE2000 differences below ``max_difference`` (single linkage), as
-    lists of indices."""
-    groups: list[list[int]] = []
-    for index, lab in enumerate(labs):
-        linked = [g for g in groups if any(float(delta_e_2000(lab, labs[j])) < max_difference for j in g)]
-        merged = [index] + [j for g in linked for j in g]
-        groups = [g for g in groups if g not in linked] + [sorted(merged)]
-    return groups
+def _srgb_spread(linear: np.ndarray) -> tuple[float, float]:
+    """The spread of a linear RGB colour's sRGB levels (0..255): max - min, and that over max."""
+    levels = [
+        255.0 * (v * 12.92 if v <= 0.0031308 else 1.055 * v ** (1 / 2.4) - 0.055)
+        for v in (min(max(float(c), 0.0), 1.0) for c in linear)
+    ]
+    span = max(levels) - min(levels)
+    return span, span / max(max(levels), 1e-9)
 
 
-def _pool_shades(surfaces: list[Surface], names: list[SurfaceName], parameters: NamingParameters) -> list[SurfaceName]:
-    """The names with the lit saturated surfaces that are shades of one colour (:func:`_shade_groups` with
-    ``shade_delta_e``) named together, by their pixel-weighted term votes: a brown tin whose print and
-    shading spread it over reddish, pinkish and orange-brown surfaces is brown, one colour."""
-    chromatic = [i for i, s in enumerate(surfaces) if s.kind != "dark" and names[i].name in CHROMATIC_TERMS]
-    pooled = list(names)
-    for group in _shade_groups([surfaces[i].lab for i in chromatic], parameters.shade_delta_e):
-        if len(group) < 2:
-            continue
-        members = [chromatic[g] for g in group]
-        votes = sum(surfaces[i].pixels * _term_votes(surfaces[i].lab, parameters) for i in members)
-        votes = votes / float(votes.sum())
-        best = int(np.argmax(votes))
-        for i in members:
-            pooled[i] = SurfaceName(CHROMATIC_TERMS[best], float(votes[best]))
-    return pooled
-
-
-def name_surface(surface: Surface, surround: float, parameters: NamingParameters = DEFAULT_PARAMETERS) -> SurfaceName:
-    """The name of one surface against the frame's surround luminance (see the module docstring)."""
+def _vote_lab(surface: Surface, parameters: NamingParameters) -> np.ndarray | None:
+    """The CIELAB colour the prototypes name a surface by, or None when it is named by lightness (white, grey or
+    black): a saturated surface's own colour, or a saturated dark pool's mean chromaticity a little lighter."""
     if surface.kind == "dark":
-        srgb = 255.0 * linear_to_srgb(surface.linear)
-        span = float(srgb.max() - srgb.min())
-        saturation = span / max(float(srgb.max()), 1e-9)
+        span, saturation = _srgb_spread(surface.linear)
         if saturation >= parameters.dark_saturation and span >= parameters.dark_span:
-            mean = linear_to_lab(surface.linear)  # judged as the same chromaticity a little lighter
+            mean = linear_to_lab(surface.linear)
             lightness = max(float(mean[0]), parameters.dark_lightness * 2.0)
-            return _chromatic_name(
-                np.array([lightness, *(mean[1:] / (mean[0] + 16.0) * (lightness + 16.0))]), parameters
-            )
+            return np.array([lightness, *(mean[1:] / (mean[0] + 16.0) * (lightness + 16.0))])
+        return None
+    return None if is_unsaturated(surface.lab, parameters) else surface.lab
+
+
+def _lightness_name(surface: Surface, surround: float, parameters: NamingParameters) -> SurfaceName:
+    """The name of a surface without a hue: a dark pool is black; an unsaturated surface is white, grey or black
+    by its lit lightness against the surround (see the module docstring)."""
+    if surface.kind == "dark":
+        saturation = _srgb_spread(surface.linear)[1]
         return SurfaceName("black", 0.5 + 0.5 * max(0.0, 1.0 - saturation / parameters.dark_saturation))
-    if not is_unsaturated(surface.lab, parameters):
-        return _chromatic_name(surface.lab, parameters)
     lightness = float(surface.lab[0])
     certainty = 0.5 + 0.5 * (1.0 - tint(surface.lab, parameters))
     luminance = ((lightness + 16.0) / 116.0) ** 3
@@ -160,17 +152,71 @@ def name_surface(surface: Surface, surround: float, parameters: NamingParameters
     return SurfaceName("black" if black else "grey", certainty)
 
 
-def name_colors(
-    pixels: np.ndarray,
-    light: FrameLight = NEUTRAL_LIGHT,
-    edges: np.ndarray | None = None,
-    parameters: NamingParameters = DEFAULT_PARAMETERS,
+def _shade_groups(linked_to: np.ndarray) -> list[list[int]]:
+    """The single-linkage groups of colours given which pairs are linked (``linked_to[i, j]`` for j < i), as
+    lists of indices."""
+    groups: list[list[int]] = []
+    for index in range(linked_to.shape[0]):
+        linked = [g for g in groups if any(linked_to[index, j] for j in g)]
+        merged = [index] + [j for g in linked for j in g]
+        groups = [g for g in groups if g not in linked] + [sorted(merged)]
+    return groups
+
+
+def _lit_chromatic(surfaces: list[Surface], names: list[SurfaceName]) -> list[int]:
+    """The indices of the lit surfaces named by a hue."""
+    return [i for i, s in enumerate(surfaces) if s.kind != "dark" and names[i].name in CHROMATIC_TERMS]
+
+
+def _shade_links(labs_per_object: list[list[np.ndarray]], max_difference: float) -> list[np.ndarray]:
+    """For each object's colours (CIELAB), which pairs are closer than ``max_difference`` in CIEDE2000 (a
+    square boolean matrix per object), from one computation over all the objects' pairs."""
+    links = [np.zeros((len(labs), len(labs)), dtype=bool) for labs in labs_per_object]
+    pairs = [(k, i, j) for k, labs in enumerate(labs_per_object) for i in range(len(labs)) for j in range(i)]
+    if pairs:
+        first = np.array([labs_per_object[k][i] for k, i, _ in pairs])
+        second = np.array([labs_per_object[k][j] for k, _, j in pairs])
+        for (k, i, j), close in zip(pairs, (delta_e_2000(first, second) < max_difference).tolist(), strict=True):
+            links[k][i, j] = close
+    return links
+
+
+def _pool_shades(
+    surfaces: list[Surface],
+    names: list[SurfaceName],
+    votes: list[np.ndarray | None],
+    links: np.ndarray,
+) -> list[SurfaceName]:
+    """The names with the lit saturated surfaces (:func:`_lit_chromatic`) that are shades of one colour (linked
+    in a chain by ``links``, from :func:`_shade_links` with ``shade_delta_e``) named together, by their
+    pixel-weighted term votes (``votes``: each surface's, None for the surfaces named by lightness): a brown tin
+    whose print and shading spread it over reddish, pinkish and orange-brown surfaces is brown, one colour."""
+    chromatic = _lit_chromatic(surfaces, names)
+    pooled = list(names)
+    for group in _shade_groups(links):
+        if len(group) < 2:
+            continue
+        members = [chromatic[g] for g in group]
+        pooled_votes = sum(surfaces[i].pixels * votes[i] for i in members)
+        pooled_votes = pooled_votes / float(pooled_votes.sum())
+        best = int(np.argmax(pooled_votes))
+        for i in members:
+            pooled[i] = SurfaceName(CHROMATIC_TERMS[best], float(pooled_votes[best]))
+    return pooled
+
+
+def name_surface(surface: Surface, surround: float, parameters: NamingParameters = DEFAULT_PARAMETERS) -> SurfaceName:
+    """The name of one surface against the frame's surround luminance (see the module docstring)."""
+    lab = _vote_lab(surface, parameters)
+    if lab is None:
+        return _lightness_name(surface, surround, parameters)
+    return _name_of_votes(_term_votes(lab, parameters)[0])
+
+
+def _object_colors(
+    surfaces: list[Surface], names: list[SurfaceName], count: int, parameters: NamingParameters
 ) -> tuple[NamedColor, ...]:
-    """The colours of an object from its RGB pixels (Nx3 uint8): the dominant one, then a second one when the
-    object has two; ``edges`` (N, from :func:`~annotators.image.color_surfaces.edge_strength`) lets pixels on
-    colour edges be left out."""
-    surfaces, count = object_surfaces(pixels, light, edges, parameters)
-    names = _pool_shades(surfaces, [name_surface(s, light.surround, parameters) for s in surfaces], parameters)
+    """The dominant colour and, when the object has two, the second one, from its named surfaces."""
     weights: dict[str, float] = {}
     certainties: dict[str, float] = {}
     lit_names = {n.name for s, n in zip(surfaces, names, strict=True) if s.kind != "dark"}
@@ -193,6 +239,48 @@ def name_colors(
             break
         result.append(NamedColor(name=name, share=share, confidence=share * certainty))
     return tuple(result)
+
+
+def name_objects_colors(
+    objects: Sequence[tuple[np.ndarray, np.ndarray | None]],
+    light: FrameLight = NEUTRAL_LIGHT,
+    parameters: NamingParameters = DEFAULT_PARAMETERS,
+) -> list[tuple[NamedColor, ...]]:
+    """:func:`name_colors` for the objects of one frame at once (each its RGB pixels and their edge strengths or
+    None): the pixels are grouped together and every surface's prototype votes come from one computation."""
+    found = objects_surfaces(objects, light, parameters)
+    vote_labs = [[_vote_lab(surface, parameters) for surface in surfaces] for surfaces, _ in found]
+    voted = [lab for labs in vote_labs for lab in labs if lab is not None]
+    all_votes = iter(_term_votes(np.array(voted), parameters) if voted else ())
+    named = []
+    for (surfaces, _), labs in zip(found, vote_labs, strict=True):
+        votes = [None if lab is None else next(all_votes) for lab in labs]
+        names = [
+            _lightness_name(surface, light.surround, parameters) if vote is None else _name_of_votes(vote)
+            for surface, vote in zip(surfaces, votes, strict=True)
+        ]
+        named.append((votes, names))
+    lit_labs = [
+        [surfaces[i].lab for i in _lit_chromatic(surfaces, names)]
+        for (surfaces, _), (_, names) in zip(found, named, strict=True)
+    ]
+    links = _shade_links(lit_labs, parameters.shade_delta_e)
+    return [
+        _object_colors(surfaces, _pool_shades(surfaces, names, votes, linked), count, parameters)
+        for (surfaces, count), (votes, names), linked in zip(found, named, links, strict=True)
+    ]
+
+
+def name_colors(
+    pixels: np.ndarray,
+    light: FrameLight = NEUTRAL_LIGHT,
+    edges: np.ndarray | None = None,
+    parameters: NamingParameters = DEFAULT_PARAMETERS,
+) -> tuple[NamedColor, ...]:
+    """The colours of an object from its RGB pixels (Nx3 uint8): the dominant one, then a second one when the
+    object has two; ``edges`` (N, from :func:`~annotators.image.color_surfaces.edge_strength`) lets pixels on
+    colour edges be left out."""
+    return name_objects_colors([(pixels, edges)], light, parameters)[0]
 
 
 def name_color(pixels: np.ndarray, light: FrameLight = NEUTRAL_LIGHT) -> tuple[str, float, dict[str, float]]:
@@ -228,15 +316,14 @@ class SemanticColorAnnotator(Annotator):
         """Name the colours of each hypothesis with pixels; fail on missing or inconsistent input."""
         image, hypotheses = image_and_hypotheses(self, "name colours for")
         light = estimate_frame_light(image)
-        named_any = False
         for hypothesis in hypotheses:
             if hypothesis.mask.shape != image.shape[:2]:
                 self.fail(f"hypothesis mask {hypothesis.mask.shape} and colour image {image.shape[:2]} sizes differ")
-            pixels, edges = object_pixels(image, hypothesis, self.max_pixels)
-            if pixels.shape[0] == 0:
-                continue
-            for color in name_colors(pixels, light, edges, self.parameters):
+        picked = objects_pixels(image, hypotheses, self.max_pixels)
+        named = [hypothesis for hypothesis, (pixels, _) in zip(hypotheses, picked, strict=True) if pixels.shape[0]]
+        objects = [(pixels, edges) for pixels, edges in picked if pixels.shape[0]]
+        for hypothesis, colors in zip(named, name_objects_colors(objects, light, self.parameters), strict=True):
+            for color in colors:
                 self.attach(hypothesis, SemanticColor(color=color.name, ratio=color.share, confidence=color.confidence))
-            named_any = True
-        if not named_any:
+        if not named:
             self.fail("every object hypothesis has an empty mask")

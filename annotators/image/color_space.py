@@ -48,14 +48,82 @@ def linear_to_lab(linear: np.ndarray) -> np.ndarray:
     """CIELAB (D65) of linear sRGB values, any shape ``...x3`` (values above 1 are allowed: L* above 100)."""
     xyz = np.asarray(linear, dtype=np.float64) @ SRGB_TO_XYZ.T / D65_WHITE
     epsilon, kappa = 216 / 24389, 24389 / 27
-    f = np.where(xyz > epsilon, np.cbrt(xyz), (kappa * xyz + 16) / 116)
-    lightness = 116 * f[..., 1] - 16
-    return np.stack([lightness, 500 * (f[..., 0] - f[..., 1]), 200 * (f[..., 1] - f[..., 2])], axis=-1)
+    f = np.cbrt(xyz)
+    dim = xyz <= epsilon  # the linear segment near black (the cube root elsewhere)
+    if np.any(dim):
+        f[dim] = (kappa * xyz[dim] + 16) / 116
+    lab = np.empty(f.shape)
+    lab[..., 0] = 116 * f[..., 1] - 16
+    lab[..., 1] = 500 * (f[..., 0] - f[..., 1])
+    lab[..., 2] = 200 * (f[..., 1] - f[..., 2])
+    return lab
 
 
 def srgb_to_lab(rgb: np.ndarray) -> np.ndarray:
     """CIELAB (D65) of sRGB values (uint8 or float 0..1), any shape ``...x3``."""
     return linear_to_lab(srgb_to_linear(rgb))
+
+
+_TWO_PI = 2.0 * np.pi
+_POW25_7 = 25.0**7
+_T_TERMS = tuple((np.cos(np.radians(d)), np.sin(np.radians(d))) for d in (30.0, 6.0, 63.0))
+"""cos and sin of the phase offsets of the hue weighting T: 30, 6 and 63 degrees."""
+_SINE_SERIES = tuple((-1.0) ** k / float(np.prod(np.arange(2.0, 2.0 * k + 2.0))) for k in range(10))
+"""Taylor coefficients of sin(x)/x in powers of x^2 (1, -1/3!, 1/5!, ...): exact to rounding for |x| <= pi/3."""
+
+
+def _seventh_power_ratio(chroma: np.ndarray) -> np.ndarray:
+    """``sqrt(C^7 / (C^7 + 25^7))``, the chroma factor of the G and R_C terms."""
+    squared = chroma * chroma
+    seventh = squared * squared * squared * chroma
+    return np.sqrt(seventh / (seventh + _POW25_7))
+
+
+def _small_sine(x: np.ndarray) -> np.ndarray:
+    """sin(x) for 0 <= x <= pi/3 by its Taylor series (cheaper than ``np.sin`` on many values)."""
+    squared = x * x
+    series = np.full_like(x, _SINE_SERIES[-1])
+    for coefficient in _SINE_SERIES[-2::-1]:
+        series *= squared
+        series += coefficient
+    return x * series
+
+
+def _hue_units(ap: np.ndarray, b: np.ndarray, cp: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """The hue unit vector (a'/C', b/C') of colours, (0, 0) for a neutral one (C' = 0)."""
+    chromatic = cp > 0
+    with np.errstate(invalid="ignore", divide="ignore"):
+        return np.where(chromatic, ap / cp, 0.0), np.where(chromatic, b / cp, 0.0)
+
+
+def _mean_hue(
+    units: tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray],
+    neutral_both: np.ndarray,
+    primes: tuple[np.ndarray, ...],
+) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """The mean hue (radians, 0..2 pi) and its cosine and sine, from the two hue unit vectors ``units`` (x1, y1,
+    x2, y2): the direction of their sum is the bisector of the smaller arc, as the mean hue is, and a neutral
+    colour adds nothing (its hue counts as 0). Where the hues are opposite (the sum vanishes) the mean hue comes
+    from the angles of ``primes`` (a1', b1, a2', b2) by the formula's case analysis."""
+    x1, y1, x2, y2 = units
+    x, y = x1 + x2, y1 + y2
+    length = np.sqrt(x * x + y * y)
+    with np.errstate(invalid="ignore", divide="ignore"):
+        cos, sin = np.where(neutral_both, 1.0, x / length), np.where(neutral_both, 0.0, y / length)
+    mean = np.arctan2(sin, cos)
+    mean = np.where(mean < 0.0, mean + _TWO_PI, mean)
+    opposite = ~neutral_both & (length < 1e-6)
+    if np.any(opposite):
+        a1p, b1, a2p, b2 = (np.broadcast_to(v, opposite.shape)[opposite] for v in primes)
+        h1, h2 = np.arctan2(b1, a1p) % _TWO_PI, np.arctan2(b2, a2p) % _TWO_PI
+        total = h1 + h2
+        fixed = np.where(
+            np.abs(h2 - h1) <= np.pi,
+            total * 0.5,
+            np.where(total < _TWO_PI, (total + _TWO_PI) * 0.5, (total - _TWO_PI) * 0.5),
+        )
+        mean[opposite], cos[opposite], sin[opposite] = fixed, np.cos(fixed), np.sin(fixed)
+    return mean, cos, sin
 
 
 def delta_e_2000(
@@ -64,45 +132,40 @@ def delta_e_2000(
     """CIEDE2000 differences between CIELAB colours; the inputs broadcast against each other (``...x3``).
 
     ``k_l``, ``k_c`` and ``k_h`` are the formula's parametric factors (1 for the reference conditions; a larger
-    factor makes differences in lightness, chroma or hue count less)."""
+    factor makes differences in lightness, chroma or hue count less). Computed with few trigonometric calls
+    (they dominate on many pairs): the hue difference term and the mean hue from the hue unit vectors (radians),
+    T's four cosines from the mean hue's cosine and sine by multiple-angle identities, and the rotation term's
+    sine by its Taylor series."""
     lab1, lab2 = np.asarray(lab1, dtype=np.float64), np.asarray(lab2, dtype=np.float64)
     l1, a1, b1 = lab1[..., 0], lab1[..., 1], lab1[..., 2]
     l2, a2, b2 = lab2[..., 0], lab2[..., 1], lab2[..., 2]
-    c_mean = (np.hypot(a1, b1) + np.hypot(a2, b2)) / 2
-    c7 = c_mean**7
-    g = 0.5 * (1 - np.sqrt(c7 / (c7 + 25.0**7)))
-    a1p, a2p = (1 + g) * a1, (1 + g) * a2
-    c1p, c2p = np.hypot(a1p, b1), np.hypot(a2p, b2)
-    h1p = np.degrees(np.arctan2(b1, a1p)) % 360
-    h2p = np.degrees(np.arctan2(b2, a2p)) % 360
+    g1 = 1.5 - 0.5 * _seventh_power_ratio((np.sqrt(a1 * a1 + b1 * b1) + np.sqrt(a2 * a2 + b2 * b2)) * 0.5)  # 1 + G
+    a1p, a2p = g1 * a1, g1 * a2
+    c1p, c2p = np.sqrt(a1p * a1p + b1 * b1), np.sqrt(a2p * a2p + b2 * b2)
     chroma_product = c1p * c2p
-    dh = h2p - h1p
-    dh = np.where(dh > 180, dh - 360, np.where(dh < -180, dh + 360, dh))
-    dh = np.where(chroma_product == 0, 0.0, dh)
-    d_l = l2 - l1
-    d_c = c2p - c1p
-    d_h = 2 * np.sqrt(chroma_product) * np.sin(np.radians(dh / 2))
-    l_mean = (l1 + l2) / 2
-    cp_mean = (c1p + c2p) / 2
-    h_sum = h1p + h2p
-    h_mean = np.where(
-        chroma_product == 0,
-        h_sum,
-        np.where(np.abs(h1p - h2p) <= 180, h_sum / 2, np.where(h_sum < 360, (h_sum + 360) / 2, (h_sum - 360) / 2)),
-    )
+    (x1, y1), (x2, y2) = _hue_units(a1p, b1, c1p), _hue_units(a2p, b2, c2p)
+    # 2 sqrt(C1' C2') sin(dh / 2) = sqrt(C1' C2') |u1 - u2|, signed as dh = h2' - h1' wrapped to (-pi, pi]
+    dx, dy = x1 - x2, y1 - y2
+    d_h = np.copysign(np.sqrt(chroma_product * (dx * dx + dy * dy)), x1 * y2 - y1 * x2)
+    h_mean, c, s = _mean_hue((x1, y1, x2, y2), (c1p == 0) & (c2p == 0), (a1p, b1, a2p, b2))
+    c2, s2 = 2.0 * c * c - 1.0, 2.0 * s * c
+    c3, s3 = c * (2.0 * c2 - 1.0), s * (2.0 * c2 + 1.0)
+    c4, s4 = 2.0 * c2 * c2 - 1.0, 2.0 * s2 * c2
+    (cos30, sin30), (cos6, sin6), (cos63, sin63) = _T_TERMS
     t = (
-        1
-        - 0.17 * np.cos(np.radians(h_mean - 30))
-        + 0.24 * np.cos(np.radians(2 * h_mean))
-        + 0.32 * np.cos(np.radians(3 * h_mean + 6))
-        - 0.20 * np.cos(np.radians(4 * h_mean - 63))
+        1.0
+        - 0.17 * (c * cos30 + s * sin30)
+        + 0.24 * c2
+        + 0.32 * (c3 * cos6 - s3 * sin6)
+        - 0.20 * (c4 * cos63 + s4 * sin63)
     )
-    s_l = 1 + 0.015 * (l_mean - 50) ** 2 / np.sqrt(20 + (l_mean - 50) ** 2)
-    s_c = 1 + 0.045 * cp_mean
-    s_h = 1 + 0.015 * cp_mean * t
-    cp7 = cp_mean**7
-    r_c = 2 * np.sqrt(cp7 / (cp7 + 25.0**7))
-    d_theta = 30 * np.exp(-(((h_mean - 275) / 25) ** 2))
-    r_t = -np.sin(np.radians(2 * d_theta)) * r_c
-    term_l, term_c, term_h = d_l / (k_l * s_l), d_c / (k_c * s_c), d_h / (k_h * s_h)
-    return np.sqrt(term_l**2 + term_c**2 + term_h**2 + r_t * term_c * term_h)
+    l_offset = (l1 + l2) * 0.5 - 50.0
+    l_offset = l_offset * l_offset
+    s_l = 1.0 + 0.015 * l_offset / np.sqrt(20.0 + l_offset)
+    cp_mean = (c1p + c2p) * 0.5
+    s_c = 1.0 + 0.045 * cp_mean
+    s_h = 1.0 + 0.015 * cp_mean * t
+    rotation = (h_mean - np.radians(275.0)) / np.radians(25.0)
+    r_t = -_small_sine(np.radians(60.0) * np.exp(-rotation * rotation)) * 2.0 * _seventh_power_ratio(cp_mean)
+    term_l, term_c, term_h = (l2 - l1) / (k_l * s_l), (c2p - c1p) / (k_c * s_c), d_h / (k_h * s_h)
+    return np.sqrt(term_l * term_l + term_c * term_c + term_h * term_h + r_t * term_c * term_h)
