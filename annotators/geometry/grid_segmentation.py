@@ -51,19 +51,36 @@ def depth_seams(depth: np.ndarray, candidates: np.ndarray, absolute: float, rela
     return seams
 
 
+def _read_only(array: np.ndarray) -> np.ndarray:
+    array.flags.writeable = False
+    return array
+
+
+_HUE_ANGLE = np.arange(256, dtype=np.float32) * np.float32(2 * np.pi / 256)
+_HUE_COS = _read_only(np.cos(_HUE_ANGLE))
+_HUE_SIN = _read_only(np.sin(_HUE_ANGLE))
+_VALUE_WEIGHT = _read_only(np.clip((np.arange(256, dtype=np.float32) - 25) / 40, 0, 1))
+"""Per 8-bit hue and value of :func:`chroma_image`: the cosine and sine of the hue angle and the dark fade-out."""
+
+
 def chroma_image(colors: np.ndarray) -> np.ndarray:
     """A shading-invariant 3-channel uint8 image: hue as an angle scaled by saturation, faded out on dark pixels.
 
     Channels 0 and 1 are ``128 + 127 * s * w * (cos h, sin h)`` with ``w`` ramping from 0 to 1 between values
     25 and 65, so shading of one surface (same hue and saturation) gives no edge while a change of hue does.
+    The trigonometry and the ramp are table look-ups over the 256 hue and value levels.
     """
     hsv = cv2.cvtColor(cv2.GaussianBlur(colors, (5, 5), 0), cv2.COLOR_RGB2HSV_FULL)
-    angle = hsv[..., 0].astype(np.float32) * np.float32(2 * np.pi / 256)
-    value_weight = np.clip((hsv[..., 2].astype(np.float32) - 25) / 40, 0, 1)
-    weight = hsv[..., 1].astype(np.float32) * value_weight * np.float32(127 / 255)
+    hue, saturation, value = cv2.split(hsv)
+    weight = cv2.LUT(value, _VALUE_WEIGHT)
+    weight *= saturation
+    weight *= np.float32(127 / 255)
     chroma = np.full(colors.shape, 128, dtype=np.uint8)
-    chroma[..., 0] = np.clip(128 + weight * np.cos(angle), 0, 255)
-    chroma[..., 1] = np.clip(128 + weight * np.sin(angle), 0, 255)
+    for channel, table in ((0, _HUE_COS), (1, _HUE_SIN)):
+        value = cv2.LUT(hue, table)
+        value *= weight
+        value += 128
+        chroma[..., channel] = np.clip(value, 0, 255, out=value)
     return chroma
 
 
@@ -159,27 +176,28 @@ def footprint_overlap(first: np.ndarray, second: np.ndarray, cell: float) -> flo
 
     The raster gives even a degenerate footprint (a wall seen edge-on is a line) an area of one cell width.
     """
-    shared_box = np.minimum(first.max(axis=0), second.max(axis=0)) - np.maximum(first.min(axis=0), second.min(axis=0))
-    if np.any(shared_box < -cell):
+    first_low, first_high = first.min(axis=0), first.max(axis=0)
+    second_low, second_high = second.min(axis=0), second.max(axis=0)
+    if np.any(np.minimum(first_high, second_high) - np.maximum(first_low, second_low) < -cell):
         return 0.0  # the footprints' bounding boxes are apart: nothing to rasterize
-    low = np.minimum(first.min(axis=0), second.min(axis=0))
-    vertices = [np.round((hull - low) / cell).astype(np.int32) for hull in (first, second)]
+    low = np.minimum(first_low, second_low)
     # each polygon on the raster of its own bounding cells; the shared cells where the two rasters overlap
-    corners = [vertex.min(axis=0) for vertex in vertices]
-    rasters = [_filled(vertex, corner) for vertex, corner in zip(vertices, corners, strict=True)]
+    rasters, corners = [], []
+    for hull in (first, second):
+        vertex = np.round((hull - low) / cell).astype(np.int32)
+        corner = vertex.min(axis=0)
+        corners.append(corner)
+        rasters.append(_filled(vertex, corner))
     window_low = np.maximum(corners[0], corners[1])
     window_high = np.minimum(corners[0] + rasters[0].shape[::-1], corners[1] + rasters[1].shape[::-1])
     shared = 0
     if np.all(window_high > window_low):
-        windows = [
-            raster[
-                window_low[1] - corner[1] : window_high[1] - corner[1],
-                window_low[0] - corner[0] : window_high[0] - corner[0],
-            ]
-            for raster, corner in zip(rasters, corners, strict=True)
-        ]
-        shared = np.count_nonzero(windows[0] & windows[1])
-    return shared / max(1, min(np.count_nonzero(rasters[0]), np.count_nonzero(rasters[1])))
+        (x0, y0), (x1, y1) = window_low.tolist(), window_high.tolist()
+        (ax, ay), (bx, by) = corners[0].tolist(), corners[1].tolist()
+        shared = cv2.countNonZero(
+            cv2.bitwise_and(rasters[0][y0 - ay : y1 - ay, x0 - ax : x1 - ax], rasters[1][y0 - by : y1 - by, x0 - bx : x1 - bx])
+        )
+    return shared / max(1, min(cv2.countNonZero(rasters[0]), cv2.countNonZero(rasters[1])))
 
 
 def _filled(vertices: np.ndarray, corner: np.ndarray) -> np.ndarray:
@@ -187,7 +205,7 @@ def _filled(vertices: np.ndarray, corner: np.ndarray) -> np.ndarray:
     local = np.ascontiguousarray(vertices - corner)
     raster = np.zeros((int(local[:, 1].max()) + 1, int(local[:, 0].max()) + 1), dtype=np.uint8)
     cv2.fillConvexPoly(raster, local, 1)
-    return raster.view(bool)
+    return raster
 
 
 def join_labels(labels: np.ndarray, pairs: list[tuple[int, int]]) -> np.ndarray:
@@ -309,15 +327,24 @@ def looks_like_inside(near: np.ndarray, far: np.ndarray, tolerance: float, depth
     far_low, far_high = _range(far[:, :2] @ across, 0.05, 0.95)
     if far_low < near_low - margin or far_high > near_high + margin:
         return False
-    if _range(far[:, 2], 0.5, 0.95)[1] > _range(near[:, 2], 0.5, 0.95)[1] + margin:
+    rim = _range(near[:, 2], 0.5, 0.95)[1]
+    far_median, far_top = _range(far[:, 2], 0.5, 0.95)
+    if far_top > rim + margin:
         return False
     near_front, near_middle = _range(near[:, :2] @ along, 0.05, 0.5)
     far_middle, far_back = _range(far[:, :2] @ along, 0.5, 0.95)
     if far_middle <= near_middle or far_back > near_front + depth_ratio * width:
         return False
-    rim = _range(near[:, 2], 0.5, 0.95)[1]
-    far_median, far_top = _range(far[:, 2], 0.5, 0.95)
     return far_top - far_median >= INNER_SPREAD * rim or far_median <= 0.5 * rim
+
+
+def _median(values: np.ndarray) -> np.floating:
+    """``np.median`` of a 1-D array (the same value, NaN when one is NaN) by one partition, without its overhead."""
+    if values.size == 0 or np.isnan(values).any():
+        return np.median(values)
+    low, high = (values.size - 1) // 2, values.size // 2
+    ordered = np.partition(values, (low, high))
+    return (ordered[low] + ordered[high]) / values.dtype.type(2)
 
 
 class _Parts:
@@ -351,7 +378,7 @@ class _Parts:
         """The median depth of the part."""
         if label not in self._depths:
             own = self.own(label)
-            self._depths[label] = float(np.median(self.depth[own[:: max(1, own.size // 500)]]))
+            self._depths[label] = float(_median(self.depth[own[:: max(1, own.size // 500)]]))
         return self._depths[label]
 
 

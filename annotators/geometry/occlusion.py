@@ -99,22 +99,35 @@ def join_occluded(
             touching = _touching(labels)
         if not _some_apart(farther[present].tolist(), touching):
             continue  # the farther objects near it all touch one another: nothing to join
-        near = cv2.dilate(_with_shadow(window == occluder, depth[y0:y1, x0:x1], wide).view(np.uint8), kernel) > 0
+        occluding = window == occluder
+        window_depth = depth[y0:y1, x0:x1]
+        near = cv2.dilate(_with_shadow(occluding, window_depth, wide).view(np.uint8), kernel) > 0
+        # the farther objects with enough pixels near the occluder; two of them must be apart to join anything
+        near_pixels, near_starts = label_groups(np.where(near, window, 0))
+        band_sizes = np.zeros(count + 1, dtype=np.int64)
+        band_sizes[: near_starts.size - 1] = np.diff(near_starts)
+        candidates = farther[band_sizes[farther] >= rules.min_points].tolist()
+        if len(candidates) < 2 or not _some_apart(candidates, touching):
+            continue
+        reach = 3 * rules.band
         behind = []
-        for piece in np.intersect1d(np.unique(window[near]), farther).tolist():
-            band = near & (window == piece)
-            if np.count_nonzero(band) < rules.min_points:
-                continue
-            facing = (cv2.dilate(band.view(np.uint8), wide) > 0) & (window == occluder)
+        for piece in candidates:
+            own = near_pixels[near_starts[piece] : near_starts[piece + 1]]
+            rows, cols = own // window.shape[1], own % window.shape[1]
+            # the occluder's pixels within reach of the band, found in the band's box grown by the reach
+            r0, c0 = max(int(rows.min()) - reach, 0), max(int(cols.min()) - reach, 0)
+            r1, c1 = int(rows.max()) + reach + 1, int(cols.max()) + reach + 1
+            band = np.zeros((min(r1, window.shape[0]) - r0, min(c1, window.shape[1]) - c0), dtype=np.uint8)
+            band[rows - r0, cols - c0] = 1
+            facing = (cv2.dilate(band, wide) > 0) & occluding[r0:r1, c0:c1]
             if np.count_nonzero(facing) < rules.min_points:
                 continue
-            piece_depth = _finite_mean(depth[y0:y1, x0:x1][band])
-            occluder_depth = _finite_mean(depth[y0:y1, x0:x1][facing])
+            piece_depth = _finite_mean(window_depth[rows, cols])
+            occluder_depth = _finite_mean(window_depth[r0:r1, c0:c1][facing])
             if not depth_jump(np.float32(piece_depth), np.float32(occluder_depth), absolute, relative):
                 continue
             if piece_depth <= occluder_depth:
                 continue
-            rows, cols = np.nonzero(band)
             flat = (rows + y0) * labels.shape[1] + cols + x0
             xyz = flat_points[flat]
             xyz = xyz[np.isfinite(xyz).all(axis=1)]
