@@ -125,7 +125,9 @@ def segment_clutter(
         colors_crop = np.ascontiguousarray(colors[::step, ::step][y0:y1, x0:x1])
         labels = split_by_color(labels, grid, normals, colors_crop, p)
     if p.complete_occluded:
-        labels = join_occluded(labels, grid, normals, plane_grid.reshape(grid.shape), p.jump_absolute, p.jump_relative, OcclusionRules())
+        labels = join_occluded(
+            labels, grid, normals, plane_grid.reshape(grid.shape), p.jump_absolute, p.jump_relative, OcclusionRules()
+        )
     return full_resolution_segments(labels, depth, (x0, y0, x1, y1), step, points, mask, model, p)
 
 

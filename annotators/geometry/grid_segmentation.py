@@ -195,7 +195,9 @@ def footprint_overlap(first: np.ndarray, second: np.ndarray, cell: float) -> flo
         (x0, y0), (x1, y1) = window_low.tolist(), window_high.tolist()
         (ax, ay), (bx, by) = corners[0].tolist(), corners[1].tolist()
         shared = cv2.countNonZero(
-            cv2.bitwise_and(rasters[0][y0 - ay : y1 - ay, x0 - ax : x1 - ax], rasters[1][y0 - by : y1 - by, x0 - bx : x1 - bx])
+            cv2.bitwise_and(
+                rasters[0][y0 - ay : y1 - ay, x0 - ax : x1 - ax], rasters[1][y0 - by : y1 - by, x0 - bx : x1 - bx]
+            )
         )
     return shared / max(1, min(cv2.countNonZero(rasters[0]), cv2.countNonZero(rasters[1])))
 
