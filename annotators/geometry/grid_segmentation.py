@@ -182,18 +182,16 @@ def footprint_overlap(first: np.ndarray, second: np.ndarray, cell: float) -> flo
         return 0.0  # the footprints' bounding boxes are apart: nothing to rasterize
     low = np.minimum(first_low, second_low)
     # each polygon on the raster of its own bounding cells; the shared cells where the two rasters overlap
-    rasters, corners = [], []
+    boxes, rasters = [], []
     for hull in (first, second):
-        vertex = np.round((hull - low) / cell).astype(np.int32)
-        corner = vertex.min(axis=0)
-        corners.append(corner)
-        rasters.append(_filled(vertex, corner))
-    window_low = np.maximum(corners[0], corners[1])
-    window_high = np.minimum(corners[0] + rasters[0].shape[::-1], corners[1] + rasters[1].shape[::-1])
+        vertices = np.round((hull - low) / cell).astype(np.int32)
+        box = cv2.boundingRect(vertices)  # x, y, width, height of the cells the vertices span
+        boxes.append(box)
+        rasters.append(_filled(vertices, box))
+    (ax, ay, aw, ah), (bx, by, bw, bh) = boxes
+    x0, y0, x1, y1 = max(ax, bx), max(ay, by), min(ax + aw, bx + bw), min(ay + ah, by + bh)
     shared = 0
-    if np.all(window_high > window_low):
-        (x0, y0), (x1, y1) = window_low.tolist(), window_high.tolist()
-        (ax, ay), (bx, by) = corners[0].tolist(), corners[1].tolist()
+    if x1 > x0 and y1 > y0:
         shared = cv2.countNonZero(
             cv2.bitwise_and(
                 rasters[0][y0 - ay : y1 - ay, x0 - ax : x1 - ax], rasters[1][y0 - by : y1 - by, x0 - bx : x1 - bx]
@@ -202,11 +200,11 @@ def footprint_overlap(first: np.ndarray, second: np.ndarray, cell: float) -> flo
     return shared / max(1, min(cv2.countNonZero(rasters[0]), cv2.countNonZero(rasters[1])))
 
 
-def _filled(vertices: np.ndarray, corner: np.ndarray) -> np.ndarray:
-    """The cells a convex polygon with integer ``vertices`` covers, on a raster whose first cell is ``corner``."""
-    local = np.ascontiguousarray(vertices - corner)
-    raster = np.zeros((int(local[:, 1].max()) + 1, int(local[:, 0].max()) + 1), dtype=np.uint8)
-    cv2.fillConvexPoly(raster, local, 1)
+def _filled(vertices: np.ndarray, box: tuple[int, int, int, int]) -> np.ndarray:
+    """The cells (uint8, 1 = covered) a convex polygon with integer ``vertices`` covers, on the raster of its
+    bounding ``box`` ``(x, y, width, height)``."""
+    raster = np.zeros((box[3], box[2]), dtype=np.uint8)
+    cv2.fillConvexPoly(raster, vertices - np.array(box[:2], dtype=np.int32), 1)
     return raster
 
 
@@ -415,18 +413,30 @@ def pixel_footprint(points: np.ndarray) -> float:
     return float(np.median(steps)) if steps.size else 0.0
 
 
-def _beside_views(array: np.ndarray, reach: int) -> list[tuple[np.ndarray, np.ndarray]]:
-    """For every horizontal / vertical neighbour pair (as :func:`_neighbour_views`), the values ``reach`` pixels
-    further out on each side: left of the left pixel and right of the right one (above / below for vertical)."""
-    width = [(0, 0)] * array.ndim
-    rows, cols = array.shape[:2]
-    fill = 0 if array.dtype.kind in "iub" else np.nan
-    horizontal = np.pad(array, [(0, 0), (reach, reach), *width[2:]], constant_values=fill)
-    vertical = np.pad(array, [(reach, reach), (0, 0), *width[2:]], constant_values=fill)
-    return [
-        (horizontal[:, : cols - 1], horizontal[:, 2 * reach + 1 :]),
-        (vertical[: rows - 1], vertical[2 * reach + 1 :]),
-    ]
+def _touching_pixels(labels: np.ndarray, reach: int) -> list[tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]]:
+    """For horizontal, then vertical 4-neighbour pairs of different non-zero labels: the flat indices of the first
+    and second pixel (row-major order) and of the pixels ``reach`` further out on each side (left of the left
+    pixel and right of the right one, above / below for vertical pairs; -1 where that lies off the grid)."""
+    rows, cols = labels.shape
+    found = []
+    for down, right in ((0, 1), (1, 0)):
+        l_a, l_b = labels[: rows - down, : cols - right], labels[down:, right:]
+        r, c = np.nonzero((l_a != l_b) & (l_a > 0) & (l_b > 0))
+        first = r * cols + c
+        second = first + (down * cols + right)
+        before_r, before_c = r - reach * down, c - reach * right
+        after_r, after_c = r + (reach + 1) * down, c + (reach + 1) * right
+        before = np.where((before_r >= 0) & (before_c >= 0), before_r * cols + before_c, -1)
+        after = np.where((after_r < rows) & (after_c < cols), after_r * cols + after_c, -1)
+        found.append((first, second, before, after))
+    return found
+
+
+def _gather(flat: np.ndarray, indices: np.ndarray, fill: float) -> np.ndarray:
+    """``flat[indices]`` with ``fill`` where an index is -1 (off the grid)."""
+    values = flat[np.maximum(indices, 0)]
+    values[indices < 0] = fill
+    return values
 
 
 def boundaries(
@@ -443,29 +453,22 @@ def boundaries(
 
     Normals and positions for ``alignment`` and ``convexity`` are taken ``reach`` pixels away from the boundary on
     either side (where those pixels still belong to the two parts), since normals right at a crease are blurred
-    across it.
+    across it. Only the boundary pixels and those beside them are read.
     """
     footprint = pixel_footprint(points)
     keys, jumps, dots, convex, near = [], [], [], [], []
     base = int(labels.max(initial=0)) + 1
-    for (l_a, l_b), (p_a, p_b), (s_la, s_lb), (s_pa, s_pb), (s_na, s_nb) in zip(
-        _neighbour_views(labels),
-        _neighbour_views(points),
-        _beside_views(labels, reach),
-        _beside_views(points, reach),
-        _beside_views(normals, reach),
-        strict=True,
-    ):
-        touching = (l_a != l_b) & (l_a > 0) & (l_b > 0)
-        a, b = l_a[touching].astype(np.int64), l_b[touching].astype(np.int64)
+    flat_labels, flat_points, flat_normals = labels.reshape(-1), points.reshape(-1, 3), normals.reshape(-1, 3)
+    for first, second, before, after in _touching_pixels(labels, reach):
+        a, b = flat_labels[first].astype(np.int64), flat_labels[second].astype(np.int64)
         keys.append(np.minimum(a, b) * base + np.maximum(a, b))
-        pa, pb = p_a[touching], p_b[touching]
+        pa, pb = flat_points[first], flat_points[second]
         jumps.append(depth_jump(pa[:, 2], pb[:, 2], absolute, relative))
         with np.errstate(invalid="ignore"):
             near.append(np.linalg.norm(pa - pb, axis=1) <= close_factor * footprint * np.fmin(pa[:, 2], pb[:, 2]))
-        same = (s_la[touching] == a) & (s_lb[touching] == b)
-        na, nb = s_na[touching], s_nb[touching]
-        offset = s_pa[touching] - s_pb[touching]
+        same = (_gather(flat_labels, before, 0) == a) & (_gather(flat_labels, after, 0) == b)
+        na, nb = _gather(flat_normals, before, np.nan), _gather(flat_normals, after, np.nan)
+        offset = _gather(flat_points, before, np.nan) - _gather(flat_points, after, np.nan)
         with np.errstate(invalid="ignore", divide="ignore"):
             dots.append(np.where(same, np.einsum("ij,ij->i", na, nb), np.nan))
             convex.append(
