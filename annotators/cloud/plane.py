@@ -43,7 +43,7 @@ def least_squares_plane(points: np.ndarray) -> np.ndarray | None:
         return None
     centre = points.mean(axis=0, dtype=np.float64)
     centred = points.astype(np.float64) - centre
-    eigenvalues, eigenvectors = np.linalg.eigh(np.einsum("ni,nj->ij", centred, centred))
+    eigenvalues, eigenvectors = np.linalg.eigh(centred.T @ centred)
     if eigenvalues[1] <= 1e-6 * max(eigenvalues[2], 1e-12):
         return None  # collinear or coincident points
     normal = eigenvectors[:, 0]
@@ -51,13 +51,13 @@ def least_squares_plane(points: np.ndarray) -> np.ndarray | None:
 
 
 def plane_distances(points: np.ndarray, model: np.ndarray) -> np.ndarray:
-    """Signed distances (HxW float32, NaN for NaN points) of an organized cloud's points to ``model``."""
-    a, b, c, d = (np.float32(v) for v in model)
-    distances = points[..., 0] * a
-    distances += points[..., 1] * b
-    distances += points[..., 2] * c
-    distances += d
-    return distances
+    """Signed distances (float32, the points' shape without the last axis; NaN for NaN points) of Nx3 or HxWx3
+    points to ``model`` (one affine transform in OpenCV, accumulated in double precision)."""
+    grid = np.ascontiguousarray(points, dtype=np.float32)
+    if grid.size == 0:
+        return np.zeros(grid.shape[:-1], dtype=np.float32)
+    distances = cv2.transform(grid.reshape(-1, 1, 3), np.asarray(model, dtype=np.float64).reshape(1, 4))
+    return distances.reshape(grid.shape[:-1])
 
 
 def _support(sample: np.ndarray, normals: np.ndarray, offsets: np.ndarray, distance: float) -> np.ndarray:
@@ -133,12 +133,13 @@ def ransac_support_plane(
 
     max_tilt = np.cos(np.radians(max_tilt_degrees))
     coarse_points, coarse_valid = points[::2, ::2], valid[::2, ::2]
-    coarse_flat = coarse_points.reshape(-1, 3)
+    coarse_cols = coarse_points.shape[1]
     for band in (distance, distance / 2):  # refit to the inliers; the narrower band keeps edges of walls out
         inliers = _inliers(coarse_points, coarse_valid, model, band)
         if inliers.size < MIN_PLANE_POINTS // 4:
             return None
-        refined = least_squares_plane(coarse_flat[inliers[:: inliers.size // 20000 + 1]])
+        chosen = inliers[:: inliers.size // 20000 + 1]
+        refined = least_squares_plane(coarse_points[chosen // coarse_cols, chosen % coarse_cols])
         if refined is None or (up is not None and refined[:3] @ up / np.linalg.norm(up) < max_tilt):
             break
         model = refined

@@ -106,8 +106,8 @@ def join_occluded(
         near_pixels, near_starts = label_groups(np.where(near, window, 0))
         band_sizes = np.zeros(count + 1, dtype=np.int64)
         band_sizes[: near_starts.size - 1] = np.diff(near_starts)
-        candidates = farther[band_sizes[farther] >= rules.min_points].tolist()
-        if len(candidates) < 2 or not _some_apart(candidates, touching):
+        candidates = _apart_from_another(farther[band_sizes[farther] >= rules.min_points].tolist(), touching)
+        if len(candidates) < 2:
             continue
         reach = 3 * rules.band
         behind = []
@@ -240,6 +240,11 @@ def _same_section(first: _Piece, second: _Piece, on_plane: np.ndarray, rules: Oc
 def _some_apart(labels: list[int], touching: set[tuple[int, int]]) -> bool:
     """Are two of the (increasing) ``labels`` not touching each other?"""
     return any((a, b) not in touching for index, a in enumerate(labels) for b in labels[index + 1 :])
+
+
+def _apart_from_another(labels: list[int], touching: set[tuple[int, int]]) -> list[int]:
+    """The (increasing) ``labels`` that do not touch at least one of the others: only those can be joined."""
+    return [a for a in labels if any((min(a, b), max(a, b)) not in touching for b in labels if b != a)]
 
 
 def _touching(labels: np.ndarray) -> set[tuple[int, int]]:
