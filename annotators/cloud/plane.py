@@ -41,8 +41,9 @@ def least_squares_plane(points: np.ndarray) -> np.ndarray | None:
     """The total-least-squares plane through Nx3 points (unit normal toward the origin), None when degenerate."""
     if points.shape[0] < 3:
         return None
-    centre = points.mean(axis=0, dtype=np.float64)
-    centred = points.astype(np.float64) - centre
+    columns = np.ascontiguousarray(points.T, dtype=np.float64)  # 3xN: each coordinate's values contiguous
+    centre = columns.mean(axis=1)
+    centred = columns.T - centre
     eigenvalues, eigenvectors = np.linalg.eigh(centred.T @ centred)
     if eigenvalues[1] <= 1e-6 * max(eigenvalues[2], 1e-12):
         return None  # collinear or coincident points
@@ -132,14 +133,13 @@ def ransac_support_plane(
     model = np.append(normals[best], offsets[best])
 
     max_tilt = np.cos(np.radians(max_tilt_degrees))
-    coarse_points, coarse_valid = points[::2, ::2], valid[::2, ::2]
-    coarse_cols = coarse_points.shape[1]
+    coarse_points, coarse_valid = np.ascontiguousarray(points[::2, ::2]), valid[::2, ::2]
+    coarse_flat = coarse_points.reshape(-1, 3)
     for band in (distance, distance / 2):  # refit to the inliers; the narrower band keeps edges of walls out
         inliers = _inliers(coarse_points, coarse_valid, model, band)
         if inliers.size < MIN_PLANE_POINTS // 4:
             return None
-        chosen = inliers[:: inliers.size // 20000 + 1]
-        refined = least_squares_plane(coarse_points[chosen // coarse_cols, chosen % coarse_cols])
+        refined = least_squares_plane(coarse_flat[inliers[:: inliers.size // 20000 + 1]])
         if refined is None or (up is not None and refined[:3] @ up / np.linalg.norm(up) < max_tilt):
             break
         model = refined
