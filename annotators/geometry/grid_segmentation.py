@@ -115,12 +115,8 @@ def grow_labels(labels: np.ndarray, region: np.ndarray, max_distance: float) -> 
     return grown
 
 
-_SHIFTS: tuple[tuple[tuple[slice, slice], tuple[slice, slice]], ...] = (
-    ((slice(None), slice(1, None)), (slice(None), slice(None, -1))),  # (pixel, its left neighbour)
-    ((slice(None), slice(None, -1)), (slice(None), slice(1, None))),  # right neighbour
-    ((slice(1, None), slice(None)), (slice(None, -1), slice(None))),  # upper neighbour
-    ((slice(None, -1), slice(None)), (slice(1, None), slice(None))),  # lower neighbour
-)
+_NEIGHBOURS: tuple[tuple[int, int], ...] = ((0, -1), (0, 1), (-1, 0), (1, 0))
+"""Row and column steps to the left, right, upper and lower 4-neighbour, in the order they are tried."""
 
 
 def grow_on_surface(
@@ -129,19 +125,30 @@ def grow_on_surface(
     """Give unlabelled pixels of ``region`` the label of a 4-neighbour on the same surface (no depth jump).
 
     Used for the far pixels of depth discontinuities: they join the surface they belong to, never the occluder
-    in front of them, so an occluder and what it hides do not touch in the label image.
+    in front of them, so an occluder and what it hides do not touch in the label image. Each round reads the
+    labels of the round before; a pixel takes its left, right, upper or lower neighbour's label, the first that
+    qualifies. Only the unlabelled pixels are visited.
     """
     grown = labels.copy()
+    rows, cols = labels.shape
+    flat = grown.reshape(-1)
+    flat_depth = np.ascontiguousarray(depth).reshape(-1)
     for _ in range(rounds):
-        before = grown.copy()
-        open_ = region & (before == 0)
-        if not open_.any():
+        open_ = np.flatnonzero(region & (grown == 0))
+        if open_.size == 0:
             break
-        for pixel, neighbour in _SHIFTS:
-            value = before[neighbour]
-            take = open_[pixel] & (value > 0) & ~depth_jump(depth[pixel], depth[neighbour], absolute, relative)
-            target = grown[pixel]
-            target[take & (target == 0)] = value[take & (target == 0)]
+        before = flat.copy()
+        row, col = open_ // cols, open_ % cols
+        open_depth = flat_depth[open_]
+        waiting = np.ones(open_.size, dtype=bool)
+        for step_row, step_col in _NEIGHBOURS:
+            beside_row, beside_col = row + step_row, col + step_col
+            inside = waiting & (beside_row >= 0) & (beside_row < rows) & (beside_col >= 0) & (beside_col < cols)
+            beside = np.where(inside, beside_row * cols + beside_col, 0)
+            value = before[beside]
+            take = inside & (value > 0) & ~depth_jump(open_depth, flat_depth[beside], absolute, relative)
+            flat[open_[take]] = value[take]
+            waiting &= ~take
     return grown
 
 

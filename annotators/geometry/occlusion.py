@@ -26,8 +26,9 @@ from dataclasses import dataclass
 
 import cv2
 import numpy as np
+from scipy import ndimage
 
-from annotators.geometry.grid_segmentation import depth_jump, join_labels, label_groups, touching_pairs
+from annotators.geometry.grid_segmentation import depth_jump, join_labels, touching_pairs
 
 
 @dataclass(frozen=True)
@@ -78,19 +79,19 @@ def join_occluded(
     flat_labels = labels.reshape(-1)
     kernel = np.ones((2 * rules.band + 1, 2 * rules.band + 1), np.uint8)
     wide = np.ones((6 * rules.band + 1, 6 * rules.band + 1), np.uint8)
-    pixels, starts = label_groups(labels)
+    sizes = np.bincount(flat_labels, minlength=count + 1)
+    boxes = ndimage.find_objects(labels, max_label=count)
     measured = np.isfinite(depth.reshape(-1)) & (flat_labels > 0)
     sums = np.bincount(flat_labels[measured], depth.reshape(-1)[measured], minlength=count + 1)
     mean_depth = sums / np.maximum(np.bincount(flat_labels[measured], minlength=count + 1), 1)
     touching: set[tuple[int, int]] | None = None
     joined: list[tuple[int, int]] = []
     for occluder in range(1, count + 1):
-        own = pixels[starts[occluder] : starts[occluder + 1]]
         # what an occluder hides lies farther than it as a whole: at least two such objects or nothing to join
         farther = np.flatnonzero(mean_depth > mean_depth[occluder])
-        if own.size < rules.min_points or farther.size < 2:
+        if sizes[occluder] < rules.min_points or farther.size < 2:
             continue
-        x0, y0, x1, y1 = _box(own, labels.shape[1], labels.shape, 3 * rules.band + 1)
+        x0, y0, x1, y1 = _grown(boxes[occluder - 1], labels.shape, 3 * rules.band + 1)
         window = labels[y0:y1, x0:x1]
         present = np.bincount(window.reshape(-1), minlength=count + 1)[farther] > 0
         if np.count_nonzero(present) < 2:
@@ -103,9 +104,8 @@ def join_occluded(
         window_depth = depth[y0:y1, x0:x1]
         near = cv2.dilate(_with_shadow(occluding, window_depth, wide).view(np.uint8), kernel) > 0
         # the farther objects with enough pixels near the occluder; two of them must be apart to join anything
-        near_pixels, near_starts = label_groups(np.where(near, window, 0))
-        band_sizes = np.zeros(count + 1, dtype=np.int64)
-        band_sizes[: near_starts.size - 1] = np.diff(near_starts)
+        near_pixels, near_starts = _grouped(near & (window > 0), window, count)
+        band_sizes = np.diff(near_starts)
         candidates = _apart_from_another(farther[band_sizes[farther] >= rules.min_points].tolist(), touching)
         if len(candidates) < 2:
             continue
@@ -178,15 +178,26 @@ def _with_shadow(occluder: np.ndarray, depth: np.ndarray, reach: np.ndarray) -> 
     return occluder | (touching[parts] & within)
 
 
-def _box(flat: np.ndarray, width: int, shape: tuple[int, int], margin: int) -> tuple[int, int, int, int]:
-    """``(x0, y0, x1, y1)`` (exclusive) of flat pixel indices, grown by ``margin`` and clipped to ``shape``."""
-    rows, cols = flat // width, flat % width
+def _grown(box: tuple[slice, slice], shape: tuple[int, int], margin: int) -> tuple[int, int, int, int]:
+    """``(x0, y0, x1, y1)`` (exclusive) of a ``find_objects`` box, grown by ``margin`` and clipped to ``shape``."""
+    rows, cols = box
     return (
-        max(int(cols.min()) - margin, 0),
-        max(int(rows.min()) - margin, 0),
-        min(int(cols.max()) + 1 + margin, shape[1]),
-        min(int(rows.max()) + 1 + margin, shape[0]),
+        max(cols.start - margin, 0),
+        max(rows.start - margin, 0),
+        min(cols.stop + margin, shape[1]),
+        min(rows.stop + margin, shape[0]),
     )
+
+
+def _grouped(where: np.ndarray, labels: np.ndarray, count: int) -> tuple[np.ndarray, np.ndarray]:
+    """The flat indices of the ``where`` pixels sorted by their label (row-major within one label) and ``starts``
+    so label k owns ``pixels[starts[k]:starts[k + 1]]`` (k = 0..count)."""
+    index = np.flatnonzero(where)
+    values = labels[where]
+    if count < 1 << 16:
+        values = values.astype(np.uint16)  # a stable sort of 16-bit keys is a radix sort: linear time
+    order = np.argsort(values, kind="stable")
+    return index[order], np.searchsorted(values[order], np.arange(count + 2))
 
 
 def _continues(first: _Piece, second: _Piece, normals: np.ndarray, rules: OcclusionRules) -> bool:
