@@ -178,7 +178,7 @@ def standing_region(
     flat = points.reshape(-1, 3)
     plane_points = flat[plane_indices[:: max(1, plane_indices.size // 2000)]]
     plane_points = plane_points[np.isfinite(plane_points).all(axis=1)]
-    feet = coarse_points.reshape(-1, 3)[coarse_indices] @ basis
+    feet = points[coarse_indices // coarse.shape[1] * step, coarse_indices % coarse.shape[1] * step] @ basis
     inside = inside_plane_extent(feet, plane_points @ basis, p.hull_margin, p.hull_cell)
     coarse.reshape(-1)[coarse_indices[~inside]] = False
     return coarse

@@ -417,7 +417,7 @@ def pixel_footprint(points: np.ndarray) -> float:
         ratio = points[..., 0] / points[..., 2]
         steps = np.abs(np.diff(ratio, axis=1))
     steps = steps[np.isfinite(steps) & (steps > 0)]
-    return float(np.median(steps)) if steps.size else 0.0
+    return float(_median(steps)) if steps.size else 0.0
 
 
 def _touching_pixels(labels: np.ndarray, reach: int) -> list[tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]]:
