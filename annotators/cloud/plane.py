@@ -63,9 +63,10 @@ def plane_distances(points: np.ndarray, model: np.ndarray) -> np.ndarray:
 
 def _support(sample: np.ndarray, normals: np.ndarray, offsets: np.ndarray, distance: float) -> np.ndarray:
     """How many of the Nx3 sample points lie within ``distance`` of each of the K planes (normals Kx3)."""
-    residuals = sample @ normals.T.astype(np.float32)
-    residuals += offsets.astype(np.float32)
-    return np.count_nonzero(np.abs(residuals) < distance, axis=0)
+    residuals = normals.astype(np.float32) @ sample.T  # KxN: each plane's residuals contiguous
+    residuals += offsets.astype(np.float32)[:, None]
+    np.abs(residuals, out=residuals)
+    return np.count_nonzero(residuals < distance, axis=1)
 
 
 def _triples(
