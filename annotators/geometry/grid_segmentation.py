@@ -52,13 +52,13 @@ def depth_seams(depth: np.ndarray, candidates: np.ndarray, absolute: float, rela
 
 
 def _read_only(array: np.ndarray) -> np.ndarray:
+    """``array``, made read-only (a module-level table)."""
     array.flags.writeable = False
     return array
 
 
-_HUE_ANGLE = np.arange(256, dtype=np.float32) * np.float32(2 * np.pi / 256)
-_HUE_COS = _read_only(np.cos(_HUE_ANGLE))
-_HUE_SIN = _read_only(np.sin(_HUE_ANGLE))
+_HUE_COS = _read_only(np.cos(np.arange(256, dtype=np.float32) * np.float32(2 * np.pi / 256)))
+_HUE_SIN = _read_only(np.sin(np.arange(256, dtype=np.float32) * np.float32(2 * np.pi / 256)))
 _VALUE_WEIGHT = _read_only(np.clip((np.arange(256, dtype=np.float32) - 25) / 40, 0, 1))
 """Per 8-bit hue and value of :func:`chroma_image`: the cosine and sine of the hue angle and the dark fade-out."""
 
