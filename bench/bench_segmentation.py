@@ -46,6 +46,8 @@ HELD_OUT = ("occluded", "cylindric")
 NAMES = {"clutter": "new", "clusters": "old", "open3d": "Open3D"}
 TICKS = 30
 SCENE_RUNS = 15
+SEGMENTATION_GOAL_MS = 40.0
+"""Goal for the new segmenter alone on the rendered 15-object scene (ms)."""
 
 
 def scores() -> dict[str, dict[str, ScoreSummary]]:
@@ -181,7 +183,9 @@ def main() -> None:
     times = segmentation_times(*fifteen_objects())
     ms = {key: statistics.median(values) * 1e3 for key, values in times.items()}
     print(f"  segmentation median: new {ms['new']:.1f} ms ({ms['new cpu']:.1f} CPU), old {ms['old']:.1f} ms")
-    print(f"  ({ms['old cpu']:.1f} CPU); new / old = {ms['new'] / ms['old']:.2f} wall; goal: <= 40 ms")
+    print(f"  ({ms['old cpu']:.1f} CPU); new / old = {ms['new'] / ms['old']:.2f} wall")
+    verdict = "met" if ms["new"] <= SEGMENTATION_GOAL_MS else "NOT met"
+    print(f"  goal <= {SEGMENTATION_GOAL_MS:.0f} ms (new segmenter): {verdict} ({ms['new']:.1f} ms on this machine)")
 
 
 if __name__ == "__main__":

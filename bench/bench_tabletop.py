@@ -12,8 +12,9 @@ Three measurements in one run, on frame 000003 of ../shared/data/uoc_tabletop_re
   objects matched by a hypothesis with point IoU >= 0.5;
 * with ``--reference REV`` (a git revision, e.g. the commit before a change): this checkout's tree and the tree of
   REV (exported with ``git archive``) ticked side by side, each in its own worker process
-  (:mod:`bench.tick_tree`), rounds alternating; ms, Hz and the ratio (goal: >= 30 Hz), and each annotator's
-  median ms per run in both trees with its speed-up and the per-expert budgets (:data:`EXPERT_GOALS_MS`).
+  (:mod:`bench.tick_tree`), rounds alternating; ms, Hz and the ratio (goal: >= 30 Hz), each annotator's ms side by
+  side with the per-expert budgets (:data:`EXPERT_GOALS_MS`), and the clutter segmentation alone on the rendered
+  15-object scene of :mod:`bench.bench_segmentation` (goal: <= 40 ms).
 
 Tree and bare rounds alternate so machine noise hits both alike. The reader decodes the PNGs once and then
 serves the cached frame (as it does on repeated ticks of the same frame); decoding is reported separately.
@@ -43,11 +44,10 @@ from annotators.cloud.clutter import ClutterParameters, segment_clutter  # noqa:
 from annotators.cloud.filters import range_mask  # noqa: E402
 from annotators.cloud.plane import ransac_support_plane  # noqa: E402
 from annotators.cloud.point_cloud import back_project, pixel_rays  # noqa: E402
-from annotators.cloud.pose import PoseAnnotator, hypotheses_rows  # noqa: E402
-from annotators.geometry.boxes import object_boxes_of_rows  # noqa: E402
-from annotators.image.color import SemanticColorAnnotator, name_objects_colors  # noqa: E402
-from annotators.image.color_surfaces import objects_pixels  # noqa: E402
-from annotators.image.white_balance import estimate_frame_light  # noqa: E402
+from annotators.cloud.pose import PoseAnnotator, hypothesis_points  # noqa: E402
+from annotators.geometry.boxes import object_box  # noqa: E402
+from annotators.image.color import SemanticColorAnnotator, name_color  # noqa: E402
+from annotators.image.pixel_expert import hypothesis_pixels  # noqa: E402
 from annotators.readers.frame_io import read_color_depth_pair  # noqa: E402
 from annotators.readers.frame_readers import PcdReader  # noqa: E402
 from robokudo.core.engine import Engine  # noqa: E402
@@ -97,11 +97,9 @@ def bare_frame(frame, rays, timings: dict[str, list[float]]) -> int:
     cloud = PointCloud(points=points, mask=mask, colors=frame.color)
     timed(
         "SemanticColorAnnotator",
-        lambda: name_objects_colors(
-            objects_pixels(frame.color, hypotheses, COLOR_PIXELS), estimate_frame_light(frame.color)
-        ),
+        lambda: [name_color(hypothesis_pixels(frame.color, h, COLOR_PIXELS)) for h in hypotheses],
     )
-    timed("PoseAnnotator", lambda: object_boxes_of_rows(hypotheses_rows(cloud, hypotheses, POSE_POINTS), None))
+    timed("PoseAnnotator", lambda: [object_box(hypothesis_points(cloud, h, POSE_POINTS), None) for h in hypotheses])
     return len(segments)
 
 
@@ -144,16 +142,28 @@ def mosd_recall(scene: str) -> tuple[int, int, list[float], float]:
     return sum(iou >= MIN_IOU for iou in ious), len(ious), ious, statistics.median(times) * 1e3
 
 
-def side_by_side(reference: str, rounds: int = 8, ticks: int = 10) -> None:
-    """This checkout's tree vs the tree of git revision ``reference`` on the same frame, rounds alternating."""
+SEGMENTATION_GOAL_MS = 40.0
+"""Goal for the clutter segmentation alone on the rendered 15-object scene (ms)."""
+
+
+def side_by_side(reference: str, rounds: int = 8, ticks: int = 10, segment_runs: int = 5) -> None:
+    """This checkout's tree vs the tree of git revision ``reference`` on the same frame, rounds alternating: whole
+    tree and per annotator; then the clutter segmentation alone on the rendered 15-object scene, likewise."""
+    from bench.bench_segmentation import fifteen_objects
+
     with tempfile.TemporaryDirectory() as folder:
         archive = subprocess.run(["git", "-C", str(ROOT), "archive", reference], check=True, capture_output=True)
+        tree_folder = Path(folder) / "reference"
+        tree_folder.mkdir()
         with tarfile.open(fileobj=io.BytesIO(archive.stdout)) as tar:
-            tar.extractall(folder, filter="data")
-        checkouts = {"this checkout": str(ROOT), f"reference {reference}": folder}
+            tar.extractall(tree_folder, filter="data")
+        scene = Path(folder) / "fifteen_objects.npz"
+        points, colors = fifteen_objects()
+        np.savez(scene, points=points, colors=colors)
+        checkouts = {"this checkout": str(ROOT), f"reference {reference}": str(tree_folder)}
         workers = {
             name: subprocess.Popen(
-                [sys.executable, str(ROOT / "bench" / "tick_tree.py"), path, str(DATA), str(FRAME)],
+                [sys.executable, str(ROOT / "bench" / "tick_tree.py"), path, str(DATA), str(FRAME), str(scene)],
                 stdin=subprocess.PIPE,
                 stdout=subprocess.PIPE,
                 text=True,
@@ -163,25 +173,38 @@ def side_by_side(reference: str, rounds: int = 8, ticks: int = 10) -> None:
         for worker in workers.values():
             if worker.stdout is None or worker.stdout.readline().strip() != "ready":
                 raise RuntimeError("a tree worker did not start")
+
+        def ask(worker: subprocess.Popen, line: str) -> dict:
+            assert worker.stdin is not None and worker.stdout is not None
+            worker.stdin.write(line + "\n")
+            worker.stdin.flush()
+            return json.loads(worker.stdout.readline())
+
         wall: dict[str, list[float]] = {name: [] for name in workers}
         cpu: dict[str, list[float]] = {name: [] for name in workers}
-        runs: dict[str, dict[str, list[float]]] = {name: {} for name in workers}
+        experts: dict[str, dict[str, list[float]]] = {name: {} for name in workers}
+        segment_wall: dict[str, list[float]] = {name: [] for name in workers}
+        segment_cpu: dict[str, list[float]] = {name: [] for name in workers}
         found: dict[str, int] = {}
+        segments: dict[str, int] = {}
         for _ in range(rounds):
             for name, worker in workers.items():
-                assert worker.stdin is not None and worker.stdout is not None
-                worker.stdin.write(f"{ticks}\n")
-                worker.stdin.flush()
-                answer = json.loads(worker.stdout.readline())
+                answer = ask(worker, str(ticks))
                 wall[name] += answer["wall"]
                 cpu[name] += answer["cpu"]
-                for node, seconds in answer.get("nodes", {}).items():
-                    runs[name].setdefault(node, []).extend(seconds)
+                for expert, seconds in answer["experts"].items():
+                    experts[name].setdefault(expert, []).extend(seconds)
                 found[name] = answer["hypotheses"]
+            for name, worker in workers.items():
+                answer = ask(worker, f"segment {segment_runs}")
+                segment_wall[name] += answer["wall"]
+                segment_cpu[name] += answer["cpu"]
+                segments[name] = answer["segments"]
         for worker in workers.values():
             assert worker.stdin is not None
             worker.stdin.close()
             worker.wait()
+    ours_name, theirs_name = "this checkout", f"reference {reference}"
     print(f"\nside by side on {DATA.name}/{FRAME:06d}, {rounds} alternating rounds of {ticks} ticks, median per tick:")
     ms = {name: statistics.median(values) * 1e3 for name, values in wall.items()}
     cpu_ms = {name: statistics.median(values) * 1e3 for name, values in cpu.items()}
@@ -190,11 +213,23 @@ def side_by_side(reference: str, rounds: int = 8, ticks: int = 10) -> None:
             f"  {name:28s} {ms[name]:7.1f} ms = {1e3 / ms[name]:5.1f} Hz  ({cpu_ms[name]:.1f} ms CPU)"
             f"  {found[name]} hypotheses"
         )
-    ours, theirs = ms["this checkout"], ms[f"reference {reference}"]
-    print_expert_table(runs["this checkout"], runs[f"reference {reference}"], reference)
-    ours_cpu, theirs_cpu = cpu_ms["this checkout"], cpu_ms[f"reference {reference}"]
+    ours, theirs = ms[ours_name], ms[theirs_name]
+    ours_cpu, theirs_cpu = cpu_ms[ours_name], cpu_ms[theirs_name]
     print(f"  speed-up over the reference: {theirs / ours:.2f}x wall, {theirs_cpu / ours_cpu:.2f}x CPU")
     print(f"  goal >= 30 Hz: {'met' if 1e3 / ours >= 30 else 'NOT met'} ({1e3 / ours:.1f} Hz on this machine now)")
+    print_expert_table(experts[ours_name], experts[theirs_name], reference)
+    seg_ms = {name: statistics.median(values) * 1e3 for name, values in segment_wall.items()}
+    seg_cpu = {name: statistics.median(values) * 1e3 for name, values in segment_cpu.items()}
+    print(
+        f"\nclutter segmentation alone on the rendered 15-object scene, {rounds} alternating rounds of {segment_runs}:"
+    )
+    for name in workers:
+        print(f"  {name:28s} {seg_ms[name]:7.1f} ms ({seg_cpu[name]:.1f} ms CPU)  {segments[name]} segments")
+    mine = seg_ms[ours_name]
+    cpu_ratio = seg_cpu[theirs_name] / seg_cpu[ours_name]
+    print(f"  speed-up over the reference: {seg_ms[theirs_name] / mine:.2f}x wall, {cpu_ratio:.2f}x CPU")
+    verdict = "met" if mine <= SEGMENTATION_GOAL_MS else "NOT met"
+    print(f"  goal <= {SEGMENTATION_GOAL_MS:.0f} ms: {verdict} ({mine:.1f} ms on this machine now)")
 
 
 EXPERT_GOALS_MS = {"SemanticColorAnnotator": 8.0, "PoseAnnotator": 3.0}

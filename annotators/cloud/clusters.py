@@ -25,6 +25,7 @@ from typing import ClassVar
 
 import cv2
 import numpy as np
+from scipy import ndimage
 
 from annotators.cloud.normals import grid_normals
 from annotators.cloud.plane import plane_basis, plane_distances
@@ -38,7 +39,6 @@ from annotators.geometry.grid_segmentation import (
     depth_seams,
     grow_labels,
     grow_on_surface,
-    label_groups,
     label_parts,
     merge_parts,
 )
@@ -178,7 +178,7 @@ def standing_region(
     flat = points.reshape(-1, 3)
     plane_points = flat[plane_indices[:: max(1, plane_indices.size // 2000)]]
     plane_points = plane_points[np.isfinite(plane_points).all(axis=1)]
-    feet = coarse_points.reshape(-1, 3)[coarse_indices] @ basis
+    feet = points[coarse_indices // coarse.shape[1] * step, coarse_indices % coarse.shape[1] * step] @ basis
     inside = inside_plane_extent(feet, plane_points @ basis, p.hull_margin, p.hull_cell)
     coarse.reshape(-1)[coarse_indices[~inside]] = False
     return coarse
@@ -209,16 +209,19 @@ def full_resolution_segments(
     fine_points = points[fy0:fy1, fx0:fx1]
     same_surface = ~depth_jump(fine_points[..., 2], sampled_depth, p.jump_absolute, p.jump_relative)
     fine = fine * (_candidates(fine_points, mask[fy0:fy1, fx0:fx1], model, p) & same_surface)
-    pixels, starts = label_groups(fine)
-    kept = [label for label in range(1, starts.size - 1) if starts[label + 1] - starts[label] >= p.min_points]
+    sizes = np.bincount(fine.reshape(-1))
+    kept = [label for label in range(1, sizes.size) if sizes[label] >= p.min_points]
+    boxes = ndimage.find_objects(fine)
     masks = np.zeros((len(kept), rows, cols), dtype=bool)  # one allocation for all masks
     segments = []
     for object_mask, label in zip(masks, kept, strict=True):
-        own = pixels[starts[label] : starts[label + 1]]
-        r, c = own // width + fy0, own % width + fx0
-        object_mask[r, c] = True
-        roi = (int(c.min()), int(r.min()), int(c.max()) + 1, int(r.max()) + 1)
-        segments.append(Segment(indices=r * cols + c, mask=object_mask, roi=roi))
+        box_rows, box_cols = boxes[label - 1]
+        own = fine[box_rows, box_cols] == label
+        top, left = box_rows.start + fy0, box_cols.start + fx0
+        object_mask[top : box_rows.stop + fy0, left : box_cols.stop + fx0] = own
+        r, c = np.nonzero(own)
+        roi = (left, top, box_cols.stop + fx0, box_rows.stop + fy0)
+        segments.append(Segment(indices=(r + top) * cols + c + left, mask=object_mask, roi=roi))
     segments.sort(key=lambda s: -s.indices.size)
     return segments
 

@@ -119,15 +119,15 @@ def segment_clutter(
     basis = plane_basis(np.asarray(model[:3], dtype=np.float64)).T.astype(np.float32)
     to_plane = np.column_stack([basis, np.asarray(model[:3], dtype=np.float32)])
     offset = np.array([0.0, 0.0, model[3]], dtype=np.float32)
-    crop_points = grid.reshape(-1, 3)
-    on_plane = lambda pixels: crop_points[pixels] @ to_plane + offset  # noqa: E731
-    labels = merge_parts(labels, depth, on_plane, p.merge_rules())
+    plane_grid = grid.reshape(-1, 3) @ to_plane + offset  # (u, v, height) of every grid point on the plane
+    labels = merge_parts(labels, depth, plane_grid.__getitem__, p.merge_rules())
     if colors is not None and p.use_color:
         colors_crop = np.ascontiguousarray(colors[::step, ::step][y0:y1, x0:x1])
         labels = split_by_color(labels, grid, normals, colors_crop, p)
     if p.complete_occluded:
-        plane_grid = on_plane(np.arange(crop_points.shape[0])).reshape(grid.shape)
-        labels = join_occluded(labels, grid, normals, plane_grid, p.jump_absolute, p.jump_relative, OcclusionRules())
+        labels = join_occluded(
+            labels, grid, normals, plane_grid.reshape(grid.shape), p.jump_absolute, p.jump_relative, OcclusionRules()
+        )
     return full_resolution_segments(labels, depth, (x0, y0, x1, y1), step, points, mask, model, p)
 
 

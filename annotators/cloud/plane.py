@@ -41,9 +41,10 @@ def least_squares_plane(points: np.ndarray) -> np.ndarray | None:
     """The total-least-squares plane through Nx3 points (unit normal toward the origin), None when degenerate."""
     if points.shape[0] < 3:
         return None
-    centre = points.mean(axis=0, dtype=np.float64)
-    centred = points.astype(np.float64) - centre
-    eigenvalues, eigenvectors = np.linalg.eigh(np.einsum("ni,nj->ij", centred, centred))
+    columns = np.ascontiguousarray(points.T, dtype=np.float64)  # 3xN: each coordinate's values contiguous
+    centre = columns.mean(axis=1)
+    centred = columns.T - centre
+    eigenvalues, eigenvectors = np.linalg.eigh(centred.T @ centred)
     if eigenvalues[1] <= 1e-6 * max(eigenvalues[2], 1e-12):
         return None  # collinear or coincident points
     normal = eigenvectors[:, 0]
@@ -51,20 +52,21 @@ def least_squares_plane(points: np.ndarray) -> np.ndarray | None:
 
 
 def plane_distances(points: np.ndarray, model: np.ndarray) -> np.ndarray:
-    """Signed distances (HxW float32, NaN for NaN points) of an organized cloud's points to ``model``."""
-    a, b, c, d = (np.float32(v) for v in model)
-    distances = points[..., 0] * a
-    distances += points[..., 1] * b
-    distances += points[..., 2] * c
-    distances += d
-    return distances
+    """Signed distances (float32, the points' shape without the last axis; NaN for NaN points) of Nx3 or HxWx3
+    points to ``model`` (one affine transform in OpenCV, accumulated in double precision)."""
+    grid = np.ascontiguousarray(points, dtype=np.float32)
+    if grid.size == 0:
+        return np.zeros(grid.shape[:-1], dtype=np.float32)
+    distances = cv2.transform(grid.reshape(-1, 1, 3), np.asarray(model, dtype=np.float64).reshape(1, 4))
+    return distances.reshape(grid.shape[:-1])
 
 
 def _support(sample: np.ndarray, normals: np.ndarray, offsets: np.ndarray, distance: float) -> np.ndarray:
     """How many of the Nx3 sample points lie within ``distance`` of each of the K planes (normals Kx3)."""
-    residuals = sample @ normals.T.astype(np.float32)
-    residuals += offsets.astype(np.float32)
-    return np.count_nonzero(np.abs(residuals) < distance, axis=0)
+    residuals = normals.astype(np.float32) @ sample.T  # KxN: each plane's residuals contiguous
+    residuals += offsets.astype(np.float32)[:, None]
+    np.abs(residuals, out=residuals)
+    return np.count_nonzero(residuals < distance, axis=1)
 
 
 def _triples(
@@ -132,7 +134,7 @@ def ransac_support_plane(
     model = np.append(normals[best], offsets[best])
 
     max_tilt = np.cos(np.radians(max_tilt_degrees))
-    coarse_points, coarse_valid = points[::2, ::2], valid[::2, ::2]
+    coarse_points, coarse_valid = np.ascontiguousarray(points[::2, ::2]), valid[::2, ::2]
     coarse_flat = coarse_points.reshape(-1, 3)
     for band in (distance, distance / 2):  # refit to the inliers; the narrower band keeps edges of walls out
         inliers = _inliers(coarse_points, coarse_valid, model, band)

@@ -49,17 +49,18 @@ def split_by_normals(patches: np.ndarray, normals: np.ndarray, spread: float) ->
     count = int(patches.max(initial=0)) + 1
     known = (patches > 0) & np.isfinite(normals[..., 0])
     labels = patches[known]
-    unit = normals[known].astype(np.float64)
+    unit = np.ascontiguousarray(normals[known].T, dtype=np.float64)  # 3xN: each component's values contiguous
     sizes = np.maximum(np.bincount(labels, minlength=count), 1).astype(np.float64)
-    mean = np.stack([np.bincount(labels, unit[:, i], count) for i in range(3)], axis=1) / sizes[:, None]
-    centred = unit - mean[labels]
+    mean = np.stack([np.bincount(labels, unit[i], count) for i in range(3)], axis=1) / sizes[:, None]
+    centred = unit - mean[labels].T
     second = np.empty((count, 3, 3))
     for i in range(3):
         for j in range(i, 3):
-            second[:, i, j] = second[:, j, i] = np.bincount(labels, centred[:, i] * centred[:, j], count) / sizes
+            second[:, i, j] = second[:, j, i] = np.bincount(labels, centred[i] * centred[j], count) / sizes
     values, vectors = np.linalg.eigh(second)
     wide = np.sqrt(np.clip(values.sum(axis=1), 0, None)) > spread
-    side = np.einsum("ij,ij->i", centred, vectors[labels, :, 2]) > 0
+    direction = vectors[:, :, 2]
+    side = (centred * direction[labels].T).sum(axis=0) > 0
     split = np.zeros(patches.shape, dtype=np.int64)
     split[known] = labels * 2 + (side & wide[labels]) + 1
     return dense_labels(split)
@@ -109,16 +110,16 @@ def patch_planes(patches: np.ndarray, points: np.ndarray) -> PatchPlanes:
     count = int(patches.max(initial=0))
     inside = patches > 0
     labels = patches[inside] - 1
-    xyz = points[inside].astype(np.float64)
-    shift = xyz.mean(axis=0) if xyz.size else np.zeros(3)
-    xyz -= shift
+    xyz = np.ascontiguousarray(points[inside].T, dtype=np.float64)  # 3xN: each coordinate's values contiguous
+    shift = xyz.mean(axis=1) if xyz.size else np.zeros(3)
+    xyz -= shift[:, None]
     counts = np.bincount(labels, minlength=count).astype(np.float64)
     safe = np.maximum(counts, 1.0)
-    means = np.stack([np.bincount(labels, xyz[:, i], count) for i in range(3)], axis=1) / safe[:, None]
+    means = np.stack([np.bincount(labels, xyz[i], count) for i in range(3)], axis=1) / safe[:, None]
     second = np.empty((count, 3, 3))
     for i in range(3):
         for j in range(i, 3):
-            second[:, i, j] = second[:, j, i] = np.bincount(labels, xyz[:, i] * xyz[:, j], count) / safe
+            second[:, i, j] = second[:, j, i] = np.bincount(labels, xyz[i] * xyz[j], count) / safe
     covariance = second - means[:, :, None] * means[:, None, :]
     values, vectors = np.linalg.eigh(covariance)
     normals = vectors[:, :, 0]

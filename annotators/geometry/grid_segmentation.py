@@ -51,19 +51,36 @@ def depth_seams(depth: np.ndarray, candidates: np.ndarray, absolute: float, rela
     return seams
 
 
+def _read_only(array: np.ndarray) -> np.ndarray:
+    """``array``, made read-only (a module-level table)."""
+    array.flags.writeable = False
+    return array
+
+
+_HUE_COS = _read_only(np.cos(np.arange(256, dtype=np.float32) * np.float32(2 * np.pi / 256)))
+_HUE_SIN = _read_only(np.sin(np.arange(256, dtype=np.float32) * np.float32(2 * np.pi / 256)))
+_VALUE_WEIGHT = _read_only(np.clip((np.arange(256, dtype=np.float32) - 25) / 40, 0, 1))
+"""Per 8-bit hue and value of :func:`chroma_image`: the cosine and sine of the hue angle and the dark fade-out."""
+
+
 def chroma_image(colors: np.ndarray) -> np.ndarray:
     """A shading-invariant 3-channel uint8 image: hue as an angle scaled by saturation, faded out on dark pixels.
 
     Channels 0 and 1 are ``128 + 127 * s * w * (cos h, sin h)`` with ``w`` ramping from 0 to 1 between values
     25 and 65, so shading of one surface (same hue and saturation) gives no edge while a change of hue does.
+    The trigonometry and the ramp are table look-ups over the 256 hue and value levels.
     """
     hsv = cv2.cvtColor(cv2.GaussianBlur(colors, (5, 5), 0), cv2.COLOR_RGB2HSV_FULL)
-    angle = hsv[..., 0].astype(np.float32) * np.float32(2 * np.pi / 256)
-    value_weight = np.clip((hsv[..., 2].astype(np.float32) - 25) / 40, 0, 1)
-    weight = hsv[..., 1].astype(np.float32) * value_weight * np.float32(127 / 255)
+    hue, saturation, value = cv2.split(hsv)
+    weight = cv2.LUT(value, _VALUE_WEIGHT)
+    weight *= saturation
+    weight *= np.float32(127 / 255)
     chroma = np.full(colors.shape, 128, dtype=np.uint8)
-    chroma[..., 0] = np.clip(128 + weight * np.cos(angle), 0, 255)
-    chroma[..., 1] = np.clip(128 + weight * np.sin(angle), 0, 255)
+    for channel, table in ((0, _HUE_COS), (1, _HUE_SIN)):
+        value = cv2.LUT(hue, table)
+        value *= weight
+        value += 128
+        chroma[..., channel] = np.clip(value, 0, 255, out=value)
     return chroma
 
 
@@ -98,12 +115,8 @@ def grow_labels(labels: np.ndarray, region: np.ndarray, max_distance: float) -> 
     return grown
 
 
-_SHIFTS: tuple[tuple[tuple[slice, slice], tuple[slice, slice]], ...] = (
-    ((slice(None), slice(1, None)), (slice(None), slice(None, -1))),  # (pixel, its left neighbour)
-    ((slice(None), slice(None, -1)), (slice(None), slice(1, None))),  # right neighbour
-    ((slice(1, None), slice(None)), (slice(None, -1), slice(None))),  # upper neighbour
-    ((slice(None, -1), slice(None)), (slice(1, None), slice(None))),  # lower neighbour
-)
+_NEIGHBOURS: tuple[tuple[int, int], ...] = ((0, -1), (0, 1), (-1, 0), (1, 0))
+"""Row and column steps to the left, right, upper and lower 4-neighbour, in the order they are tried."""
 
 
 def grow_on_surface(
@@ -112,19 +125,30 @@ def grow_on_surface(
     """Give unlabelled pixels of ``region`` the label of a 4-neighbour on the same surface (no depth jump).
 
     Used for the far pixels of depth discontinuities: they join the surface they belong to, never the occluder
-    in front of them, so an occluder and what it hides do not touch in the label image.
+    in front of them, so an occluder and what it hides do not touch in the label image. Each round reads the
+    labels of the round before; a pixel takes its left, right, upper or lower neighbour's label, the first that
+    qualifies. Only the unlabelled pixels are visited.
     """
     grown = labels.copy()
+    rows, cols = labels.shape
+    flat = grown.reshape(-1)
+    flat_depth = np.ascontiguousarray(depth).reshape(-1)
     for _ in range(rounds):
-        before = grown.copy()
-        open_ = region & (before == 0)
-        if not open_.any():
+        open_ = np.flatnonzero(region & (grown == 0))
+        if open_.size == 0:
             break
-        for pixel, neighbour in _SHIFTS:
-            value = before[neighbour]
-            take = open_[pixel] & (value > 0) & ~depth_jump(depth[pixel], depth[neighbour], absolute, relative)
-            target = grown[pixel]
-            target[take & (target == 0)] = value[take & (target == 0)]
+        before = flat.copy()
+        row, col = open_ // cols, open_ % cols
+        open_depth = flat_depth[open_]
+        waiting = np.ones(open_.size, dtype=bool)
+        for step_row, step_col in _NEIGHBOURS:
+            beside_row, beside_col = row + step_row, col + step_col
+            inside = waiting & (beside_row >= 0) & (beside_row < rows) & (beside_col >= 0) & (beside_col < cols)
+            beside = np.where(inside, beside_row * cols + beside_col, 0)
+            value = before[beside]
+            take = inside & (value > 0) & ~depth_jump(open_depth, flat_depth[beside], absolute, relative)
+            flat[open_[take]] = value[take]
+            waiting &= ~take
     return grown
 
 
@@ -159,35 +183,36 @@ def footprint_overlap(first: np.ndarray, second: np.ndarray, cell: float) -> flo
 
     The raster gives even a degenerate footprint (a wall seen edge-on is a line) an area of one cell width.
     """
-    shared_box = np.minimum(first.max(axis=0), second.max(axis=0)) - np.maximum(first.min(axis=0), second.min(axis=0))
-    if np.any(shared_box < -cell):
+    first_low, first_high = first.min(axis=0), first.max(axis=0)
+    second_low, second_high = second.min(axis=0), second.max(axis=0)
+    if np.any(np.minimum(first_high, second_high) - np.maximum(first_low, second_low) < -cell):
         return 0.0  # the footprints' bounding boxes are apart: nothing to rasterize
-    low = np.minimum(first.min(axis=0), second.min(axis=0))
-    vertices = [np.round((hull - low) / cell).astype(np.int32) for hull in (first, second)]
+    low = np.minimum(first_low, second_low)
     # each polygon on the raster of its own bounding cells; the shared cells where the two rasters overlap
-    corners = [vertex.min(axis=0) for vertex in vertices]
-    rasters = [_filled(vertex, corner) for vertex, corner in zip(vertices, corners, strict=True)]
-    window_low = np.maximum(corners[0], corners[1])
-    window_high = np.minimum(corners[0] + rasters[0].shape[::-1], corners[1] + rasters[1].shape[::-1])
+    boxes, rasters = [], []
+    for hull in (first, second):
+        vertices = np.round((hull - low) / cell).astype(np.int32)
+        box = cv2.boundingRect(vertices)  # x, y, width, height of the cells the vertices span
+        boxes.append(box)
+        rasters.append(_filled(vertices, box))
+    (ax, ay, aw, ah), (bx, by, bw, bh) = boxes
+    x0, y0, x1, y1 = max(ax, bx), max(ay, by), min(ax + aw, bx + bw), min(ay + ah, by + bh)
     shared = 0
-    if np.all(window_high > window_low):
-        windows = [
-            raster[
-                window_low[1] - corner[1] : window_high[1] - corner[1],
-                window_low[0] - corner[0] : window_high[0] - corner[0],
-            ]
-            for raster, corner in zip(rasters, corners, strict=True)
-        ]
-        shared = np.count_nonzero(windows[0] & windows[1])
-    return shared / max(1, min(np.count_nonzero(rasters[0]), np.count_nonzero(rasters[1])))
+    if x1 > x0 and y1 > y0:
+        shared = cv2.countNonZero(
+            cv2.bitwise_and(
+                rasters[0][y0 - ay : y1 - ay, x0 - ax : x1 - ax], rasters[1][y0 - by : y1 - by, x0 - bx : x1 - bx]
+            )
+        )
+    return shared / max(1, min(cv2.countNonZero(rasters[0]), cv2.countNonZero(rasters[1])))
 
 
-def _filled(vertices: np.ndarray, corner: np.ndarray) -> np.ndarray:
-    """The cells a convex polygon with integer ``vertices`` covers, on a raster whose first cell is ``corner``."""
-    local = np.ascontiguousarray(vertices - corner)
-    raster = np.zeros((int(local[:, 1].max()) + 1, int(local[:, 0].max()) + 1), dtype=np.uint8)
-    cv2.fillConvexPoly(raster, local, 1)
-    return raster.view(bool)
+def _filled(vertices: np.ndarray, box: tuple[int, int, int, int]) -> np.ndarray:
+    """The cells (uint8, 1 = covered) a convex polygon with integer ``vertices`` covers, on the raster of its
+    bounding ``box`` ``(x, y, width, height)``."""
+    raster = np.zeros((box[3], box[2]), dtype=np.uint8)
+    cv2.fillConvexPoly(raster, vertices - np.array(box[:2], dtype=np.int32), 1)
+    return raster
 
 
 def join_labels(labels: np.ndarray, pairs: list[tuple[int, int]]) -> np.ndarray:
@@ -309,15 +334,24 @@ def looks_like_inside(near: np.ndarray, far: np.ndarray, tolerance: float, depth
     far_low, far_high = _range(far[:, :2] @ across, 0.05, 0.95)
     if far_low < near_low - margin or far_high > near_high + margin:
         return False
-    if _range(far[:, 2], 0.5, 0.95)[1] > _range(near[:, 2], 0.5, 0.95)[1] + margin:
+    rim = _range(near[:, 2], 0.5, 0.95)[1]
+    far_median, far_top = _range(far[:, 2], 0.5, 0.95)
+    if far_top > rim + margin:
         return False
     near_front, near_middle = _range(near[:, :2] @ along, 0.05, 0.5)
     far_middle, far_back = _range(far[:, :2] @ along, 0.5, 0.95)
     if far_middle <= near_middle or far_back > near_front + depth_ratio * width:
         return False
-    rim = _range(near[:, 2], 0.5, 0.95)[1]
-    far_median, far_top = _range(far[:, 2], 0.5, 0.95)
     return far_top - far_median >= INNER_SPREAD * rim or far_median <= 0.5 * rim
+
+
+def _median(values: np.ndarray) -> np.floating:
+    """``np.median`` of a 1-D array (the same value, NaN when one is NaN) by one partition, without its overhead."""
+    if values.size == 0 or np.isnan(values).any():
+        return np.median(values)
+    low, high = (values.size - 1) // 2, values.size // 2
+    ordered = np.partition(values, (low, high))
+    return (ordered[low] + ordered[high]) / values.dtype.type(2)
 
 
 class _Parts:
@@ -351,7 +385,7 @@ class _Parts:
         """The median depth of the part."""
         if label not in self._depths:
             own = self.own(label)
-            self._depths[label] = float(np.median(self.depth[own[:: max(1, own.size // 500)]]))
+            self._depths[label] = float(_median(self.depth[own[:: max(1, own.size // 500)]]))
         return self._depths[label]
 
 
@@ -383,21 +417,33 @@ def pixel_footprint(points: np.ndarray) -> float:
         ratio = points[..., 0] / points[..., 2]
         steps = np.abs(np.diff(ratio, axis=1))
     steps = steps[np.isfinite(steps) & (steps > 0)]
-    return float(np.median(steps)) if steps.size else 0.0
+    return float(_median(steps)) if steps.size else 0.0
 
 
-def _beside_views(array: np.ndarray, reach: int) -> list[tuple[np.ndarray, np.ndarray]]:
-    """For every horizontal / vertical neighbour pair (as :func:`_neighbour_views`), the values ``reach`` pixels
-    further out on each side: left of the left pixel and right of the right one (above / below for vertical)."""
-    width = [(0, 0)] * array.ndim
-    rows, cols = array.shape[:2]
-    fill = 0 if array.dtype.kind in "iub" else np.nan
-    horizontal = np.pad(array, [(0, 0), (reach, reach), *width[2:]], constant_values=fill)
-    vertical = np.pad(array, [(reach, reach), (0, 0), *width[2:]], constant_values=fill)
-    return [
-        (horizontal[:, : cols - 1], horizontal[:, 2 * reach + 1 :]),
-        (vertical[: rows - 1], vertical[2 * reach + 1 :]),
-    ]
+def _touching_pixels(labels: np.ndarray, reach: int) -> list[tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]]:
+    """For horizontal, then vertical 4-neighbour pairs of different non-zero labels: the flat indices of the first
+    and second pixel (row-major order) and of the pixels ``reach`` further out on each side (left of the left
+    pixel and right of the right one, above / below for vertical pairs; -1 where that lies off the grid)."""
+    rows, cols = labels.shape
+    found = []
+    for down, right in ((0, 1), (1, 0)):
+        l_a, l_b = labels[: rows - down, : cols - right], labels[down:, right:]
+        r, c = np.nonzero((l_a != l_b) & (l_a > 0) & (l_b > 0))
+        first = r * cols + c
+        second = first + (down * cols + right)
+        before_r, before_c = r - reach * down, c - reach * right
+        after_r, after_c = r + (reach + 1) * down, c + (reach + 1) * right
+        before = np.where((before_r >= 0) & (before_c >= 0), before_r * cols + before_c, -1)
+        after = np.where((after_r < rows) & (after_c < cols), after_r * cols + after_c, -1)
+        found.append((first, second, before, after))
+    return found
+
+
+def _gather(flat: np.ndarray, indices: np.ndarray, fill: float) -> np.ndarray:
+    """``flat[indices]`` with ``fill`` where an index is -1 (off the grid)."""
+    values = flat[np.maximum(indices, 0)]
+    values[indices < 0] = fill
+    return values
 
 
 def boundaries(
@@ -414,29 +460,22 @@ def boundaries(
 
     Normals and positions for ``alignment`` and ``convexity`` are taken ``reach`` pixels away from the boundary on
     either side (where those pixels still belong to the two parts), since normals right at a crease are blurred
-    across it.
+    across it. Only the boundary pixels and those beside them are read.
     """
     footprint = pixel_footprint(points)
     keys, jumps, dots, convex, near = [], [], [], [], []
     base = int(labels.max(initial=0)) + 1
-    for (l_a, l_b), (p_a, p_b), (s_la, s_lb), (s_pa, s_pb), (s_na, s_nb) in zip(
-        _neighbour_views(labels),
-        _neighbour_views(points),
-        _beside_views(labels, reach),
-        _beside_views(points, reach),
-        _beside_views(normals, reach),
-        strict=True,
-    ):
-        touching = (l_a != l_b) & (l_a > 0) & (l_b > 0)
-        a, b = l_a[touching].astype(np.int64), l_b[touching].astype(np.int64)
+    flat_labels, flat_points, flat_normals = labels.reshape(-1), points.reshape(-1, 3), normals.reshape(-1, 3)
+    for first, second, before, after in _touching_pixels(labels, reach):
+        a, b = flat_labels[first].astype(np.int64), flat_labels[second].astype(np.int64)
         keys.append(np.minimum(a, b) * base + np.maximum(a, b))
-        pa, pb = p_a[touching], p_b[touching]
+        pa, pb = flat_points[first], flat_points[second]
         jumps.append(depth_jump(pa[:, 2], pb[:, 2], absolute, relative))
         with np.errstate(invalid="ignore"):
             near.append(np.linalg.norm(pa - pb, axis=1) <= close_factor * footprint * np.fmin(pa[:, 2], pb[:, 2]))
-        same = (s_la[touching] == a) & (s_lb[touching] == b)
-        na, nb = s_na[touching], s_nb[touching]
-        offset = s_pa[touching] - s_pb[touching]
+        same = (_gather(flat_labels, before, 0) == a) & (_gather(flat_labels, after, 0) == b)
+        na, nb = _gather(flat_normals, before, np.nan), _gather(flat_normals, after, np.nan)
+        offset = _gather(flat_points, before, np.nan) - _gather(flat_points, after, np.nan)
         with np.errstate(invalid="ignore", divide="ignore"):
             dots.append(np.where(same, np.einsum("ij,ij->i", na, nb), np.nan))
             convex.append(

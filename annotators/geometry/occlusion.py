@@ -26,8 +26,9 @@ from dataclasses import dataclass
 
 import cv2
 import numpy as np
+from scipy import ndimage
 
-from annotators.geometry.grid_segmentation import depth_jump, join_labels, label_groups, touching_pairs
+from annotators.geometry.grid_segmentation import depth_jump, join_labels, touching_pairs
 
 
 @dataclass(frozen=True)
@@ -78,19 +79,19 @@ def join_occluded(
     flat_labels = labels.reshape(-1)
     kernel = np.ones((2 * rules.band + 1, 2 * rules.band + 1), np.uint8)
     wide = np.ones((6 * rules.band + 1, 6 * rules.band + 1), np.uint8)
-    pixels, starts = label_groups(labels)
+    sizes = np.bincount(flat_labels, minlength=count + 1)
+    boxes = ndimage.find_objects(labels, max_label=count)
     measured = np.isfinite(depth.reshape(-1)) & (flat_labels > 0)
     sums = np.bincount(flat_labels[measured], depth.reshape(-1)[measured], minlength=count + 1)
     mean_depth = sums / np.maximum(np.bincount(flat_labels[measured], minlength=count + 1), 1)
     touching: set[tuple[int, int]] | None = None
     joined: list[tuple[int, int]] = []
     for occluder in range(1, count + 1):
-        own = pixels[starts[occluder] : starts[occluder + 1]]
         # what an occluder hides lies farther than it as a whole: at least two such objects or nothing to join
         farther = np.flatnonzero(mean_depth > mean_depth[occluder])
-        if own.size < rules.min_points or farther.size < 2:
+        if sizes[occluder] < rules.min_points or farther.size < 2:
             continue
-        x0, y0, x1, y1 = _box(own, labels.shape[1], labels.shape, 3 * rules.band + 1)
+        x0, y0, x1, y1 = _grown(boxes[occluder - 1], labels.shape, 3 * rules.band + 1)
         window = labels[y0:y1, x0:x1]
         present = np.bincount(window.reshape(-1), minlength=count + 1)[farther] > 0
         if np.count_nonzero(present) < 2:
@@ -99,22 +100,34 @@ def join_occluded(
             touching = _touching(labels)
         if not _some_apart(farther[present].tolist(), touching):
             continue  # the farther objects near it all touch one another: nothing to join
-        near = cv2.dilate(_with_shadow(window == occluder, depth[y0:y1, x0:x1], wide).view(np.uint8), kernel) > 0
+        occluding = window == occluder
+        window_depth = depth[y0:y1, x0:x1]
+        near = cv2.dilate(_with_shadow(occluding, window_depth, wide).view(np.uint8), kernel) > 0
+        # the farther objects with enough pixels near the occluder; two of them must be apart to join anything
+        near_pixels, near_starts = _grouped(near & (window > 0), window, count)
+        band_sizes = np.diff(near_starts)
+        candidates = _apart_from_another(farther[band_sizes[farther] >= rules.min_points].tolist(), touching)
+        if len(candidates) < 2:
+            continue
+        reach = 3 * rules.band
         behind = []
-        for piece in np.intersect1d(np.unique(window[near]), farther).tolist():
-            band = near & (window == piece)
-            if np.count_nonzero(band) < rules.min_points:
-                continue
-            facing = (cv2.dilate(band.view(np.uint8), wide) > 0) & (window == occluder)
+        for piece in candidates:
+            own = near_pixels[near_starts[piece] : near_starts[piece + 1]]
+            rows, cols = own // window.shape[1], own % window.shape[1]
+            # the occluder's pixels within reach of the band, found in the band's box grown by the reach
+            r0, c0 = max(int(rows.min()) - reach, 0), max(int(cols.min()) - reach, 0)
+            r1, c1 = int(rows.max()) + reach + 1, int(cols.max()) + reach + 1
+            band = np.zeros((min(r1, window.shape[0]) - r0, min(c1, window.shape[1]) - c0), dtype=np.uint8)
+            band[rows - r0, cols - c0] = 1
+            facing = (cv2.dilate(band, wide) > 0) & occluding[r0:r1, c0:c1]
             if np.count_nonzero(facing) < rules.min_points:
                 continue
-            piece_depth = _finite_mean(depth[y0:y1, x0:x1][band])
-            occluder_depth = _finite_mean(depth[y0:y1, x0:x1][facing])
+            piece_depth = _finite_mean(window_depth[rows, cols])
+            occluder_depth = _finite_mean(window_depth[r0:r1, c0:c1][facing])
             if not depth_jump(np.float32(piece_depth), np.float32(occluder_depth), absolute, relative):
                 continue
             if piece_depth <= occluder_depth:
                 continue
-            rows, cols = np.nonzero(band)
             flat = (rows + y0) * labels.shape[1] + cols + x0
             xyz = flat_points[flat]
             xyz = xyz[np.isfinite(xyz).all(axis=1)]
@@ -165,15 +178,26 @@ def _with_shadow(occluder: np.ndarray, depth: np.ndarray, reach: np.ndarray) -> 
     return occluder | (touching[parts] & within)
 
 
-def _box(flat: np.ndarray, width: int, shape: tuple[int, int], margin: int) -> tuple[int, int, int, int]:
-    """``(x0, y0, x1, y1)`` (exclusive) of flat pixel indices, grown by ``margin`` and clipped to ``shape``."""
-    rows, cols = flat // width, flat % width
+def _grown(box: tuple[slice, slice], shape: tuple[int, int], margin: int) -> tuple[int, int, int, int]:
+    """``(x0, y0, x1, y1)`` (exclusive) of a ``find_objects`` box, grown by ``margin`` and clipped to ``shape``."""
+    rows, cols = box
     return (
-        max(int(cols.min()) - margin, 0),
-        max(int(rows.min()) - margin, 0),
-        min(int(cols.max()) + 1 + margin, shape[1]),
-        min(int(rows.max()) + 1 + margin, shape[0]),
+        max(cols.start - margin, 0),
+        max(rows.start - margin, 0),
+        min(cols.stop + margin, shape[1]),
+        min(rows.stop + margin, shape[0]),
     )
+
+
+def _grouped(where: np.ndarray, labels: np.ndarray, count: int) -> tuple[np.ndarray, np.ndarray]:
+    """The flat indices of the ``where`` pixels sorted by their label (row-major within one label) and ``starts``
+    so label k owns ``pixels[starts[k]:starts[k + 1]]`` (k = 0..count)."""
+    index = np.flatnonzero(where)
+    values = labels[where]
+    if count < 1 << 16:
+        values = values.astype(np.uint16)  # a stable sort of 16-bit keys is a radix sort: linear time
+    order = np.argsort(values, kind="stable")
+    return index[order], np.searchsorted(values[order], np.arange(count + 2))
 
 
 def _continues(first: _Piece, second: _Piece, normals: np.ndarray, rules: OcclusionRules) -> bool:
@@ -227,6 +251,11 @@ def _same_section(first: _Piece, second: _Piece, on_plane: np.ndarray, rules: Oc
 def _some_apart(labels: list[int], touching: set[tuple[int, int]]) -> bool:
     """Are two of the (increasing) ``labels`` not touching each other?"""
     return any((a, b) not in touching for index, a in enumerate(labels) for b in labels[index + 1 :])
+
+
+def _apart_from_another(labels: list[int], touching: set[tuple[int, int]]) -> list[int]:
+    """The (increasing) ``labels`` that do not touch at least one of the others: only those can be joined."""
+    return [a for a in labels if any((min(a, b), max(a, b)) not in touching for b in labels if b != a)]
 
 
 def _touching(labels: np.ndarray) -> set[tuple[int, int]]:
