@@ -437,19 +437,15 @@ class _Assignment:
         units = self.units
         if self._order is None:
             self._order = sorted(units, key=lambda k: (rounds.get(k, 0), k))
-        if by_rounds:
-            for key in self._order:
-                unit = units[key]
-                latest = unit.latest_round
-                for type_name in unit.guaranteed_sorted:
-                    # a by-product made from later types could close a cycle in the strict mode
-                    if type_name not in found and latest < rounds.get(type_name, 0):
-                        found[type_name] = key
-        else:
-            for key in self._order:
-                for type_name in units[key].guaranteed_sorted:
-                    if type_name not in found:
-                        found[type_name] = key
+        for key in self._order:
+            unit = units[key]
+            latest = unit.latest_round
+            for type_name in unit.guaranteed_sorted:
+                if type_name in found:
+                    continue
+                if by_rounds and latest >= rounds.get(type_name, 0):
+                    continue  # a by-product made from later types could close a cycle in the strict mode
+                found[type_name] = key
         for type_name, key in self.pinned.items():
             if key in self.units and type_name in self.units[key].guaranteed():
                 found[type_name] = key
@@ -591,32 +587,7 @@ class _Assignment:
         return False
 
     def _assign(self) -> None:
-        """Give every needed type a unit, until every required input of every chosen provider is guaranteed.
-
-        Choosing a unit's providers again (when its own unit leads back to a consumer) can take a by-product from
-        a unit that others already read: the needs left without a unit are queued again, a few times at most.
-        """
         queue: deque[tuple[str, str | None]] = deque((r.annotation_type, None) for r in self.requirements)
-        for _ in range(_UNMET_ROUNDS):
-            self._assign_queue(queue)
-            queue.extend(self._unmet())
-            if not queue:
-                return
-        raise _OrderingError("the chosen alternatives keep leaving inputs without a unit")
-
-    def _unmet(self) -> list[tuple[str, str]]:
-        """(type, consumer unit) for the required inputs of chosen providers that no unit guarantees."""
-        guaranteed = self.guaranteed_by()
-        sensors = self.catalog.sensors
-        return [
-            (needed, key)
-            for key, unit in self.units.items()
-            for spec in unit.providers
-            for needed in spec.inputs
-            if needed not in guaranteed and needed not in sensors
-        ]
-
-    def _assign_queue(self, queue: deque[tuple[str, str | None]]) -> None:
         sensors, units = self.catalog.sensors, self.units
         while queue:
             type_name, consumer = queue.popleft()
@@ -655,9 +626,7 @@ class _Assignment:
             free = [s for s in valid if s.name not in owner]
             if not free:
                 if not self._take_over(type_name, valid, consumer, above):
-                    # the greedy mode's error is never shown (the strict mode runs next): it names no excluded providers
-                    why = self.catalog.why_not(type_name, value) if self.by_rounds else "its providers are taken"
-                    raise _OrderingError(f"cannot produce {type_name}: {why}")
+                    raise _OrderingError(f"cannot produce {type_name}: {self.catalog.why_not(type_name, value)}")
                 continue
             self.units[type_name] = _UnitChoice(type_name, free, value, self.catalog)
             self._order = None
@@ -696,22 +665,11 @@ class _Assignment:
             self._invalidate()
 
 
-_UNMET_ROUNDS = 4  # passes of the assignment over needs left without a unit before the strict mode is asked
-
-
 def _units_of(types: tuple[str, ...], guaranteed: Mapping[str, str]) -> tuple[str, ...]:
     """The units (sorted, each once) that guarantee ``types`` by ``guaranteed``."""
-    count = len(types)
-    if count == 1:
+    if len(types) == 1:
         key = guaranteed.get(types[0])
         return () if key is None else (key,)
-    if count == 2:
-        first, second = guaranteed.get(types[0]), guaranteed.get(types[1])
-        if first is None or first == second:
-            return () if second is None else (second,)
-        if second is None:
-            return (first,)
-        return (first, second) if first < second else (second, first)
     return tuple(sorted({guaranteed[t] for t in types if t in guaranteed}))
 
 
@@ -761,7 +719,6 @@ class _Layout:
         self.source = source
         self.parameters = parameters
         self._labels: dict[str, str] = {}
-        self._branch_members: dict[tuple[str, str], list[AnnotatorSpec]] = {}
         self.branches = self._branches()
         absorbed = {t for owned in self.branches.values() for types in owned.values() for t in types}
         self.final: dict[str, str] = dict.fromkeys(catalog.sensors, "reader")
@@ -870,12 +827,8 @@ class _Layout:
 
     def _members(self, type_name: str, spec: AnnotatorSpec) -> list[AnnotatorSpec]:
         """The annotators of one branch: absorbed providers in dependency order, then the alternative."""
-        found = self._branch_members.get((type_name, spec.name))
-        if found is None:
-            owned = self.branches.get(type_name, {}).get(spec.name, [])
-            found = [self.units[t].providers[0] for t in _topological(owned, self.units)] + [spec]
-            self._branch_members[(type_name, spec.name)] = found
-        return found
+        owned = self.branches.get(type_name, {}).get(spec.name, [])
+        return [self.units[t].providers[0] for t in _topological(owned, self.units)] + [spec]
 
     def _branches(self) -> dict[str, dict[str, list[str]]]:
         """For each unit with alternatives: the units only one alternative needs, moved into its branch.
@@ -1049,20 +1002,17 @@ class _Layout:
 
 def _topological(keys: list[str], units: Mapping[str, _UnitChoice]) -> list[str]:
     """Order units so that each comes after the units of the same list whose types it needs."""
-    if len(keys) < 2:
-        return list(keys)
-    needs = {key: frozenset(units[key].providers[0].inputs) for key in keys}
     ordered: list[str] = []
-    remaining = sorted(keys)
+    remaining = list(keys)
     while remaining:
-        for key in remaining:
-            wanted = needs[key]
-            if all(other == key or wanted.isdisjoint(units[other].guaranteed()) for other in remaining):
+        for key in sorted(remaining):
+            needs = set(units[key].providers[0].inputs)
+            if not any(units[other].guaranteed() & needs for other in remaining if other != key):
                 ordered.append(key)
                 remaining.remove(key)
                 break
         else:
-            ordered.extend(remaining)
+            ordered.extend(sorted(remaining))
             break
     return ordered
 
