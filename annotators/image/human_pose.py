@@ -26,7 +26,7 @@ import numpy as np
 
 from annotators.cloud.people import HUMAN, IMAGE_UP, PeopleParameters, PersonSegment, find_people, ground_plane
 from annotators.cloud.plane import plane_distances, up_in_camera
-from annotators.people.body_points import body_mask, centroid
+from annotators.people.body_points import body_mask, centroid, support_surfaces
 from robokudo.core.annotator import Annotator
 from robokudo.core.capability import Capability
 from robokudo.core.resources import Guarded
@@ -272,6 +272,11 @@ class HumanPoseDetector(Annotator):
     predict). The full search (the depth candidates, each through the single-image model) runs on the first
     frame, when a followed person is not found again, when the sequence breaks (another recording, time going
     back or a gap over ``max_gap`` seconds) and every ``search_every`` frames, so people who walk in are found.
+
+    With ``follow_target`` (a continuous track of a person: its tracker follows one person) only the target is
+    followed between searches, so a frame costs one model run however many people are in view: the target is the
+    most confident person of the first search (the one a tracker locks onto) and, after a later search, the person
+    nearest to where the target was expected (the one a tracker associates). A search still reports everyone.
     """
 
     inputs: ClassVar[tuple[type[CasType], ...]] = (ColorImage,)
@@ -297,6 +302,8 @@ class HumanPoseDetector(Annotator):
         search_every: int = 30,
         max_gap: float = 5.0,
         top_speed: float = 2.5,
+        follow_target: bool = False,
+        support_clearance: float = 0.15,
         name: str | None = None,
     ) -> None:
         super().__init__(name=name)
@@ -304,7 +311,7 @@ class HumanPoseDetector(Annotator):
             raise ValueError(f"search_every must be a whole number >= 1, not {search_every!r}")
         numbers = (
             ("follow_margin", follow_margin), ("follow_reach", follow_reach), ("max_gap", max_gap),
-            ("top_speed", top_speed),
+            ("top_speed", top_speed), ("support_clearance", support_clearance),
         )  # fmt: skip
         for label, value in numbers:
             if not np.isfinite(value) or value < 0:
@@ -325,6 +332,11 @@ class HumanPoseDetector(Annotator):
         self.top_speed = top_speed
         """The fastest a person moves (m/s): a faster step between two frames is a jump of the detection, and the
         prediction of where the person is next does not use it."""
+        self.support_clearance = support_clearance
+        """How far (m) below the shoulders a surface facing up must lie to be a support (a table, the floor) and
+        not the person (the top of the shoulders and head face up too)."""
+        self.follow_target = bool(follow_target)
+        """Whether only the target (see the class) is followed between searches, not everyone seen."""
         self.searches = 0
         """How many frames had the full search (the others followed the people of the previous frame)."""
         self._followed: list[_Followed] = []
@@ -337,6 +349,8 @@ class HumanPoseDetector(Annotator):
         self._gap = 0.0
         """Seconds between the previous frame and this one (0 when unknown)."""
         self._since_search = 0
+        self._unbroken = False
+        """Whether this frame continues the previous one's sequence (the same recording, a gap up to ``max_gap``)."""
 
     def model(self) -> Guarded[Any]:
         """The pose model, loaded on first use and shared through this annotator's resources."""
@@ -363,7 +377,7 @@ class HumanPoseDetector(Annotator):
         self._since_search = 0
         self.searches += 1
         people, standing = self._search(model, image, points, cloud)
-        self._remember(people, standing)
+        self._remember(self._target(people, image.shape[:2]) if self.follow_target else people, standing)
         for person in people:
             self.write(person)
 
@@ -393,9 +407,10 @@ class HumanPoseDetector(Annotator):
         key = ("", "", 0.0) if info is None else (info.recording, info.frame_id, float(info.timestamp))
         previous, self._sequence = self._sequence, key
         self._gap = key[2] - previous[2] if previous is not None and key[2] > 0 and previous[2] > 0 else 0.0
-        if previous is None or info is None or key[2] <= 0 or self._since_search + 1 >= self.search_every:
-            return False
-        return previous[:2] == key[:2] and 0 < key[2] - previous[2] <= self.max_gap
+        self._unbroken = (
+            previous is not None and info is not None and previous[:2] == key[:2] and 0 < self._gap <= self.max_gap
+        )
+        return self._unbroken and self._since_search + 1 < self.search_every
 
     def _follow(self, image: np.ndarray, points: np.ndarray | None) -> list[PersonHypothesis] | None:
         """Each followed person in a crop around its predicted box (its previous box moved on as it moved between
@@ -465,6 +480,19 @@ class HumanPoseDetector(Annotator):
                 keep &= np.einsum("...i,...i->...", across, across) < reach * reach
         return keep
 
+    def _target(self, people: list[PersonHypothesis], shape: tuple[int, int]) -> list[PersonHypothesis]:
+        """The one person of a search to follow: the one nearest to where the followed target was expected (by
+        its 3-D position) when there was a target, else the most confident one (the first of equals)."""
+        if len(people) <= 1:
+            return people
+        expected = self._followed[0].predicted(self._gap, shape)[1] if self._followed and self._unbroken else None
+        if expected is not None:
+            positions = [_position(p) for p in people]
+            placed = [(float(np.linalg.norm(p - expected)), i) for i, p in enumerate(positions) if p is not None]
+            if placed:
+                return [people[min(placed)[1]]]
+        return [max(people, key=lambda p: (_position(p) is not None, p.confidence))]
+
     def _remember(self, people: list[PersonHypothesis], standing: bool) -> None:
         """Follow these people from the next frame on, each with a video-mode model of this node (``standing``:
         they were found as depth candidates standing on the ground, and are looked for there)."""
@@ -501,6 +529,19 @@ class HumanPoseDetector(Annotator):
                     continue  # the skeleton does not lie on the candidate's points: something else was seen
             found.append(self._person(pixels, visibility, xyz, candidate, points, allowed))
         return found
+
+    def _support_below_shoulders(self, points: np.ndarray, region: np.ndarray, xyz: np.ndarray) -> np.ndarray:
+        """The pixels of ``region`` on surfaces facing up lower than ``support_clearance`` below the person's
+        shoulders (a table she stands at, the floor): not the person, and cut so that depth does not join what
+        stands on them (nothing when the shoulders have no depth)."""
+        shoulders = xyz[[LANDMARKS.index("left_shoulder"), LANDMARKS.index("right_shoulder")]]
+        shoulders = shoulders[np.isfinite(shoulders).all(axis=1)]
+        if shoulders.shape[0] == 0:
+            return np.zeros(region.shape, dtype=bool)
+        up = up_in_camera(self.optional_view(CameraInfo))
+        up = IMAGE_UP if up is None else up
+        below = float(np.min(shoulders @ up)) - self.support_clearance
+        return support_surfaces(points, region, up, below)
 
     def _near_bones(self, points: np.ndarray, body: np.ndarray, xyz: np.ndarray) -> np.ndarray:
         """The body pixels within ``body_reach`` of the skeleton's bones (or the torso): what touches the person
@@ -540,6 +581,7 @@ class HumanPoseDetector(Annotator):
         mask = region
         position = None
         if points is not None and xyz is not None:
+            region = region & ~self._support_below_shoulders(points, region, xyz)
             body = body_mask(points, region, pixels, _unoccluded(xyz))
             if body is not None and body.any():
                 body = self._near_bones(points, body, xyz)
