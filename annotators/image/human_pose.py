@@ -160,8 +160,8 @@ def _unoccluded(keypoints: np.ndarray, body_depth: float = 0.3, arm_reach: float
 def near_skeleton(points: np.ndarray, keypoints: np.ndarray, reach: float) -> np.ndarray | None:
     """Which of the Nx3 ``points`` lie within ``reach`` of a bone between keypoints with depth (33x3); the torso
     (between the shoulders and the hips) counts too. None when no bone has depth at both ends."""
-    keypoints = _unoccluded(keypoints)
-    cloud = np.asarray(points, dtype=np.float64)
+    keypoints = _unoccluded(keypoints).astype(np.float32)  # centimetres matter, not more: single precision
+    cloud = np.asarray(points, dtype=np.float32)
     near = np.zeros(cloud.shape[0], dtype=bool)
     open_ = np.flatnonzero(np.isfinite(cloud[:, 2]))  # the valid points not found near yet (each bone tests only these)
     corners = keypoints[list(TORSO)]
@@ -183,7 +183,7 @@ def near_skeleton(points: np.ndarray, keypoints: np.ndarray, reach: float) -> np
         ab = b - a
         length = float(ab @ ab)
         offset = cloud[open_] - a
-        t = np.zeros(open_.size) if length < 1e-12 else np.clip(offset @ ab / length, 0.0, 1.0)
+        t = np.zeros(open_.size, np.float32) if length < 1e-12 else np.clip(offset @ ab / np.float32(length), 0, 1)
         offset -= t[:, None] * ab
         limit = reach + (first == "nose") * 0.05
         inside = np.einsum("ij,ij->i", offset, offset) < limit * limit

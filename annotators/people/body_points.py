@@ -159,6 +159,10 @@ def support_surfaces(
 
 def centroid(points: np.ndarray, mask: np.ndarray) -> np.ndarray | None:
     """The mean of the valid points under ``mask`` (the person's position, see the module), or None."""
-    chosen = points[mask]
+    box = _bounding_box(mask)
+    if box is None:
+        return None
+    top, left, bottom, right = box
+    chosen = points[top:bottom, left:right][mask[top:bottom, left:right]]
     chosen = chosen[np.isfinite(chosen[:, 2])]
     return chosen.mean(axis=0, dtype=np.float64) if chosen.shape[0] else None
