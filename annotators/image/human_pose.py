@@ -274,9 +274,10 @@ class HumanPoseDetector(Annotator):
     back or a gap over ``max_gap`` seconds) and every ``search_every`` frames, so people who walk in are found.
 
     With ``follow_target`` (a continuous track of a person: its tracker follows one person) only the target is
-    followed between searches, so a frame costs one model run however many people are in view: the target is the
-    most confident person of the first search (the one a tracker locks onto) and, after a later search, the person
-    nearest to where the target was expected (the one a tracker associates). A search still reports everyone.
+    followed between searches (which then run every ``target_search_every`` frames), so a frame costs one model run
+    however many people are in view: the target is the most confident person of the first search (the one a
+    tracker locks onto) and, after a later search, the person nearest to where the target was expected (the one a
+    tracker associates). A search still reports everyone.
     """
 
     inputs: ClassVar[tuple[type[CasType], ...]] = (ColorImage,)
@@ -303,12 +304,14 @@ class HumanPoseDetector(Annotator):
         max_gap: float = 5.0,
         top_speed: float = 2.5,
         follow_target: bool = False,
+        target_search_every: int = 90,
         support_clearance: float = 0.15,
         name: str | None = None,
     ) -> None:
         super().__init__(name=name)
-        if isinstance(search_every, bool) or not isinstance(search_every, int) or search_every < 1:
-            raise ValueError(f"search_every must be a whole number >= 1, not {search_every!r}")
+        for label, count in (("search_every", search_every), ("target_search_every", target_search_every)):
+            if isinstance(count, bool) or not isinstance(count, int) or count < 1:
+                raise ValueError(f"{label} must be a whole number >= 1, not {count!r}")
         numbers = (
             ("follow_margin", follow_margin), ("follow_reach", follow_reach), ("max_gap", max_gap),
             ("top_speed", top_speed), ("support_clearance", support_clearance),
@@ -337,6 +340,10 @@ class HumanPoseDetector(Annotator):
         not the person (the top of the shoulders and head face up too)."""
         self.follow_target = bool(follow_target)
         """Whether only the target (see the class) is followed between searches, not everyone seen."""
+        self.target_search_every = target_search_every
+        """Every how many frames the full search runs while only the target is followed (``search_every`` when
+        everyone is): rarer, as people walking in do not matter to a track of one person and a follow that loses
+        the target or finds it more than a step away searches at once."""
         self.searches = 0
         """How many frames had the full search (the others followed the people of the previous frame)."""
         self._followed: list[_Followed] = []
@@ -410,7 +417,8 @@ class HumanPoseDetector(Annotator):
         self._unbroken = (
             previous is not None and info is not None and previous[:2] == key[:2] and 0 < self._gap <= self.max_gap
         )
-        return self._unbroken and self._since_search + 1 < self.search_every
+        every = self.target_search_every if self.follow_target else self.search_every
+        return self._unbroken and self._since_search + 1 < every
 
     def _follow(self, image: np.ndarray, points: np.ndarray | None) -> list[PersonHypothesis] | None:
         """Each followed person in a crop around its predicted box (its previous box moved on as it moved between

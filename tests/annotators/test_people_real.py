@@ -200,7 +200,7 @@ def test_following_only_the_target_runs_the_model_once_a_frame_on_the_most_confi
         return detect(model, image)
 
     monkeypatch.setattr(human_pose, "detect_landmarks", counted)
-    detector = HumanPoseDetector(follow_target=True, search_every=4)
+    detector = HumanPoseDetector(follow_target=True, target_search_every=4)
     reader = PcdReader(five_people)
     root = Pipeline("people", [reader, Restamp(), detector])
     engine = Engine(root)
