@@ -6,10 +6,12 @@ table (frames rendered before the run, so rendering is not timed) and the real f
 frame reader, point cloud, range filter, the people detectors' Fallback (HumanPoseDetector first), HumanTracker,
 answer step - on every new frame, and then, side by side in the same run, the same experts are called bare: a
 plain Pipeline of fresh instances on the same frames, ticked directly (no service, loop, answer step or engine
-rate). Printed per scene: the loop's runs per second (answers per second), the bare chain's frames per second,
-per-expert milliseconds (median, p90) in the loop and bare, and whether the goal of the issue, >= 15 Hz with
-pose detection in the loop, is met. ``--profile`` adds the top functions of the loop's ticks (cProfile in the
-engine thread, answer step included; ``--profile-out`` writes them to a file).
+rate), built with the plan's parameters (the pose detector follows only the tracked person between searches); as
+a reference the same bare chain with the pose detector following everyone it sees (``follow_target`` off, the
+behaviour before). Printed per scene: the loop's runs per second (answers per second), the bare chain's and the
+reference's frames per second, per-expert milliseconds (median, p90) in the loop and bare, and whether the goal of
+the issue, >= 15 Hz with pose detection in the loop, is met. ``--profile`` adds the top functions of the loop's
+ticks (cProfile in the engine thread, answer step included; ``--profile-out`` writes them to a file).
 
 Run: ``.venv/bin/python bench/bench_track.py [--seconds S] [--profile] [--profile-out FILE]``
 """
@@ -50,6 +52,7 @@ BARE = ("PointCloudGenerator", "RangeFilter", "HumanPoseDetector", "HumanTracker
 """The experts of the planned track tree called bare (the reader is the stream's)."""
 
 Table = dict[str, list[float]]
+Arguments = dict[str, dict[str, object]]
 
 
 def kitchen_walk(frames: int = 30) -> Callable[[], Iterator[tuple[Frame, str]]]:
@@ -84,14 +87,18 @@ def _profiled(tick: Callable[[], object], profile: cProfile.Profile) -> Callable
     return run
 
 
-def loop_run(stream: FrameStream, seconds: float, profile: cProfile.Profile | None = None) -> tuple[float, Table, int]:
-    """Answers per second of the served track loop after a warm-up, per-expert ms and answers that saw the person;
-    with ``profile`` the engine's ticks after the warm-up are profiled (answer step included)."""
+def loop_run(
+    stream: FrameStream, seconds: float, profile: cProfile.Profile | None = None
+) -> tuple[float, Table, int, Arguments]:
+    """Answers per second of the served track loop after a warm-up, per-expert ms, answers that saw the person and
+    the plan's constructor arguments per expert; with ``profile`` the engine's ticks after the warm-up are profiled
+    (answer step included)."""
     with (
         tempfile.TemporaryDirectory() as folder,
         AnsweringService.open(Path(folder) / "b.sqlite", hz=60, stream=stream, lost_after=30.0) as service,
     ):
         handle = service.start(QUERY)
+        arguments: Arguments = {step.annotator: dict(step.parameters) for step in handle.plan.plan.steps()}
         for _ in range(3):  # warm-up: model loading, first frames
             if handle.next_answer(timeout=180) is None:
                 raise SystemExit(f"no answer: {handle.reason}")
@@ -117,13 +124,16 @@ def loop_run(stream: FrameStream, seconds: float, profile: cProfile.Profile | No
             handle.cancel()
         except TimeoutError as error:  # a long tick (the full search on a busy machine); closing stops the engine
             print(f"  (cancel: {error})")
-    return answers / elapsed, durations, seen
+    return answers / elapsed, durations, seen, arguments
 
 
-def bare_run(stream: FrameStream, seconds: float, profile: cProfile.Profile | None) -> tuple[float, Table]:
-    """Frames per second of the same experts in a plain Pipeline ticked directly, and their per-expert ms."""
+def bare_run(
+    stream: FrameStream, seconds: float, profile: cProfile.Profile | None, arguments: Arguments
+) -> tuple[float, Table]:
+    """Frames per second of the same experts (built with ``arguments`` per expert) in a plain Pipeline ticked
+    directly, and their per-expert ms."""
     catalog = AnnotatorCatalog.discover()
-    experts = [catalog[name](name=name) for name in BARE]
+    experts = [catalog[name](name=name, **arguments.get(name, {})) for name in BARE]
     root = Pipeline("bare", [StreamReader(stream, wait=False, name="read frame"), *experts])
     engine = Engine(root)
     for _ in range(3):
@@ -174,9 +184,18 @@ def main() -> None:
     profiles: list[str] = []
     for label, make in scenes:
         profile = cProfile.Profile() if args.profile else None
-        rate, loop, seen = loop_run(make(), args.seconds, profile)
-        bare_rate, bare = bare_run(make(), args.seconds, None)
+        rate, loop, seen, arguments = loop_run(make(), args.seconds, profile)
+        bare_rate, bare = bare_run(make(), args.seconds, None, arguments)
+        everyone = {
+            name: {**values, "follow_target": False} for name, values in arguments.items() if "follow_target" in values
+        }
+        reference_rate, _ = bare_run(make(), args.seconds, None, {**arguments, **everyone}) if everyone else (0.0, {})
         print(f"\n{label}: loop {rate:.1f} runs/s (the person seen in {seen} answers); bare experts {bare_rate:.1f}/s")
+        if everyone:
+            ratio = bare_rate / reference_rate if reference_rate else float("inf")
+            print(
+                f"  reference, bare experts following everyone seen: {reference_rate:.1f}/s (target only: {ratio:.2f}x)"
+            )
         print(f"  {'expert':26s} {'loop median':>9s} {'p90':>9s}   {'bare median':>9s} {'p90':>9s}   (ms)")
         names = sorted(set(loop) | set(bare), key=lambda n: -statistics.median(loop.get(n) or bare.get(n) or [0.0]))
         for name in names:

@@ -26,7 +26,7 @@ import numpy as np
 
 from annotators.cloud.people import HUMAN, IMAGE_UP, PeopleParameters, PersonSegment, find_people, ground_plane
 from annotators.cloud.plane import plane_distances, up_in_camera
-from annotators.people.body_points import body_mask, centroid
+from annotators.people.body_points import body_mask, centroid, support_surfaces
 from robokudo.core.annotator import Annotator
 from robokudo.core.capability import Capability
 from robokudo.core.resources import Guarded
@@ -160,8 +160,8 @@ def _unoccluded(keypoints: np.ndarray, body_depth: float = 0.3, arm_reach: float
 def near_skeleton(points: np.ndarray, keypoints: np.ndarray, reach: float) -> np.ndarray | None:
     """Which of the Nx3 ``points`` lie within ``reach`` of a bone between keypoints with depth (33x3); the torso
     (between the shoulders and the hips) counts too. None when no bone has depth at both ends."""
-    keypoints = _unoccluded(keypoints)
-    cloud = np.asarray(points, dtype=np.float64)
+    keypoints = _unoccluded(keypoints).astype(np.float32)  # centimetres matter, not more: single precision
+    cloud = np.asarray(points, dtype=np.float32)
     near = np.zeros(cloud.shape[0], dtype=bool)
     open_ = np.flatnonzero(np.isfinite(cloud[:, 2]))  # the valid points not found near yet (each bone tests only these)
     corners = keypoints[list(TORSO)]
@@ -183,7 +183,7 @@ def near_skeleton(points: np.ndarray, keypoints: np.ndarray, reach: float) -> np
         ab = b - a
         length = float(ab @ ab)
         offset = cloud[open_] - a
-        t = np.zeros(open_.size) if length < 1e-12 else np.clip(offset @ ab / length, 0.0, 1.0)
+        t = np.zeros(open_.size, np.float32) if length < 1e-12 else np.clip(offset @ ab / np.float32(length), 0, 1)
         offset -= t[:, None] * ab
         limit = reach + (first == "nose") * 0.05
         inside = np.einsum("ij,ij->i", offset, offset) < limit * limit
@@ -272,6 +272,12 @@ class HumanPoseDetector(Annotator):
     predict). The full search (the depth candidates, each through the single-image model) runs on the first
     frame, when a followed person is not found again, when the sequence breaks (another recording, time going
     back or a gap over ``max_gap`` seconds) and every ``search_every`` frames, so people who walk in are found.
+
+    With ``follow_target`` (a continuous track of a person: its tracker follows one person) only the target is
+    followed between searches (which then run every ``target_search_every`` frames), so a frame costs one model run
+    however many people are in view: the target is the most confident person of the first search (the one a
+    tracker locks onto) and, after a later search, the person nearest to where the target was expected (the one a
+    tracker associates). A search still reports everyone.
     """
 
     inputs: ClassVar[tuple[type[CasType], ...]] = (ColorImage,)
@@ -297,14 +303,18 @@ class HumanPoseDetector(Annotator):
         search_every: int = 30,
         max_gap: float = 5.0,
         top_speed: float = 2.5,
+        follow_target: bool = False,
+        target_search_every: int = 90,
+        support_clearance: float = 0.15,
         name: str | None = None,
     ) -> None:
         super().__init__(name=name)
-        if isinstance(search_every, bool) or not isinstance(search_every, int) or search_every < 1:
-            raise ValueError(f"search_every must be a whole number >= 1, not {search_every!r}")
+        for label, count in (("search_every", search_every), ("target_search_every", target_search_every)):
+            if isinstance(count, bool) or not isinstance(count, int) or count < 1:
+                raise ValueError(f"{label} must be a whole number >= 1, not {count!r}")
         numbers = (
             ("follow_margin", follow_margin), ("follow_reach", follow_reach), ("max_gap", max_gap),
-            ("top_speed", top_speed),
+            ("top_speed", top_speed), ("support_clearance", support_clearance),
         )  # fmt: skip
         for label, value in numbers:
             if not np.isfinite(value) or value < 0:
@@ -325,6 +335,15 @@ class HumanPoseDetector(Annotator):
         self.top_speed = top_speed
         """The fastest a person moves (m/s): a faster step between two frames is a jump of the detection, and the
         prediction of where the person is next does not use it."""
+        self.support_clearance = support_clearance
+        """How far (m) below the shoulders a surface facing up must lie to be a support (a table, the floor) and
+        not the person (the top of the shoulders and head face up too)."""
+        self.follow_target = bool(follow_target)
+        """Whether only the target (see the class) is followed between searches, not everyone seen."""
+        self.target_search_every = target_search_every
+        """Every how many frames the full search runs while only the target is followed (``search_every`` when
+        everyone is): rarer, as people walking in do not matter to a track of one person and a follow that loses
+        the target or finds it more than a step away searches at once."""
         self.searches = 0
         """How many frames had the full search (the others followed the people of the previous frame)."""
         self._followed: list[_Followed] = []
@@ -337,6 +356,8 @@ class HumanPoseDetector(Annotator):
         self._gap = 0.0
         """Seconds between the previous frame and this one (0 when unknown)."""
         self._since_search = 0
+        self._unbroken = False
+        """Whether this frame continues the previous one's sequence (the same recording, a gap up to ``max_gap``)."""
 
     def model(self) -> Guarded[Any]:
         """The pose model, loaded on first use and shared through this annotator's resources."""
@@ -363,7 +384,7 @@ class HumanPoseDetector(Annotator):
         self._since_search = 0
         self.searches += 1
         people, standing = self._search(model, image, points, cloud)
-        self._remember(people, standing)
+        self._remember(self._target(people, image.shape[:2]) if self.follow_target else people, standing)
         for person in people:
             self.write(person)
 
@@ -393,9 +414,11 @@ class HumanPoseDetector(Annotator):
         key = ("", "", 0.0) if info is None else (info.recording, info.frame_id, float(info.timestamp))
         previous, self._sequence = self._sequence, key
         self._gap = key[2] - previous[2] if previous is not None and key[2] > 0 and previous[2] > 0 else 0.0
-        if previous is None or info is None or key[2] <= 0 or self._since_search + 1 >= self.search_every:
-            return False
-        return previous[:2] == key[:2] and 0 < key[2] - previous[2] <= self.max_gap
+        self._unbroken = (
+            previous is not None and info is not None and previous[:2] == key[:2] and 0 < self._gap <= self.max_gap
+        )
+        every = self.target_search_every if self.follow_target else self.search_every
+        return self._unbroken and self._since_search + 1 < every
 
     def _follow(self, image: np.ndarray, points: np.ndarray | None) -> list[PersonHypothesis] | None:
         """Each followed person in a crop around its predicted box (its previous box moved on as it moved between
@@ -465,6 +488,19 @@ class HumanPoseDetector(Annotator):
                 keep &= np.einsum("...i,...i->...", across, across) < reach * reach
         return keep
 
+    def _target(self, people: list[PersonHypothesis], shape: tuple[int, int]) -> list[PersonHypothesis]:
+        """The one person of a search to follow: the one nearest to where the followed target was expected (by
+        its 3-D position) when there was a target, else the most confident one (the first of equals)."""
+        if len(people) <= 1:
+            return people
+        expected = self._followed[0].predicted(self._gap, shape)[1] if self._followed and self._unbroken else None
+        if expected is not None:
+            positions = [_position(p) for p in people]
+            placed = [(float(np.linalg.norm(p - expected)), i) for i, p in enumerate(positions) if p is not None]
+            if placed:
+                return [people[min(placed)[1]]]
+        return [max(people, key=lambda p: (_position(p) is not None, p.confidence))]
+
     def _remember(self, people: list[PersonHypothesis], standing: bool) -> None:
         """Follow these people from the next frame on, each with a video-mode model of this node (``standing``:
         they were found as depth candidates standing on the ground, and are looked for there)."""
@@ -501,6 +537,19 @@ class HumanPoseDetector(Annotator):
                     continue  # the skeleton does not lie on the candidate's points: something else was seen
             found.append(self._person(pixels, visibility, xyz, candidate, points, allowed))
         return found
+
+    def _support_below_shoulders(self, points: np.ndarray, region: np.ndarray, xyz: np.ndarray) -> np.ndarray:
+        """The pixels of ``region`` on surfaces facing up lower than ``support_clearance`` below the person's
+        shoulders (a table she stands at, the floor): not the person, and cut so that depth does not join what
+        stands on them (nothing when the shoulders have no depth)."""
+        shoulders = xyz[[LANDMARKS.index("left_shoulder"), LANDMARKS.index("right_shoulder")]]
+        shoulders = shoulders[np.isfinite(shoulders).all(axis=1)]
+        if shoulders.shape[0] == 0:
+            return np.zeros(region.shape, dtype=bool)
+        up = up_in_camera(self.optional_view(CameraInfo))
+        up = IMAGE_UP if up is None else up
+        below = float(np.min(shoulders @ up)) - self.support_clearance
+        return support_surfaces(points, region, up, below)
 
     def _near_bones(self, points: np.ndarray, body: np.ndarray, xyz: np.ndarray) -> np.ndarray:
         """The body pixels within ``body_reach`` of the skeleton's bones (or the torso): what touches the person
@@ -540,6 +589,7 @@ class HumanPoseDetector(Annotator):
         mask = region
         position = None
         if points is not None and xyz is not None:
+            region = region & ~self._support_below_shoulders(points, region, xyz)
             body = body_mask(points, region, pixels, _unoccluded(xyz))
             if body is not None and body.any():
                 body = self._near_bones(points, body, xyz)

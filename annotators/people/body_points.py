@@ -121,8 +121,48 @@ def _region_mask(
     return np.isin(labels, sorted(seeds))
 
 
+def support_surfaces(
+    points: np.ndarray,
+    allowed: np.ndarray,
+    up: np.ndarray,
+    below: float,
+    max_tilt_degrees: float = 25.0,
+    step: int = 2,
+) -> np.ndarray:
+    """The pixels (HxW bool) within ``allowed`` that lie on a surface facing up (its normal within
+    ``max_tilt_degrees`` of ``up``) lower than ``below`` (a height along ``up``, in the cloud's frame): the top of
+    a table or the floor beside a person, which depth connects to the person where the body meets its far edge.
+    Normals come from the neighbours ``step`` pixels away on either side (NaN where one is missing: not cut)."""
+    cut = np.zeros(allowed.shape, dtype=bool)
+    box = _bounding_box(allowed)
+    if box is None:
+        return cut
+    top, left, bottom, right = box
+    top, left = max(0, top - step), max(0, left - step)
+    bottom, right = min(allowed.shape[0], bottom + step), min(allowed.shape[1], right + step)
+    window = points[top:bottom, left:right].astype(np.float32)
+    if window.shape[0] <= 2 * step or window.shape[1] <= 2 * step:
+        return cut
+    across = window[step:-step, 2 * step :] - window[step:-step, : -2 * step]  # along the rows (u)
+    down = window[2 * step :, step:-step] - window[: -2 * step, step:-step]  # along the columns (v)
+    normal = np.cross(across, down)
+    direction = (up / np.linalg.norm(up)).astype(np.float32)
+    centre = window[step:-step, step:-step]
+    with np.errstate(invalid="ignore"):
+        length = np.linalg.norm(normal, axis=-1)
+        facing = np.abs(normal @ direction) > np.cos(np.radians(max_tilt_degrees)) * length
+        low = centre @ direction < below
+    inner = facing & low & (length > 0)
+    cut[top + step : bottom - step, left + step : right - step] = inner
+    return cut & allowed
+
+
 def centroid(points: np.ndarray, mask: np.ndarray) -> np.ndarray | None:
     """The mean of the valid points under ``mask`` (the person's position, see the module), or None."""
-    chosen = points[mask]
+    box = _bounding_box(mask)
+    if box is None:
+        return None
+    top, left, bottom, right = box
+    chosen = points[top:bottom, left:right][mask[top:bottom, left:right]]
     chosen = chosen[np.isfinite(chosen[:, 2])]
     return chosen.mean(axis=0, dtype=np.float64) if chosen.shape[0] else None

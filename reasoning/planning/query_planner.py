@@ -5,7 +5,7 @@ from __future__ import annotations
 from collections.abc import Iterable
 from dataclasses import dataclass, replace
 
-from queries.model import FREE_SPACE_KEY, Query
+from queries.model import CONTINUOUS_KINDS, FREE_SPACE_KEY, Query
 from reasoning.knowledge.knowledge_base import KnowledgeBase
 from reasoning.knowledge.model import AnnotatorSpec, Conditions
 from reasoning.planning.interpretation import TRACK_TYPE, Interpretation, interpret
@@ -137,6 +137,17 @@ def pointing_parameters(kb: KnowledgeBase, target: str) -> dict[str, dict[str, o
     }
 
 
+KEYPOINT_OUTPUT = "BodyKeypoints"
+
+
+def follow_parameters(kb: KnowledgeBase, task: Task) -> dict[str, dict[str, object]]:
+    """Constructor arguments of the body keypoint detectors in a continuous task: its tracker follows one target,
+    so they follow only that person between frames (``follow_target``) instead of everyone in view."""
+    if task.kind not in CONTINUOUS_KINDS:
+        return {}
+    return {spec.name: {"follow_target": True} for spec in kb.annotators() if KEYPOINT_OUTPUT in spec.outputs}
+
+
 class QueryPlanner:
     """Plans queries against one knowledge base, keeping what only changes with the ontology (class profiles, the
     annotators that take parameters, the trackers).
@@ -184,6 +195,8 @@ class QueryPlanner:
             parameters.setdefault(spec.name, {}).update(target_parameters(self.kb, task))
         if task.pointing is not None:
             parameters.update(pointing_parameters(self.kb, task.pointing))
+        for name, arguments in follow_parameters(self.kb, task).items():
+            parameters.setdefault(name, {}).update(arguments)
         plan = plan_requirements(
             interpretation.task,
             interpretation.requirements,

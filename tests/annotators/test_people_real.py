@@ -17,6 +17,7 @@ import pytest
 from py_trees.common import Status
 
 from annotators.cloud.people import DepthPeopleDetector
+from annotators.image import human_pose
 from annotators.image.human_pose import HumanPoseDetector
 from annotators.readers.frame_readers import PcdReader
 from queries import parse_query
@@ -186,3 +187,43 @@ def test_on_a_sequence_the_people_followed_stay_near_their_points(five_people: P
     # two of these people overlap in the image: following one of them in its crop may find the other, which the
     # step check refuses and the search then settles, so every frame's people stay right
     assert 1 <= detector.searches <= frames
+
+
+def test_following_only_the_target_runs_the_model_once_a_frame_on_the_most_confident_person(
+    five_people: Path, monkeypatch: pytest.MonkeyPatch
+) -> None:
+    calls: list[tuple[int, int]] = []
+    detect = human_pose.detect_landmarks
+
+    def counted(model: object, image: np.ndarray) -> tuple[np.ndarray, np.ndarray] | None:
+        calls.append(image.shape[:2])
+        return detect(model, image)
+
+    monkeypatch.setattr(human_pose, "detect_landmarks", counted)
+    detector = HumanPoseDetector(follow_target=True, target_search_every=4)
+    reader = PcdReader(five_people)
+    root = Pipeline("people", [reader, Restamp(), detector])
+    engine = Engine(root)
+    target: np.ndarray | None = None
+    followed = 0
+    for frame in range(9):
+        searches, before = detector.searches, len(calls)
+        assert engine.tick() is Status.SUCCESS, [(c.name, c.feedback_message) for c in root.children]
+        people = root.cas.annotations(PersonHypothesis)
+        points = reader.last_frame.points
+        for person in people:
+            error = np.linalg.norm(
+                person.first(Pose).position - reference_centroid(points, person.first(BodyKeypoints))
+            )
+            assert error < MAX_POSITION_ERROR, (frame, round(float(error), 3))
+        if detector.searches > searches:  # a search reports everyone; the target is the most confident at first
+            assert 4 <= len(people) <= 5
+            chosen = max(people, key=lambda p: p.confidence) if target is None else None
+            if chosen is not None:
+                target = chosen.first(Pose).position
+            continue
+        followed += 1
+        (person,) = people  # only the target is followed: one person, one model run
+        assert len(calls) - before == 1
+        assert target is not None and np.linalg.norm(person.first(Pose).position - target) < 0.2
+    assert followed >= 4  # the target was followed between the searches (every 4th frame at least)

@@ -60,6 +60,13 @@ def test_the_object_tracker_is_told_the_class_with_its_subclasses_and_the_colour
     assert dict(parameters["target_values"]) == {"color": ("Blue",)}
 
 
+def test_the_pose_detector_follows_only_the_target_in_a_track_and_everyone_in_a_detect(kb: KnowledgeBase) -> None:
+    for text, follows in (("track the person", True), ("find the person", False)):
+        query_plan = plan_query(parse_query(text), kb, sensor_source(kb, None))
+        (step,) = [s for s in query_plan.plan.steps() if s.annotator == "HumanPoseDetector"]
+        assert dict(step.parameters).get("follow_target", False) is follows, text
+
+
 def test_one_shot_kinds_keep_a_plain_pipeline_and_plan_no_tracker(kb: KnowledgeBase) -> None:
     for text in ("find the person", "find the blue cup"):
         query_plan = plan_query(parse_query(text), kb, sensor_source(kb, None))
