@@ -399,7 +399,8 @@ class Boundaries:
     millimetres apart in depth); over the continuous ones with known normals,
     ``alignment`` is the mean cosine between the two normals and ``convexity`` the mean of
     ``(n_a - n_b) . (p_a - p_b) / |p_a - p_b|`` (positive across a convex edge, negative in a concave crease);
-    ``creased`` is the share of those whose convexity is below ``-crease`` (a concave crease along that stretch).
+    ``creased`` is the share of those whose convexity is below ``-crease`` (a concave crease along that stretch)
+    and ``crease_length`` their number (how many 4-neighbour pixel pairs long the crease runs).
     """
 
     pairs: np.ndarray
@@ -409,6 +410,7 @@ class Boundaries:
     alignment: np.ndarray
     convexity: np.ndarray
     creased: np.ndarray
+    crease_length: np.ndarray
 
 
 def pixel_footprint(points: np.ndarray) -> float:
@@ -484,7 +486,7 @@ def boundaries(
     key = np.concatenate(keys)
     if key.size == 0:
         empty = np.zeros(0)
-        return Boundaries(np.zeros((0, 2), np.int64), empty, empty, empty, empty, empty, empty)
+        return Boundaries(np.zeros((0, 2), np.int64), empty, empty, empty, empty, empty, empty, empty)
     unique, inverse = np.unique(key, return_inverse=True)
     jump, dot, convexity = np.concatenate(jumps), np.concatenate(dots), np.concatenate(convex)
     length = np.bincount(inverse, minlength=unique.size).astype(np.float64)
@@ -498,9 +500,12 @@ def boundaries(
     continuous = np.bincount(inverse, weights=smooth, minlength=unique.size) / length
     close = np.bincount(inverse, weights=np.concatenate(near), minlength=unique.size) / length
     pairs = np.column_stack([unique // base, unique % base])
+    crease_length = np.bincount(inverse, weights=known & (convexity < -crease), minlength=unique.size)
     with np.errstate(invalid="ignore", divide="ignore"):
-        creased = np.bincount(inverse, weights=known & (convexity < -crease), minlength=unique.size) / known_count
-    return Boundaries(pairs, length, continuous, close, alignment, mean_convexity, np.nan_to_num(creased))
+        creased = crease_length / known_count
+    return Boundaries(
+        pairs, length, continuous, close, alignment, mean_convexity, np.nan_to_num(creased), crease_length
+    )
 
 
 @dataclass(frozen=True)
