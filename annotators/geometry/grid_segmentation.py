@@ -6,7 +6,7 @@ and OpenCV, never with per-point Python loops; labels are int32 with 0 meaning "
 
 from __future__ import annotations
 
-from collections.abc import Callable
+from collections.abc import Callable, Sequence
 from dataclasses import dataclass
 
 import cv2
@@ -183,31 +183,53 @@ def footprint_overlap(first: np.ndarray, second: np.ndarray, cell: float) -> flo
 
     The raster gives even a degenerate footprint (a wall seen edge-on is a line) an area of one cell width.
     """
-    first_low, first_high = first.min(axis=0), first.max(axis=0)
-    second_low, second_high = second.min(axis=0), second.max(axis=0)
-    if np.any(np.minimum(first_high, second_high) - np.maximum(first_low, second_low) < -cell):
-        return 0.0  # the footprints' bounding boxes are apart: nothing to rasterize
+    return float(footprint_overlaps([first], [second], cell)[0])
+
+
+def footprint_overlaps(firsts: Sequence[np.ndarray], seconds: Sequence[np.ndarray], cell: float) -> np.ndarray:
+    """:func:`footprint_overlap` of every pair ``(firsts[k], seconds[k])`` of convex polygons (Nx2, metres).
+
+    The bounds, the test for footprints apart and the raster vertices of all polygons are computed at once; only
+    the filling and counting of the rasters goes pair by pair.
+    """
+    count = len(firsts)
+    shares = np.zeros(count)
+    if count == 0:
+        return shares
+    hulls = [*firsts, *seconds]
+    sizes = np.array([hull.shape[0] for hull in hulls])
+    starts = np.cumsum(sizes) - sizes
+    stacked = np.concatenate(hulls)
+    lows, highs = np.minimum.reduceat(stacked, starts, axis=0), np.maximum.reduceat(stacked, starts, axis=0)
+    first_low, second_low = lows[:count], lows[count:]
+    overlap = np.minimum(highs[:count], highs[count:]) - np.maximum(first_low, second_low)
+    near = ~np.any(overlap < -cell, axis=1)  # the footprints' bounding boxes are apart: nothing to rasterize
     low = np.minimum(first_low, second_low)
     # each polygon on the raster of its own bounding cells; the shared cells where the two rasters overlap
-    boxes, rasters = [], []
-    for hull in (first, second):
-        vertices = np.round((hull - low) / cell).astype(np.int32)
-        box = cv2.boundingRect(vertices)  # x, y, width, height of the cells the vertices span
-        boxes.append(box)
-        rasters.append(_filled(vertices, box))
-    (ax, ay, aw, ah), (bx, by, bw, bh) = boxes
-    x0, y0, x1, y1 = max(ax, bx), max(ay, by), min(ax + aw, bx + bw), min(ay + ah, by + bh)
-    shared = 0
-    if x1 > x0 and y1 > y0:
-        shared = cv2.countNonZero(
-            cv2.bitwise_and(
-                rasters[0][y0 - ay : y1 - ay, x0 - ax : x1 - ax], rasters[1][y0 - by : y1 - by, x0 - bx : x1 - bx]
+    vertices = np.round((stacked - np.repeat(np.concatenate([low, low]), sizes, axis=0)) / cell).astype(np.int32)
+    corner = np.minimum.reduceat(vertices, starts, axis=0)
+    far_corner = np.maximum.reduceat(vertices, starts, axis=0) + 1
+    boxes = np.column_stack([corner, far_corner - corner]).tolist()  # x, y, width, height of the cells spanned
+    ends = (starts + sizes).tolist()
+    starts = starts.tolist()
+    for pair in np.flatnonzero(near).tolist():
+        rasters = []
+        for hull in (pair, pair + count):
+            rasters.append(_filled(vertices[starts[hull] : ends[hull]], boxes[hull]))
+        (ax, ay, aw, ah), (bx, by, bw, bh) = boxes[pair], boxes[pair + count]
+        x0, y0, x1, y1 = max(ax, bx), max(ay, by), min(ax + aw, bx + bw), min(ay + ah, by + bh)
+        shared = 0
+        if x1 > x0 and y1 > y0:
+            shared = cv2.countNonZero(
+                cv2.bitwise_and(
+                    rasters[0][y0 - ay : y1 - ay, x0 - ax : x1 - ax], rasters[1][y0 - by : y1 - by, x0 - bx : x1 - bx]
+                )
             )
-        )
-    return shared / max(1, min(cv2.countNonZero(rasters[0]), cv2.countNonZero(rasters[1])))
+        shares[pair] = shared / max(1, min(cv2.countNonZero(rasters[0]), cv2.countNonZero(rasters[1])))
+    return shares
 
 
-def _filled(vertices: np.ndarray, box: tuple[int, int, int, int]) -> np.ndarray:
+def _filled(vertices: np.ndarray, box: Sequence[int]) -> np.ndarray:
     """The cells (uint8, 1 = covered) a convex polygon with integer ``vertices`` covers, on the raster of its
     bounding ``box`` ``(x, y, width, height)``."""
     raster = np.zeros((box[3], box[2]), dtype=np.uint8)
@@ -591,17 +613,25 @@ def merge_parts(
                 and (alignment >= rules.smooth_cosine or convexity >= rules.convex)
             ):
                 smooth.add((a, b))
+    # the footprints of the pairs the overlap rule may join, all at once
+    footprint_pairs = [
+        pair
+        for pair in map(tuple, pairs.tolist())
+        if pair not in smooth and pair not in occluding and rules.overlap < 1.0
+    ]
+    overlaps = footprint_overlaps(
+        [parts.hull(a) for a, _ in footprint_pairs], [parts.hull(b) for _, b in footprint_pairs], rules.cell
+    )
+    overlapping = {
+        pair for pair, share in zip(footprint_pairs, overlaps.tolist(), strict=True) if share > rules.overlap
+    }
     allowed: list[tuple[int, int]] = []
     for first, second in pairs.tolist():
         if (first, second) in smooth:
             allowed.append((first, second))
             continue
         stacked = False
-        if (
-            (first, second) not in occluding
-            and rules.overlap < 1.0
-            and footprint_overlap(parts.hull(first), parts.hull(second), rules.cell) > rules.overlap
-        ):
+        if (first, second) in overlapping:
             heights = (parts.coordinates(first)[:, 2], parts.coordinates(second)[:, 2])
             if (
                 not rules.nested
