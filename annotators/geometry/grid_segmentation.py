@@ -342,29 +342,57 @@ def looks_like_inside(near: np.ndarray, far: np.ndarray, tolerance: float, depth
     width, and it falls away below the rim (:data:`INNER_SPREAD`). A separate object behind is wider, taller,
     elsewhere or flat on top. Robust 5 % / 95 % quantiles are used.
     """
-    if near.shape[0] < 3 or far.shape[0] < 3:
-        return False
+    outside = container_outside(near, tolerance)
+    return outside is not None and outside.could_hold(far, depth_ratio)
+
+
+@dataclass(frozen=True)
+class ContainerOutside:
+    """A part seen as the outside of a possible container (see :func:`looks_like_inside`): the horizontal
+    directions ``along`` the line of sight and ``across`` it, its 5 %-95 % extent across (``low``, ``high``) with
+    the ``margin`` allowed beyond it, its ``rim`` height (95 %), and its front (5 %) and middle along the line."""
+
+    along: np.ndarray
+    across: np.ndarray
+    low: float
+    high: float
+    margin: float
+    rim: float
+    front: float
+    middle: float
+
+    def could_hold(self, far: np.ndarray, depth_ratio: float) -> bool:
+        """Could part ``far`` (Nx3 plane coordinates) be the inside of this container?"""
+        if far.shape[0] < 3:
+            return False
+        far_low, far_high = _range(far[:, :2] @ self.across, 0.05, 0.95)
+        if far_low < self.low - self.margin or far_high > self.high + self.margin:
+            return False
+        far_median, far_top = _range(far[:, 2], 0.5, 0.95)
+        if far_top > self.rim + self.margin:
+            return False
+        far_middle, far_back = _range(far[:, :2] @ self.along, 0.5, 0.95)
+        if far_middle <= self.middle or far_back > self.front + depth_ratio * (self.high - self.low):
+            return False
+        return far_top - far_median >= INNER_SPREAD * self.rim or far_median <= 0.5 * self.rim
+
+
+def container_outside(near: np.ndarray, tolerance: float) -> ContainerOutside | None:
+    """Part ``near`` (Nx3 plane coordinates) as the outside of a possible container (``tolerance`` metres of
+    margin at least); None when it has too few points or lies right below the camera."""
+    if near.shape[0] < 3:
+        return None
     centre = near[:, :2].mean(axis=0)
     distance = float(np.linalg.norm(centre))
     if distance < 1e-6:
-        return False
+        return None
     along = centre / distance
     across = np.array([-along[1], along[0]], dtype=near.dtype)
     near_low, near_high = _range(near[:, :2] @ across, 0.05, 0.95)
-    width = near_high - near_low
-    margin = max(tolerance, 0.1 * width)
-    far_low, far_high = _range(far[:, :2] @ across, 0.05, 0.95)
-    if far_low < near_low - margin or far_high > near_high + margin:
-        return False
+    margin = max(tolerance, 0.1 * (near_high - near_low))
     rim = _range(near[:, 2], 0.5, 0.95)[1]
-    far_median, far_top = _range(far[:, 2], 0.5, 0.95)
-    if far_top > rim + margin:
-        return False
     near_front, near_middle = _range(near[:, :2] @ along, 0.05, 0.5)
-    far_middle, far_back = _range(far[:, :2] @ along, 0.5, 0.95)
-    if far_middle <= near_middle or far_back > near_front + depth_ratio * width:
-        return False
-    return far_top - far_median >= INNER_SPREAD * rim or far_median <= 0.5 * rim
+    return ContainerOutside(along, across, near_low, near_high, margin, rim, near_front, near_middle)
 
 
 def _median(values: np.ndarray) -> np.floating:
@@ -386,6 +414,7 @@ class _Parts:
         self._coordinates: dict[int, np.ndarray] = {}
         self._hulls: dict[int, np.ndarray] = {}
         self._depths: dict[int, float] = {}
+        self._outsides: dict[tuple[int, float], ContainerOutside | None] = {}
 
     def own(self, label: int) -> np.ndarray:
         return self.pixels[self.starts[label] : self.starts[label + 1]]
@@ -402,6 +431,12 @@ class _Parts:
         if label not in self._hulls:
             self._hulls[label] = cv2.convexHull(np.ascontiguousarray(self.coordinates(label)[:, :2])).reshape(-1, 2)
         return self._hulls[label]
+
+    def outside(self, label: int, tolerance: float) -> ContainerOutside | None:
+        """The part as the outside of a possible container (:func:`container_outside`)."""
+        if (label, tolerance) not in self._outsides:
+            self._outsides[label, tolerance] = container_outside(self.coordinates(label), tolerance)
+        return self._outsides[label, tolerance]
 
     def depth_of(self, label: int) -> float:
         """The median depth of the part."""
@@ -644,9 +679,8 @@ def merge_parts(
                 continue
             stacked = True
         near, far = sorted((first, second), key=parts.depth_of)
-        if rules.inside and looks_like_inside(
-            parts.coordinates(near), parts.coordinates(far), rules.inside_tolerance, rules.inside_depth_ratio
-        ):
+        outside = parts.outside(near, rules.inside_tolerance) if rules.inside else None
+        if outside is not None and outside.could_hold(parts.coordinates(far), rules.inside_depth_ratio):
             allowed.append((first, second))
         elif stacked:
             creases.append((first, second))  # one stands on the other: never joined, not even through a third
