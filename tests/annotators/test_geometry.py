@@ -12,6 +12,8 @@ from annotators.geometry.boxes import object_box, principal_box, upright_box
 from annotators.geometry.grid_segmentation import (
     MergeRules,
     boundaries,
+    footprint_overlap,
+    footprint_overlaps,
     heights_nest,
     is_floor_within,
     looks_like_inside,
@@ -175,3 +177,19 @@ def test_a_crease_is_measured_along_the_part_of_a_boundary_it_runs(fold: float, 
         assert found.pairs.tolist() == [[1, 2]]
         assert found.crease_length.tolist() == [rows]
         assert (found.creased > 0) == (rows > 0)
+
+
+def square(x: float, y: float, side: float) -> np.ndarray:
+    """The corners (4x2, metres, float32) of an axis-aligned square with its lower corner at (x, y)."""
+    return np.array([[x, y], [x + side, y], [x + side, y + side], [x, y + side]], dtype=np.float32)
+
+
+def test_footprint_overlaps_of_many_pairs_are_those_of_each_pair_alone() -> None:
+    firsts = [square(0.0, 0.0, 0.1), square(0.0, 0.0, 0.1), square(0.0, 0.0, 0.1), square(0.3, 0.2, 0.04)]
+    seconds = [square(0.05, 0.0, 0.1), square(0.5, 0.5, 0.1), square(0.02, 0.02, 0.05), square(0.0, 0.0, 0.1)]
+    shares = footprint_overlaps(firsts, seconds, 0.005)
+    assert shares[0] == pytest.approx(0.5, abs=0.06)  # half of one square lies on the other
+    assert shares[1] == 0.0 and shares[3] == 0.0  # apart
+    assert shares[2] == 1.0  # the small square lies within the large one
+    assert shares.tolist() == [footprint_overlap(a, b, 0.005) for a, b in zip(firsts, seconds, strict=True)]
+    assert footprint_overlaps([], [], 0.005).shape == (0,)
