@@ -140,9 +140,11 @@ def split_by_color(
 
     Each object is cut at hue edges into pieces; pieces whose shared boundary is creased (the surfaces meet - their
     points along it are close in 3-D - and a share of at least ``p.creased_share`` of it is concave, the surfaces
-    not coplanar) must stay apart. Everything else of the object joins again - longest shared boundaries first, so a
-    piece goes with the side it shares most with. A print on a box (no crease) or the pieces of one object seen on
-    both sides of an occluder never split.
+    not coplanar) must stay apart. The crease must also run as long as a joint :func:`merge_parts` trusts
+    (``boundary_share`` times the square root of the smaller piece's size, at least ``min_boundary``): a few
+    creased pixel pairs between a large piece and a crumb are noise, not two objects meeting. Everything else of
+    the object joins again - longest shared boundaries first, so a piece goes with the side it shares most with. A
+    print on a box (no crease) or the pieces of one object seen on both sides of an occluder never split.
     """
     step = max(1, p.stride)
     objects = labels > 0
@@ -164,8 +166,11 @@ def split_by_color(
     window = np.where(several[y0:y1, x0:x1], pieces[y0:y1, x0:x1], 0)
     surface = boundaries(window, grid[y0:y1, x0:x1], normals[y0:y1, x0:x1], p.jump_absolute, p.jump_relative)
     rules = p.merge_rules()
+    sizes = np.bincount(window.reshape(-1), minlength=owner.size)
+    smaller = np.minimum(sizes[surface.pairs[:, 0]], sizes[surface.pairs[:, 1]])
     creased = (
         (surface.creased > p.creased_share)
+        & (surface.crease_length >= np.maximum(rules.min_boundary, rules.boundary_share * np.sqrt(smaller)))
         & (surface.close >= rules.continuous)
         & (surface.convexity < rules.concave)
         & (surface.alignment < rules.coplanar_cosine)

@@ -6,7 +6,7 @@ and OpenCV, never with per-point Python loops; labels are int32 with 0 meaning "
 
 from __future__ import annotations
 
-from collections.abc import Callable
+from collections.abc import Callable, Sequence
 from dataclasses import dataclass
 
 import cv2
@@ -183,31 +183,53 @@ def footprint_overlap(first: np.ndarray, second: np.ndarray, cell: float) -> flo
 
     The raster gives even a degenerate footprint (a wall seen edge-on is a line) an area of one cell width.
     """
-    first_low, first_high = first.min(axis=0), first.max(axis=0)
-    second_low, second_high = second.min(axis=0), second.max(axis=0)
-    if np.any(np.minimum(first_high, second_high) - np.maximum(first_low, second_low) < -cell):
-        return 0.0  # the footprints' bounding boxes are apart: nothing to rasterize
+    return float(footprint_overlaps([first], [second], cell)[0])
+
+
+def footprint_overlaps(firsts: Sequence[np.ndarray], seconds: Sequence[np.ndarray], cell: float) -> np.ndarray:
+    """:func:`footprint_overlap` of every pair ``(firsts[k], seconds[k])`` of convex polygons (Nx2, metres).
+
+    The bounds, the test for footprints apart and the raster vertices of all polygons are computed at once; only
+    the filling and counting of the rasters goes pair by pair.
+    """
+    count = len(firsts)
+    shares = np.zeros(count)
+    if count == 0:
+        return shares
+    hulls = [*firsts, *seconds]
+    sizes = np.array([hull.shape[0] for hull in hulls])
+    starts = np.cumsum(sizes) - sizes
+    stacked = np.concatenate(hulls)
+    lows, highs = np.minimum.reduceat(stacked, starts, axis=0), np.maximum.reduceat(stacked, starts, axis=0)
+    first_low, second_low = lows[:count], lows[count:]
+    overlap = np.minimum(highs[:count], highs[count:]) - np.maximum(first_low, second_low)
+    near = ~np.any(overlap < -cell, axis=1)  # the footprints' bounding boxes are apart: nothing to rasterize
     low = np.minimum(first_low, second_low)
     # each polygon on the raster of its own bounding cells; the shared cells where the two rasters overlap
-    boxes, rasters = [], []
-    for hull in (first, second):
-        vertices = np.round((hull - low) / cell).astype(np.int32)
-        box = cv2.boundingRect(vertices)  # x, y, width, height of the cells the vertices span
-        boxes.append(box)
-        rasters.append(_filled(vertices, box))
-    (ax, ay, aw, ah), (bx, by, bw, bh) = boxes
-    x0, y0, x1, y1 = max(ax, bx), max(ay, by), min(ax + aw, bx + bw), min(ay + ah, by + bh)
-    shared = 0
-    if x1 > x0 and y1 > y0:
-        shared = cv2.countNonZero(
-            cv2.bitwise_and(
-                rasters[0][y0 - ay : y1 - ay, x0 - ax : x1 - ax], rasters[1][y0 - by : y1 - by, x0 - bx : x1 - bx]
+    vertices = np.round((stacked - np.repeat(np.concatenate([low, low]), sizes, axis=0)) / cell).astype(np.int32)
+    corner = np.minimum.reduceat(vertices, starts, axis=0)
+    far_corner = np.maximum.reduceat(vertices, starts, axis=0) + 1
+    boxes = np.column_stack([corner, far_corner - corner]).tolist()  # x, y, width, height of the cells spanned
+    ends = (starts + sizes).tolist()
+    starts = starts.tolist()
+    for pair in np.flatnonzero(near).tolist():
+        rasters = []
+        for hull in (pair, pair + count):
+            rasters.append(_filled(vertices[starts[hull] : ends[hull]], boxes[hull]))
+        (ax, ay, aw, ah), (bx, by, bw, bh) = boxes[pair], boxes[pair + count]
+        x0, y0, x1, y1 = max(ax, bx), max(ay, by), min(ax + aw, bx + bw), min(ay + ah, by + bh)
+        shared = 0
+        if x1 > x0 and y1 > y0:
+            shared = cv2.countNonZero(
+                cv2.bitwise_and(
+                    rasters[0][y0 - ay : y1 - ay, x0 - ax : x1 - ax], rasters[1][y0 - by : y1 - by, x0 - bx : x1 - bx]
+                )
             )
-        )
-    return shared / max(1, min(cv2.countNonZero(rasters[0]), cv2.countNonZero(rasters[1])))
+        shares[pair] = shared / max(1, min(cv2.countNonZero(rasters[0]), cv2.countNonZero(rasters[1])))
+    return shares
 
 
-def _filled(vertices: np.ndarray, box: tuple[int, int, int, int]) -> np.ndarray:
+def _filled(vertices: np.ndarray, box: Sequence[int]) -> np.ndarray:
     """The cells (uint8, 1 = covered) a convex polygon with integer ``vertices`` covers, on the raster of its
     bounding ``box`` ``(x, y, width, height)``."""
     raster = np.zeros((box[3], box[2]), dtype=np.uint8)
@@ -320,29 +342,57 @@ def looks_like_inside(near: np.ndarray, far: np.ndarray, tolerance: float, depth
     width, and it falls away below the rim (:data:`INNER_SPREAD`). A separate object behind is wider, taller,
     elsewhere or flat on top. Robust 5 % / 95 % quantiles are used.
     """
-    if near.shape[0] < 3 or far.shape[0] < 3:
-        return False
+    outside = container_outside(near, tolerance)
+    return outside is not None and outside.could_hold(far, depth_ratio)
+
+
+@dataclass(frozen=True)
+class ContainerOutside:
+    """A part seen as the outside of a possible container (see :func:`looks_like_inside`): the horizontal
+    directions ``along`` the line of sight and ``across`` it, its 5 %-95 % extent across (``low``, ``high``) with
+    the ``margin`` allowed beyond it, its ``rim`` height (95 %), and its front (5 %) and middle along the line."""
+
+    along: np.ndarray
+    across: np.ndarray
+    low: float
+    high: float
+    margin: float
+    rim: float
+    front: float
+    middle: float
+
+    def could_hold(self, far: np.ndarray, depth_ratio: float) -> bool:
+        """Could part ``far`` (Nx3 plane coordinates) be the inside of this container?"""
+        if far.shape[0] < 3:
+            return False
+        far_low, far_high = _range(far[:, :2] @ self.across, 0.05, 0.95)
+        if far_low < self.low - self.margin or far_high > self.high + self.margin:
+            return False
+        far_median, far_top = _range(far[:, 2], 0.5, 0.95)
+        if far_top > self.rim + self.margin:
+            return False
+        far_middle, far_back = _range(far[:, :2] @ self.along, 0.5, 0.95)
+        if far_middle <= self.middle or far_back > self.front + depth_ratio * (self.high - self.low):
+            return False
+        return far_top - far_median >= INNER_SPREAD * self.rim or far_median <= 0.5 * self.rim
+
+
+def container_outside(near: np.ndarray, tolerance: float) -> ContainerOutside | None:
+    """Part ``near`` (Nx3 plane coordinates) as the outside of a possible container (``tolerance`` metres of
+    margin at least); None when it has too few points or lies right below the camera."""
+    if near.shape[0] < 3:
+        return None
     centre = near[:, :2].mean(axis=0)
     distance = float(np.linalg.norm(centre))
     if distance < 1e-6:
-        return False
+        return None
     along = centre / distance
     across = np.array([-along[1], along[0]], dtype=near.dtype)
     near_low, near_high = _range(near[:, :2] @ across, 0.05, 0.95)
-    width = near_high - near_low
-    margin = max(tolerance, 0.1 * width)
-    far_low, far_high = _range(far[:, :2] @ across, 0.05, 0.95)
-    if far_low < near_low - margin or far_high > near_high + margin:
-        return False
+    margin = max(tolerance, 0.1 * (near_high - near_low))
     rim = _range(near[:, 2], 0.5, 0.95)[1]
-    far_median, far_top = _range(far[:, 2], 0.5, 0.95)
-    if far_top > rim + margin:
-        return False
     near_front, near_middle = _range(near[:, :2] @ along, 0.05, 0.5)
-    far_middle, far_back = _range(far[:, :2] @ along, 0.5, 0.95)
-    if far_middle <= near_middle or far_back > near_front + depth_ratio * width:
-        return False
-    return far_top - far_median >= INNER_SPREAD * rim or far_median <= 0.5 * rim
+    return ContainerOutside(along, across, near_low, near_high, margin, rim, near_front, near_middle)
 
 
 def _median(values: np.ndarray) -> np.floating:
@@ -364,6 +414,7 @@ class _Parts:
         self._coordinates: dict[int, np.ndarray] = {}
         self._hulls: dict[int, np.ndarray] = {}
         self._depths: dict[int, float] = {}
+        self._outsides: dict[tuple[int, float], ContainerOutside | None] = {}
 
     def own(self, label: int) -> np.ndarray:
         return self.pixels[self.starts[label] : self.starts[label + 1]]
@@ -380,6 +431,12 @@ class _Parts:
         if label not in self._hulls:
             self._hulls[label] = cv2.convexHull(np.ascontiguousarray(self.coordinates(label)[:, :2])).reshape(-1, 2)
         return self._hulls[label]
+
+    def outside(self, label: int, tolerance: float) -> ContainerOutside | None:
+        """The part as the outside of a possible container (:func:`container_outside`)."""
+        if (label, tolerance) not in self._outsides:
+            self._outsides[label, tolerance] = container_outside(self.coordinates(label), tolerance)
+        return self._outsides[label, tolerance]
 
     def depth_of(self, label: int) -> float:
         """The median depth of the part."""
@@ -399,7 +456,8 @@ class Boundaries:
     millimetres apart in depth); over the continuous ones with known normals,
     ``alignment`` is the mean cosine between the two normals and ``convexity`` the mean of
     ``(n_a - n_b) . (p_a - p_b) / |p_a - p_b|`` (positive across a convex edge, negative in a concave crease);
-    ``creased`` is the share of those whose convexity is below ``-crease`` (a concave crease along that stretch).
+    ``creased`` is the share of those whose convexity is below ``-crease`` (a concave crease along that stretch)
+    and ``crease_length`` their number (how many 4-neighbour pixel pairs long the crease runs).
     """
 
     pairs: np.ndarray
@@ -409,6 +467,7 @@ class Boundaries:
     alignment: np.ndarray
     convexity: np.ndarray
     creased: np.ndarray
+    crease_length: np.ndarray
 
 
 def pixel_footprint(points: np.ndarray) -> float:
@@ -484,7 +543,7 @@ def boundaries(
     key = np.concatenate(keys)
     if key.size == 0:
         empty = np.zeros(0)
-        return Boundaries(np.zeros((0, 2), np.int64), empty, empty, empty, empty, empty, empty)
+        return Boundaries(np.zeros((0, 2), np.int64), empty, empty, empty, empty, empty, empty, empty)
     unique, inverse = np.unique(key, return_inverse=True)
     jump, dot, convexity = np.concatenate(jumps), np.concatenate(dots), np.concatenate(convex)
     length = np.bincount(inverse, minlength=unique.size).astype(np.float64)
@@ -498,9 +557,12 @@ def boundaries(
     continuous = np.bincount(inverse, weights=smooth, minlength=unique.size) / length
     close = np.bincount(inverse, weights=np.concatenate(near), minlength=unique.size) / length
     pairs = np.column_stack([unique // base, unique % base])
+    crease_length = np.bincount(inverse, weights=known & (convexity < -crease), minlength=unique.size)
     with np.errstate(invalid="ignore", divide="ignore"):
-        creased = np.bincount(inverse, weights=known & (convexity < -crease), minlength=unique.size) / known_count
-    return Boundaries(pairs, length, continuous, close, alignment, mean_convexity, np.nan_to_num(creased))
+        creased = crease_length / known_count
+    return Boundaries(
+        pairs, length, continuous, close, alignment, mean_convexity, np.nan_to_num(creased), crease_length
+    )
 
 
 @dataclass(frozen=True)
@@ -586,17 +648,25 @@ def merge_parts(
                 and (alignment >= rules.smooth_cosine or convexity >= rules.convex)
             ):
                 smooth.add((a, b))
+    # the footprints of the pairs the overlap rule may join, all at once
+    footprint_pairs = [
+        pair
+        for pair in map(tuple, pairs.tolist())
+        if pair not in smooth and pair not in occluding and rules.overlap < 1.0
+    ]
+    overlaps = footprint_overlaps(
+        [parts.hull(a) for a, _ in footprint_pairs], [parts.hull(b) for _, b in footprint_pairs], rules.cell
+    )
+    overlapping = {
+        pair for pair, share in zip(footprint_pairs, overlaps.tolist(), strict=True) if share > rules.overlap
+    }
     allowed: list[tuple[int, int]] = []
     for first, second in pairs.tolist():
         if (first, second) in smooth:
             allowed.append((first, second))
             continue
         stacked = False
-        if (
-            (first, second) not in occluding
-            and rules.overlap < 1.0
-            and footprint_overlap(parts.hull(first), parts.hull(second), rules.cell) > rules.overlap
-        ):
+        if (first, second) in overlapping:
             heights = (parts.coordinates(first)[:, 2], parts.coordinates(second)[:, 2])
             if (
                 not rules.nested
@@ -609,9 +679,8 @@ def merge_parts(
                 continue
             stacked = True
         near, far = sorted((first, second), key=parts.depth_of)
-        if rules.inside and looks_like_inside(
-            parts.coordinates(near), parts.coordinates(far), rules.inside_tolerance, rules.inside_depth_ratio
-        ):
+        outside = parts.outside(near, rules.inside_tolerance) if rules.inside else None
+        if outside is not None and outside.could_hold(parts.coordinates(far), rules.inside_depth_ratio):
             allowed.append((first, second))
         elif stacked:
             creases.append((first, second))  # one stands on the other: never joined, not even through a third

@@ -93,12 +93,13 @@ def join_occluded(
             continue
         x0, y0, x1, y1 = _grown(boxes[occluder - 1], labels.shape, 3 * rules.band + 1)
         window = labels[y0:y1, x0:x1]
-        present = np.bincount(window.reshape(-1), minlength=count + 1)[farther] > 0
-        if np.count_nonzero(present) < 2:
-            continue  # fewer than two farther objects anywhere near this one
+        # a piece's band near the occluder lies in the window: only pieces with enough pixels there can join
+        possible = farther[np.bincount(window.reshape(-1), minlength=count + 1)[farther] >= rules.min_points]
+        if possible.size < 2:
+            continue  # fewer than two farther objects near this one
         if touching is None:
             touching = _touching(labels)
-        if not _some_apart(farther[present].tolist(), touching):
+        if len(_apart_from_another(possible.tolist(), touching)) < 2:
             continue  # the farther objects near it all touch one another: nothing to join
         occluding = window == occluder
         window_depth = depth[y0:y1, x0:x1]
@@ -169,10 +170,13 @@ def _with_shadow(occluder: np.ndarray, depth: np.ndarray, reach: np.ndarray) -> 
     unmeasured = ~np.isfinite(depth)
     if not unmeasured.any():
         return occluder
-    count, parts = cv2.connectedComponents(unmeasured.view(np.uint8), connectivity=4)
     beside = cv2.dilate(occluder.view(np.uint8), np.ones((3, 3), np.uint8)) > 0
+    shadow_seeds = beside & unmeasured
+    if not shadow_seeds.any():
+        return occluder  # no unmeasured pixel touches the occluder: no shadow beside it
+    count, parts = cv2.connectedComponents(unmeasured.view(np.uint8), connectivity=4)
     touching = np.zeros(count, dtype=bool)
-    touching[parts[beside & unmeasured]] = True
+    touching[parts[shadow_seeds]] = True
     touching[0] = False
     within = cv2.dilate(occluder.view(np.uint8), reach) > 0
     return occluder | (touching[parts] & within)
@@ -246,11 +250,6 @@ def _same_section(first: _Piece, second: _Piece, on_plane: np.ndarray, rules: Oc
     if high_a - low_a > high_b - low_b:
         low_a, high_a, low_b, high_b = low_b, high_b, low_a, high_a
     return low_a >= low_b - width and high_a <= high_b + width
-
-
-def _some_apart(labels: list[int], touching: set[tuple[int, int]]) -> bool:
-    """Are two of the (increasing) ``labels`` not touching each other?"""
-    return any((a, b) not in touching for index, a in enumerate(labels) for b in labels[index + 1 :])
 
 
 def _apart_from_another(labels: list[int], touching: set[tuple[int, int]]) -> list[int]:

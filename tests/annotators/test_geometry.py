@@ -6,9 +6,18 @@ import cv2
 import numpy as np
 import pytest
 
+from annotators.cloud.normals import grid_normals
 from annotators.cloud.plane import ransac_support_plane, up_in_camera
 from annotators.geometry.boxes import object_box, principal_box, upright_box
-from annotators.geometry.grid_segmentation import MergeRules, heights_nest, is_floor_within, looks_like_inside
+from annotators.geometry.grid_segmentation import (
+    MergeRules,
+    boundaries,
+    footprint_overlap,
+    footprint_overlaps,
+    heights_nest,
+    is_floor_within,
+    looks_like_inside,
+)
 from robokudo.core.types import CameraInfo, CameraIntrinsics
 
 
@@ -144,3 +153,43 @@ def test_a_bowls_floor_joins_its_walls_and_a_box_under_another_does_not() -> Non
     # a flat object beside the bowl (a coaster partly outside its footprint) is not its floor
     coaster = _disk((0.08, 0.6), 0.04, np.full(200, 0.005))
     assert not is_floor_within(walls, coaster, _hull(walls), _hull(coaster), rules)
+
+
+def folded_sheet(fold: float) -> tuple[np.ndarray, np.ndarray]:
+    """A 40x40 organized sheet 1 m ahead (4 mm pixels) folded along its middle column: ``fold`` > 0 bends the
+    middle away from the camera (a concave crease), < 0 toward it (a convex ridge); points and their normals."""
+    v, u = np.mgrid[0:40, 0:40].astype(np.float32)
+    x, y = (u - 20) * 0.004, (v - 20) * 0.004
+    points = np.stack([x, y, 1.0 - fold * np.abs(x)], axis=-1).astype(np.float32)
+    return points, grid_normals(points, 2, 3, 0.02, 0.01)
+
+
+@pytest.mark.parametrize(("fold", "crease_rows"), [(0.5, (36, 8)), (-0.5, (0, 0))])
+def test_a_crease_is_measured_along_the_part_of_a_boundary_it_runs(fold: float, crease_rows: tuple[int, int]) -> None:
+    points, normals = folded_sheet(fold)
+    cols = np.arange(40)[None, :].repeat(40, axis=0)
+    halves = np.where(cols < 20, 1, 2).astype(np.int32)
+    halves[:, :2] = 0
+    upper_joined = halves.copy()  # the right half's upper 30 rows belong to the left part: 10 rows of crease left
+    upper_joined[:30][upper_joined[:30] == 2] = 1
+    for labels, rows in zip((halves, upper_joined), crease_rows, strict=True):
+        found = boundaries(labels, points, normals, 0.02, 0.01)
+        assert found.pairs.tolist() == [[1, 2]]
+        assert found.crease_length.tolist() == [rows]
+        assert (found.creased > 0) == (rows > 0)
+
+
+def square(x: float, y: float, side: float) -> np.ndarray:
+    """The corners (4x2, metres, float32) of an axis-aligned square with its lower corner at (x, y)."""
+    return np.array([[x, y], [x + side, y], [x + side, y + side], [x, y + side]], dtype=np.float32)
+
+
+def test_footprint_overlaps_of_many_pairs_are_those_of_each_pair_alone() -> None:
+    firsts = [square(0.0, 0.0, 0.1), square(0.0, 0.0, 0.1), square(0.0, 0.0, 0.1), square(0.3, 0.2, 0.04)]
+    seconds = [square(0.05, 0.0, 0.1), square(0.5, 0.5, 0.1), square(0.02, 0.02, 0.05), square(0.0, 0.0, 0.1)]
+    shares = footprint_overlaps(firsts, seconds, 0.005)
+    assert shares[0] == pytest.approx(0.5, abs=0.06)  # half of one square lies on the other
+    assert shares[1] == 0.0 and shares[3] == 0.0  # apart
+    assert shares[2] == 1.0  # the small square lies within the large one
+    assert shares.tolist() == [footprint_overlap(a, b, 0.005) for a, b in zip(firsts, seconds, strict=True)]
+    assert footprint_overlaps([], [], 0.005).shape == (0,)
