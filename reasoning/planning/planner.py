@@ -384,7 +384,8 @@ class _Assignment:
         self.pinned: dict[str, str] = {}  # type -> unit chosen for it when several units write it
         self._order: list[str] | None = None  # the units' types by fixpoint round, then name (until units come or go)
         self._check_feasible()
-        self._assign()
+        self._assign(deque((r.annotation_type, None) for r in self.requirements))
+        self._complete()
         self._prune()
 
     def _note(self, type_name: str, reason: str) -> None:
@@ -586,8 +587,33 @@ class _Assignment:
             self._set_providers(key, previous)
         return False
 
-    def _assign(self) -> None:
-        queue: deque[tuple[str, str | None]] = deque((r.annotation_type, None) for r in self.requirements)
+    def _unplanned_inputs(self) -> list[tuple[str, str]]:
+        """(type, unit) for each required input of a chosen provider that no unit guarantees and no sensor gives."""
+        guaranteed = self.guaranteed_by()
+        sensors = self.catalog.sensors
+        return [
+            (needed, key)
+            for key, unit in self.units.items()
+            for spec in unit.providers
+            for needed in spec.inputs
+            if needed not in guaranteed and needed not in sensors
+        ]
+
+    def _complete(self) -> None:
+        """Plan the inputs that lost their unit while units were re-chosen (a type pinned to a unit that was then
+        committed to another provider); an alternative whose input still has no unit is dropped."""
+        for _ in range(len(self.units) + 1):
+            missing = self._unplanned_inputs()
+            if not missing:
+                return
+            self._assign(deque(missing))
+        while missing := self._unplanned_inputs():
+            needed, key = missing[0]
+            if not self._drop_needing(key, needed):
+                raise _OrderingError(f"cannot produce {needed} for {key} without a cycle")
+
+    def _assign(self, queue: deque[tuple[str, str | None]]) -> None:
+        """Give each (type, consumer unit) of ``queue`` a unit, and so on for the inputs of its providers."""
         sensors, units = self.catalog.sensors, self.units
         while queue:
             type_name, consumer = queue.popleft()

@@ -2,7 +2,9 @@
 hierarchy the small random capability ontologies lack) build trees whose data flow is valid.
 
 A refiner of a by-product (an annotator reading and writing a supertype of what some unit makes) once read a type
-whose unit had moved into one branch of a Fallback: the tree read it where only that branch makes it.
+whose unit had moved into one branch of a Fallback: the tree read it where only that branch makes it. Without depth
+and camera pose, two track queries once planned an alternative reading PersonTrack after its unit had been re-chosen
+(the type was pinned to a unit that was then committed to another provider): no unit made it outside one branch.
 """
 
 from __future__ import annotations
@@ -57,7 +59,13 @@ def test_plans_on_a_generated_ontology_have_valid_data_flow(kb: KnowledgeBase) -
     names = [c for c in kb.names_of_kind("class") if c.startswith("GenObject")]
     texts = [f"detect {{ obj: {{ type: {rng.choice(names)}, color: red }} }}" for _ in range(10)]
     texts += [f"find {rng.choice(names)} in the fridge" for _ in range(5)]
+    texts += [
+        f"{verb} {{ obj: {{ type: {rng.choice(names)}, color: red }} }}"
+        for verb in ("track", "inspect")
+        for _ in range(10)
+    ]
     assert "detect { obj: { type: GenObject0133, color: red } }" in texts  # the query whose plan was invalid
+    assert "track { obj: { type: GenObject0239, color: red } }" in texts  # invalid without depth and pose
     reader = kb.annotator("KitchenSceneReader")
     chosen = SensorSource(Step(reader.name, reader.implemented_by, (), reader.outputs, (("view", "table"),), "reads"))
     planner = QueryPlanner(kb)
