@@ -87,11 +87,15 @@ def plan_requirements(
         catalog = _Catalog(index, source.types, task.object_class, conditions)
         if catalogs is not None:
             catalogs[key] = catalog
+    # providers whose inputs are derived in earlier fixpoint rounds are always acyclic (fewer alternatives): the
+    # strict choice, made at once when some types need each other (there the greedy choice of all alternatives can
+    # paint itself into a cycle, and on large ontologies it nearly always does)
+    strict = catalog.cyclic()
     try:
-        assignment = _Assignment(catalog, requirements, by_rounds=False)
+        assignment = _Assignment(catalog, requirements, by_rounds=strict)
     except _OrderingError:
-        # the greedy choice of alternatives painted itself into a cycle: choose again, allowing only
-        # providers whose inputs are derived in earlier fixpoint rounds (always acyclic, fewer alternatives)
+        if strict:
+            raise
         assignment = _Assignment(catalog, requirements, by_rounds=True)
     layout = _Layout(catalog, assignment, source, dict(parameters or {}))
     return Plan(task=task, stages=layout.stages(), sensor_types=source.types)
@@ -252,21 +256,10 @@ class _Catalog:
     def _fixpoint(self, forbidden: int) -> int:
         """Make each type known once one of its producing rules has all its inputs known, until none becomes so.
 
-        The rules are regrouped per type (the distinct input masks of the rules providing it) at the first call.
         """
-        if self._producing is None:
-            inputs_of: dict[int, dict[int, None]] = {}  # type bit -> the input masks of the rules providing it
-            for inputs, provided in self._rules:
-                while provided:
-                    bit = provided & -provided
-                    inputs_of.setdefault(bit, {})[inputs] = None
-                    provided ^= bit
-            self._producing = [
-                (bit, tuple(inputs_of[bit])) for bit in self.ontology.type_bits.values() if bit in inputs_of
-            ]
         known = self._sensor_mask
         skip = known | forbidden
-        pending = [entry for entry in self._producing if not entry[0] & skip]
+        pending = [entry for entry in self.producing() if not entry[0] & skip]
         while True:
             waiting = []
             for bit, masks in pending:
@@ -279,6 +272,39 @@ class _Catalog:
             if len(waiting) == len(pending):
                 return known
             pending = waiting
+
+    def producing(self) -> list[tuple[int, tuple[int, ...]]]:
+        """The rules regrouped per type: (type bit, the distinct input masks of the rules providing it), in type
+        order (made at the first call)."""
+        if self._producing is None:
+            inputs_of: dict[int, dict[int, None]] = {}  # type bit -> the input masks of the rules providing it
+            for inputs, provided in self._rules:
+                while provided:
+                    bit = provided & -provided
+                    inputs_of.setdefault(bit, {})[inputs] = None
+                    provided ^= bit
+            self._producing = [
+                (bit, tuple(inputs_of[bit])) for bit in self.ontology.type_bits.values() if bit in inputs_of
+            ]
+        return self._producing
+
+    def cyclic(self) -> bool:
+        """Whether some producible types need each other: a type may need another (one of its providers reads it),
+        and the types that need nothing outside the sensors and the types already peeled off are peeled off until none
+        is left (acyclic) or none can be peeled."""
+        done = self._sensor_mask
+        pending = [entry for entry in self.producing() if not entry[0] & done]
+        while pending:
+            waiting = []
+            for bit, masks in pending:
+                if all(inputs & done == inputs for inputs in masks):
+                    done |= bit
+                else:
+                    waiting.append((bit, masks))
+            if len(waiting) == len(pending):
+                return True
+            pending = waiting
+        return False
 
     def producible_without(self, forbidden: frozenset[str]) -> int:
         """What can be produced when the ``forbidden`` types may not be used, as a mask of types."""
