@@ -125,6 +125,7 @@ class _Catalog:
         self._refiners: dict[str, list[AnnotatorSpec]] = {}
         self._without: dict[int, int] = {}
         self._input_rounds: dict[str, int] = {}
+        self._known_by_round: list[int] = []
         self._producing: list[tuple[int, tuple[int, ...]]] | None = None
         self._excluded, self._own_types_only = index.provider_exclusions(object_class, conditions)
         masks = self.ontology.port_masks
@@ -154,6 +155,7 @@ class _Catalog:
             merged[inputs] = merged.get(inputs, 0) | provided
         pending = list(merged.items())
         fired: list[tuple[int, int]] = []
+        self._known_by_round = [known]  # what is producible after each round
         current = 0
         while True:
             current += 1
@@ -170,6 +172,7 @@ class _Catalog:
                 return rounds, fired
             rounds.update(dict.fromkeys((t for t, bit in self.ontology.type_bits.items() if bit & new), current))
             known |= new
+            self._known_by_round.append(known)
             pending = waiting
 
     def with_supertypes(self, types: Iterable[str]) -> frozenset[str]:
@@ -256,8 +259,15 @@ class _Catalog:
     def _fixpoint(self, forbidden: int) -> int:
         """Make each type known once one of its producing rules has all its inputs known, until none becomes so.
 
+        It starts from every type made in a round before the first forbidden type is: each of them was first made
+        from types of earlier rounds, none of them forbidden.
         """
-        known = self._sensor_mask
+        by_round = self._known_by_round
+        known = by_round[0]
+        for made in by_round[1:]:
+            if made & forbidden:
+                break
+            known = made
         skip = known | forbidden
         pending = [entry for entry in self.producing() if not entry[0] & skip]
         while True:
@@ -289,21 +299,25 @@ class _Catalog:
         return self._producing
 
     def cyclic(self) -> bool:
-        """Whether some producible types need each other: a type may need another (one of its providers reads it),
-        and the types that need nothing outside the sensors and the types already peeled off are peeled off until none
-        is left (acyclic) or none can be peeled."""
+        """Whether some producible types need each other (a provider of one reads the other, transitively).
+
+        Types are peeled off once every rule providing them reads only sensor types and types already peeled off;
+        what is left when nothing more can be peeled lies on or behind a cycle.
+        """
         done = self._sensor_mask
-        pending = [entry for entry in self.producing() if not entry[0] & done]
+        pending = [(inputs, provided & ~done) for inputs, provided in self._rules if provided & ~done]
         while pending:
-            waiting = []
-            for bit, masks in pending:
-                if all(inputs & done == inputs for inputs in masks):
-                    done |= bit
+            blocked = ready = 0
+            for inputs, provided in pending:
+                if inputs & done == inputs:
+                    ready |= provided
                 else:
-                    waiting.append((bit, masks))
-            if len(waiting) == len(pending):
+                    blocked |= provided
+            ready &= ~blocked
+            if not ready:
                 return True
-            pending = waiting
+            done |= ready
+            pending = [(inputs, provided & ~done) for inputs, provided in pending if provided & ~done]
         return False
 
     def producible_without(self, forbidden: frozenset[str]) -> int:
