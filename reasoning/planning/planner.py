@@ -126,6 +126,7 @@ class _Catalog:
         self._without: dict[int, int] = {}
         self._input_rounds: dict[str, int] = {}
         self._known_by_round: list[int] = []
+        self._fired_round: dict[int, int] = {}  # inputs mask of a rule -> the fixpoint round in which it fires
         self._producing: list[tuple[int, tuple[int, ...]]] | None = None
         self._excluded, self._own_types_only = index.provider_exclusions(object_class, conditions)
         masks = self.ontology.port_masks
@@ -165,6 +166,7 @@ class _Catalog:
                 if rule[0] & known == rule[0]:
                     new |= rule[1]
                     fired.append(rule)
+                    self._fired_round[rule[0]] = current
                 else:
                     waiting.append(rule)
             new &= ~known
@@ -191,8 +193,14 @@ class _Catalog:
         """The latest fixpoint round among the inputs of ``spec`` (0 without inputs)."""
         found = self._input_rounds.get(spec.name)
         if found is None:
-            rounds = self.rounds
-            found = self._input_rounds[spec.name] = max((rounds.get(t, 0) for t in spec.inputs), default=0)
+            # a rule fires in the round after its latest input became producible
+            fired = self._fired_round.get(self.ontology.port_masks[spec.name][0]) if spec.inputs else None
+            if fired is None:
+                rounds = self.rounds
+                found = max((rounds.get(t, 0) for t in spec.inputs), default=0)
+            else:
+                found = fired - 1
+            self._input_rounds[spec.name] = found
         return found
 
     def written(self, spec: AnnotatorSpec) -> frozenset[str]:
@@ -338,8 +346,9 @@ class _Catalog:
         masks = self.ontology.port_masks
         found = [s for s in self.providers(type_name, value) if masks[s.name][0] & usable == masks[s.name][0]]
         if by_rounds and found:
-            limit = min(map(self.input_round, found))
-            found = [s for s in found if self.input_round(s) <= limit]
+            rounds = [self.input_round(s) for s in found]
+            limit = min(rounds)
+            found = [s for s, r in zip(found, rounds, strict=True) if r <= limit]
         return found
 
     def why_not(self, type_name: str, value: str | None) -> str:
@@ -466,7 +475,7 @@ class _Assignment:
             previous = self._last_guaranteed
             # the same mapping as before (most changes of providers keep it) is the same object, so that what was
             # derived from it stays valid
-            same = previous is not None and list(found.items()) == list(previous.items())
+            same = previous is not None and found == previous  # read by key or sorted: the order is no matter
             self._guaranteed = self._last_guaranteed = previous if same else found
         return self._guaranteed
 
