@@ -794,6 +794,7 @@ class _Layout:
         self.source = source
         self.parameters = parameters
         self._labels: dict[str, str] = {}
+        self._branch_members: dict[tuple[str, str], list[AnnotatorSpec]] = {}  # (type, alternative) -> _members
         self.branches = self._branches()
         absorbed = {t for owned in self.branches.values() for types in owned.values() for t in types}
         self.final: dict[str, str] = dict.fromkeys(catalog.sensors, "reader")
@@ -902,8 +903,13 @@ class _Layout:
 
     def _members(self, type_name: str, spec: AnnotatorSpec) -> list[AnnotatorSpec]:
         """The annotators of one branch: absorbed providers in dependency order, then the alternative."""
-        owned = self.branches.get(type_name, {}).get(spec.name, [])
-        return [self.units[t].providers[0] for t in _topological(owned, self.units)] + [spec]
+        key = (type_name, spec.name)
+        found = self._branch_members.get(key)
+        if found is None:
+            owned = self.branches.get(type_name, {}).get(spec.name, [])
+            ordered = _topological(owned, self.units) if owned else []
+            found = self._branch_members[key] = [self.units[t].providers[0] for t in ordered] + [spec]
+        return found
 
     def _branches(self) -> dict[str, dict[str, list[str]]]:
         """For each unit with alternatives: the units only one alternative needs, moved into its branch.
