@@ -156,6 +156,7 @@ class _Catalog:
             merged[inputs] = merged.get(inputs, 0) | provided
         pending = list(merged.items())
         fired: list[tuple[int, int]] = []
+        names = {bit: name for name, bit in self.ontology.type_bits.items()}
         self._known_by_round = [known]  # what is producible after each round
         current = 0
         while True:
@@ -172,8 +173,11 @@ class _Catalog:
             new &= ~known
             if not new:
                 return rounds, fired
-            rounds.update(dict.fromkeys((t for t, bit in self.ontology.type_bits.items() if bit & new), current))
-            known |= new
+            while new:
+                bit = new & -new
+                rounds[names[bit]] = current
+                known |= bit
+                new ^= bit
             self._known_by_round.append(known)
             pending = waiting
 
@@ -292,8 +296,8 @@ class _Catalog:
             pending = waiting
 
     def producing(self) -> list[tuple[int, tuple[int, ...]]]:
-        """The rules regrouped per type: (type bit, the distinct input masks of the rules providing it), in type
-        order (made at the first call)."""
+        """The rules regrouped per type: (type bit, the distinct input masks of the rules providing it), made at the
+        first call."""
         if self._producing is None:
             inputs_of: dict[int, dict[int, None]] = {}  # type bit -> the input masks of the rules providing it
             for inputs, provided in self._rules:
@@ -301,9 +305,7 @@ class _Catalog:
                     bit = provided & -provided
                     inputs_of.setdefault(bit, {})[inputs] = None
                     provided ^= bit
-            self._producing = [
-                (bit, tuple(inputs_of[bit])) for bit in self.ontology.type_bits.values() if bit in inputs_of
-            ]
+            self._producing = [(bit, tuple(masks)) for bit, masks in inputs_of.items()]
         return self._producing
 
     def cyclic(self) -> bool:
