@@ -428,6 +428,7 @@ class _Assignment:
         self._guaranteed: dict[str, str] | None = None
         self._last_guaranteed: dict[str, str] | None = None
         self._owner: dict[str, str] | None = None
+        self._owners: dict[str, str] = {}  # annotator name -> its unit, kept as the units change
         self._version = 0  # counts changes of the units
         self._clean_below: dict[str, set[str]] = {}  # unit -> the units below it, while they are unchanged
         self._inputs_for: dict[str, str] | None = None
@@ -455,9 +456,10 @@ class _Assignment:
                 )
 
     def owner(self) -> dict[str, str]:
-        """Annotator name -> the type of the unit it belongs to (cached until the units change; read only)."""
+        """Annotator name -> the type of the unit it belongs to, as the units are now (read only; a later change of the
+        units leaves it as it was)."""
         if self._owner is None:
-            self._owner = {s.name: key for key, unit in self.units.items() for s in unit.providers}
+            self._owner = dict(self._owners)
         return self._owner
 
     def _invalidate(self) -> None:
@@ -467,7 +469,11 @@ class _Assignment:
         self._owner = None
 
     def _set_providers(self, key: str, providers: list[AnnotatorSpec]) -> None:
+        owners = self._owners
+        for spec in self.units[key].providers:
+            del owners[spec.name]
         self.units[key].providers = providers
+        owners.update(dict.fromkeys((spec.name for spec in providers), key))
         self._invalidate()
 
     def guaranteed_by(self) -> dict[str, str]:
@@ -706,6 +712,7 @@ class _Assignment:
                     raise _OrderingError(f"cannot produce {type_name}: {self.catalog.why_not(type_name, value)}")
                 continue
             self.units[type_name] = _UnitChoice(type_name, free, value, self.catalog)
+            self._owners.update(dict.fromkeys((spec.name for spec in free), type_name))
             self._order = None
             self._invalidate()
             self.above[type_name] = set(above)
@@ -737,7 +744,8 @@ class _Assignment:
             if not unneeded:
                 return
             for key in unneeded:
-                del self.units[key]
+                for spec in self.units.pop(key).providers:
+                    del self._owners[spec.name]
             self._order = None
             self._invalidate()
 
