@@ -1035,25 +1035,25 @@ class _Layout:
         return " / ".join(s.name for s in self.units[name].providers)
 
     def _step(self, spec: AnnotatorSpec, why: str, provides: str = "", inside: Iterable[str] = ()) -> Step:
-        inside_types = {t for key in inside for t in self.units[key].guaranteed()}
-        guaranteed = self.assignment.guaranteed_by()
+        inside_types = {t for key in inside for t in self.units[key].guaranteed()} if inside else frozenset()
+        final = self.final
         feeds = []
         for needed in spec.inputs:
             if needed in inside_types:
-                feeds.append(f"{needed} from {self.units[guaranteed[needed]].providers[0].name}")
+                maker = self.units[self.assignment.guaranteed_by()[needed]].providers[0].name
+                feeds.append(f"{needed} from {maker}")
             elif needed in spec.outputs and spec.name in self.refines_output_of:
                 feeds.append(f"{needed} from {self._label(self.refines_output_of[spec.name])}")
-            elif needed in self.final:
-                feeds.append(f"{needed} from {self._label(self.final[needed])}")
-        reason = f"{spec.name}: {why}"
-        if feeds:
-            reason += f"; needs {', '.join(feeds)}"
+            elif needed in final:
+                feeds.append(f"{needed} from {self._label(final[needed])}")
+        reason = f"{spec.name}: {why}; needs {', '.join(feeds)}" if feeds else f"{spec.name}: {why}"
+        parameters = self.parameters.get(spec.name)
         return Step(
             annotator=spec.name,
             implemented_by=spec.implemented_by,
             inputs=tuple(spec.inputs),
             outputs=tuple(spec.outputs),
-            parameters=tuple(sorted(self.parameters.get(spec.name, {}).items())),
+            parameters=tuple(sorted(parameters.items())) if parameters else (),
             reason=reason,
             provides=provides,
         )
