@@ -22,6 +22,7 @@ The algorithm, polynomial in annotators x types:
 
 from __future__ import annotations
 
+from bisect import insort
 from collections import deque
 from collections.abc import Iterable, Mapping, Sequence
 from dataclasses import dataclass
@@ -434,7 +435,7 @@ class _Assignment:
         self._inputs_for: dict[str, str] | None = None
         self._input_units_of: dict[str, tuple[str, ...]] = {}
         self.pinned: dict[str, str] = {}  # type -> unit chosen for it when several units write it
-        self._order: list[str] | None = None  # the units' types by fixpoint round, then name (until units come or go)
+        self._order: list[tuple[int, str]] = []  # (fixpoint round, type) of each unit, sorted
         self._check_feasible()
         self._assign(deque((r.annotation_type, None) for r in self.requirements))
         self._complete()
@@ -493,9 +494,7 @@ class _Assignment:
         # by-products come from the unit derived earliest, the one least likely to depend on their readers
         by_rounds = self.by_rounds
         units = self.units
-        if self._order is None:
-            self._order = sorted(units, key=lambda k: (rounds.get(k, 0), k))
-        for key in self._order:
+        for _, key in self._order:
             unit = units[key]
             latest = unit.latest_round
             for type_name in unit.guaranteed_sorted:
@@ -713,7 +712,7 @@ class _Assignment:
                 continue
             self.units[type_name] = _UnitChoice(type_name, free, value, self.catalog)
             self._owners.update(dict.fromkeys((spec.name for spec in free), type_name))
-            self._order = None
+            insort(self._order, (self.catalog.rounds.get(type_name, 0), type_name))
             self._invalidate()
             self.above[type_name] = set(above)
             reasons = self.reasons
@@ -746,7 +745,7 @@ class _Assignment:
             for key in unneeded:
                 for spec in self.units.pop(key).providers:
                     del self._owners[spec.name]
-            self._order = None
+            self._order = [entry for entry in self._order if entry[1] in self.units]
             self._invalidate()
 
 
