@@ -128,7 +128,6 @@ class _Catalog:
         self._input_rounds: dict[str, int] = {}
         self._known_by_round: list[int] = []
         self._fired_round: dict[int, int] = {}  # inputs mask of a rule -> the fixpoint round in which it fires
-        self._producing: list[tuple[int, tuple[int, ...]]] | None = None
         self._excluded, self._own_types_only = index.provider_exclusions(object_class, conditions)
         masks = self.ontology.port_masks
         rules: list[tuple[int, int]] = []
@@ -270,7 +269,7 @@ class _Catalog:
         return found
 
     def _fixpoint(self, forbidden: int) -> int:
-        """Make each type known once one of its producing rules has all its inputs known, until none becomes so.
+        """Make the types a rule provides known (unless forbidden) once all its inputs are, until none becomes so.
 
         It starts from every type made in a round before the first forbidden type is: each of them was first made
         from types of earlier rounds, none of them forbidden.
@@ -281,33 +280,18 @@ class _Catalog:
             if made & forbidden:
                 break
             known = made
-        skip = known | forbidden
-        pending = [entry for entry in self.producing() if not entry[0] & skip]
+        allowed = ~forbidden
+        pending = [rule for rule in self._rules if rule[1] & allowed & ~known]
         while True:
             waiting = []
-            for bit, masks in pending:
-                for inputs in masks:
-                    if inputs & known == inputs:
-                        known |= bit
-                        break
+            for rule in pending:
+                if rule[0] & known == rule[0]:
+                    known |= rule[1] & allowed
                 else:
-                    waiting.append((bit, masks))
+                    waiting.append(rule)
             if len(waiting) == len(pending):
                 return known
             pending = waiting
-
-    def producing(self) -> list[tuple[int, tuple[int, ...]]]:
-        """The rules regrouped per type: (type bit, the distinct input masks of the rules providing it), made at the
-        first call."""
-        if self._producing is None:
-            inputs_of: dict[int, dict[int, None]] = {}  # type bit -> the input masks of the rules providing it
-            for inputs, provided in self._rules:
-                while provided:
-                    bit = provided & -provided
-                    inputs_of.setdefault(bit, {})[inputs] = None
-                    provided ^= bit
-            self._producing = [(bit, tuple(masks)) for bit, masks in inputs_of.items()]
-        return self._producing
 
     def cyclic(self) -> bool:
         """Whether some producible types need each other (a provider of one reads the other, transitively).
