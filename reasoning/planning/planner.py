@@ -11,6 +11,10 @@ The algorithm, polynomial in annotators x types:
 3. *Assignment*, breadth first from the requirements back to the sensors: each needed type gets one unit
    - its single valid provider, or all of them as Alternatives (a Fallback, in rank order) - and each
    annotator belongs to at most one unit. A type that an already planned unit guarantees needs no unit.
+   When some types need each other (a cycle among the providers' rules, as on large ontologies) the greedy choice
+   of all alternatives can paint itself into a cycle: there every type takes only the providers whose inputs are
+   derived in the earliest fixpoint round (always acyclic, fewer alternatives), as it does when the greedy choice
+   fails. An input that lost its unit while units were re-chosen is planned again (or its alternative dropped).
 4. *Pruning and cycle breaking*: units nothing needs are dropped; an alternative whose inputs would close a
    dependency cycle is dropped from its Fallback.
 5. *Refinements* of planned types run after the type's unit and before its readers: every refiner whose
