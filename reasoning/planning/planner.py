@@ -11,6 +11,10 @@ The algorithm, polynomial in annotators x types:
 3. *Assignment*, breadth first from the requirements back to the sensors: each needed type gets one unit
    - its single valid provider, or all of them as Alternatives (a Fallback, in rank order) - and each
    annotator belongs to at most one unit. A type that an already planned unit guarantees needs no unit.
+   When some types need each other (a cycle among the providers' rules, as on large ontologies) the greedy choice
+   of all alternatives can paint itself into a cycle: there every type takes only the providers whose inputs are
+   derived in the earliest fixpoint round (always acyclic, fewer alternatives), as it does when the greedy choice
+   fails. An input that lost its unit while units were re-chosen is planned again (or its alternative dropped).
 4. *Pruning and cycle breaking*: units nothing needs are dropped; an alternative whose inputs would close a
    dependency cycle is dropped from its Fallback.
 5. *Refinements* of planned types run after the type's unit and before its readers: every refiner whose
@@ -22,6 +26,7 @@ The algorithm, polynomial in annotators x types:
 
 from __future__ import annotations
 
+from bisect import insort
 from collections import deque
 from collections.abc import Iterable, Mapping, Sequence
 from dataclasses import dataclass
@@ -87,11 +92,15 @@ def plan_requirements(
         catalog = _Catalog(index, source.types, task.object_class, conditions)
         if catalogs is not None:
             catalogs[key] = catalog
+    # providers whose inputs are derived in earlier fixpoint rounds are always acyclic (fewer alternatives): the
+    # strict choice, made at once when some types need each other (there the greedy choice of all alternatives can
+    # paint itself into a cycle, and on large ontologies it nearly always does)
+    strict = catalog.cyclic()
     try:
-        assignment = _Assignment(catalog, requirements, by_rounds=False)
+        assignment = _Assignment(catalog, requirements, by_rounds=strict)
     except _OrderingError:
-        # the greedy choice of alternatives painted itself into a cycle: choose again, allowing only
-        # providers whose inputs are derived in earlier fixpoint rounds (always acyclic, fewer alternatives)
+        if strict:
+            raise
         assignment = _Assignment(catalog, requirements, by_rounds=True)
     layout = _Layout(catalog, assignment, source, dict(parameters or {}))
     return Plan(task=task, stages=layout.stages(), sensor_types=source.types)
@@ -121,7 +130,8 @@ class _Catalog:
         self._refiners: dict[str, list[AnnotatorSpec]] = {}
         self._without: dict[int, int] = {}
         self._input_rounds: dict[str, int] = {}
-        self._producing: list[tuple[int, tuple[int, ...]]] | None = None
+        self._known_by_round: list[int] = []
+        self._fired_round: dict[int, int] = {}  # inputs mask of a rule -> the fixpoint round in which it fires
         self._excluded, self._own_types_only = index.provider_exclusions(object_class, conditions)
         masks = self.ontology.port_masks
         rules: list[tuple[int, int]] = []
@@ -150,6 +160,8 @@ class _Catalog:
             merged[inputs] = merged.get(inputs, 0) | provided
         pending = list(merged.items())
         fired: list[tuple[int, int]] = []
+        names = {bit: name for name, bit in self.ontology.type_bits.items()}
+        self._known_by_round = [known]  # what is producible after each round
         current = 0
         while True:
             current += 1
@@ -159,13 +171,18 @@ class _Catalog:
                 if rule[0] & known == rule[0]:
                     new |= rule[1]
                     fired.append(rule)
+                    self._fired_round[rule[0]] = current
                 else:
                     waiting.append(rule)
             new &= ~known
             if not new:
                 return rounds, fired
-            rounds.update(dict.fromkeys((t for t, bit in self.ontology.type_bits.items() if bit & new), current))
-            known |= new
+            while new:
+                bit = new & -new
+                rounds[names[bit]] = current
+                known |= bit
+                new ^= bit
+            self._known_by_round.append(known)
             pending = waiting
 
     def with_supertypes(self, types: Iterable[str]) -> frozenset[str]:
@@ -184,8 +201,14 @@ class _Catalog:
         """The latest fixpoint round among the inputs of ``spec`` (0 without inputs)."""
         found = self._input_rounds.get(spec.name)
         if found is None:
-            rounds = self.rounds
-            found = self._input_rounds[spec.name] = max((rounds.get(t, 0) for t in spec.inputs), default=0)
+            # a rule fires in the round after its latest input became producible
+            fired = self._fired_round.get(self.ontology.port_masks[spec.name][0]) if spec.inputs else None
+            if fired is None:
+                rounds = self.rounds
+                found = max((rounds.get(t, 0) for t in spec.inputs), default=0)
+            else:
+                found = fired - 1
+            self._input_rounds[spec.name] = found
         return found
 
     def written(self, spec: AnnotatorSpec) -> frozenset[str]:
@@ -250,35 +273,51 @@ class _Catalog:
         return found
 
     def _fixpoint(self, forbidden: int) -> int:
-        """Make each type known once one of its producing rules has all its inputs known, until none becomes so.
+        """Make the types a rule provides known (unless forbidden) once all its inputs are, until none becomes so.
 
-        The rules are regrouped per type (the distinct input masks of the rules providing it) at the first call.
+        It starts from every type made in a round before the first forbidden type is: each of them was first made
+        from types of earlier rounds, none of them forbidden.
         """
-        if self._producing is None:
-            inputs_of: dict[int, dict[int, None]] = {}  # type bit -> the input masks of the rules providing it
-            for inputs, provided in self._rules:
-                while provided:
-                    bit = provided & -provided
-                    inputs_of.setdefault(bit, {})[inputs] = None
-                    provided ^= bit
-            self._producing = [
-                (bit, tuple(inputs_of[bit])) for bit in self.ontology.type_bits.values() if bit in inputs_of
-            ]
-        known = self._sensor_mask
-        skip = known | forbidden
-        pending = [entry for entry in self._producing if not entry[0] & skip]
+        by_round = self._known_by_round
+        known = by_round[0]
+        for made in by_round[1:]:
+            if made & forbidden:
+                break
+            known = made
+        allowed = ~forbidden
+        pending = [rule for rule in self._rules if rule[1] & allowed & ~known]
         while True:
             waiting = []
-            for bit, masks in pending:
-                for inputs in masks:
-                    if inputs & known == inputs:
-                        known |= bit
-                        break
+            for rule in pending:
+                if rule[0] & known == rule[0]:
+                    known |= rule[1] & allowed
                 else:
-                    waiting.append((bit, masks))
+                    waiting.append(rule)
             if len(waiting) == len(pending):
                 return known
             pending = waiting
+
+    def cyclic(self) -> bool:
+        """Whether some producible types need each other (a provider of one reads the other, transitively).
+
+        Types are peeled off once every rule providing them reads only sensor types and types already peeled off;
+        what is left when nothing more can be peeled lies on or behind a cycle.
+        """
+        done = self._sensor_mask
+        pending = [(inputs, provided & ~done) for inputs, provided in self._rules if provided & ~done]
+        while pending:
+            blocked = ready = 0
+            for inputs, provided in pending:
+                if inputs & done == inputs:
+                    ready |= provided
+                else:
+                    blocked |= provided
+            ready &= ~blocked
+            if not ready:
+                return True
+            done |= ready
+            pending = [(inputs, provided & ~done) for inputs, provided in pending if provided & ~done]
+        return False
 
     def producible_without(self, forbidden: frozenset[str]) -> int:
         """What can be produced when the ``forbidden`` types may not be used, as a mask of types."""
@@ -298,8 +337,9 @@ class _Catalog:
         masks = self.ontology.port_masks
         found = [s for s in self.providers(type_name, value) if masks[s.name][0] & usable == masks[s.name][0]]
         if by_rounds and found:
-            limit = min(map(self.input_round, found))
-            found = [s for s in found if self.input_round(s) <= limit]
+            rounds = [self.input_round(s) for s in found]
+            limit = min(rounds)
+            found = [s for s, r in zip(found, rounds, strict=True) if r <= limit]
         return found
 
     def why_not(self, type_name: str, value: str | None) -> str:
@@ -377,14 +417,16 @@ class _Assignment:
         self._guaranteed: dict[str, str] | None = None
         self._last_guaranteed: dict[str, str] | None = None
         self._owner: dict[str, str] | None = None
+        self._owners: dict[str, str] = {}  # annotator name -> its unit, kept as the units change
         self._version = 0  # counts changes of the units
         self._clean_below: dict[str, set[str]] = {}  # unit -> the units below it, while they are unchanged
         self._inputs_for: dict[str, str] | None = None
         self._input_units_of: dict[str, tuple[str, ...]] = {}
         self.pinned: dict[str, str] = {}  # type -> unit chosen for it when several units write it
-        self._order: list[str] | None = None  # the units' types by fixpoint round, then name (until units come or go)
+        self._order: list[tuple[int, str]] = []  # (fixpoint round, type) of each unit, sorted
         self._check_feasible()
-        self._assign()
+        self._assign(deque((r.annotation_type, None) for r in self.requirements))
+        self._complete()
         self._prune()
 
     def _note(self, type_name: str, reason: str) -> None:
@@ -403,9 +445,10 @@ class _Assignment:
                 )
 
     def owner(self) -> dict[str, str]:
-        """Annotator name -> the type of the unit it belongs to (cached until the units change; read only)."""
+        """Annotator name -> the type of the unit it belongs to, as the units are now (read only; a later change of the
+        units leaves it as it was)."""
         if self._owner is None:
-            self._owner = {s.name: key for key, unit in self.units.items() for s in unit.providers}
+            self._owner = dict(self._owners)
         return self._owner
 
     def _invalidate(self) -> None:
@@ -415,7 +458,11 @@ class _Assignment:
         self._owner = None
 
     def _set_providers(self, key: str, providers: list[AnnotatorSpec]) -> None:
+        owners = self._owners
+        for spec in self.units[key].providers:
+            del owners[spec.name]
         self.units[key].providers = providers
+        owners.update(dict.fromkeys((spec.name for spec in providers), key))
         self._invalidate()
 
     def guaranteed_by(self) -> dict[str, str]:
@@ -425,7 +472,7 @@ class _Assignment:
             previous = self._last_guaranteed
             # the same mapping as before (most changes of providers keep it) is the same object, so that what was
             # derived from it stays valid
-            same = previous is not None and list(found.items()) == list(previous.items())
+            same = previous is not None and found == previous  # read by key or sorted: the order is no matter
             self._guaranteed = self._last_guaranteed = previous if same else found
         return self._guaranteed
 
@@ -435,9 +482,7 @@ class _Assignment:
         # by-products come from the unit derived earliest, the one least likely to depend on their readers
         by_rounds = self.by_rounds
         units = self.units
-        if self._order is None:
-            self._order = sorted(units, key=lambda k: (rounds.get(k, 0), k))
-        for key in self._order:
+        for _, key in self._order:
             unit = units[key]
             latest = unit.latest_round
             for type_name in unit.guaranteed_sorted:
@@ -586,8 +631,33 @@ class _Assignment:
             self._set_providers(key, previous)
         return False
 
-    def _assign(self) -> None:
-        queue: deque[tuple[str, str | None]] = deque((r.annotation_type, None) for r in self.requirements)
+    def _unplanned_inputs(self) -> list[tuple[str, str]]:
+        """(type, unit) for each required input of a chosen provider that no unit guarantees and no sensor gives."""
+        guaranteed = self.guaranteed_by()
+        sensors = self.catalog.sensors
+        return [
+            (needed, key)
+            for key, unit in self.units.items()
+            for spec in unit.providers
+            for needed in spec.inputs
+            if needed not in guaranteed and needed not in sensors
+        ]
+
+    def _complete(self) -> None:
+        """Plan the inputs that lost their unit while units were re-chosen (a type pinned to a unit that was then
+        committed to another provider); an alternative whose input still has no unit is dropped."""
+        for _ in range(len(self.units) + 1):
+            missing = self._unplanned_inputs()
+            if not missing:
+                return
+            self._assign(deque(missing))
+        while missing := self._unplanned_inputs():
+            needed, key = missing[0]
+            if not self._drop_needing(key, needed):
+                raise _OrderingError(f"cannot produce {needed} for {key} without a cycle")
+
+    def _assign(self, queue: deque[tuple[str, str | None]]) -> None:
+        """Give each (type, consumer unit) of ``queue`` a unit, and so on for the inputs of its providers."""
         sensors, units = self.catalog.sensors, self.units
         while queue:
             type_name, consumer = queue.popleft()
@@ -629,7 +699,8 @@ class _Assignment:
                     raise _OrderingError(f"cannot produce {type_name}: {self.catalog.why_not(type_name, value)}")
                 continue
             self.units[type_name] = _UnitChoice(type_name, free, value, self.catalog)
-            self._order = None
+            self._owners.update(dict.fromkeys((spec.name for spec in free), type_name))
+            insort(self._order, (self.catalog.rounds.get(type_name, 0), type_name))
             self._invalidate()
             self.above[type_name] = set(above)
             reasons = self.reasons
@@ -660,8 +731,9 @@ class _Assignment:
             if not unneeded:
                 return
             for key in unneeded:
-                del self.units[key]
-            self._order = None
+                for spec in self.units.pop(key).providers:
+                    del self._owners[spec.name]
+            self._order = [entry for entry in self._order if entry[1] in self.units]
             self._invalidate()
 
 
@@ -719,6 +791,7 @@ class _Layout:
         self.source = source
         self.parameters = parameters
         self._labels: dict[str, str] = {}
+        self._branch_members: dict[tuple[str, str], list[AnnotatorSpec]] = {}  # (type, alternative) -> _members
         self.branches = self._branches()
         absorbed = {t for owned in self.branches.values() for types in owned.values() for t in types}
         self.final: dict[str, str] = dict.fromkeys(catalog.sensors, "reader")
@@ -827,8 +900,13 @@ class _Layout:
 
     def _members(self, type_name: str, spec: AnnotatorSpec) -> list[AnnotatorSpec]:
         """The annotators of one branch: absorbed providers in dependency order, then the alternative."""
-        owned = self.branches.get(type_name, {}).get(spec.name, [])
-        return [self.units[t].providers[0] for t in _topological(owned, self.units)] + [spec]
+        key = (type_name, spec.name)
+        found = self._branch_members.get(key)
+        if found is None:
+            owned = self.branches.get(type_name, {}).get(spec.name, [])
+            ordered = _topological(owned, self.units) if owned else []
+            found = self._branch_members[key] = [self.units[t].providers[0] for t in ordered] + [spec]
+        return found
 
     def _branches(self) -> dict[str, dict[str, list[str]]]:
         """For each unit with alternatives: the units only one alternative needs, moved into its branch.
@@ -944,25 +1022,25 @@ class _Layout:
         return " / ".join(s.name for s in self.units[name].providers)
 
     def _step(self, spec: AnnotatorSpec, why: str, provides: str = "", inside: Iterable[str] = ()) -> Step:
-        inside_types = {t for key in inside for t in self.units[key].guaranteed()}
-        guaranteed = self.assignment.guaranteed_by()
+        inside_types = {t for key in inside for t in self.units[key].guaranteed()} if inside else frozenset()
+        final = self.final
         feeds = []
         for needed in spec.inputs:
             if needed in inside_types:
-                feeds.append(f"{needed} from {self.units[guaranteed[needed]].providers[0].name}")
+                maker = self.units[self.assignment.guaranteed_by()[needed]].providers[0].name
+                feeds.append(f"{needed} from {maker}")
             elif needed in spec.outputs and spec.name in self.refines_output_of:
                 feeds.append(f"{needed} from {self._label(self.refines_output_of[spec.name])}")
-            elif needed in self.final:
-                feeds.append(f"{needed} from {self._label(self.final[needed])}")
-        reason = f"{spec.name}: {why}"
-        if feeds:
-            reason += f"; needs {', '.join(feeds)}"
+            elif needed in final:
+                feeds.append(f"{needed} from {self._label(final[needed])}")
+        reason = f"{spec.name}: {why}; needs {', '.join(feeds)}" if feeds else f"{spec.name}: {why}"
+        parameters = self.parameters.get(spec.name)
         return Step(
             annotator=spec.name,
             implemented_by=spec.implemented_by,
             inputs=tuple(spec.inputs),
             outputs=tuple(spec.outputs),
-            parameters=tuple(sorted(self.parameters.get(spec.name, {}).items())),
+            parameters=tuple(sorted(parameters.items())) if parameters else (),
             reason=reason,
             provides=provides,
         )

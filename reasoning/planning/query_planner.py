@@ -191,8 +191,10 @@ class QueryPlanner:
         conditions = Conditions(depth=depth, region=box is not None, transparent=interpretation.transparent)
         task = interpretation.task
         parameters = annotator_parameters(self.kb, box, self.profiles(), task.object_class, task, self._parameterised)
-        for spec in self._trackers:  # a tracker of any object: told which one to follow
-            parameters.setdefault(spec.name, {}).update(target_parameters(self.kb, task))
+        if self._trackers:  # a tracker of any object: told which one to follow
+            target = target_parameters(self.kb, task)
+            for spec in self._trackers:
+                parameters.setdefault(spec.name, {}).update(target)
         if task.pointing is not None:
             parameters.update(pointing_parameters(self.kb, task.pointing))
         for name, arguments in follow_parameters(self.kb, task).items():
