@@ -159,6 +159,10 @@ class OntologyIndex:
     """CAS type -> its providers that read it too (refiners), cheapest first (by cost, then name)."""
     inspected_types: tuple[str, ...] = ()
     """The annotation types answering the query keys marked ``rk:refinedByInspection true``, sorted."""
+    bit_types: tuple[str, ...] = ()
+    """The CAS types by bit position: ``type_bits[bit_types[i]] == 1 << i``."""
+    rule_ports: tuple[tuple[str, int, int, int], ...] = ()
+    """The annotators with inputs (not sensor readers) in rank order, each with its ``port_masks``."""
 
     def mask(self, types: Iterable[str]) -> int:
         """The bit mask of CAS types (names that are no CAS type are left out)."""
@@ -223,7 +227,9 @@ class _Builder:
         cas_types = frozenset(self.down.get("CasType", frozenset()))
         providers = self._providers(annotators)
         ranked = tuple(sorted(annotators.values(), key=lambda s: (-s.reliability, s.cost_ms, s.name)))
-        type_bits = {name: 1 << i for i, name in enumerate(sorted(cas_types))}
+        bit_types = tuple(sorted(cas_types))
+        type_bits = {name: 1 << i for i, name in enumerate(bit_types)}
+        port_masks = self._port_masks(annotators, providers, type_bits)
         needing: dict[str, set[str]] = defaultdict(set)
         for name, keys in annotator_conditions.items():
             for key in keys:
@@ -257,7 +263,7 @@ class _Builder:
             name_keys=self._name_keys(),
             ranked=ranked,
             type_bits=type_bits,
-            port_masks=self._port_masks(annotators, providers, type_bits),
+            port_masks=port_masks,
             needing={key: frozenset(names) for key, names in needing.items()},
             class_domain=tuple(spec for spec in ranked if spec.classes),
             look_alikes=self._look_alikes(profiles),
@@ -269,6 +275,8 @@ class _Builder:
                 t: tuple(sorted((s for s in specs if t in s.inputs), key=lambda s: (s.cost_ms, s.name)))
                 for t, specs in providers.items()
             },
+            bit_types=bit_types,
+            rule_ports=tuple((s.name, *port_masks[s.name]) for s in ranked if s.inputs),
         )
 
     def _written_types(self, annotators: Mapping[str, AnnotatorSpec]) -> dict[str, frozenset[str]]:

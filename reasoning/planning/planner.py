@@ -133,14 +133,14 @@ class _Catalog:
         self._known_by_round: list[int] = []
         self._fired_round: dict[int, int] = {}  # inputs mask of a rule -> the fixpoint round in which it fires
         self._excluded, self._own_types_only = index.provider_exclusions(object_class, conditions)
-        masks = self.ontology.port_masks
+        excluded, own_types_only = self._excluded, self._own_types_only
         rules: list[tuple[int, int]] = []
-        for spec in self.ontology.ranked:
-            # annotators without inputs are sensor readers; a provider does not provide what it reads (a refiner)
-            if not spec.inputs or spec.name in self._excluded:
+        # annotators without inputs (sensor readers) are not in ``rule_ports``; a provider does not provide what it
+        # reads (a refiner)
+        for name, inputs, outputs, written in self.ontology.rule_ports:
+            if name in excluded:
                 continue
-            inputs, outputs, written = masks[spec.name]
-            provided = (outputs if spec.name in self._own_types_only else written) & ~inputs
+            provided = (outputs if name in own_types_only else written) & ~inputs
             if provided:
                 rules.append((inputs, provided))
         self._sensor_mask = self.ontology.mask(self.sensors)
@@ -160,11 +160,13 @@ class _Catalog:
             merged[inputs] = merged.get(inputs, 0) | provided
         pending = list(merged.items())
         fired: list[tuple[int, int]] = []
-        names = {bit: name for name, bit in self.ontology.type_bits.items()}
+        names = self.ontology.bit_types
         self._known_by_round = [known]  # what is producible after each round
+        self._fired_before = [0]  # per round: how many rules fired in earlier rounds (their place in ``fired``)
         current = 0
         while True:
             current += 1
+            self._fired_before.append(len(fired))
             new = 0
             waiting = []
             for rule in pending:
@@ -179,7 +181,7 @@ class _Catalog:
                 return rounds, fired
             while new:
                 bit = new & -new
-                rounds[names[bit]] = current
+                rounds[names[bit.bit_length() - 1]] = current
                 known |= bit
                 new ^= bit
             self._known_by_round.append(known)
@@ -279,21 +281,25 @@ class _Catalog:
         from types of earlier rounds, none of them forbidden.
         """
         by_round = self._known_by_round
-        known = by_round[0]
+        start = 0
         for made in by_round[1:]:
             if made & forbidden:
                 break
-            known = made
+            start += 1
+        known = by_round[start]
+        # a rule that fired by round ``start`` provides only types already known
         allowed = ~forbidden
-        pending = [rule for rule in self._rules if rule[1] & allowed & ~known]
+        missing = allowed & ~known
+        pending = [rule for rule in self._rules[self._fired_before[start + 1] :] if rule[1] & missing]
         while True:
+            before = known
             waiting = []
             for rule in pending:
                 if rule[0] & known == rule[0]:
                     known |= rule[1] & allowed
                 else:
                     waiting.append(rule)
-            if len(waiting) == len(pending):
+            if known == before:  # the waiting rules wait for types that nothing made in this pass
                 return known
             pending = waiting
 
