@@ -274,19 +274,24 @@ class _Catalog:
             self._refiners[type_name] = found
         return found
 
+    def _start_round(self, forbidden: int) -> int:
+        """The last fixpoint round before the first in which a ``forbidden`` type is made: what was made by then
+        is producible without the forbidden types."""
+        start = 0
+        for made in self._known_by_round[1:]:
+            if made & forbidden:
+                break
+            start += 1
+        return start
+
     def _fixpoint(self, forbidden: int) -> int:
         """Make the types a rule provides known (unless forbidden) once all its inputs are, until none becomes so.
 
         It starts from every type made in a round before the first forbidden type is: each of them was first made
         from types of earlier rounds, none of them forbidden.
         """
-        by_round = self._known_by_round
-        start = 0
-        for made in by_round[1:]:
-            if made & forbidden:
-                break
-            start += 1
-        known = by_round[start]
+        start = self._start_round(forbidden)
+        known = self._known_by_round[start]
         # a rule that fired by round ``start`` provides only types already known
         allowed = ~forbidden
         missing = allowed & ~known
@@ -339,9 +344,27 @@ class _Catalog:
         """Providers of ``type_name`` whose inputs can be produced without it and without the types ``above`` it
         (those that need it), so that choosing them cannot create a cycle; ``by_rounds`` keeps only those whose
         inputs are derived earliest."""
-        usable = self.producible_without(above | {type_name})
+        providers = self.providers(type_name, value)
         masks = self.ontology.port_masks
-        found = [s for s in self.providers(type_name, value) if masks[s.name][0] & usable == masks[s.name][0]]
+        # what was made before the first round making a forbidden type is producible without them: providers
+        # reading only that are usable without the fixpoint, which is needed only when others could be chosen too
+        forbidden = self.ontology.mask(above) | self.ontology.type_bits.get(type_name, 0)
+        surely = self._known_by_round[self._start_round(forbidden & self._forbiddable)]
+        sure = [s for s in providers if masks[s.name][0] & surely == masks[s.name][0]]
+        if by_rounds and sure:
+            rounds = [self.input_round(s) for s in sure]
+            limit = min(rounds)
+            # the others fire after that round (when their rule fires at all): the strict choice drops them whether
+            # usable or not
+            fired = self._fired_round
+            if len(sure) == len(providers) or all(
+                masks[s.name][0] in fired or self.input_round(s) > limit for s in providers if s not in sure
+            ):
+                return [s for s, r in zip(sure, rounds, strict=True) if r == limit]
+        elif len(sure) == len(providers):
+            return sure
+        usable = self.producible_without(above | {type_name})
+        found = [s for s in providers if masks[s.name][0] & usable == masks[s.name][0]]
         if by_rounds and found:
             rounds = [self.input_round(s) for s in found]
             limit = min(rounds)
