@@ -350,18 +350,20 @@ class _Catalog:
         # reading only that are usable without the fixpoint, which is needed only when others could be chosen too
         forbidden = self.ontology.mask(above) | self.ontology.type_bits.get(type_name, 0)
         surely = self._known_by_round[self._start_round(forbidden & self._forbiddable)]
-        sure = [s for s in providers if masks[s.name][0] & surely == masks[s.name][0]]
+        sure: list[AnnotatorSpec] = []
+        others: list[AnnotatorSpec] = []
+        for spec in providers:
+            inputs = masks[spec.name][0]
+            (sure if inputs & surely == inputs else others).append(spec)
         if by_rounds and sure:
             rounds = [self.input_round(s) for s in sure]
             limit = min(rounds)
             # the others fire after that round (when their rule fires at all): the strict choice drops them whether
             # usable or not
             fired = self._fired_round
-            if len(sure) == len(providers) or all(
-                masks[s.name][0] in fired or self.input_round(s) > limit for s in providers if s not in sure
-            ):
+            if all(masks[s.name][0] in fired or self.input_round(s) > limit for s in others):
                 return [s for s, r in zip(sure, rounds, strict=True) if r == limit]
-        elif len(sure) == len(providers):
+        elif not others:
             return sure
         usable = self.producible_without(above | {type_name})
         found = [s for s in providers if masks[s.name][0] & usable == masks[s.name][0]]
