@@ -446,6 +446,7 @@ class _Assignment:
         self.units: dict[str, _UnitChoice] = {}
         self.above: dict[str, set[str]] = {}
         self._guaranteed: dict[str, str] | None = None
+        self._by_order: dict[str, str] | None = None  # the type -> unit mapping by unit order alone, when current
         self._last_guaranteed: dict[str, str] | None = None
         self._owner: dict[str, str] | None = None
         self._owners: dict[str, str] = {}  # annotator name -> its unit, kept as the units change
@@ -484,6 +485,7 @@ class _Assignment:
 
     def _invalidate(self) -> None:
         self._version += 1
+        self._by_order = None
         self._clean_below = {}
         self._guaranteed = None
         self._owner = None
@@ -522,6 +524,33 @@ class _Assignment:
                 if by_rounds and latest >= rounds.get(type_name, 0):
                     continue  # a by-product made from later types could close a cycle in the strict mode
                 found[type_name] = key
+        self._by_order = found
+        return self._overridden(found)
+
+    def _add_guaranteed(self, key: str) -> None:
+        """Update the type -> unit mapping for the new unit ``key`` (when the mapping by unit order is known): the
+        types it guarantees that no unit earlier in the order does are now its."""
+        by_order = self._by_order
+        self._invalidate()
+        if by_order is None:
+            return
+        rounds = self.catalog.rounds
+        unit = self.units[key]
+        latest = unit.latest_round
+        place = (rounds.get(key, 0), key)
+        for type_name in unit.guaranteed_sorted:
+            if self.by_rounds and latest >= rounds.get(type_name, 0):
+                continue
+            present = by_order.get(type_name)
+            if present is None or (rounds.get(present, 0), present) > place:
+                by_order[type_name] = key
+        self._by_order = by_order
+        # the new unit's own type maps to it now (it did not before): the mapping changed
+        self._guaranteed = self._last_guaranteed = self._overridden(by_order)
+
+    def _overridden(self, by_order: dict[str, str]) -> dict[str, str]:
+        """The mapping by unit order with the pinned types and each unit's own type put to their units."""
+        found = dict(by_order)
         for type_name, key in self.pinned.items():
             if key in self.units and type_name in self.units[key].guaranteed():
                 found[type_name] = key
@@ -732,7 +761,7 @@ class _Assignment:
             self.units[type_name] = _UnitChoice(type_name, free, value, self.catalog)
             self._owners.update(dict.fromkeys((spec.name for spec in free), type_name))
             insort(self._order, (self.catalog.rounds.get(type_name, 0), type_name))
-            self._invalidate()
+            self._add_guaranteed(type_name)
             self.above[type_name] = set(above)
             reasons = self.reasons
             for spec in free:
