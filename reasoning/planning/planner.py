@@ -805,6 +805,32 @@ def _units_of(types: tuple[str, ...], guaranteed: Mapping[str, str]) -> tuple[st
     return tuple(sorted({guaranteed[t] for t in types if t in guaranteed}))
 
 
+def _depths(graph: Mapping[str, set[str]]) -> dict[str, int] | None:
+    """Each node's depth (0 without dependencies, else one more than its deepest dependency), or None when the
+    graph has a cycle."""
+    depth: dict[str, int] = {}
+
+    def level(node: str) -> int | None:
+        found = depth.get(node)
+        if found is not None:
+            return None if found < 0 else found  # -1: still being visited, a cycle
+        depth[node] = -1
+        deepest = -1
+        for dep in graph.get(node, ()):
+            below = level(dep)
+            if below is None:
+                return None
+            if below > deepest:
+                deepest = below
+        depth[node] = deepest + 1
+        return deepest + 1
+
+    for node in graph:
+        if level(node) is None:
+            return None
+    return depth
+
+
 def _find_cycle(graph: Mapping[str, set[str]]) -> list[str] | None:
     """A cycle of the graph (each node followed by a node it depends on), or None."""
     state: dict[str, int] = {}
@@ -893,6 +919,7 @@ class _Layout:
         for type_name, specs in self.refinements.items():
             self.final[type_name] = f"refine:{specs[-1].name}"
         self.dependencies: dict[str, set[str]] = {"reader": set()}
+        self._depth: dict[str, int] | None = None
         self.optional_edges: set[tuple[str, str]] = set()
         self.refines_output_of: dict[str, str] = {}
         for type_name, specs in sorted(self.refinements.items()):
@@ -982,7 +1009,7 @@ class _Layout:
             for spec in unit.providers:
                 for needed in spec.inputs:
                     consumers.setdefault(needed, set()).add(spec.name)
-        for type_name in sorted(set(self.units) | set(self.catalog.sensors)):
+        for type_name in set(self.units) | self.catalog.sensors:  # (sets of readers: the order is no matter)
             for spec in self.catalog.refiners(type_name):
                 for needed in spec.inputs:
                     consumers.setdefault(needed, set()).add(spec.name)
@@ -1026,22 +1053,29 @@ class _Layout:
         annotators): single-provider units whose outputs only the branch (or the ``rivals``) read."""
         owned: list[str] = []
         members = {spec.name}
+        readers = members | rivals  # who may read what moves into the branch
         frontier = list(spec.inputs)
         while frontier:
             needed = frontier.pop(0)
             key = guaranteed.get(needed)
             if key is None or key in owned or key == type_name or len(self.units[key].providers) != 1:
                 continue
-            if any(not consumers.get(t, set()) <= members | rivals for t in guarantees[key]):
+            if any(t in consumers and not consumers[t] <= readers for t in guarantees[key]):
                 continue
             owned.append(key)
             inner = self.units[key].providers[0]
             members.add(inner.name)
+            readers.add(inner.name)
             frontier.extend(inner.inputs)
         return owned, members
 
     def _required_cycle(self) -> list[str] | None:
-        """Drop optional ordering edges that close cycles; return a cycle of required edges, if any."""
+        """Drop optional ordering edges that close cycles; return a cycle of required edges, if any.
+
+        Without a cycle the units' depths (their stages) are kept from the check."""
+        self._depth = _depths(self.dependencies)
+        if self._depth is not None:
+            return None
         while True:
             cycle = _find_cycle(self.dependencies)
             if cycle is None:
@@ -1055,16 +1089,11 @@ class _Layout:
 
     def stages(self) -> tuple[tuple[Unit, ...], ...]:
         """Units grouped by dependency depth, in a deterministic order."""
-        depth: dict[str, int] = {}
-
-        def level(key: str) -> int:
-            if key not in depth:
-                depth[key] = 1 + max((level(d) for d in self.dependencies.get(key, set())), default=-1)
-            return depth[key]
-
+        depth = self._depth if self._depth is not None else _depths(self.dependencies)
+        assert depth is not None, "the dependencies were checked for cycles"
         by_level: dict[int, list[str]] = {}
         for key in sorted(self.dependencies):
-            by_level.setdefault(level(key), []).append(key)
+            by_level.setdefault(depth[key], []).append(key)
         return tuple(tuple(self._unit(key) for key in sorted(keys)) for _, keys in sorted(by_level.items()))
 
     def _label(self, key: str) -> str:
