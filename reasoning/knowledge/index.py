@@ -163,6 +163,8 @@ class OntologyIndex:
     """The CAS types by bit position: ``type_bits[bit_types[i]] == 1 << i``."""
     rule_ports: tuple[tuple[str, int, int, int], ...] = ()
     """The annotators with inputs (not sensor readers) in rank order, each with its ``port_masks``."""
+    rank_notes: Mapping[str, str] = field(default_factory=dict)
+    """Annotator -> its name with its rank: ``Name (reliability 0.9, 12 ms)`` (for the reasons of alternatives)."""
 
     def mask(self, types: Iterable[str]) -> int:
         """The bit mask of CAS types (names that are no CAS type are left out)."""
@@ -277,6 +279,7 @@ class _Builder:
             },
             bit_types=bit_types,
             rule_ports=tuple((s.name, *port_masks[s.name]) for s in ranked if s.inputs),
+            rank_notes={s.name: f"{s.name} (reliability {s.reliability:g}, {s.cost_ms:g} ms)" for s in ranked},
         )
 
     def _written_types(self, annotators: Mapping[str, AnnotatorSpec]) -> dict[str, frozenset[str]]:

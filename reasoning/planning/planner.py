@@ -950,9 +950,14 @@ class _Layout:
                 continue
             required: dict[str, None] = {}
             optional: dict[str, None] = {}
+            branches = self.branches.get(type_name)
             for spec in self.units[type_name].providers:
+                if not branches or not branches.get(spec.name):  # the alternative alone in its branch
+                    required.update(dict.fromkeys(spec.inputs))
+                    optional.update(dict.fromkeys(spec.optional_inputs))
+                    continue
                 members = self._members(type_name, spec)
-                inside = set(self.branches.get(type_name, {}).get(spec.name, []))
+                inside = set(branches[spec.name])
                 required.update(dict.fromkeys(t for m in members for t in m.inputs if t not in inside))
                 optional.update(dict.fromkeys(t for m in members for t in m.optional_inputs if t not in inside))
             found[type_name] = (tuple(required), tuple(optional))
@@ -1110,12 +1115,15 @@ class _Layout:
             return name
         return " / ".join(s.name for s in self.units[name].providers)
 
-    def _step(self, spec: AnnotatorSpec, why: str, provides: str = "", inside: Iterable[str] = ()) -> Step:
-        inside_types = {t for key in inside for t in self.units[key].guaranteed()} if inside else frozenset()
+    def _step(
+        self, spec: AnnotatorSpec, why: str, provides: str = "", inside_types: frozenset[str] = frozenset()
+    ) -> Step:
+        """The step of ``spec``, its reason naming what feeds each input (``inside_types``: the types made by the
+        units moved into its branch)."""
         final = self.final
         feeds = []
         for needed in spec.inputs:
-            if needed in inside_types:
+            if inside_types and needed in inside_types:
                 maker = self.units[self.assignment.guaranteed_by()[needed]].providers[0].name
                 feeds.append(f"{needed} from {maker}")
             elif needed in spec.outputs and spec.name in self.refines_output_of:
@@ -1155,11 +1163,18 @@ class _Layout:
         branches = []
         why = self._why(name)
         for spec in unit.providers:
-            members = self._members(name, spec)
             owned = self.branches[name][spec.name]
-            inner = tuple(self._step(m, f"needed only by {spec.name}", inside=owned) for m in members[:-1])
-            branches.append((*inner, self._step(spec, why, provides=name, inside=owned)))
-        ranking = ", ".join(f"{s.name} (reliability {s.reliability:g}, {s.cost_ms:g} ms)" for s in unit.providers)
+            if not owned:
+                branches.append((self._step(spec, why, provides=name),))
+                continue
+            inside = frozenset(t for key in owned for t in self.units[key].guaranteed())
+            inner = tuple(
+                self._step(m, f"needed only by {spec.name}", inside_types=inside)
+                for m in self._members(name, spec)[:-1]
+            )
+            branches.append((*inner, self._step(spec, why, provides=name, inside_types=inside)))
+        notes = self.catalog.ontology.rank_notes
+        ranking = ", ".join(notes[s.name] for s in unit.providers)
         return Alternatives(
             provides=name,
             branches=tuple(branches),
