@@ -163,6 +163,8 @@ class OntologyIndex:
     """The CAS types by bit position: ``type_bits[bit_types[i]] == 1 << i``."""
     rule_ports: tuple[tuple[str, int, int, int], ...] = ()
     """The annotators with inputs (not sensor readers) in rank order, each with its ``port_masks``."""
+    class_annotators: Mapping[str, frozenset[str]] = field(default_factory=dict)
+    """Object class -> the annotators with a class domain naming it (``class_domain`` by class)."""
     rank_notes: Mapping[str, str] = field(default_factory=dict)
     """Annotator -> its name with its rank: ``Name (reliability 0.9, 12 ms)`` (for the reasons of alternatives)."""
 
@@ -279,8 +281,18 @@ class _Builder:
             },
             bit_types=bit_types,
             rule_ports=tuple((s.name, *port_masks[s.name]) for s in ranked if s.inputs),
+            class_annotators=self._class_annotators(ranked),
             rank_notes={s.name: f"{s.name} (reliability {s.reliability:g}, {s.cost_ms:g} ms)" for s in ranked},
         )
+
+    @staticmethod
+    def _class_annotators(ranked: Iterable[AnnotatorSpec]) -> dict[str, frozenset[str]]:
+        """Object class -> the annotators whose class domain names it."""
+        found: dict[str, set[str]] = defaultdict(set)
+        for spec in ranked:
+            for class_name in spec.classes:
+                found[class_name].add(spec.name)
+        return {name: frozenset(specs) for name, specs in found.items()}
 
     def _written_types(self, annotators: Mapping[str, AnnotatorSpec]) -> dict[str, frozenset[str]]:
         """Per annotator whose port types are all classes: its outputs and their supertypes, minus its inputs and
