@@ -401,26 +401,23 @@ class _UnitChoice:
         self._written = catalog.written
         self._written_types = catalog.ontology.written_types
         self._input_round = catalog.input_round
+        self.choose(providers)
+
+    def choose(self, providers: list[AnnotatorSpec]) -> None:
+        """Make ``providers`` (best first) the unit's alternatives."""
         self.providers = providers
-
-    @property
-    def providers(self) -> list[AnnotatorSpec]:
-        """The alternatives, best first."""
-        return self._providers
-
-    @providers.setter
-    def providers(self, providers: list[AnnotatorSpec]) -> None:
-        self._providers = providers
         known = self._written_types
         self._guaranteed = frozenset.intersection(*[known.get(s.name) or self._written(s) for s in providers])
         self.guaranteed_sorted = tuple(sorted(self._guaranteed))
+        # the types some alternative reads
+        self.read: frozenset[str] | tuple[str, ...] = frozenset(t for s in providers for t in s.inputs) if len(providers) > 1 else providers[0].inputs
         self._latest_round: int | None = None
 
     @property
     def latest_round(self) -> int:
         """The latest fixpoint round among the inputs of any provider."""
         if self._latest_round is None:
-            self._latest_round = max(map(self._input_round, self._providers))
+            self._latest_round = max(map(self._input_round, self.providers))
         return self._latest_round
 
     def guaranteed(self) -> frozenset[str]:
@@ -494,7 +491,7 @@ class _Assignment:
         owners = self._owners
         for spec in self.units[key].providers:
             del owners[spec.name]
-        self.units[key].providers = providers
+        self.units[key].choose(providers)
         owners.update(dict.fromkeys((spec.name for spec in providers), key))
         self._invalidate()
 
@@ -727,7 +724,7 @@ class _Assignment:
                 above: set[str] = set()
             else:
                 unit = units.get(consumer)
-                if unit is None or not any(type_name in s.inputs for s in unit.providers):
+                if unit is None or type_name not in unit.read:
                     continue  # the consumer's alternatives that needed it were dropped
                 above = self.above.get(consumer, set()) | {consumer}
             existing = (self._guaranteed or self.guaranteed_by()).get(type_name)
@@ -1094,6 +1091,7 @@ class _Layout:
 
     def stages(self) -> tuple[tuple[Unit, ...], ...]:
         """Units grouped by dependency depth, in a deterministic order."""
+        self._refiner_of = {s.name: (t, s) for t, specs in self.refinements.items() for s in specs}
         depth = self._depth if self._depth is not None else _depths(self.dependencies)
         assert depth is not None, "the dependencies were checked for cycles"
         by_level: dict[int, list[str]] = {}
@@ -1155,7 +1153,7 @@ class _Layout:
             return self.source.step
         kind, name = key.split(":", 1)
         if kind == "refine":
-            refined, spec = next((t, s) for t, specs in self.refinements.items() for s in specs if s.name == name)
+            refined, spec = self._refiner_of[name]
             return self._step(spec, f"refines {refined} before it is used ({_precondition_note(spec)})")
         unit = self.units[name]
         if len(unit.providers) == 1:
