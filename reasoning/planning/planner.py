@@ -410,7 +410,9 @@ class _UnitChoice:
         self._guaranteed = frozenset.intersection(*[known.get(s.name) or self._written(s) for s in providers])
         self.guaranteed_sorted = tuple(sorted(self._guaranteed))
         # the types some alternative reads
-        self.read: frozenset[str] | tuple[str, ...] = frozenset(t for s in providers for t in s.inputs) if len(providers) > 1 else providers[0].inputs
+        self.read: frozenset[str] | tuple[str, ...] = (
+            frozenset(t for s in providers for t in s.inputs) if len(providers) > 1 else providers[0].inputs
+        )
         self._latest_round: int | None = None
 
     @property
