@@ -130,6 +130,7 @@ class _Catalog:
         self._refiners: dict[str, list[AnnotatorSpec]] = {}
         self._without: dict[int, int] = {}
         self._input_rounds: dict[str, int] = {}
+        self._grouped: dict[tuple[str, str | None], tuple[int, int, tuple[AnnotatorSpec, ...]] | None] = {}
         self._known_by_round: list[int] = []
         self._fired_round: dict[int, int] = {}  # inputs mask of a rule -> the fixpoint round in which it fires
         self._excluded, self._own_types_only = index.provider_exclusions(object_class, conditions)
@@ -345,11 +346,22 @@ class _Catalog:
         (those that need it), so that choosing them cannot create a cycle; ``by_rounds`` keeps only those whose
         inputs are derived earliest."""
         providers = self.providers(type_name, value)
+        if not providers:
+            return []
         masks = self.ontology.port_masks
         # what was made before the first round making a forbidden type is producible without them: providers
         # reading only that are usable without the fixpoint, which is needed only when others could be chosen too
         forbidden = self.ontology.mask(above) | self.ontology.type_bits.get(type_name, 0)
-        surely = self._known_by_round[self._start_round(forbidden & self._forbiddable)]
+        start = self._start_round(forbidden & self._forbiddable)
+        grouped = self._input_rounds_of(type_name, value, providers)
+        if grouped is not None:
+            # every provider's rule fires: it reads only what was made by ``start`` when it fires by ``start + 1``
+            earliest, latest, first = grouped
+            if by_rounds and earliest <= start:
+                return list(first)
+            if not by_rounds and latest <= start:
+                return list(providers)
+        surely = self._known_by_round[start]
         sure: list[AnnotatorSpec] = []
         others: list[AnnotatorSpec] = []
         for spec in providers:
@@ -371,6 +383,25 @@ class _Catalog:
             rounds = [self.input_round(s) for s in found]
             limit = min(rounds)
             found = [s for s, r in zip(found, rounds, strict=True) if r <= limit]
+        return found
+
+    def _input_rounds_of(
+        self, type_name: str, value: str | None, providers: tuple[AnnotatorSpec, ...]
+    ) -> tuple[int, int, tuple[AnnotatorSpec, ...]] | None:
+        """The earliest and latest input round of the (non-empty) ``providers`` of ``type_name`` for ``value``, and
+        those with the earliest (memoised); None when the rule of some provider never fires."""
+        key = (type_name, value)
+        if key in self._grouped:
+            return self._grouped[key]
+        masks, fired = self.ontology.port_masks, self._fired_round
+        found: tuple[int, int, tuple[AnnotatorSpec, ...]] | None = None
+        # a provider's input round is the one before its rule fires (:meth:`input_round`)
+        rounds = [fired.get(masks[s.name][0], -1) for s in providers]
+        if -1 not in rounds:
+            earliest = min(rounds)
+            first = tuple(s for s, r in zip(providers, rounds, strict=True) if r == earliest)
+            found = (earliest - 1, max(rounds) - 1, first)
+        self._grouped[key] = found
         return found
 
     def why_not(self, type_name: str, value: str | None) -> str:
