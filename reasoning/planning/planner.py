@@ -1107,11 +1107,10 @@ class _Layout:
     def _required_cycle(self) -> list[str] | None:
         """Drop optional ordering edges that close cycles; return a cycle of required edges, if any.
 
-        Without a cycle the units' depths (their stages) are kept from the check."""
+        Without a cycle the units' depths (their stages) are kept from the check (which finds no depths when there
+        is one)."""
         self._depth = _depths(self.dependencies)
-        if self._depth is not None:
-            return None
-        while True:
+        while self._depth is None:
             cycle = _find_cycle(self.dependencies)
             if cycle is None:
                 return None
@@ -1121,6 +1120,8 @@ class _Layout:
                 return cycle
             consumer, producer = optional[0]
             self.dependencies[consumer].discard(producer)
+            self._depth = _depths(self.dependencies)
+        return None
 
     def stages(self) -> tuple[tuple[Unit, ...], ...]:
         """Units grouped by dependency depth, in a deterministic order."""
