@@ -385,6 +385,16 @@ class _Catalog:
             found = [s for s, r in zip(found, rounds, strict=True) if r <= limit]
         return found
 
+    def has_valid(self, type_name: str, value: str | None) -> bool:
+        """Whether :meth:`valid` finds some provider of ``type_name`` for ``value`` (nothing forbidden above it)."""
+        providers = self.providers(type_name, value)
+        if not providers:
+            return False
+        grouped = self._input_rounds_of(type_name, value, providers)
+        start = self._start_round(self.ontology.type_bits.get(type_name, 0) & self._forbiddable)
+        # a provider whose rule fires by ``start + 1`` reads only what was made without the type
+        return (grouped is not None and grouped[0] <= start) or bool(self.valid(type_name, value))
+
     def _input_rounds_of(
         self, type_name: str, value: str | None, providers: tuple[AnnotatorSpec, ...]
     ) -> tuple[int, int, tuple[AnnotatorSpec, ...]] | None:
@@ -501,7 +511,7 @@ class _Assignment:
             type_name, value = requirement.annotation_type, requirement.value
             if type_name in self.catalog.sensors:
                 continue
-            if type_name not in self.catalog.producible or not self.catalog.valid(type_name, value):
+            if type_name not in self.catalog.producible or not self.catalog.has_valid(type_name, value):
                 raise PlanningError(
                     f"cannot satisfy '{requirement.reason or type_name}': {self.catalog.why_not(type_name, value)}"
                 )
