@@ -779,7 +779,7 @@ class _Assignment:
             if existing == type_name:
                 # the type's own unit leads back to this consumer: choose its providers again under all constraints
                 combined = above | self.above.get(type_name, set())
-                owner = self.owner()
+                owner = self._owners  # read here only, before the units change
                 again = [
                     s
                     for s in self.catalog.valid(type_name, value, frozenset(combined), self.by_rounds)
@@ -792,8 +792,8 @@ class _Assignment:
                 queue.extend((needed, type_name) for spec in again for needed in spec.inputs)
                 continue
             valid = self.catalog.valid(type_name, value, frozenset(above), self.by_rounds)
-            owner = self.owner()
-            free = [s for s in valid if s.name not in owner]
+            owners = self._owners  # read here only, before the units change
+            free = [s for s in valid if s.name not in owners]
             if not free:
                 if not self._take_over(type_name, valid, consumer, above):
                     raise _OrderingError(f"cannot produce {type_name}: {self.catalog.why_not(type_name, value)}")
