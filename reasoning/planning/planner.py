@@ -130,7 +130,9 @@ class _Catalog:
         self._refiners: dict[str, list[AnnotatorSpec]] = {}
         self._without: dict[int, int] = {}
         self._input_rounds: dict[str, int] = {}
-        self._grouped: dict[tuple[str, str | None], tuple[int, int, tuple[AnnotatorSpec, ...]] | None] = {}
+        self._grouped: dict[
+            tuple[str, str | None], tuple[int, int, tuple[AnnotatorSpec, ...], tuple[AnnotatorSpec, ...]] | None
+        ] = {}
         self._known_by_round: list[int] = []
         self._fired_round: dict[int, int] = {}  # inputs mask of a rule -> the fixpoint round in which it fires
         self._excluded, self._own_types_only = index.provider_exclusions(object_class, conditions)
@@ -356,11 +358,11 @@ class _Catalog:
         grouped = self._input_rounds_of(type_name, value, providers)
         if grouped is not None:
             # every provider's rule fires: it reads only what was made by ``start`` when it fires by ``start + 1``
-            earliest, latest, first = grouped
+            earliest, latest, first, candidates = grouped
             if by_rounds and earliest <= start:
                 return list(first)
             if not by_rounds and latest <= start:
-                return list(providers)
+                return list(candidates)
         surely = self._known_by_round[start]
         sure: list[AnnotatorSpec] = []
         others: list[AnnotatorSpec] = []
@@ -397,20 +399,23 @@ class _Catalog:
 
     def _input_rounds_of(
         self, type_name: str, value: str | None, providers: tuple[AnnotatorSpec, ...]
-    ) -> tuple[int, int, tuple[AnnotatorSpec, ...]] | None:
-        """The earliest and latest input round of the (non-empty) ``providers`` of ``type_name`` for ``value``, and
-        those with the earliest (memoised); None when the rule of some provider never fires."""
+    ) -> tuple[int, int, tuple[AnnotatorSpec, ...], tuple[AnnotatorSpec, ...]] | None:
+        """Of the ``providers`` of ``type_name`` for ``value`` that read only producible types (no others are ever
+        valid): the earliest and latest input round, those with the earliest and all of them (memoised); None when
+        there are none or the rule of one of them never fires."""
         key = (type_name, value)
         if key in self._grouped:
             return self._grouped[key]
         masks, fired = self.ontology.port_masks, self._fired_round
-        found: tuple[int, int, tuple[AnnotatorSpec, ...]] | None = None
+        producible = self._known_by_round[-1]
+        found: tuple[int, int, tuple[AnnotatorSpec, ...], tuple[AnnotatorSpec, ...]] | None = None
+        candidates = tuple(s for s in providers if masks[s.name][0] & producible == masks[s.name][0])
         # a provider's input round is the one before its rule fires (:meth:`input_round`)
-        rounds = [fired.get(masks[s.name][0], -1) for s in providers]
-        if -1 not in rounds:
+        rounds = [fired.get(masks[s.name][0], -1) for s in candidates]
+        if candidates and -1 not in rounds:
             earliest = min(rounds)
-            first = tuple(s for s, r in zip(providers, rounds, strict=True) if r == earliest)
-            found = (earliest - 1, max(rounds) - 1, first)
+            first = tuple(s for s, r in zip(candidates, rounds, strict=True) if r == earliest)
+            found = (earliest - 1, max(rounds) - 1, first, candidates)
         self._grouped[key] = found
         return found
 
