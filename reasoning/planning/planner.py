@@ -1054,39 +1054,43 @@ class _Layout:
         """
         # only required inputs bind a unit to the stage: an optional reader (size or shape using the plane when
         # there is one) runs after the Fallback that may have made it and does without when no branch did
+        multiple = sorted(t for t, unit in self.units.items() if len(unit.providers) > 1)
+        if not multiple:
+            return {}
         consumers: dict[str, set[str]] = {}
-        for unit in self.units.values():
-            for spec in unit.providers:
-                for needed in spec.inputs:
-                    consumers.setdefault(needed, set()).add(spec.name)
+        specs = [s for unit in self.units.values() for s in unit.providers]
         for type_name in set(self.units) | self.catalog.sensors:  # (sets of readers: the order is no matter)
-            for spec in self.catalog.refiners(type_name):
-                for needed in spec.inputs:
-                    consumers.setdefault(needed, set()).add(spec.name)
+            specs += self.catalog.refiners(type_name)
+        for spec in specs:
+            for needed in spec.inputs:
+                found = consumers.get(needed)
+                if found is None:
+                    consumers[needed] = {spec.name}
+                else:
+                    found.add(spec.name)
         guaranteed = self.assignment.guaranteed_by()
         guarantees: dict[str, list[str]] = {}
         for type_name, key in guaranteed.items():
             guarantees.setdefault(key, []).append(type_name)
+        # per unit: who reads what it guarantees
+        readers = {key: set().union(*(consumers.get(t, ()) for t in types)) for key, types in guarantees.items()}
         branches: dict[str, dict[str, list[str]]] = {}
-        for type_name in sorted(self.units):
+        for type_name in multiple:
             unit = self.units[type_name]
-            if len(unit.providers) < 2:
-                continue
             rivals = {s.name for s in unit.providers}
             # a unit only alternatives of this type need goes into each of their branches: a branch that fails
             # (its plane not found) then hands over to the next, which makes its own - unless some alternative
             # needing it would not own it, then units go into a branch only when that branch alone needs them
-            shared = {spec.name: self._owned(spec, type_name, consumers, guaranteed, guarantees, rivals)
-                      for spec in unit.providers}  # fmt: skip
+            shared = {spec.name: self._owned(spec, type_name, guaranteed, readers, rivals) for spec in unit.providers}
             if not all(
                 consumer in members or (consumer in rivals and key in shared[consumer][0])
                 for owned, members in shared.values()
                 for key in owned
-                for t in guarantees[key]
-                for consumer in consumers.get(t, set())
+                for consumer in readers[key]
             ):
-                shared = {spec.name: self._owned(spec, type_name, consumers, guaranteed, guarantees, set())
-                          for spec in unit.providers}  # fmt: skip
+                shared = {
+                    spec.name: self._owned(spec, type_name, guaranteed, readers, set()) for spec in unit.providers
+                }
             branches[type_name] = {name: owned for name, (owned, _) in shared.items()}
         return branches
 
@@ -1094,28 +1098,28 @@ class _Layout:
         self,
         spec: AnnotatorSpec,
         type_name: str,
-        consumers: dict[str, set[str]],
         guaranteed: dict[str, str],
-        guarantees: dict[str, list[str]],
+        readers: dict[str, set[str]],
         rivals: set[str],
     ) -> tuple[list[str], set[str]]:
         """The units that move into the branch of alternative ``spec`` of ``type_name`` (and the branch's
-        annotators): single-provider units whose outputs only the branch (or the ``rivals``) read."""
+        annotators): single-provider units whose outputs only the branch (or the ``rivals``) read (``readers``: who
+        reads what each unit guarantees)."""
         owned: list[str] = []
         members = {spec.name}
-        readers = members | rivals  # who may read what moves into the branch
+        allowed = members | rivals  # who may read what moves into the branch
         frontier = list(spec.inputs)
         while frontier:
             needed = frontier.pop(0)
             key = guaranteed.get(needed)
             if key is None or key in owned or key == type_name or len(self.units[key].providers) != 1:
                 continue
-            if any(t in consumers and not consumers[t] <= readers for t in guarantees[key]):
+            if not readers[key] <= allowed:
                 continue
             owned.append(key)
             inner = self.units[key].providers[0]
             members.add(inner.name)
-            readers.add(inner.name)
+            allowed.add(inner.name)
             frontier.extend(inner.inputs)
         return owned, members
 
