@@ -409,13 +409,21 @@ class _Catalog:
         masks, fired = self.ontology.port_masks, self._fired_round
         producible = self._known_by_round[-1]
         found: tuple[int, int, tuple[AnnotatorSpec, ...], tuple[AnnotatorSpec, ...]] | None = None
-        candidates = tuple(s for s in providers if masks[s.name][0] & producible == masks[s.name][0])
-        # a provider's input round is the one before its rule fires (:meth:`input_round`)
-        rounds = [fired.get(masks[s.name][0], -1) for s in candidates]
-        if candidates and -1 not in rounds:
+        chosen: list[AnnotatorSpec] = []
+        rounds: list[int] = []  # a provider's input round is the one before its rule fires (:meth:`input_round`)
+        for spec in providers:
+            inputs = masks[spec.name][0]
+            fires = fired.get(inputs)
+            if fires is not None:
+                chosen.append(spec)
+                rounds.append(fires)
+            elif inputs & producible == inputs:  # reads only producible types, yet its rule never fires
+                rounds = []
+                break
+        if rounds:
             earliest = min(rounds)
-            first = tuple(s for s, r in zip(candidates, rounds, strict=True) if r == earliest)
-            found = (earliest - 1, max(rounds) - 1, first, candidates)
+            first = tuple(s for s, r in zip(chosen, rounds, strict=True) if r == earliest)
+            found = (earliest - 1, max(rounds) - 1, first, tuple(chosen))
         self._grouped[key] = found
         return found
 
