@@ -986,12 +986,17 @@ class _Layout:
                 self.dependencies[key] = (required | optional) - {key}
                 previous = key
         final = self.final
+        edges, dependencies = self.optional_edges, self.dependencies
         for type_name, (required_types, optional_types) in self._unit_inputs.items():
             key = f"type:{type_name}"
             deps = {final[t] for t in required_types if t in final}
-            optional = {final[t] for t in optional_types if t in final}
-            self.optional_edges |= {(key, dep) for dep in optional - deps}
-            self.dependencies[key] = (deps | optional) - {key}
+            if optional_types:
+                optional = {final[t] for t in optional_types if t in final} - deps
+                if optional:
+                    edges.update((key, dep) for dep in optional)
+                    deps |= optional
+            deps.discard(key)
+            dependencies[key] = deps
 
     def _branch_inputs(self) -> dict[str, tuple[tuple[str, ...], tuple[str, ...]]]:
         """Per provider unit not absorbed into a branch (sorted): the required and the optional input types its
