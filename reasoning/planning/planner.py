@@ -166,6 +166,7 @@ class _Catalog:
         names = self.ontology.bit_types
         self._known_by_round = [known]  # what is producible after each round
         self._fired_before = [0]  # per round: how many rules fired in earlier rounds (their place in ``fired``)
+        fired_round = self._fired_round
         current = 0
         while True:
             current += 1
@@ -173,10 +174,11 @@ class _Catalog:
             new = 0
             waiting = []
             for rule in pending:
-                if rule[0] & known == rule[0]:
+                inputs = rule[0]
+                if inputs & known == inputs:
                     new |= rule[1]
                     fired.append(rule)
-                    self._fired_round[rule[0]] = current
+                    fired_round[inputs] = current
                 else:
                     waiting.append(rule)
             new &= ~known
