@@ -137,7 +137,7 @@ class _Catalog:
         self._fired_round: dict[int, int] = {}  # inputs mask of a rule -> the fixpoint round in which it fires
         self._excluded, self._own_types_only = index.provider_exclusions(object_class, conditions)
         excluded, own_types_only = self._excluded, self._own_types_only
-        rules: list[tuple[int, int]] = []
+        rules: dict[int, int] = {}  # the usable providers' rules, merged per inputs: inputs -> what they provide
         # annotators without inputs (sensor readers) are not in ``rule_ports``; a provider does not provide what it
         # reads (a refiner)
         for name, inputs, outputs, written in self.ontology.rule_ports:
@@ -145,23 +145,20 @@ class _Catalog:
                 continue
             provided = (outputs if name in own_types_only else written) & ~inputs
             if provided:
-                rules.append((inputs, provided))
+                rules[inputs] = rules.get(inputs, 0) | provided
         self._sensor_mask = self.ontology.mask(self.sensors)
         self.rounds, self._rules = self._rounds(rules)
         self.producible = frozenset(self.rounds)
         # forbidding a sensor type or one nothing produces changes no fixpoint: such types are left out of the key
         self._forbiddable = self.ontology.mask(self.producible) & ~self._sensor_mask
 
-    def _rounds(self, rules: list[tuple[int, int]]) -> tuple[dict[str, int], list[tuple[int, int]]]:
-        """The fixpoint round in which each producible type first becomes producible (sensors: 0), and the rules
-        that can fire at all, merged per inputs and in the order they fire (later fixpoints, which forbid types,
-        fire a subset of them)."""
+    def _rounds(self, rules: dict[int, int]) -> tuple[dict[str, int], list[tuple[int, int]]]:
+        """The fixpoint round in which each producible type first becomes producible (sensors: 0), and the
+        ``rules`` (merged per inputs) that can fire at all, in the order they fire (later fixpoints, which forbid
+        types, fire a subset of them)."""
         rounds = dict.fromkeys(self.sensors, 0)
         known = self._sensor_mask
-        merged: dict[int, int] = {}
-        for inputs, provided in rules:
-            merged[inputs] = merged.get(inputs, 0) | provided
-        pending = list(merged.items())
+        pending = list(rules.items())
         fired: list[tuple[int, int]] = []
         names = self.ontology.bit_types
         self._known_by_round = [known]  # what is producible after each round
