@@ -1157,6 +1157,7 @@ class _Layout:
     def stages(self) -> tuple[tuple[Unit, ...], ...]:
         """Units grouped by dependency depth, in a deterministic order."""
         self._refiner_of = {s.name: (t, s) for t, specs in self.refinements.items() for s in specs}
+        self._made_by: dict[str, str] = {}  # type -> "<type> from <its final producer>" (for the steps' reasons)
         depth = self._depth if self._depth is not None else _depths(self.dependencies)
         assert depth is not None, "the dependencies were checked for cycles"
         by_level: dict[int, list[str]] = {}
@@ -1183,7 +1184,7 @@ class _Layout:
     ) -> Step:
         """The step of ``spec``, its reason naming what feeds each input (``inside_types``: the types made by the
         units moved into its branch)."""
-        final = self.final
+        final, made = self.final, self._made_by
         feeds = []
         for needed in spec.inputs:
             if inside_types and needed in inside_types:
@@ -1192,7 +1193,10 @@ class _Layout:
             elif needed in spec.outputs and spec.name in self.refines_output_of:
                 feeds.append(f"{needed} from {self._label(self.refines_output_of[spec.name])}")
             elif needed in final:
-                feeds.append(f"{needed} from {self._label(final[needed])}")
+                feed = made.get(needed)
+                if feed is None:
+                    feed = made[needed] = f"{needed} from {self._label(final[needed])}"
+                feeds.append(feed)
         reason = f"{spec.name}: {why}; needs {', '.join(feeds)}" if feeds else f"{spec.name}: {why}"
         parameters = self.parameters.get(spec.name)
         return Step(
