@@ -869,8 +869,12 @@ def _depths(graph: Mapping[str, set[str]]) -> dict[str, int] | None:
         depth[node] = -1
         deepest = -1
         for dep in graph.get(node, ()):
-            below = level(dep)
+            below = depth.get(dep)
             if below is None:
+                below = level(dep)
+                if below is None:
+                    return None
+            elif below < 0:
                 return None
             if below > deepest:
                 deepest = below
@@ -878,7 +882,7 @@ def _depths(graph: Mapping[str, set[str]]) -> dict[str, int] | None:
         return deepest + 1
 
     for node in graph:
-        if level(node) is None:
+        if node not in depth and level(node) is None:
             return None
     return depth
 
