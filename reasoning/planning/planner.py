@@ -150,7 +150,7 @@ class _Catalog:
         self.rounds, self._rules = self._rounds(rules)
         self.producible = frozenset(self.rounds)
         # forbidding a sensor type or one nothing produces changes no fixpoint: such types are left out of the key
-        self._forbiddable = self.ontology.mask(self.producible) & ~self._sensor_mask
+        self._forbiddable = self._known_by_round[-1] & ~self._sensor_mask  # the producible types by bit
 
     def _rounds(self, rules: dict[int, int]) -> tuple[dict[str, int], list[tuple[int, int]]]:
         """The fixpoint round in which each producible type first becomes producible (sensors: 0), and the
