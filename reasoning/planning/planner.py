@@ -1203,20 +1203,25 @@ class _Layout:
                 feeds.append(feed)
         reason = f"{spec.name}: {why}; needs {', '.join(feeds)}" if feeds else f"{spec.name}: {why}"
         parameters = self.parameters.get(spec.name)
+        # positional (many steps per plan): annotator, implemented_by, inputs, outputs, parameters, reason, provides
         return Step(
-            annotator=spec.name,
-            implemented_by=spec.implemented_by,
-            inputs=tuple(spec.inputs),
-            outputs=tuple(spec.outputs),
-            parameters=tuple(sorted(parameters.items())) if parameters else (),
-            reason=reason,
-            provides=provides,
+            spec.name,
+            spec.implemented_by,
+            tuple(spec.inputs),
+            tuple(spec.outputs),
+            tuple(sorted(parameters.items())) if parameters else (),
+            reason,
+            provides,
         )
 
     def _why(self, type_name: str) -> str:
-        reasons = self.assignment.reasons.get(type_name, [])
-        consumers = [r.removeprefix("needed by ") for r in reasons if r.startswith("needed by ")]
-        others = [r for r in reasons if not r.startswith("needed by ")]
+        consumers: list[str] = []
+        others: list[str] = []
+        for reason in self.assignment.reasons.get(type_name, ()):
+            if reason.startswith("needed by "):
+                consumers.append(reason.removeprefix("needed by "))
+            else:
+                others.append(reason)
         if consumers:
             others.append(f"{type_name} is needed by {', '.join(consumers)}")
         return "; ".join(others) if others else f"provides {type_name}"
