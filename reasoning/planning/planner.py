@@ -781,7 +781,8 @@ class _Assignment:
                 unit = units.get(consumer)
                 if unit is None or type_name not in unit.read:
                     continue  # the consumer's alternatives that needed it were dropped
-                above = self.above.get(consumer, set()) | {consumer}
+                known = self.above.get(consumer)
+                above = {consumer} if known is None else known | {consumer}
             existing = (self._guaranteed or self.guaranteed_by()).get(type_name)
             if existing is not None and self._cut_and_reuse(existing, above):
                 continue
