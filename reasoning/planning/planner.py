@@ -1029,13 +1029,16 @@ class _Layout:
         """Refiners of planned types whose other inputs are planned too and that are not otherwise used."""
         used = set(self.assignment.owner())
         read = {r.annotation_type for r in self.assignment.requirements}
-        read |= {t for unit in self.units.values() for s in unit.providers for t in s.inputs}
+        for unit in self.units.values():
+            read.update(unit.read)
         found: dict[str, list[AnnotatorSpec]] = {}
-        for type_name in sorted(self.final.keys() & read):
+        final = self.final
+        for type_name in sorted(final.keys() & read):
+            candidates = self.catalog.refiners(type_name)
+            if not candidates:
+                continue
             usable = [
-                s
-                for s in self.catalog.refiners(type_name)
-                if s.name not in used and all(t == type_name or t in self.final for t in s.inputs)
+                s for s in candidates if s.name not in used and all(t == type_name or t in final for t in s.inputs)
             ]
             # refiners made for a situation (with preconditions, which hold) all apply; of the general-purpose
             # ones only the cheapest does, so two interchangeable crops are never chained
