@@ -937,10 +937,12 @@ class _Layout:
         self._branch_members: dict[tuple[str, str], list[AnnotatorSpec]] = {}  # (type, alternative) -> _members
         self.branches = self._branches()
         absorbed = {t for owned in self.branches.values() for types in owned.values() for t in types}
+        # type -> the key of its final producer (read by type only: the order is no matter)
         self.final: dict[str, str] = dict.fromkeys(catalog.sensors, "reader")
-        for type_name, key in sorted(assignment.guaranteed_by().items()):
+        keys = {key: f"type:{key}" for key in self.units}
+        for type_name, key in assignment.guaranteed_by().items():
             if key not in absorbed:
-                self.final[type_name] = f"type:{key}"
+                self.final[type_name] = keys[key]
         for owner_type, owned in self.branches.items():
             for types in owned.values():
                 for type_name in types:
