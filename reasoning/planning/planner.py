@@ -1005,11 +1005,11 @@ class _Layout:
             dependencies[key] = deps
 
     def _branch_inputs(self) -> dict[str, tuple[tuple[str, ...], tuple[str, ...]]]:
-        """Per provider unit not absorbed into a branch (sorted): the required and the optional input types its
+        """Per provider unit not absorbed into a branch: the required and the optional input types its
         branches read from outside themselves (they do not change with the refinements)."""
         absorbed = {t for owned in self.branches.values() for types in owned.values() for t in types}
         found: dict[str, tuple[tuple[str, ...], tuple[str, ...]]] = {}
-        for type_name in sorted(self.units):
+        for type_name in self.units:  # (read by type: the order is no matter)
             if type_name in absorbed:
                 continue
             required: dict[str, None] = {}
