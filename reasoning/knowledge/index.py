@@ -159,6 +159,14 @@ class OntologyIndex:
     """CAS type -> its providers that read it too (refiners), cheapest first (by cost, then name)."""
     inspected_types: tuple[str, ...] = ()
     """The annotation types answering the query keys marked ``rk:refinedByInspection true``, sorted."""
+    bit_types: tuple[str, ...] = ()
+    """The CAS types by bit position: ``type_bits[bit_types[i]] == 1 << i``."""
+    rule_ports: tuple[tuple[str, int, int, int], ...] = ()
+    """The annotators with inputs (not sensor readers) in rank order, each with its ``port_masks``."""
+    class_annotators: Mapping[str, frozenset[str]] = field(default_factory=dict)
+    """Object class -> the annotators with a class domain naming it (``class_domain`` by class)."""
+    rank_notes: Mapping[str, str] = field(default_factory=dict)
+    """Annotator -> its name with its rank: ``Name (reliability 0.9, 12 ms)`` (for the reasons of alternatives)."""
 
     def mask(self, types: Iterable[str]) -> int:
         """The bit mask of CAS types (names that are no CAS type are left out)."""
@@ -223,7 +231,9 @@ class _Builder:
         cas_types = frozenset(self.down.get("CasType", frozenset()))
         providers = self._providers(annotators)
         ranked = tuple(sorted(annotators.values(), key=lambda s: (-s.reliability, s.cost_ms, s.name)))
-        type_bits = {name: 1 << i for i, name in enumerate(sorted(cas_types))}
+        bit_types = tuple(sorted(cas_types))
+        type_bits = {name: 1 << i for i, name in enumerate(bit_types)}
+        port_masks = self._port_masks(annotators, providers, type_bits)
         needing: dict[str, set[str]] = defaultdict(set)
         for name, keys in annotator_conditions.items():
             for key in keys:
@@ -257,7 +267,7 @@ class _Builder:
             name_keys=self._name_keys(),
             ranked=ranked,
             type_bits=type_bits,
-            port_masks=self._port_masks(annotators, providers, type_bits),
+            port_masks=port_masks,
             needing={key: frozenset(names) for key, names in needing.items()},
             class_domain=tuple(spec for spec in ranked if spec.classes),
             look_alikes=self._look_alikes(profiles),
@@ -269,7 +279,20 @@ class _Builder:
                 t: tuple(sorted((s for s in specs if t in s.inputs), key=lambda s: (s.cost_ms, s.name)))
                 for t, specs in providers.items()
             },
+            bit_types=bit_types,
+            rule_ports=tuple((s.name, *port_masks[s.name]) for s in ranked if s.inputs),
+            class_annotators=self._class_annotators(ranked),
+            rank_notes={s.name: f"{s.name} (reliability {s.reliability:g}, {s.cost_ms:g} ms)" for s in ranked},
         )
+
+    @staticmethod
+    def _class_annotators(ranked: Iterable[AnnotatorSpec]) -> dict[str, frozenset[str]]:
+        """Object class -> the annotators whose class domain names it."""
+        found: dict[str, set[str]] = defaultdict(set)
+        for spec in ranked:
+            for class_name in spec.classes:
+                found[class_name].add(spec.name)
+        return {name: frozenset(specs) for name, specs in found.items()}
 
     def _written_types(self, annotators: Mapping[str, AnnotatorSpec]) -> dict[str, frozenset[str]]:
         """Per annotator whose port types are all classes: its outputs and their supertypes, minus its inputs and

@@ -499,10 +499,11 @@ class KnowledgeBase:
         holds["opaque"] = not transparent
         unmet = [key for key, held in holds.items() if not held]
         everywhere: set[str] = set().union(*(index.needing.get(key, ()) for key in unmet))
-        own_types: set[str] = set()
-        for spec in index.class_domain:
-            if object_up is None or spec.classes.isdisjoint(object_up):
-                own_types.add(spec.name)
-                if object_down is not None and spec.classes.isdisjoint(object_down):
-                    everywhere.add(spec.name)
+        # class-domain annotators naming no superclass (or the class itself) serve only their own types, and those
+        # naming no subclass either serve none
+        domains = index.class_annotators
+        own_types = {spec.name for spec in index.class_domain}
+        if object_up is not None and object_down is not None:
+            own_types.difference_update(*(domains.get(c, ()) for c in object_up))
+            everywhere |= own_types.difference(*(domains.get(c, ()) for c in object_down))
         return frozenset(everywhere), frozenset(own_types - everywhere)

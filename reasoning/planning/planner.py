@@ -130,48 +130,52 @@ class _Catalog:
         self._refiners: dict[str, list[AnnotatorSpec]] = {}
         self._without: dict[int, int] = {}
         self._input_rounds: dict[str, int] = {}
+        self._grouped: dict[
+            tuple[str, str | None], tuple[int, int, tuple[AnnotatorSpec, ...], tuple[AnnotatorSpec, ...]] | None
+        ] = {}
         self._known_by_round: list[int] = []
         self._fired_round: dict[int, int] = {}  # inputs mask of a rule -> the fixpoint round in which it fires
         self._excluded, self._own_types_only = index.provider_exclusions(object_class, conditions)
-        masks = self.ontology.port_masks
-        rules: list[tuple[int, int]] = []
-        for spec in self.ontology.ranked:
-            # annotators without inputs are sensor readers; a provider does not provide what it reads (a refiner)
-            if not spec.inputs or spec.name in self._excluded:
+        excluded, own_types_only = self._excluded, self._own_types_only
+        rules: dict[int, int] = {}  # the usable providers' rules, merged per inputs: inputs -> what they provide
+        # annotators without inputs (sensor readers) are not in ``rule_ports``; a provider does not provide what it
+        # reads (a refiner)
+        for name, inputs, outputs, written in self.ontology.rule_ports:
+            if name in excluded:
                 continue
-            inputs, outputs, written = masks[spec.name]
-            provided = (outputs if spec.name in self._own_types_only else written) & ~inputs
+            provided = (outputs if name in own_types_only else written) & ~inputs
             if provided:
-                rules.append((inputs, provided))
+                rules[inputs] = rules.get(inputs, 0) | provided
         self._sensor_mask = self.ontology.mask(self.sensors)
         self.rounds, self._rules = self._rounds(rules)
         self.producible = frozenset(self.rounds)
         # forbidding a sensor type or one nothing produces changes no fixpoint: such types are left out of the key
-        self._forbiddable = self.ontology.mask(self.producible) & ~self._sensor_mask
+        self._forbiddable = self._known_by_round[-1] & ~self._sensor_mask  # the producible types by bit
 
-    def _rounds(self, rules: list[tuple[int, int]]) -> tuple[dict[str, int], list[tuple[int, int]]]:
-        """The fixpoint round in which each producible type first becomes producible (sensors: 0), and the rules
-        that can fire at all, merged per inputs and in the order they fire (later fixpoints, which forbid types,
-        fire a subset of them)."""
+    def _rounds(self, rules: dict[int, int]) -> tuple[dict[str, int], list[tuple[int, int]]]:
+        """The fixpoint round in which each producible type first becomes producible (sensors: 0), and the
+        ``rules`` (merged per inputs) that can fire at all, in the order they fire (later fixpoints, which forbid
+        types, fire a subset of them)."""
         rounds = dict.fromkeys(self.sensors, 0)
         known = self._sensor_mask
-        merged: dict[int, int] = {}
-        for inputs, provided in rules:
-            merged[inputs] = merged.get(inputs, 0) | provided
-        pending = list(merged.items())
+        pending = list(rules.items())
         fired: list[tuple[int, int]] = []
-        names = {bit: name for name, bit in self.ontology.type_bits.items()}
+        names = self.ontology.bit_types
         self._known_by_round = [known]  # what is producible after each round
+        self._fired_before = [0]  # per round: how many rules fired in earlier rounds (their place in ``fired``)
+        fired_round = self._fired_round
         current = 0
         while True:
             current += 1
+            self._fired_before.append(len(fired))
             new = 0
             waiting = []
             for rule in pending:
-                if rule[0] & known == rule[0]:
+                inputs = rule[0]
+                if inputs & known == inputs:
                     new |= rule[1]
                     fired.append(rule)
-                    self._fired_round[rule[0]] = current
+                    fired_round[inputs] = current
                 else:
                     waiting.append(rule)
             new &= ~known
@@ -179,7 +183,7 @@ class _Catalog:
                 return rounds, fired
             while new:
                 bit = new & -new
-                rounds[names[bit]] = current
+                rounds[names[bit.bit_length() - 1]] = current
                 known |= bit
                 new ^= bit
             self._known_by_round.append(known)
@@ -272,28 +276,37 @@ class _Catalog:
             self._refiners[type_name] = found
         return found
 
+    def _start_round(self, forbidden: int) -> int:
+        """The last fixpoint round before the first in which a ``forbidden`` type is made: what was made by then
+        is producible without the forbidden types."""
+        start = 0
+        for made in self._known_by_round[1:]:
+            if made & forbidden:
+                break
+            start += 1
+        return start
+
     def _fixpoint(self, forbidden: int) -> int:
         """Make the types a rule provides known (unless forbidden) once all its inputs are, until none becomes so.
 
         It starts from every type made in a round before the first forbidden type is: each of them was first made
         from types of earlier rounds, none of them forbidden.
         """
-        by_round = self._known_by_round
-        known = by_round[0]
-        for made in by_round[1:]:
-            if made & forbidden:
-                break
-            known = made
+        start = self._start_round(forbidden)
+        known = self._known_by_round[start]
+        # a rule that fired by round ``start`` provides only types already known
         allowed = ~forbidden
-        pending = [rule for rule in self._rules if rule[1] & allowed & ~known]
+        missing = allowed & ~known
+        pending = [rule for rule in self._rules[self._fired_before[start + 1] :] if rule[1] & missing]
         while True:
+            before = known
             waiting = []
             for rule in pending:
                 if rule[0] & known == rule[0]:
                     known |= rule[1] & allowed
                 else:
                     waiting.append(rule)
-            if len(waiting) == len(pending):
+            if known == before:  # the waiting rules wait for types that nothing made in this pass
                 return known
             pending = waiting
 
@@ -333,13 +346,84 @@ class _Catalog:
         """Providers of ``type_name`` whose inputs can be produced without it and without the types ``above`` it
         (those that need it), so that choosing them cannot create a cycle; ``by_rounds`` keeps only those whose
         inputs are derived earliest."""
-        usable = self.producible_without(above | {type_name})
+        providers = self.providers(type_name, value)
+        if not providers:
+            return []
         masks = self.ontology.port_masks
-        found = [s for s in self.providers(type_name, value) if masks[s.name][0] & usable == masks[s.name][0]]
+        # what was made before the first round making a forbidden type is producible without them: providers
+        # reading only that are usable without the fixpoint, which is needed only when others could be chosen too
+        forbidden = self.ontology.mask(above) | self.ontology.type_bits.get(type_name, 0)
+        start = self._start_round(forbidden & self._forbiddable)
+        grouped = self._input_rounds_of(type_name, value, providers)
+        if grouped is not None:
+            # every provider's rule fires: it reads only what was made by ``start`` when it fires by ``start + 1``
+            earliest, latest, first, candidates = grouped
+            if by_rounds and earliest <= start:
+                return list(first)
+            if not by_rounds and latest <= start:
+                return list(candidates)
+        surely = self._known_by_round[start]
+        sure: list[AnnotatorSpec] = []
+        others: list[AnnotatorSpec] = []
+        for spec in providers:
+            inputs = masks[spec.name][0]
+            (sure if inputs & surely == inputs else others).append(spec)
+        if by_rounds and sure:
+            rounds = [self.input_round(s) for s in sure]
+            limit = min(rounds)
+            # the others fire after that round (when their rule fires at all): the strict choice drops them whether
+            # usable or not
+            fired = self._fired_round
+            if all(masks[s.name][0] in fired or self.input_round(s) > limit for s in others):
+                return [s for s, r in zip(sure, rounds, strict=True) if r == limit]
+        elif not others:
+            return sure
+        usable = self.producible_without(above | {type_name})
+        found = [s for s in providers if masks[s.name][0] & usable == masks[s.name][0]]
         if by_rounds and found:
             rounds = [self.input_round(s) for s in found]
             limit = min(rounds)
             found = [s for s, r in zip(found, rounds, strict=True) if r <= limit]
+        return found
+
+    def has_valid(self, type_name: str, value: str | None) -> bool:
+        """Whether :meth:`valid` finds some provider of ``type_name`` for ``value`` (nothing forbidden above it)."""
+        providers = self.providers(type_name, value)
+        if not providers:
+            return False
+        grouped = self._input_rounds_of(type_name, value, providers)
+        start = self._start_round(self.ontology.type_bits.get(type_name, 0) & self._forbiddable)
+        # a provider whose rule fires by ``start + 1`` reads only what was made without the type
+        return (grouped is not None and grouped[0] <= start) or bool(self.valid(type_name, value))
+
+    def _input_rounds_of(
+        self, type_name: str, value: str | None, providers: tuple[AnnotatorSpec, ...]
+    ) -> tuple[int, int, tuple[AnnotatorSpec, ...], tuple[AnnotatorSpec, ...]] | None:
+        """Of the ``providers`` of ``type_name`` for ``value`` that read only producible types (no others are ever
+        valid): the earliest and latest input round, those with the earliest and all of them (memoised); None when
+        there are none or the rule of one of them never fires."""
+        key = (type_name, value)
+        if key in self._grouped:
+            return self._grouped[key]
+        masks, fired = self.ontology.port_masks, self._fired_round
+        producible = self._known_by_round[-1]
+        found: tuple[int, int, tuple[AnnotatorSpec, ...], tuple[AnnotatorSpec, ...]] | None = None
+        chosen: list[AnnotatorSpec] = []
+        rounds: list[int] = []  # a provider's input round is the one before its rule fires (:meth:`input_round`)
+        for spec in providers:
+            inputs = masks[spec.name][0]
+            fires = fired.get(inputs)
+            if fires is not None:
+                chosen.append(spec)
+                rounds.append(fires)
+            elif inputs & producible == inputs:  # reads only producible types, yet its rule never fires
+                rounds = []
+                break
+        if rounds:
+            earliest = min(rounds)
+            first = tuple(s for s, r in zip(chosen, rounds, strict=True) if r == earliest)
+            found = (earliest - 1, max(rounds) - 1, first, tuple(chosen))
+        self._grouped[key] = found
         return found
 
     def why_not(self, type_name: str, value: str | None) -> str:
@@ -370,26 +454,25 @@ class _UnitChoice:
         self._written = catalog.written
         self._written_types = catalog.ontology.written_types
         self._input_round = catalog.input_round
+        self.choose(providers)
+
+    def choose(self, providers: list[AnnotatorSpec]) -> None:
+        """Make ``providers`` (best first) the unit's alternatives."""
         self.providers = providers
-
-    @property
-    def providers(self) -> list[AnnotatorSpec]:
-        """The alternatives, best first."""
-        return self._providers
-
-    @providers.setter
-    def providers(self, providers: list[AnnotatorSpec]) -> None:
-        self._providers = providers
         known = self._written_types
         self._guaranteed = frozenset.intersection(*[known.get(s.name) or self._written(s) for s in providers])
         self.guaranteed_sorted = tuple(sorted(self._guaranteed))
+        # the types some alternative reads
+        self.read: frozenset[str] | tuple[str, ...] = (
+            frozenset(t for s in providers for t in s.inputs) if len(providers) > 1 else providers[0].inputs
+        )
         self._latest_round: int | None = None
 
     @property
     def latest_round(self) -> int:
         """The latest fixpoint round among the inputs of any provider."""
         if self._latest_round is None:
-            self._latest_round = max(map(self._input_round, self._providers))
+            self._latest_round = max(map(self._input_round, self.providers))
         return self._latest_round
 
     def guaranteed(self) -> frozenset[str]:
@@ -415,6 +498,7 @@ class _Assignment:
         self.units: dict[str, _UnitChoice] = {}
         self.above: dict[str, set[str]] = {}
         self._guaranteed: dict[str, str] | None = None
+        self._by_order: dict[str, str] | None = None  # the type -> unit mapping by unit order alone, when current
         self._last_guaranteed: dict[str, str] | None = None
         self._owner: dict[str, str] | None = None
         self._owners: dict[str, str] = {}  # annotator name -> its unit, kept as the units change
@@ -439,7 +523,7 @@ class _Assignment:
             type_name, value = requirement.annotation_type, requirement.value
             if type_name in self.catalog.sensors:
                 continue
-            if type_name not in self.catalog.producible or not self.catalog.valid(type_name, value):
+            if type_name not in self.catalog.producible or not self.catalog.has_valid(type_name, value):
                 raise PlanningError(
                     f"cannot satisfy '{requirement.reason or type_name}': {self.catalog.why_not(type_name, value)}"
                 )
@@ -453,6 +537,7 @@ class _Assignment:
 
     def _invalidate(self) -> None:
         self._version += 1
+        self._by_order = None
         self._clean_below = {}
         self._guaranteed = None
         self._owner = None
@@ -461,7 +546,7 @@ class _Assignment:
         owners = self._owners
         for spec in self.units[key].providers:
             del owners[spec.name]
-        self.units[key].providers = providers
+        self.units[key].choose(providers)
         owners.update(dict.fromkeys((spec.name for spec in providers), key))
         self._invalidate()
 
@@ -491,6 +576,33 @@ class _Assignment:
                 if by_rounds and latest >= rounds.get(type_name, 0):
                     continue  # a by-product made from later types could close a cycle in the strict mode
                 found[type_name] = key
+        self._by_order = found
+        return self._overridden(found)
+
+    def _add_guaranteed(self, key: str) -> None:
+        """Update the type -> unit mapping for the new unit ``key`` (when the mapping by unit order is known): the
+        types it guarantees that no unit earlier in the order does are now its."""
+        by_order = self._by_order
+        self._invalidate()
+        if by_order is None:
+            return
+        rounds = self.catalog.rounds
+        unit = self.units[key]
+        latest = unit.latest_round
+        place = (rounds.get(key, 0), key)
+        for type_name in unit.guaranteed_sorted:
+            if self.by_rounds and latest >= rounds.get(type_name, 0):
+                continue
+            present = by_order.get(type_name)
+            if present is None or (rounds.get(present, 0), present) > place:
+                by_order[type_name] = key
+        self._by_order = by_order
+        # the new unit's own type maps to it now (it did not before): the mapping changed
+        self._guaranteed = self._last_guaranteed = self._overridden(by_order)
+
+    def _overridden(self, by_order: dict[str, str]) -> dict[str, str]:
+        """The mapping by unit order with the pinned types and each unit's own type put to their units."""
+        found = dict(by_order)
         for type_name, key in self.pinned.items():
             if key in self.units and type_name in self.units[key].guaranteed():
                 found[type_name] = key
@@ -667,9 +779,10 @@ class _Assignment:
                 above: set[str] = set()
             else:
                 unit = units.get(consumer)
-                if unit is None or not any(type_name in s.inputs for s in unit.providers):
+                if unit is None or type_name not in unit.read:
                     continue  # the consumer's alternatives that needed it were dropped
-                above = self.above.get(consumer, set()) | {consumer}
+                known = self.above.get(consumer)
+                above = {consumer} if known is None else known | {consumer}
             existing = (self._guaranteed or self.guaranteed_by()).get(type_name)
             if existing is not None and self._cut_and_reuse(existing, above):
                 continue
@@ -679,7 +792,7 @@ class _Assignment:
             if existing == type_name:
                 # the type's own unit leads back to this consumer: choose its providers again under all constraints
                 combined = above | self.above.get(type_name, set())
-                owner = self.owner()
+                owner = self._owners  # read here only, before the units change
                 again = [
                     s
                     for s in self.catalog.valid(type_name, value, frozenset(combined), self.by_rounds)
@@ -692,8 +805,8 @@ class _Assignment:
                 queue.extend((needed, type_name) for spec in again for needed in spec.inputs)
                 continue
             valid = self.catalog.valid(type_name, value, frozenset(above), self.by_rounds)
-            owner = self.owner()
-            free = [s for s in valid if s.name not in owner]
+            owners = self._owners  # read here only, before the units change
+            free = [s for s in valid if s.name not in owners]
             if not free:
                 if not self._take_over(type_name, valid, consumer, above):
                     raise _OrderingError(f"cannot produce {type_name}: {self.catalog.why_not(type_name, value)}")
@@ -701,7 +814,7 @@ class _Assignment:
             self.units[type_name] = _UnitChoice(type_name, free, value, self.catalog)
             self._owners.update(dict.fromkeys((spec.name for spec in free), type_name))
             insort(self._order, (self.catalog.rounds.get(type_name, 0), type_name))
-            self._invalidate()
+            self._add_guaranteed(type_name)
             self.above[type_name] = set(above)
             reasons = self.reasons
             for spec in free:
@@ -743,6 +856,36 @@ def _units_of(types: tuple[str, ...], guaranteed: Mapping[str, str]) -> tuple[st
         key = guaranteed.get(types[0])
         return () if key is None else (key,)
     return tuple(sorted({guaranteed[t] for t in types if t in guaranteed}))
+
+
+def _depths(graph: Mapping[str, set[str]]) -> dict[str, int] | None:
+    """Each node's depth (0 without dependencies, else one more than its deepest dependency), or None when the
+    graph has a cycle."""
+    depth: dict[str, int] = {}
+
+    def level(node: str) -> int | None:
+        found = depth.get(node)
+        if found is not None:
+            return None if found < 0 else found  # -1: still being visited, a cycle
+        depth[node] = -1
+        deepest = -1
+        for dep in graph.get(node, ()):
+            below = depth.get(dep)
+            if below is None:
+                below = level(dep)
+                if below is None:
+                    return None
+            elif below < 0:
+                return None
+            if below > deepest:
+                deepest = below
+        depth[node] = deepest + 1
+        return deepest + 1
+
+    for node in graph:
+        if node not in depth and level(node) is None:
+            return None
+    return depth
 
 
 def _find_cycle(graph: Mapping[str, set[str]]) -> list[str] | None:
@@ -794,10 +937,12 @@ class _Layout:
         self._branch_members: dict[tuple[str, str], list[AnnotatorSpec]] = {}  # (type, alternative) -> _members
         self.branches = self._branches()
         absorbed = {t for owned in self.branches.values() for types in owned.values() for t in types}
+        # type -> the key of its final producer (read by type only: the order is no matter)
         self.final: dict[str, str] = dict.fromkeys(catalog.sensors, "reader")
-        for type_name, key in sorted(assignment.guaranteed_by().items()):
+        keys = {key: f"type:{key}" for key in self.units}
+        for type_name, key in assignment.guaranteed_by().items():
             if key not in absorbed:
-                self.final[type_name] = f"type:{key}"
+                self.final[type_name] = keys[key]
         for owner_type, owned in self.branches.items():
             for types in owned.values():
                 for type_name in types:
@@ -833,6 +978,7 @@ class _Layout:
         for type_name, specs in self.refinements.items():
             self.final[type_name] = f"refine:{specs[-1].name}"
         self.dependencies: dict[str, set[str]] = {"reader": set()}
+        self._depth: dict[str, int] | None = None
         self.optional_edges: set[tuple[str, str]] = set()
         self.refines_output_of: dict[str, str] = {}
         for type_name, specs in sorted(self.refinements.items()):
@@ -846,26 +992,36 @@ class _Layout:
                 self.dependencies[key] = (required | optional) - {key}
                 previous = key
         final = self.final
+        edges, dependencies = self.optional_edges, self.dependencies
         for type_name, (required_types, optional_types) in self._unit_inputs.items():
             key = f"type:{type_name}"
             deps = {final[t] for t in required_types if t in final}
-            optional = {final[t] for t in optional_types if t in final}
-            self.optional_edges |= {(key, dep) for dep in optional - deps}
-            self.dependencies[key] = (deps | optional) - {key}
+            if optional_types:
+                optional = {final[t] for t in optional_types if t in final} - deps
+                if optional:
+                    edges.update((key, dep) for dep in optional)
+                    deps |= optional
+            deps.discard(key)
+            dependencies[key] = deps
 
     def _branch_inputs(self) -> dict[str, tuple[tuple[str, ...], tuple[str, ...]]]:
-        """Per provider unit not absorbed into a branch (sorted): the required and the optional input types its
+        """Per provider unit not absorbed into a branch: the required and the optional input types its
         branches read from outside themselves (they do not change with the refinements)."""
         absorbed = {t for owned in self.branches.values() for types in owned.values() for t in types}
         found: dict[str, tuple[tuple[str, ...], tuple[str, ...]]] = {}
-        for type_name in sorted(self.units):
+        for type_name in self.units:  # (read by type: the order is no matter)
             if type_name in absorbed:
                 continue
             required: dict[str, None] = {}
             optional: dict[str, None] = {}
+            branches = self.branches.get(type_name)
             for spec in self.units[type_name].providers:
+                if not branches or not branches.get(spec.name):  # the alternative alone in its branch
+                    required.update(dict.fromkeys(spec.inputs))
+                    optional.update(dict.fromkeys(spec.optional_inputs))
+                    continue
                 members = self._members(type_name, spec)
-                inside = set(self.branches.get(type_name, {}).get(spec.name, []))
+                inside = set(branches[spec.name])
                 required.update(dict.fromkeys(t for m in members for t in m.inputs if t not in inside))
                 optional.update(dict.fromkeys(t for m in members for t in m.optional_inputs if t not in inside))
             found[type_name] = (tuple(required), tuple(optional))
@@ -875,13 +1031,16 @@ class _Layout:
         """Refiners of planned types whose other inputs are planned too and that are not otherwise used."""
         used = set(self.assignment.owner())
         read = {r.annotation_type for r in self.assignment.requirements}
-        read |= {t for unit in self.units.values() for s in unit.providers for t in s.inputs}
+        for unit in self.units.values():
+            read.update(unit.read)
         found: dict[str, list[AnnotatorSpec]] = {}
-        for type_name in sorted(self.final.keys() & read):
+        final = self.final
+        for type_name in sorted(final.keys() & read):
+            candidates = self.catalog.refiners(type_name)
+            if not candidates:
+                continue
             usable = [
-                s
-                for s in self.catalog.refiners(type_name)
-                if s.name not in used and all(t == type_name or t in self.final for t in s.inputs)
+                s for s in candidates if s.name not in used and all(t == type_name or t in final for t in s.inputs)
             ]
             # refiners made for a situation (with preconditions, which hold) all apply; of the general-purpose
             # ones only the cheapest does, so two interchangeable crops are never chained
@@ -917,39 +1076,43 @@ class _Layout:
         """
         # only required inputs bind a unit to the stage: an optional reader (size or shape using the plane when
         # there is one) runs after the Fallback that may have made it and does without when no branch did
+        multiple = sorted(t for t, unit in self.units.items() if len(unit.providers) > 1)
+        if not multiple:
+            return {}
         consumers: dict[str, set[str]] = {}
-        for unit in self.units.values():
-            for spec in unit.providers:
-                for needed in spec.inputs:
-                    consumers.setdefault(needed, set()).add(spec.name)
-        for type_name in sorted(set(self.units) | set(self.catalog.sensors)):
-            for spec in self.catalog.refiners(type_name):
-                for needed in spec.inputs:
-                    consumers.setdefault(needed, set()).add(spec.name)
+        specs = [s for unit in self.units.values() for s in unit.providers]
+        for type_name in set(self.units) | self.catalog.sensors:  # (sets of readers: the order is no matter)
+            specs += self.catalog.refiners(type_name)
+        for spec in specs:
+            for needed in spec.inputs:
+                found = consumers.get(needed)
+                if found is None:
+                    consumers[needed] = {spec.name}
+                else:
+                    found.add(spec.name)
         guaranteed = self.assignment.guaranteed_by()
         guarantees: dict[str, list[str]] = {}
         for type_name, key in guaranteed.items():
             guarantees.setdefault(key, []).append(type_name)
+        # per unit: who reads what it guarantees
+        readers = {key: set().union(*(consumers.get(t, ()) for t in types)) for key, types in guarantees.items()}
         branches: dict[str, dict[str, list[str]]] = {}
-        for type_name in sorted(self.units):
+        for type_name in multiple:
             unit = self.units[type_name]
-            if len(unit.providers) < 2:
-                continue
             rivals = {s.name for s in unit.providers}
             # a unit only alternatives of this type need goes into each of their branches: a branch that fails
             # (its plane not found) then hands over to the next, which makes its own - unless some alternative
             # needing it would not own it, then units go into a branch only when that branch alone needs them
-            shared = {spec.name: self._owned(spec, type_name, consumers, guaranteed, guarantees, rivals)
-                      for spec in unit.providers}  # fmt: skip
+            shared = {spec.name: self._owned(spec, type_name, guaranteed, readers, rivals) for spec in unit.providers}
             if not all(
                 consumer in members or (consumer in rivals and key in shared[consumer][0])
                 for owned, members in shared.values()
                 for key in owned
-                for t in guarantees[key]
-                for consumer in consumers.get(t, set())
+                for consumer in readers[key]
             ):
-                shared = {spec.name: self._owned(spec, type_name, consumers, guaranteed, guarantees, set())
-                          for spec in unit.providers}  # fmt: skip
+                shared = {
+                    spec.name: self._owned(spec, type_name, guaranteed, readers, set()) for spec in unit.providers
+                }
             branches[type_name] = {name: owned for name, (owned, _) in shared.items()}
         return branches
 
@@ -957,32 +1120,38 @@ class _Layout:
         self,
         spec: AnnotatorSpec,
         type_name: str,
-        consumers: dict[str, set[str]],
         guaranteed: dict[str, str],
-        guarantees: dict[str, list[str]],
+        readers: dict[str, set[str]],
         rivals: set[str],
     ) -> tuple[list[str], set[str]]:
         """The units that move into the branch of alternative ``spec`` of ``type_name`` (and the branch's
-        annotators): single-provider units whose outputs only the branch (or the ``rivals``) read."""
+        annotators): single-provider units whose outputs only the branch (or the ``rivals``) read (``readers``: who
+        reads what each unit guarantees)."""
         owned: list[str] = []
         members = {spec.name}
+        allowed = members | rivals  # who may read what moves into the branch
         frontier = list(spec.inputs)
         while frontier:
             needed = frontier.pop(0)
             key = guaranteed.get(needed)
             if key is None or key in owned or key == type_name or len(self.units[key].providers) != 1:
                 continue
-            if any(not consumers.get(t, set()) <= members | rivals for t in guarantees[key]):
+            if not readers[key] <= allowed:
                 continue
             owned.append(key)
             inner = self.units[key].providers[0]
             members.add(inner.name)
+            allowed.add(inner.name)
             frontier.extend(inner.inputs)
         return owned, members
 
     def _required_cycle(self) -> list[str] | None:
-        """Drop optional ordering edges that close cycles; return a cycle of required edges, if any."""
-        while True:
+        """Drop optional ordering edges that close cycles; return a cycle of required edges, if any.
+
+        Without a cycle the units' depths (their stages) are kept from the check (which finds no depths when there
+        is one)."""
+        self._depth = _depths(self.dependencies)
+        while self._depth is None:
             cycle = _find_cycle(self.dependencies)
             if cycle is None:
                 return None
@@ -992,19 +1161,18 @@ class _Layout:
                 return cycle
             consumer, producer = optional[0]
             self.dependencies[consumer].discard(producer)
+            self._depth = _depths(self.dependencies)
+        return None
 
     def stages(self) -> tuple[tuple[Unit, ...], ...]:
         """Units grouped by dependency depth, in a deterministic order."""
-        depth: dict[str, int] = {}
-
-        def level(key: str) -> int:
-            if key not in depth:
-                depth[key] = 1 + max((level(d) for d in self.dependencies.get(key, set())), default=-1)
-            return depth[key]
-
+        self._refiner_of = {s.name: (t, s) for t, specs in self.refinements.items() for s in specs}
+        self._made_by: dict[str, str] = {}  # type -> "<type> from <its final producer>" (for the steps' reasons)
+        depth = self._depth if self._depth is not None else _depths(self.dependencies)
+        assert depth is not None, "the dependencies were checked for cycles"
         by_level: dict[int, list[str]] = {}
         for key in sorted(self.dependencies):
-            by_level.setdefault(level(key), []).append(key)
+            by_level.setdefault(depth[key], []).append(key)
         return tuple(tuple(self._unit(key) for key in sorted(keys)) for _, keys in sorted(by_level.items()))
 
     def _label(self, key: str) -> str:
@@ -1021,34 +1189,45 @@ class _Layout:
             return name
         return " / ".join(s.name for s in self.units[name].providers)
 
-    def _step(self, spec: AnnotatorSpec, why: str, provides: str = "", inside: Iterable[str] = ()) -> Step:
-        inside_types = {t for key in inside for t in self.units[key].guaranteed()} if inside else frozenset()
-        final = self.final
+    def _step(
+        self, spec: AnnotatorSpec, why: str, provides: str = "", inside_types: frozenset[str] = frozenset()
+    ) -> Step:
+        """The step of ``spec``, its reason naming what feeds each input (``inside_types``: the types made by the
+        units moved into its branch)."""
+        final, made = self.final, self._made_by
         feeds = []
         for needed in spec.inputs:
-            if needed in inside_types:
+            if inside_types and needed in inside_types:
                 maker = self.units[self.assignment.guaranteed_by()[needed]].providers[0].name
                 feeds.append(f"{needed} from {maker}")
             elif needed in spec.outputs and spec.name in self.refines_output_of:
                 feeds.append(f"{needed} from {self._label(self.refines_output_of[spec.name])}")
             elif needed in final:
-                feeds.append(f"{needed} from {self._label(final[needed])}")
+                feed = made.get(needed)
+                if feed is None:
+                    feed = made[needed] = f"{needed} from {self._label(final[needed])}"
+                feeds.append(feed)
         reason = f"{spec.name}: {why}; needs {', '.join(feeds)}" if feeds else f"{spec.name}: {why}"
         parameters = self.parameters.get(spec.name)
+        # positional (many steps per plan): annotator, implemented_by, inputs, outputs, parameters, reason, provides
         return Step(
-            annotator=spec.name,
-            implemented_by=spec.implemented_by,
-            inputs=tuple(spec.inputs),
-            outputs=tuple(spec.outputs),
-            parameters=tuple(sorted(parameters.items())) if parameters else (),
-            reason=reason,
-            provides=provides,
+            spec.name,
+            spec.implemented_by,
+            tuple(spec.inputs),
+            tuple(spec.outputs),
+            tuple(sorted(parameters.items())) if parameters else (),
+            reason,
+            provides,
         )
 
     def _why(self, type_name: str) -> str:
-        reasons = self.assignment.reasons.get(type_name, [])
-        consumers = [r.removeprefix("needed by ") for r in reasons if r.startswith("needed by ")]
-        others = [r for r in reasons if not r.startswith("needed by ")]
+        consumers: list[str] = []
+        others: list[str] = []
+        for reason in self.assignment.reasons.get(type_name, ()):
+            if reason.startswith("needed by "):
+                consumers.append(reason.removeprefix("needed by "))
+            else:
+                others.append(reason)
         if consumers:
             others.append(f"{type_name} is needed by {', '.join(consumers)}")
         return "; ".join(others) if others else f"provides {type_name}"
@@ -1058,7 +1237,7 @@ class _Layout:
             return self.source.step
         kind, name = key.split(":", 1)
         if kind == "refine":
-            refined, spec = next((t, s) for t, specs in self.refinements.items() for s in specs if s.name == name)
+            refined, spec = self._refiner_of[name]
             return self._step(spec, f"refines {refined} before it is used ({_precondition_note(spec)})")
         unit = self.units[name]
         if len(unit.providers) == 1:
@@ -1066,11 +1245,18 @@ class _Layout:
         branches = []
         why = self._why(name)
         for spec in unit.providers:
-            members = self._members(name, spec)
             owned = self.branches[name][spec.name]
-            inner = tuple(self._step(m, f"needed only by {spec.name}", inside=owned) for m in members[:-1])
-            branches.append((*inner, self._step(spec, why, provides=name, inside=owned)))
-        ranking = ", ".join(f"{s.name} (reliability {s.reliability:g}, {s.cost_ms:g} ms)" for s in unit.providers)
+            if not owned:
+                branches.append((self._step(spec, why, provides=name),))
+                continue
+            inside = frozenset(t for key in owned for t in self.units[key].guaranteed())
+            inner = tuple(
+                self._step(m, f"needed only by {spec.name}", inside_types=inside)
+                for m in self._members(name, spec)[:-1]
+            )
+            branches.append((*inner, self._step(spec, why, provides=name, inside_types=inside)))
+        notes = self.catalog.ontology.rank_notes
+        ranking = ", ".join(notes[s.name] for s in unit.providers)
         return Alternatives(
             provides=name,
             branches=tuple(branches),

@@ -2,7 +2,7 @@
 
 from __future__ import annotations
 
-from collections.abc import Iterable
+from collections.abc import Iterable, Mapping
 from dataclasses import dataclass, replace
 
 from queries.model import CONTINUOUS_KINDS, FREE_SPACE_KEY, Query
@@ -69,6 +69,7 @@ def annotator_parameters(
     expected: str | None = None,
     task: Task | None = None,
     annotators: Iterable[AnnotatorSpec] | None = None,
+    region: Mapping[str, object] | None = None,
 ) -> dict[str, dict[str, object]]:
     """Constructor arguments the plan hands to annotators, from the ontology and the task.
 
@@ -76,10 +77,11 @@ def annotator_parameters(
     domain is the root class) is a classifier by knowledge and gets the profiles of the classes and the class
     the query asks for (``expected``). A provider of free placements gets the task's footprint, the region box
     when there is one and the task's result limit. ``annotators`` limits the search (default: all; see
-    :func:`parameterised_annotators`).
+    :func:`parameterised_annotators`); ``region``: :func:`region_parameters` of ``box`` when known.
     """
     parameters: dict[str, dict[str, object]] = {}
-    region = region_parameters(box) if box is not None else {}
+    if region is None:
+        region = region_parameters(box) if box is not None else {}
     free_space_type = kb.annotation_type_for_key(FREE_SPACE_KEY)
     for spec in kb.annotators() if annotators is None else annotators:
         if task is not None and task.footprint is not None and free_space_type in spec.outputs:
@@ -164,6 +166,7 @@ class QueryPlanner:
         self._parameterised: tuple[AnnotatorSpec, ...] = ()
         self._trackers: tuple[AnnotatorSpec, ...] = ()
         self._catalogs: dict[tuple[object, ...], object] = {}
+        self._regions: dict[str, tuple[RegionBox, dict[str, object]]] = {}
 
     def _refresh(self) -> None:
         """Drop what was derived from an older ontology (after the knowledge base reloaded)."""
@@ -172,6 +175,8 @@ class QueryPlanner:
             self._profiles = class_profiles(self.kb)
             self._parameterised = parameterised_annotators(self.kb)
             self._trackers = tuple(spec for spec in self.kb.annotators() if TRACK_TYPE in spec.outputs)
+            # the semantic map's region boxes as annotator arguments (a focus box is converted when planned)
+            self._regions = {box.name: (box, region_parameters(box)) for box in self.kb.regions()}
             self._catalogs = {}
 
     def profiles(self) -> tuple[dict[str, object], ...]:
@@ -190,7 +195,14 @@ class QueryPlanner:
         box = interpretation.region_box
         conditions = Conditions(depth=depth, region=box is not None, transparent=interpretation.transparent)
         task = interpretation.task
-        parameters = annotator_parameters(self.kb, box, self.profiles(), task.object_class, task, self._parameterised)
+        self._refresh()
+        region = None
+        if box is not None:
+            known = self._regions.get(box.name)
+            region = known[1] if known is not None and known[0] is box else region_parameters(box)
+        parameters = annotator_parameters(
+            self.kb, box, self.profiles(), task.object_class, task, self._parameterised, region
+        )
         if self._trackers:  # a tracker of any object: told which one to follow
             target = target_parameters(self.kb, task)
             for spec in self._trackers:
