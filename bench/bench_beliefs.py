@@ -28,7 +28,10 @@ Run: ``.venv/bin/python bench/bench_beliefs.py [--update-sizes N ...] [--query-s
 from __future__ import annotations
 
 import argparse
+import cProfile
+import io
 import os
+import pstats
 import shutil
 import sqlite3
 import statistics
@@ -445,10 +448,6 @@ def serve_idle_rss(folder: Path) -> float | None:
 def profile_updates(size: int, frames: int, per_frame: int, cameras: int, folder: Path, out: Path) -> None:
     """cProfile of ``store.integrate`` over ``frames`` frames into a store of ``size``, frames at random places and
     then from ``cameras`` fixed cameras; the top entries by own and by cumulative time are written to ``out``."""
-    import cProfile
-    import io
-    import pstats
-
     path = folder / f"profile-{size}.sqlite"
     seeded = seed_file(path, size, np.random.default_rng(size), named_regions=False)
     text = io.StringIO()
@@ -471,21 +470,14 @@ def profile_updates(size: int, frames: int, per_frame: int, cameras: int, folder
         store.close()
         where = f"from {scenario} fixed cameras in turn" if scenario else "each at a random place"
         text.write(f"store.integrate, {frames} frames x {per_frame} hypotheses {where}, {size} stored objects\n")
-        pstats.Stats(profiler, stream=text).sort_stats("tottime").print_stats(25)
-        pstats.Stats(profiler, stream=text).sort_stats("cumulative").print_stats(25)
-    out.parent.mkdir(parents=True, exist_ok=True)
-    out.write_text(text.getvalue().replace(str(ROOT) + "/", ""))
-    print(f"profile written to {out}")
+        write_top_entries(profiler, text, 25)
+    write_profile(text.getvalue(), out)
 
 
 def profile_queries(size: int, repeats: int, folder: Path, out: Path) -> None:
     """cProfile of ``answer_from_memory`` (every memory query ``repeats`` times) on a store of ``size`` objects; the
     median ms of each query to designators and the top entries by own and by cumulative time are written to
     ``out``."""
-    import cProfile
-    import io
-    import pstats
-
     path = folder / f"profile-queries-{size}.sqlite"
     seed_file(path, size, np.random.default_rng(size + 1))
     text = io.StringIO()
@@ -505,10 +497,20 @@ def profile_queries(size: int, repeats: int, folder: Path, out: Path) -> None:
                 answer_from_memory(store, belief_filter)
         profiler.disable()
     text.write(f"answer_from_memory, {len(queries)} queries x {repeats}, {size} stored objects\n")
-    pstats.Stats(profiler, stream=text).sort_stats("tottime").print_stats(20)
-    pstats.Stats(profiler, stream=text).sort_stats("cumulative").print_stats(20)
+    write_top_entries(profiler, text, 20)
+    write_profile(text.getvalue(), out)
+
+
+def write_top_entries(profiler: cProfile.Profile, text: io.StringIO, count: int) -> None:
+    """The ``count`` top entries of ``profiler`` by own and by cumulative time, written to ``text``."""
+    pstats.Stats(profiler, stream=text).sort_stats("tottime").print_stats(count)
+    pstats.Stats(profiler, stream=text).sort_stats("cumulative").print_stats(count)
+
+
+def write_profile(text: str, out: Path) -> None:
+    """Write a profile's text to ``out`` with paths relative to the project."""
     out.parent.mkdir(parents=True, exist_ok=True)
-    out.write_text(text.getvalue().replace(str(ROOT) + "/", ""))
+    out.write_text(text.replace(str(ROOT) + "/", ""))
     print(f"profile written to {out}")
 
 
