@@ -915,12 +915,13 @@ def _index_entries(indexed: str) -> set[tuple[str, str]]:
 
 
 def _decode_attributes(text: str) -> dict[str, AttributeBelief]:
-    return {
-        name: AttributeBelief(
-            name, {value: ValueSupport(s[0], s[1], set(s[2]), s[3], s[4]) for value, s in values.items()}
-        )
-        for name, values in json.loads(text).items()
-    }
+    decoded: dict[str, AttributeBelief] = {}
+    for name, values in json.loads(text).items():
+        supports = {}
+        for value, s in values.items():
+            supports[value] = ValueSupport(s[0], s[1], set(s[2]), s[3], s[4])
+        decoded[name] = AttributeBelief(name, supports)
+    return decoded
 
 
 def _belief_from_row(row: tuple) -> ObjectBelief:

@@ -151,18 +151,24 @@ def typical_size(dimensions: np.ndarray) -> float:
 
 def typical_sizes(items: Sequence[Trackable]) -> np.ndarray:
     """:func:`typical_size` of every item's dimensions (0 when it has none), computed for all at once."""
-    sizes = np.zeros(len(items))
-    full = [k for k, item in enumerate(items) if item.dimensions is not None and len(item.dimensions) == 3]
+    dimensions = [item.dimensions for item in items]
+    sizes = np.zeros(len(dimensions))
+    full = [k for k, d in enumerate(dimensions) if d is not None and len(d) == 3]
     if full:
-        extents = np.array([items[k].dimensions for k in full], dtype=np.float64)
+        chosen = dimensions if len(full) == len(dimensions) else [dimensions[k] for k in full]
+        extents = np.array(chosen, dtype=np.float64)
         positive = (extents > 0).all(axis=1)
-        logs = np.log(np.where(positive[:, None], extents, 1.0))
-        sizes[np.asarray(full)[positive]] = np.exp(logs[positive].sum(axis=1) / 3.0)
-        for k in np.asarray(full)[~positive].tolist():
-            sizes[k] = typical_size(items[k].dimensions)  # type: ignore[arg-type]
-    for k, item in enumerate(items):
-        if item.dimensions is not None and len(item.dimensions) != 3 and len(item.dimensions):
-            sizes[k] = typical_size(item.dimensions)
+        if positive.all():  # the common case: no zero extent, no masking
+            sizes[full] = np.exp(np.log(extents).sum(axis=1) / 3.0)
+        else:
+            logs = np.log(np.where(positive[:, None], extents, 1.0))
+            sizes[np.asarray(full)[positive]] = np.exp(logs[positive].sum(axis=1) / 3.0)
+            for k in np.asarray(full)[~positive].tolist():
+                sizes[k] = typical_size(dimensions[k])  # type: ignore[arg-type]
+    if len(full) < len(dimensions):
+        for k, d in enumerate(dimensions):
+            if d is not None and len(d) != 3 and len(d):
+                sizes[k] = typical_size(d)
     return sizes
 
 
@@ -234,28 +240,28 @@ def assign(cost: np.ndarray) -> Association:
     if rows == 0 or cols == 0:
         return Association((), tuple(range(rows)), tuple(range(cols)))
     feasible = cost < INFEASIBLE
-    pairs: list[tuple[int, int]]
     if not feasible.any():
-        pairs = []
-    elif rows == 1 or cols == 1:
+        return Association((), tuple(range(rows)), tuple(range(cols)))
+    if rows == 1 or cols == 1:
         i, j = np.unravel_index(int(np.argmin(cost)), cost.shape)
-        pairs = [(int(i), int(j))]
+        chosen_rows, chosen_cols = np.array([i]), np.array([j])
     elif _disjoint(feasible):
         # no two feasible pairs share an observation or a belief: the optimal assignment takes them all (leaving
         # one out would put a prohibitive cost in its place), so there is nothing to choose
-        pairs = [(int(i), int(j)) for i, j in zip(*np.nonzero(feasible), strict=True)]
+        chosen_rows, chosen_cols = np.nonzero(feasible)
     else:
         from scipy.optimize import linear_sum_assignment
 
-        row_index, col_index = linear_sum_assignment(np.where(feasible, cost, INFEASIBLE))
-        pairs = [(int(i), int(j)) for i, j in zip(row_index, col_index, strict=True)]
-    matches = tuple((i, j, float(cost[i, j])) for i, j in pairs if feasible[i, j])
-    matched_rows = {i for i, _, _ in matches}
-    matched_cols = {j for _, j, _ in matches}
+        chosen_rows, chosen_cols = linear_sum_assignment(np.where(feasible, cost, INFEASIBLE))
+    kept = feasible[chosen_rows, chosen_cols]
+    matched_rows, matched_cols = chosen_rows[kept].tolist(), chosen_cols[kept].tolist()
+    costs = cost[chosen_rows[kept], chosen_cols[kept]].tolist()
+    matches = tuple(zip(matched_rows, matched_cols, costs, strict=True))
+    taken_rows, taken_cols = set(matched_rows), set(matched_cols)
     return Association(
         matches,
-        tuple(i for i in range(rows) if i not in matched_rows),
-        tuple(j for j in range(cols) if j not in matched_cols),
+        tuple(i for i in range(rows) if i not in taken_rows),
+        tuple(j for j in range(cols) if j not in taken_cols),
     )
 
 

@@ -39,7 +39,10 @@ CLASS_ATTRIBUTE = Classification.attribute
 def logit(confidence: float) -> float:
     """Log-odds of a confidence, clipped to :data:`CONFIDENCE_CLIP`."""
     low, high = CONFIDENCE_CLIP
-    p = min(max(float(confidence), low), high)
+    p = float(confidence)
+    # min(max(p, low), high), written out (the same value, NaN included: it passes through both)
+    p = low if p < low else p
+    p = high if p > high else p
     return math.log(p / (1.0 - p))
 
 
@@ -78,14 +81,16 @@ class ValueSupport:
 
     def add(self, log_odds: float, sources: Iterable[str], time: float, count: int = 1) -> None:
         """Accumulate ``log_odds`` (clipped) from ``sources``."""
-        if self.count == 0:
+        # min, max and _clamp written out (the hot path of every update; the same values, NaN included)
+        if self.count == 0 or time < self.first_seen:
             self.first_seen = time
-        else:
-            self.first_seen = min(self.first_seen, time)
-        self.log_odds = _clamp(self.log_odds + log_odds)
+        total = self.log_odds + log_odds
+        total = -MAX_LOG_ODDS if total < -MAX_LOG_ODDS else total
+        self.log_odds = MAX_LOG_ODDS if total > MAX_LOG_ODDS else total
         self.count += count
         self.sources.update(sources)
-        self.last_seen = max(self.last_seen, time)
+        if self.last_seen < time:
+            self.last_seen = time
 
 
 @dataclass(frozen=True, slots=True)

@@ -130,6 +130,18 @@ def _same_class(a: str, b: str) -> bool:
     return a == b
 
 
+def _stated_colors_and_classes(observation: FrameObject) -> tuple[set[str], set[str]]:
+    """The colours and the classes stated for an observation (``values`` of both, in one pass)."""
+    colors: set[str] = set()
+    classes: set[str] = set()
+    for e in observation.evidence:
+        if e.attribute == SemanticColor.attribute:
+            colors.add(e.value)
+        elif e.attribute == CLASS_ATTRIBUTE:
+            classes.add(e.value)
+    return colors, classes
+
+
 class BeliefTracker:
     """Associates frames of objects with beliefs and updates them (see the module docstring)."""
 
@@ -203,9 +215,10 @@ class BeliefTracker:
         class_added = [0.0] * rows.size
         pairs = zip(rows.tolist(), cols.tolist(), compared[rows, cols].tolist(), strict=True)
         for k, (i, j, histograms_compared) in enumerate(pairs):
-            if i not in stated:
-                stated[i] = (observations[i].values(SemanticColor.attribute), observations[i].values(CLASS_ATTRIBUTE))
-            observation_colors, observation_classes = stated[i]
+            found = stated.get(i)
+            if found is None:
+                found = stated[i] = _stated_colors_and_classes(observations[i])
+            observation_colors, observation_classes = found
             if observation_colors and not histograms_compared:
                 if j not in colors:
                     colors[j] = beliefs[j].value(SemanticColor.attribute)
@@ -219,8 +232,10 @@ class BeliefTracker:
                 else:
                     class_added[k] = config.class_penalty
         # the colour penalty first, then the class penalty, as pair_cost adds them (adding 0.0 changes nothing)
-        cost[rows, cols] += np.array(color_added)
-        cost[rows, cols] += np.array(class_added)
+        if any(color_added):
+            cost[rows, cols] += np.array(color_added)
+        if any(class_added):
+            cost[rows, cols] += np.array(class_added)
         return assign(cost)
 
     def _create(self, observation: FrameObject, time: float, belief_id: int) -> ObjectBelief:

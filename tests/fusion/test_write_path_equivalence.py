@@ -1,10 +1,12 @@
 """The belief write path's faster steps give exactly what the plain ones give: the reused C JSON encoder the text
 ``json`` makes, statements accumulated in one pass the supports of :meth:`AttributeBelief.add` one by one (bit for
-bit), and the assignment that skips the Hungarian when no two feasible pairs conflict the Hungarian's own."""
+bit), the assignment that skips the Hungarian when no two feasible pairs conflict the Hungarian's own, and the
+support update and log-odds with min, max and clamp written out the values of the plain forms."""
 
 from __future__ import annotations
 
 import json
+import math
 
 import numpy as np
 from hypothesis import given, settings
@@ -14,7 +16,15 @@ from scipy.optimize import linear_sum_assignment
 from reasoning.beliefs.json_text import JsonText
 from reasoning.beliefs.store import _rounded
 from reasoning.fusion.association import INFEASIBLE, assign
-from reasoning.fusion.rule import AttributeBelief, Evidence, accumulate_into
+from reasoning.fusion.rule import (
+    CONFIDENCE_CLIP,
+    MAX_LOG_ODDS,
+    AttributeBelief,
+    Evidence,
+    ValueSupport,
+    accumulate_into,
+    logit,
+)
 
 JSON_VALUES = st.recursive(
     st.none()
@@ -105,3 +115,43 @@ def test_remembered_rounding_gives_the_text_of_round(values: list[float], digits
     for value in values + values + numpy:  # the second time answered from the cache
         assert json.dumps(_rounded(value, digits)) == json.dumps(round(value, digits))
         assert type(_rounded(value, digits)) is type(round(value, digits))
+
+
+NUMBERS = (
+    st.floats(allow_nan=True, allow_infinity=True)
+    | st.integers(-10, 10)
+    | st.sampled_from([0.0, -0.0, 0.01, 0.99, MAX_LOG_ODDS, -MAX_LOG_ODDS, 6.0, -6.0])
+)
+
+
+def _same(a: object, b: object) -> bool:
+    """Equal values of one type (NaN equal to NaN, 0.0 not to -0.0)."""
+    return type(a) is type(b) and (json.dumps(a) == json.dumps(b)) and (a == b or a != a)
+
+
+@settings(max_examples=400, deadline=None)
+@given(
+    start=st.tuples(NUMBERS, st.integers(0, 3), NUMBERS, NUMBERS),
+    steps=st.lists(st.tuples(NUMBERS, NUMBERS, st.integers(1, 3)), max_size=6),
+)
+def test_value_support_add_is_the_rule_with_min_max_and_clamp(start: tuple, steps: list[tuple]) -> None:
+    log_odds, count, first_seen, last_seen = start
+    support = ValueSupport(log_odds, count, set(), first_seen, last_seen)
+    reference = [log_odds, count, first_seen, last_seen]
+    for added, time, times in steps:
+        support.add(added, ("E",), time, times)
+        reference[2] = time if reference[1] == 0 else min(reference[2], time)
+        reference[0] = min(max(reference[0] + added, -MAX_LOG_ODDS), MAX_LOG_ODDS)
+        reference[1] += times
+        reference[3] = max(reference[3], time)
+        found = [support.log_odds, support.count, support.first_seen, support.last_seen]
+        assert all(_same(a, b) for a, b in zip(found, reference, strict=True)), (found, reference)
+
+
+@settings(max_examples=300, deadline=None)
+@given(confidence=NUMBERS)
+def test_logit_is_the_log_odds_of_the_clipped_confidence(confidence: float) -> None:
+    low, high = CONFIDENCE_CLIP
+    p = min(max(float(confidence), low), high)
+    expected = math.log(p / (1.0 - p))
+    assert _same(logit(confidence), expected)
