@@ -500,15 +500,47 @@ class BeliefStore:
         log = [] if writes is None else writes
         loaded = loaded or {}
         cache = self._sources_cache()
-        rows = {b.id: _object_row(b, class_test, cache) for b in beliefs}
-        fresh = [rows[b.id] for b in beliefs if b.id not in loaded]
+        fresh: list[tuple] = []
+        volatile: list[tuple] = []
+        relabelled: list[tuple] = []
+        added: list[tuple[str, str, int]] = []
+        removed: list[tuple[str, str, int]] = []
+        moved: list[tuple] = []
+        classes: set[tuple[str]] = set()
+        latest = {b.id: b for b in beliefs}  # a belief given twice is written as its last object is
+        written = beliefs if len(latest) == len(beliefs) else [latest[b.id] for b in beliefs]
+        r = RTREE_SLACK
+        for b, current in zip(beliefs, written, strict=True):  # one pass: each statement's rows in belief order
+            belief_id = b.id
+            row = _object_row(current, class_test, cache)
+            state = loaded.get(belief_id)
+            indexed = row[_INDEXED]
+            if state is None:
+                fresh.append(row)
+                old: set[tuple[str, str]] = set()
+            else:
+                volatile.append(_volatile(row))
+                labels = _labels(row)
+                if labels != _state(state):
+                    relabelled.append((*labels, belief_id))
+                old = _index_entries(state.indexed) if state.indexed != indexed else set()
+            if state is None or state.indexed != indexed:
+                new = _index_entries(indexed)
+                added.extend((name, value, belief_id) for name, value in new - old)
+                removed.extend((name, value, belief_id) for name, value in old - new)
+            x, y, z = row[3:6]
+            if (
+                state is None
+                or max(abs(x - state.place[0]), abs(y - state.place[1]), abs(z - state.place[2])) > RTREE_SLACK / 2
+            ):
+                moved.append((belief_id, x - r, x + r, y - r, y + r, z - r, z + r))
+            if b.class_name and b.class_name != (state.class_name if state is not None else None):
+                classes.add((b.class_name,))
         if fresh:
             _write(conn, log, "DELETE FROM attribute_index WHERE object_id = ?", [(row[0],) for row in fresh])
             _write(conn, log, f"INSERT OR REPLACE INTO objects ({_OBJECT_COLUMNS}) VALUES ({_PLACEHOLDERS})", fresh)
-        known = [b for b in beliefs if b.id in loaded]
-        if known:
-            _write(conn, log, _UPDATE_VOLATILE, [_volatile(rows[b.id]) for b in known])
-            relabelled = [(*_labels(rows[b.id]), b.id) for b in known if _labels(rows[b.id]) != _state(loaded[b.id])]
+        if volatile:
+            _write(conn, log, _UPDATE_VOLATILE, volatile)
             if relabelled:
                 _write(
                     conn,
@@ -516,32 +548,12 @@ class BeliefStore:
                     "UPDATE objects SET class_name = ?, region = ?, region_class = ?, indexed = ? WHERE id = ?",
                     relabelled,
                 )
-        added: list[tuple[str, str, int]] = []
-        removed: list[tuple[str, str, int]] = []
-        for b in beliefs:
-            state = loaded.get(b.id)
-            indexed = rows[b.id][_INDEXED]
-            if state is not None and state.indexed == indexed:
-                continue
-            new = _index_entries(indexed)
-            old = _index_entries(state.indexed) if state is not None else set()
-            added.extend((name, value, b.id) for name, value in new - old)
-            removed.extend((name, value, b.id) for name, value in old - new)
         if removed:
             _write(conn, log, "DELETE FROM attribute_index WHERE name = ? AND value = ? AND object_id = ?", removed)
         if added:
             _write(conn, log, "INSERT OR IGNORE INTO attribute_index VALUES (?, ?, ?)", added)
-        moved = []
-        for b in beliefs:
-            x, y, z = rows[b.id][3:6]
-            state = loaded.get(b.id)
-            centre = state.place if state is not None else None
-            if centre is None or max(abs(x - centre[0]), abs(y - centre[1]), abs(z - centre[2])) > RTREE_SLACK / 2:
-                r = RTREE_SLACK
-                moved.append((b.id, x - r, x + r, y - r, y + r, z - r, z + r))
         if moved:
             _write(conn, log, "INSERT OR REPLACE INTO objects_place VALUES (?, ?, ?, ?, ?, ?, ?)", moved)
-        classes = {(b.class_name,) for b in beliefs if b.class_name and b.class_name != _loaded_class(loaded, b.id)}
         if classes:
             _write(conn, log, "INSERT OR IGNORE INTO classes VALUES (?)", list(classes))
 
@@ -827,6 +839,8 @@ def _object_row(b: ObjectBelief, class_test: ClassTest | None, sources: dict[fro
 
 def _floats(values: np.ndarray | Sequence[float], count: int) -> list[float]:
     """The first ``count`` values as Python floats (one conversion of the array, not one per element)."""
+    if type(values) is np.ndarray and values.dtype == np.float64 and values.shape == (count,):
+        return values.tolist()  # the common case: already that array
     return np.asarray(values, dtype=np.float64)[:count].tolist()
 
 
@@ -848,11 +862,6 @@ _labels = operator.itemgetter(*_LABEL_COLUMNS)
 
 def _state(loaded: _Loaded) -> tuple:
     return loaded.class_name, loaded.region, loaded.region_class, loaded.indexed
-
-
-def _loaded_class(loaded: Mapping[int, _Loaded], belief_id: int) -> str | None:
-    state = loaded.get(belief_id)
-    return state.class_name if state is not None else None
 
 
 def _encoded_sources(experts: set[str], cache: dict[frozenset[str], str]) -> str:

@@ -13,7 +13,7 @@ import pytest
 from reasoning.beliefs.store import BeliefFilter, BeliefStore
 from reasoning.fusion.association import CameraModel
 from reasoning.fusion.frame import FrameObject
-from reasoning.fusion.rule import Evidence
+from reasoning.fusion.rule import AttributeBelief, Evidence, ValueSupport
 from reasoning.fusion.tracking import GONE, PRESENT, BeliefTracker, ObjectBelief, TrackerConfig
 from robokudo.core.regions import RegionBox
 from robokudo.core.types import CameraIntrinsics
@@ -151,6 +151,19 @@ def test_put_and_get_round_trip_a_belief(store_path: Path) -> None:
         assert loaded is not None and store.get(8) is None
         np.testing.assert_allclose(loaded.appearance, belief.appearance)
         assert store.allocate_ids(2) == [8, 9]
+
+
+def test_a_belief_put_twice_in_one_call_is_stored_as_its_last_object(store_path: Path) -> None:
+    def painted(color: str, x: float) -> ObjectBelief:
+        attributes = {"color": AttributeBelief("color", {color: ValueSupport(1.0, 1, {"Colour"})})}
+        return ObjectBelief(id=3, frame="world", position=np.array([x, 0.0, 0.0]), attributes=attributes)
+
+    with BeliefStore(store_path) as store:
+        store.put([painted("red", 0.0), painted("blue", 2.0)])
+        stored = store.get(3)
+        assert stored is not None and stored.value("color") == "blue" and stored.position[0] == 2.0
+        assert [b.id for b in store.query(BeliefFilter(attributes={"color": "blue"}))] == [3]
+        assert store.query(BeliefFilter(attributes={"color": "red"})) == []  # no index entry of the first object
 
 
 def test_readers_see_committed_snapshots_while_the_engine_writes(store_path: Path) -> None:
