@@ -23,7 +23,7 @@ from dataclasses import dataclass
 import cv2
 import numpy as np
 
-from annotators.image.color_space import linear_to_lab, srgb_to_linear
+from annotators.image.color_space import UINT8_TO_LINEAR32, linear_to_lab
 from annotators.image.white_balance import LUMINANCE, NEUTRAL_LIGHT, FrameLight
 from robokudo.core.types import ObjectHypothesis
 
@@ -166,7 +166,7 @@ def _modes(points: np.ndarray, cells: np.ndarray, radius: float, min_count: floa
             centres.append(centre)
         outside = ~inside
         points, keys = points[outside], keys[outside]
-    return np.array(centres, dtype=np.complex128)
+    return np.array(centres, dtype=points.dtype)
 
 
 def _rows(array: np.ndarray, where: np.ndarray) -> np.ndarray:
@@ -182,13 +182,15 @@ def _surface(rows: np.ndarray, percentile: float, kind: str) -> Surface:
     ranked = rows[:3].copy()
     ranked.partition(sorted({lit_rank, middle_rank}), axis=1)  # order statistics, exact
     lit = float(ranked[0, lit_rank])
-    return Surface(np.array([lit, *(ranked[1:, middle_rank] * (lit + 16.0))]), rows[3:].mean(axis=1), count, kind)
+    chromaticity = ranked[1:, middle_rank].astype(np.float64)
+    linear = rows[3:].mean(axis=1, dtype=np.float64)
+    return Surface(np.array([lit, *(chromaticity * (lit + 16.0))]), linear, count, kind)
 
 
 def _pixel_rows(lab: np.ndarray, linear: np.ndarray) -> np.ndarray:
     """Pixels (CIELAB and linear RGB, Nx3 each) as 6xN rows: L*, a*/(L*+16), b*/(L*+16) (a chromaticity that a
     uniform change of light leaves alone), and linear R, G, B."""
-    rows = np.empty((6, lab.shape[0]))
+    rows = np.empty((6, lab.shape[0]), dtype=lab.dtype)
     rows[0] = lab[:, 0]
     np.multiply(lab[:, 1:].T, 1.0 / (lab[:, 0] + 16.0), out=rows[1:3])
     rows[3:] = linear.T
@@ -377,7 +379,7 @@ def objects_surfaces(
     keep = interior | (interior_counts < parameters.min_interior_share * sizes)[owner]
     rgb, owner = _rows(rgb, keep), owner[keep]
     counts = np.bincount(owner, minlength=len(objects))
-    linear = srgb_to_linear(rgb) * light.gains
+    linear = UINT8_TO_LINEAR32[rgb] * np.asarray(light.gains, dtype=np.float32)  # single precision from here on
     lab = linear_to_lab(linear)
     red, green, blue = rgb[:, 0], rgb[:, 1], rgb[:, 2]
     brightest, darkest = np.maximum(np.maximum(red, green), blue), np.minimum(np.minimum(red, green), blue)
@@ -463,7 +465,7 @@ def _grouped_surfaces(pixels: _Pixels, count: int, parameters: NamingParameters)
         surfaces.append(_surface(rows.compress(dark, axis=1), 50.0, "dark"))
     if not surfaces:  # only highlights, too few of them to count as a white surface otherwise
         highlight = pixels.highlight
-        white_linear = rows[3:].compress(highlight, axis=1).mean(axis=1)
+        white_linear = rows[3:].compress(highlight, axis=1).mean(axis=1, dtype=np.float64)
         surfaces.append(Surface(WHITE_LAB, white_linear, int(np.count_nonzero(highlight)), "regular"))
     return surfaces
 
