@@ -493,8 +493,8 @@ def is_unsaturated(lab: np.ndarray, parameters: NamingParameters = DEFAULT_PARAM
 
 
 def object_pixels(image: np.ndarray, hypothesis: ObjectHypothesis, max_pixels: int) -> tuple[np.ndarray, np.ndarray]:
-    """Up to ``max_pixels`` RGB pixels of the hypothesis, its outline left out when enough remain (as
-    :func:`~annotators.image.pixel_expert.hypothesis_pixels` picks them), and their edge strengths."""
+    """Up to ``max_pixels`` RGB pixels of the hypothesis, its outline left out when enough remain, and their
+    edge strengths (see :func:`objects_pixels`)."""
     return objects_pixels(image, [hypothesis], max_pixels)[0]
 
 
@@ -523,11 +523,14 @@ def _box_sobel(
 def objects_pixels(
     image: np.ndarray, hypotheses: Sequence[ObjectHypothesis], max_pixels: int
 ) -> list[tuple[np.ndarray, np.ndarray]]:
-    """:func:`object_pixels` of several hypotheses of one image: each one's pixels and their edge strengths.
+    """Each hypothesis' pixels (RGB, Nx3 uint8) and their edge strengths, for the hypotheses of one image.
 
-    The edge strength of a pixel is :func:`edge_strength` of the hypothesis' box cut out of the image: the
-    frame's Sobel derivatives, except on the box's border, where they are summed at the pixel with the box
-    mirrored as OpenCV does (:func:`_box_sobel`)."""
+    A hypothesis' pixels are its mask's, its outline left out when enough remain, taken with the stride (in
+    raster order) that leaves ``max_pixels`` to twice that, as
+    :func:`~annotators.image.pixel_expert.hypothesis_pixels` picks them. The edge strength of a pixel is
+    :func:`edge_strength` of the hypothesis' box cut out of the image: the Sobel derivatives of the part of the
+    frame the boxes cover, except on a box's border, where they are summed at the pixel with the box mirrored as
+    OpenCV does (:func:`_box_sobel`)."""
     rows_parts, cols_parts, boxes, sizes = [], [], [], []
     for hypothesis in hypotheses:
         x0, y0, x1, y1 = hypothesis.roi
@@ -546,15 +549,20 @@ def objects_pixels(
     rows, cols = np.concatenate(rows_parts), np.concatenate(cols_parts)
     y0, y1, x0, x1 = np.repeat(np.array(boxes, dtype=np.int64).reshape(-1, 4), sizes, axis=0).T
     image = np.ascontiguousarray(image)
-    flat = rows * image.shape[1] + cols
-    gx = np.take(cv2.Sobel(image, cv2.CV_16S, 1, 0, ksize=3).reshape(-1, 3), flat, axis=0)
-    gy = np.take(cv2.Sobel(image, cv2.CV_16S, 0, 1, ksize=3).reshape(-1, 3), flat, axis=0)
+    # the derivatives of the boxes' union and a pixel around it: inside it, a box pixel's are the frame's
+    top, left = max(min(b[0] for b in boxes) - 1, 0), max(min(b[2] for b in boxes) - 1, 0)
+    bottom = min(max(b[1] for b in boxes) + 1, image.shape[0])
+    right = min(max(b[3] for b in boxes) + 1, image.shape[1])
+    covered = image[top:bottom, left:right]
+    flat = (rows - top) * (right - left) + (cols - left)
+    gx = np.take(cv2.Sobel(covered, cv2.CV_16S, 1, 0, ksize=3).reshape(-1, 3), flat, axis=0)
+    gy = np.take(cv2.Sobel(covered, cv2.CV_16S, 0, 1, ksize=3).reshape(-1, 3), flat, axis=0)
     border = (rows == y0) | (rows == y1 - 1) | (cols == x0) | (cols == x1 - 1)  # the box mirrors, not the frame
     if np.any(border):
         at = np.flatnonzero(border)
         gx[at], gy[at] = _box_sobel(image, rows[at], cols[at], (y0[at], y1[at], x0[at], x1[at]))
     squared = gx.astype(np.float32) ** 2 + gy.astype(np.float32) ** 2
     edges = np.sqrt(np.maximum(np.maximum(squared[:, 0], squared[:, 1]), squared[:, 2])) / 8.0
-    pixels = np.take(image.reshape(-1, 3), flat, axis=0)
+    pixels = np.take(image.reshape(-1, 3), rows * image.shape[1] + cols, axis=0)
     ends = np.cumsum(sizes)
     return [(pixels[end - size : end], edges[end - size : end]) for end, size in zip(ends.tolist(), sizes, strict=True)]
