@@ -12,6 +12,9 @@ joins the nearer of the two; a lighter, paler group that is a blend of a saturat
 highlight on it, or a white part its colour bleeds into on a small or blurred object) is the saturated surface's
 highlight when it is mostly that colour, else the white it is mixed with (:func:`_merge_white_blends`); and a
 darker group of nearly the same hue and saturation as a larger one is its shaded side.
+
+The grouping and the groups' order statistics run compiled, for all the objects of a frame in one call
+(:mod:`annotators.image.color_groups`); the pixels are held in single precision.
 """
 
 from __future__ import annotations
@@ -137,54 +140,9 @@ def chroma_plane(lab: np.ndarray, softness: float) -> np.ndarray:
     return lab[:, 1:] * scale[:, None]
 
 
-def _modes(points: np.ndarray, cells: np.ndarray, radius: float, min_count: float, max_groups: int) -> np.ndarray:
-    """Centres (complex) of the densest modes of 2-D features given as complex ``points`` (one subtraction and
-    one modulus give every distance) with their histogram cells (2xN, cells of radius / 2): flat-kernel mean
-    shift from the fullest cell, each mode taking the points within ``radius``, which are then removed, so later
-    modes search only what remains; modes with fewer than ``min_count`` members are dropped."""
-    x, y = cells[0] - cells[0].min(), cells[1] - cells[1].min()
-    keys = x * (int(y.max()) + 1) + y
-    tolerance = 1e-6 * radius * radius
-    centres: list[complex] = []
-    for _ in range(4 * max_groups):
-        if len(centres) == max_groups or points.size < min_count:
-            break
-        seed = points[keys == int(np.argmax(np.bincount(keys)))]
-        centre = complex(np.add.reduce(seed)) / seed.size
-        inside = None  # the points within radius of centre, once known
-        for _ in range(10):
-            within = np.abs(points - centre) < radius
-            near = points[within]
-            moved = complex(np.add.reduce(near)) / near.size
-            if abs(moved - centre) ** 2 < tolerance:
-                inside = within
-                break
-            centre = moved
-        if inside is None:
-            inside = np.abs(points - centre) < radius
-        if np.count_nonzero(inside) >= min_count:
-            centres.append(centre)
-        outside = ~inside
-        points, keys = points[outside], keys[outside]
-    return np.array(centres, dtype=points.dtype)
-
-
 def _rows(array: np.ndarray, where: np.ndarray) -> np.ndarray:
     """The rows of ``array`` where ``where`` is set (as ``array[where]``, faster for rows of a few values)."""
     return array.compress(where, axis=0)
-
-
-def _surface(rows: np.ndarray, percentile: float, kind: str) -> Surface:
-    """A surface from its pixels given as rows (:func:`_pixel_rows`): median chromaticity at the ``percentile``
-    lightness, mean linear RGB."""
-    count = rows.shape[1]
-    lit_rank, middle_rank = round(percentile / 100.0 * (count - 1)), round(0.5 * (count - 1))
-    ranked = rows[:3].copy()
-    ranked.partition(sorted({lit_rank, middle_rank}), axis=1)  # order statistics, exact
-    lit = float(ranked[0, lit_rank])
-    chromaticity = ranked[1:, middle_rank].astype(np.float64)
-    linear = rows[3:].mean(axis=1, dtype=np.float64)
-    return Surface(np.array([lit, *(chromaticity * (lit + 16.0))]), linear, count, kind)
 
 
 def _pixel_rows(lab: np.ndarray, linear: np.ndarray) -> np.ndarray:
@@ -361,7 +319,8 @@ def objects_surfaces(
     parameters: NamingParameters = DEFAULT_PARAMETERS,
 ) -> list[tuple[list[Surface], int]]:
     """:func:`object_surfaces` of several objects of one frame (each its RGB pixels and their edge strengths or
-    None): the per-pixel steps run once over all the objects' pixels, the grouping per object."""
+    None): the per-pixel steps and the grouping (:func:`~annotators.image.color_groups.all_groups`) run once
+    over all the objects' pixels, the merging of the groups per object."""
     rgb_parts = [np.asarray(pixels, dtype=np.uint8).reshape(-1, 3) for pixels, _ in objects]
     sizes = np.array([part.shape[0] for part in rgb_parts], dtype=np.int64)
     if not rgb_parts:
@@ -393,81 +352,50 @@ def objects_surfaces(
     lab[whitened] = WHITE_LAB
     regular |= whitened
     features = chroma_plane(lab, parameters.chroma_softness)
-    points = features[:, 0] + 1j * features[:, 1]
-    cells = np.floor(features.T / (parameters.group_radius / 2)).astype(np.int64)
     rows = _pixel_rows(lab, linear)
     ends = np.cumsum(counts)
+    from annotators.image import color_groups  # numba is loaded with the first objects named
+
+    cells = np.ascontiguousarray(np.floor(features.T / np.float32(parameters.group_radius / 2)), dtype=np.int64)
+    settings = np.array(
+        [
+            parameters.group_radius,
+            parameters.min_group_share,
+            parameters.lit_percentile,
+            parameters.black_lightness,
+            parameters.achromatic_chroma,
+            parameters.daylight_chroma,
+            parameters.dark_tint_ratio,
+        ]
+    )
+    groups = color_groups.all_groups(
+        rows,
+        np.ascontiguousarray(features[:, 0]),
+        np.ascontiguousarray(features[:, 1]),
+        cells,
+        regular,
+        dark,
+        ends,
+        settings,
+        parameters.max_groups,
+    )
+    firsts = np.searchsorted(groups[:, 0], np.arange(len(objects) + 1))
     result = []
     for index, count in enumerate(counts.tolist()):
-        part = slice(int(ends[index]) - count, int(ends[index]))
-        pixels = _Pixels(rows[:, part], points[part], cells[:, part], regular[part], dark[part], highlight[part])
-        result.append((_grouped_surfaces(pixels, count, parameters), count))
+        found = [
+            Surface(row[2:5].copy(), row[5:8].copy(), int(row[8]), "dark" if row[1] == color_groups.DARK else "regular")
+            for row in groups[firsts[index] : firsts[index + 1]]
+        ]
+        surfaces = _merge_mixtures([s for s in found if s.kind == "regular"], parameters.mixture_tolerance)
+        surfaces = _merge_shaded(_merge_white_blends(surfaces, parameters), parameters)
+        surfaces += [s for s in found if s.kind == "dark"]
+        if not surfaces:  # only highlights, too few of them to count as a white surface otherwise
+            part = slice(int(ends[index]) - count, int(ends[index]))
+            highlights = highlight[part]
+            white_linear = rows[3:, part].compress(highlights, axis=1).mean(axis=1, dtype=np.float64)
+            surfaces.append(Surface(WHITE_LAB, white_linear, int(np.count_nonzero(highlights)), "regular"))
+        result.append((surfaces, count))
     return result
-
-
-@dataclass(frozen=True)
-class _Pixels:
-    """One object's pixels after edge pixels were left out: lightness, chromaticity and linear RGB as rows
-    (:func:`_pixel_rows`), log-chroma features (:func:`chroma_plane`) as complex points and their histogram cells
-    (2xN), and which are regular, in the dark pool or highlights."""
-
-    rows: np.ndarray
-    points: np.ndarray
-    cells: np.ndarray
-    regular: np.ndarray
-    dark: np.ndarray
-    highlight: np.ndarray
-
-
-def _group_members(points: np.ndarray, centres: np.ndarray, min_count: float) -> list[np.ndarray]:
-    """Which points (complex) each mode owns (those nearer its centre than any other's), for the modes owning
-    at least ``min_count``."""
-    if centres.size == 1:
-        return [np.ones(points.size, dtype=bool)]
-    if centres.size == 0:
-        return []
-    offsets = points[:, None] - centres[None, :]
-    owner = np.argmin(offsets.real**2 + offsets.imag**2, axis=1)
-    counts = np.bincount(owner, minlength=centres.size)
-    return [owner == group for group in np.flatnonzero(counts >= min_count).tolist()]
-
-
-def _grouped_surfaces(pixels: _Pixels, count: int, parameters: NamingParameters) -> list[Surface]:
-    """One object's surfaces from its pixels (see the module docstring); the dark pool comes last."""
-    rows, regular, dark = pixels.rows, pixels.regular, pixels.dark
-    min_count = max(3.0, parameters.min_group_share * count)
-    surfaces: list[Surface] = []
-    percentile = parameters.lit_percentile
-    if np.count_nonzero(regular) >= min_count:
-        colors = rows.compress(regular, axis=1)
-        points = pixels.points[regular]
-        centres = _modes(
-            points,
-            pixels.cells.compress(regular, axis=1),
-            parameters.group_radius,
-            min_count,
-            parameters.max_groups,
-        )
-        for member in _group_members(points, centres, min_count):
-            surface = _surface(colors.compress(member, axis=1), percentile, "regular")
-            if not is_unsaturated(surface.lab, parameters):
-                surfaces.append(surface)
-                continue
-            blackish = member & (colors[0] < parameters.black_lightness)
-            for part in (member & ~blackish, blackish):  # black print on white: two surfaces
-                if np.count_nonzero(part) >= min_count:
-                    surfaces.append(_surface(colors.compress(part, axis=1), percentile, "regular"))
-    if not surfaces and np.count_nonzero(regular):  # too few pixels for a group: they are one surface
-        surfaces.append(_surface(rows.compress(regular, axis=1), percentile, "regular"))
-    surfaces = _merge_mixtures(surfaces, parameters.mixture_tolerance)
-    surfaces = _merge_shaded(_merge_white_blends(surfaces, parameters), parameters)
-    if np.count_nonzero(dark):
-        surfaces.append(_surface(rows.compress(dark, axis=1), 50.0, "dark"))
-    if not surfaces:  # only highlights, too few of them to count as a white surface otherwise
-        highlight = pixels.highlight
-        white_linear = rows[3:].compress(highlight, axis=1).mean(axis=1, dtype=np.float64)
-        surfaces.append(Surface(WHITE_LAB, white_linear, int(np.count_nonzero(highlight)), "regular"))
-    return surfaces
 
 
 def tints(lab: np.ndarray, parameters: NamingParameters) -> np.ndarray:
