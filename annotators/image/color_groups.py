@@ -38,6 +38,38 @@ def _round_half_even(value: float) -> int:
 
 
 @njit(cache=True, nogil=True)
+def _select(values: np.ndarray, rank: int) -> float:
+    """The ``rank``-th smallest of ``values`` (reordered in place): quickselect with median-of-three pivots."""
+    low, high = 0, values.size - 1
+    while high > low:
+        middle = (low + high) // 2
+        if values[middle] < values[low]:
+            values[middle], values[low] = values[low], values[middle]
+        if values[high] < values[low]:
+            values[high], values[low] = values[low], values[high]
+        if values[high] < values[middle]:
+            values[high], values[middle] = values[middle], values[high]
+        pivot = values[middle]
+        i, j = low, high
+        while i <= j:
+            while values[i] < pivot:
+                i += 1
+            while pivot < values[j]:
+                j -= 1
+            if i <= j:
+                values[i], values[j] = values[j], values[i]
+                i += 1
+                j -= 1
+        if rank <= j:
+            high = j
+        elif rank >= i:
+            low = i
+        else:
+            break
+    return float(values[rank])
+
+
+@njit(cache=True, nogil=True)
 def _write_group(
     out: np.ndarray, at: int, obj: int, kind: int, rows: np.ndarray, members: np.ndarray, percentile: float
 ) -> None:
@@ -58,12 +90,12 @@ def _write_group(
         blue += rows[5, i]
     lit_rank = _round_half_even(percentile / 100.0 * (count - 1))
     middle_rank = _round_half_even(0.5 * (count - 1))
-    lit = float(np.partition(lightness, lit_rank)[lit_rank])
+    lit = float(_select(lightness, lit_rank))
     out[at, 0] = obj
     out[at, 1] = kind
     out[at, 2] = lit
-    out[at, 3] = float(np.partition(chroma_a, middle_rank)[middle_rank]) * (lit + 16.0)
-    out[at, 4] = float(np.partition(chroma_b, middle_rank)[middle_rank]) * (lit + 16.0)
+    out[at, 3] = float(_select(chroma_a, middle_rank)) * (lit + 16.0)
+    out[at, 4] = float(_select(chroma_b, middle_rank)) * (lit + 16.0)
     out[at, 5] = red / count
     out[at, 6] = green / count
     out[at, 7] = blue / count
@@ -79,6 +111,7 @@ def _modes(
     centres = np.empty((max_groups, 2))
     found = 0
     tolerance = 1e-6 * float(radius) * float(radius)
+    radius_squared = radius * radius  # distances are compared squared, in single precision
     cells = np.zeros(keys.max() + 1 if keys.size else 1, dtype=np.int64)
     for _ in range(4 * max_groups):
         if found == max_groups or alive.size < min_count:
@@ -100,7 +133,7 @@ def _modes(
             sx = sy = 0.0
             near = 0
             for i in alive:
-                if np.hypot(px[i] - x32, py[i] - y32) < radius:
+                if (px[i] - x32) ** 2 + (py[i] - y32) ** 2 < radius_squared:
                     sx += px[i]
                     sy += py[i]
                     near += 1
@@ -113,7 +146,7 @@ def _modes(
         members = 0
         for k in range(alive.size):
             i = alive[k]
-            inside[k] = np.hypot(px[i] - x32, py[i] - y32) < radius
+            inside[k] = (px[i] - x32) ** 2 + (py[i] - y32) ** 2 < radius_squared
             members += inside[k]
         if members >= min_count:
             centres[found, 0], centres[found, 1] = cx, cy

@@ -59,7 +59,8 @@ def estimate_frame_light(image: np.ndarray, max_gain: float = 2.0, scale: int = 
     linear = cv2.LUT(rgb, _UINT8_TO_LINEAR.reshape(1, 256))
     clipped = np.maximum(np.maximum(rgb[..., 0], rgb[..., 1]), rgb[..., 2]) >= 248
     gains = np.clip(1.0 / grey_edge_illuminant(linear, clipped, sigma=1.0 / scale), 1.0 / max_gain, max_gain)
-    weights = (gains * LUMINANCE).astype(np.float32)
-    luminance = (linear[..., 0] * weights[0] + linear[..., 1] * weights[1] + linear[..., 2] * weights[2]).ravel()
-    surround = float(np.partition(luminance, luminance.size // 2)[luminance.size // 2])
+    luminance = cv2.transform(linear, (gains * LUMINANCE).astype(np.float32).reshape(1, 3)).reshape(-1)
+    middle = luminance.size // 2
+    luminance.partition(middle)  # a fresh array: its median is found in place
+    surround = float(luminance[middle])
     return FrameLight(gains=gains, surround=max(surround, 1e-4))
