@@ -426,28 +426,6 @@ def object_pixels(image: np.ndarray, hypothesis: ObjectHypothesis, max_pixels: i
     return objects_pixels(image, [hypothesis], max_pixels)[0]
 
 
-def _reflected(index: np.ndarray, low: np.ndarray, high: np.ndarray) -> np.ndarray:
-    """Indices moved back into ``low..high-1`` by mirroring about the end pixels (OpenCV's BORDER_REFLECT_101),
-    for indices at most one step outside."""
-    index = np.where(index < low, np.minimum(low + 1, high - 1), index)
-    return np.where(index >= high, np.maximum(high - 2, low), index)
-
-
-def _box_sobel(
-    image: np.ndarray, rows: np.ndarray, cols: np.ndarray, boxes: tuple[np.ndarray, ...]
-) -> tuple[np.ndarray, np.ndarray]:
-    """The 3x3 Sobel derivatives (x, y; int16, Nx3) of an RGB image at pixels (``rows``, ``cols``) of each one's
-    box (y0, y1, x0, x1 per pixel) cut out of the image, mirrored at the box's border as OpenCV does."""
-    y0, y1, x0, x1 = boxes
-    row_index = np.stack([_reflected(rows - 1, y0, y1), rows, _reflected(rows + 1, y0, y1)]) * image.shape[1]
-    col_index = np.stack([_reflected(cols - 1, x0, x1), cols, _reflected(cols + 1, x0, x1)])
-    neighbourhood = (row_index[:, None, :] + col_index[None, :, :]).reshape(9, -1)  # 3x3, row-major, per pixel
-    p = np.take(image.reshape(-1, 3), neighbourhood, axis=0).astype(np.int16).reshape(3, 3, -1, 3)
-    gx = p[0, 2] + p[2, 2] - p[0, 0] - p[2, 0] + 2 * (p[1, 2] - p[1, 0])
-    gy = p[2, 0] + p[2, 2] - p[0, 0] - p[0, 2] + 2 * (p[2, 1] - p[0, 1])
-    return gx, gy
-
-
 def objects_pixels(
     image: np.ndarray, hypotheses: Sequence[ObjectHypothesis], max_pixels: int
 ) -> list[tuple[np.ndarray, np.ndarray]]:
@@ -455,42 +433,28 @@ def objects_pixels(
 
     A hypothesis' pixels are its mask's, its outline left out when enough remain, taken with the stride (in
     raster order) that leaves ``max_pixels`` to twice that, as
-    :func:`~annotators.image.pixel_expert.hypothesis_pixels` picks them. The edge strength of a pixel is
-    :func:`edge_strength` of the hypothesis' box cut out of the image: the Sobel derivatives of the part of the
-    frame the boxes cover, except on a box's border, where they are summed at the pixel with the box mirrored as
-    OpenCV does (:func:`_box_sobel`)."""
+    :func:`~annotators.image.pixel_expert.hypothesis_pixels` picks them
+    (:func:`~annotators.image.pixel_picking.mask_pixels`). The edge strength of a pixel is :func:`edge_strength`
+    of the hypothesis' box cut out of the image, computed at the picked pixels only
+    (:func:`~annotators.image.pixel_picking.box_pixels_and_edges`)."""
+    from annotators.image.pixel_picking import box_pixels_and_edges, mask_pixels  # numba loads on first use
+
     rows_parts, cols_parts, boxes, sizes = [], [], [], []
     for hypothesis in hypotheses:
-        x0, y0, x1, y1 = hypothesis.roi
-        local = hypothesis.mask[y0:y1, x0:x1]
-        inner = cv2.erode(local.view(np.uint8), np.ones((3, 3), np.uint8)).view(bool)
-        if np.count_nonzero(inner) >= max(20, np.count_nonzero(local) // 3):
-            local = inner
-        rows, cols = np.nonzero(local)
-        step = max(1, rows.size // max_pixels)
-        rows_parts.append(rows[::step] + y0)
-        cols_parts.append(cols[::step] + x0)
+        x0, y0, x1, y1 = (int(v) for v in hypothesis.roi)
+        rows, cols = mask_pixels(hypothesis.mask, y0, y1, x0, x1, max_pixels, 20)
+        rows_parts.append(rows)
+        cols_parts.append(cols)
         boxes.append((y0, y1, x0, x1))
-        sizes.append(rows_parts[-1].size)
+        sizes.append(rows.size)
     if not sizes:
         return []
-    rows, cols = np.concatenate(rows_parts), np.concatenate(cols_parts)
-    y0, y1, x0, x1 = np.repeat(np.array(boxes, dtype=np.int64).reshape(-1, 4), sizes, axis=0).T
-    image = np.ascontiguousarray(image)
-    # the derivatives of the boxes' union and a pixel around it: inside it, a box pixel's are the frame's
-    top, left = max(min(b[0] for b in boxes) - 1, 0), max(min(b[2] for b in boxes) - 1, 0)
-    bottom = min(max(b[1] for b in boxes) + 1, image.shape[0])
-    right = min(max(b[3] for b in boxes) + 1, image.shape[1])
-    covered = image[top:bottom, left:right]
-    flat = (rows - top) * (right - left) + (cols - left)
-    gx = np.take(cv2.Sobel(covered, cv2.CV_16S, 1, 0, ksize=3).reshape(-1, 3), flat, axis=0)
-    gy = np.take(cv2.Sobel(covered, cv2.CV_16S, 0, 1, ksize=3).reshape(-1, 3), flat, axis=0)
-    border = (rows == y0) | (rows == y1 - 1) | (cols == x0) | (cols == x1 - 1)  # the box mirrors, not the frame
-    if np.any(border):
-        at = np.flatnonzero(border)
-        gx[at], gy[at] = _box_sobel(image, rows[at], cols[at], (y0[at], y1[at], x0[at], x1[at]))
-    squared = gx.astype(np.float32) ** 2 + gy.astype(np.float32) ** 2
-    edges = np.sqrt(np.maximum(np.maximum(squared[:, 0], squared[:, 1]), squared[:, 2])) / 8.0
-    pixels = np.take(image.reshape(-1, 3), rows * image.shape[1] + cols, axis=0)
+    pixels, edges = box_pixels_and_edges(
+        np.ascontiguousarray(image, dtype=np.uint8),
+        np.concatenate(rows_parts),
+        np.concatenate(cols_parts),
+        np.array(boxes, dtype=np.int64).reshape(-1, 4),
+        np.repeat(np.arange(len(sizes)), sizes),
+    )
     ends = np.cumsum(sizes)
     return [(pixels[end - size : end], edges[end - size : end]) for end, size in zip(ends.tolist(), sizes, strict=True)]
