@@ -24,7 +24,7 @@ GROUP_FIELDS = 9
 """Columns of a group row: object index, kind (0 regular, 1 dark pool), L*, a*, b*, linear R, G, B, pixel count."""
 
 REGULAR, DARK = 0, 1
-"""The kinds of a group row."""
+"""The kinds of a group row (``DARK`` is :data:`~annotators.image.color_surfaces.DARK_GROUP`)."""
 
 
 @njit(cache=True, nogil=True)
@@ -235,7 +235,8 @@ def all_groups(
     ``regular`` or ``dark``), as rows of :data:`GROUP_FIELDS` values, object by object, each object's regular
     groups before its dark pool. ``settings``: the group radius, the smallest group's share of the object, the
     lit percentile, the black lightness and the achromatic ellipse (a* radius, b* radius, dark tint ratio) of
-    :class:`~annotators.image.color_surfaces.NamingParameters`."""
+    :class:`~annotators.image.color_surfaces.NamingParameters`
+    (:func:`~annotators.image.color_surfaces.group_settings`)."""
     out = np.empty((ends.size * (2 * max_groups + 2), GROUP_FIELDS))
     at = 0
     start = 0

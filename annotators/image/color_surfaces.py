@@ -301,6 +301,51 @@ def _merge_shaded(surfaces: list[Surface], parameters: NamingParameters) -> list
     return kept
 
 
+DARK_GROUP = 1
+"""The kind of a dark pool's row in :func:`~annotators.image.color_groups.all_groups`' result."""
+
+
+def group_settings(parameters: NamingParameters) -> np.ndarray:
+    """The constants :func:`~annotators.image.color_groups.all_groups` groups pixels with, in its order."""
+    return np.array(
+        [
+            parameters.group_radius,
+            parameters.min_group_share,
+            parameters.lit_percentile,
+            parameters.black_lightness,
+            parameters.achromatic_chroma,
+            parameters.daylight_chroma,
+            parameters.dark_tint_ratio,
+        ]
+    )
+
+
+def _groups(
+    rows: np.ndarray,
+    features: np.ndarray,
+    regular: np.ndarray,
+    dark: np.ndarray,
+    ends: np.ndarray,
+    parameters: NamingParameters,
+) -> np.ndarray:
+    """The surface groups of the objects whose pixels (:func:`_pixel_rows`, log-chroma ``features``, which are
+    ``regular`` or ``dark``) end at ``ends``: :func:`~annotators.image.color_groups.all_groups`' rows."""
+    from annotators.image.color_groups import all_groups  # numba is loaded with the first objects named
+
+    cells = np.floor(features.T / np.float32(parameters.group_radius / 2))
+    return all_groups(
+        rows,
+        np.ascontiguousarray(features[:, 0]),
+        np.ascontiguousarray(features[:, 1]),
+        np.ascontiguousarray(cells, dtype=np.int64),
+        regular,
+        dark,
+        ends,
+        group_settings(parameters),
+        parameters.max_groups,
+    )
+
+
 def object_surfaces(
     pixels: np.ndarray,
     light: FrameLight = NEUTRAL_LIGHT,
@@ -354,36 +399,12 @@ def objects_surfaces(
     features = chroma_plane(lab, parameters.chroma_softness)
     rows = _pixel_rows(lab, linear)
     ends = np.cumsum(counts)
-    from annotators.image import color_groups  # numba is loaded with the first objects named
-
-    cells = np.ascontiguousarray(np.floor(features.T / np.float32(parameters.group_radius / 2)), dtype=np.int64)
-    settings = np.array(
-        [
-            parameters.group_radius,
-            parameters.min_group_share,
-            parameters.lit_percentile,
-            parameters.black_lightness,
-            parameters.achromatic_chroma,
-            parameters.daylight_chroma,
-            parameters.dark_tint_ratio,
-        ]
-    )
-    groups = color_groups.all_groups(
-        rows,
-        np.ascontiguousarray(features[:, 0]),
-        np.ascontiguousarray(features[:, 1]),
-        cells,
-        regular,
-        dark,
-        ends,
-        settings,
-        parameters.max_groups,
-    )
+    groups = _groups(rows, features, regular, dark, ends, parameters)
     firsts = np.searchsorted(groups[:, 0], np.arange(len(objects) + 1))
     result = []
     for index, count in enumerate(counts.tolist()):
         found = [
-            Surface(row[2:5].copy(), row[5:8].copy(), int(row[8]), "dark" if row[1] == color_groups.DARK else "regular")
+            Surface(row[2:5].copy(), row[5:8].copy(), int(row[8]), "dark" if row[1] == DARK_GROUP else "regular")
             for row in groups[firsts[index] : firsts[index + 1]]
         ]
         surfaces = _merge_mixtures([s for s in found if s.kind == "regular"], parameters.mixture_tolerance)

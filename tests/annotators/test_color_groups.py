@@ -6,22 +6,11 @@ import numpy as np
 import pytest
 
 from annotators.image.color_groups import DARK, GROUP_FIELDS, REGULAR, all_groups
-from annotators.image.color_surfaces import DEFAULT_PARAMETERS
+from annotators.image.color_surfaces import DARK_GROUP, DEFAULT_PARAMETERS, group_settings
 
 
 def _settings() -> np.ndarray:
-    p = DEFAULT_PARAMETERS
-    return np.array(
-        [
-            p.group_radius,
-            p.min_group_share,
-            p.lit_percentile,
-            p.black_lightness,
-            p.achromatic_chroma,
-            p.daylight_chroma,
-            p.dark_tint_ratio,
-        ]
-    )
+    return group_settings(DEFAULT_PARAMETERS)
 
 
 def _expected(rows: np.ndarray, percentile: float) -> np.ndarray:
@@ -52,6 +41,7 @@ def test_two_separated_colours_are_two_groups_with_exact_statistics(seed: int) -
     groups = all_groups(rows, px, py, cells, ~dark, dark, np.array([total]), _settings(), 5)
     assert groups.shape == (3, GROUP_FIELDS)
     assert list(groups[:, 1]) == [REGULAR, REGULAR, DARK]
+    assert DARK == DARK_GROUP
     first, second = np.arange(sizes[0]), np.arange(sizes[0], sizes[0] + sizes[1])
     for row, members, percentile in ((0, first, 80.0), (1, second, 80.0), (2, np.flatnonzero(dark), 50.0)):
         np.testing.assert_allclose(groups[row, 2:], _expected(rows[:, members], percentile), rtol=1e-12)
