@@ -59,8 +59,8 @@ def estimate_frame_light(image: np.ndarray, max_gain: float = 2.0, scale: int = 
     linear = cv2.LUT(rgb, _UINT8_TO_LINEAR.reshape(1, 256))
     clipped = np.maximum(np.maximum(rgb[..., 0], rgb[..., 1]), rgb[..., 2]) >= 248
     gains = np.clip(1.0 / grey_edge_illuminant(linear, clipped, sigma=1.0 / scale), 1.0 / max_gain, max_gain)
+    from annotators.image.radix_select import kth_smallest  # numba is loaded with the first frame
+
     luminance = cv2.transform(linear, (gains * LUMINANCE).astype(np.float32).reshape(1, 3)).reshape(-1)
-    middle = luminance.size // 2
-    luminance.partition(middle)  # a fresh array: its median is found in place
-    surround = float(luminance[middle])
+    surround = kth_smallest(luminance, luminance.size // 2)
     return FrameLight(gains=gains, surround=max(surround, 1e-4))
