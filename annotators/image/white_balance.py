@@ -4,7 +4,8 @@ Grey-edge (van de Weijer, Gevers and Gijsenij 2007, "Edge-based color constancy"
 of a scene is achromatic, so the mean gradient magnitude per channel (first order, Minkowski norm 1, Gaussian
 sigma 1 pixel at full size; computed on the half-size frame for speed) estimates the illuminant colour. It is
 divided out in linear RGB (von Kries). Grey-world and the support plane are no good references on wooden or
-coloured tables: they make the table grey instead of the light.
+coloured tables: they make the table grey instead of the light. The surround luminance is the median luminance of
+the half-size frame after the gains (:func:`~annotators.image.radix_select.kth_smallest`).
 """
 
 from __future__ import annotations
