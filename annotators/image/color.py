@@ -73,6 +73,9 @@ _ALL_TERMS, _ALL_LAB, _ALL_NAMES = prototypes(COLOR_TERMS)
 _CHROMATIC = np.array([term in CHROMATIC_TERMS for term in _ALL_TERMS])
 _PROTOTYPE_TERMS = tuple(t for t, chromatic in zip(_ALL_TERMS, _CHROMATIC, strict=True) if chromatic)
 _PROTOTYPE_LAB = _ALL_LAB[_CHROMATIC]
+_PROTOTYPE_LAB32 = _PROTOTYPE_LAB.astype(np.float32)
+"""The prototypes in single precision: the votes' CIEDE2000 distances are computed in it (twice as fast; their
+differences from double precision, about 1e-4 relative, are far below the kernel's width)."""
 _PROTOTYPE_CODES = np.array([CHROMATIC_TERMS.index(t) for t in _PROTOTYPE_TERMS])
 _TERM_AVERAGE = np.eye(len(CHROMATIC_TERMS))[_PROTOTYPE_CODES] / np.bincount(_PROTOTYPE_CODES)
 """Prototypes x terms: averages the prototypes' votes per term."""
@@ -97,9 +100,10 @@ class NamedColor:
 
 def _term_votes(labs: np.ndarray, parameters: NamingParameters) -> np.ndarray:
     """The chromatic terms' shares of the prototype votes for CIELAB colours (Sx3 in, S x terms out; each row
-    sums to 1, all on the nearest prototype's term when the colour is far from every prototype)."""
-    labs = np.asarray(labs, dtype=np.float64).reshape(-1, 3)
-    distances = delta_e_2000(labs[:, None, :], _PROTOTYPE_LAB[None, :, :])
+    sums to 1, all on the nearest prototype's term when the colour is far from every prototype). The distances
+    are computed in single precision, the votes from them in double."""
+    labs = np.asarray(labs, dtype=np.float32).reshape(-1, 3)
+    distances = delta_e_2000(labs[:, None, :], _PROTOTYPE_LAB32[None, :, :]).astype(np.float64)
     density = np.exp(-0.5 * (distances / parameters.kernel_width) ** 2) @ _TERM_AVERAGE
     total = density.sum(axis=1)
     far = total <= 1e-300

@@ -12,6 +12,9 @@ joins the nearer of the two; a lighter, paler group that is a blend of a saturat
 highlight on it, or a white part its colour bleeds into on a small or blurred object) is the saturated surface's
 highlight when it is mostly that colour, else the white it is mixed with (:func:`_merge_white_blends`); and a
 darker group of nearly the same hue and saturation as a larger one is its shaded side.
+
+The grouping and the groups' order statistics run compiled, for all the objects of a frame in one call
+(:mod:`annotators.image.color_groups`); the pixels are held in single precision.
 """
 
 from __future__ import annotations
@@ -23,7 +26,7 @@ from dataclasses import dataclass
 import cv2
 import numpy as np
 
-from annotators.image.color_space import linear_to_lab, srgb_to_linear
+from annotators.image.color_space import UINT8_TO_LINEAR32, linear_to_lab
 from annotators.image.white_balance import LUMINANCE, NEUTRAL_LIGHT, FrameLight
 from robokudo.core.types import ObjectHypothesis
 
@@ -137,58 +140,15 @@ def chroma_plane(lab: np.ndarray, softness: float) -> np.ndarray:
     return lab[:, 1:] * scale[:, None]
 
 
-def _modes(points: np.ndarray, cells: np.ndarray, radius: float, min_count: float, max_groups: int) -> np.ndarray:
-    """Centres (complex) of the densest modes of 2-D features given as complex ``points`` (one subtraction and
-    one modulus give every distance) with their histogram cells (2xN, cells of radius / 2): flat-kernel mean
-    shift from the fullest cell, each mode taking the points within ``radius``, which are then removed, so later
-    modes search only what remains; modes with fewer than ``min_count`` members are dropped."""
-    x, y = cells[0] - cells[0].min(), cells[1] - cells[1].min()
-    keys = x * (int(y.max()) + 1) + y
-    tolerance = 1e-6 * radius * radius
-    centres: list[complex] = []
-    for _ in range(4 * max_groups):
-        if len(centres) == max_groups or points.size < min_count:
-            break
-        seed = points[keys == int(np.argmax(np.bincount(keys)))]
-        centre = complex(np.add.reduce(seed)) / seed.size
-        inside = None  # the points within radius of centre, once known
-        for _ in range(10):
-            within = np.abs(points - centre) < radius
-            near = points[within]
-            moved = complex(np.add.reduce(near)) / near.size
-            if abs(moved - centre) ** 2 < tolerance:
-                inside = within
-                break
-            centre = moved
-        if inside is None:
-            inside = np.abs(points - centre) < radius
-        if np.count_nonzero(inside) >= min_count:
-            centres.append(centre)
-        outside = ~inside
-        points, keys = points[outside], keys[outside]
-    return np.array(centres, dtype=np.complex128)
-
-
 def _rows(array: np.ndarray, where: np.ndarray) -> np.ndarray:
     """The rows of ``array`` where ``where`` is set (as ``array[where]``, faster for rows of a few values)."""
     return array.compress(where, axis=0)
 
 
-def _surface(rows: np.ndarray, percentile: float, kind: str) -> Surface:
-    """A surface from its pixels given as rows (:func:`_pixel_rows`): median chromaticity at the ``percentile``
-    lightness, mean linear RGB."""
-    count = rows.shape[1]
-    lit_rank, middle_rank = round(percentile / 100.0 * (count - 1)), round(0.5 * (count - 1))
-    ranked = rows[:3].copy()
-    ranked.partition(sorted({lit_rank, middle_rank}), axis=1)  # order statistics, exact
-    lit = float(ranked[0, lit_rank])
-    return Surface(np.array([lit, *(ranked[1:, middle_rank] * (lit + 16.0))]), rows[3:].mean(axis=1), count, kind)
-
-
 def _pixel_rows(lab: np.ndarray, linear: np.ndarray) -> np.ndarray:
     """Pixels (CIELAB and linear RGB, Nx3 each) as 6xN rows: L*, a*/(L*+16), b*/(L*+16) (a chromaticity that a
     uniform change of light leaves alone), and linear R, G, B."""
-    rows = np.empty((6, lab.shape[0]))
+    rows = np.empty((6, lab.shape[0]), dtype=lab.dtype)
     rows[0] = lab[:, 0]
     np.multiply(lab[:, 1:].T, 1.0 / (lab[:, 0] + 16.0), out=rows[1:3])
     rows[3:] = linear.T
@@ -341,6 +301,51 @@ def _merge_shaded(surfaces: list[Surface], parameters: NamingParameters) -> list
     return kept
 
 
+DARK_GROUP = 1
+"""The kind of a dark pool's row in :func:`~annotators.image.color_groups.all_groups`' result."""
+
+
+def group_settings(parameters: NamingParameters) -> np.ndarray:
+    """The constants :func:`~annotators.image.color_groups.all_groups` groups pixels with, in its order."""
+    return np.array(
+        [
+            parameters.group_radius,
+            parameters.min_group_share,
+            parameters.lit_percentile,
+            parameters.black_lightness,
+            parameters.achromatic_chroma,
+            parameters.daylight_chroma,
+            parameters.dark_tint_ratio,
+        ]
+    )
+
+
+def _groups(
+    rows: np.ndarray,
+    features: np.ndarray,
+    regular: np.ndarray,
+    dark: np.ndarray,
+    ends: np.ndarray,
+    parameters: NamingParameters,
+) -> np.ndarray:
+    """The surface groups of the objects whose pixels (:func:`_pixel_rows`, log-chroma ``features``, which are
+    ``regular`` or ``dark``) end at ``ends``: :func:`~annotators.image.color_groups.all_groups`' rows."""
+    from annotators.image.color_groups import all_groups  # numba is loaded with the first objects named
+
+    cells = np.floor(features.T / np.float32(parameters.group_radius / 2))
+    return all_groups(
+        rows,
+        np.ascontiguousarray(features[:, 0]),
+        np.ascontiguousarray(features[:, 1]),
+        np.ascontiguousarray(cells, dtype=np.int64),
+        regular,
+        dark,
+        ends,
+        group_settings(parameters),
+        parameters.max_groups,
+    )
+
+
 def object_surfaces(
     pixels: np.ndarray,
     light: FrameLight = NEUTRAL_LIGHT,
@@ -359,7 +364,8 @@ def objects_surfaces(
     parameters: NamingParameters = DEFAULT_PARAMETERS,
 ) -> list[tuple[list[Surface], int]]:
     """:func:`object_surfaces` of several objects of one frame (each its RGB pixels and their edge strengths or
-    None): the per-pixel steps run once over all the objects' pixels, the grouping per object."""
+    None): the per-pixel steps and the grouping (:func:`~annotators.image.color_groups.all_groups`) run once
+    over all the objects' pixels, the merging of the groups per object."""
     rgb_parts = [np.asarray(pixels, dtype=np.uint8).reshape(-1, 3) for pixels, _ in objects]
     sizes = np.array([part.shape[0] for part in rgb_parts], dtype=np.int64)
     if not rgb_parts:
@@ -377,7 +383,7 @@ def objects_surfaces(
     keep = interior | (interior_counts < parameters.min_interior_share * sizes)[owner]
     rgb, owner = _rows(rgb, keep), owner[keep]
     counts = np.bincount(owner, minlength=len(objects))
-    linear = srgb_to_linear(rgb) * light.gains
+    linear = UINT8_TO_LINEAR32[rgb] * np.asarray(light.gains, dtype=np.float32)  # single precision from here on
     lab = linear_to_lab(linear)
     red, green, blue = rgb[:, 0], rgb[:, 1], rgb[:, 2]
     brightest, darkest = np.maximum(np.maximum(red, green), blue), np.minimum(np.minimum(red, green), blue)
@@ -391,81 +397,26 @@ def objects_surfaces(
     lab[whitened] = WHITE_LAB
     regular |= whitened
     features = chroma_plane(lab, parameters.chroma_softness)
-    points = features[:, 0] + 1j * features[:, 1]
-    cells = np.floor(features.T / (parameters.group_radius / 2)).astype(np.int64)
     rows = _pixel_rows(lab, linear)
     ends = np.cumsum(counts)
+    groups = _groups(rows, features, regular, dark, ends, parameters)
+    firsts = np.searchsorted(groups[:, 0], np.arange(len(objects) + 1))
     result = []
     for index, count in enumerate(counts.tolist()):
-        part = slice(int(ends[index]) - count, int(ends[index]))
-        pixels = _Pixels(rows[:, part], points[part], cells[:, part], regular[part], dark[part], highlight[part])
-        result.append((_grouped_surfaces(pixels, count, parameters), count))
+        found = [
+            Surface(row[2:5].copy(), row[5:8].copy(), int(row[8]), "dark" if row[1] == DARK_GROUP else "regular")
+            for row in groups[firsts[index] : firsts[index + 1]]
+        ]
+        surfaces = _merge_mixtures([s for s in found if s.kind == "regular"], parameters.mixture_tolerance)
+        surfaces = _merge_shaded(_merge_white_blends(surfaces, parameters), parameters)
+        surfaces += [s for s in found if s.kind == "dark"]
+        if not surfaces:  # only highlights, too few of them to count as a white surface otherwise
+            part = slice(int(ends[index]) - count, int(ends[index]))
+            highlights = highlight[part]
+            white_linear = rows[3:, part].compress(highlights, axis=1).mean(axis=1, dtype=np.float64)
+            surfaces.append(Surface(WHITE_LAB, white_linear, int(np.count_nonzero(highlights)), "regular"))
+        result.append((surfaces, count))
     return result
-
-
-@dataclass(frozen=True)
-class _Pixels:
-    """One object's pixels after edge pixels were left out: lightness, chromaticity and linear RGB as rows
-    (:func:`_pixel_rows`), log-chroma features (:func:`chroma_plane`) as complex points and their histogram cells
-    (2xN), and which are regular, in the dark pool or highlights."""
-
-    rows: np.ndarray
-    points: np.ndarray
-    cells: np.ndarray
-    regular: np.ndarray
-    dark: np.ndarray
-    highlight: np.ndarray
-
-
-def _group_members(points: np.ndarray, centres: np.ndarray, min_count: float) -> list[np.ndarray]:
-    """Which points (complex) each mode owns (those nearer its centre than any other's), for the modes owning
-    at least ``min_count``."""
-    if centres.size == 1:
-        return [np.ones(points.size, dtype=bool)]
-    if centres.size == 0:
-        return []
-    offsets = points[:, None] - centres[None, :]
-    owner = np.argmin(offsets.real**2 + offsets.imag**2, axis=1)
-    counts = np.bincount(owner, minlength=centres.size)
-    return [owner == group for group in np.flatnonzero(counts >= min_count).tolist()]
-
-
-def _grouped_surfaces(pixels: _Pixels, count: int, parameters: NamingParameters) -> list[Surface]:
-    """One object's surfaces from its pixels (see the module docstring); the dark pool comes last."""
-    rows, regular, dark = pixels.rows, pixels.regular, pixels.dark
-    min_count = max(3.0, parameters.min_group_share * count)
-    surfaces: list[Surface] = []
-    percentile = parameters.lit_percentile
-    if np.count_nonzero(regular) >= min_count:
-        colors = rows.compress(regular, axis=1)
-        points = pixels.points[regular]
-        centres = _modes(
-            points,
-            pixels.cells.compress(regular, axis=1),
-            parameters.group_radius,
-            min_count,
-            parameters.max_groups,
-        )
-        for member in _group_members(points, centres, min_count):
-            surface = _surface(colors.compress(member, axis=1), percentile, "regular")
-            if not is_unsaturated(surface.lab, parameters):
-                surfaces.append(surface)
-                continue
-            blackish = member & (colors[0] < parameters.black_lightness)
-            for part in (member & ~blackish, blackish):  # black print on white: two surfaces
-                if np.count_nonzero(part) >= min_count:
-                    surfaces.append(_surface(colors.compress(part, axis=1), percentile, "regular"))
-    if not surfaces and np.count_nonzero(regular):  # too few pixels for a group: they are one surface
-        surfaces.append(_surface(rows.compress(regular, axis=1), percentile, "regular"))
-    surfaces = _merge_mixtures(surfaces, parameters.mixture_tolerance)
-    surfaces = _merge_shaded(_merge_white_blends(surfaces, parameters), parameters)
-    if np.count_nonzero(dark):
-        surfaces.append(_surface(rows.compress(dark, axis=1), 50.0, "dark"))
-    if not surfaces:  # only highlights, too few of them to count as a white surface otherwise
-        highlight = pixels.highlight
-        white_linear = rows[3:].compress(highlight, axis=1).mean(axis=1)
-        surfaces.append(Surface(WHITE_LAB, white_linear, int(np.count_nonzero(highlight)), "regular"))
-    return surfaces
 
 
 def tints(lab: np.ndarray, parameters: NamingParameters) -> np.ndarray:
@@ -491,68 +442,40 @@ def is_unsaturated(lab: np.ndarray, parameters: NamingParameters = DEFAULT_PARAM
 
 
 def object_pixels(image: np.ndarray, hypothesis: ObjectHypothesis, max_pixels: int) -> tuple[np.ndarray, np.ndarray]:
-    """Up to ``max_pixels`` RGB pixels of the hypothesis, its outline left out when enough remain (as
-    :func:`~annotators.image.pixel_expert.hypothesis_pixels` picks them), and their edge strengths."""
+    """Up to ``max_pixels`` RGB pixels of the hypothesis, its outline left out when enough remain, and their
+    edge strengths (see :func:`objects_pixels`)."""
     return objects_pixels(image, [hypothesis], max_pixels)[0]
-
-
-def _reflected(index: np.ndarray, low: np.ndarray, high: np.ndarray) -> np.ndarray:
-    """Indices moved back into ``low..high-1`` by mirroring about the end pixels (OpenCV's BORDER_REFLECT_101),
-    for indices at most one step outside."""
-    index = np.where(index < low, np.minimum(low + 1, high - 1), index)
-    return np.where(index >= high, np.maximum(high - 2, low), index)
-
-
-def _box_sobel(
-    image: np.ndarray, rows: np.ndarray, cols: np.ndarray, boxes: tuple[np.ndarray, ...]
-) -> tuple[np.ndarray, np.ndarray]:
-    """The 3x3 Sobel derivatives (x, y; int16, Nx3) of an RGB image at pixels (``rows``, ``cols``) of each one's
-    box (y0, y1, x0, x1 per pixel) cut out of the image, mirrored at the box's border as OpenCV does."""
-    y0, y1, x0, x1 = boxes
-    row_index = np.stack([_reflected(rows - 1, y0, y1), rows, _reflected(rows + 1, y0, y1)]) * image.shape[1]
-    col_index = np.stack([_reflected(cols - 1, x0, x1), cols, _reflected(cols + 1, x0, x1)])
-    neighbourhood = (row_index[:, None, :] + col_index[None, :, :]).reshape(9, -1)  # 3x3, row-major, per pixel
-    p = np.take(image.reshape(-1, 3), neighbourhood, axis=0).astype(np.int16).reshape(3, 3, -1, 3)
-    gx = p[0, 2] + p[2, 2] - p[0, 0] - p[2, 0] + 2 * (p[1, 2] - p[1, 0])
-    gy = p[2, 0] + p[2, 2] - p[0, 0] - p[0, 2] + 2 * (p[2, 1] - p[0, 1])
-    return gx, gy
 
 
 def objects_pixels(
     image: np.ndarray, hypotheses: Sequence[ObjectHypothesis], max_pixels: int
 ) -> list[tuple[np.ndarray, np.ndarray]]:
-    """:func:`object_pixels` of several hypotheses of one image: each one's pixels and their edge strengths.
+    """Each hypothesis' pixels (RGB, Nx3 uint8) and their edge strengths, for the hypotheses of one image.
 
-    The edge strength of a pixel is :func:`edge_strength` of the hypothesis' box cut out of the image: the
-    frame's Sobel derivatives, except on the box's border, where they are summed at the pixel with the box
-    mirrored as OpenCV does (:func:`_box_sobel`)."""
+    A hypothesis' pixels are its mask's, its outline left out when enough remain, taken with the stride (in
+    raster order) that leaves ``max_pixels`` to twice that, as
+    :func:`~annotators.image.pixel_expert.hypothesis_pixels` picks them
+    (:func:`~annotators.image.pixel_picking.mask_pixels`). The edge strength of a pixel is :func:`edge_strength`
+    of the hypothesis' box cut out of the image, computed at the picked pixels only
+    (:func:`~annotators.image.pixel_picking.box_pixels_and_edges`)."""
+    from annotators.image.pixel_picking import box_pixels_and_edges, mask_pixels  # numba loads on first use
+
     rows_parts, cols_parts, boxes, sizes = [], [], [], []
     for hypothesis in hypotheses:
-        x0, y0, x1, y1 = hypothesis.roi
-        local = hypothesis.mask[y0:y1, x0:x1]
-        inner = cv2.erode(local.view(np.uint8), np.ones((3, 3), np.uint8)).view(bool)
-        if np.count_nonzero(inner) >= max(20, np.count_nonzero(local) // 3):
-            local = inner
-        rows, cols = np.nonzero(local)
-        step = max(1, rows.size // max_pixels)
-        rows_parts.append(rows[::step] + y0)
-        cols_parts.append(cols[::step] + x0)
+        x0, y0, x1, y1 = (int(v) for v in hypothesis.roi)
+        rows, cols = mask_pixels(hypothesis.mask, y0, y1, x0, x1, max_pixels, 20)
+        rows_parts.append(rows)
+        cols_parts.append(cols)
         boxes.append((y0, y1, x0, x1))
-        sizes.append(rows_parts[-1].size)
+        sizes.append(rows.size)
     if not sizes:
         return []
-    rows, cols = np.concatenate(rows_parts), np.concatenate(cols_parts)
-    y0, y1, x0, x1 = np.repeat(np.array(boxes, dtype=np.int64).reshape(-1, 4), sizes, axis=0).T
-    image = np.ascontiguousarray(image)
-    flat = rows * image.shape[1] + cols
-    gx = np.take(cv2.Sobel(image, cv2.CV_16S, 1, 0, ksize=3).reshape(-1, 3), flat, axis=0)
-    gy = np.take(cv2.Sobel(image, cv2.CV_16S, 0, 1, ksize=3).reshape(-1, 3), flat, axis=0)
-    border = (rows == y0) | (rows == y1 - 1) | (cols == x0) | (cols == x1 - 1)  # the box mirrors, not the frame
-    if np.any(border):
-        at = np.flatnonzero(border)
-        gx[at], gy[at] = _box_sobel(image, rows[at], cols[at], (y0[at], y1[at], x0[at], x1[at]))
-    squared = gx.astype(np.float32) ** 2 + gy.astype(np.float32) ** 2
-    edges = np.sqrt(np.maximum(np.maximum(squared[:, 0], squared[:, 1]), squared[:, 2])) / 8.0
-    pixels = np.take(image.reshape(-1, 3), flat, axis=0)
+    pixels, edges = box_pixels_and_edges(
+        np.ascontiguousarray(image, dtype=np.uint8),
+        np.concatenate(rows_parts),
+        np.concatenate(cols_parts),
+        np.array(boxes, dtype=np.int64).reshape(-1, 4),
+        np.repeat(np.arange(len(sizes)), sizes),
+    )
     ends = np.cumsum(sizes)
     return [(pixels[end - size : end], edges[end - size : end]) for end, size in zip(ends.tolist(), sizes, strict=True)]

@@ -4,7 +4,8 @@ Grey-edge (van de Weijer, Gevers and Gijsenij 2007, "Edge-based color constancy"
 of a scene is achromatic, so the mean gradient magnitude per channel (first order, Minkowski norm 1, Gaussian
 sigma 1 pixel at full size; computed on the half-size frame for speed) estimates the illuminant colour. It is
 divided out in linear RGB (von Kries). Grey-world and the support plane are no good references on wooden or
-coloured tables: they make the table grey instead of the light.
+coloured tables: they make the table grey instead of the light. The surround luminance is the median luminance of
+the half-size frame after the gains (:func:`~annotators.image.radix_select.kth_smallest`).
 """
 
 from __future__ import annotations
@@ -59,7 +60,8 @@ def estimate_frame_light(image: np.ndarray, max_gain: float = 2.0, scale: int = 
     linear = cv2.LUT(rgb, _UINT8_TO_LINEAR.reshape(1, 256))
     clipped = np.maximum(np.maximum(rgb[..., 0], rgb[..., 1]), rgb[..., 2]) >= 248
     gains = np.clip(1.0 / grey_edge_illuminant(linear, clipped, sigma=1.0 / scale), 1.0 / max_gain, max_gain)
-    weights = (gains * LUMINANCE).astype(np.float32)
-    luminance = (linear[..., 0] * weights[0] + linear[..., 1] * weights[1] + linear[..., 2] * weights[2]).ravel()
-    surround = float(np.partition(luminance, luminance.size // 2)[luminance.size // 2])
+    from annotators.image.radix_select import kth_smallest  # numba is loaded with the first frame
+
+    luminance = cv2.transform(linear, (gains * LUMINANCE).astype(np.float32).reshape(1, 3)).reshape(-1)
+    surround = kth_smallest(luminance, luminance.size // 2)
     return FrameLight(gains=gains, surround=max(surround, 1e-4))
