@@ -34,8 +34,11 @@ Deciding. The score is not a probability: many classes share colour, shape and s
 are all small cylinders). The calibration (``calibration.FITTED``, fitted on labelled objects) turns the best
 match's score, lead and whether its printed text went unread into the probability that it is right. A class is
 asserted only when it fits (score >= ``min_score``) and that probability reaches :data:`ASSERT_PROBABILITY`; its
-Classification confidence is that probability. Otherwise the query's class (``expected``) may break a near-tie:
-a match of that class that fits and scores within ``margin`` of the best fitting one is asserted with its own
+Classification confidence is that probability. Otherwise the most specific class above the best one that fits
+and reaches that probability by its own score and lead is asserted (cues that cannot tell a white ceramic bowl
+from a plastic one still say bowl). Otherwise the query's class (``expected``) may break a tie:
+a match of that class that fits and scores as high as the best fitting one (within ``margin``: equal but for
+rounding, so the cues cannot tell the two classes apart) is asserted with its own
 (low) calibrated probability - the query never lifts a poor fit (a class named by printed text fits only when its
 text was read; the root class breaks no tie). Everything
 else is classified :data:`UNKNOWN_CLASS` ("unknown object") with confidence 1 - probability (how sure the
@@ -68,9 +71,11 @@ from robokudo.core.types import (
 )
 
 WEIGHTS: Mapping[str, float] = MappingProxyType(
-    {"color": 1.0, "shape": 1.0, "size": 0.5, "handle": 1.0, "open": 0.5, "ratio": 1.0, "text": 3.0}
+    {"color": 1.0, "shape": 1.0, "size": 1.0, "handle": 1.0, "open": 1.0, "ratio": 1.0, "text": 3.0}
 )
-"""How much each cue counts in the score."""
+"""How much each cue counts in the score. The open top and the size class count as much as the handle: the open top
+is what tells a cup, a mug or a bowl from a closed can, jar or tub of the same size, shape and proportions; the size
+what tells a mug from a pitcher or a pot (open, with a handle, of the same proportions)."""
 
 HANDLE_HIDDEN = 0.3
 """Handle agreement of a class with a handle when none was seen: it may be on the hidden side, but from most
@@ -93,8 +98,11 @@ UNKNOWN_CLASS = "PhysicalObject"
 MIN_SCORE = 0.6
 """Default score a profile needs to fit at all."""
 
-TIE_MARGIN = 0.05
-"""Default score difference within which the query's class may decide between fitting candidates."""
+TIE_MARGIN = 1e-6
+"""Default score difference within which the query's class may decide between fitting candidates: equal scores
+only. A class the cues score lower, however slightly (a can's closed top seen with little confidence, its colour
+against a cup's), is not lifted over the one they prefer: the query's class decides only what the cues leave
+open (a cup and a glass look alike to a depth camera), so it cannot do the work of the cues."""
 
 ASSERT_PROBABILITY = 0.5
 """Calibrated probability of being right from which a class is asserted (more likely right than wrong)."""
@@ -282,8 +290,30 @@ def lead(match: Match, matches: Sequence[Match]) -> float:
     return match.score - max(rivals, default=0.0)
 
 
+def more_general_fit(
+    best: Match, matches: Sequence[Match], min_score: float, calibration: Calibration, assert_probability: float
+) -> tuple[Match, float] | None:
+    """The most specific class above ``best`` (one of its ancestors, not the root class) that fits and is right with
+    at least ``assert_probability`` by its own score and lead, with that probability; None when there is none. When
+    the cues cannot tell a white ceramic bowl from a plastic one, it is still surely a bowl."""
+    above = [
+        m
+        for m in matches
+        if m is not best
+        and m.profile.class_name.lower() in best.profile.ancestors
+        and m.profile.class_name.lower() != UNKNOWN_CLASS.lower()
+    ]
+    for match in sorted(above, key=lambda m: -len(m.profile.ancestors)):
+        if match.score < min_score or match.unread:
+            continue
+        p = calibration.probability(match.score, lead(match, matches), match.unread)
+        if p >= assert_probability:
+            return match, p
+    return None
+
+
 def choose_expected(matches: Sequence[Match], expected: str, min_score: float, margin: float) -> Match | None:
-    """The query's class breaking a near-tie: among the fitting matches within ``margin`` of the best fitting
+    """The query's class breaking a tie: among the fitting matches within ``margin`` of the best fitting
     score, the best one of the expected class (or a subclass); None otherwise, and always for the root class
     (a query for any object prefers none). A match fits when it scores at least ``min_score`` and, for a class
     named by printed text, its text was read."""
@@ -292,7 +322,7 @@ def choose_expected(matches: Sequence[Match], expected: str, min_score: float, m
     if not fitting or wanted == UNKNOWN_CLASS.lower():
         return None
     top = max(m.score for m in fitting)
-    candidates = [m for m in fitting if top - m.score < margin and wanted in m.profile.ancestors]
+    candidates = [m for m in fitting if top - m.score <= margin and wanted in m.profile.ancestors]
     return max(candidates, key=lambda m: (m.score, -len(m.profile.ancestors)), default=None)
 
 
@@ -332,6 +362,19 @@ def decide(
     name = best.profile.class_name
     if best.score >= min_score and p >= assert_probability:
         return Decision(name, p, best, best_lead, p, f"fits {name} (score {best.score:.2f}, lead {best_lead:.2f})")
+    general = more_general_fit(best, matches, min_score, calibration, assert_probability)
+    if general is not None:
+        match, general_p = general
+        general_name = match.profile.class_name
+        return Decision(
+            general_name,
+            general_p,
+            best,
+            best_lead,
+            p,
+            f"fits {name} but leads only by {best_lead:.2f}; fits {general_name}, a class above it "
+            f"(score {match.score:.2f}, lead {lead(match, matches):.2f})",
+        )
     if expected:
         pick = choose_expected(matches, expected, min_score, margin)
         if pick is not None:

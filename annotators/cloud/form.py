@@ -19,7 +19,10 @@ Measured on the hypothesis' points in the upright support frame (:mod:`annotator
   a line of sight from the one behind runs through their hull too, but leaves it lower, between them.) What is
   seen through an opening is the far part of the inside: seen from above, it lies within the footprint of the
   object's top (its points above ``RIM_EXIT`` of the height: the rim), widened by ``THROUGH_MIN``, and beyond
-  the middle of that top as seen from the camera (the near rim hides the near inside). A taller object's face
+  the middle of that top as seen from the camera (the near rim hides the near inside). The middle is halfway
+  between the top's near and far edge, not the middle of its points: an open top seen obliquely shows many points
+  on its far rim and the upper far inside and few on its thin near rim, so the points' median lies near the far
+  rim. A taller object's face
   seen over a shorter one cut together with it in front, or a bottle's shoulder below its cap, is seen over the
   top of the hull too, but in front of the top's middle or beside the top. The share of points seen through the
   hull for more than ``THROUGH`` of the footprint's extent (and at least ``THROUGH_MIN`` metres), leaving it
@@ -63,6 +66,9 @@ THROUGH_MIN = 0.01
 """... and for at least this many metres (depth noise puts surface points a few millimetres inside the hull)."""
 RIM_EXIT = 0.85
 """... leaving the hull over the rim: at least this share of the height up (not between two objects cut as one)."""
+TOP_SPAN = (0.1, 0.9)
+"""The quantiles of the top's points (along the direction away from the camera) taken as its near and far edge:
+its middle lies halfway between them (stray points, or a second object cut together with it, move it little)."""
 THROUGH_TESTED = 400
 """At most about this many points (evenly taken) are tested for being seen through the object."""
 OPEN_SHARE = 0.1
@@ -148,7 +154,8 @@ def lines_of_sight(points: np.ndarray, tested: np.ndarray, camera: np.ndarray) -
 def far_inside_top(points: np.ndarray, tested: np.ndarray, rim_height: float, camera: np.ndarray) -> np.ndarray:
     """Which of the Mx3 ``tested`` points lie, seen from above, in the far part of the top of the Nx3 ``points``
     (those at least ``rim_height`` high): inside its footprint (convex hull in x, y, widened by ``THROUGH_MIN``)
-    and beyond its middle (median) as seen from ``camera``; none without such a footprint."""
+    and beyond its middle as seen from ``camera`` (halfway between its near and far edge, at the ``TOP_SPAN``
+    quantiles along the direction away from the camera); none without such a footprint."""
     top = points[points[:, 2] >= rim_height, :2]
     none = np.zeros(tested.shape[0], dtype=bool)
     if top.shape[0] < 3:
@@ -157,12 +164,16 @@ def far_inside_top(points: np.ndarray, tested: np.ndarray, rim_height: float, ca
         hull = ConvexHull(top)
     except QhullError:  # the top is a line or a point: it encloses nothing
         return none
-    outside = tested[:, :2] @ hull.equations[:, :2].T + hull.equations[:, 2]  # > 0: beyond that edge
-    middle = np.median(top, axis=0)
-    away = middle - camera[:2]
-    if np.linalg.norm(away) < 1e-9:  # seen from straight above: no near and far side
-        return outside.max(axis=1) <= THROUGH_MIN
-    return (outside.max(axis=1) <= THROUGH_MIN) & ((tested[:, :2] - middle) @ away > 0.0)
+    inside = (tested[:, :2] @ hull.equations[:, :2].T + hull.equations[:, 2]).max(axis=1) <= THROUGH_MIN
+    centre = np.median(top, axis=0)
+    away = centre - camera[:2]
+    length = float(np.linalg.norm(away))
+    if length < 1e-9:  # seen from straight above: no near and far side
+        return inside
+    away /= length
+    near, far = np.quantile((top - centre) @ away, TOP_SPAN)
+    middle = centre + away * (near + far) / 2.0
+    return inside & ((tested[:, :2] - middle) @ away > 0.0)
 
 
 def open_evidence(points: np.ndarray, bottom: float, height: float, camera: np.ndarray) -> tuple[bool, float]:

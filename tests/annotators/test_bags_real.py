@@ -112,7 +112,8 @@ def test_robokudo_query_on_the_bag_answers_as_on_the_uoc_folder(
     for name, source in (("bag", bag), ("uoc", uoc_folder)):
         monkeypatch.setenv("ROBOKUDO_BELIEF_STORE", str(tmp_path / f"{name}.sqlite"))
         monkeypatch.setenv("ROBOKUDO_USER_ONTOLOGY", str(tmp_path / f"{name}.ttl"))
-        query = ["query", "detect { obj: { type: Cup } }", "--input", str(source), "--frame", "1", "--json"]
+        # frame 1 holds the blue mug and no cup (a can once answered "cup" there)
+        query = ["query", "detect { obj: { type: Mug } }", "--input", str(source), "--frame", "1", "--json"]
         assert cli.main(query) == 0
         answers.append(json.loads(capsys.readouterr().out)["objects"])
     from_bag, from_uoc = ([np.asarray(o["pose"]["position"]) for o in objects] for objects in answers)

@@ -17,6 +17,7 @@ from annotators.readers.frame_readers import KitchenSceneReader
 from annotators.simulation.kitchen_scene import RenderedScene, SceneObject
 from annotators.text.reader import TextReader
 from reasoning.knowledge.knowledge_base import KnowledgeBase
+from reasoning.planning.query_planner import class_profiles
 from robokudo.core.engine import Engine
 from robokudo.core.parallel import ThresholdParallel
 from robokudo.core.pipeline import Pipeline
@@ -27,21 +28,8 @@ CLASSES = ("Milk", "LactoseFreeMilk", "WholeMilk", "CerealBox", "Cup", "Bowl", "
 
 
 def profiles(kb: KnowledgeBase) -> list[dict[str, object]]:
-    """The planner's plain-data profiles of some candidate classes (lower-case ontology labels)."""
-    found = []
-    for name in CLASSES:
-        profile = kb.object_profile(name)
-        found.append(
-            {
-                "class": name,
-                "colors": tuple(c.lower() for c in profile.colors),
-                "shape": profile.shape.lower() if profile.shape else None,
-                "size": profile.size_class.lower() if profile.size_class else None,
-                "texts": profile.texts,
-                "ancestors": (name, *kb.superclasses(name)),
-            }
-        )
-    return found
+    """The planner's plain-data profiles (colour, shape, size, texts and form) of some candidate classes."""
+    return [profile for profile in class_profiles(kb) if profile["class"] in CLASSES]
 
 
 @pytest.fixture(scope="module")
