@@ -25,6 +25,7 @@ only by the callers' ``ray`` module argument; this module imports nothing of it.
 
 from __future__ import annotations
 
+import contextlib
 import threading
 from collections.abc import Callable
 from types import ModuleType
@@ -135,10 +136,8 @@ class CompiledCalls:
         with self._lock:
             graph, self._graph = self._graph, None
             if graph is not None:
-                try:
+                with contextlib.suppress(Exception):  # a graph whose actor is gone may fail to tear down; dropped
                     graph.teardown()
-                except Exception:  # a graph whose actor is gone may fail to tear down; it is dropped either way
-                    pass
 
 
 class _Pending:
