@@ -10,8 +10,9 @@ every node of a resource pool that calls that actor (an actor runs one compiled 
   of the answer keeps the output channel's buffer (the arrays in a result would otherwise hold it, and the
   graph's next call would wait for them forever).
 * A compiled graph cannot cancel an execution in flight. A cancelled (or timed-out) call leaves it to finish on
-  the actor; its reference is dropped at once, and Ray releases its result unread when the graph's next call
-  reads past it (so the next call gets its own answer, never the stale one).
+  the actor and returns at once; its reference is kept, and the graph's next call, which waits in slices (still
+  cancellable) until the actor has finished both, discards that result unread before it returns its own (so it
+  gets its own answer, never the stale one; executions finish in order).
 * A channel that closes (the actor died: Ray then shuts the graph down) or a graph that can take no more calls
   ends the graph: :meth:`CompiledCalls.reset` tears it down and the next call compiles it anew, on the actor Ray
   restarted.
@@ -56,6 +57,9 @@ class CompiledCalls:
         self.buffer_bytes = buffer_bytes
         self._lock = threading.Lock()
         self._graph: Any = None
+        self._stale: list[Any] = []
+        """The references of cancelled calls' executions, oldest first (dropping one would make Ray wait for its
+        result at once, in the thread that drops it)."""
         self.unavailable: str | None = _missing_api(ray)
         """Why compiled graphs cannot be used for this actor (None while they can)."""
         self.compiles = 0
@@ -120,15 +124,34 @@ class CompiledCalls:
                     if finished:
                         reference, pending.reference = pending.reference, None
                         packed = ray.get(reference)
+                        self._drain()
                         break
                 check()
         except ray.exceptions.RayChannelError as error:
             raise ChannelClosedError(f"{type(error).__name__}: {_first_line(error)}") from None
         finally:
-            if pending.reference is not None:
-                with self._lock:  # dropped unread: Ray releases its result when a later call reads past it
+            if pending.reference is not None:  # left to finish on the actor; a later call discards its result
+                with self._lock:
+                    self._stale.append(pending.reference)
                     pending.reference = None
         return ray.cloudpickle.loads(packed)
+
+    def _drain(self) -> None:
+        """Discard the results of the abandoned executions that have finished (under the lock). Their results
+        are read when a later call reads past them (executions finish in order); read now, they free the graph's
+        result buffer."""
+        ray, graph = self._ray, self._graph
+        while self._stale:
+            reference = self._stale[0]
+            try:
+                graph._execute_until(reference._execution_index, reference._channel_index, 0)
+            except ray.exceptions.RayChannelTimeoutError:
+                return
+            except ray.exceptions.RayChannelError:
+                pass  # closed: the get below ends it
+            self._stale.pop(0)
+            with contextlib.suppress(Exception):  # an abandoned call's error is as unwanted as its answer
+                ray.get(reference)
 
     def reset(self) -> None:
         """Tear the graph down (after its actor died, or before the actor is stopped); the next call compiles a
@@ -138,6 +161,7 @@ class CompiledCalls:
             if graph is not None:
                 with contextlib.suppress(Exception):  # a graph whose actor is gone may fail to tear down; dropped
                     graph.teardown()
+            self._stale.clear()  # (a torn-down graph's references are dropped without waiting)
 
 
 class _Pending:

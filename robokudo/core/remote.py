@@ -384,9 +384,9 @@ class RemoteAnnotator(ThreadedAnnotator):
         """End the actor's process now (an actor also ends when the last handle to it is gone)."""
         if self._actor is not None:
             calls = self.compiled_calls()
-            require_ray().kill(self._actor, no_restart=True)
             if calls is not None:
                 calls.reset()
+            require_ray().kill(self._actor, no_restart=True)
             self._actor = None
 
 
