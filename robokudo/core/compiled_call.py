@@ -16,6 +16,9 @@ every node of a resource pool that calls that actor (an actor runs one compiled 
 * A channel that closes (the actor died: Ray then shuts the graph down) or a graph that can take no more calls
   ends the graph: :meth:`CompiledCalls.reset` tears it down and the next call compiles it anew, on the actor Ray
   restarted.
+* An idle graph's actor polls its input channel (Ray 2.60 spins on it: about half a core or more), so a graph
+  that took no call for :data:`IDLE_SECONDS` is torn down; the next call compiles it again (0.1-0.4 s, once).
+  While calls keep coming (a camera's frames) the actor polls between them.
 * Channels start at :data:`BUFFER_BYTES` (a 640x480 RGB-D frame with its hypotheses fits) and Ray grows them
   when a larger input comes.
 
@@ -28,6 +31,7 @@ from __future__ import annotations
 
 import contextlib
 import threading
+import time
 from collections.abc import Callable
 from types import ModuleType
 from typing import Any
@@ -38,6 +42,10 @@ hypotheses' masks fit; Ray grows a channel for a larger input."""
 
 SUBMIT_SLICE = 0.05
 """Seconds a call waits at most, in one go, for the input channel (the actor takes its input when it starts)."""
+
+IDLE_SECONDS = 2.0
+"""A graph that took no call for this long is torn down (the next call compiles it again, in 0.1-0.4 s): an idle
+compiled graph's actor polls its input channel, which keeps a core about half busy or more (Ray 2.60)."""
 
 PLAIN_CALLS = "plain actor calls"
 COMPILED_GRAPH = "compiled graph (shared-memory channels)"
@@ -50,12 +58,23 @@ class ChannelClosedError(Exception):
 class CompiledCalls:
     """The compiled graph of one actor, built on first use, thread-safe (see the module)."""
 
-    def __init__(self, ray: ModuleType, actor: Any, method: str = "analyse_packed", buffer_bytes: int = BUFFER_BYTES):
+    def __init__(
+        self,
+        ray: ModuleType,
+        actor: Any,
+        method: str = "analyse_packed",
+        buffer_bytes: int = BUFFER_BYTES,
+        idle_seconds: float = IDLE_SECONDS,
+    ) -> None:
         self._ray = ray
         self._actor = actor
         self._method = method
         self.buffer_bytes = buffer_bytes
+        self.idle_seconds = idle_seconds
         self._lock = threading.Lock()
+        self._calls_in_progress = 0
+        self._last_call = 0.0
+        self._watcher: threading.Thread | None = None
         self._graph: Any = None
         self._stale: list[Any] = []
         """The references of cancelled calls' executions, oldest first (dropping one would make Ray wait for its
@@ -63,7 +82,9 @@ class CompiledCalls:
         self.unavailable: str | None = _missing_api(ray)
         """Why compiled graphs cannot be used for this actor (None while they can)."""
         self.compiles = 0
-        """How often the graph was compiled (a new graph after each reset)."""
+        """How often the graph was compiled (a new graph after each reset or idle release)."""
+        self.idle_releases = 0
+        """How often the graph was torn down for want of calls."""
 
     def path(self) -> str:
         """Which path calls take: the compiled graph, or plain actor calls and why."""
@@ -88,7 +109,25 @@ class CompiledCalls:
                 self.unavailable = f"the graph did not compile: {type(error).__name__}: {error}"[:300]
                 raise ChannelClosedError(self.unavailable) from None
             self.compiles += 1
+            self._last_call = time.monotonic()
+            if self._watcher is None:
+                self._watcher = threading.Thread(target=self._release_when_idle, name="idle graph", daemon=True)
+                self._watcher.start()
         return self._graph
+
+    def _release_when_idle(self) -> None:
+        """Tear the graph down once it took no call for ``idle_seconds`` (ends with the graph)."""
+        while True:
+            time.sleep(self.idle_seconds / 4)
+            with self._lock:
+                if self._graph is not None:
+                    idle = time.monotonic() - self._last_call >= self.idle_seconds
+                    if not idle or self._calls_in_progress or self._stale:
+                        continue
+                    self._teardown()
+                    self.idle_releases += 1
+                self._watcher = None
+                return
 
     def call(self, arguments: Any, check: Callable[[], None], poll: float) -> Any:
         """The actor's answer to ``arguments`` (unpickled). ``check()`` is called every ``poll`` seconds while the
@@ -98,9 +137,11 @@ class CompiledCalls:
         with self._lock:
             if self.unavailable is not None:
                 raise ChannelClosedError(self.unavailable)
-            graph = self._compiled()
+            self._calls_in_progress += 1
         pending = _Pending()
         try:
+            with self._lock:
+                graph = self._compiled()
             while pending.reference is None:
                 with self._lock:
                     try:
@@ -130,10 +171,12 @@ class CompiledCalls:
         except ray.exceptions.RayChannelError as error:
             raise ChannelClosedError(f"{type(error).__name__}: {_first_line(error)}") from None
         finally:
-            if pending.reference is not None:  # left to finish on the actor; a later call discards its result
-                with self._lock:
+            with self._lock:
+                if pending.reference is not None:  # left to finish on the actor; a later call discards its result
                     self._stale.append(pending.reference)
                     pending.reference = None
+                self._calls_in_progress -= 1
+                self._last_call = time.monotonic()
         return ray.cloudpickle.loads(packed)
 
     def _drain(self) -> None:
@@ -157,11 +200,15 @@ class CompiledCalls:
         """Tear the graph down (after its actor died, or before the actor is stopped); the next call compiles a
         new one."""
         with self._lock:
-            graph, self._graph = self._graph, None
-            if graph is not None:
-                with contextlib.suppress(Exception):  # a graph whose actor is gone may fail to tear down; dropped
-                    graph.teardown()
-            self._stale.clear()  # (a torn-down graph's references are dropped without waiting)
+            self._teardown()
+
+    def _teardown(self) -> None:
+        """Tear the graph down (under the lock)."""
+        graph, self._graph = self._graph, None
+        if graph is not None:
+            with contextlib.suppress(Exception):  # a graph whose actor is gone may fail to tear down; dropped
+                graph.teardown()
+        self._stale.clear()  # (a torn-down graph's references are dropped without waiting)
 
 
 class _Pending:

@@ -279,6 +279,25 @@ def test_an_interrupted_call_ends_its_worker_at_once_and_the_next_run_works(clus
         node.stop_actor()
 
 
+def test_an_idle_graph_is_torn_down_and_the_next_call_compiles_it_again(cluster: ModuleType) -> None:
+    tree, node = echo_tree([1, 2], [(48, 64)], timeout=30.0)
+    calls = node.compiled_calls()
+    assert calls is not None
+    calls.idle_seconds = 0.3
+    engine = Engine(tree, hz=1000)
+    try:
+        assert run_to_end(engine) is Status.SUCCESS and echoed(tree) == ["1 (48, 64, 3) depth 3072"]
+        waited = time.monotonic()
+        while calls.idle_releases == 0:
+            assert time.monotonic() - waited < DEADLINE, "the idle graph was not torn down"
+            time.sleep(0.05)
+        assert calls.compiles == 1
+        assert run_to_end(engine) is Status.SUCCESS and echoed(tree) == ["2 (48, 64, 3) depth 3072"]
+        assert calls.compiles == 2 and node.call_path == COMPILED_GRAPH
+    finally:
+        node.stop_actor()
+
+
 def test_inputs_larger_than_the_channel_buffers_grow_them(cluster: ModuleType) -> None:
     """A 640x480 RGB-D frame fits the channels as they start; a 1280x960 one (8.6 MB) is larger, and Ray grows
     them: the call stays on the compiled graph and gets the right answer."""
