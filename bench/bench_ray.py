@@ -10,16 +10,20 @@ workers run at this process's priority (``robokudo.application.cluster``).
    cluster's start and the first round, where the workers import the code, are printed apart; the sequential
    side is warm too). The CPU time both sides spent on the scenes is printed: the same work.
 2. Per-call overhead of a remote expert: the colour expert on the kitchen scene's hypotheses, run locally and on
-   a Ray actor, alternating, each run on a new frame object (so the frame's image is put into the object store
-   for every remote call, as for a live camera), after a warm-up of a few seconds (the actor's imports, the
-   object store's pages). The remote call's latency is the node's own (its worker thread: declared inputs
-   gathered and packed, the image put, the actor called, its answer in hand and its writes checked), not the
-   tree's tick period. The overhead is that latency minus the local run's time, call by call. Goal: <= 2 ms
-   median. Printed beside it: the latency against the expert's run on the actor (measured there), the stages
-   of the remote call, and Ray's own floor on this machine, measured alternately with the expert's calls in the
-   same way (waited for in a thread while this one ticks) for calls of growing shape: the simplest call (no
-   arguments, returns None), the actor busy as long as the expert ran, the image put and passed, the packed
-   hypotheses passed (the expert's call shape).
+   a Ray actor in two ways, alternating call by call (which remote side goes first alternates too): through the
+   actor's compiled graph (the default: shared-memory channels) and by plain actor calls
+   (``Placement(compiled_graph=False)``: the image put into the object store, the call submitted as a Ray task).
+   Each run is on a new frame object (so the frame's image is sent anew for every remote call, as for a live
+   camera), after a warm-up of a few seconds (the actors' imports, the object store's pages). The remote call's
+   latency is the node's own (its worker thread: declared inputs gathered and packed, sent, the actor called, its
+   answer in hand and its writes checked), not the tree's tick period. The overhead is that latency minus the
+   paired local run's time, call by call; its median and 90th percentile are printed for both ways side by side.
+   Goal: <= 2 ms median (the compiled graph, the default path). Printed beside it: the latency against the
+   expert's run on the actor (measured there), the stages of the remote call, the CPU time each run cost this
+   process and the actor's, and Ray's own floor on this machine: a bare compiled-graph call of the expert's shape,
+   and for plain calls, measured alternately with the expert's calls in the same way (waited for in a thread
+   while this one ticks), calls of growing shape: the simplest call (no arguments, returns None), the actor busy
+   as long as the expert ran, the image put and passed, the packed hypotheses passed (the expert's call shape).
 
 Run: ``PYTHONPATH=. .venv/bin/python bench/bench_ray.py``. The load average is printed: the machine is shared,
 and when other jobs take the cores, two workers cannot run twice as fast as one.
@@ -295,14 +299,21 @@ class RemoteSide:
         self.versus_local_ms: list[float] = []
         self.wall_ms: list[float] = []
         self.stages: dict[str, list[float]] = {}
+        self.cpu_ms: list[float] = []
+        self.actor_cpu_ms: list[float] = []
+        self.actor_pid = 0
 
     def run(self, tick: float, local_ms: float | None) -> None:
         """One run; with ``local_ms`` (the paired local run's time) its figures are kept."""
+        actor_cpu = process_cpu(self.actor_pid)
+        cpu = time.process_time()
         start = time.perf_counter()
         one_run(self.engine, tick)
         wall = 1000 * (time.perf_counter() - start)
         if local_ms is None:
             return
+        self.cpu_ms.append(1000 * (time.process_time() - cpu))
+        self.actor_cpu_ms.append(1000 * (process_cpu(self.actor_pid) - actor_cpu))
         latency = 1000 * self.node.stats.last_seconds
         self.wall_ms.append(wall)
         self.latency_ms.append(latency)
@@ -310,6 +321,15 @@ class RemoteSide:
         self.versus_local_ms.append(latency - local_ms)
         for stage, seconds in self.node.call_times.stages().items():
             self.stages.setdefault(stage, []).append(1000 * seconds)
+
+
+def process_cpu(pid: int) -> float:
+    """Seconds of CPU process ``pid`` has used (0 where /proc cannot tell)."""
+    try:
+        fields = Path(f"/proc/{pid}/stat").read_text().rsplit(")", 1)[1].split()
+    except (OSError, IndexError):
+        return 0.0
+    return (int(fields[11]) + int(fields[12])) / os.sysconf("SC_CLK_TCK")
 
 
 def compiled_floor(ray: ModuleType, annotations: list[Any], image: np.ndarray, seconds: float) -> float:
@@ -363,6 +383,7 @@ def bench_overhead(ray: ModuleType, calls: int = CALLS, tick: float = 0.0002) ->
         warm_runs += 1
     for side in sides:
         print(f"   {side.label:8s}: calls take {side.node.call_path}")
+        side.actor_pid = side.node.actor_process_id()
     floors.ms = {rung: [] for rung in floors.RUNGS}
     local_ms, local_wall, actor_ms = [], [], []
     for call in range(calls):
@@ -390,6 +411,11 @@ def bench_overhead(ray: ModuleType, calls: int = CALLS, tick: float = 0.0002) ->
             f"{median(side.added_ms):.2f} ms"
         )
         print(
+            f"      CPU per run (ms, sums over the measured runs / runs, the local run included in neither): "
+            f"this process (tree, worker, ticks) {statistics.mean(side.cpu_ms):.2f}, "
+            f"the actor's process {statistics.mean(side.actor_cpu_ms):.2f}"
+        )
+        print(
             "      stages (medians, ms): "
             + ", ".join(f"{stage} {median(values):.2f}" for stage, values in side.stages.items())
         )
@@ -407,7 +433,8 @@ def bench_overhead(ray: ModuleType, calls: int = CALLS, tick: float = 0.0002) ->
         values = side.versus_local_ms
         print(f"      {side.label:8s} median {median(values):6.2f} ms   p90 {percentile(values, 0.9):6.2f} ms")
     compiled, plain = (median(side.versus_local_ms) for side in sides)
-    print(f"      plain / compiled overhead: {plain / compiled:.1f}x" if compiled > 0 else "")
+    if compiled > 0:
+        print(f"      plain / compiled overhead: {plain / compiled:.1f}x")
     print(
         f"   overhead per call (compiled graph, the default): median {compiled:.2f} ms   "
         f"goal <= {OVERHEAD_GOAL_MS} ms: {verdict(compiled <= OVERHEAD_GOAL_MS)}"
