@@ -288,11 +288,21 @@ def percentile(values: list[float], fraction: float) -> float:
 class RemoteSide:
     """One way of calling the expert on an actor (a tree of its own) and its figures, call by call."""
 
-    def __init__(self, label: str, image: ColorImage, hypotheses: list[ObjectHypothesis], compiled: bool) -> None:
+    def __init__(
+        self,
+        label: str,
+        image: ColorImage,
+        hypotheses: list[ObjectHypothesis],
+        compiled: bool,
+        nap: float | None = None,
+    ) -> None:
         self.label = label
         tree = Pipeline(label, [Replay(image, hypotheses), SemanticColorAnnotator()])
-        hints = Placement(remote=True, num_cpus=0.5, compiled_graph=compiled)  # both actors fit beside the floor's
+        hints = Placement(remote=True, num_cpus=0.3, compiled_graph=compiled)  # all actors fit beside the floor's
         [self.node] = place_remote(tree, ["SemanticColorAnnotator"], hints)
+        calls = self.node.compiled_calls()
+        if calls is not None and nap is not None:
+            calls.nap_fraction = nap
         self.engine = Engine(tree, hz=100000)
         self.latency_ms: list[float] = []
         self.added_ms: list[float] = []
@@ -355,7 +365,7 @@ def compiled_floor(ray: ModuleType, annotations: list[Any], image: np.ndarray, s
     return statistics.median(ms)
 
 
-def bench_overhead(ray: ModuleType, calls: int = CALLS, tick: float = 0.0002) -> None:
+def bench_overhead(ray: ModuleType, calls: int = CALLS, tick: float = 0.0002, compare_nap: bool = False) -> None:
     root = tabletop.create_tree()
     one_run(Engine(root, hz=1000))
     cas = next(pipelines(root)).cas
@@ -371,6 +381,8 @@ def bench_overhead(ray: ModuleType, calls: int = CALLS, tick: float = 0.0002) ->
         RemoteSide("compiled", image, hypotheses, compiled=True),
         RemoteSide("plain", image, hypotheses, compiled=False),
     ]
+    if compare_nap:  # a compiled side that sleeps through most of the expected wait (CPU and tail vs the default)
+        sides.append(RemoteSide("nap 0.8", image, hypotheses, compiled=True, nap=0.8))
     sent = [in_transit(copy.copy(hypothesis), (ObjectHypothesis,)) for hypothesis in hypotheses]
     floors = Floors(ray, sent, image.image, tick)
     warm_until = time.perf_counter() + WARM_SECONDS
@@ -432,7 +444,7 @@ def bench_overhead(ray: ModuleType, calls: int = CALLS, tick: float = 0.0002) ->
     for side in sides:
         values = side.versus_local_ms
         print(f"      {side.label:8s} median {median(values):6.2f} ms   p90 {percentile(values, 0.9):6.2f} ms")
-    compiled, plain = (median(side.versus_local_ms) for side in sides)
+    compiled, plain = (median(side.versus_local_ms) for side in sides[:2])
     if compiled > 0:
         print(f"      plain / compiled overhead: {plain / compiled:.1f}x")
     print(
@@ -445,6 +457,9 @@ def main() -> None:
     parser = argparse.ArgumentParser(description=__doc__.split("\n", 1)[0])
     parser.add_argument("--only", choices=("eval", "overhead"), help="run one of the two benchmarks")
     parser.add_argument("--calls", type=int, default=CALLS, help="remote calls measured (overhead)")
+    parser.add_argument(
+        "--compare-nap", action="store_true", help="also a compiled side that sleeps while it waits (overhead)"
+    )
     parser.add_argument("--tick-ms", type=float, default=0.2, help="tick period while a run is RUNNING (overhead)")
     args = parser.parse_args()
     if not LEARN.is_dir():
@@ -456,7 +471,7 @@ def main() -> None:
         if args.only != "overhead":
             bench_eval()
         if args.only != "eval":
-            bench_overhead(ray, args.calls, args.tick_ms / 1000)
+            bench_overhead(ray, args.calls, args.tick_ms / 1000, args.compare_nap)
 
 
 if __name__ == "__main__":

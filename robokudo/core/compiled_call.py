@@ -16,6 +16,9 @@ every node of a resource pool that calls that actor (an actor runs one compiled 
 * A channel that closes (the actor died: Ray then shuts the graph down) or a graph that can take no more calls
   ends the graph: :meth:`CompiledCalls.reset` tears it down and the next call compiles it anew, on the actor Ray
   restarted.
+* Waiting for an answer in Ray's read polls a core for as long as the expert runs; a call can first sleep
+  through most of the time the last calls took (:attr:`CompiledCalls.nap_fraction`, off by default: see
+  :data:`NAP_FRACTION`), then wait in the read.
 * An idle graph's actor polls its input channel (Ray 2.60 spins on it: about half a core or more), so a graph
   that took no call for :data:`IDLE_SECONDS` is torn down; the next call compiles it again (0.1-0.4 s, once).
   While calls keep coming (a camera's frames) the actor polls between them.
@@ -29,6 +32,7 @@ only by the callers' ``ray`` module argument; this module imports nothing of it.
 
 from __future__ import annotations
 
+import collections
 import contextlib
 import threading
 import time
@@ -46,6 +50,13 @@ SUBMIT_SLICE = 0.05
 IDLE_SECONDS = 2.0
 """A graph that took no call for this long is torn down (the next call compiles it again, in 0.1-0.4 s): an idle
 compiled graph's actor polls its input channel, which keeps a core about half busy or more (Ray 2.60)."""
+
+NAP_FRACTION = 0.0
+"""A call may sleep through this fraction of the shortest of the last calls' times before it waits in Ray's read of
+the answer, which polls (a core busy for the whole wait: as long as the expert's run). 0 (no sleep) by default: on
+a loaded 2-core machine, 0.8 cut the caller's CPU per call by about a third in one run and not at all in another,
+and the woken thread's delays gave a 90th percentile of 12-26 ms overhead against 5 ms without sleeping
+(``bench/bench_ray.py --compare-nap``)."""
 
 PLAIN_CALLS = "plain actor calls"
 COMPILED_GRAPH = "compiled graph (shared-memory channels)"
@@ -72,6 +83,9 @@ class CompiledCalls:
         self.buffer_bytes = buffer_bytes
         self.idle_seconds = idle_seconds
         self._lock = threading.Lock()
+        self.nap_fraction = NAP_FRACTION
+        self._took: collections.deque[float] = collections.deque(maxlen=8)
+        """Seconds the last calls took from their input sent to their answer in hand."""
         self._calls_in_progress = 0
         self._last_call = 0.0
         self._watcher: threading.Thread | None = None
@@ -152,6 +166,8 @@ class CompiledCalls:
                         raise ChannelClosedError(f"{type(error).__name__}: {_first_line(error)}") from None
                 if pending.reference is None:
                     check()
+            sent = time.perf_counter()
+            self._nap(sent, check, poll)
             while True:
                 with self._lock:
                     try:
@@ -165,6 +181,7 @@ class CompiledCalls:
                     if finished:
                         reference, pending.reference = pending.reference, None
                         packed = ray.get(reference)
+                        self._took.append(time.perf_counter() - sent)
                         self._drain()
                         break
                 check()
@@ -178,6 +195,17 @@ class CompiledCalls:
                 self._calls_in_progress -= 1
                 self._last_call = time.monotonic()
         return ray.cloudpickle.loads(packed)
+
+    def _nap(self, sent: float, check: Callable[[], None], poll: float) -> None:
+        """Sleep through most of the time the answer is expected to take (``nap_fraction`` of the shortest of the
+        last calls), checking ``check()`` every ``poll`` seconds: waiting in Ray's read polls a core."""
+        with self._lock:
+            if not self._took or self._stale:
+                return
+            wake = sent + self.nap_fraction * min(self._took)
+        while (left := wake - time.perf_counter()) > 0:
+            time.sleep(min(left, poll))
+            check()
 
     def _drain(self) -> None:
         """Discard the results of the abandoned executions that have finished (under the lock). Their results

@@ -230,8 +230,10 @@ class Frame(Annotator):
         self.write(DepthImage(np.ones(shape, np.float32)))
 
 
-def echo_tree(firsts: list[int], shapes: list[tuple[int, int]], timeout: float) -> tuple[Pipeline, RemoteAnnotator]:
-    tree = Pipeline("echo", [Frame(firsts, shapes), Echo(slow=3.0)])
+def echo_tree(
+    firsts: list[int], shapes: list[tuple[int, int]], timeout: float, slow: float = 3.0
+) -> tuple[Pipeline, RemoteAnnotator]:
+    tree = Pipeline("echo", [Frame(firsts, shapes), Echo(slow=slow)])
     [node] = place_remote(tree, ["echo"])
     node.timeout = timeout
     return tree, node
@@ -275,6 +277,26 @@ def test_an_interrupted_call_ends_its_worker_at_once_and_the_next_run_works(clus
         assert node.stop_worker(timeout=1.0)  # the worker stops waiting at once (the actor goes on)
         assert run_to_end(engine) is Status.SUCCESS and echoed(tree) == ["2 (48, 64, 3) depth 3072"]
         assert node.call_path == COMPILED_GRAPH
+    finally:
+        node.stop_actor()
+
+
+def test_a_call_that_sleeps_through_the_expected_wait_answers_and_can_be_interrupted_in_its_sleep(
+    cluster: ModuleType,
+) -> None:
+    tree, node = echo_tree([255, 255, 2], [(48, 64)], timeout=30.0, slow=1.0)
+    calls = node.compiled_calls()
+    assert calls is not None
+    calls.nap_fraction = 0.8
+    engine = Engine(tree, hz=1000)
+    try:
+        assert run_to_end(engine) is Status.SUCCESS and echoed(tree) == ["255 (48, 64, 3) depth 3072"]
+        assert engine.tick() is Status.RUNNING  # the next call sleeps ~0.8 s before it reads
+        time.sleep(0.2)
+        tree.stop(Status.INVALID)
+        assert node.stop_worker(timeout=0.4)  # before its sleep (0.6 s more) would have ended: it checked
+        assert run_to_end(engine) is Status.SUCCESS and echoed(tree) == ["2 (48, 64, 3) depth 3072"]
+        assert calls.compiles == 1
     finally:
         node.stop_actor()
 
