@@ -55,7 +55,7 @@ import py_trees
 
 from robokudo.core.annotator import Annotator, PortError, RunCancelledError, _Run
 from robokudo.core.cas import CAS, AddAnnotation, SetView
-from robokudo.core.compiled_call import ChannelClosedError, CompiledCalls
+from robokudo.core.compiled_call import ChannelClosedError, CompiledCalls, GraphStalledError
 from robokudo.core.pipeline import StructureError
 from robokudo.core.placement import Placement
 from robokudo.core.threaded import ThreadedAnnotator
@@ -187,11 +187,14 @@ class ExpertHost:
                 return "FAILURE", message, [], seconds, (entered, time.perf_counter())
         return status.name, message, writes, seconds, (entered, time.perf_counter())
 
-    def analyse_packed(self, inputs: tuple[list[Annotation], list[View]]) -> bytes:
+    def analyse_packed(self, inputs: tuple[list[Annotation], list[View]] | None) -> bytes:
         """:meth:`analyse` on ``(annotations, views)`` as a compiled graph's call brings them, its answer pickled
-        (so no array of the answer keeps the graph's output channel once the caller has read it)."""
+        (so no array of the answer keeps the graph's output channel once the caller has read it); None for None
+        (a new graph's first call)."""
         import ray
 
+        if inputs is None:
+            return ray.cloudpickle.dumps(None)
         annotations, views = inputs
         return ray.cloudpickle.dumps(self.analyse(annotations, *views))
 
@@ -306,10 +309,7 @@ class RemoteAnnotator(ThreadedAnnotator):
             stamp = time.perf_counter()
             answer = None
             if compiled is not None and compiled.unavailable is None:
-                try:
-                    answer = compiled.call((sent, views), self._check_cancelled, POLL_SECONDS)
-                except ChannelClosedError:  # this run goes as a plain call; the next compiles a new graph
-                    compiled.reset()
+                answer = self._compiled_call(ray, actor, compiled, (sent, views))
             called = stamp
             if answer is None:
                 references = self.frames().references(ray, views)
@@ -362,21 +362,38 @@ class RemoteAnnotator(ThreadedAnnotator):
             _cancel(ray, pending)
             raise
 
+    def _compiled_call(self, ray: ModuleType, actor: Any, compiled: CompiledCalls, inputs: tuple) -> Any:
+        """The actor's answer through its compiled graph; None when this run is to go as a plain call (the graph
+        closed: the next run compiles a new one)."""
+        for _ in range(2):
+            try:
+                return compiled.call(inputs, self._check_cancelled, POLL_SECONDS)
+            except GraphStalledError as stalled:  # its actor's process restarts: wait for it, compile again
+                self._await_restart(ray, actor, stalled.process_id)
+            except ChannelClosedError:
+                compiled.reset()
+                return None
+        return None
+
     def _check_cancelled(self) -> None:
         """RunCancelledError once this run is cancelled."""
         if self.cancelled:  # (reading it raises RunCancelledError once the run is cancelled)
             raise RunCancelledError()
 
-    def _await_restart(self, ray: ModuleType, actor: Any) -> None:
-        """After the actor died: wait until Ray has restarted it (a call sent while it restarts would fail)."""
+    def _await_restart(self, ray: ModuleType, actor: Any, old_process_id: int | None = None) -> None:
+        """After the actor died (or its process ``old_process_id`` was ended): wait until Ray has restarted it (a
+        call sent while it restarts would fail)."""
         while True:
             try:
-                self._wait(ray, actor.process_id.remote())
+                process_id = self._wait(ray, actor.process_id.remote())
             except ray.exceptions.ActorUnavailableError:
                 time.sleep(POLL_SECONDS)
                 continue
             except ray.exceptions.RayActorError as error:
                 self.fail(f"remote actor of {self.name} is gone: {_summary(error)}")
+            if process_id == old_process_id:  # the ended process has not gone yet
+                time.sleep(POLL_SECONDS)
+                continue
             self._actor_failed = False
             return
 

@@ -10,6 +10,7 @@ missing Ray fails them. The messages the options give without Ray are tested by 
 
 from __future__ import annotations
 
+import contextlib
 import json
 import logging
 import os
@@ -298,6 +299,40 @@ def test_a_call_that_sleeps_through_the_expected_wait_answers_and_can_be_interru
         assert run_to_end(engine) is Status.SUCCESS and echoed(tree) == ["2 (48, 64, 3) depth 3072"]
         assert calls.compiles == 1
     finally:
+        node.stop_actor()
+
+
+def test_a_new_graph_that_does_not_answer_has_its_actor_restarted_and_the_run_goes_on(
+    cluster: ModuleType, monkeypatch: pytest.MonkeyPatch
+) -> None:
+    """The first graph's actor is stopped right after the graph compiled (as if its loop never started): its first
+    call gets no answer, the actor's process is ended for Ray to restart, a new graph is compiled there, and the
+    run answers its frame."""
+    monkeypatch.setattr(compiled_call, "VERIFY_SECONDS", 1.0)
+    compile_graph = compiled_call.CompiledCalls._compiled
+    stopped: list[int] = []
+
+    def compile_and_stop_the_first(self: compiled_call.CompiledCalls) -> object:
+        fresh = self._graph is None
+        graph = compile_graph(self)
+        if fresh and not stopped:
+            stopped.append(self._process_id)
+            os.kill(self._process_id, signal.SIGSTOP)
+        return graph
+
+    monkeypatch.setattr(compiled_call.CompiledCalls, "_compiled", compile_and_stop_the_first)
+    tree, node = echo_tree([1, 2], [(48, 64)], timeout=60.0)
+    engine = Engine(tree, hz=1000)
+    try:
+        assert run_to_end(engine) is Status.SUCCESS, node.feedback_message
+        assert echoed(tree) == ["1 (48, 64, 3) depth 3072"]
+        assert node.compiled_calls().compiles == 2 and node.call_path == COMPILED_GRAPH
+        assert node.actor_process_id() != stopped[0]
+        assert run_to_end(engine) is Status.SUCCESS and echoed(tree) == ["2 (48, 64, 3) depth 3072"]
+    finally:
+        for pid in stopped:
+            with contextlib.suppress(ProcessLookupError):
+                os.kill(pid, signal.SIGKILL)
         node.stop_actor()
 
 
