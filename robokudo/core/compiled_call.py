@@ -113,7 +113,7 @@ class CompiledCalls:
         self._stale: list[Any] = []
         """The references of cancelled calls' executions, oldest first (dropping one would make Ray wait for its
         result at once, in the thread that drops it)."""
-        self.unavailable: str | None = _missing_api(ray)
+        self.unavailable: str | None = unavailable_reason(ray)
         """Why compiled graphs cannot be used for this actor (None while they can)."""
         self.compiles = 0
         """How often the graph was compiled (a new graph after each reset or idle release)."""
@@ -304,8 +304,8 @@ class _Pending:
         self.reference: Any = None
 
 
-def _missing_api(ray: ModuleType) -> str | None:
-    """Why this Ray cannot run compiled graphs for us (None when it can)."""
+def unavailable_reason(ray: ModuleType) -> str | None:
+    """Why this Ray cannot run compiled graphs for remote experts (None when it can)."""
     try:
         from ray.dag import InputNode  # noqa: F401
         from ray.dag.compiled_dag_node import CompiledDAG

@@ -53,9 +53,16 @@ from typing import Any, ClassVar
 import numpy as np
 import py_trees
 
+from robokudo.core import compiled_call
 from robokudo.core.annotator import Annotator, PortError, RunCancelledError, _Run
 from robokudo.core.cas import CAS, AddAnnotation, SetView
-from robokudo.core.compiled_call import ChannelClosedError, CompiledCalls, GraphStalledError
+from robokudo.core.compiled_call import (
+    COMPILED_GRAPH,
+    PLAIN_CALLS,
+    ChannelClosedError,
+    CompiledCalls,
+    GraphStalledError,
+)
 from robokudo.core.pipeline import StructureError
 from robokudo.core.placement import Placement
 from robokudo.core.threaded import ThreadedAnnotator
@@ -259,10 +266,12 @@ class RemoteAnnotator(ThreadedAnnotator):
     @property
     def call_path(self) -> str:
         """Which path this node's calls take: the compiled graph, or plain actor calls (and why)."""
-        calls = self.compiled_calls()
-        if calls is None:
-            return "plain actor calls (as placed: compiled_graph=False)"
-        return calls.path()
+        if not self.where.compiled_graph:
+            return f"{PLAIN_CALLS} (as placed: compiled_graph=False)"
+        if self._actor is None:  # not started: what its calls would take, without starting it
+            missing = compiled_call.unavailable_reason(require_ray())
+            return COMPILED_GRAPH if missing is None else f"{PLAIN_CALLS} ({missing})"
+        return self.compiled_calls().path()  # type: ignore[union-attr]
 
     def actor_process_id(self, timeout: float = 60.0) -> int:
         """The process id of the actor's current process (waits for it to start)."""

@@ -180,7 +180,7 @@ def test_plain_actor_calls_give_the_local_answer_too(cluster: ModuleType, local_
 def test_without_compiled_graphs_the_calls_are_plain_and_say_why(
     cluster: ModuleType, local_colours: list, monkeypatch: pytest.MonkeyPatch
 ) -> None:
-    monkeypatch.setattr(compiled_call, "_missing_api", lambda ray: "this Ray has no compiled graphs (hidden)")
+    monkeypatch.setattr(compiled_call, "unavailable_reason", lambda ray: "this Ray has no compiled graphs (hidden)")
     root = tabletop.create_tree()
     [remote] = place_remote(root, ["SemanticColorAnnotator"])
     try:
