@@ -10,16 +10,20 @@ workers run at this process's priority (``robokudo.application.cluster``).
    cluster's start and the first round, where the workers import the code, are printed apart; the sequential
    side is warm too). The CPU time both sides spent on the scenes is printed: the same work.
 2. Per-call overhead of a remote expert: the colour expert on the kitchen scene's hypotheses, run locally and on
-   a Ray actor, alternating, each run on a new frame object (so the frame's image is put into the object store
-   for every remote call, as for a live camera), after a warm-up of a few seconds (the actor's imports, the
-   object store's pages). The remote call's latency is the node's own (its worker thread: declared inputs
-   gathered and packed, the image put, the actor called, its answer in hand and its writes checked), not the
-   tree's tick period. The overhead is that latency minus the local run's time, call by call. Goal: <= 2 ms
-   median. Printed beside it: the latency against the expert's run on the actor (measured there), the stages
-   of the remote call, and Ray's own floor on this machine, measured alternately with the expert's calls in the
-   same way (waited for in a thread while this one ticks) for calls of growing shape: the simplest call (no
-   arguments, returns None), the actor busy as long as the expert ran, the image put and passed, the packed
-   hypotheses passed (the expert's call shape).
+   a Ray actor in two ways, alternating call by call (which remote side goes first alternates too): through the
+   actor's compiled graph (the default: shared-memory channels) and by plain actor calls
+   (``Placement(compiled_graph=False)``: the image put into the object store, the call submitted as a Ray task).
+   Each run is on a new frame object (so the frame's image is sent anew for every remote call, as for a live
+   camera), after a warm-up of a few seconds (the actors' imports, the object store's pages). The remote call's
+   latency is the node's own (its worker thread: declared inputs gathered and packed, sent, the actor called, its
+   answer in hand and its writes checked), not the tree's tick period. The overhead is that latency minus the
+   paired local run's time, call by call; its median and 90th percentile are printed for both ways side by side.
+   Goal: <= 2 ms median (the compiled graph, the default path). Printed beside it: the latency against the
+   expert's run on the actor (measured there), the stages of the remote call, the CPU time each run cost this
+   process and the actor's, and Ray's own floor on this machine: a bare compiled-graph call of the expert's shape,
+   and for plain calls, measured alternately with the expert's calls in the same way (waited for in a thread
+   while this one ticks), calls of growing shape: the simplest call (no arguments, returns None), the actor busy
+   as long as the expert ran, the image put and passed, the packed hypotheses passed (the expert's call shape).
 
 Run: ``PYTHONPATH=. .venv/bin/python bench/bench_ray.py``. The load average is printed: the machine is shared,
 and when other jobs take the cores, two workers cannot run twice as fast as one.
@@ -57,6 +61,7 @@ from robokudo.application.parallel import map_on_cluster, run_in_order  # noqa: 
 from robokudo.core.annotator import Annotator  # noqa: E402
 from robokudo.core.engine import Engine  # noqa: E402
 from robokudo.core.pipeline import Pipeline, pipelines  # noqa: E402
+from robokudo.core.placement import Placement  # noqa: E402
 from robokudo.core.remote import in_transit, place_remote  # noqa: E402
 from robokudo.core.types import CasType, ColorImage, ObjectHypothesis  # noqa: E402
 from trees import tabletop  # noqa: E402
@@ -184,6 +189,10 @@ class Busy:
         while time.perf_counter() < end:
             pass
 
+    def packed(self, inputs: tuple[list[Any], ColorImage, float]) -> None:
+        """:meth:`call` as a compiled graph's call brings its arguments."""
+        self.call(*inputs)
+
 
 def in_worker(work: Callable[[], object], tick: float) -> float:
     """Ms that ``work`` took in a worker thread while this thread ticked every ``tick`` s (as a remote node's
@@ -271,7 +280,92 @@ def ray_floor(ray: ModuleType, image: np.ndarray) -> tuple[float, float]:
     return statistics.median(empty), statistics.median(with_image)
 
 
-def bench_overhead(ray: ModuleType, calls: int = CALLS, tick: float = 0.0002) -> None:
+def percentile(values: list[float], fraction: float) -> float:
+    ordered = sorted(values)
+    return ordered[min(len(ordered) - 1, int(fraction * len(ordered)))]
+
+
+class RemoteSide:
+    """One way of calling the expert on an actor (a tree of its own) and its figures, call by call."""
+
+    def __init__(
+        self,
+        label: str,
+        image: ColorImage,
+        hypotheses: list[ObjectHypothesis],
+        compiled: bool,
+        nap: float | None = None,
+    ) -> None:
+        self.label = label
+        tree = Pipeline(label, [Replay(image, hypotheses), SemanticColorAnnotator()])
+        hints = Placement(remote=True, num_cpus=0.3, compiled_graph=compiled)  # all actors fit beside the floor's
+        [self.node] = place_remote(tree, ["SemanticColorAnnotator"], hints)
+        calls = self.node.compiled_calls()
+        if calls is not None and nap is not None:
+            calls.nap_fraction = nap
+        self.engine = Engine(tree, hz=100000)
+        self.latency_ms: list[float] = []
+        self.added_ms: list[float] = []
+        self.versus_local_ms: list[float] = []
+        self.wall_ms: list[float] = []
+        self.stages: dict[str, list[float]] = {}
+        self.cpu_ms: list[float] = []
+        self.actor_cpu_ms: list[float] = []
+        self.actor_pid = 0
+
+    def run(self, tick: float, local_ms: float | None) -> None:
+        """One run; with ``local_ms`` (the paired local run's time) its figures are kept."""
+        actor_cpu = process_cpu(self.actor_pid)
+        cpu = time.process_time()
+        start = time.perf_counter()
+        one_run(self.engine, tick)
+        wall = 1000 * (time.perf_counter() - start)
+        if local_ms is None:
+            return
+        self.cpu_ms.append(1000 * (time.process_time() - cpu))
+        self.actor_cpu_ms.append(1000 * (process_cpu(self.actor_pid) - actor_cpu))
+        latency = 1000 * self.node.stats.last_seconds
+        self.wall_ms.append(wall)
+        self.latency_ms.append(latency)
+        self.added_ms.append(latency - 1000 * self.node.remote_seconds)
+        self.versus_local_ms.append(latency - local_ms)
+        for stage, seconds in self.node.call_times.stages().items():
+            self.stages.setdefault(stage, []).append(1000 * seconds)
+
+
+def process_cpu(pid: int) -> float:
+    """Seconds of CPU process ``pid`` has used (0 where /proc cannot tell)."""
+    try:
+        fields = Path(f"/proc/{pid}/stat").read_text().rsplit(")", 1)[1].split()
+    except (OSError, IndexError):
+        return 0.0
+    return (int(fields[11]) + int(fields[12])) / os.sysconf("SC_CLK_TCK")
+
+
+def compiled_floor(ray: ModuleType, annotations: list[Any], image: np.ndarray, seconds: float) -> float:
+    """Median ms beyond the actor's work of a bare compiled-graph call of the expert's shape (image and packed
+    hypotheses in, None out), called back to back from this thread."""
+    from ray.dag import InputNode
+
+    actor = ray.remote(Busy).options(num_cpus=0.5).remote()
+    with InputNode() as inputs:
+        graph = actor.packed.bind(inputs)
+    compiled = graph.experimental_compile(_buffer_size_bytes=4 << 20)
+    try:
+        for _ in range(5):
+            ray.get(compiled.execute((annotations, ColorImage(image), seconds)))
+        ms = []
+        for _ in range(FLOOR_CALLS):
+            start = time.perf_counter()
+            ray.get(compiled.execute((annotations, ColorImage(image), seconds)))
+            ms.append(1000 * (time.perf_counter() - start - seconds))
+    finally:
+        compiled.teardown()
+        ray.kill(actor)
+    return statistics.median(ms)
+
+
+def bench_overhead(ray: ModuleType, calls: int = CALLS, tick: float = 0.0002, compare_nap: bool = False) -> None:
     root = tabletop.create_tree()
     one_run(Engine(root, hz=1000))
     cas = next(pipelines(root)).cas
@@ -283,69 +377,79 @@ def bench_overhead(ray: ModuleType, calls: int = CALLS, tick: float = 0.0002) ->
     )
     local = SemanticColorAnnotator()
     local_engine = Engine(Pipeline("local", [Replay(image, hypotheses), local]), hz=100000)
-    remote_tree = Pipeline("remote", [Replay(image, hypotheses), SemanticColorAnnotator()])
-    [remote] = place_remote(remote_tree, ["SemanticColorAnnotator"])
-    remote_engine = Engine(remote_tree, hz=100000)
+    sides = [
+        RemoteSide("compiled", image, hypotheses, compiled=True),
+        RemoteSide("plain", image, hypotheses, compiled=False),
+    ]
+    if compare_nap:  # a compiled side that sleeps through most of the expected wait (CPU and tail vs the default)
+        sides.append(RemoteSide("nap 0.8", image, hypotheses, compiled=True, nap=0.8))
     sent = [in_transit(copy.copy(hypothesis), (ObjectHypothesis,)) for hypothesis in hypotheses]
     floors = Floors(ray, sent, image.image, tick)
     warm_until = time.perf_counter() + WARM_SECONDS
     warm_runs = 0
     while warm_runs < 5 or time.perf_counter() < warm_until:
         one_run(local_engine, tick)
-        one_run(remote_engine, tick)
+        for side in sides:
+            side.run(tick, None)
         floors.measure(0.001)
         warm_runs += 1
+    for side in sides:
+        print(f"   {side.label:8s}: calls take {side.node.call_path}")
+        side.actor_pid = side.node.actor_process_id()
     floors.ms = {rung: [] for rung in floors.RUNGS}
-    local_ms, latency_ms, actor_ms, added_ms, versus_local_ms, local_wall, remote_wall = [], [], [], [], [], [], []
-    stages: dict[str, list[float]] = {}
-    for _ in range(calls):
+    local_ms, local_wall, actor_ms = [], [], []
+    for call in range(calls):
         start = time.perf_counter()
         one_run(local_engine, tick)
         local_wall.append(1000 * (time.perf_counter() - start))
         local_ms.append(1000 * local.stats.last_seconds)
-        start = time.perf_counter()
-        one_run(remote_engine, tick)
-        remote_wall.append(1000 * (time.perf_counter() - start))
-        latency_ms.append(1000 * remote.stats.last_seconds)
-        actor_ms.append(1000 * remote.remote_seconds)
-        added_ms.append(latency_ms[-1] - actor_ms[-1])
-        versus_local_ms.append(latency_ms[-1] - local_ms[-1])
-        for stage, seconds in remote.call_times.stages().items():
-            stages.setdefault(stage, []).append(1000 * seconds)
-        floors.measure(remote.remote_seconds)
-    remote.stop_actor()
+        for side in sides if call % 2 else sides[::-1]:  # which remote side goes first alternates
+            side.run(tick, local_ms[-1])
+        actor_ms.append(1000 * sides[0].node.remote_seconds)
+        floors.measure(sides[0].node.remote_seconds)
+    for side in sides:
+        side.node.stop_actor()
     floors.close()
     empty_ms, image_ms = ray_floor(ray, image.image)
+    compiled_ms = compiled_floor(ray, sent, image.image, statistics.median(actor_ms) / 1000)
     median = statistics.median
     rungs = floors.medians()
-    print(f"   (warmed for {warm_runs} rounds: the actor's process, its caches, the object store's pages)")
+    print(f"   (warmed for {warm_runs} rounds: the actors' processes, their caches, the object store's pages)")
     print(f"   local run of the expert   median {median(local_ms):7.2f} ms   (tree run {median(local_wall):.2f} ms)")
-    print(
-        f"   remote call latency       median {median(latency_ms):7.2f} ms   (tree run {median(remote_wall):.2f} ms, "
-        f"ticking every {1000 * tick:g} ms), of which the expert's run on the actor {median(actor_ms):.2f} ms"
-    )
-    print(
-        "   stages of a remote call (medians, ms): "
-        + ", ".join(f"{stage} {median(values):.2f}" for stage, values in stages.items())
-    )
+    for side in sides:
+        print(
+            f"   {side.label:8s} remote call latency median {median(side.latency_ms):7.2f} ms   (tree run "
+            f"{median(side.wall_ms):.2f} ms, ticking every {1000 * tick:g} ms); latency - the run on the actor "
+            f"{median(side.added_ms):.2f} ms"
+        )
+        print(
+            f"      CPU per run (ms, sums over the measured runs / runs, the local run included in neither): "
+            f"this process (tree, worker, ticks) {statistics.mean(side.cpu_ms):.2f}, "
+            f"the actor's process {statistics.mean(side.actor_cpu_ms):.2f}"
+        )
+        print(
+            "      stages (medians, ms): "
+            + ", ".join(f"{stage} {median(values):.2f}" for stage, values in side.stages.items())
+        )
     print(
         f"   Ray's floor, back to back from one thread: an empty actor call {empty_ms:.2f} ms, "
-        f"one with a reference to a 640x480 image put for it {image_ms:.2f} ms"
+        f"one with a reference to a 640x480 image put for it {image_ms:.2f} ms; a compiled-graph call of the "
+        f"expert's shape (image and packed hypotheses in) {compiled_ms:.2f} ms beyond the actor's work"
     )
-    print("   Ray's floor, waited for in a thread as the node waits, alternating with the expert's calls (ms beyond")
-    print("   the actor's work, medians):")
+    print("   Ray's floor for plain calls, waited for in a thread as the node waits, alternating with the expert's")
+    print("   calls (ms beyond the actor's work, medians):")
     for rung, value in rungs.items():
         print(f"      {rung:52s} {value:6.2f}")
-    overhead = median(added_ms)
-    shaped = rungs[Floors.RUNGS[-1]]
+    print("   overhead per call (remote latency - local run, paired calls), side by side in one run:")
+    for side in sides:
+        values = side.versus_local_ms
+        print(f"      {side.label:8s} median {median(values):6.2f} ms   p90 {percentile(values, 0.9):6.2f} ms")
+    compiled, plain = (median(side.versus_local_ms) for side in sides[:2])
+    if compiled > 0:
+        print(f"      plain / compiled overhead: {plain / compiled:.1f}x")
     print(
-        f"   latency - the run on the actor: median {overhead:.2f} ms, of which ours (beyond Ray's floor for this "
-        f"shape) {overhead - shaped:.2f} ms"
-    )
-    versus_local = median(versus_local_ms)
-    print(
-        f"   overhead per call (remote latency - local run, paired calls): median {versus_local:.2f} ms   "
-        f"goal <= {OVERHEAD_GOAL_MS} ms: {verdict(versus_local <= OVERHEAD_GOAL_MS)}"
+        f"   overhead per call (compiled graph, the default): median {compiled:.2f} ms   "
+        f"goal <= {OVERHEAD_GOAL_MS} ms: {verdict(compiled <= OVERHEAD_GOAL_MS)}"
     )
 
 
@@ -353,6 +457,9 @@ def main() -> None:
     parser = argparse.ArgumentParser(description=__doc__.split("\n", 1)[0])
     parser.add_argument("--only", choices=("eval", "overhead"), help="run one of the two benchmarks")
     parser.add_argument("--calls", type=int, default=CALLS, help="remote calls measured (overhead)")
+    parser.add_argument(
+        "--compare-nap", action="store_true", help="also a compiled side that sleeps while it waits (overhead)"
+    )
     parser.add_argument("--tick-ms", type=float, default=0.2, help="tick period while a run is RUNNING (overhead)")
     args = parser.parse_args()
     if not LEARN.is_dir():
@@ -364,7 +471,7 @@ def main() -> None:
         if args.only != "overhead":
             bench_eval()
         if args.only != "eval":
-            bench_overhead(ray, args.calls, args.tick_ms / 1000)
+            bench_overhead(ray, args.calls, args.tick_ms / 1000, args.compare_nap)
 
 
 if __name__ == "__main__":

@@ -4,7 +4,8 @@ An annotator class declares it beside its ports and capability (``placement: Cla
 builder or the ``--remote NAME`` option of ``run`` / ``query`` / ``serve`` can place any annotator remotely
 without changing its class (:func:`robokudo.core.remote.place_remote`). The hints are Ray's scheduling
 resources: the actor waits for a node with ``num_cpus`` CPUs and ``num_gpus`` GPUs free, and Ray restarts its
-process up to ``max_restarts`` times (-1: always) when it dies.
+process up to ``max_restarts`` times (-1: always) when it dies. Calls go through a Ray compiled graph unless
+``compiled_graph`` is False.
 """
 
 from __future__ import annotations
@@ -20,6 +21,9 @@ class Placement:
     num_cpus: float = 1.0
     num_gpus: float = 0.0
     max_restarts: int = -1
+    compiled_graph: bool = True
+    """Call the actor through a Ray compiled graph (shared-memory channels) where Ray can; False: plain actor
+    calls through Ray's object store."""
 
     def __post_init__(self) -> None:
         for name in ("num_cpus", "num_gpus"):

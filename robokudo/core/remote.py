@@ -9,19 +9,26 @@ annotator's name, reason, ports and capability; on each run its worker thread
    declared input type too, as a shallow copy that shares its arrays, and with its mask cut to its ``roi``
    when nothing of the mask lies outside: the actor restores the full-frame mask, so the expert sees what
    it would see locally),
-2. puts each view into Ray's object store once per frame (:class:`FrameStore`: every remote expert of a
-   resource pool that reads the frame's image sends the same reference; the put is the one copy the transfer
-   needs, nothing else is copied here) and calls the actor with the references and the (small) annotations;
-   on the actor's node the arrays are read in place, read-only,
+2. sends them to the actor through the actor's Ray compiled graph (:mod:`robokudo.core.compiled_call`: the
+   views and annotations are serialised straight into a pre-allocated shared-memory channel, the one copy the
+   transfer needs, nothing else is copied here; a call costs tens of microseconds instead of Ray's task
+   submission's milliseconds), or, where compiled graphs are not available or the placement asks for it
+   (``Placement(compiled_graph=False)``), by a plain actor call: each view put into Ray's object store once per
+   frame (:class:`FrameStore`: every remote expert of a resource pool that reads the frame's image sends the
+   same reference) and the call made with the references and the (small) annotations. On the actor's node the
+   arrays are read in place, read-only. :attr:`RemoteAnnotator.call_path` says which path the calls take,
 3. waits (the node is RUNNING, the tick loop goes on), polling its cancel flag: a cancelled or timed-out run
-   asks Ray to cancel the call and discards its result, as a local threaded annotator does,
+   discards its result, as a local threaded annotator does (a plain call is also cancelled in Ray; a compiled
+   graph's execution cannot be, so it finishes on the actor and Ray releases its result unread when the next
+   call reads past it),
 4. commits what the actor's annotator wrote through its own port checks (attachments go to the local
    hypotheses they were made for).
 
 The actor rebuilds the annotator from its class and its own attributes (its parameters; framework state is
 left behind), so an annotator whose attributes cannot be pickled cannot be placed (:class:`PlacementError`
 names the attribute). A dead actor makes the run FAIL with the reason; Ray restarts the actor's process (up to
-``max_restarts`` times) and the next run goes to the new one. Actors are kept in the node's
+``max_restarts`` times), its compiled graph is torn down and the next run compiles a new one on the new
+process. Actors are kept in the node's
 :class:`~robokudo.core.resources.SharedResources` under the class and parameters, so every tree built with
 one pool (a serving instance's) shares one actor per expert.
 
@@ -46,8 +53,16 @@ from typing import Any, ClassVar
 import numpy as np
 import py_trees
 
+from robokudo.core import compiled_call
 from robokudo.core.annotator import Annotator, PortError, RunCancelledError, _Run
 from robokudo.core.cas import CAS, AddAnnotation, SetView
+from robokudo.core.compiled_call import (
+    COMPILED_GRAPH,
+    PLAIN_CALLS,
+    ChannelClosedError,
+    CompiledCalls,
+    GraphStalledError,
+)
 from robokudo.core.pipeline import StructureError
 from robokudo.core.placement import Placement
 from robokudo.core.threaded import ThreadedAnnotator
@@ -179,6 +194,17 @@ class ExpertHost:
                 return "FAILURE", message, [], seconds, (entered, time.perf_counter())
         return status.name, message, writes, seconds, (entered, time.perf_counter())
 
+    def analyse_packed(self, inputs: tuple[list[Annotation], list[View]] | None) -> bytes:
+        """:meth:`analyse` on ``(annotations, views)`` as a compiled graph's call brings them, its answer pickled
+        (so no array of the answer keeps the graph's output channel once the caller has read it); None for None
+        (a new graph's first call)."""
+        import ray
+
+        if inputs is None:
+            return ray.cloudpickle.dumps(None)
+        annotations, views = inputs
+        return ray.cloudpickle.dumps(self.analyse(annotations, *views))
+
 
 @functools.cache
 def _actor_class() -> Any:
@@ -227,6 +253,26 @@ class RemoteAnnotator(ThreadedAnnotator):
             self._actor = self.resources.get((*self.recipe.key(), placement), start)
         return self._actor
 
+    def compiled_calls(self) -> CompiledCalls | None:
+        """The compiled graph of this node's actor (shared like the actor), None when the placement asks for plain
+        actor calls."""
+        if not self.where.compiled_graph:
+            return None
+        ray = require_ray()
+        actor = self.actor()
+        key = (*self.recipe.key(), self.where, "compiled graph")
+        return self.resources.get(key, lambda: CompiledCalls(ray, actor))
+
+    @property
+    def call_path(self) -> str:
+        """Which path this node's calls take: the compiled graph, or plain actor calls (and why)."""
+        if not self.where.compiled_graph:
+            return f"{PLAIN_CALLS} (as placed: compiled_graph=False)"
+        if self._actor is None:  # not started: what its calls would take, without starting it
+            missing = compiled_call.unavailable_reason(require_ray())
+            return COMPILED_GRAPH if missing is None else f"{PLAIN_CALLS} ({missing})"
+        return self.compiled_calls().path()  # type: ignore[union-attr]
+
     def actor_process_id(self, timeout: float = 60.0) -> int:
         """The process id of the actor's current process (waits for it to start)."""
         ray = require_ray()
@@ -265,16 +311,23 @@ class RemoteAnnotator(ThreadedAnnotator):
         views, sent, local = self._inputs()
         _, times.inputs = _lap(start)
         actor = self.actor()
+        compiled = self.compiled_calls()
         if self._actor_failed:
             self._await_restart(ray, actor)
         try:
             stamp = time.perf_counter()
-            references = self.frames().references(ray, views)
-            stamp, times.put = _lap(stamp)
-            pending = actor.analyse.remote(sent, *references)
-            stamp, times.call = _lap(stamp)
-            status, message, writes, times.expert, (entered, left) = self._wait(ray, pending)
+            answer = None
+            if compiled is not None and compiled.unavailable is None:
+                answer = self._compiled_call(ray, actor, compiled, (sent, views))
             called = stamp
+            if answer is None:
+                references = self.frames().references(ray, views)
+                stamp, times.put = _lap(stamp)
+                pending = actor.analyse.remote(sent, *references)
+                stamp, times.call = _lap(stamp)
+                called = stamp
+                answer = self._wait(ray, pending)
+            status, message, writes, times.expert, (entered, left) = answer
             stamp, times.answer = _lap(called)
             times.actor = left - entered
             times.to_actor, times.from_actor = entered - called, stamp - left
@@ -286,6 +339,8 @@ class RemoteAnnotator(ThreadedAnnotator):
             self.fail(f"remote {self.name} raised {_summary(error)}")
         except (ray.exceptions.RayActorError, ray.exceptions.ActorUnavailableError) as error:
             self._actor_failed = True
+            if compiled is not None:
+                compiled.reset()  # Ray shut the graph down; the next run compiles one on the restarted actor
             self.fail(f"remote actor of {self.name} died: {_summary(error)}")
         except ray.exceptions.RayError as error:
             self.fail(f"remote {self.name} failed: {type(error).__name__}: {_summary(error)}")
@@ -316,22 +371,47 @@ class RemoteAnnotator(ThreadedAnnotator):
             _cancel(ray, pending)
             raise
 
-    def _await_restart(self, ray: ModuleType, actor: Any) -> None:
-        """After the actor died: wait until Ray has restarted it (a call sent while it restarts would fail)."""
+    def _compiled_call(self, ray: ModuleType, actor: Any, compiled: CompiledCalls, inputs: tuple) -> Any:
+        """The actor's answer through its compiled graph; None when this run is to go as a plain call (the graph
+        closed: the next run compiles a new one)."""
+        for _ in range(2):
+            try:
+                return compiled.call(inputs, self._check_cancelled, POLL_SECONDS)
+            except GraphStalledError as stalled:  # its actor's process restarts: wait for it, compile again
+                self._await_restart(ray, actor, stalled.process_id)
+            except ChannelClosedError:
+                compiled.reset()
+                return None
+        return None
+
+    def _check_cancelled(self) -> None:
+        """RunCancelledError once this run is cancelled."""
+        if self.cancelled:  # (reading it raises RunCancelledError once the run is cancelled)
+            raise RunCancelledError()
+
+    def _await_restart(self, ray: ModuleType, actor: Any, old_process_id: int | None = None) -> None:
+        """After the actor died (or its process ``old_process_id`` was ended): wait until Ray has restarted it (a
+        call sent while it restarts would fail)."""
         while True:
             try:
-                self._wait(ray, actor.process_id.remote())
+                process_id = self._wait(ray, actor.process_id.remote())
             except ray.exceptions.ActorUnavailableError:
                 time.sleep(POLL_SECONDS)
                 continue
             except ray.exceptions.RayActorError as error:
                 self.fail(f"remote actor of {self.name} is gone: {_summary(error)}")
+            if process_id == old_process_id:  # the ended process has not gone yet
+                time.sleep(POLL_SECONDS)
+                continue
             self._actor_failed = False
             return
 
     def stop_actor(self) -> None:
         """End the actor's process now (an actor also ends when the last handle to it is gone)."""
         if self._actor is not None:
+            calls = self.compiled_calls()
+            if calls is not None:
+                calls.reset()
             require_ray().kill(self._actor, no_restart=True)
             self._actor = None
 

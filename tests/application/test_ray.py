@@ -10,6 +10,7 @@ missing Ray fails them. The messages the options give without Ray are tested by 
 
 from __future__ import annotations
 
+import contextlib
 import json
 import logging
 import os
@@ -20,6 +21,7 @@ import time
 from collections.abc import Iterator
 from pathlib import Path
 from types import ModuleType
+from typing import ClassVar
 
 import numpy as np
 import pytest
@@ -30,9 +32,12 @@ from py_trees.common import Status
 
 from annotators.image.color import SemanticColorAnnotator
 from robokudo.application import cli
+from robokudo.core import compiled_call
+from robokudo.core.annotator import Annotator
 from robokudo.core.cas import CAS
+from robokudo.core.compiled_call import BUFFER_BYTES, COMPILED_GRAPH, PLAIN_CALLS
 from robokudo.core.engine import Engine
-from robokudo.core.pipeline import pipelines
+from robokudo.core.pipeline import Pipeline, pipelines
 from robokudo.core.placement import Placement
 from robokudo.core.remote import (
     ACTOR_ENV,
@@ -47,7 +52,7 @@ from robokudo.core.remote import (
     place_remote,
     restored,
 )
-from robokudo.core.types import ColorImage, DepthImage, ObjectHypothesis, Pose, SemanticColor
+from robokudo.core.types import CasType, ColorImage, DepthImage, ObjectHypothesis, Pose, SemanticColor, Text
 from tests.annotators.conftest import SHARED_DATA, require_folder
 from trees import tabletop
 
@@ -122,6 +127,7 @@ def test_the_colour_expert_on_an_actor_gives_the_local_answer(cluster: ModuleTyp
         assert remote.actor_process_id() != os.getpid()
         assert run_to_end(Engine(root, hz=1000)) is Status.SUCCESS
         assert colours(root) == local_colours
+        assert remote.call_path == COMPILED_GRAPH
         environment = process_environment(remote.actor_process_id())
         assert environment is None or ACTOR_ENV.items() <= environment.items()
     finally:
@@ -152,11 +158,217 @@ def test_a_killed_actor_fails_its_node_with_the_reason_and_the_next_run_works(
         assert "remote actor of SemanticColorAnnotator died" in remote.feedback_message
         assert run_to_end(engine) is Status.SUCCESS, remote.feedback_message
         assert colours(root) == local_colours
+        assert remote.call_path == COMPILED_GRAPH  # a new graph, compiled on the restarted actor
         restarted = process_environment(remote.actor_process_id())
         assert restarted is None or ACTOR_ENV.items() <= restarted.items()
         assert remote.actor_process_id() != pid
     finally:
         remote.stop_actor()
+
+
+def test_plain_actor_calls_give_the_local_answer_too(cluster: ModuleType, local_colours: list) -> None:
+    root = tabletop.create_tree()
+    [remote] = place_remote(root, ["SemanticColorAnnotator"], Placement(remote=True, compiled_graph=False))
+    try:
+        assert run_to_end(Engine(root, hz=1000)) is Status.SUCCESS
+        assert colours(root) == local_colours
+        assert remote.call_path.startswith(PLAIN_CALLS) and "compiled_graph=False" in remote.call_path
+    finally:
+        remote.stop_actor()
+
+
+def test_without_compiled_graphs_the_calls_are_plain_and_say_why(
+    cluster: ModuleType, local_colours: list, monkeypatch: pytest.MonkeyPatch
+) -> None:
+    monkeypatch.setattr(compiled_call, "unavailable_reason", lambda ray: "this Ray has no compiled graphs (hidden)")
+    root = tabletop.create_tree()
+    [remote] = place_remote(root, ["SemanticColorAnnotator"])
+    try:
+        assert run_to_end(Engine(root, hz=1000)) is Status.SUCCESS
+        assert colours(root) == local_colours
+        assert remote.call_path == f"{PLAIN_CALLS} (this Ray has no compiled graphs (hidden))"
+    finally:
+        remote.stop_actor()
+
+
+class Echo(Annotator):
+    """Reports the first pixel of its colour image and the image's shape; takes ``slow`` seconds when that pixel
+    is 255 (a long run to cancel)."""
+
+    inputs: ClassVar[tuple[type[CasType], ...]] = (ColorImage,)
+    optional_inputs: ClassVar[tuple[type[CasType], ...]] = (DepthImage,)
+    outputs: ClassVar[tuple[type[CasType], ...]] = (Text,)
+
+    def __init__(self, slow: float = 0.0) -> None:
+        super().__init__(name="echo")
+        self.slow = slow
+
+    def analyse(self) -> None:
+        image = self.view(ColorImage).image
+        if image[0, 0, 0] == 255:
+            time.sleep(self.slow)
+        depth = self.optional_view(DepthImage)
+        total = "" if depth is None else f" depth {int(depth.depth.sum())}"
+        self.write(Text(text=f"{int(image[0, 0, 0])} {image.shape}{total}"))
+
+
+class Frame(Annotator):
+    """Writes a new frame each run: a colour image whose first pixel is the next of ``firsts``, and a depth
+    image of ones, of the next of ``shapes`` (the last one again when they run out)."""
+
+    outputs: ClassVar[tuple[type[CasType], ...]] = (ColorImage, DepthImage)
+
+    def __init__(self, firsts: list[int], shapes: list[tuple[int, int]]) -> None:
+        super().__init__(name="frame")
+        self.firsts = firsts
+        self.shapes = shapes
+
+    def analyse(self) -> None:
+        shape = self.shapes.pop(0) if len(self.shapes) > 1 else self.shapes[0]
+        image = np.zeros((*shape, 3), np.uint8)
+        image[0, 0, 0] = self.firsts.pop(0)
+        self.write(ColorImage(image))
+        self.write(DepthImage(np.ones(shape, np.float32)))
+
+
+def echo_tree(
+    firsts: list[int], shapes: list[tuple[int, int]], timeout: float, slow: float = 3.0
+) -> tuple[Pipeline, RemoteAnnotator]:
+    tree = Pipeline("echo", [Frame(firsts, shapes), Echo(slow=slow)])
+    [node] = place_remote(tree, ["echo"])
+    node.timeout = timeout
+    return tree, node
+
+
+def echoed(tree: Pipeline) -> list[str]:
+    return [text.text for text in tree.cas.annotations(Text)]
+
+
+def test_a_timed_out_call_is_drained_and_the_next_run_gets_its_own_answer(cluster: ModuleType) -> None:
+    """The compiled graph cannot cancel the slow execution: the run times out (FAILURE, as a local threaded
+    annotator), the actor finishes it, and its result is dropped unread; each later run answers its own frame."""
+    tree, node = echo_tree([1, 255, 2, 3], [(48, 64)], timeout=15.0)
+    engine = Engine(tree, hz=1000)
+    try:
+        assert run_to_end(engine) is Status.SUCCESS and echoed(tree) == ["1 (48, 64, 3) depth 3072"]
+        assert node.call_path == COMPILED_GRAPH
+        node.timeout = 0.3
+        assert run_to_end(engine) is Status.FAILURE
+        assert node.feedback_message == "timed out after 0.3 s"
+        node.timeout = 15.0
+        assert run_to_end(engine) is Status.SUCCESS and echoed(tree) == ["2 (48, 64, 3) depth 3072"]
+        assert run_to_end(engine) is Status.SUCCESS and echoed(tree) == ["3 (48, 64, 3) depth 3072"]
+        assert node.call_path == COMPILED_GRAPH and node.compiled_calls().compiles == 1  # one graph throughout
+    finally:
+        node.stop_actor()
+
+
+def test_an_interrupted_call_ends_its_worker_at_once_and_the_next_run_works(cluster: ModuleType) -> None:
+    tree, node = echo_tree([1, 255, 2], [(48, 64)], timeout=15.0)
+    engine = Engine(tree, hz=1000)
+    try:
+        assert run_to_end(engine) is Status.SUCCESS
+        assert engine.tick() is Status.RUNNING
+        waited = time.monotonic()
+        while node.status is not Status.RUNNING:
+            assert time.monotonic() - waited < DEADLINE
+            engine.tick()
+        time.sleep(0.2)  # the actor works on the slow frame
+        tree.stop(Status.INVALID)  # as a Fallback moving on interrupts it
+        assert node.stop_worker(timeout=1.0)  # the worker stops waiting at once (the actor goes on)
+        assert run_to_end(engine) is Status.SUCCESS and echoed(tree) == ["2 (48, 64, 3) depth 3072"]
+        assert node.call_path == COMPILED_GRAPH
+    finally:
+        node.stop_actor()
+
+
+def test_a_call_that_sleeps_through_the_expected_wait_answers_and_can_be_interrupted_in_its_sleep(
+    cluster: ModuleType,
+) -> None:
+    tree, node = echo_tree([255, 255, 2], [(48, 64)], timeout=30.0, slow=1.0)
+    calls = node.compiled_calls()
+    assert calls is not None
+    calls.nap_fraction = 0.8
+    engine = Engine(tree, hz=1000)
+    try:
+        assert run_to_end(engine) is Status.SUCCESS and echoed(tree) == ["255 (48, 64, 3) depth 3072"]
+        assert engine.tick() is Status.RUNNING  # the next call sleeps ~0.8 s before it reads
+        time.sleep(0.2)
+        tree.stop(Status.INVALID)
+        assert node.stop_worker(timeout=0.4)  # before its sleep (0.6 s more) would have ended: it checked
+        assert run_to_end(engine) is Status.SUCCESS and echoed(tree) == ["2 (48, 64, 3) depth 3072"]
+        assert calls.compiles == 1
+    finally:
+        node.stop_actor()
+
+
+def test_a_new_graph_that_does_not_answer_has_its_actor_restarted_and_the_run_goes_on(
+    cluster: ModuleType, monkeypatch: pytest.MonkeyPatch
+) -> None:
+    """The first graph's actor is stopped right after the graph compiled (as if its loop never started): its first
+    call gets no answer, the actor's process is ended for Ray to restart, a new graph is compiled there, and the
+    run answers its frame."""
+    monkeypatch.setattr(compiled_call, "VERIFY_SECONDS", 1.0)
+    compile_graph = compiled_call.CompiledCalls._compiled
+    stopped: list[int] = []
+
+    def compile_and_stop_the_first(self: compiled_call.CompiledCalls) -> object:
+        fresh = self._graph is None
+        graph = compile_graph(self)
+        if fresh and not stopped:
+            stopped.append(self._process_id)
+            os.kill(self._process_id, signal.SIGSTOP)
+        return graph
+
+    monkeypatch.setattr(compiled_call.CompiledCalls, "_compiled", compile_and_stop_the_first)
+    tree, node = echo_tree([1, 2], [(48, 64)], timeout=60.0)
+    engine = Engine(tree, hz=1000)
+    try:
+        assert run_to_end(engine) is Status.SUCCESS, node.feedback_message
+        assert echoed(tree) == ["1 (48, 64, 3) depth 3072"]
+        assert node.compiled_calls().compiles == 2 and node.call_path == COMPILED_GRAPH
+        assert node.actor_process_id() != stopped[0]
+        assert run_to_end(engine) is Status.SUCCESS and echoed(tree) == ["2 (48, 64, 3) depth 3072"]
+    finally:
+        for pid in stopped:
+            with contextlib.suppress(ProcessLookupError):
+                os.kill(pid, signal.SIGKILL)
+        node.stop_actor()
+
+
+def test_an_idle_graph_is_torn_down_and_the_next_call_compiles_it_again(cluster: ModuleType) -> None:
+    tree, node = echo_tree([1, 2], [(48, 64)], timeout=30.0)
+    calls = node.compiled_calls()
+    assert calls is not None
+    calls.idle_seconds = 0.3
+    engine = Engine(tree, hz=1000)
+    try:
+        assert run_to_end(engine) is Status.SUCCESS and echoed(tree) == ["1 (48, 64, 3) depth 3072"]
+        waited = time.monotonic()
+        while calls.idle_releases == 0:
+            assert time.monotonic() - waited < DEADLINE, "the idle graph was not torn down"
+            time.sleep(0.05)
+        assert calls.compiles == 1
+        assert run_to_end(engine) is Status.SUCCESS and echoed(tree) == ["2 (48, 64, 3) depth 3072"]
+        assert calls.compiles == 2 and node.call_path == COMPILED_GRAPH
+    finally:
+        node.stop_actor()
+
+
+def test_inputs_larger_than_the_channel_buffers_grow_them(cluster: ModuleType) -> None:
+    """A 640x480 RGB-D frame fits the channels as they start; a 1280x960 one (8.6 MB) is larger, and Ray grows
+    them: the call stays on the compiled graph and gets the right answer."""
+    assert 640 * 480 * (3 + 4) < BUFFER_BYTES < 1280 * 960 * (3 + 4)
+    shapes = [(480, 640), (960, 1280), (480, 640), (1920, 2560)]
+    tree, node = echo_tree([7, 8, 9, 10], list(shapes), timeout=30.0)
+    engine = Engine(tree, hz=1000)
+    try:
+        for first, shape in zip((7, 8, 9, 10), shapes, strict=True):
+            assert run_to_end(engine) is Status.SUCCESS, node.feedback_message
+            assert echoed(tree) == [f"{first} ({shape[0]}, {shape[1]}, 3) depth {shape[0] * shape[1]}"]
+            assert node.call_path == COMPILED_GRAPH and node.compiled_calls().compiles == 1
+    finally:
+        node.stop_actor()
 
 
 def scene_paths() -> list[str]:

@@ -62,8 +62,11 @@ def run(args: argparse.Namespace) -> int:
             names = ", ".join(sorted({node.name for node in annotators}))
             raise RemoteOptionError(f"--remote {unknown[0]}: no annotator of that name in the tree ({names})")
         with remote_cluster(args, (type(node) for node in annotators)):
-            place_remote(root, args.remote, hints)
-            return _run(args, root)
+            placed = place_remote(root, args.remote, hints)
+            status = _run(args, root)
+            for node in placed:
+                print(f"remote {node.name}: {node.where.describe()}, calls through {node.call_path}")
+            return status
     except (RemoteOptionError, PlacementError, ClusterError) as error:
         print(f"robokudo run: {error}", file=sys.stderr)
         return 2
