@@ -35,7 +35,7 @@ from annotators.cloud.clusters import (
 )
 from annotators.cloud.normals import grid_normals
 from annotators.cloud.plane import plane_basis
-from annotators.geometry.border_pixels import BorderRules, claim_border_pixels
+from annotators.geometry.border_pixels import BorderRules, claim_border_pixels, plane_noise
 from annotators.geometry.convexity import ConvexityRules, convex_groups, dense_labels, grid_patches, split_by_normals
 from annotators.geometry.grid_segmentation import (
     MergeRules,
@@ -91,9 +91,17 @@ class ClutterParameters(ClusterParameters):
 
     def border_rules(self) -> BorderRules:
         """The thresholds of :func:`annotators.geometry.border_pixels.claim_border_pixels` at full resolution: the
-        depth jumps, and the span of the normals (``normal_step`` coarse pixels) and the smoothness angle."""
+        depth jumps, the span of the normals (``normal_step`` coarse pixels), the smoothness angle, the concave
+        crease of the merge rules, the candidates' lowest height and the outline the ``stride`` grid loses."""
+        step = max(1, self.stride)
         return BorderRules(
-            self.jump_absolute, self.jump_relative, self.normal_step * max(1, self.stride), self.smooth_degrees
+            jump_absolute=self.jump_absolute,
+            jump_relative=self.jump_relative,
+            normal_step=self.normal_step * step,
+            smooth_degrees=self.smooth_degrees,
+            crease=self.convexity,
+            min_height=self.min_height,
+            outline_rounds=step - 1,
         )
 
     def merge_rules(self) -> MergeRules:
@@ -141,7 +149,10 @@ def segment_clutter(
         labels = join_occluded(
             labels, grid, normals, plane_grid.reshape(grid.shape), p.jump_absolute, p.jump_relative, OcclusionRules()
         )
-    refine = partial(claim_border_pixels, rules=p.border_rules()) if p.claim_borders else None
+    refine = None
+    if p.claim_borders:
+        floor = plane_noise(points, model, plane_indices)
+        refine = partial(claim_border_pixels, plane=model, floor=floor, rules=p.border_rules())
     return full_resolution_segments(labels, depth, (x0, y0, x1, y1), step, points, mask, model, p, refine)
 
 

@@ -1,15 +1,28 @@
-"""Border pixels: the measured pixels along a segment's outline that the coarse grid left unlabelled.
+"""Border pixels: the measured pixels along a segment's outline that the segmentation left unlabelled.
 
-A segmentation on every ``stride``-th pixel is carried back to full resolution by giving each pixel the label of
-its cell's sample, kept only where the pixel lies on the sample's surface. Along an outline the sample often lies
-on the surface behind (or is a cut pixel without a label), so a band up to ``stride - 1`` pixels wide of the
-object's own pixels stays unlabelled: the masks lose their border.
+Two bands of an object's own pixels stay unlabelled after a segmentation on every ``stride``-th pixel:
 
-:func:`claim_border_pixels` gives such a pixel to the one segment it touches (4-neighbours) when it continues that
-segment's surface: no depth jump to the neighbour it touches and a normal that differs from the neighbour's by at
-most the segmenter's smoothness angle. A pixel touching two segments on its surface lies between them and stays
-unlabelled; the normals are estimated only at the pixels examined, so the step costs little beside the
-segmentation.
+* the **outline**: the grid is carried back to full resolution by giving each pixel the label of its cell's sample,
+  kept only where the pixel lies on the sample's surface; along an outline the sample often lies on the surface
+  behind (or is a cut pixel without a label), so up to ``stride - 1`` pixels of the object's rim are lost;
+* the **foot**: only points at least ``min_height`` above the supporting plane are candidates, so the lowest
+  centimetre of every object, where it stands on the plane, is cut off.
+
+:func:`claim_border_pixels` gives an outline pixel to the one segment it touches (4-neighbours) when it continues
+that segment's surface: no depth jump to the neighbour it touches, and normals that agree within the segmenter's
+smoothness angle or meet over a convex edge - never a concave crease, where another surface meets the segment; a
+pixel touching two segments on its surface lies between them and stays unlabelled. This is done in
+``stride - 1`` rounds.
+
+Foot pixels must stand out of the plane's noise (higher than 95 % of the plane's own inliers lie off it,
+:func:`plane_noise`) and face away from the plane (a normal more than the smoothness angle off the plane's): the
+plane itself and what lies flat on it stay out. Linked where they continue one another smoothly (no depth jump,
+normals within the smoothness angle) and to the segments they continue smoothly, they join the segment nearest
+along these links, so the foot running along two touching objects is shared between them.
+
+Only the pixels within reach of a segment are examined (the foot within the pixels ``min_height`` spans at the
+segments' nearest depth), normals are estimated only there, and the foot is one graph search, so the step costs
+little beside the segmentation.
 """
 
 from __future__ import annotations
@@ -18,6 +31,8 @@ from dataclasses import dataclass
 
 import cv2
 import numpy as np
+from scipy import sparse
+from scipy.sparse import csgraph
 
 from annotators.geometry.grid_segmentation import depth_jump
 
@@ -27,86 +42,228 @@ _CROSS = np.array([[0, 1, 0], [1, 1, 1], [0, 1, 0]], dtype=np.uint8)
 _NEIGHBOURS: tuple[tuple[int, int], ...] = ((0, -1), (0, 1), (-1, 0), (1, 0))
 """Row and column steps to the left, right, upper and lower 4-neighbour."""
 
+NOISE_SHARE = 0.95
+"""The share of the plane's inliers that lie closer to it than its noise level (:func:`plane_noise`)."""
+
+SAMPLE = 2000
+"""At most this many points are read to measure the plane's noise or the pixel pitch."""
+
 
 @dataclass(frozen=True)
 class BorderRules:
     """Thresholds of :func:`claim_border_pixels`, all the segmenter's own: a depth jump is a difference of more
     than ``jump_absolute + jump_relative * nearer depth`` (metres); normals are spanned by the points
-    ``normal_step`` pixels away and continue a surface when they differ by at most ``smooth_degrees``."""
+    ``normal_step`` pixels away and continue a surface when they differ by at most ``smooth_degrees`` or bend
+    convexly (a concave crease bends by less than ``-crease``, as between touching parts); candidates start
+    ``min_height`` above the plane; ``outline_rounds`` is how wide the lost outline can be (``stride - 1``)."""
 
     jump_absolute: float
     jump_relative: float
     normal_step: int
     smooth_degrees: float
+    crease: float
+    min_height: float
+    outline_rounds: int
 
 
-def normals_at(points: np.ndarray, rows: np.ndarray, cols: np.ndarray, rules: BorderRules) -> np.ndarray:
-    """Nx3 unit normals (facing the camera) of an organized HxWx3 cloud at the pixels ``(rows, cols)``.
+def _neighbours(pixels: np.ndarray, shape: tuple[int, ...]) -> list[tuple[np.ndarray, np.ndarray]]:
+    """For the left, right, upper and lower 4-neighbour of the flat ``pixels`` on a grid of ``shape``: which lie on
+    the grid (bool) and their flat indices (0 where off the grid)."""
+    height, width = shape[:2]
+    rows, cols = pixels // width, pixels % width
+    found = []
+    for step_row, step_col in _NEIGHBOURS:
+        row, col = rows + step_row, cols + step_col
+        inside = (row >= 0) & (row < height) & (col >= 0) & (col < width)
+        found.append((inside, np.where(inside, pixels + step_row * width + step_col, 0)))
+    return found
+
+
+def normals_at(points: np.ndarray, pixels: np.ndarray, rules: BorderRules) -> np.ndarray:
+    """Nx3 unit normals (facing the camera) of an organized HxWx3 cloud at the flat ``pixels``.
 
     Each axis is spanned by the points ``rules.normal_step`` pixels to either side, or by the pixel itself and the
     one side on its own surface (no depth jump) at an outline; NaN where neither side is on its surface.
     """
     height, width = points.shape[:2]
-    centre = points[rows, cols]
+    flat = points.reshape(-1, 3)
+    centre = flat[pixels]
+    rows, cols = pixels // width, pixels % width
     spans = []
     for step_row, step_col in ((0, 1), (1, 0)):
         ends = []
         for sign in (1, -1):
-            row = rows + sign * step_row * rules.normal_step
-            col = cols + sign * step_col * rules.normal_step
+            row, col = rows + sign * step_row * rules.normal_step, cols + sign * step_col * rules.normal_step
             inside = (row >= 0) & (row < height) & (col >= 0) & (col < width)
-            other = points[np.where(inside, row, 0), np.where(inside, col, 0)]
+            other = flat[np.where(inside, row * width + col, 0)]
             with np.errstate(invalid="ignore"):
                 same = inside & ~depth_jump(centre[:, 2], other[:, 2], rules.jump_absolute, rules.jump_relative)
             same &= np.isfinite(other[:, 2])
             ends.append((np.where(same[:, None], other, centre), same))
         (forward, forward_ok), (backward, backward_ok) = ends
         spans.append(np.where((forward_ok | backward_ok)[:, None], forward - backward, np.nan))
-    normals = np.cross(spans[0], spans[1])
+    (ux, uy, uz), (vx, vy, vz) = spans[0].T, spans[1].T
+    normals = np.column_stack([uy * vz - uz * vy, uz * vx - ux * vz, ux * vy - uy * vx])
     with np.errstate(invalid="ignore", divide="ignore"):
-        normals /= np.linalg.norm(normals, axis=1, keepdims=True)
+        normals /= np.sqrt(np.einsum("ij,ij->i", normals, normals))[:, None]
         away = np.einsum("ij,ij->i", normals, centre) > 0
     normals[away] *= -1
     return normals
 
 
-def claim_border_pixels(
-    labels: np.ndarray, points: np.ndarray, candidates: np.ndarray, rules: BorderRules
-) -> np.ndarray:
-    """``labels`` (HxW int, 0 = none) with the unlabelled ``candidates`` pixels that continue the one segment they
-    touch given its label (see the module docstring); ``points`` is the HxWx3 cloud of the same pixels."""
-    touching = cv2.dilate((labels > 0).view(np.uint8), _CROSS).view(bool)
-    open_ = np.flatnonzero(touching & candidates & (labels == 0))
-    if open_.size == 0:
-        return labels
-    height, width = labels.shape
-    rows, cols = open_ // width, open_ % width
-    flat_labels = labels.reshape(-1)
-    flat_depth = points[..., 2].reshape(-1)
-    depth = flat_depth[open_]
+def plane_noise(points: np.ndarray, plane: np.ndarray, plane_indices: np.ndarray) -> float:
+    """How far (metres) the supporting plane's own points scatter off it: the :data:`NOISE_SHARE` quantile of the
+    distances of its inliers (flat indices ``plane_indices`` of the HxWx3 ``points``, at most :data:`SAMPLE`)."""
+    sample = points.reshape(-1, 3)[plane_indices[:: max(1, plane_indices.size // SAMPLE)]]
+    with np.errstate(invalid="ignore"):
+        distances = np.abs(sample.astype(np.float64) @ np.asarray(plane[:3], dtype=np.float64) + float(plane[3]))
+    distances = distances[np.isfinite(distances)]
+    return float(np.quantile(distances, NOISE_SHARE)) if distances.size else 0.0
+
+
+def _claim_outline(labels: np.ndarray, points: np.ndarray, open_: np.ndarray, rules: BorderRules) -> np.ndarray:
+    """Give each pixel of ``open_`` (flat indices of unlabelled pixels) the label of the one segment whose surface
+    it continues, in place; returns the pixels claimed."""
+    flat_labels, flat_points = labels.reshape(-1), points.reshape(-1, 3)
+    depth = flat_points[open_, 2]
     lowest = np.full(open_.size, np.iinfo(np.int64).max, dtype=np.int64)
     highest = np.zeros(open_.size, dtype=np.int64)
-    beside = np.full(open_.size, -1, dtype=np.int64)  # the first neighbour on the pixel's surface
-    for step_row, step_col in _NEIGHBOURS:
-        row, col = rows + step_row, cols + step_col
-        inside = (row >= 0) & (row < height) & (col >= 0) & (col < width)
-        neighbour = np.where(inside, row * width + col, 0)
+    beside = np.full(open_.size, -1, dtype=np.int64)  # the first labelled neighbour on the pixel's surface
+    for inside, neighbour in _neighbours(open_, labels.shape):
         label = np.where(inside, flat_labels[neighbour], 0).astype(np.int64)
         with np.errstate(invalid="ignore"):
-            on_surface = (label > 0) & ~depth_jump(
-                depth, flat_depth[neighbour], rules.jump_absolute, rules.jump_relative
-            )
+            jump = depth_jump(depth, flat_points[neighbour, 2], rules.jump_absolute, rules.jump_relative)
+        on_surface = (label > 0) & ~jump
         lowest = np.where(on_surface, np.minimum(lowest, label), lowest)
         highest = np.where(on_surface, np.maximum(highest, label), highest)
         beside = np.where(on_surface & (beside < 0), neighbour, beside)
     one = (highest > 0) & (lowest == highest)
-    if not one.any():
-        return labels
-    open_, rows, cols, beside = open_[one], rows[one], cols[one], beside[one]
-    own = normals_at(points, rows, cols, rules)
-    theirs = normals_at(points, beside // width, beside % width, rules)
+    open_, beside = open_[one], beside[one]
+    if open_.size == 0:
+        return open_
+    normals = normals_at(points, np.concatenate([open_, beside]), rules)
+    own, theirs = normals[: open_.size], normals[open_.size :]
+    offset = flat_points[open_] - flat_points[beside]
+    with np.errstate(invalid="ignore", divide="ignore"):
+        aligned = np.einsum("ij,ij->i", own, theirs) >= np.cos(np.radians(rules.smooth_degrees))
+        convexity = np.einsum("ij,ij->i", own - theirs, offset) / np.linalg.norm(offset, axis=1)
+        continues = aligned | (convexity >= -rules.crease)
+    claimed = open_[continues]
+    flat_labels[claimed] = flat_labels[beside[continues]]
+    return claimed
+
+
+def _foot_reach(points: np.ndarray, pixels: np.ndarray, min_height: float) -> int:
+    """How many pixels ``min_height`` spans at most at the depths of the flat ``pixels`` (a sample of them): the
+    height over the pitch of a pixel at the nearest depth (the angle between neighbouring pixels times the depth)."""
+    width = points.shape[1]
+    sample = pixels[:: max(1, pixels.size // SAMPLE)]
+    sample = sample[sample % width < width - 1]
+    flat = points.reshape(-1, 3)
+    here, right = flat[sample], flat[sample + 1]
+    with np.errstate(invalid="ignore", divide="ignore"):
+        angles = np.abs(here[:, 0] / here[:, 2] - right[:, 0] / right[:, 2])
+    angles = angles[np.isfinite(angles) & (angles > 0)]
+    depths = here[np.isfinite(here[:, 2]), 2]
+    if angles.size == 0 or depths.size == 0:
+        return 0
+    return int(np.ceil(min_height / (float(np.median(angles)) * float(depths.min()))))
+
+
+def _claim_foot(
+    labels: np.ndarray,
+    points: np.ndarray,
+    candidates: np.ndarray,
+    plane: np.ndarray,
+    floor: float,
+    rules: BorderRules,
+    reach: int,
+) -> None:
+    """Give the foot pixels within ``reach`` pixels of a segment that continue a segment the label of the nearest
+    such segment, in place.
+
+    The foot pixels facing away from the plane are the nodes of a graph, with one node per segment besides:
+    4-neighbours are linked when no depth jump lies between them and their normals are within the smoothness angle,
+    and a pixel and a segment it touches the same way. One breadth-first search from all segments at once finds
+    each pixel's nearest segment.
+    """
+    kernel = np.ones((2 * reach + 1, 2 * reach + 1), dtype=np.uint8)
+    near = cv2.dilate((labels > 0).view(np.uint8), kernel).view(bool)
+    near &= labels == 0
+    near &= ~candidates
+    pixels = np.flatnonzero(near)
+    flat_points, flat_labels = points.reshape(-1, 3), labels.reshape(-1)
     with np.errstate(invalid="ignore"):
-        smooth = np.einsum("ij,ij->i", own, theirs) >= np.cos(np.radians(rules.smooth_degrees))
+        heights = flat_points[pixels] @ plane[:3].astype(points.dtype) + points.dtype.type(plane[3])
+        pixels = pixels[(heights > floor) & (heights < rules.min_height)]
+    if pixels.size == 0:
+        return
+    normals = normals_at(points, pixels, rules)
+    smooth_cosine = np.cos(np.radians(rules.smooth_degrees))
+    with np.errstate(invalid="ignore"):
+        facing_away = np.abs(normals @ plane[:3]) < smooth_cosine
+    pixels, normals = pixels[facing_away], normals[facing_away]
+    if pixels.size == 0:
+        return
+    depth = flat_points[pixels, 2]
+    links, contacts = [], []
+    for inside, neighbour in _neighbours(pixels, labels.shape):
+        with np.errstate(invalid="ignore"):
+            on_surface = inside & ~depth_jump(
+                depth, flat_points[neighbour, 2], rules.jump_absolute, rules.jump_relative
+            )
+        other = np.minimum(np.searchsorted(pixels, neighbour), pixels.size - 1)  # pixels are sorted
+        between_feet = on_surface & (pixels[other] == neighbour) & (other > np.arange(pixels.size))
+        links.append(np.flatnonzero(between_feet))
+        links.append(other[between_feet])
+        touching = np.flatnonzero(on_surface & (flat_labels[neighbour] > 0))
+        contacts.append(np.column_stack([touching, neighbour[touching]]))
+    feet = np.column_stack([np.concatenate(links[0::2]), np.concatenate(links[1::2])])
+    touches = np.concatenate(contacts)
+    theirs = normals_at(points, touches[:, 1], rules)
+    with np.errstate(invalid="ignore"):
+        feet = feet[np.einsum("ij,ij->i", normals[feet[:, 0]], normals[feet[:, 1]]) >= smooth_cosine]
+        touches = touches[np.einsum("ij,ij->i", normals[touches[:, 0]], theirs) >= smooth_cosine]
+    if touches.size == 0:
+        return
+    segment_node = pixels.size + flat_labels[touches[:, 1]].astype(np.int64)
+    edges = np.concatenate([feet, np.column_stack([touches[:, 0], segment_node])])
+    size = pixels.size + int(segment_node.max()) + 1
+    graph = sparse.csr_matrix((np.ones(edges.shape[0]), (edges[:, 0], edges[:, 1])), shape=(size, size))
+    _, _, nearest = csgraph.dijkstra(
+        graph, directed=False, indices=np.unique(segment_node), unweighted=True, min_only=True, return_predecessors=True
+    )
+    nearest = nearest[: pixels.size]
+    reached = nearest >= 0
+    flat_labels[pixels[reached]] = nearest[reached] - pixels.size
+
+
+def claim_border_pixels(
+    labels: np.ndarray,
+    points: np.ndarray,
+    candidates: np.ndarray,
+    *,
+    plane: np.ndarray,
+    floor: float,
+    rules: BorderRules,
+) -> np.ndarray:
+    """``labels`` (HxW int, 0 = none) with the outline and foot pixels that continue a segment given its label (see
+    the module docstring). ``points`` is the HxWx3 cloud of the same pixels, ``candidates`` the pixels the
+    segmentation could label, ``plane`` the supporting plane (unit normal toward the camera) and ``floor`` the height
+    above it below which a point counts as the plane's (its noise, :func:`plane_noise`)."""
+    occupied = (labels > 0).view(np.uint8)
+    if not cv2.countNonZero(occupied):
+        return labels
     claimed = labels.copy()
-    claimed.reshape(-1)[open_[smooth]] = flat_labels[beside[smooth]]
+    outline = np.zeros(0, dtype=np.int64)
+    for _ in range(rules.outline_rounds):
+        ring = cv2.dilate((claimed > 0).view(np.uint8), _CROSS).view(bool)
+        ring &= candidates
+        ring &= claimed == 0
+        outline = np.flatnonzero(ring)
+        if _claim_outline(claimed, points, outline, rules).size == 0:
+            break
+    reach = _foot_reach(points, outline, rules.min_height)
+    if reach > 0:
+        _claim_foot(claimed, points, candidates, np.asarray(plane, dtype=np.float64), floor, rules, reach)
     return claimed
