@@ -194,14 +194,14 @@ def full_resolution_segments(
     mask: np.ndarray,
     model: np.ndarray,
     p: ClusterParameters,
-    refine: Callable[[np.ndarray, np.ndarray, np.ndarray], np.ndarray] | None = None,
+    refine: Callable[[np.ndarray, np.ndarray, np.ndarray, np.ndarray], np.ndarray] | None = None,
 ) -> list[Segment]:
     """Segments on the full grid from coarse labels of the region ``box`` (coarse pixels, x1/y1 exclusive).
 
     A pixel takes the label of its coarse cell when it is a candidate itself and lies on the same surface as
     the cell's sample (no depth jump), so silhouettes do not bleed onto what is behind them. ``refine(labels,
-    points, candidates)``, when given, revises the full-resolution labels of the region before the segments are cut
-    (HxW labels, HxWx3 points and HxW candidate mask of the region).
+    points, heights, candidates)``, when given, revises the full-resolution labels of the region before the segments
+    are cut (HxW labels, HxWx3 points, HxW heights above the plane and candidate mask of the region).
     """
     rows, cols = mask.shape
     x0, y0, x1, y1 = box
@@ -212,10 +212,11 @@ def full_resolution_segments(
     sampled_depth = np.repeat(np.repeat(coarse_depth, step, axis=0), step, axis=1)[:height, :width]
     fine_points = points[fy0:fy1, fx0:fx1]
     same_surface = ~depth_jump(fine_points[..., 2], sampled_depth, p.jump_absolute, p.jump_relative)
-    candidates = _candidates(fine_points, mask[fy0:fy1, fx0:fx1], model, p)
+    heights = plane_distances(fine_points, model)
+    candidates = _between_heights(heights, mask[fy0:fy1, fx0:fx1], p)
     fine = fine * (candidates & same_surface)
     if refine is not None:
-        fine = refine(fine, fine_points, candidates)
+        fine = refine(fine, fine_points, heights, candidates)
     sizes = np.bincount(fine.reshape(-1))
     kept = [label for label in range(1, sizes.size) if sizes[label] >= p.min_points]
     boxes = ndimage.find_objects(fine)
@@ -235,7 +236,11 @@ def full_resolution_segments(
 
 def _candidates(points: np.ndarray, mask: np.ndarray, model: np.ndarray, p: ClusterParameters) -> np.ndarray:
     """Points of interest between ``min_height`` and ``max_height`` above the plane."""
-    heights = plane_distances(points, model)
+    return _between_heights(plane_distances(points, model), mask, p)
+
+
+def _between_heights(heights: np.ndarray, mask: np.ndarray, p: ClusterParameters) -> np.ndarray:
+    """The pixels of ``mask`` whose ``heights`` above the plane lie between ``min_height`` and ``max_height``."""
     with np.errstate(invalid="ignore"):
         return mask & (heights > p.min_height) & (heights < p.max_height)
 

@@ -101,7 +101,7 @@ class ClutterParameters(ClusterParameters):
             smooth_degrees=self.smooth_degrees,
             crease=self.convexity,
             min_height=self.min_height,
-            outline_rounds=step - 1,
+            stride=step,
         )
 
     def merge_rules(self) -> MergeRules:
@@ -152,7 +152,7 @@ def segment_clutter(
     refine = None
     if p.claim_borders:
         floor = plane_noise(points, model, plane_indices)
-        refine = partial(claim_border_pixels, plane=model, floor=floor, rules=p.border_rules())
+        refine = partial(claim_border_pixels, plane=model, floor=floor, coarse_normals=normals, rules=p.border_rules())
     return full_resolution_segments(labels, depth, (x0, y0, x1, y1), step, points, mask, model, p, refine)
 
 

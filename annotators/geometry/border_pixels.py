@@ -55,7 +55,8 @@ class BorderRules:
     than ``jump_absolute + jump_relative * nearer depth`` (metres); normals are spanned by the points
     ``normal_step`` pixels away and continue a surface when they differ by at most ``smooth_degrees`` or bend
     convexly (a concave crease bends by less than ``-crease``, as between touching parts); candidates start
-    ``min_height`` above the plane; ``outline_rounds`` is how wide the lost outline can be (``stride - 1``)."""
+    ``min_height`` above the plane; the segmentation labels every ``stride``-th pixel, so the outline it loses is
+    up to ``stride - 1`` pixels wide."""
 
     jump_absolute: float
     jump_relative: float
@@ -63,20 +64,30 @@ class BorderRules:
     smooth_degrees: float
     crease: float
     min_height: float
-    outline_rounds: int
+    stride: int
 
 
-def _neighbours(pixels: np.ndarray, shape: tuple[int, ...]) -> list[tuple[np.ndarray, np.ndarray]]:
-    """For the left, right, upper and lower 4-neighbour of the flat ``pixels`` on a grid of ``shape``: which lie on
-    the grid (bool) and their flat indices (0 where off the grid)."""
+def _neighbours(pixels: np.ndarray, shape: tuple[int, ...], step: int = 1) -> tuple[np.ndarray, np.ndarray]:
+    """The left, right, upper and lower neighbours ``step`` pixels away of the flat ``pixels`` on a grid of
+    ``shape``: Nx4 flat indices (0 where off the grid) and Nx4 bool, which lie on the grid."""
     height, width = shape[:2]
-    rows, cols = pixels // width, pixels % width
-    found = []
-    for step_row, step_col in _NEIGHBOURS:
-        row, col = rows + step_row, cols + step_col
-        inside = (row >= 0) & (row < height) & (col >= 0) & (col < width)
-        found.append((inside, np.where(inside, pixels + step_row * width + step_col, 0)))
-    return found
+    rows, cols = (pixels // width)[:, None], (pixels % width)[:, None]
+    row_steps = np.array([[0, 0, -step, step]])
+    col_steps = np.array([[-step, step, 0, 0]])
+    inside = (rows + row_steps >= 0) & (rows + row_steps < height) & (cols + col_steps >= 0)
+    inside &= cols + col_steps < width
+    neighbours = pixels[:, None] + (row_steps * width + col_steps)
+    neighbours[~inside] = 0
+    return neighbours, inside
+
+
+def _on_surface(flat_points: np.ndarray, pixels: np.ndarray, neighbours: np.ndarray, rules: BorderRules) -> np.ndarray:
+    """NxK bool: which ``neighbours`` (NxK flat indices) of the ``pixels`` are measured and on their surface."""
+    with np.errstate(invalid="ignore"):
+        other = flat_points[neighbours, 2]
+        return ~depth_jump(flat_points[pixels, 2][:, None], other, rules.jump_absolute, rules.jump_relative) & (
+            np.isfinite(other)
+        )
 
 
 def normals_at(points: np.ndarray, pixels: np.ndarray, rules: BorderRules) -> np.ndarray:
@@ -85,25 +96,14 @@ def normals_at(points: np.ndarray, pixels: np.ndarray, rules: BorderRules) -> np
     Each axis is spanned by the points ``rules.normal_step`` pixels to either side, or by the pixel itself and the
     one side on its own surface (no depth jump) at an outline; NaN where neither side is on its surface.
     """
-    height, width = points.shape[:2]
     flat = points.reshape(-1, 3)
+    neighbours, inside = _neighbours(pixels, points.shape, rules.normal_step)
+    same = inside & _on_surface(flat, pixels, neighbours, rules)
     centre = flat[pixels]
-    rows, cols = pixels // width, pixels % width
-    spans = []
-    for step_row, step_col in ((0, 1), (1, 0)):
-        ends = []
-        for sign in (1, -1):
-            row, col = rows + sign * step_row * rules.normal_step, cols + sign * step_col * rules.normal_step
-            inside = (row >= 0) & (row < height) & (col >= 0) & (col < width)
-            other = flat[np.where(inside, row * width + col, 0)]
-            with np.errstate(invalid="ignore"):
-                same = inside & ~depth_jump(centre[:, 2], other[:, 2], rules.jump_absolute, rules.jump_relative)
-            same &= np.isfinite(other[:, 2])
-            ends.append((np.where(same[:, None], other, centre), same))
-        (forward, forward_ok), (backward, backward_ok) = ends
-        spans.append(np.where((forward_ok | backward_ok)[:, None], forward - backward, np.nan))
-    (ux, uy, uz), (vx, vy, vz) = spans[0].T, spans[1].T
-    normals = np.column_stack([uy * vz - uz * vy, uz * vx - ux * vz, ux * vy - uy * vx])
+    ends = np.where(same[..., None], flat[neighbours], centre[:, None, :])  # Nx4x3: left, right, up, down
+    spans = ends[:, 1::2] - ends[:, 0::2]  # Nx2x3: left to right, up to down
+    spans[~(same[:, 0::2] | same[:, 1::2])] = np.nan
+    normals = np.cross(spans[:, 0], spans[:, 1])
     with np.errstate(invalid="ignore", divide="ignore"):
         normals /= np.sqrt(np.einsum("ij,ij->i", normals, normals))[:, None]
         away = np.einsum("ij,ij->i", normals, centre) > 0
@@ -123,22 +123,17 @@ def plane_noise(points: np.ndarray, plane: np.ndarray, plane_indices: np.ndarray
 
 def _claim_outline(labels: np.ndarray, points: np.ndarray, open_: np.ndarray, rules: BorderRules) -> np.ndarray:
     """Give each pixel of ``open_`` (flat indices of unlabelled pixels) the label of the one segment whose surface
-    it continues, in place; returns the pixels claimed."""
+    it continues, in place; returns the pixels claimed. Normals are estimated at the pixels themselves: along an
+    outline the grid's are unknown (a depth jump lies within their span)."""
     flat_labels, flat_points = labels.reshape(-1), points.reshape(-1, 3)
-    depth = flat_points[open_, 2]
-    lowest = np.full(open_.size, np.iinfo(np.int64).max, dtype=np.int64)
-    highest = np.zeros(open_.size, dtype=np.int64)
-    beside = np.full(open_.size, -1, dtype=np.int64)  # the first labelled neighbour on the pixel's surface
-    for inside, neighbour in _neighbours(open_, labels.shape):
-        label = np.where(inside, flat_labels[neighbour], 0).astype(np.int64)
-        with np.errstate(invalid="ignore"):
-            jump = depth_jump(depth, flat_points[neighbour, 2], rules.jump_absolute, rules.jump_relative)
-        on_surface = (label > 0) & ~jump
-        lowest = np.where(on_surface, np.minimum(lowest, label), lowest)
-        highest = np.where(on_surface, np.maximum(highest, label), highest)
-        beside = np.where(on_surface & (beside < 0), neighbour, beside)
+    neighbours, inside = _neighbours(open_, labels.shape)
+    label = np.where(inside, flat_labels[neighbours], 0)
+    on_surface = (label > 0) & _on_surface(flat_points, open_, neighbours, rules)
+    highest = np.where(on_surface, label, 0).max(axis=1)
+    lowest = np.where(on_surface, label, np.iinfo(label.dtype).max).min(axis=1)
     one = (highest > 0) & (lowest == highest)
-    open_, beside = open_[one], beside[one]
+    beside = neighbours[one, np.argmax(on_surface[one], axis=1)]  # the first labelled neighbour on its surface
+    open_ = open_[one]
     if open_.size == 0:
         return open_
     normals = normals_at(points, np.concatenate([open_, beside]), rules)
@@ -151,6 +146,13 @@ def _claim_outline(labels: np.ndarray, points: np.ndarray, open_: np.ndarray, ru
     claimed = open_[continues]
     flat_labels[claimed] = flat_labels[beside[continues]]
     return claimed
+
+
+def _sampled(coarse: np.ndarray, pixels: np.ndarray, width: int, stride: int) -> np.ndarray:
+    """Nx3: the values of the HxWx3 ``coarse`` grid (every ``stride``-th pixel) at the cells of the flat ``pixels``
+    of a full-resolution grid ``width`` pixels wide."""
+    rows, cols = pixels // width // stride, pixels % width // stride
+    return coarse.reshape(-1, 3)[rows * coarse.shape[1] + cols]
 
 
 def _foot_reach(points: np.ndarray, pixels: np.ndarray, min_height: float) -> int:
@@ -173,9 +175,11 @@ def _foot_reach(points: np.ndarray, pixels: np.ndarray, min_height: float) -> in
 def _claim_foot(
     labels: np.ndarray,
     points: np.ndarray,
+    heights: np.ndarray,
     candidates: np.ndarray,
     plane: np.ndarray,
     floor: float,
+    coarse_normals: np.ndarray,
     rules: BorderRules,
     reach: int,
 ) -> None:
@@ -191,39 +195,35 @@ def _claim_foot(
     near = cv2.dilate((labels > 0).view(np.uint8), kernel).view(bool)
     near &= labels == 0
     near &= ~candidates
+    with np.errstate(invalid="ignore"):
+        near &= heights > floor
+        near &= heights < rules.min_height
     pixels = np.flatnonzero(near)
     flat_points, flat_labels = points.reshape(-1, 3), labels.reshape(-1)
-    with np.errstate(invalid="ignore"):
-        heights = flat_points[pixels] @ plane[:3].astype(points.dtype) + points.dtype.type(plane[3])
-        pixels = pixels[(heights > floor) & (heights < rules.min_height)]
     if pixels.size == 0:
         return
-    normals = normals_at(points, pixels, rules)
     smooth_cosine = np.cos(np.radians(rules.smooth_degrees))
+    normals = _sampled(coarse_normals, pixels, labels.shape[1], rules.stride)
     with np.errstate(invalid="ignore"):
         facing_away = np.abs(normals @ plane[:3]) < smooth_cosine
     pixels, normals = pixels[facing_away], normals[facing_away]
     if pixels.size == 0:
         return
-    depth = flat_points[pixels, 2]
-    links, contacts = [], []
-    for inside, neighbour in _neighbours(pixels, labels.shape):
-        with np.errstate(invalid="ignore"):
-            on_surface = inside & ~depth_jump(
-                depth, flat_points[neighbour, 2], rules.jump_absolute, rules.jump_relative
-            )
-        other = np.minimum(np.searchsorted(pixels, neighbour), pixels.size - 1)  # pixels are sorted
-        between_feet = on_surface & (pixels[other] == neighbour) & (other > np.arange(pixels.size))
-        links.append(np.flatnonzero(between_feet))
-        links.append(other[between_feet])
-        touching = np.flatnonzero(on_surface & (flat_labels[neighbour] > 0))
-        contacts.append(np.column_stack([touching, neighbour[touching]]))
-    feet = np.column_stack([np.concatenate(links[0::2]), np.concatenate(links[1::2])])
-    touches = np.concatenate(contacts)
-    theirs = normals_at(points, touches[:, 1], rules)
+    neighbours, inside = _neighbours(pixels, labels.shape)
+    on_surface = inside & _on_surface(flat_points, pixels, neighbours, rules)
+    # links between two foot pixels (each once), and from a foot pixel to a segment pixel it touches
+    other = np.minimum(np.searchsorted(pixels, neighbours), pixels.size - 1)  # pixels are sorted
+    node = np.broadcast_to(np.arange(pixels.size)[:, None], other.shape)
+    between_feet = on_surface & (pixels[other] == neighbours) & (other > node)
+    touching = on_surface & (flat_labels[neighbours] > 0)
+    first, second = node[between_feet], other[between_feet]
+    touching_node, segment_pixels = node[touching], neighbours[touching]
+    theirs = _sampled(coarse_normals, segment_pixels, labels.shape[1], rules.stride)
     with np.errstate(invalid="ignore"):
-        feet = feet[np.einsum("ij,ij->i", normals[feet[:, 0]], normals[feet[:, 1]]) >= smooth_cosine]
-        touches = touches[np.einsum("ij,ij->i", normals[touches[:, 0]], theirs) >= smooth_cosine]
+        linked = np.einsum("ij,ij->i", normals[first], normals[second]) >= smooth_cosine
+        touches = np.einsum("ij,ij->i", normals[touching_node], theirs) >= smooth_cosine
+    feet = np.column_stack([first[linked], second[linked]])
+    touches = np.column_stack([touching_node[touches], segment_pixels[touches]])
     if touches.size == 0:
         return
     segment_node = pixels.size + flat_labels[touches[:, 1]].astype(np.int64)
@@ -241,22 +241,26 @@ def _claim_foot(
 def claim_border_pixels(
     labels: np.ndarray,
     points: np.ndarray,
+    heights: np.ndarray,
     candidates: np.ndarray,
     *,
     plane: np.ndarray,
     floor: float,
+    coarse_normals: np.ndarray,
     rules: BorderRules,
 ) -> np.ndarray:
     """``labels`` (HxW int, 0 = none) with the outline and foot pixels that continue a segment given its label (see
-    the module docstring). ``points`` is the HxWx3 cloud of the same pixels, ``candidates`` the pixels the
-    segmentation could label, ``plane`` the supporting plane (unit normal toward the camera) and ``floor`` the height
-    above it below which a point counts as the plane's (its noise, :func:`plane_noise`)."""
+    the module docstring). ``points`` is the HxWx3 cloud of the same pixels, ``heights`` their heights above the
+    plane (NaN where unmeasured), ``candidates`` the pixels the segmentation could label, ``plane`` the supporting
+    plane (unit normal toward the camera) and ``floor`` the height above it below which a point counts as the
+    plane's (its noise, :func:`plane_noise`); ``coarse_normals`` are the segmentation's normals on every
+    ``rules.stride``-th pixel (the foot's pixels take their cell's)."""
     occupied = (labels > 0).view(np.uint8)
     if not cv2.countNonZero(occupied):
         return labels
     claimed = labels.copy()
     outline = np.zeros(0, dtype=np.int64)
-    for _ in range(rules.outline_rounds):
+    for _ in range(rules.stride - 1):
         ring = cv2.dilate((claimed > 0).view(np.uint8), _CROSS).view(bool)
         ring &= candidates
         ring &= claimed == 0
@@ -265,5 +269,6 @@ def claim_border_pixels(
             break
     reach = _foot_reach(points, outline, rules.min_height)
     if reach > 0:
-        _claim_foot(claimed, points, candidates, np.asarray(plane, dtype=np.float64), floor, rules, reach)
+        plane = np.asarray(plane, dtype=np.float64)
+        _claim_foot(claimed, points, heights, candidates, plane, floor, coarse_normals, rules, reach)
     return claimed
