@@ -31,8 +31,6 @@ from dataclasses import dataclass
 
 import cv2
 import numpy as np
-from scipy import sparse
-from scipy.sparse import csgraph
 
 from annotators.geometry.grid_segmentation import depth_jump
 
@@ -71,7 +69,7 @@ def _neighbours(pixels: np.ndarray, shape: tuple[int, ...], step: int = 1) -> tu
     """The left, right, upper and lower neighbours ``step`` pixels away of the flat ``pixels`` on a grid of
     ``shape``: Nx4 flat indices (0 where off the grid) and Nx4 bool, which lie on the grid."""
     height, width = shape[:2]
-    rows, cols = (pixels // width)[:, None], (pixels % width)[:, None]
+    rows, cols = np.divmod(pixels[:, None], width)
     row_steps = np.array([[0, 0, -step, step]])
     col_steps = np.array([[-step, step, 0, 0]])
     inside = (rows + row_steps >= 0) & (rows + row_steps < height) & (cols + col_steps >= 0)
@@ -103,7 +101,8 @@ def normals_at(points: np.ndarray, pixels: np.ndarray, rules: BorderRules) -> np
     ends = np.where(same[..., None], flat[neighbours], centre[:, None, :])  # Nx4x3: left, right, up, down
     spans = ends[:, 1::2] - ends[:, 0::2]  # Nx2x3: left to right, up to down
     spans[~(same[:, 0::2] | same[:, 1::2])] = np.nan
-    normals = np.cross(spans[:, 0], spans[:, 1])
+    (ux, uy, uz), (vx, vy, vz) = spans[:, 0].T, spans[:, 1].T
+    normals = np.column_stack([uy * vz - uz * vy, uz * vx - ux * vz, ux * vy - uy * vx])
     with np.errstate(invalid="ignore", divide="ignore"):
         normals /= np.sqrt(np.einsum("ij,ij->i", normals, normals))[:, None]
         away = np.einsum("ij,ij->i", normals, centre) > 0
@@ -186,10 +185,10 @@ def _claim_foot(
     """Give the foot pixels within ``reach`` pixels of a segment that continue a segment the label of the nearest
     such segment, in place.
 
-    The foot pixels facing away from the plane are the nodes of a graph, with one node per segment besides:
-    4-neighbours are linked when no depth jump lies between them and their normals are within the smoothness angle,
-    and a pixel and a segment it touches the same way. One breadth-first search from all segments at once finds
-    each pixel's nearest segment.
+    The foot pixels facing away from the plane are the nodes of a graph: 4-neighbours are linked when no depth
+    jump lies between them and their normals are within the smoothness angle, and a pixel touching a segment the
+    same way starts with its label. A breadth-first search from all of them at once, at most ``reach`` links deep
+    (the foot spans no more), gives every pixel reached the label of its nearest start.
     """
     kernel = np.ones((2 * reach + 1, 2 * reach + 1), dtype=np.uint8)
     near = cv2.dilate((labels > 0).view(np.uint8), kernel).view(bool)
@@ -211,31 +210,39 @@ def _claim_foot(
         return
     neighbours, inside = _neighbours(pixels, labels.shape)
     on_surface = inside & _on_surface(flat_points, pixels, neighbours, rules)
-    # links between two foot pixels (each once), and from a foot pixel to a segment pixel it touches
+    # links between neighbouring foot pixels, and contacts of foot pixels with the segment pixels they touch
     other = np.minimum(np.searchsorted(pixels, neighbours), pixels.size - 1)  # pixels are sorted
-    node = np.broadcast_to(np.arange(pixels.size)[:, None], other.shape)
-    between_feet = on_surface & (pixels[other] == neighbours) & (other > node)
+    linked = on_surface & (pixels[other] == neighbours)
     touching = on_surface & (flat_labels[neighbours] > 0)
-    first, second = node[between_feet], other[between_feet]
+    node = np.broadcast_to(np.arange(pixels.size)[:, None], other.shape)
+    first, second = node[linked], other[linked]
     touching_node, segment_pixels = node[touching], neighbours[touching]
     theirs = _sampled(coarse_normals, segment_pixels, labels.shape[1], rules.stride)
     with np.errstate(invalid="ignore"):
-        linked = np.einsum("ij,ij->i", normals[first], normals[second]) >= smooth_cosine
+        linked[linked] = np.einsum("ij,ij->i", normals[first], normals[second]) >= smooth_cosine
         touches = np.einsum("ij,ij->i", normals[touching_node], theirs) >= smooth_cosine
-    feet = np.column_stack([first[linked], second[linked]])
-    touches = np.column_stack([touching_node[touches], segment_pixels[touches]])
-    if touches.size == 0:
-        return
-    segment_node = pixels.size + flat_labels[touches[:, 1]].astype(np.int64)
-    edges = np.concatenate([feet, np.column_stack([touches[:, 0], segment_node])])
-    size = pixels.size + int(segment_node.max()) + 1
-    graph = sparse.csr_matrix((np.ones(edges.shape[0]), (edges[:, 0], edges[:, 1])), shape=(size, size))
-    _, _, nearest = csgraph.dijkstra(
-        graph, directed=False, indices=np.unique(segment_node), unweighted=True, min_only=True, return_predecessors=True
-    )
-    nearest = nearest[: pixels.size]
-    reached = nearest >= 0
-    flat_labels[pixels[reached]] = nearest[reached] - pixels.size
+    label = np.zeros(pixels.size, dtype=flat_labels.dtype)
+    label[touching_node[touches]] = flat_labels[segment_pixels[touches]]
+    _spread(label, other, linked, reach)
+    reached = label > 0
+    flat_labels[pixels[reached]] = label[reached]
+
+
+def _spread(label: np.ndarray, other: np.ndarray, linked: np.ndarray, rounds: int) -> None:
+    """Breadth-first, in place, for at most ``rounds`` links: each unlabelled node takes the label of a linked node
+    one round after it got one (``other`` Nx4 node indices, ``linked`` Nx4 bool, symmetric), so every node reached
+    ends up with the label of a nearest labelled node."""
+    frontier = np.flatnonzero(label)
+    for _ in range(rounds):
+        if frontier.size == 0:
+            break
+        links = linked[frontier]
+        source = np.repeat(frontier, np.count_nonzero(links, axis=1))
+        target = other[frontier][links]
+        fresh = label[target] == 0
+        source, target = source[fresh], target[fresh]
+        label[target] = label[source]
+        frontier = np.unique(target)
 
 
 def claim_border_pixels(
