@@ -201,7 +201,8 @@ def full_resolution_segments(
     A pixel takes the label of its coarse cell when it is a candidate itself and lies on the same surface as
     the cell's sample (no depth jump), so silhouettes do not bleed onto what is behind them. ``refine(labels,
     points, heights, candidates)``, when given, revises the full-resolution labels of the region before the segments
-    are cut (HxW labels, HxWx3 points, HxW heights above the plane and candidate mask of the region).
+    are cut (HxW labels, HxWx3 points, HxW heights above the plane and candidate mask of the region); which
+    segments are large enough (``min_points``) is judged before, so refining never adds one.
     """
     rows, cols = mask.shape
     x0, y0, x1, y1 = box
@@ -215,10 +216,10 @@ def full_resolution_segments(
     heights = plane_distances(fine_points, model)
     candidates = _between_heights(heights, mask[fy0:fy1, fx0:fx1], p)
     fine = fine * (candidates & same_surface)
+    sizes = np.bincount(fine.reshape(-1))
+    kept = [label for label in range(1, sizes.size) if sizes[label] >= p.min_points]  # judged before refining
     if refine is not None:
         fine = refine(fine, fine_points, heights, candidates)
-    sizes = np.bincount(fine.reshape(-1))
-    kept = [label for label in range(1, sizes.size) if sizes[label] >= p.min_points]
     boxes = ndimage.find_objects(fine)
     masks = np.zeros((len(kept), rows, cols), dtype=bool)  # one allocation for all masks
     segments = []
