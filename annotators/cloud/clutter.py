@@ -14,8 +14,9 @@ Works like :mod:`annotators.cloud.clusters` on every ``stride``-th pixel of the 
    standing flush on a can is one convex surface but two colours with a crease between);
 5. pieces that an occluder in front splits apart join when they continue one plane behind it
    (:func:`annotators.geometry.occlusion.join_occluded`);
-6. at full resolution, the outline pixels the coarse grid left unlabelled join the one object whose surface they
-   continue (:func:`annotators.geometry.border_pixels.claim_border_pixels`).
+6. at full resolution, the outline pixels the coarse grid left unlabelled and the foot below the candidates'
+   lowest height join the object whose surface they continue
+   (:func:`annotators.geometry.border_pixels.claim_border_pixels`).
 """
 
 from __future__ import annotations
@@ -62,7 +63,7 @@ class ClutterParameters(ClusterParameters):
     coarse pixels, split when their normals spread by more than ``normal_spread``), the grouping
     (:class:`~annotators.geometry.convexity.ConvexityRules`) and the share of a boundary that must be creased for a
     hue edge to split an object (``creased_share``); ``claim_borders`` gives the outline pixels the coarse grid
-    left unlabelled to the object they continue."""
+    left unlabelled and each object's foot (below ``min_height``) to the object they continue."""
 
     jump_relative: float = 0.01
     normal_step: int = 2

@@ -15,14 +15,15 @@ pixel touching two segments on its surface lies between them and stays unlabelle
 ``stride - 1`` rounds.
 
 Foot pixels must stand out of the plane's noise (higher than 95 % of the plane's own inliers lie off it,
-:func:`plane_noise`) and face away from the plane (a normal more than the smoothness angle off the plane's): the
-plane itself and what lies flat on it stay out. Linked where they continue one another smoothly (no depth jump,
-normals within the smoothness angle) and to the segments they continue smoothly, they join the segment nearest
-along these links, so the foot running along two touching objects is shared between them.
+:func:`plane_noise`) and face away from the plane (the normal of their cell on the segmentation's grid more than the
+smoothness angle off the plane's): the plane itself and what lies flat on it stay out. Linked where they continue
+one another smoothly (no depth jump, normals within the smoothness angle) and to the segments they continue
+smoothly, they join the segment nearest along these links (a breadth-first search at most as many links deep as
+``min_height`` spans pixels at the segments' nearest depth), so the foot running along two touching objects is
+shared between them.
 
-Only the pixels within reach of a segment are examined (the foot within the pixels ``min_height`` spans at the
-segments' nearest depth), normals are estimated only there, and the foot is one graph search, so the step costs
-little beside the segmentation.
+Only the pixels within that reach of a segment are examined and normals are estimated only at the outline's pixels,
+so the step costs little beside the segmentation.
 """
 
 from __future__ import annotations
