@@ -275,7 +275,8 @@ def claim_border_pixels(
         outline = np.flatnonzero(ring)
         if _claim_outline(claimed, points, outline, rules).size == 0:
             break
-    reach = _foot_reach(points, outline, rules.min_height)
+    # the reach of the foot at the depths of the segments' outline (their own pixels when no outline was examined)
+    reach = _foot_reach(points, outline if outline.size else np.flatnonzero(occupied), rules.min_height)
     if reach > 0:
         plane = np.asarray(plane, dtype=np.float64)
         _claim_foot(claimed, points, heights, candidates, plane, floor, coarse_normals, rules, reach)
