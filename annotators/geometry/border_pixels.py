@@ -44,7 +44,7 @@ _NEIGHBOURS: tuple[tuple[int, int], ...] = ((0, -1), (0, 1), (-1, 0), (1, 0))
 NOISE_SHARE = 0.95
 """The share of the plane's inliers that lie closer to it than its noise level (:func:`plane_noise`)."""
 
-SAMPLE = 2000
+SAMPLE = 500
 """At most this many points are read to measure the plane's noise or the pixel pitch."""
 
 
@@ -267,6 +267,7 @@ def claim_border_pixels(
     if not cv2.countNonZero(occupied):
         return labels
     claimed = labels.copy()
+    points = np.ascontiguousarray(points)  # one copy of a window's points, so that every flat view is free
     outline = np.zeros(0, dtype=np.int64)
     for _ in range(rules.stride - 1):
         ring = cv2.dilate((claimed > 0).view(np.uint8), _CROSS).view(bool)
