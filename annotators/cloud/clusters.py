@@ -50,7 +50,8 @@ from robokudo.core.types import CasType, ObjectHypothesis, Plane, PointCloud
 
 @dataclass(frozen=True, eq=False)
 class Segment:
-    """One cluster on the grid: flat point indices, an HxW mask and the ROI (x1/y1 exclusive)."""
+    """One cluster on the grid: flat point indices, an HxW mask and the ROI (x1/y1 exclusive). The mask may hold
+    border pixels beyond the points (see :func:`full_resolution_segments`)."""
 
     indices: np.ndarray
     mask: np.ndarray
@@ -201,8 +202,11 @@ def full_resolution_segments(
     A pixel takes the label of its coarse cell when it is a candidate itself and lies on the same surface as
     the cell's sample (no depth jump), so silhouettes do not bleed onto what is behind them. ``refine(labels,
     points, heights, candidates)``, when given, revises the full-resolution labels of the region before the segments
-    are cut (HxW labels, HxWx3 points, HxW heights above the plane and candidate mask of the region); which
-    segments are large enough (``min_points``) is judged before, so refining never adds one.
+    are cut (HxW labels, HxWx3 points, HxW heights above the plane and candidate mask of the region): the pixels
+    it adds join the segments' masks and ROIs (their image regions) but not their point indices, so the 3-D experts
+    measure the points the segmentation labelled itself, away from the mixed pixels of an outline and the band
+    where an object meets the plane. Which segments are large enough (``min_points``) is judged before refining,
+    so refining never adds one.
     """
     rows, cols = mask.shape
     x0, y0, x1, y1 = box
@@ -218,6 +222,7 @@ def full_resolution_segments(
     fine = fine * (candidates & same_surface)
     sizes = np.bincount(fine.reshape(-1))
     kept = [label for label in range(1, sizes.size) if sizes[label] >= p.min_points]  # judged before refining
+    core = fine  # the pixels the segmentation labelled itself: the point indices
     if refine is not None:
         fine = refine(fine, fine_points, heights, candidates)
     boxes = ndimage.find_objects(fine)
@@ -228,7 +233,7 @@ def full_resolution_segments(
         own = fine[box_rows, box_cols] == label
         top, left = box_rows.start + fy0, box_cols.start + fx0
         object_mask[top : box_rows.stop + fy0, left : box_cols.stop + fx0] = own
-        r, c = np.nonzero(own)
+        r, c = np.nonzero(core[box_rows, box_cols] == label)
         roi = (left, top, box_cols.stop + fx0, box_rows.stop + fy0)
         segments.append(Segment(indices=(r + top) * cols + c + left, mask=object_mask, roi=roi))
     segments.sort(key=lambda s: -s.indices.size)
