@@ -4,7 +4,8 @@ and foot pixels the clutter segmenter's coarse grid and height cut leave unlabel
 learn0 (two stacked cereal boxes) is from the categories the segmenter was tuned on; learn30 (occluded objects) and
 learn36 (a bowl, a tub and a tin) are held out. On each, the masks with the step are compared with the masks the
 same segmenter gives without it: the overlap F-measure of the masks rises, the pixels added belong to the object
-they were given to, and the same objects are found.
+they were given to, the same objects are found, and their point indices (what the 3-D experts measure) stay the
+same.
 """
 
 from __future__ import annotations
@@ -34,22 +35,25 @@ MIN_RISE = 0.005
 loses is about 1 % of a mask, the foot below the candidates' lowest height 2 %)."""
 
 
-def segment(path: Path, claim_borders: bool) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
-    """Segment labels, ground-truth object labels and measured pixels of one labelled scene."""
+def segment(path: Path, claim_borders: bool) -> tuple[np.ndarray, np.ndarray, np.ndarray, list[np.ndarray]]:
+    """Segment labels (of the masks), ground-truth object labels, measured pixels and the hypotheses' point indices
+    (sorted, largest hypothesis first) of one labelled scene."""
     reader = PcdReader(path)
     segmenter = ClutterSegmenter(claim_borders=claim_borders)
     root = Pipeline("border", [reader, RangeFilter(min_depth=0.2, max_depth=2.5), SupportPlaneSegmenter(), segmenter])
     assert Engine(root).tick() is Status.SUCCESS
     frame = reader.last_frame
-    labels = hypothesis_labels(root.cas.annotations(ObjectHypothesis), frame.depth.shape)
-    return labels, object_labels(frame.labels), np.isfinite(frame.points[..., 2])
+    hypotheses = root.cas.annotations(ObjectHypothesis)
+    labels = hypothesis_labels(hypotheses, frame.depth.shape)
+    indices = [np.sort(h.point_indices) for h in sorted(hypotheses, key=lambda h: -h.point_indices.size)]
+    return labels, object_labels(frame.labels), np.isfinite(frame.points[..., 2]), indices
 
 
 @pytest.mark.parametrize("scene", ["learn0", "learn30", "learn36"])
 def test_border_pixels_join_their_object_and_raise_the_mask_f_measure(shared_data: Path, scene: str) -> None:
     path = require_folder(shared_data / "pcl_mosd_tabletop" / "learn") / f"{scene}.pcd"
-    before, truth, measured = segment(path, claim_borders=False)
-    after, _, _ = segment(path, claim_borders=True)
+    before, truth, measured, points_before = segment(path, claim_borders=False)
+    after, _, _, points_after = segment(path, claim_borders=True)
 
     # the same objects, each mask only grown
     assert after.max() == before.max()
@@ -67,3 +71,6 @@ def test_border_pixels_join_their_object_and_raise_the_mask_f_measure(shared_dat
     assert score_after.overlap_f >= score_before.overlap_f + MIN_RISE, (score_before, score_after)
     assert score_after.overlap_recall > score_before.overlap_recall
     assert score_after.matched == score_before.matched == score_after.objects
+    # the 3-D experts measure the same points: the border joins the masks only
+    assert len(points_after) == len(points_before)
+    assert all(np.array_equal(a, b) for a, b in zip(points_after, points_before, strict=True))
