@@ -233,17 +233,19 @@ def _spread(label: np.ndarray, other: np.ndarray, linked: np.ndarray, rounds: in
     """Breadth-first, in place, for at most ``rounds`` links: each unlabelled node takes the label of a linked node
     one round after it got one (``other`` Nx4 node indices, ``linked`` Nx4 bool, symmetric), so every node reached
     ends up with the label of a nearest labelled node."""
+    size = label.size
+    targets = np.where(linked, other, size)  # node ``size`` is a sentinel that counts as labelled
+    labels = np.append(label, np.ones(1, dtype=label.dtype))
     frontier = np.flatnonzero(label)
     for _ in range(rounds):
-        if frontier.size == 0:
+        reached = targets[frontier]
+        fresh = labels[reached] == 0
+        if not fresh.any():
             break
-        links = linked[frontier]
-        source = np.repeat(frontier, np.count_nonzero(links, axis=1))
-        target = other[frontier][links]
-        fresh = label[target] == 0
-        source, target = source[fresh], target[fresh]
-        label[target] = label[source]
-        frontier = np.unique(target)
+        sources = np.broadcast_to(frontier[:, None], reached.shape)[fresh]
+        frontier = reached[fresh]  # a node reached from several sides appears more than once: harmless
+        labels[frontier] = labels[sources]
+    label[:] = labels[:size]
 
 
 def claim_border_pixels(
