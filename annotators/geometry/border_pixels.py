@@ -23,7 +23,8 @@ smoothly, they join the segment nearest along these links (a breadth-first searc
 shared between them.
 
 Only the pixels within that reach of a segment are examined and normals are estimated only at the outline's pixels,
-so the step costs little beside the segmentation.
+so the step's cost grows with the length of the outlines and the area of the feet, not with the frame
+(``bench/bench_border_pixels.py``).
 """
 
 from __future__ import annotations
