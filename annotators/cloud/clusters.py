@@ -20,6 +20,7 @@ Each hypothesis gets its flat point indices, an image mask and the ROI ``(x0, y0
 
 from __future__ import annotations
 
+from collections.abc import Callable
 from dataclasses import dataclass
 from typing import ClassVar
 
@@ -49,7 +50,8 @@ from robokudo.core.types import CasType, ObjectHypothesis, Plane, PointCloud
 
 @dataclass(frozen=True, eq=False)
 class Segment:
-    """One cluster on the grid: flat point indices, an HxW mask and the ROI (x1/y1 exclusive)."""
+    """One cluster on the grid: flat point indices, an HxW mask and the ROI (x1/y1 exclusive). The mask may hold
+    border pixels beyond the points (see :func:`full_resolution_segments`)."""
 
     indices: np.ndarray
     mask: np.ndarray
@@ -193,11 +195,18 @@ def full_resolution_segments(
     mask: np.ndarray,
     model: np.ndarray,
     p: ClusterParameters,
+    refine: Callable[[np.ndarray, np.ndarray, np.ndarray, np.ndarray], np.ndarray] | None = None,
 ) -> list[Segment]:
     """Segments on the full grid from coarse labels of the region ``box`` (coarse pixels, x1/y1 exclusive).
 
     A pixel takes the label of its coarse cell when it is a candidate itself and lies on the same surface as
-    the cell's sample (no depth jump), so silhouettes do not bleed onto what is behind them.
+    the cell's sample (no depth jump), so silhouettes do not bleed onto what is behind them. ``refine(labels,
+    points, heights, candidates)``, when given, revises the full-resolution labels of the region before the segments
+    are cut (HxW labels, HxWx3 points, HxW heights above the plane and candidate mask of the region): the pixels
+    it adds join the segments' masks and ROIs (their image regions) but not their point indices, so the 3-D experts
+    measure the points the segmentation labelled itself, away from the mixed pixels of an outline and the band
+    where an object meets the plane. Which segments are large enough (``min_points``) is judged before refining,
+    so refining never adds one.
     """
     rows, cols = mask.shape
     x0, y0, x1, y1 = box
@@ -208,9 +217,14 @@ def full_resolution_segments(
     sampled_depth = np.repeat(np.repeat(coarse_depth, step, axis=0), step, axis=1)[:height, :width]
     fine_points = points[fy0:fy1, fx0:fx1]
     same_surface = ~depth_jump(fine_points[..., 2], sampled_depth, p.jump_absolute, p.jump_relative)
-    fine = fine * (_candidates(fine_points, mask[fy0:fy1, fx0:fx1], model, p) & same_surface)
+    heights = plane_distances(fine_points, model)
+    candidates = _between_heights(heights, mask[fy0:fy1, fx0:fx1], p)
+    fine = fine * (candidates & same_surface)
     sizes = np.bincount(fine.reshape(-1))
-    kept = [label for label in range(1, sizes.size) if sizes[label] >= p.min_points]
+    kept = [label for label in range(1, sizes.size) if sizes[label] >= p.min_points]  # judged before refining
+    core = fine  # the pixels the segmentation labelled itself: the point indices
+    if refine is not None:
+        fine = refine(fine, fine_points, heights, candidates)
     boxes = ndimage.find_objects(fine)
     masks = np.zeros((len(kept), rows, cols), dtype=bool)  # one allocation for all masks
     segments = []
@@ -219,7 +233,7 @@ def full_resolution_segments(
         own = fine[box_rows, box_cols] == label
         top, left = box_rows.start + fy0, box_cols.start + fx0
         object_mask[top : box_rows.stop + fy0, left : box_cols.stop + fx0] = own
-        r, c = np.nonzero(own)
+        r, c = np.nonzero(core[box_rows, box_cols] == label)
         roi = (left, top, box_cols.stop + fx0, box_rows.stop + fy0)
         segments.append(Segment(indices=(r + top) * cols + c + left, mask=object_mask, roi=roi))
     segments.sort(key=lambda s: -s.indices.size)
@@ -228,7 +242,11 @@ def full_resolution_segments(
 
 def _candidates(points: np.ndarray, mask: np.ndarray, model: np.ndarray, p: ClusterParameters) -> np.ndarray:
     """Points of interest between ``min_height`` and ``max_height`` above the plane."""
-    heights = plane_distances(points, model)
+    return _between_heights(plane_distances(points, model), mask, p)
+
+
+def _between_heights(heights: np.ndarray, mask: np.ndarray, p: ClusterParameters) -> np.ndarray:
+    """The pixels of ``mask`` whose ``heights`` above the plane lie between ``min_height`` and ``max_height``."""
     with np.errstate(invalid="ignore"):
         return mask & (heights > p.min_height) & (heights < p.max_height)
 

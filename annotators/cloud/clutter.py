@@ -13,12 +13,16 @@ Works like :mod:`annotators.cloud.clusters` on every ``stride``-th pixel of the 
 4. an object is split along a hue edge only where a concave crease runs along it (:func:`split_by_color`: a can
    standing flush on a can is one convex surface but two colours with a crease between);
 5. pieces that an occluder in front splits apart join when they continue one plane behind it
-   (:func:`annotators.geometry.occlusion.join_occluded`).
+   (:func:`annotators.geometry.occlusion.join_occluded`);
+6. at full resolution, the outline pixels the coarse grid left unlabelled and the foot below the candidates'
+   lowest height join the object whose surface they continue
+   (:func:`annotators.geometry.border_pixels.claim_border_pixels`).
 """
 
 from __future__ import annotations
 
 from dataclasses import dataclass, fields, replace
+from functools import partial
 from typing import ClassVar
 
 import numpy as np
@@ -32,6 +36,7 @@ from annotators.cloud.clusters import (
 )
 from annotators.cloud.normals import grid_normals
 from annotators.cloud.plane import plane_basis
+from annotators.geometry.border_pixels import BorderRules, claim_border_pixels, plane_noise
 from annotators.geometry.convexity import ConvexityRules, convex_groups, dense_labels, grid_patches, split_by_normals
 from annotators.geometry.grid_segmentation import (
     MergeRules,
@@ -57,7 +62,8 @@ class ClutterParameters(ClusterParameters):
     merging), the normals (``normal_step`` / ``normal_smoothing`` coarse pixels), the patches (``cell`` x ``cell``
     coarse pixels, split when their normals spread by more than ``normal_spread``), the grouping
     (:class:`~annotators.geometry.convexity.ConvexityRules`) and the share of a boundary that must be creased for a
-    hue edge to split an object (``creased_share``)."""
+    hue edge to split an object (``creased_share``); ``claim_borders`` gives the outline pixels the coarse grid
+    left unlabelled and each object's foot (below ``min_height``) to the object they continue."""
 
     jump_relative: float = 0.01
     normal_step: int = 2
@@ -78,10 +84,26 @@ class ClutterParameters(ClusterParameters):
     creased_share: float = 0.2
     use_color: bool = True
     complete_occluded: bool = True
+    claim_borders: bool = True
 
     def convexity_rules(self) -> ConvexityRules:
         """The thresholds of :func:`annotators.geometry.convexity.convex_groups`."""
         return ConvexityRules(**{f.name: getattr(self, f.name) for f in fields(ConvexityRules)})
+
+    def border_rules(self) -> BorderRules:
+        """The thresholds of :func:`annotators.geometry.border_pixels.claim_border_pixels` at full resolution: the
+        depth jumps, the span of the normals (``normal_step`` coarse pixels), the smoothness angle, the concave
+        crease of the merge rules, the candidates' lowest height and the outline the ``stride`` grid loses."""
+        step = max(1, self.stride)
+        return BorderRules(
+            jump_absolute=self.jump_absolute,
+            jump_relative=self.jump_relative,
+            normal_step=self.normal_step * step,
+            smooth_degrees=self.smooth_degrees,
+            crease=self.convexity,
+            min_height=self.min_height,
+            stride=step,
+        )
 
     def merge_rules(self) -> MergeRules:
         """The cluster extractor's merge rules with the footprint rule only for parts whose heights nest (a bowl's
@@ -128,7 +150,11 @@ def segment_clutter(
         labels = join_occluded(
             labels, grid, normals, plane_grid.reshape(grid.shape), p.jump_absolute, p.jump_relative, OcclusionRules()
         )
-    return full_resolution_segments(labels, depth, (x0, y0, x1, y1), step, points, mask, model, p)
+    refine = None
+    if p.claim_borders:
+        floor = plane_noise(points, model, plane_indices)
+        refine = partial(claim_border_pixels, plane=model, floor=floor, coarse_normals=normals, rules=p.border_rules())
+    return full_resolution_segments(labels, depth, (x0, y0, x1, y1), step, points, mask, model, p, refine)
 
 
 def split_by_color(
