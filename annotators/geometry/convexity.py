@@ -57,9 +57,16 @@ def split_by_normals(patches: np.ndarray, normals: np.ndarray, spread: float) ->
     for i in range(3):
         for j in range(i, 3):
             second[:, i, j] = second[:, j, i] = np.bincount(labels, centred[i] * centred[j], count) / sizes
-    values, vectors = np.linalg.eigh(second)
-    wide = np.sqrt(np.clip(values.sum(axis=1), 0, None)) > spread
-    direction = vectors[:, :, 2]
+    # the spread is the root of the trace; the eigen-decomposition (its sum of eigenvalues decides exactly as
+    # before, and its main direction) is needed only for the wide patches and those within rounding of the limit
+    trace = np.sqrt(np.clip(second[:, 0, 0] + second[:, 1, 1] + second[:, 2, 2], 0, None))
+    wide = trace > spread
+    maybe = np.flatnonzero(wide | (trace > spread * (1 - 1e-6)))
+    direction = np.zeros((count, 3))
+    if maybe.size:
+        values, vectors = np.linalg.eigh(second[maybe])
+        wide[maybe] = np.sqrt(np.clip(values.sum(axis=1), 0, None)) > spread
+        direction[maybe] = vectors[:, :, 2]
     side = (centred * direction[labels].T).sum(axis=0) > 0
     split = np.zeros(patches.shape, dtype=np.int64)
     split[known] = labels * 2 + (side & wide[labels]) + 1

@@ -11,8 +11,6 @@ from dataclasses import dataclass
 
 import cv2
 import numpy as np
-from scipy import sparse
-from scipy.sparse import csgraph
 
 
 def _neighbour_views(array: np.ndarray) -> list[tuple[np.ndarray, np.ndarray]]:
@@ -99,19 +97,28 @@ def label_parts(region: np.ndarray, min_points: int) -> np.ndarray:
 
 
 def grow_labels(labels: np.ndarray, region: np.ndarray, max_distance: float) -> np.ndarray:
-    """Give every unlabelled pixel of ``region`` the label of the nearest labelled pixel within ``max_distance`` px."""
+    """Give every unlabelled pixel of ``region`` the label of the nearest labelled pixel within ``max_distance`` px.
+
+    The distance transform runs on the box of those pixels grown by the farthest a seed within ``max_distance``
+    can lie (its 3x3 chamfer distance is at least 0.955 times the larger coordinate difference), so every pixel
+    it gives a label sees the same seeds and paths as on the whole grid.
+    """
     unlabelled = region & (labels == 0)
     if not unlabelled.any() or not labels.any():
         return labels
+    x0, y0, x1, y1 = bounding_box(unlabelled, margin=int(np.ceil(max_distance / 0.95)) + 2)
+    window = labels[y0:y1, x0:x1]
+    seeds = window > 0
+    if not seeds.any():
+        return labels
     distance, nearest = cv2.distanceTransformWithLabels(
-        (labels == 0).view(np.uint8), cv2.DIST_L2, 3, labelType=cv2.DIST_LABEL_PIXEL
+        (~seeds).view(np.uint8), cv2.DIST_L2, 3, labelType=cv2.DIST_LABEL_PIXEL
     )
     lookup = np.zeros(int(nearest.max()) + 1, dtype=labels.dtype)
-    seeds = labels > 0
-    lookup[nearest[seeds]] = labels[seeds]
-    reach = unlabelled & (distance <= max_distance)
+    lookup[nearest[seeds]] = window[seeds]
+    reach = unlabelled[y0:y1, x0:x1] & (distance <= max_distance)
     grown = labels.copy()
-    grown[reach] = lookup[nearest[reach]]
+    grown[y0:y1, x0:x1][reach] = lookup[nearest[reach]]
     return grown
 
 
@@ -240,15 +247,23 @@ def _filled(vertices: np.ndarray, box: Sequence[int]) -> np.ndarray:
 def join_labels(labels: np.ndarray, pairs: list[tuple[int, int]]) -> np.ndarray:
     """Labels with every connected group of ``pairs`` joined, renumbered 1..n in order of first label."""
     count = int(labels.max(initial=0)) + 1
-    rows = [a for a, _ in pairs]
-    cols = [b for _, b in pairs]
-    graph = sparse.csr_matrix((np.ones(len(pairs)), (rows, cols)), shape=(count, count))
-    _, component = csgraph.connected_components(graph, directed=False)
-    present = np.flatnonzero(np.bincount(labels.reshape(-1), minlength=count))
-    present = present[present > 0]
+    root = list(range(count))  # union-find over the few labels; each group's root is its smallest label
+
+    def find(node: int) -> int:
+        while root[node] != node:
+            root[node] = root[root[node]]
+            node = root[node]
+        return node
+
+    for a, b in pairs:
+        ra, rb = find(int(a)), find(int(b))
+        if ra != rb:
+            root[max(ra, rb)] = min(ra, rb)
+    present = np.bincount(labels.reshape(-1), minlength=count) > 0
     renumber = np.zeros(count, dtype=np.int32)
-    _, dense = np.unique(component[present], return_inverse=True)
-    renumber[present] = dense.reshape(-1) + 1
+    numbers: dict[int, int] = {}
+    for label in np.flatnonzero(present[1:]).tolist():
+        renumber[label + 1] = numbers.setdefault(find(label + 1), len(numbers) + 1)
     return renumber[labels]
 
 
