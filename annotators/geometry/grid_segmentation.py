@@ -12,6 +12,8 @@ from dataclasses import dataclass
 import cv2
 import numpy as np
 
+from annotators.geometry.grid_kernels import touching_keys
+
 
 def _neighbour_views(array: np.ndarray) -> list[tuple[np.ndarray, np.ndarray]]:
     """The (first, second) views of every horizontally and vertically adjacent pixel pair."""
@@ -161,16 +163,9 @@ def grow_on_surface(
 
 def touching_pairs(labels: np.ndarray) -> np.ndarray:
     """Kx2 int array of the distinct label pairs ``(a, b)``, ``0 < a < b``, that touch as 4-neighbours."""
-    found = []
-    for l_a, l_b in _neighbour_views(labels):
-        touching = (l_a != l_b) & (l_a > 0) & (l_b > 0)
-        a, b = l_a[touching], l_b[touching]
-        found.append(np.column_stack([np.minimum(a, b), np.maximum(a, b)]))
-    pairs = np.concatenate(found).astype(np.int64)
-    if pairs.shape[0] == 0:
-        return pairs.reshape(0, 2)
-    keys = np.unique(pairs[:, 0] * (int(labels.max()) + 1) + pairs[:, 1])
-    return np.column_stack([keys // (int(labels.max()) + 1), keys % (int(labels.max()) + 1)])
+    base = int(labels.max(initial=0)) + 1
+    keys = np.unique(touching_keys(np.ascontiguousarray(labels), base))
+    return np.column_stack([keys // base, keys % base])
 
 
 def label_groups(labels: np.ndarray) -> tuple[np.ndarray, np.ndarray]:

@@ -28,6 +28,7 @@ import cv2
 import numpy as np
 from scipy import ndimage
 
+from annotators.geometry.grid_kernels import facing_values
 from annotators.geometry.grid_segmentation import depth_jump, join_labels, touching_pairs
 
 
@@ -115,16 +116,12 @@ def join_occluded(
         for piece in candidates:
             own = near_pixels[near_starts[piece] : near_starts[piece + 1]]
             rows, cols = own // window.shape[1], own % window.shape[1]
-            # the occluder's pixels within reach of the band, found in the band's box grown by the reach
-            r0, c0 = max(int(rows.min()) - reach, 0), max(int(cols.min()) - reach, 0)
-            r1, c1 = int(rows.max()) + reach + 1, int(cols.max()) + reach + 1
-            band = np.zeros((min(r1, window.shape[0]) - r0, min(c1, window.shape[1]) - c0), dtype=np.uint8)
-            band[rows - r0, cols - c0] = 1
-            facing = (cv2.dilate(band, wide) > 0) & occluding[r0:r1, c0:c1]
-            if np.count_nonzero(facing) < rules.min_points:
+            # the depths of the occluder's pixels within reach of the band
+            facing = facing_values(rows, cols, occluding, window_depth, reach)
+            if facing.size < rules.min_points:
                 continue
             piece_depth = _finite_mean(window_depth[rows, cols])
-            occluder_depth = _finite_mean(window_depth[r0:r1, c0:c1][facing])
+            occluder_depth = _finite_mean(facing)
             if not depth_jump(np.float32(piece_depth), np.float32(occluder_depth), absolute, relative):
                 continue
             if piece_depth <= occluder_depth:

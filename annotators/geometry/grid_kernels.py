@@ -1,0 +1,88 @@
+"""Compiled loops over the organized grid for the segmentation primitives: passes over pixels or pixel pairs that
+whole-array numpy would make with many temporaries, and loops over a few pieces that numpy would make call by call.
+
+Each kernel gives exactly what the numpy expression it replaces gives (integer and boolean results, or values
+picked from the input unchanged), so the segmentations do not change. They are compiled by numba on first use
+(numba is imported then, not with this module) and the machine code is cached on disk next to this file.
+"""
+
+from __future__ import annotations
+
+import functools
+from collections.abc import Callable
+from typing import Any
+
+import numpy as np
+
+
+def _compiled_on_first_use(function: Callable[..., Any]) -> Callable[..., Any]:
+    """``function`` compiled by numba (no Python objects, cached on disk) when it is first called."""
+
+    @functools.cache
+    def compiled() -> Callable[..., Any]:
+        from numba import njit
+
+        return njit(cache=True, nogil=True)(function)
+
+    @functools.wraps(function)
+    def call(*args: Any) -> Any:
+        return compiled()(*args)
+
+    return call
+
+
+@_compiled_on_first_use
+def touching_keys(labels: np.ndarray, base: int) -> np.ndarray:
+    """``min(a, b) * base + max(a, b)`` (int64) of every horizontally or vertically adjacent pixel pair of
+    different non-zero labels ``a``, ``b`` (HxW integer labels), once per pixel pair, in no particular order."""
+    keys = np.empty(2 * labels.size, dtype=np.int64)
+    count = 0
+    rows, cols = labels.shape
+    for r in range(rows):
+        for c in range(cols):
+            a = labels[r, c]
+            if a <= 0:
+                continue
+            if c + 1 < cols:
+                b = labels[r, c + 1]
+                if b > 0 and b != a:
+                    keys[count] = min(a, b) * base + max(a, b)
+                    count += 1
+            if r + 1 < rows:
+                b = labels[r + 1, c]
+                if b > 0 and b != a:
+                    keys[count] = min(a, b) * base + max(a, b)
+                    count += 1
+    return keys[:count]
+
+
+
+@_compiled_on_first_use
+def facing_values(rows: np.ndarray, cols: np.ndarray, target: np.ndarray, values: np.ndarray, radius: int) -> np.ndarray:
+    """The ``values`` (HxW) of the ``target`` pixels (HxW bool) within ``radius`` pixels (a square window) of any
+    of the marked pixels ``rows``, ``cols`` (distinct, at least one), in row-major order: what
+    ``values[box][cv2.dilate(marked, ones(2 radius + 1)) & target[box]]`` gives on the box of the marked pixels
+    grown by ``radius``."""
+    height, width = target.shape
+    r0, c0 = max(rows.min() - radius, 0), max(cols.min() - radius, 0)
+    r1, c1 = min(rows.max() + radius + 1, height), min(cols.max() + radius + 1, width)
+    box_rows, box_cols = r1 - r0, c1 - c0
+    sums = np.zeros((box_rows + 1, box_cols + 1), dtype=np.int32)  # 2-D prefix sums of the marked pixels
+    for k in range(rows.size):
+        sums[rows[k] - r0 + 1, cols[k] - c0 + 1] = 1
+    for r in range(1, box_rows + 1):
+        for c in range(1, box_cols + 1):
+            sums[r, c] += sums[r - 1, c] + sums[r, c - 1] - sums[r - 1, c - 1]
+    found = np.empty(box_rows * box_cols, dtype=values.dtype)
+    count = 0
+    for r in range(box_rows):
+        top, bottom = max(r - radius, 0), min(r + radius + 1, box_rows)
+        for c in range(box_cols):
+            if not target[r0 + r, c0 + c]:
+                continue
+            left, right = max(c - radius, 0), min(c + radius + 1, box_cols)
+            if sums[bottom, right] - sums[top, right] - sums[bottom, left] + sums[top, left] > 0:
+                found[count] = values[r0 + r, c0 + c]
+                count += 1
+    return found[:count]
+
