@@ -56,9 +56,10 @@ def touching_keys(labels: np.ndarray, base: int) -> np.ndarray:
     return keys[:count]
 
 
-
 @_compiled_on_first_use
-def facing_values(rows: np.ndarray, cols: np.ndarray, target: np.ndarray, values: np.ndarray, radius: int) -> np.ndarray:
+def facing_values(
+    rows: np.ndarray, cols: np.ndarray, target: np.ndarray, values: np.ndarray, radius: int
+) -> np.ndarray:
     """The ``values`` (HxW) of the ``target`` pixels (HxW bool) within ``radius`` pixels (a square window) of any
     of the marked pixels ``rows``, ``cols`` (distinct, at least one), in row-major order: what
     ``values[box][cv2.dilate(marked, ones(2 radius + 1)) & target[box]]`` gives on the box of the marked pixels
@@ -85,4 +86,3 @@ def facing_values(rows: np.ndarray, cols: np.ndarray, target: np.ndarray, values
                 found[count] = values[r0 + r, c0 + c]
                 count += 1
     return found[:count]
-
