@@ -86,3 +86,55 @@ def facing_values(
                 found[count] = values[r0 + r, c0 + c]
                 count += 1
     return found[:count]
+
+
+@_compiled_on_first_use
+def shadowed_near(occluding: np.ndarray, unmeasured: np.ndarray, shadow_radius: int, near_radius: int) -> np.ndarray:
+    """HxW bool: the pixels within ``near_radius`` (a square window) of an occluder (``occluding``, HxW bool) or
+    of its shadow - the 4-connected unmeasured regions (``unmeasured``) that touch it (8-neighbours), where they
+    lie within ``shadow_radius`` of it. What ``cv2.dilate`` with square kernels of ones and
+    ``cv2.connectedComponents`` give."""
+    rows, cols = occluding.shape
+
+    def box_sums(marked: np.ndarray) -> np.ndarray:  # sums[r, c]: the marked pixels above and left of (r, c)
+        sums = np.zeros((rows + 1, cols + 1), dtype=np.int32)
+        for r in range(rows):
+            running = 0
+            for c in range(cols):
+                running += marked[r, c]
+                sums[r + 1, c + 1] = sums[r, c + 1] + running
+        return sums
+
+    def any_within(sums: np.ndarray, r: int, c: int, radius: int) -> bool:
+        r0, r1 = max(r - radius, 0), min(r + radius + 1, rows)
+        c0, c1 = max(c - radius, 0), min(c + radius + 1, cols)
+        return sums[r1, c1] - sums[r0, c1] - sums[r1, c0] + sums[r0, c0] > 0
+
+    occluder_sums = box_sums(occluding)
+    region = occluding.copy()
+    stack = np.empty(rows * cols, dtype=np.int64)
+    seen = np.zeros((rows, cols), dtype=np.bool_)
+    top = 0
+    for r in range(rows):  # the shadow's seeds: unmeasured pixels beside the occluder
+        for c in range(cols):
+            if unmeasured[r, c] and any_within(occluder_sums, r, c, 1):
+                seen[r, c] = True
+                stack[top] = r * cols + c
+                top += 1
+    while top > 0:  # their 4-connected unmeasured regions, kept within reach of the occluder
+        top -= 1
+        r, c = stack[top] // cols, stack[top] % cols
+        if any_within(occluder_sums, r, c, shadow_radius):
+            region[r, c] = True
+        for dr, dc in ((0, -1), (0, 1), (-1, 0), (1, 0)):
+            nr, nc = r + dr, c + dc
+            if 0 <= nr < rows and 0 <= nc < cols and unmeasured[nr, nc] and not seen[nr, nc]:
+                seen[nr, nc] = True
+                stack[top] = nr * cols + nc
+                top += 1
+    region_sums = box_sums(region)
+    near = np.zeros((rows, cols), dtype=np.bool_)
+    for r in range(rows):
+        for c in range(cols):
+            near[r, c] = any_within(region_sums, r, c, near_radius)
+    return near

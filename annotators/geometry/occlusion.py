@@ -24,11 +24,10 @@ from __future__ import annotations
 
 from dataclasses import dataclass
 
-import cv2
 import numpy as np
 from scipy import ndimage
 
-from annotators.geometry.grid_kernels import facing_values
+from annotators.geometry.grid_kernels import facing_values, shadowed_near
 from annotators.geometry.grid_segmentation import depth_jump, join_labels, touching_pairs
 
 
@@ -78,11 +77,10 @@ def join_occluded(
     depth = points[..., 2]
     flat_points = points.reshape(-1, 3)
     flat_labels = labels.reshape(-1)
-    kernel = np.ones((2 * rules.band + 1, 2 * rules.band + 1), np.uint8)
-    wide = np.ones((6 * rules.band + 1, 6 * rules.band + 1), np.uint8)
     sizes = np.bincount(flat_labels, minlength=count + 1)
     boxes = ndimage.find_objects(labels, max_label=count)
-    measured = np.isfinite(depth.reshape(-1)) & (flat_labels > 0)
+    unmeasured = ~np.isfinite(depth)
+    measured = ~unmeasured.reshape(-1) & (flat_labels > 0)
     sums = np.bincount(flat_labels[measured], depth.reshape(-1)[measured], minlength=count + 1)
     mean_depth = sums / np.maximum(np.bincount(flat_labels[measured], minlength=count + 1), 1)
     touching: set[tuple[int, int]] | None = None
@@ -104,7 +102,7 @@ def join_occluded(
             continue  # the farther objects near it all touch one another: nothing to join
         occluding = window == occluder
         window_depth = depth[y0:y1, x0:x1]
-        near = cv2.dilate(_with_shadow(occluding, window_depth, wide).view(np.uint8), kernel) > 0
+        near = shadowed_near(occluding, unmeasured[y0:y1, x0:x1], 3 * rules.band, rules.band)
         # the farther objects with enough pixels near the occluder; two of them must be apart to join anything
         near_pixels, near_starts = _grouped(near & (window > 0), window, count)
         band_sizes = np.diff(near_starts)
@@ -159,24 +157,6 @@ def _finite_mean(values: np.ndarray) -> float:
     """The mean of the finite values (NaN when there is none)."""
     finite = values[np.isfinite(values)]
     return float(finite.mean()) if finite.size else float("nan")
-
-
-def _with_shadow(occluder: np.ndarray, depth: np.ndarray, reach: np.ndarray) -> np.ndarray:
-    """The occluder's mask and the unmeasured pixels (no depth) beside it, within ``reach`` (a kernel) of it:
-    a depth sensor sees no depth in the shadow an occluding edge casts on what is behind it."""
-    unmeasured = ~np.isfinite(depth)
-    if not unmeasured.any():
-        return occluder
-    beside = cv2.dilate(occluder.view(np.uint8), np.ones((3, 3), np.uint8)) > 0
-    shadow_seeds = beside & unmeasured
-    if not shadow_seeds.any():
-        return occluder  # no unmeasured pixel touches the occluder: no shadow beside it
-    count, parts = cv2.connectedComponents(unmeasured.view(np.uint8), connectivity=4)
-    touching = np.zeros(count, dtype=bool)
-    touching[parts[shadow_seeds]] = True
-    touching[0] = False
-    within = cv2.dilate(occluder.view(np.uint8), reach) > 0
-    return occluder | (touching[parts] & within)
 
 
 def _grown(box: tuple[slice, slice], shape: tuple[int, int], margin: int) -> tuple[int, int, int, int]:
