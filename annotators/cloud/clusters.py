@@ -25,17 +25,16 @@ from typing import ClassVar
 
 import cv2
 import numpy as np
-from scipy import ndimage
 
 from annotators.cloud.normals import grid_normals
 from annotators.cloud.plane import plane_basis, plane_distances
 from annotators.cloud.point_cloud import cloud_problem
+from annotators.geometry.grid_kernels import label_pixels, upsampled_labels
 from annotators.geometry.grid_segmentation import (
     MergeRules,
     boundaries,
     bounding_box,
     color_edges,
-    depth_jump,
     depth_seams,
     grow_labels,
     grow_on_surface,
@@ -203,25 +202,24 @@ def full_resolution_segments(
     x0, y0, x1, y1 = box
     fy0, fx0 = y0 * step, x0 * step
     fy1, fx1 = min(y1 * step, rows), min(x1 * step, cols)
-    height, width = fy1 - fy0, fx1 - fx0
-    fine = np.repeat(np.repeat(labels, step, axis=0), step, axis=1)[:height, :width]
-    sampled_depth = np.repeat(np.repeat(coarse_depth, step, axis=0), step, axis=1)[:height, :width]
+    width = fx1 - fx0
     fine_points = points[fy0:fy1, fx0:fx1]
-    same_surface = ~depth_jump(fine_points[..., 2], sampled_depth, p.jump_absolute, p.jump_relative)
-    fine = fine * (_candidates(fine_points, mask[fy0:fy1, fx0:fx1], model, p) & same_surface)
-    sizes = np.bincount(fine.reshape(-1))
+    candidates = _candidates(fine_points, mask[fy0:fy1, fx0:fx1], model, p)
+    fine = upsampled_labels(
+        labels, coarse_depth, fine_points[..., 2], candidates, step, p.jump_absolute, p.jump_relative
+    )
+    pixels, starts, boxes = label_pixels(fine)
+    sizes = np.diff(starts)
     kept = [label for label in range(1, sizes.size) if sizes[label] >= p.min_points]
-    boxes = ndimage.find_objects(fine)
     masks = np.zeros((len(kept), rows, cols), dtype=bool)  # one allocation for all masks
     segments = []
     for object_mask, label in zip(masks, kept, strict=True):
-        box_rows, box_cols = boxes[label - 1]
-        own = fine[box_rows, box_cols] == label
-        top, left = box_rows.start + fy0, box_cols.start + fx0
-        object_mask[top : box_rows.stop + fy0, left : box_cols.stop + fx0] = own
-        r, c = np.nonzero(own)
-        roi = (left, top, box_cols.stop + fx0, box_rows.stop + fy0)
-        segments.append(Segment(indices=(r + top) * cols + c + left, mask=object_mask, roi=roi))
+        own = pixels[starts[label] : starts[label + 1]]
+        indices = (own // width + fy0) * cols + own % width + fx0
+        object_mask.reshape(-1)[indices] = True
+        left, top, right, bottom = boxes[label].tolist()
+        roi = (left + fx0, top + fy0, right + fx0, bottom + fy0)
+        segments.append(Segment(indices=indices, mask=object_mask, roi=roi))
     segments.sort(key=lambda s: -s.indices.size)
     return segments
 

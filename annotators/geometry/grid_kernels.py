@@ -138,3 +138,67 @@ def shadowed_near(occluding: np.ndarray, unmeasured: np.ndarray, shadow_radius: 
         for c in range(cols):
             near[r, c] = any_within(region_sums, r, c, near_radius)
     return near
+
+
+@_compiled_on_first_use
+def upsampled_labels(
+    labels: np.ndarray,
+    coarse_depth: np.ndarray,
+    depth: np.ndarray,
+    keep: np.ndarray,
+    step: int,
+    absolute: float,
+    relative: float,
+) -> np.ndarray:
+    """HxW int32 (the shape of ``depth``, float32): each pixel's label in ``labels`` (every ``step``-th pixel's)
+    where ``keep`` (HxW bool) allows it and no depth jump (:func:`depth_jump`'s float32 arithmetic) parts it from
+    its coarse sample's depth ``coarse_depth``; 0 elsewhere."""
+    rows, cols = depth.shape
+    absolute32, relative32 = np.float32(absolute), np.float32(relative)
+    fine = np.zeros((rows, cols), dtype=np.int32)
+    for r in range(rows):
+        for c in range(cols):
+            label = labels[r // step, c // step]
+            if label == 0 or not keep[r, c]:
+                continue
+            z, sample = depth[r, c], coarse_depth[r // step, c // step]
+            nearer = sample if np.isnan(z) else (z if np.isnan(sample) else min(z, sample))
+            if not abs(z - sample) > nearer * relative32 + absolute32:
+                fine[r, c] = label
+    return fine
+
+
+@_compiled_on_first_use
+def label_pixels(labels: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """The flat indices of the labelled pixels of HxW ``labels`` sorted by label (increasing within one), ``starts``
+    so label k owns ``pixels[starts[k]:starts[k + 1]]``, and each label's box ``(x0, y0, x1, y1)`` (exclusive;
+    row k for label k, zeros for a label without pixels)."""
+    rows, cols = labels.shape
+    count = 0
+    for r in range(rows):
+        for c in range(cols):
+            count = max(count, labels[r, c])
+    starts = np.zeros(count + 2, dtype=np.int64)
+    boxes = np.zeros((count + 1, 4), dtype=np.int64)
+    boxes[:, 0], boxes[:, 1] = cols, rows
+    for r in range(rows):
+        for c in range(cols):
+            label = labels[r, c]
+            if label > 0:
+                starts[label + 1] += 1
+                boxes[label, 0], boxes[label, 1] = min(boxes[label, 0], c), min(boxes[label, 1], r)
+                boxes[label, 2], boxes[label, 3] = max(boxes[label, 2], c + 1), max(boxes[label, 3], r + 1)
+    for label in range(1, count + 2):
+        starts[label] += starts[label - 1]
+    pixels = np.empty(starts[count + 1], dtype=np.int64)
+    filled = starts[:-1].copy()
+    for r in range(rows):
+        for c in range(cols):
+            label = labels[r, c]
+            if label > 0:
+                pixels[filled[label]] = r * cols + c
+                filled[label] += 1
+    for label in range(count + 1):
+        if starts[label + 1] == starts[label]:
+            boxes[label] = 0
+    return pixels, starts, boxes
