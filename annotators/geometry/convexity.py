@@ -18,6 +18,7 @@ import numpy as np
 from scipy import sparse
 from scipy.sparse import csgraph
 
+from annotators.geometry.grid_kernels import label_centres, label_moments
 from annotators.geometry.grid_segmentation import grow_labels, join_unless_apart, pixel_footprint, touching_pairs
 
 
@@ -50,13 +51,10 @@ def split_by_normals(patches: np.ndarray, normals: np.ndarray, spread: float) ->
     known = (patches > 0) & np.isfinite(normals[..., 0])
     labels = patches[known]
     unit = np.ascontiguousarray(normals[known].T, dtype=np.float64)  # 3xN: each component's values contiguous
-    sizes = np.maximum(np.bincount(labels, minlength=count), 1).astype(np.float64)
-    mean = np.stack([np.bincount(labels, unit[i], count) for i in range(3)], axis=1) / sizes[:, None]
-    centred = unit - mean[labels].T
-    second = np.empty((count, 3, 3))
-    for i in range(3):
-        for j in range(i, 3):
-            second[:, i, j] = second[:, j, i] = np.bincount(labels, centred[i] * centred[j], count) / sizes
+    pixels, sums, _ = label_moments(labels, unit, np.zeros((count, 3)), count)
+    sizes = np.maximum(pixels, 1).astype(np.float64)
+    mean = sums / sizes[:, None]
+    second = _symmetric(label_moments(labels, unit, mean, count)[2] / sizes[:, None])
     # the spread is the root of the trace; the eigen-decomposition (its sum of eigenvalues decides exactly as
     # before, and its main direction) is needed only for the wide patches and those within rounding of the limit
     trace = np.sqrt(np.clip(second[:, 0, 0] + second[:, 1, 1] + second[:, 2, 2], 0, None))
@@ -67,9 +65,12 @@ def split_by_normals(patches: np.ndarray, normals: np.ndarray, spread: float) ->
         values, vectors = np.linalg.eigh(second[maybe])
         wide[maybe] = np.sqrt(np.clip(values.sum(axis=1), 0, None)) > spread
         direction[maybe] = vectors[:, :, 2]
-    side = (centred * direction[labels].T).sum(axis=0) > 0
+    side = wide[labels]  # which side of its mean a pixel's normal lies on matters only in a wide patch
+    if side.any():
+        centred = unit[:, side] - mean[labels[side]].T
+        side[side] = (centred * direction[labels[side]].T).sum(axis=0) > 0
     split = np.zeros(patches.shape, dtype=np.int64)
-    split[known] = labels * 2 + (side & wide[labels]) + 1
+    split[known] = labels * 2 + side + 1
     return dense_labels(split)
 
 
@@ -120,13 +121,11 @@ def patch_planes(patches: np.ndarray, points: np.ndarray) -> PatchPlanes:
     xyz = np.ascontiguousarray(points[inside].T, dtype=np.float64)  # 3xN: each coordinate's values contiguous
     shift = xyz.mean(axis=1) if xyz.size else np.zeros(3)
     xyz -= shift[:, None]
-    counts = np.bincount(labels, minlength=count).astype(np.float64)
+    pixels, sums, products = label_moments(labels, xyz, np.zeros((count, 3)), count)
+    counts = pixels.astype(np.float64)
     safe = np.maximum(counts, 1.0)
-    means = np.stack([np.bincount(labels, xyz[i], count) for i in range(3)], axis=1) / safe[:, None]
-    second = np.empty((count, 3, 3))
-    for i in range(3):
-        for j in range(i, 3):
-            second[:, i, j] = second[:, j, i] = np.bincount(labels, xyz[i] * xyz[j], count) / safe
+    means = sums / safe[:, None]
+    second = _symmetric(products / safe[:, None])
     covariance = second - means[:, :, None] * means[:, None, :]
     values, vectors = np.linalg.eigh(covariance)
     normals = vectors[:, :, 0]
@@ -135,6 +134,14 @@ def patch_planes(patches: np.ndarray, points: np.ndarray) -> PatchPlanes:
     thickness = np.clip(values[:, 0], 0, None) / np.maximum(values[:, 1], 1e-12)
     width = np.clip(values[:, 1], 0, None) / np.maximum(values[:, 2], 1e-12)
     return PatchPlanes(counts.astype(np.int64), centroids, normals, thickness, width)
+
+
+def _symmetric(products: np.ndarray) -> np.ndarray:
+    """Kx3x3 symmetric matrices from their Kx6 entries 00, 01, 02, 11, 12, 22."""
+    matrices = np.empty((products.shape[0], 3, 3))
+    for k, (i, j) in enumerate(((0, 0), (0, 1), (0, 2), (1, 1), (1, 2), (2, 2))):
+        matrices[:, i, j] = matrices[:, j, i] = products[:, k]
+    return matrices
 
 
 def connection_bending(planes: PatchPlanes, pairs: np.ndarray) -> np.ndarray:
@@ -156,12 +163,8 @@ def close_in_space(
     Patches touching on the grid across a depth jump (an object and what is behind it) are not."""
     if pairs.size == 0:
         return np.zeros(0, dtype=bool)
-    inside = patches > 0
-    rows, cols = np.nonzero(inside)
-    labels = patches[inside]
-    counts = np.maximum(np.bincount(labels, minlength=planes.counts.size + 1), 1)
-    pixel = np.stack([np.bincount(labels, rows, counts.size), np.bincount(labels, cols, counts.size)], axis=1)
-    pixel /= counts[:, None]
+    counts, pixel = label_centres(np.ascontiguousarray(patches), planes.counts.size + 1)
+    pixel /= np.maximum(counts, 1)[:, None]
     a, b = pairs[:, 0], pairs[:, 1]
     on_grid = np.linalg.norm(pixel[a] - pixel[b], axis=1)
     depth = np.minimum(planes.centroids[a - 1, 2], planes.centroids[b - 1, 2])

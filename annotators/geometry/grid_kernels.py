@@ -202,3 +202,46 @@ def label_pixels(labels: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray
         if starts[label + 1] == starts[label]:
             boxes[label] = 0
     return pixels, starts, boxes
+
+
+@_compiled_on_first_use
+def label_moments(
+    labels: np.ndarray, values: np.ndarray, means: np.ndarray, count: int
+) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """Per label ``0..count-1`` of N ``labels``: the number of values, the sums of the 3xN ``values`` (float64) and
+    the sums of the products ``(v_i - m_i) (v_j - m_j)`` for ``i <= j`` in the order 00, 01, 02, 11, 12, 22, with
+    ``m`` the label's row of ``means`` (Kx3; zeros for plain second moments). Added up in the order of the values,
+    as ``np.bincount`` adds its weights, so the sums are the same."""
+    counts = np.zeros(count, dtype=np.int64)
+    sums = np.zeros((count, 3))
+    products = np.zeros((count, 6))
+    for k in range(labels.size):
+        label = labels[k]
+        a, b, c = values[0, k] - means[label, 0], values[1, k] - means[label, 1], values[2, k] - means[label, 2]
+        counts[label] += 1
+        sums[label, 0] += values[0, k]
+        sums[label, 1] += values[1, k]
+        sums[label, 2] += values[2, k]
+        products[label, 0] += a * a
+        products[label, 1] += a * b
+        products[label, 2] += a * c
+        products[label, 3] += b * b
+        products[label, 4] += b * c
+        products[label, 5] += c * c
+    return counts, sums, products
+
+
+@_compiled_on_first_use
+def label_centres(labels: np.ndarray, count: int) -> tuple[np.ndarray, np.ndarray]:
+    """Per label ``0..count-1`` of HxW ``labels`` (label 0 counted too): the number of pixels and the sums of
+    their rows and columns (Kx2 float64; exact, they are integers)."""
+    counts = np.zeros(count, dtype=np.int64)
+    sums = np.zeros((count, 2))
+    rows, cols = labels.shape
+    for r in range(rows):
+        for c in range(cols):
+            label = labels[r, c]
+            counts[label] += 1
+            sums[label, 0] += r
+            sums[label, 1] += c
+    return counts, sums
