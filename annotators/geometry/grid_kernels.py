@@ -245,3 +245,26 @@ def label_centres(labels: np.ndarray, count: int) -> tuple[np.ndarray, np.ndarra
             sums[label, 0] += r
             sums[label, 1] += c
     return counts, sums
+
+
+@_compiled_on_first_use
+def grouped_pixels(labels: np.ndarray, where: np.ndarray, count: int) -> tuple[np.ndarray, np.ndarray]:
+    """The flat indices of the ``where`` pixels (HxW bool) with a label 1..count in HxW ``labels``, sorted by label
+    (row-major within one), and ``starts`` (count + 2) so label k owns ``pixels[starts[k]:starts[k + 1]]``."""
+    rows, cols = labels.shape
+    starts = np.zeros(count + 2, dtype=np.int64)
+    for r in range(rows):
+        for c in range(cols):
+            if where[r, c] and labels[r, c] > 0:
+                starts[labels[r, c] + 1] += 1
+    for label in range(1, count + 2):
+        starts[label] += starts[label - 1]
+    pixels = np.empty(starts[count + 1], dtype=np.int64)
+    filled = starts[:-1].copy()
+    for r in range(rows):
+        for c in range(cols):
+            label = labels[r, c]
+            if where[r, c] and label > 0:
+                pixels[filled[label]] = r * cols + c
+                filled[label] += 1
+    return pixels, starts

@@ -27,7 +27,7 @@ from dataclasses import dataclass
 import numpy as np
 from scipy import ndimage
 
-from annotators.geometry.grid_kernels import facing_values, shadowed_near
+from annotators.geometry.grid_kernels import facing_values, grouped_pixels, shadowed_near
 from annotators.geometry.grid_segmentation import depth_jump, join_labels, touching_pairs
 
 
@@ -104,7 +104,7 @@ def join_occluded(
         window_depth = depth[y0:y1, x0:x1]
         near = shadowed_near(occluding, unmeasured[y0:y1, x0:x1], 3 * rules.band, rules.band)
         # the farther objects with enough pixels near the occluder; two of them must be apart to join anything
-        near_pixels, near_starts = _grouped(near & (window > 0), window, count)
+        near_pixels, near_starts = grouped_pixels(window, near, count)
         band_sizes = np.diff(near_starts)
         candidates = _apart_from_another(farther[band_sizes[farther] >= rules.min_points].tolist(), touching)
         if len(candidates) < 2:
@@ -168,17 +168,6 @@ def _grown(box: tuple[slice, slice], shape: tuple[int, int], margin: int) -> tup
         min(cols.stop + margin, shape[1]),
         min(rows.stop + margin, shape[0]),
     )
-
-
-def _grouped(where: np.ndarray, labels: np.ndarray, count: int) -> tuple[np.ndarray, np.ndarray]:
-    """The flat indices of the ``where`` pixels sorted by their label (row-major within one label) and ``starts``
-    so label k owns ``pixels[starts[k]:starts[k + 1]]`` (k = 0..count)."""
-    index = np.flatnonzero(where)
-    values = labels[where]
-    if count < 1 << 16:
-        values = values.astype(np.uint16)  # a stable sort of 16-bit keys is a radix sort: linear time
-    order = np.argsort(values, kind="stable")
-    return index[order], np.searchsorted(values[order], np.arange(count + 2))
 
 
 def _continues(first: _Piece, second: _Piece, normals: np.ndarray, rules: OcclusionRules) -> bool:
