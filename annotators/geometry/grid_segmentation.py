@@ -264,7 +264,11 @@ def join_labels(labels: np.ndarray, pairs: list[tuple[int, int]]) -> np.ndarray:
 
 def _range(values: np.ndarray, low: float, high: float) -> tuple[float, float]:
     """The ``low`` and ``high`` quantiles (0..1) of a 1-D array, by sorting (cheap for a few hundred values)."""
-    ordered = np.sort(values)
+    return _sorted_range(np.sort(values), low, high)
+
+
+def _sorted_range(ordered: np.ndarray, low: float, high: float) -> tuple[float, float]:
+    """:func:`_range` of values already sorted."""
     last = ordered.size - 1
     return float(ordered[round(low * last)]), float(ordered[round(high * last)])
 
@@ -281,8 +285,13 @@ def heights_nest(first: np.ndarray, second: np.ndarray, tolerance: float) -> boo
     above it. A part in the rim band (:data:`RIM_BAND`) may reach up to the other's top instead of its 95 % height;
     a neighbour of about the same height never counts as in the rim band, so its top must nest strictly.
     """
-    ranges = [_range(heights, 0.05, 0.95) for heights in (first, second)]
-    tops = [_range(heights, 0.05, 0.99)[1] for heights in (first, second)]
+    return _sorted_heights_nest(np.sort(first), np.sort(second), tolerance)
+
+
+def _sorted_heights_nest(first: np.ndarray, second: np.ndarray, tolerance: float) -> bool:
+    """:func:`heights_nest` of heights already sorted."""
+    ranges = [_sorted_range(heights, 0.05, 0.95) for heights in (first, second)]
+    tops = [_sorted_range(heights, 0.05, 0.99)[1] for heights in (first, second)]
     for inner, outer in ((0, 1), (1, 0)):
         (low_in, high_in), (low_out, high_out) = ranges[inner], ranges[outer]
         in_band = high_in - low_in <= RIM_BAND * (high_out - low_out)
@@ -310,14 +319,21 @@ def is_floor_within(
     (:data:`FLOOR_FLATNESS`), lies within the other's hull (:data:`FLOOR_INSIDE` of its footprint) and no higher
     than the other's lowest heights (5 %, with ``rules.nest_tolerance``).
     """
+    return _sorted_floor_within(np.sort(first, axis=0), np.sort(second, axis=0), hull_first, hull_second, rules)
+
+
+def _sorted_floor_within(
+    first: np.ndarray, second: np.ndarray, hull_first: np.ndarray, hull_second: np.ndarray, rules: MergeRules
+) -> bool:
+    """:func:`is_floor_within` of plane coordinates whose columns are each sorted."""
     for floor, walls, floor_hull, walls_hull in (
         (first, second, hull_first, hull_second),
         (second, first, hull_second, hull_first),
     ):
-        low, high = _range(floor[:, 2], 0.05, 0.95)
-        if high > _range(walls[:, 2], 0.05, 0.95)[0] + rules.nest_tolerance:
+        low, high = _sorted_range(floor[:, 2], 0.05, 0.95)
+        if high > _sorted_range(walls[:, 2], 0.05, 0.95)[0] + rules.nest_tolerance:
             continue
-        width = float(np.max([np.subtract(*_range(floor[:, axis], 0.95, 0.05)) for axis in (0, 1)]))
+        width = float(np.max([np.subtract(*_sorted_range(floor[:, axis], 0.95, 0.05)) for axis in (0, 1)]))
         if high - low > FLOOR_FLATNESS * width:
             continue
         if _inside_share(floor_hull, walls_hull, rules.cell) >= FLOOR_INSIDE:
@@ -423,6 +439,7 @@ class _Parts:
         self.plane_coordinates = plane_coordinates
         self._coordinates: dict[int, np.ndarray] = {}
         self._hulls: dict[int, np.ndarray] = {}
+        self._sorted: dict[int, np.ndarray] = {}
         self._depths: dict[int, float] = {}
         self._outsides: dict[tuple[int, float], ContainerOutside | None] = {}
 
@@ -435,6 +452,12 @@ class _Parts:
             own = self.own(label)
             self._coordinates[label] = self.plane_coordinates(own[:: max(1, own.size // 400)])
         return self._coordinates[label]
+
+    def sorted_coordinates(self, label: int) -> np.ndarray:
+        """:meth:`coordinates` with each column sorted (for quantiles)."""
+        if label not in self._sorted:
+            self._sorted[label] = np.sort(self.coordinates(label), axis=0)
+        return self._sorted[label]
 
     def hull(self, label: int) -> np.ndarray:
         """The convex hull of the part's footprint (Kx2)."""
@@ -677,13 +700,11 @@ def merge_parts(
             continue
         stacked = False
         if (first, second) in overlapping:
-            heights = (parts.coordinates(first)[:, 2], parts.coordinates(second)[:, 2])
+            ordered = (parts.sorted_coordinates(first), parts.sorted_coordinates(second))
             if (
                 not rules.nested
-                or heights_nest(*heights, rules.nest_tolerance)
-                or is_floor_within(
-                    parts.coordinates(first), parts.coordinates(second), parts.hull(first), parts.hull(second), rules
-                )
+                or _sorted_heights_nest(ordered[0][:, 2], ordered[1][:, 2], rules.nest_tolerance)
+                or _sorted_floor_within(*ordered, parts.hull(first), parts.hull(second), rules)
             ):
                 allowed.append((first, second))
                 continue
