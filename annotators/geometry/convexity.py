@@ -18,7 +18,7 @@ import numpy as np
 from scipy import sparse
 from scipy.sparse import csgraph
 
-from annotators.geometry.grid_kernels import label_centres, label_moments
+from annotators.geometry.grid_kernels import label_centres, label_moments, symmetric_eigen
 from annotators.geometry.grid_segmentation import grow_labels, join_unless_apart, pixel_footprint, touching_pairs
 
 
@@ -55,16 +55,10 @@ def split_by_normals(patches: np.ndarray, normals: np.ndarray, spread: float) ->
     sizes = np.maximum(pixels, 1).astype(np.float64)
     mean = sums / sizes[:, None]
     second = _symmetric(label_moments(labels, unit, mean, count)[2] / sizes[:, None])
-    # the spread is the root of the trace; the eigen-decomposition (its sum of eigenvalues decides exactly as
-    # before, and its main direction) is needed only for the wide patches and those within rounding of the limit
-    trace = np.sqrt(np.clip(second[:, 0, 0] + second[:, 1, 1] + second[:, 2, 2], 0, None))
-    wide = trace > spread
-    maybe = np.flatnonzero(wide | (trace > spread * (1 - 1e-6)))
+    # the spread is the root of the trace (the sum of the eigenvalues); the direction is needed in wide patches
+    wide = np.sqrt(np.clip(second[:, 0, 0] + second[:, 1, 1] + second[:, 2, 2], 0, None)) > spread
     direction = np.zeros((count, 3))
-    if maybe.size:
-        values, vectors = np.linalg.eigh(second[maybe])
-        wide[maybe] = np.sqrt(np.clip(values.sum(axis=1), 0, None)) > spread
-        direction[maybe] = vectors[:, :, 2]
+    direction[wide] = symmetric_eigen(second[wide])[1][:, :, 2]
     side = wide[labels]  # which side of its mean a pixel's normal lies on matters only in a wide patch
     if side.any():
         centred = unit[:, side] - mean[labels[side]].T
@@ -127,7 +121,7 @@ def patch_planes(patches: np.ndarray, points: np.ndarray) -> PatchPlanes:
     means = sums / safe[:, None]
     second = _symmetric(products / safe[:, None])
     covariance = second - means[:, :, None] * means[:, None, :]
-    values, vectors = np.linalg.eigh(covariance)
+    values, vectors = symmetric_eigen(covariance)
     normals = vectors[:, :, 0]
     centroids = means + shift
     normals *= np.where(np.einsum("ij,ij->i", normals, centroids) > 0, -1.0, 1.0)[:, None]

@@ -1,9 +1,10 @@
 """Compiled loops over the organized grid for the segmentation primitives: passes over pixels or pixel pairs that
 whole-array numpy would make with many temporaries, and loops over a few pieces that numpy would make call by call.
 
-Each kernel gives exactly what the numpy expression it replaces gives (integer and boolean results, or values
-picked from the input unchanged), so the segmentations do not change. They are compiled by numba on first use
-(numba is imported then, not with this module) and the machine code is cached on disk next to this file.
+The kernels give exactly what the numpy or OpenCV expressions they replace give (integer and boolean results,
+values picked from the input unchanged, sums added in the same order), except :func:`symmetric_eigen`, which
+agrees with ``np.linalg.eigh`` to rounding. They are compiled by numba on first use (numba is imported then, not
+with this module) and the machine code is cached on disk next to this file.
 """
 
 from __future__ import annotations
@@ -268,3 +269,55 @@ def grouped_pixels(labels: np.ndarray, where: np.ndarray, count: int) -> tuple[n
                 pixels[filled[label]] = r * cols + c
                 filled[label] += 1
     return pixels, starts
+
+
+@_compiled_on_first_use
+def symmetric_eigen(matrices: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """Eigenvalues (Kx3, increasing) and unit eigenvectors (Kx3x3, column i for value i) of K symmetric 3x3
+    matrices, by cyclic Jacobi rotations to full double precision: ``np.linalg.eigh`` for many small matrices
+    without a LAPACK call each (the values agree to rounding; a vector's sign may differ)."""
+    count = matrices.shape[0]
+    values = np.empty((count, 3))
+    vectors = np.empty((count, 3, 3))
+    a = np.empty((3, 3))
+    v = np.empty((3, 3))
+    for k in range(count):
+        for i in range(3):
+            for j in range(3):
+                a[i, j] = matrices[k, i, j]
+                v[i, j] = 1.0 if i == j else 0.0
+        for _ in range(50):
+            off = a[0, 1] * a[0, 1] + a[0, 2] * a[0, 2] + a[1, 2] * a[1, 2]
+            scale = a[0, 0] * a[0, 0] + a[1, 1] * a[1, 1] + a[2, 2] * a[2, 2]
+            if off <= 1e-36 * scale or off == 0.0 or not np.isfinite(off):
+                break
+            for p, q in ((0, 1), (0, 2), (1, 2)):
+                if a[p, q] == 0.0:
+                    continue
+                theta = (a[q, q] - a[p, p]) / (2.0 * a[p, q])
+                t = 1.0 / (abs(theta) + np.sqrt(theta * theta + 1.0))
+                if theta < 0.0:
+                    t = -t
+                c = 1.0 / np.sqrt(t * t + 1.0)
+                s = t * c
+                for r in range(3):  # A <- A J (columns p, q)
+                    arp, arq = a[r, p], a[r, q]
+                    a[r, p], a[r, q] = c * arp - s * arq, s * arp + c * arq
+                for r in range(3):  # A <- J^T A (rows p, q)
+                    apr, aqr = a[p, r], a[q, r]
+                    a[p, r], a[q, r] = c * apr - s * aqr, s * apr + c * aqr
+                for r in range(3):
+                    vrp, vrq = v[r, p], v[r, q]
+                    v[r, p], v[r, q] = c * vrp - s * vrq, s * vrp + c * vrq
+        first, middle, last = 0, 1, 2  # the diagonal's order, by three comparisons
+        if a[first, first] > a[middle, middle]:
+            first, middle = middle, first
+        if a[middle, middle] > a[last, last]:
+            middle, last = last, middle
+        if a[first, first] > a[middle, middle]:
+            first, middle = middle, first
+        for i, column in enumerate((first, middle, last)):
+            values[k, i] = a[column, column]
+            for r in range(3):
+                vectors[k, r, i] = v[r, column]
+    return values, vectors
