@@ -321,3 +321,66 @@ def symmetric_eigen(matrices: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
             for r in range(3):
                 vectors[k, r, i] = v[r, column]
     return values, vectors
+
+
+@_compiled_on_first_use
+def organized_normals(points: np.ndarray, step: int, smoothing: int, absolute: float, relative: float) -> np.ndarray:
+    """HxWx3 float32 unit normals facing the camera of an organized HxWx3 float32 cloud (NaN where unknown):
+    the cross product of the central differences across ``step`` pixels, summed over a ``smoothing`` x
+    ``smoothing`` window (each raw normal of unit length; none where a neighbour is missing or across a depth jump
+    of more than ``absolute + relative * nearer depth``), then normalised. The grid ``step`` pixels wide along the
+    border gets none (see :func:`annotators.cloud.normals.grid_normals`)."""
+    height, width = points.shape[0], points.shape[1]
+    normals = np.full((height, width, 3), np.nan, dtype=np.float32)
+    if height <= 2 * step or width <= 2 * step:
+        return normals
+    rows, cols = height - 2 * step, width - 2 * step
+    raw = np.zeros((rows, cols, 3), dtype=np.float32)
+    broken = np.ones((rows, cols), dtype=np.bool_)
+    absolute32, relative32 = np.float32(absolute), np.float32(relative)
+    for r in range(rows):
+        for c in range(cols):
+            pr, pc = r + step, c + step
+            z = points[pr, pc, 2]
+            if not np.isfinite(z):
+                continue
+            jump = False
+            for nr, nc in ((pr, pc - step), (pr, pc + step), (pr - step, pc), (pr + step, pc)):
+                other = points[nr, nc, 2]
+                if not np.isfinite(other) or abs(z - other) > min(z, other) * relative32 + absolute32:
+                    jump = True
+            if jump:
+                continue
+            broken[r, c] = False
+            h0 = points[pr, pc + step, 0] - points[pr, pc - step, 0]
+            h1 = points[pr, pc + step, 1] - points[pr, pc - step, 1]
+            h2 = points[pr, pc + step, 2] - points[pr, pc - step, 2]
+            v0 = points[pr + step, pc, 0] - points[pr - step, pc, 0]
+            v1 = points[pr + step, pc, 1] - points[pr - step, pc, 1]
+            v2 = points[pr + step, pc, 2] - points[pr - step, pc, 2]
+            n0, n1, n2 = h1 * v2 - h2 * v1, h2 * v0 - h0 * v2, h0 * v1 - h1 * v0
+            length = np.sqrt(n0 * n0 + n1 * n1 + n2 * n2)
+            if not length > 0:
+                length = np.float32(1.0)
+            sign = np.float32(-1.0) if n0 * points[pr, pc, 0] + n1 * points[pr, pc, 1] + n2 * z > 0 else np.float32(1.0)
+            scale = sign / length
+            for axis, value in enumerate((n0 * scale, n1 * scale, n2 * scale)):
+                raw[r, c, axis] = value if np.isfinite(value) else np.float32(0.0)
+    radius = smoothing // 2
+    for r in range(rows):
+        for c in range(cols):
+            if broken[r, c]:
+                continue
+            s0, s1, s2 = 0.0, 0.0, 0.0
+            for wr in range(max(r - radius, 0), min(r + smoothing - radius, rows)):
+                for wc in range(max(c - radius, 0), min(c + smoothing - radius, cols)):
+                    s0 += raw[wr, wc, 0]
+                    s1 += raw[wr, wc, 1]
+                    s2 += raw[wr, wc, 2]
+            length = np.sqrt(s0 * s0 + s1 * s1 + s2 * s2)
+            if not length > 0:
+                length = 1.0
+            normals[r + step, c + step, 0] = np.float32(s0 / length)
+            normals[r + step, c + step, 1] = np.float32(s1 / length)
+            normals[r + step, c + step, 2] = np.float32(s2 / length)
+    return normals
