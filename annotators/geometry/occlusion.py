@@ -27,7 +27,7 @@ from dataclasses import dataclass
 import numpy as np
 from scipy import ndimage
 
-from annotators.geometry.grid_kernels import facing_values, grouped_pixels, shadowed_near
+from annotators.geometry.grid_kernels import grouped_pixels, piece_near, shadowed_near
 from annotators.geometry.grid_segmentation import depth_jump, join_labels, touching_pairs
 
 
@@ -75,7 +75,6 @@ def join_occluded(
     if count < 3:
         return labels
     depth = points[..., 2]
-    flat_points = points.reshape(-1, 3)
     flat_labels = labels.reshape(-1)
     sizes = np.bincount(flat_labels, minlength=count + 1)
     boxes = ndimage.find_objects(labels, max_label=count)
@@ -113,24 +112,16 @@ def join_occluded(
         behind = []
         for piece in candidates:
             own = near_pixels[near_starts[piece] : near_starts[piece + 1]]
-            rows, cols = own // window.shape[1], own % window.shape[1]
-            # the depths of the occluder's pixels within reach of the band
-            facing = facing_values(rows, cols, occluding, window_depth, reach)
-            if facing.size < rules.min_points:
-                continue
-            piece_depth = _finite_mean(window_depth[rows, cols])
-            occluder_depth = _finite_mean(facing)
+            facing, piece_depth, occluder_depth, flat, xyz, centre, pixel = piece_near(
+                own, (window.shape[1], y0, x0), occluding, window_depth, reach, points
+            )
+            if facing < rules.min_points:
+                continue  # too few of the occluder's pixels within reach of the band
             if not depth_jump(np.float32(piece_depth), np.float32(occluder_depth), absolute, relative):
                 continue
-            if piece_depth <= occluder_depth:
+            if piece_depth <= occluder_depth or xyz.shape[0] < rules.min_points:
                 continue
-            flat = (rows + y0) * labels.shape[1] + cols + x0
-            xyz = flat_points[flat]
-            xyz = xyz[np.isfinite(xyz).all(axis=1)]
-            if xyz.shape[0] < rules.min_points:
-                continue
-            pixel = np.array([rows.mean() + y0, cols.mean() + x0])
-            behind.append(_Piece(piece, flat, xyz, xyz.mean(axis=0), pixel))
+            behind.append(_Piece(piece, flat, xyz, centre, pixel))
         for index, first in enumerate(behind):
             for second in behind[index + 1 :]:
                 key = (min(first.label, second.label), max(first.label, second.label))
@@ -151,12 +142,6 @@ def _coplanar(first: _Piece, second: _Piece, flat: float) -> bool:
     centred = xyz - xyz.mean(axis=0)
     smallest = np.linalg.eigvalsh(centred.T @ centred / xyz.shape[0])[0]
     return bool(np.sqrt(max(smallest, 0.0)) <= flat)
-
-
-def _finite_mean(values: np.ndarray) -> float:
-    """The mean of the finite values (NaN when there is none)."""
-    finite = values[np.isfinite(values)]
-    return float(finite.mean()) if finite.size else float("nan")
 
 
 def _grown(box: tuple[slice, slice], shape: tuple[int, int], margin: int) -> tuple[int, int, int, int]:

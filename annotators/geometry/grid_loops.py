@@ -1,0 +1,384 @@
+"""The compiled loops behind :mod:`annotators.geometry.grid_kernels` (numba, machine code cached on disk next to
+this file). Importing this module imports numba; the segmentation modules reach it through
+:mod:`~annotators.geometry.grid_kernels` only, on first use."""
+
+from __future__ import annotations
+
+import numpy as np
+from numba import njit
+
+
+@njit(cache=True, nogil=True)
+def touching_keys(labels: np.ndarray, base: int) -> np.ndarray:
+    """See :func:`annotators.geometry.grid_kernels.touching_keys`."""
+    keys = np.empty(2 * labels.size, dtype=np.int64)
+    count = 0
+    rows, cols = labels.shape
+    for r in range(rows):
+        for c in range(cols):
+            a = labels[r, c]
+            if a <= 0:
+                continue
+            if c + 1 < cols:
+                b = labels[r, c + 1]
+                if b > 0 and b != a:
+                    keys[count] = min(a, b) * base + max(a, b)
+                    count += 1
+            if r + 1 < rows:
+                b = labels[r + 1, c]
+                if b > 0 and b != a:
+                    keys[count] = min(a, b) * base + max(a, b)
+                    count += 1
+    return keys[:count]
+
+
+@njit(cache=True, nogil=True)
+def facing_values(
+    rows: np.ndarray, cols: np.ndarray, target: np.ndarray, values: np.ndarray, radius: int
+) -> np.ndarray:
+    """See :func:`annotators.geometry.grid_kernels.facing_values`."""
+    height, width = target.shape
+    r0, c0 = max(rows.min() - radius, 0), max(cols.min() - radius, 0)
+    r1, c1 = min(rows.max() + radius + 1, height), min(cols.max() + radius + 1, width)
+    box_rows, box_cols = r1 - r0, c1 - c0
+    sums = np.zeros((box_rows + 1, box_cols + 1), dtype=np.int32)  # 2-D prefix sums of the marked pixels
+    for k in range(rows.size):
+        sums[rows[k] - r0 + 1, cols[k] - c0 + 1] = 1
+    for r in range(1, box_rows + 1):
+        for c in range(1, box_cols + 1):
+            sums[r, c] += sums[r - 1, c] + sums[r, c - 1] - sums[r - 1, c - 1]
+    found = np.empty(box_rows * box_cols, dtype=values.dtype)
+    count = 0
+    for r in range(box_rows):
+        top, bottom = max(r - radius, 0), min(r + radius + 1, box_rows)
+        for c in range(box_cols):
+            if not target[r0 + r, c0 + c]:
+                continue
+            left, right = max(c - radius, 0), min(c + radius + 1, box_cols)
+            if sums[bottom, right] - sums[top, right] - sums[bottom, left] + sums[top, left] > 0:
+                found[count] = values[r0 + r, c0 + c]
+                count += 1
+    return found[:count]
+
+
+@njit(cache=True, nogil=True)
+def shadowed_near(occluding: np.ndarray, unmeasured: np.ndarray, shadow_radius: int, near_radius: int) -> np.ndarray:
+    """See :func:`annotators.geometry.grid_kernels.shadowed_near`."""
+    rows, cols = occluding.shape
+
+    def box_sums(marked: np.ndarray) -> np.ndarray:  # sums[r, c]: the marked pixels above and left of (r, c)
+        sums = np.zeros((rows + 1, cols + 1), dtype=np.int32)
+        for r in range(rows):
+            running = 0
+            for c in range(cols):
+                running += marked[r, c]
+                sums[r + 1, c + 1] = sums[r, c + 1] + running
+        return sums
+
+    def any_within(sums: np.ndarray, r: int, c: int, radius: int) -> bool:
+        r0, r1 = max(r - radius, 0), min(r + radius + 1, rows)
+        c0, c1 = max(c - radius, 0), min(c + radius + 1, cols)
+        return sums[r1, c1] - sums[r0, c1] - sums[r1, c0] + sums[r0, c0] > 0
+
+    occluder_sums = box_sums(occluding)
+    region = occluding.copy()
+    stack = np.empty(rows * cols, dtype=np.int64)
+    seen = np.zeros((rows, cols), dtype=np.bool_)
+    top = 0
+    for r in range(rows):  # the shadow's seeds: unmeasured pixels beside the occluder
+        for c in range(cols):
+            if unmeasured[r, c] and any_within(occluder_sums, r, c, 1):
+                seen[r, c] = True
+                stack[top] = r * cols + c
+                top += 1
+    while top > 0:  # their 4-connected unmeasured regions, kept within reach of the occluder
+        top -= 1
+        r, c = stack[top] // cols, stack[top] % cols
+        if any_within(occluder_sums, r, c, shadow_radius):
+            region[r, c] = True
+        for dr, dc in ((0, -1), (0, 1), (-1, 0), (1, 0)):
+            nr, nc = r + dr, c + dc
+            if 0 <= nr < rows and 0 <= nc < cols and unmeasured[nr, nc] and not seen[nr, nc]:
+                seen[nr, nc] = True
+                stack[top] = nr * cols + nc
+                top += 1
+    region_sums = box_sums(region)
+    near = np.zeros((rows, cols), dtype=np.bool_)
+    for r in range(rows):
+        for c in range(cols):
+            near[r, c] = any_within(region_sums, r, c, near_radius)
+    return near
+
+
+@njit(cache=True, nogil=True)
+def upsampled_labels(
+    labels: np.ndarray,
+    coarse_depth: np.ndarray,
+    depth: np.ndarray,
+    keep: np.ndarray,
+    step: int,
+    absolute: float,
+    relative: float,
+) -> np.ndarray:
+    """See :func:`annotators.geometry.grid_kernels.upsampled_labels`."""
+    rows, cols = depth.shape
+    absolute32, relative32 = np.float32(absolute), np.float32(relative)
+    fine = np.zeros((rows, cols), dtype=np.int32)
+    for r in range(rows):
+        for c in range(cols):
+            label = labels[r // step, c // step]
+            if label == 0 or not keep[r, c]:
+                continue
+            z, sample = depth[r, c], coarse_depth[r // step, c // step]
+            nearer = sample if np.isnan(z) else (z if np.isnan(sample) else min(z, sample))
+            if not abs(z - sample) > nearer * relative32 + absolute32:
+                fine[r, c] = label
+    return fine
+
+
+@njit(cache=True, nogil=True)
+def label_pixels(labels: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """See :func:`annotators.geometry.grid_kernels.label_pixels`."""
+    rows, cols = labels.shape
+    count = 0
+    for r in range(rows):
+        for c in range(cols):
+            count = max(count, labels[r, c])
+    starts = np.zeros(count + 2, dtype=np.int64)
+    boxes = np.zeros((count + 1, 4), dtype=np.int64)
+    boxes[:, 0], boxes[:, 1] = cols, rows
+    for r in range(rows):
+        for c in range(cols):
+            label = labels[r, c]
+            if label > 0:
+                starts[label + 1] += 1
+                boxes[label, 0], boxes[label, 1] = min(boxes[label, 0], c), min(boxes[label, 1], r)
+                boxes[label, 2], boxes[label, 3] = max(boxes[label, 2], c + 1), max(boxes[label, 3], r + 1)
+    for label in range(1, count + 2):
+        starts[label] += starts[label - 1]
+    pixels = np.empty(starts[count + 1], dtype=np.int64)
+    filled = starts[:-1].copy()
+    for r in range(rows):
+        for c in range(cols):
+            label = labels[r, c]
+            if label > 0:
+                pixels[filled[label]] = r * cols + c
+                filled[label] += 1
+    for label in range(count + 1):
+        if starts[label + 1] == starts[label]:
+            boxes[label] = 0
+    return pixels, starts, boxes
+
+
+@njit(cache=True, nogil=True)
+def label_moments(
+    labels: np.ndarray, values: np.ndarray, means: np.ndarray, count: int
+) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """See :func:`annotators.geometry.grid_kernels.label_moments`."""
+    counts = np.zeros(count, dtype=np.int64)
+    sums = np.zeros((count, 3))
+    products = np.zeros((count, 6))
+    for k in range(labels.size):
+        label = labels[k]
+        a, b, c = values[0, k] - means[label, 0], values[1, k] - means[label, 1], values[2, k] - means[label, 2]
+        counts[label] += 1
+        sums[label, 0] += values[0, k]
+        sums[label, 1] += values[1, k]
+        sums[label, 2] += values[2, k]
+        products[label, 0] += a * a
+        products[label, 1] += a * b
+        products[label, 2] += a * c
+        products[label, 3] += b * b
+        products[label, 4] += b * c
+        products[label, 5] += c * c
+    return counts, sums, products
+
+
+@njit(cache=True, nogil=True)
+def label_centres(labels: np.ndarray, count: int) -> tuple[np.ndarray, np.ndarray]:
+    """See :func:`annotators.geometry.grid_kernels.label_centres`."""
+    counts = np.zeros(count, dtype=np.int64)
+    sums = np.zeros((count, 2))
+    rows, cols = labels.shape
+    for r in range(rows):
+        for c in range(cols):
+            label = labels[r, c]
+            counts[label] += 1
+            sums[label, 0] += r
+            sums[label, 1] += c
+    return counts, sums
+
+
+@njit(cache=True, nogil=True)
+def grouped_pixels(labels: np.ndarray, where: np.ndarray, count: int) -> tuple[np.ndarray, np.ndarray]:
+    """See :func:`annotators.geometry.grid_kernels.grouped_pixels`."""
+    rows, cols = labels.shape
+    starts = np.zeros(count + 2, dtype=np.int64)
+    for r in range(rows):
+        for c in range(cols):
+            if where[r, c] and labels[r, c] > 0:
+                starts[labels[r, c] + 1] += 1
+    for label in range(1, count + 2):
+        starts[label] += starts[label - 1]
+    pixels = np.empty(starts[count + 1], dtype=np.int64)
+    filled = starts[:-1].copy()
+    for r in range(rows):
+        for c in range(cols):
+            label = labels[r, c]
+            if where[r, c] and label > 0:
+                pixels[filled[label]] = r * cols + c
+                filled[label] += 1
+    return pixels, starts
+
+
+@njit(cache=True, nogil=True)
+def symmetric_eigen(matrices: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """See :func:`annotators.geometry.grid_kernels.symmetric_eigen`."""
+    count = matrices.shape[0]
+    values = np.empty((count, 3))
+    vectors = np.empty((count, 3, 3))
+    a = np.empty((3, 3))
+    v = np.empty((3, 3))
+    for k in range(count):
+        for i in range(3):
+            for j in range(3):
+                a[i, j] = matrices[k, i, j]
+                v[i, j] = 1.0 if i == j else 0.0
+        for _ in range(50):
+            off = a[0, 1] * a[0, 1] + a[0, 2] * a[0, 2] + a[1, 2] * a[1, 2]
+            scale = a[0, 0] * a[0, 0] + a[1, 1] * a[1, 1] + a[2, 2] * a[2, 2]
+            if off <= 1e-36 * scale or off == 0.0 or not np.isfinite(off):
+                break
+            for p, q in ((0, 1), (0, 2), (1, 2)):
+                if a[p, q] == 0.0:
+                    continue
+                theta = (a[q, q] - a[p, p]) / (2.0 * a[p, q])
+                t = 1.0 / (abs(theta) + np.sqrt(theta * theta + 1.0))
+                if theta < 0.0:
+                    t = -t
+                c = 1.0 / np.sqrt(t * t + 1.0)
+                s = t * c
+                for r in range(3):  # A <- A J (columns p, q)
+                    arp, arq = a[r, p], a[r, q]
+                    a[r, p], a[r, q] = c * arp - s * arq, s * arp + c * arq
+                for r in range(3):  # A <- J^T A (rows p, q)
+                    apr, aqr = a[p, r], a[q, r]
+                    a[p, r], a[q, r] = c * apr - s * aqr, s * apr + c * aqr
+                for r in range(3):
+                    vrp, vrq = v[r, p], v[r, q]
+                    v[r, p], v[r, q] = c * vrp - s * vrq, s * vrp + c * vrq
+        first, middle, last = 0, 1, 2  # the diagonal's order, by three comparisons
+        if a[first, first] > a[middle, middle]:
+            first, middle = middle, first
+        if a[middle, middle] > a[last, last]:
+            middle, last = last, middle
+        if a[first, first] > a[middle, middle]:
+            first, middle = middle, first
+        for i, column in enumerate((first, middle, last)):
+            values[k, i] = a[column, column]
+            for r in range(3):
+                vectors[k, r, i] = v[r, column]
+    return values, vectors
+
+
+@njit(cache=True, nogil=True)
+def organized_normals(points: np.ndarray, step: int, smoothing: int, absolute: float, relative: float) -> np.ndarray:
+    """See :func:`annotators.geometry.grid_kernels.organized_normals`."""
+    height, width = points.shape[0], points.shape[1]
+    normals = np.full((height, width, 3), np.nan, dtype=np.float32)
+    if height <= 2 * step or width <= 2 * step:
+        return normals
+    rows, cols = height - 2 * step, width - 2 * step
+    raw = np.zeros((rows, cols, 3), dtype=np.float32)
+    broken = np.ones((rows, cols), dtype=np.bool_)
+    absolute32, relative32 = np.float32(absolute), np.float32(relative)
+    for r in range(rows):
+        for c in range(cols):
+            pr, pc = r + step, c + step
+            z = points[pr, pc, 2]
+            if not np.isfinite(z):
+                continue
+            jump = False
+            for nr, nc in ((pr, pc - step), (pr, pc + step), (pr - step, pc), (pr + step, pc)):
+                other = points[nr, nc, 2]
+                if not np.isfinite(other) or abs(z - other) > min(z, other) * relative32 + absolute32:
+                    jump = True
+            if jump:
+                continue
+            broken[r, c] = False
+            h0 = points[pr, pc + step, 0] - points[pr, pc - step, 0]
+            h1 = points[pr, pc + step, 1] - points[pr, pc - step, 1]
+            h2 = points[pr, pc + step, 2] - points[pr, pc - step, 2]
+            v0 = points[pr + step, pc, 0] - points[pr - step, pc, 0]
+            v1 = points[pr + step, pc, 1] - points[pr - step, pc, 1]
+            v2 = points[pr + step, pc, 2] - points[pr - step, pc, 2]
+            n0, n1, n2 = h1 * v2 - h2 * v1, h2 * v0 - h0 * v2, h0 * v1 - h1 * v0
+            length = np.sqrt(n0 * n0 + n1 * n1 + n2 * n2)
+            if not length > 0:
+                length = np.float32(1.0)
+            sign = np.float32(-1.0) if n0 * points[pr, pc, 0] + n1 * points[pr, pc, 1] + n2 * z > 0 else np.float32(1.0)
+            scale = sign / length
+            for axis, value in enumerate((n0 * scale, n1 * scale, n2 * scale)):
+                raw[r, c, axis] = value if np.isfinite(value) else np.float32(0.0)
+    radius = smoothing // 2
+    for r in range(rows):
+        for c in range(cols):
+            if broken[r, c]:
+                continue
+            s0, s1, s2 = 0.0, 0.0, 0.0
+            for wr in range(max(r - radius, 0), min(r + smoothing - radius, rows)):
+                for wc in range(max(c - radius, 0), min(c + smoothing - radius, cols)):
+                    s0 += raw[wr, wc, 0]
+                    s1 += raw[wr, wc, 1]
+                    s2 += raw[wr, wc, 2]
+            length = np.sqrt(s0 * s0 + s1 * s1 + s2 * s2)
+            if not length > 0:
+                length = 1.0
+            normals[r + step, c + step, 0] = np.float32(s0 / length)
+            normals[r + step, c + step, 1] = np.float32(s1 / length)
+            normals[r + step, c + step, 2] = np.float32(s2 / length)
+    return normals
+
+
+@njit(cache=True, nogil=True)
+def piece_near(
+    own: np.ndarray,
+    window: tuple[int, int, int],
+    occluding: np.ndarray,
+    depth: np.ndarray,
+    radius: int,
+    points: np.ndarray,
+) -> tuple[int, float, float, np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
+    """See :func:`annotators.geometry.grid_kernels.piece_near`."""
+    width, y0, x0 = window
+    rows, cols = own // width, own % width
+    facing = facing_values(rows, cols, occluding, depth, radius)
+    total, known = 0.0, 0
+    for value in facing:
+        if np.isfinite(value):
+            total += value
+            known += 1
+    occluder_depth = total / known if known else np.nan
+    total, known = 0.0, 0
+    for k in range(own.size):
+        value = depth[rows[k], cols[k]]
+        if np.isfinite(value):
+            total += value
+            known += 1
+    piece_depth = total / known if known else np.nan
+    grid_cols = points.shape[1]
+    flat = (rows + y0) * grid_cols + cols + x0
+    xyz = np.empty((own.size, 3), dtype=np.float32)
+    centre = np.zeros(3)
+    count = 0
+    for k in range(own.size):
+        r, c = rows[k] + y0, cols[k] + x0
+        if np.isfinite(points[r, c, 0]) and np.isfinite(points[r, c, 1]) and np.isfinite(points[r, c, 2]):
+            for axis in range(3):
+                xyz[count, axis] = points[r, c, axis]
+                centre[axis] += points[r, c, axis]
+            count += 1
+    if count:
+        centre /= count
+    pixel = np.array([rows.mean() + y0, cols.mean() + x0])
+    return facing.size, piece_depth, occluder_depth, flat, xyz[:count], centre, pixel
