@@ -123,3 +123,22 @@ def piece_near(
     of the band and of those occluder pixels (NaN when there is none), the band's flat indices in the grid, its
     finite points (Nx3 float32), their centroid and the band's mean pixel (row, column) in the grid."""
     return _loops().piece_near(own, window, occluding, depth, radius, points)
+
+
+def boundary_pairs(
+    labels: np.ndarray,
+    points: np.ndarray,
+    normals: np.ndarray,
+    reach: int,
+    absolute: float,
+    relative: float,
+    near_factor: float,
+) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
+    """Per 4-neighbour pixel pair of different non-zero labels ``a``, ``b`` (HxW ``labels``; horizontal pairs in
+    row-major order, then vertical ones): the key ``min * (max label + 1) + max``, whether a depth jump
+    (``absolute + relative * nearer depth``) parts them, whether their points (HxWx3 float32) are at most
+    ``near_factor`` times the nearer depth apart, and - where the pixels ``reach`` further out on either side
+    still carry ``a`` and ``b`` - the dot product of those pixels' normals and ``(n_a - n_b) . (p_a - p_b) /
+    |p_a - p_b|`` (float32, NaN elsewhere): the per-pair values :func:`~annotators.geometry.grid_segmentation.
+    boundaries` sums up per label pair."""
+    return _loops().boundary_pairs(labels, points, normals, reach, absolute, relative, near_factor)

@@ -382,3 +382,58 @@ def piece_near(
         centre /= count
     pixel = np.array([rows.mean() + y0, cols.mean() + x0])
     return facing.size, piece_depth, occluder_depth, flat, xyz[:count], centre, pixel
+
+
+@njit(cache=True, nogil=True)
+def boundary_pairs(
+    labels: np.ndarray,
+    points: np.ndarray,
+    normals: np.ndarray,
+    reach: int,
+    absolute: float,
+    relative: float,
+    near_factor: float,
+) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
+    """See :func:`annotators.geometry.grid_kernels.boundary_pairs`."""
+    rows, cols = labels.shape
+    base = np.int64(labels.max()) + 1
+    size = 2 * labels.size
+    keys = np.empty(size, dtype=np.int64)
+    jumps = np.empty(size, dtype=np.bool_)
+    near = np.empty(size, dtype=np.bool_)
+    dots = np.empty(size, dtype=np.float32)
+    convex = np.empty(size, dtype=np.float32)
+    absolute32, relative32, near32 = np.float32(absolute), np.float32(relative), np.float32(near_factor)
+    count = 0
+    for down, right in ((0, 1), (1, 0)):
+        for r in range(rows - down):
+            for c in range(cols - right):
+                a, b = labels[r, c], labels[r + down, c + right]
+                if a == b or a <= 0 or b <= 0:
+                    continue
+                keys[count] = min(a, b) * base + max(a, b)
+                za, zb = points[r, c, 2], points[r + down, c + right, 2]
+                nearer = zb if np.isnan(za) else (za if np.isnan(zb) else min(za, zb))
+                jumps[count] = abs(za - zb) > nearer * relative32 + absolute32
+                d0 = points[r, c, 0] - points[r + down, c + right, 0]
+                d1 = points[r, c, 1] - points[r + down, c + right, 1]
+                d2 = za - zb
+                near[count] = np.sqrt(d0 * d0 + d1 * d1 + d2 * d2) <= near32 * nearer
+                dots[count], convex[count] = np.nan, np.nan
+                br, bc = r - reach * down, c - reach * right
+                ar, ac = r + (reach + 1) * down, c + (reach + 1) * right
+                if br >= 0 and bc >= 0 and ar < rows and ac < cols and labels[br, bc] == a and labels[ar, ac] == b:
+                    n0 = normals[br, bc, 0] - normals[ar, ac, 0]
+                    n1 = normals[br, bc, 1] - normals[ar, ac, 1]
+                    n2 = normals[br, bc, 2] - normals[ar, ac, 2]
+                    o0 = points[br, bc, 0] - points[ar, ac, 0]
+                    o1 = points[br, bc, 1] - points[ar, ac, 1]
+                    o2 = points[br, bc, 2] - points[ar, ac, 2]
+                    dots[count] = (
+                        normals[br, bc, 0] * normals[ar, ac, 0]
+                        + normals[br, bc, 1] * normals[ar, ac, 1]
+                        + normals[br, bc, 2] * normals[ar, ac, 2]
+                    )
+                    convex[count] = (n0 * o0 + n1 * o1 + n2 * o2) / np.sqrt(o0 * o0 + o1 * o1 + o2 * o2)
+                count += 1
+    return keys[:count], jumps[:count], near[:count], dots[:count], convex[:count]

@@ -12,7 +12,7 @@ from dataclasses import dataclass
 import cv2
 import numpy as np
 
-from annotators.geometry.grid_kernels import touching_keys
+from annotators.geometry.grid_kernels import boundary_pairs, touching_keys
 
 
 def _neighbour_views(array: np.ndarray) -> list[tuple[np.ndarray, np.ndarray]]:
@@ -512,32 +512,6 @@ def pixel_footprint(points: np.ndarray) -> float:
     return float(_median(steps)) if steps.size else 0.0
 
 
-def _touching_pixels(labels: np.ndarray, reach: int) -> list[tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]]:
-    """For horizontal, then vertical 4-neighbour pairs of different non-zero labels: the flat indices of the first
-    and second pixel (row-major order) and of the pixels ``reach`` further out on each side (left of the left
-    pixel and right of the right one, above / below for vertical pairs; -1 where that lies off the grid)."""
-    rows, cols = labels.shape
-    found = []
-    for down, right in ((0, 1), (1, 0)):
-        l_a, l_b = labels[: rows - down, : cols - right], labels[down:, right:]
-        r, c = np.nonzero((l_a != l_b) & (l_a > 0) & (l_b > 0))
-        first = r * cols + c
-        second = first + (down * cols + right)
-        before_r, before_c = r - reach * down, c - reach * right
-        after_r, after_c = r + (reach + 1) * down, c + (reach + 1) * right
-        before = np.where((before_r >= 0) & (before_c >= 0), before_r * cols + before_c, -1)
-        after = np.where((after_r < rows) & (after_c < cols), after_r * cols + after_c, -1)
-        found.append((first, second, before, after))
-    return found
-
-
-def _gather(flat: np.ndarray, indices: np.ndarray, fill: float) -> np.ndarray:
-    """``flat[indices]`` with ``fill`` where an index is -1 (off the grid)."""
-    values = flat[np.maximum(indices, 0)]
-    values[indices < 0] = fill
-    return values
-
-
 def boundaries(
     labels: np.ndarray,
     points: np.ndarray,
@@ -555,30 +529,19 @@ def boundaries(
     across it. Only the boundary pixels and those beside them are read.
     """
     footprint = pixel_footprint(points)
-    keys, jumps, dots, convex, near = [], [], [], [], []
-    base = int(labels.max(initial=0)) + 1
-    flat_labels, flat_points, flat_normals = labels.reshape(-1), points.reshape(-1, 3), normals.reshape(-1, 3)
-    for first, second, before, after in _touching_pixels(labels, reach):
-        a, b = flat_labels[first].astype(np.int64), flat_labels[second].astype(np.int64)
-        keys.append(np.minimum(a, b) * base + np.maximum(a, b))
-        pa, pb = flat_points[first], flat_points[second]
-        jumps.append(depth_jump(pa[:, 2], pb[:, 2], absolute, relative))
-        with np.errstate(invalid="ignore"):
-            near.append(np.linalg.norm(pa - pb, axis=1) <= close_factor * footprint * np.fmin(pa[:, 2], pb[:, 2]))
-        same = (_gather(flat_labels, before, 0) == a) & (_gather(flat_labels, after, 0) == b)
-        na, nb = _gather(flat_normals, before, np.nan), _gather(flat_normals, after, np.nan)
-        offset = _gather(flat_points, before, np.nan) - _gather(flat_points, after, np.nan)
-        with np.errstate(invalid="ignore", divide="ignore"):
-            dots.append(np.where(same, np.einsum("ij,ij->i", na, nb), np.nan))
-            convex.append(
-                np.where(same, np.einsum("ij,ij->i", na - nb, offset) / np.linalg.norm(offset, axis=1), np.nan)
-            )
-    key = np.concatenate(keys)
+    key, jump, near, dot, convexity = boundary_pairs(
+        np.ascontiguousarray(labels),
+        np.ascontiguousarray(points, dtype=np.float32),
+        np.ascontiguousarray(normals, dtype=np.float32),
+        reach,
+        absolute,
+        relative,
+        close_factor * footprint,
+    )
     if key.size == 0:
         empty = np.zeros(0)
         return Boundaries(np.zeros((0, 2), np.int64), empty, empty, empty, empty, empty, empty, empty)
     unique, inverse = np.unique(key, return_inverse=True)
-    jump, dot, convexity = np.concatenate(jumps), np.concatenate(dots), np.concatenate(convex)
     length = np.bincount(inverse, minlength=unique.size).astype(np.float64)
     smooth = ~jump
     known = smooth & np.isfinite(dot) & np.isfinite(convexity)
@@ -588,7 +551,8 @@ def boundaries(
         mean_convexity = np.bincount(inverse, weights=np.where(known, convexity, 0.0), minlength=unique.size)
         mean_convexity /= known_count
     continuous = np.bincount(inverse, weights=smooth, minlength=unique.size) / length
-    close = np.bincount(inverse, weights=np.concatenate(near), minlength=unique.size) / length
+    close = np.bincount(inverse, weights=near, minlength=unique.size) / length
+    base = int(labels.max(initial=0)) + 1
     pairs = np.column_stack([unique // base, unique % base])
     crease_length = np.bincount(inverse, weights=known & (convexity < -crease), minlength=unique.size)
     with np.errstate(invalid="ignore", divide="ignore"):
