@@ -29,7 +29,7 @@ import numpy as np
 from annotators.cloud.normals import grid_normals
 from annotators.cloud.plane import plane_basis, plane_distances
 from annotators.cloud.point_cloud import cloud_problem
-from annotators.geometry.grid_kernels import label_pixels, upsampled_labels
+from annotators.geometry.grid_kernels import label_pixels, standing_candidates, upsampled_labels
 from annotators.geometry.grid_segmentation import (
     MergeRules,
     boundaries,
@@ -96,13 +96,12 @@ class ClusterParameters:
         )
 
 
-def inside_plane_extent(feet: np.ndarray, plane_feet: np.ndarray, margin: float, cell: float) -> np.ndarray:
-    """For Nx2 plane coordinates ``feet``: inside the convex hull of ``plane_feet`` shrunk by ``margin``?
-
-    The hull is rasterized with ``cell`` metres per pixel and eroded, so the test is one lookup per point.
-    """
-    if plane_feet.shape[0] < 3 or feet.shape[0] == 0:
-        return np.zeros(feet.shape[0], dtype=bool)
+def plane_extent(plane_feet: np.ndarray, margin: float, cell: float) -> tuple[np.ndarray, np.ndarray] | None:
+    """The convex hull of the Nx2 plane coordinates ``plane_feet`` shrunk by ``margin``, rasterized with ``cell``
+    metres per pixel and eroded: the raster (uint8, 1 inside; rows along the second coordinate) and the plane
+    coordinates of its corner (float32), so the test of a point is one lookup. None for fewer than 3 feet."""
+    if plane_feet.shape[0] < 3:
+        return None
     hull = cv2.convexHull(plane_feet.astype(np.float32)).reshape(-1, 2)
     pad = round(margin / cell) + 1  # room so that erosion also shrinks the hull where it touches the raster edge
     low = hull.min(axis=0) - pad * cell
@@ -111,11 +110,7 @@ def inside_plane_extent(feet: np.ndarray, plane_feet: np.ndarray, margin: float,
     cv2.fillConvexPoly(raster, np.round((hull - low) / cell).astype(np.int32), 1)
     if pad > 1:
         raster = cv2.erode(raster, np.ones((2 * pad - 1, 2 * pad - 1), np.uint8))
-    cells = np.floor((feet - low) / cell).astype(np.int64)
-    inside = (cells[:, 0] >= 0) & (cells[:, 1] >= 0) & (cells[:, 0] < size[0]) & (cells[:, 1] < size[1])
-    result = np.zeros(feet.shape[0], dtype=bool)
-    result[inside] = raster[cells[inside, 1], cells[inside, 0]] > 0
-    return result
+    return raster, low
 
 
 def extract_clusters(
@@ -170,17 +165,17 @@ def standing_region(
     step = max(1, p.stride)
     basis = plane_basis(np.asarray(model[:3], dtype=np.float64)).T.astype(np.float32)
     coarse_points = points[::step, ::step]
-    coarse = _candidates(coarse_points, mask[::step, ::step], model, p)
-    coarse_indices = np.flatnonzero(coarse)
-    if coarse_indices.size == 0:
-        return coarse
+    heights = plane_distances(coarse_points, model)
     flat = points.reshape(-1, 3)
     plane_points = flat[plane_indices[:: max(1, plane_indices.size // 2000)]]
     plane_points = plane_points[np.isfinite(plane_points).all(axis=1)]
-    feet = points[coarse_indices // coarse.shape[1] * step, coarse_indices % coarse.shape[1] * step] @ basis
-    inside = inside_plane_extent(feet, plane_points @ basis, p.hull_margin, p.hull_cell)
-    coarse.reshape(-1)[coarse_indices[~inside]] = False
-    return coarse
+    extent = plane_extent(plane_points @ basis, p.hull_margin, p.hull_cell)
+    if extent is None:
+        return np.zeros(heights.shape, dtype=bool)
+    raster, low = extent
+    return standing_candidates(
+        heights, mask[::step, ::step], coarse_points, basis, raster, low, p.hull_cell, p.min_height, p.max_height
+    )
 
 
 def full_resolution_segments(

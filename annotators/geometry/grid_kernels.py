@@ -142,3 +142,21 @@ def boundary_pairs(
     |p_a - p_b|`` (float32, NaN elsewhere): the per-pair values :func:`~annotators.geometry.grid_segmentation.
     boundaries` sums up per label pair."""
     return _loops().boundary_pairs(labels, points, normals, reach, absolute, relative, near_factor)
+
+
+def standing_candidates(
+    heights: np.ndarray,
+    mask: np.ndarray,
+    points: np.ndarray,
+    basis: np.ndarray,
+    raster: np.ndarray,
+    low: np.ndarray,
+    cell: float,
+    min_height: float,
+    max_height: float,
+) -> np.ndarray:
+    """HxW bool: the ``mask`` pixels whose height above the plane (``heights``, float32) lies strictly between
+    ``min_height`` and ``max_height`` and whose foot on the plane (the point, HxWx3 float32, times the 3x2 float32
+    ``basis``) falls in a non-zero cell of ``raster`` (cells of ``cell`` metres, corner ``low``; rows along the
+    second coordinate)."""
+    return _loops().standing_candidates(heights, mask, points, basis, raster, low, cell, min_height, max_height)

@@ -437,3 +437,33 @@ def boundary_pairs(
                     convex[count] = (n0 * o0 + n1 * o1 + n2 * o2) / np.sqrt(o0 * o0 + o1 * o1 + o2 * o2)
                 count += 1
     return keys[:count], jumps[:count], near[:count], dots[:count], convex[:count]
+
+
+@njit(cache=True, nogil=True)
+def standing_candidates(
+    heights: np.ndarray,
+    mask: np.ndarray,
+    points: np.ndarray,
+    basis: np.ndarray,
+    raster: np.ndarray,
+    low: np.ndarray,
+    cell: float,
+    min_height: float,
+    max_height: float,
+) -> np.ndarray:
+    """See :func:`annotators.geometry.grid_kernels.standing_candidates`."""
+    rows, cols = heights.shape
+    candidates = np.zeros((rows, cols), dtype=np.bool_)
+    cell32, low32, high32 = np.float32(cell), np.float32(min_height), np.float32(max_height)
+    for r in range(rows):
+        for c in range(cols):
+            height = heights[r, c]
+            if not (mask[r, c] and height > low32 and height < high32):
+                continue
+            x, y, z = points[r, c, 0], points[r, c, 1], points[r, c, 2]
+            u = x * basis[0, 0] + y * basis[1, 0] + z * basis[2, 0]
+            v = x * basis[0, 1] + y * basis[1, 1] + z * basis[2, 1]
+            column, row = np.floor((u - low[0]) / cell32), np.floor((v - low[1]) / cell32)
+            if 0 <= column < raster.shape[1] and 0 <= row < raster.shape[0]:
+                candidates[r, c] = raster[int(row), int(column)] > 0
+    return candidates
