@@ -160,3 +160,9 @@ def standing_candidates(
     ``basis``) falls in a non-zero cell of ``raster`` (cells of ``cell`` metres, corner ``low``; rows along the
     second coordinate)."""
     return _loops().standing_candidates(heights, mask, points, basis, raster, low, cell, min_height, max_height)
+
+
+def connected_parts(region: np.ndarray, min_points: int) -> np.ndarray:
+    """HxW int32: the 4-connected parts of the HxW bool ``region`` with at least ``min_points`` pixels, labelled
+    1..n in the raster order of their first pixels (as ``cv2.connectedComponents`` numbers them); 0 elsewhere."""
+    return _loops().connected_parts(region, min_points)

@@ -467,3 +467,53 @@ def standing_candidates(
             if 0 <= column < raster.shape[1] and 0 <= row < raster.shape[0]:
                 candidates[r, c] = raster[int(row), int(column)] > 0
     return candidates
+
+
+@njit(cache=True, nogil=True)
+def connected_parts(region: np.ndarray, min_points: int) -> np.ndarray:
+    """See :func:`annotators.geometry.grid_kernels.connected_parts`."""
+    rows, cols = region.shape
+    provisional = np.zeros((rows, cols), dtype=np.int32)
+    parent = np.empty(rows * cols // 2 + 2, dtype=np.int32)
+    count = 0
+
+    def root(node: int) -> int:
+        while parent[node] != node:
+            parent[node] = parent[parent[node]]
+            node = parent[node]
+        return node
+
+    for r in range(rows):
+        for c in range(cols):
+            if not region[r, c]:
+                continue
+            left = provisional[r, c - 1] if c > 0 else 0
+            up = provisional[r - 1, c] if r > 0 else 0
+            if left == 0 and up == 0:
+                count += 1  # at most every other pixel starts a label: the parent table is large enough
+                parent[count] = count
+                provisional[r, c] = count
+            elif left == 0 or up == 0:
+                provisional[r, c] = left + up
+            else:
+                a, b = root(left), root(up)
+                if a != b:
+                    parent[max(a, b)] = min(a, b)
+                provisional[r, c] = min(a, b)
+    sizes = np.zeros(count + 1, dtype=np.int64)
+    for r in range(rows):
+        for c in range(cols):
+            if provisional[r, c]:
+                provisional[r, c] = root(provisional[r, c])
+                sizes[provisional[r, c]] += 1
+    final = np.zeros(count + 1, dtype=np.int32)
+    number = 0
+    for label in range(1, count + 1):  # roots are each part's first label in raster order
+        if parent[label] == label and sizes[label] >= min_points:
+            number += 1
+            final[label] = number
+    labels = np.empty((rows, cols), dtype=np.int32)
+    for r in range(rows):
+        for c in range(cols):
+            labels[r, c] = final[provisional[r, c]]
+    return labels

@@ -12,7 +12,7 @@ from dataclasses import dataclass
 import cv2
 import numpy as np
 
-from annotators.geometry.grid_kernels import boundary_pairs, touching_keys
+from annotators.geometry.grid_kernels import boundary_pairs, connected_parts, touching_keys
 
 
 def _neighbour_views(array: np.ndarray) -> list[tuple[np.ndarray, np.ndarray]]:
@@ -91,11 +91,7 @@ def color_edges(colors: np.ndarray, low: float, high: float) -> np.ndarray:
 
 def label_parts(region: np.ndarray, min_points: int) -> np.ndarray:
     """4-connected components of ``region`` with at least ``min_points`` pixels, labelled 1..n (int32)."""
-    _, labels, stats, _ = cv2.connectedComponentsWithStats(np.ascontiguousarray(region).view(np.uint8), connectivity=4)
-    keep = stats[:, cv2.CC_STAT_AREA] >= min_points
-    keep[0] = False
-    renumber = (np.cumsum(keep) * keep).astype(np.int32)
-    return renumber[labels]
+    return connected_parts(np.ascontiguousarray(region, dtype=bool), min_points)
 
 
 def grow_labels(labels: np.ndarray, region: np.ndarray, max_distance: float) -> np.ndarray:
