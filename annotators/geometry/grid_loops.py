@@ -517,3 +517,74 @@ def connected_parts(region: np.ndarray, min_points: int) -> np.ndarray:
         for c in range(cols):
             labels[r, c] = final[provisional[r, c]]
     return labels
+
+
+@njit(cache=True, nogil=True)
+def _quantiles(values: np.ndarray, low: float, high: float) -> tuple[float, float]:
+    """The ``low`` and ``high`` quantiles of a 1-D array by sorting (``_range`` of grid_segmentation)."""
+    ordered = np.sort(values)
+    last = ordered.size - 1
+    return float(ordered[int(np.rint(low * last))]), float(ordered[int(np.rint(high * last))])
+
+
+@njit(cache=True, nogil=True)
+def _projected(points: np.ndarray, direction: np.ndarray) -> np.ndarray:
+    """``points[:, :2] @ direction`` in float32."""
+    result = np.empty(points.shape[0], dtype=np.float32)
+    for k in range(points.shape[0]):
+        result[k] = points[k, 0] * direction[0] + points[k, 1] * direction[1]
+    return result
+
+
+@njit(cache=True, nogil=True)
+def container_numbers(near: np.ndarray) -> tuple[bool, np.ndarray, float, float, float, float, float]:
+    """See :func:`annotators.geometry.grid_kernels.container_numbers`."""
+    along = np.zeros(2, dtype=np.float32)
+    if near.shape[0] < 3:
+        return False, along, 0.0, 0.0, 0.0, 0.0, 0.0
+    sum0, sum1 = np.float32(0.0), np.float32(0.0)
+    for k in range(near.shape[0]):
+        sum0 += near[k, 0]
+        sum1 += near[k, 1]
+    count = np.float32(near.shape[0])
+    centre0, centre1 = sum0 / count, sum1 / count
+    distance = float(np.sqrt(centre0 * centre0 + centre1 * centre1))
+    if distance < 1e-6:
+        return False, along, 0.0, 0.0, 0.0, 0.0, 0.0
+    along[0], along[1] = np.float32(centre0 / distance), np.float32(centre1 / distance)
+    across = np.array([-along[1], along[0]], dtype=np.float32)
+    low, high = _quantiles(_projected(near, across), 0.05, 0.95)
+    heights = np.empty(near.shape[0], dtype=np.float32)
+    for k in range(near.shape[0]):
+        heights[k] = near[k, 2]
+    rim = _quantiles(heights, 0.5, 0.95)[1]
+    front, middle = _quantiles(_projected(near, along), 0.05, 0.5)
+    return True, along, low, high, rim, front, middle
+
+
+@njit(cache=True, nogil=True)
+def could_hold(
+    far: np.ndarray,
+    along: np.ndarray,
+    across: np.ndarray,
+    bounds: tuple[float, float, float, float, float, float],
+    depth_ratio: float,
+    inner_spread: float,
+) -> bool:
+    """See :func:`annotators.geometry.grid_kernels.could_hold`."""
+    low, high, margin, rim, front, middle = bounds
+    if far.shape[0] < 3:
+        return False
+    far_low, far_high = _quantiles(_projected(far, across), 0.05, 0.95)
+    if far_low < low - margin or far_high > high + margin:
+        return False
+    heights = np.empty(far.shape[0], dtype=far.dtype)
+    for k in range(far.shape[0]):
+        heights[k] = far[k, 2]
+    far_median, far_top = _quantiles(heights, 0.5, 0.95)
+    if far_top > rim + margin:
+        return False
+    far_middle, far_back = _quantiles(_projected(far, along), 0.5, 0.95)
+    if far_middle <= middle or far_back > front + depth_ratio * (high - low):
+        return False
+    return far_top - far_median >= inner_spread * rim or far_median <= 0.5 * rim
