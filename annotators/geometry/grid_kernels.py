@@ -166,24 +166,3 @@ def connected_parts(region: np.ndarray, min_points: int) -> np.ndarray:
     """HxW int32: the 4-connected parts of the HxW bool ``region`` with at least ``min_points`` pixels, labelled
     1..n in the raster order of their first pixels (as ``cv2.connectedComponents`` numbers them); 0 elsewhere."""
     return _loops().connected_parts(region, min_points)
-
-
-def container_numbers(near: np.ndarray) -> tuple[bool, np.ndarray, float, float, float, float, float]:
-    """The numbers of :func:`annotators.geometry.grid_segmentation.container_outside` for the Nx3 float32 plane
-    coordinates ``near``: whether it can be a container's outside (3 points or more, not right below the camera),
-    the unit direction ``along`` the line of sight (float32), the 5 % and 95 % extent across it, the rim (95 %
-    height), and the 5 % and 50 % positions along it."""
-    return _loops().container_numbers(near)
-
-
-def could_hold(
-    far: np.ndarray,
-    along: np.ndarray,
-    across: np.ndarray,
-    bounds: tuple[float, float, float, float, float, float],
-    depth_ratio: float,
-    inner_spread: float,
-) -> bool:
-    """:meth:`annotators.geometry.grid_segmentation.ContainerOutside.could_hold` of the Nx3 float32 plane
-    coordinates ``far``, with the outside's directions and ``bounds = (low, high, margin, rim, front, middle)``."""
-    return _loops().could_hold(far, along, across, bounds, depth_ratio, inner_spread)

@@ -12,13 +12,7 @@ from dataclasses import dataclass
 import cv2
 import numpy as np
 
-from annotators.geometry.grid_kernels import (
-    boundary_pairs,
-    connected_parts,
-    container_numbers,
-    could_hold,
-    touching_keys,
-)
+from annotators.geometry.grid_kernels import boundary_pairs, connected_parts, touching_keys
 
 
 def _neighbour_views(array: np.ndarray) -> list[tuple[np.ndarray, np.ndarray]]:
@@ -391,24 +385,35 @@ class ContainerOutside:
 
     def could_hold(self, far: np.ndarray, depth_ratio: float) -> bool:
         """Could part ``far`` (Nx3 plane coordinates) be the inside of this container?"""
-        bounds = (self.low, self.high, self.margin, self.rim, self.front, self.middle)
-        return bool(
-            could_hold(
-                np.ascontiguousarray(far, dtype=np.float32), self.along, self.across, bounds, depth_ratio, INNER_SPREAD
-            )
-        )
+        if far.shape[0] < 3:
+            return False
+        far_low, far_high = _range(far[:, :2] @ self.across, 0.05, 0.95)
+        if far_low < self.low - self.margin or far_high > self.high + self.margin:
+            return False
+        far_median, far_top = _range(far[:, 2], 0.5, 0.95)
+        if far_top > self.rim + self.margin:
+            return False
+        far_middle, far_back = _range(far[:, :2] @ self.along, 0.5, 0.95)
+        if far_middle <= self.middle or far_back > self.front + depth_ratio * (self.high - self.low):
+            return False
+        return far_top - far_median >= INNER_SPREAD * self.rim or far_median <= 0.5 * self.rim
 
 
 def container_outside(near: np.ndarray, tolerance: float) -> ContainerOutside | None:
     """Part ``near`` (Nx3 plane coordinates) as the outside of a possible container (``tolerance`` metres of
     margin at least); None when it has too few points or lies right below the camera."""
-    usable, along, near_low, near_high, rim, near_front, near_middle = container_numbers(
-        np.ascontiguousarray(near, dtype=np.float32)
-    )
-    if not usable:
+    if near.shape[0] < 3:
         return None
-    across = np.array([-along[1], along[0]], dtype=np.float32)
+    centre = near[:, :2].mean(axis=0)
+    distance = float(np.linalg.norm(centre))
+    if distance < 1e-6:
+        return None
+    along = centre / distance
+    across = np.array([-along[1], along[0]], dtype=near.dtype)
+    near_low, near_high = _range(near[:, :2] @ across, 0.05, 0.95)
     margin = max(tolerance, 0.1 * (near_high - near_low))
+    rim = _range(near[:, 2], 0.5, 0.95)[1]
+    near_front, near_middle = _range(near[:, :2] @ along, 0.05, 0.5)
     return ContainerOutside(along, across, near_low, near_high, margin, rim, near_front, near_middle)
 
 
