@@ -115,7 +115,6 @@ def upsampled_labels(
     labels: np.ndarray,
     coarse_depth: np.ndarray,
     depth: np.ndarray,
-    keep: np.ndarray,
     step: int,
     absolute: float,
     relative: float,
@@ -127,7 +126,7 @@ def upsampled_labels(
     for r in range(rows):
         for c in range(cols):
             label = labels[r // step, c // step]
-            if label == 0 or not keep[r, c]:
+            if label == 0:
                 continue
             z, sample = depth[r, c], coarse_depth[r // step, c // step]
             nearer = sample if np.isnan(z) else (z if np.isnan(sample) else min(z, sample))
