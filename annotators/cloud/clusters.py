@@ -199,12 +199,10 @@ def full_resolution_segments(
     fy1, fx1 = min(y1 * step, rows), min(x1 * step, cols)
     width = fx1 - fx0
     fine_points = points[fy0:fy1, fx0:fx1]
-    fine = upsampled_labels(labels, coarse_depth, fine_points[..., 2], step, p.jump_absolute, p.jump_relative)
-    # of those, the candidates (heights only where a label arrived: each point's height is computed alone)
-    own = np.flatnonzero(fine)
-    rows_of, cols_of = own // width + fy0, own % width + fx0
-    keep = _candidates(points[rows_of, cols_of], mask[rows_of, cols_of], model, p)
-    fine.reshape(-1)[own[~keep]] = 0
+    candidates = _candidates(fine_points, mask[fy0:fy1, fx0:fx1], model, p)
+    fine = upsampled_labels(
+        labels, coarse_depth, fine_points[..., 2], candidates, step, p.jump_absolute, p.jump_relative
+    )
     pixels, starts, boxes = label_pixels(fine)
     sizes = np.diff(starts)
     kept = [label for label in range(1, sizes.size) if sizes[label] >= p.min_points]

@@ -51,14 +51,15 @@ def upsampled_labels(
     labels: np.ndarray,
     coarse_depth: np.ndarray,
     depth: np.ndarray,
+    keep: np.ndarray,
     step: int,
     absolute: float,
     relative: float,
 ) -> np.ndarray:
     """HxW int32 (the shape of ``depth``, float32): each pixel's label in ``labels`` (every ``step``-th pixel's)
-    where no depth jump (:func:`~annotators.geometry.grid_segmentation.depth_jump`'s float32 arithmetic) parts it
-    from its coarse sample's depth ``coarse_depth``; 0 elsewhere."""
-    return _loops().upsampled_labels(labels, coarse_depth, depth, step, absolute, relative)
+    where ``keep`` (HxW bool) allows it and no depth jump (:func:`depth_jump`'s float32 arithmetic) parts it from
+    its coarse sample's depth ``coarse_depth``; 0 elsewhere."""
+    return _loops().upsampled_labels(labels, coarse_depth, depth, keep, step, absolute, relative)
 
 
 def label_pixels(labels: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray]:

@@ -115,6 +115,7 @@ def upsampled_labels(
     labels: np.ndarray,
     coarse_depth: np.ndarray,
     depth: np.ndarray,
+    keep: np.ndarray,
     step: int,
     absolute: float,
     relative: float,
@@ -126,7 +127,7 @@ def upsampled_labels(
     for r in range(rows):
         for c in range(cols):
             label = labels[r // step, c // step]
-            if label == 0:
+            if label == 0 or not keep[r, c]:
                 continue
             z, sample = depth[r, c], coarse_depth[r // step, c // step]
             nearer = sample if np.isnan(z) else (z if np.isnan(sample) else min(z, sample))
