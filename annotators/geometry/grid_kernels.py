@@ -166,3 +166,10 @@ def connected_parts(region: np.ndarray, min_points: int) -> np.ndarray:
     """HxW int32: the 4-connected parts of the HxW bool ``region`` with at least ``min_points`` pixels, labelled
     1..n in the raster order of their first pixels (as ``cv2.connectedComponents`` numbers them); 0 elsewhere."""
     return _loops().connected_parts(region, min_points)
+
+
+def object_pieces(labels: np.ndarray, parts: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """The pieces objects are cut into: HxW int32 labels 1..n of the pixels of each (object, part) pair of
+    ``labels`` and ``parts`` (HxW; parts lie within objects), numbered in increasing (object, part) order; each
+    piece's object (``owner``, index 0 for no piece) and pixel count (index 0 for the pixels of no piece)."""
+    return _loops().object_pieces(labels, parts)

@@ -517,3 +517,32 @@ def connected_parts(region: np.ndarray, min_points: int) -> np.ndarray:
         for c in range(cols):
             labels[r, c] = final[provisional[r, c]]
     return labels
+
+
+@njit(cache=True, nogil=True)
+def object_pieces(labels: np.ndarray, parts: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """See :func:`annotators.geometry.grid_kernels.object_pieces`."""
+    rows, cols = labels.shape
+    width = np.int64(parts.max()) + 1
+    present = np.zeros((np.int64(labels.max()) + 1) * width, dtype=np.int64)
+    for r in range(rows):
+        for c in range(cols):
+            if parts[r, c] > 0:
+                present[labels[r, c] * width + parts[r, c]] = 1
+    count = 0
+    for key in range(present.size):  # numbered in increasing (object, part) order
+        if present[key]:
+            count += 1
+            present[key] = count
+    owner = np.zeros(count + 1, dtype=np.int64)
+    sizes = np.zeros(count + 1, dtype=np.int64)
+    pieces = np.zeros((rows, cols), dtype=np.int32)
+    for r in range(rows):
+        for c in range(cols):
+            if parts[r, c] > 0:
+                piece = present[labels[r, c] * width + parts[r, c]]
+                pieces[r, c] = piece
+                owner[piece] = labels[r, c]
+                sizes[piece] += 1
+    sizes[0] = rows * cols - sizes.sum()
+    return pieces, owner, sizes
