@@ -18,7 +18,13 @@ import numpy as np
 from scipy import sparse
 from scipy.sparse import csgraph
 
-from annotators.geometry.grid_kernels import label_centres, label_moments, symmetric_eigen
+from annotators.geometry.grid_kernels import (
+    label_centres,
+    label_moments,
+    labelled_values,
+    normal_halves,
+    symmetric_eigen,
+)
 from annotators.geometry.grid_segmentation import grow_labels, join_unless_apart, pixel_footprint, touching_pairs
 
 
@@ -48,9 +54,7 @@ def split_by_normals(patches: np.ndarray, normals: np.ndarray, spread: float) ->
     of a box or across the crease between two objects so becomes two patches, one per surface. Pixels without a
     normal are left out (0). Labels 1..n."""
     count = int(patches.max(initial=0)) + 1
-    known = (patches > 0) & np.isfinite(normals[..., 0])
-    labels = patches[known]
-    unit = np.ascontiguousarray(normals[known].T, dtype=np.float64)  # 3xN: each component's values contiguous
+    labels, unit = labelled_values(patches, normals, True)  # 3xN: each component's values contiguous
     pixels, sums, _ = label_moments(labels, unit, np.zeros((count, 3)), count)
     sizes = np.maximum(pixels, 1).astype(np.float64)
     mean = sums / sizes[:, None]
@@ -59,13 +63,7 @@ def split_by_normals(patches: np.ndarray, normals: np.ndarray, spread: float) ->
     wide = np.sqrt(np.clip(second[:, 0, 0] + second[:, 1, 1] + second[:, 2, 2], 0, None)) > spread
     direction = np.zeros((count, 3))
     direction[wide] = symmetric_eigen(second[wide])[1][:, :, 2]
-    side = wide[labels]  # which side of its mean a pixel's normal lies on matters only in a wide patch
-    if side.any():
-        centred = unit[:, side] - mean[labels[side]].T
-        side[side] = (centred * direction[labels[side]].T).sum(axis=0) > 0
-    split = np.zeros(patches.shape, dtype=np.int64)
-    split[known] = labels * 2 + side + 1
-    return dense_labels(split)
+    return dense_labels(normal_halves(patches, normals, mean, direction, wide))
 
 
 @dataclass(frozen=True)
@@ -110,9 +108,8 @@ class PatchPlanes:
 def patch_planes(patches: np.ndarray, points: np.ndarray) -> PatchPlanes:
     """Plane fits of all patches at once (sums by ``bincount``, one batched 3x3 eigen-decomposition)."""
     count = int(patches.max(initial=0))
-    inside = patches > 0
-    labels = patches[inside] - 1
-    xyz = np.ascontiguousarray(points[inside].T, dtype=np.float64)  # 3xN: each coordinate's values contiguous
+    labels, xyz = labelled_values(patches, points, False)  # 3xN: each coordinate's values contiguous
+    labels -= 1
     shift = xyz.mean(axis=1) if xyz.size else np.zeros(3)
     xyz -= shift[:, None]
     pixels, sums, products = label_moments(labels, xyz, np.zeros((count, 3)), count)

@@ -173,3 +173,18 @@ def object_pieces(labels: np.ndarray, parts: np.ndarray) -> tuple[np.ndarray, np
     ``labels`` and ``parts`` (HxW; parts lie within objects), numbered in increasing (object, part) order; each
     piece's object (``owner``, index 0 for no piece) and pixel count (index 0 for the pixels of no piece)."""
     return _loops().object_pieces(labels, parts)
+
+
+def labelled_values(labels: np.ndarray, values: np.ndarray, finite_only: bool) -> tuple[np.ndarray, np.ndarray]:
+    """The labels (1-D) and the HxWx3 ``values`` (3xN float64) of the pixels with a label (HxW, > 0) - and a
+    finite first value, with ``finite_only`` - in row-major order: ``labels[where]``, ``values[where].T``."""
+    return _loops().labelled_values(labels, values, finite_only)
+
+
+def normal_halves(
+    patches: np.ndarray, normals: np.ndarray, mean: np.ndarray, direction: np.ndarray, wide: np.ndarray
+) -> np.ndarray:
+    """HxW int64: ``2 patch + 1``, plus one where the patch is ``wide`` and the pixel's normal lies on the positive
+    side of its patch's ``mean`` normal along the patch's ``direction`` (Kx3 float64 each); 0 for the pixels
+    without a patch or a normal."""
+    return _loops().normal_halves(patches, normals, mean, direction, wide)

@@ -546,3 +546,47 @@ def object_pieces(labels: np.ndarray, parts: np.ndarray) -> tuple[np.ndarray, np
                 sizes[piece] += 1
     sizes[0] = rows * cols - sizes.sum()
     return pieces, owner, sizes
+
+
+@njit(cache=True, nogil=True)
+def labelled_values(labels: np.ndarray, values: np.ndarray, finite_only: bool) -> tuple[np.ndarray, np.ndarray]:
+    """See :func:`annotators.geometry.grid_kernels.labelled_values`."""
+    rows, cols = labels.shape
+    count = 0
+    for r in range(rows):
+        for c in range(cols):
+            if labels[r, c] > 0 and (not finite_only or np.isfinite(values[r, c, 0])):
+                count += 1
+    found = np.empty(count, dtype=labels.dtype)
+    gathered = np.empty((3, count))
+    k = 0
+    for r in range(rows):
+        for c in range(cols):
+            if labels[r, c] > 0 and (not finite_only or np.isfinite(values[r, c, 0])):
+                found[k] = labels[r, c]
+                for axis in range(3):
+                    gathered[axis, k] = values[r, c, axis]
+                k += 1
+    return found, gathered
+
+
+@njit(cache=True, nogil=True)
+def normal_halves(
+    patches: np.ndarray, normals: np.ndarray, mean: np.ndarray, direction: np.ndarray, wide: np.ndarray
+) -> np.ndarray:
+    """See :func:`annotators.geometry.grid_kernels.normal_halves`."""
+    rows, cols = patches.shape
+    split = np.zeros((rows, cols), dtype=np.int64)
+    for r in range(rows):
+        for c in range(cols):
+            label = patches[r, c]
+            if label <= 0 or not np.isfinite(normals[r, c, 0]):
+                continue
+            side = 0
+            if wide[label]:
+                along = (np.float64(normals[r, c, 0]) - mean[label, 0]) * direction[label, 0]
+                along += (np.float64(normals[r, c, 1]) - mean[label, 1]) * direction[label, 1]
+                along += (np.float64(normals[r, c, 2]) - mean[label, 2]) * direction[label, 2]
+                side = 1 if along > 0 else 0
+            split[r, c] = np.int64(label) * 2 + side + 1
+    return split
