@@ -1,7 +1,8 @@
 """Segmentation primitives on the organized pixel grid: cuts, labelling, growing and merging of parts.
 
-All functions take HxW (or HxWx3) arrays of one region of the image and work with whole-array operations
-and OpenCV, never with per-point Python loops; labels are int32 with 0 meaning "no part".
+All functions take HxW (or HxWx3) arrays of one region of the image and work with whole-array operations,
+OpenCV and the compiled loops of :mod:`annotators.geometry.grid_kernels`, never with per-point Python loops; labels
+are int32 with 0 meaning "no part".
 """
 
 from __future__ import annotations
