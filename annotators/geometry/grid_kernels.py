@@ -188,3 +188,16 @@ def normal_halves(
     side of its patch's ``mean`` normal along the patch's ``direction`` (Kx3 float64 each); 0 for the pixels
     without a patch or a normal."""
     return _loops().normal_halves(patches, normals, mean, direction, wide)
+
+
+def seam_pixels(depth: np.ndarray, candidates: np.ndarray, absolute: float, relative: float) -> np.ndarray:
+    """:func:`~annotators.geometry.grid_segmentation.depth_seams` (HxW float32 ``depth``, HxW bool ``candidates``)
+    in one pass over the 4-neighbour pairs."""
+    return _loops().seam_pixels(depth, candidates, absolute, relative)
+
+
+def surface_growth(
+    labels: np.ndarray, region: np.ndarray, depth: np.ndarray, absolute: float, relative: float, rounds: int
+) -> np.ndarray:
+    """:func:`~annotators.geometry.grid_segmentation.grow_on_surface` in one pass per round over the pixels."""
+    return _loops().surface_growth(labels, region, depth, absolute, relative, rounds)

@@ -590,3 +590,56 @@ def normal_halves(
                 side = 1 if along > 0 else 0
             split[r, c] = np.int64(label) * 2 + side + 1
     return split
+
+
+@njit(cache=True, nogil=True)
+def _jump(z_a: float, z_b: float, absolute32: float, relative32: float) -> bool:
+    """``depth_jump`` of grid_segmentation for two float32 depths (float32 arithmetic)."""
+    nearer = z_b if np.isnan(z_a) else (z_a if np.isnan(z_b) else min(z_a, z_b))
+    return abs(z_a - z_b) > nearer * relative32 + absolute32
+
+
+@njit(cache=True, nogil=True)
+def seam_pixels(depth: np.ndarray, candidates: np.ndarray, absolute: float, relative: float) -> np.ndarray:
+    """See :func:`annotators.geometry.grid_kernels.seam_pixels`."""
+    rows, cols = depth.shape
+    absolute32, relative32 = np.float32(absolute), np.float32(relative)
+    seams = np.zeros((rows, cols), dtype=np.bool_)
+    for down, right in ((0, 1), (1, 0)):
+        for r in range(rows - down):
+            for c in range(cols - right):
+                if not (candidates[r, c] and candidates[r + down, c + right]):
+                    continue
+                z_a, z_b = depth[r, c], depth[r + down, c + right]
+                if _jump(z_a, z_b, absolute32, relative32):
+                    if z_a > z_b:
+                        seams[r, c] = True
+                    else:
+                        seams[r + down, c + right] = True
+    return seams
+
+
+@njit(cache=True, nogil=True)
+def surface_growth(
+    labels: np.ndarray, region: np.ndarray, depth: np.ndarray, absolute: float, relative: float, rounds: int
+) -> np.ndarray:
+    """See :func:`annotators.geometry.grid_kernels.surface_growth`."""
+    rows, cols = labels.shape
+    absolute32, relative32 = np.float32(absolute), np.float32(relative)
+    grown = labels.copy()
+    for _ in range(rounds):
+        before = grown.copy()
+        changed = False
+        for r in range(rows):
+            for c in range(cols):
+                if not region[r, c] or before[r, c] != 0:
+                    continue
+                for nr, nc in ((r, c - 1), (r, c + 1), (r - 1, c), (r + 1, c)):
+                    inside = 0 <= nr < rows and 0 <= nc < cols
+                    if inside and before[nr, nc] > 0 and not _jump(depth[r, c], depth[nr, nc], absolute32, relative32):
+                        grown[r, c] = before[nr, nc]
+                        changed = True
+                        break
+        if not changed:
+            break
+    return grown

@@ -13,12 +13,13 @@ from dataclasses import dataclass
 import cv2
 import numpy as np
 
-from annotators.geometry.grid_kernels import boundary_pairs, connected_parts, touching_keys
-
-
-def _neighbour_views(array: np.ndarray) -> list[tuple[np.ndarray, np.ndarray]]:
-    """The (first, second) views of every horizontally and vertically adjacent pixel pair."""
-    return [(array[:, :-1], array[:, 1:]), (array[:-1, :], array[1:, :])]
+from annotators.geometry.grid_kernels import (
+    boundary_pairs,
+    connected_parts,
+    seam_pixels,
+    surface_growth,
+    touching_keys,
+)
 
 
 def depth_jump(z_a: np.ndarray, z_b: np.ndarray, absolute: float, relative: float) -> np.ndarray:
@@ -40,16 +41,7 @@ def depth_seams(depth: np.ndarray, candidates: np.ndarray, absolute: float, rela
     Only the far pixel of such a pair is marked, so an occluding object keeps its full outline while the
     pixel behind it is cut away; 4-connected labelling then cannot cross the discontinuity.
     """
-    seams = np.zeros(candidates.shape, dtype=bool)
-    seam_views = _neighbour_views(seams)
-    for (z_a, z_b), (c_a, c_b), (s_a, s_b) in zip(
-        _neighbour_views(depth), _neighbour_views(candidates), seam_views, strict=True
-    ):
-        broken = c_a & c_b & depth_jump(z_a, z_b, absolute, relative)
-        a_farther = z_a > z_b
-        s_a |= broken & a_farther
-        s_b |= broken & ~a_farther
-    return seams
+    return seam_pixels(np.ascontiguousarray(depth, dtype=np.float32), candidates, absolute, relative)
 
 
 def _read_only(array: np.ndarray) -> np.ndarray:
@@ -121,10 +113,6 @@ def grow_labels(labels: np.ndarray, region: np.ndarray, max_distance: float) -> 
     return grown
 
 
-_NEIGHBOURS: tuple[tuple[int, int], ...] = ((0, -1), (0, 1), (-1, 0), (1, 0))
-"""Row and column steps to the left, right, upper and lower 4-neighbour, in the order they are tried."""
-
-
 def grow_on_surface(
     labels: np.ndarray, region: np.ndarray, depth: np.ndarray, absolute: float, relative: float, rounds: int = 2
 ) -> np.ndarray:
@@ -135,27 +123,7 @@ def grow_on_surface(
     labels of the round before; a pixel takes its left, right, upper or lower neighbour's label, the first that
     qualifies. Only the unlabelled pixels are visited.
     """
-    grown = labels.copy()
-    rows, cols = labels.shape
-    flat = grown.reshape(-1)
-    flat_depth = np.ascontiguousarray(depth).reshape(-1)
-    for _ in range(rounds):
-        open_ = np.flatnonzero(region & (grown == 0))
-        if open_.size == 0:
-            break
-        before = flat.copy()
-        row, col = open_ // cols, open_ % cols
-        open_depth = flat_depth[open_]
-        waiting = np.ones(open_.size, dtype=bool)
-        for step_row, step_col in _NEIGHBOURS:
-            beside_row, beside_col = row + step_row, col + step_col
-            inside = waiting & (beside_row >= 0) & (beside_row < rows) & (beside_col >= 0) & (beside_col < cols)
-            beside = np.where(inside, beside_row * cols + beside_col, 0)
-            value = before[beside]
-            take = inside & (value > 0) & ~depth_jump(open_depth, flat_depth[beside], absolute, relative)
-            flat[open_[take]] = value[take]
-            waiting &= ~take
-    return grown
+    return surface_growth(labels, region, np.asarray(depth, dtype=np.float32), absolute, relative, rounds)
 
 
 def touching_pairs(labels: np.ndarray) -> np.ndarray:

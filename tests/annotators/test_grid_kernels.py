@@ -15,6 +15,7 @@ from annotators.geometry.grid_kernels import (
     symmetric_eigen,
     touching_keys,
 )
+from annotators.geometry.grid_segmentation import depth_seams, grow_on_surface
 
 
 def _blobs(seed: int, shape: tuple[int, int] = (40, 50), labels: int = 6) -> np.ndarray:
@@ -103,3 +104,41 @@ def test_symmetric_eigen_agrees_with_lapack() -> None:
     expected_values, expected_vectors = np.linalg.eigh(matrices)
     assert np.allclose(values, expected_values, rtol=1e-9, atol=1e-15)
     assert np.allclose(np.abs(np.einsum("kij,kij->kj", vectors, expected_vectors)), 1.0, atol=1e-6)
+
+
+def _jump(a: float, b: float, absolute: float, relative: float) -> bool:
+    return abs(a - b) > absolute + relative * min(a, b)
+
+
+def test_depth_seams_mark_the_far_pixel_of_each_jump() -> None:
+    rng = np.random.default_rng(4)
+    depth = (1.0 + 0.05 * rng.integers(0, 3, (12, 15))).astype(np.float32)
+    candidates = rng.random((12, 15)) < 0.8
+    expected = np.zeros((12, 15), dtype=bool)
+    for r in range(12):
+        for c in range(15):
+            for nr, nc in ((r, c + 1), (r + 1, c)):
+                both = nr < 12 and nc < 15 and candidates[r, c] and candidates[nr, nc]
+                if both and _jump(float(depth[r, c]), float(depth[nr, nc]), 0.01, 0.01):
+                    expected[(r, c) if depth[r, c] > depth[nr, nc] else (nr, nc)] = True
+    assert np.array_equal(depth_seams(depth, candidates, 0.01, 0.01), expected)
+
+
+def test_grow_on_surface_takes_the_first_neighbour_on_the_same_surface() -> None:
+    rng = np.random.default_rng(5)
+    labels = np.where(rng.random((12, 15)) < 0.4, rng.integers(1, 4, (12, 15)), 0).astype(np.int32)
+    depth = (1.0 + 0.05 * rng.integers(0, 2, (12, 15))).astype(np.float32)
+    region = rng.random((12, 15)) < 0.9
+    expected = labels.copy()
+    for _ in range(2):
+        before = expected.copy()
+        for r in range(12):
+            for c in range(15):
+                if not region[r, c] or before[r, c]:
+                    continue
+                for nr, nc in ((r, c - 1), (r, c + 1), (r - 1, c), (r + 1, c)):
+                    labelled = 0 <= nr < 12 and 0 <= nc < 15 and before[nr, nc] > 0
+                    if labelled and not _jump(float(depth[r, c]), float(depth[nr, nc]), 0.01, 0.01):
+                        expected[r, c] = before[nr, nc]
+                        break
+    assert np.array_equal(grow_on_surface(labels, region, depth, 0.01, 0.01), expected)
