@@ -19,6 +19,8 @@ from scipy import sparse
 from scipy.sparse import csgraph
 
 from annotators.geometry.grid_kernels import (
+    cell_patches,
+    dense_keys,
     label_centres,
     label_moments,
     labelled_values,
@@ -31,21 +33,15 @@ from annotators.geometry.grid_segmentation import grow_labels, join_unless_apart
 def grid_patches(surfaces: np.ndarray, cell: int) -> np.ndarray:
     """Patch labels (int32, 0 = none, 1..n): each labelled surface of ``surfaces`` cut into ``cell`` x ``cell``
     grid cells; a cell that two surfaces share gives one patch to each."""
-    rows, cols = surfaces.shape
-    across = -(-cols // cell)
-    cell_id = (np.arange(rows)[:, None] // cell) * across + (np.arange(cols)[None, :] // cell)
-    key = surfaces.astype(np.int64) * (across * (-(-rows // cell))) + cell_id
-    return dense_labels(np.where(surfaces > 0, key + 1, 0))
+    return cell_patches(np.ascontiguousarray(surfaces), cell)
 
 
 def dense_labels(keys: np.ndarray) -> np.ndarray:
     """Non-negative integer keys (0 = none) renumbered 1..n in increasing order, as int32; by a lookup table over
     the key range (linear time) rather than by sorting."""
-    present = np.zeros(int(keys.max(initial=0)) + 1, dtype=bool)
-    present[keys.reshape(-1)] = True
-    present[0] = False
-    renumber = np.cumsum(present, dtype=np.int32) * present
-    return renumber[keys]
+    if keys.ndim != 2:
+        return dense_keys(keys.reshape(1, -1)).reshape(keys.shape)
+    return dense_keys(keys)
 
 
 def split_by_normals(patches: np.ndarray, normals: np.ndarray, spread: float) -> np.ndarray:

@@ -201,3 +201,14 @@ def surface_growth(
 ) -> np.ndarray:
     """:func:`~annotators.geometry.grid_segmentation.grow_on_surface` in one pass per round over the pixels."""
     return _loops().surface_growth(labels, region, depth, absolute, relative, rounds)
+
+
+def dense_keys(keys: np.ndarray) -> np.ndarray:
+    """HxW non-negative integer ``keys`` (0 = none) renumbered 1..n in increasing order, as int32."""
+    return _loops().dense_keys(keys)
+
+
+def cell_patches(surfaces: np.ndarray, cell: int) -> np.ndarray:
+    """:func:`~annotators.geometry.convexity.grid_patches`: each labelled surface cut into ``cell`` x ``cell``
+    cells, the (surface, cell) pairs numbered 1..n in increasing order of surface, then cell (row-major)."""
+    return _loops().cell_patches(surfaces, cell)

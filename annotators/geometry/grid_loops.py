@@ -643,3 +643,41 @@ def surface_growth(
         if not changed:
             break
     return grown
+
+
+@njit(cache=True, nogil=True)
+def dense_keys(keys: np.ndarray) -> np.ndarray:
+    """See :func:`annotators.geometry.grid_kernels.dense_keys`."""
+    rows, cols = keys.shape
+    largest = 0
+    for r in range(rows):
+        for c in range(cols):
+            largest = max(largest, keys[r, c])
+    number = np.zeros(largest + 1, dtype=np.int32)
+    for r in range(rows):
+        for c in range(cols):
+            number[keys[r, c]] = 1
+    number[0] = 0
+    count = 0
+    for key in range(largest + 1):
+        if number[key]:
+            count += 1
+            number[key] = count
+    labels = np.empty((rows, cols), dtype=np.int32)
+    for r in range(rows):
+        for c in range(cols):
+            labels[r, c] = number[keys[r, c]]
+    return labels
+
+
+@njit(cache=True, nogil=True)
+def cell_patches(surfaces: np.ndarray, cell: int) -> np.ndarray:
+    """See :func:`annotators.geometry.grid_kernels.cell_patches`."""
+    rows, cols = surfaces.shape
+    across, down = -(-cols // cell), -(-rows // cell)
+    keys = np.zeros((rows, cols), dtype=np.int64)
+    for r in range(rows):
+        for c in range(cols):
+            if surfaces[r, c] > 0:
+                keys[r, c] = np.int64(surfaces[r, c]) * (across * down) + (r // cell) * across + c // cell + 1
+    return dense_keys(keys)
