@@ -22,6 +22,7 @@ behind an occluder):
 
 from __future__ import annotations
 
+import functools
 from dataclasses import dataclass
 
 import numpy as np
@@ -47,14 +48,26 @@ class OcclusionRules:
 
 @dataclass(frozen=True, eq=False)
 class _Piece:
-    """A piece near an occluder: its pixels there (flat indices), their finite 3-D points and centroid, and their
-    image centroid."""
+    """A piece near an occluder: its pixels there (flat indices), their finite 3-D points and centroid, their
+    image centroid, and their finite normals and plane coordinates ``(u, v, height)``."""
 
     label: int
     band: np.ndarray
     points: np.ndarray
     centre: np.ndarray
     pixel: np.ndarray
+    normals: np.ndarray
+    section: np.ndarray
+
+    @functools.cached_property
+    def middle(self) -> np.ndarray:
+        """The median plane position ``(u, v)`` of the band."""
+        return np.median(self.section[:, :2], axis=0)
+
+    @functools.cached_property
+    def heights(self) -> np.ndarray:
+        """The 5 % and 95 % heights of the band above the plane."""
+        return np.quantile(self.section[:, 2], (0.05, 0.95))
 
 
 def join_occluded(
@@ -76,6 +89,7 @@ def join_occluded(
         return labels
     depth = points[..., 2]
     flat_labels = labels.reshape(-1)
+    flat_normals, flat_plane = normals.reshape(-1, 3), on_plane.reshape(-1, 3)
     sizes = np.bincount(flat_labels, minlength=count + 1)
     boxes = ndimage.find_objects(labels, max_label=count)
     unmeasured = ~np.isfinite(depth)
@@ -121,15 +135,18 @@ def join_occluded(
                 continue
             if piece_depth <= occluder_depth or xyz.shape[0] < rules.min_points:
                 continue
-            behind.append(_Piece(piece, flat, xyz, centre, pixel))
+            band_normals, section = flat_normals[flat], flat_plane[flat]
+            band_normals = band_normals[np.isfinite(band_normals).all(axis=1)]
+            section = section[np.isfinite(section).all(axis=1)]
+            behind.append(_Piece(piece, flat, xyz, centre, pixel, band_normals, section))
         for index, first in enumerate(behind):
             for second in behind[index + 1 :]:
                 key = (min(first.label, second.label), max(first.label, second.label))
                 if key in touching:
                     continue
                 if (
-                    _continues(first, second, normals, rules)
-                    and _same_section(first, second, on_plane, rules)
+                    _continues(first, second, rules)
+                    and _same_section(first, second, rules)
                     and _across(flat_labels, depth, labels.shape, occluder, first, second) >= rules.through_occluder
                 ):
                     joined.append(key)
@@ -155,7 +172,7 @@ def _grown(box: tuple[slice, slice], shape: tuple[int, int], margin: int) -> tup
     )
 
 
-def _continues(first: _Piece, second: _Piece, normals: np.ndarray, rules: OcclusionRules) -> bool:
+def _continues(first: _Piece, second: _Piece, rules: OcclusionRules) -> bool:
     """Does the line between the pieces' centroids lie in the tangent planes of both (for at least
     ``rules.tangent_share`` of the pixels with a normal of each)?"""
     offset = second.centre - first.centre
@@ -164,10 +181,8 @@ def _continues(first: _Piece, second: _Piece, normals: np.ndarray, rules: Occlus
         return False
     direction = offset / length
     sine = np.sin(np.radians(rules.degrees))
-    flat_normals = normals.reshape(-1, 3)
     for piece in (first, second):
-        known = flat_normals[piece.band]
-        known = known[np.isfinite(known).all(axis=1)]
+        known = piece.normals
         if known.shape[0] < rules.min_points:
             return False
         if np.count_nonzero(np.abs(known @ direction) <= sine) < rules.tangent_share * known.shape[0]:
@@ -175,12 +190,10 @@ def _continues(first: _Piece, second: _Piece, normals: np.ndarray, rules: Occlus
     return True
 
 
-def _same_section(first: _Piece, second: _Piece, on_plane: np.ndarray, rules: OcclusionRules) -> bool:
+def _same_section(first: _Piece, second: _Piece, rules: OcclusionRules) -> bool:
     """Seen along the line between them, do the pieces reach the same height and span the same width?"""
-    flat = on_plane.reshape(-1, 3)
-    a, b = flat[first.band], flat[second.band]
-    a, b = a[np.isfinite(a).all(axis=1)], b[np.isfinite(b).all(axis=1)]
-    along = np.median(b[:, :2], axis=0) - np.median(a[:, :2], axis=0)
+    a, b = first.section, second.section
+    along = second.middle - first.middle
     norm = float(np.linalg.norm(along))
     if norm < 1e-6:
         return False
@@ -188,8 +201,7 @@ def _same_section(first: _Piece, second: _Piece, on_plane: np.ndarray, rules: Oc
     slack = lambda low_a, high_a, low_b, high_b: max(  # noqa: E731
         rules.tolerance, rules.relative * max(high_a - low_a, high_b - low_b)
     )
-    low_a, high_a = np.quantile(a[:, 2], (0.05, 0.95))
-    low_b, high_b = np.quantile(b[:, 2], (0.05, 0.95))
+    (low_a, high_a), (low_b, high_b) = first.heights, second.heights
     if abs(high_a - high_b) > slack(low_a, high_a, low_b, high_b):
         return False  # one reaches higher than the other
     if _coplanar(first, second, rules.flat):
