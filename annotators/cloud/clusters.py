@@ -26,17 +26,16 @@ from typing import ClassVar
 
 import cv2
 import numpy as np
-from scipy import ndimage
 
 from annotators.cloud.normals import grid_normals
 from annotators.cloud.plane import plane_basis, plane_distances
 from annotators.cloud.point_cloud import cloud_problem
+from annotators.geometry.grid_kernels import label_pixels, standing_candidates, upsampled_labels
 from annotators.geometry.grid_segmentation import (
     MergeRules,
     boundaries,
     bounding_box,
     color_edges,
-    depth_jump,
     depth_seams,
     grow_labels,
     grow_on_surface,
@@ -99,13 +98,12 @@ class ClusterParameters:
         )
 
 
-def inside_plane_extent(feet: np.ndarray, plane_feet: np.ndarray, margin: float, cell: float) -> np.ndarray:
-    """For Nx2 plane coordinates ``feet``: inside the convex hull of ``plane_feet`` shrunk by ``margin``?
-
-    The hull is rasterized with ``cell`` metres per pixel and eroded, so the test is one lookup per point.
-    """
-    if plane_feet.shape[0] < 3 or feet.shape[0] == 0:
-        return np.zeros(feet.shape[0], dtype=bool)
+def plane_extent(plane_feet: np.ndarray, margin: float, cell: float) -> tuple[np.ndarray, np.ndarray] | None:
+    """The convex hull of the Nx2 plane coordinates ``plane_feet`` shrunk by ``margin``, rasterized with ``cell``
+    metres per pixel and eroded: the raster (uint8, 1 inside; rows along the second coordinate) and the plane
+    coordinates of its corner (float32), so the test of a point is one lookup. None for fewer than 3 feet."""
+    if plane_feet.shape[0] < 3:
+        return None
     hull = cv2.convexHull(plane_feet.astype(np.float32)).reshape(-1, 2)
     pad = round(margin / cell) + 1  # room so that erosion also shrinks the hull where it touches the raster edge
     low = hull.min(axis=0) - pad * cell
@@ -114,11 +112,7 @@ def inside_plane_extent(feet: np.ndarray, plane_feet: np.ndarray, margin: float,
     cv2.fillConvexPoly(raster, np.round((hull - low) / cell).astype(np.int32), 1)
     if pad > 1:
         raster = cv2.erode(raster, np.ones((2 * pad - 1, 2 * pad - 1), np.uint8))
-    cells = np.floor((feet - low) / cell).astype(np.int64)
-    inside = (cells[:, 0] >= 0) & (cells[:, 1] >= 0) & (cells[:, 0] < size[0]) & (cells[:, 1] < size[1])
-    result = np.zeros(feet.shape[0], dtype=bool)
-    result[inside] = raster[cells[inside, 1], cells[inside, 0]] > 0
-    return result
+    return raster, low
 
 
 def extract_clusters(
@@ -173,17 +167,17 @@ def standing_region(
     step = max(1, p.stride)
     basis = plane_basis(np.asarray(model[:3], dtype=np.float64)).T.astype(np.float32)
     coarse_points = points[::step, ::step]
-    coarse = _candidates(coarse_points, mask[::step, ::step], model, p)
-    coarse_indices = np.flatnonzero(coarse)
-    if coarse_indices.size == 0:
-        return coarse
+    heights = plane_distances(coarse_points, model)
     flat = points.reshape(-1, 3)
     plane_points = flat[plane_indices[:: max(1, plane_indices.size // 2000)]]
     plane_points = plane_points[np.isfinite(plane_points).all(axis=1)]
-    feet = points[coarse_indices // coarse.shape[1] * step, coarse_indices % coarse.shape[1] * step] @ basis
-    inside = inside_plane_extent(feet, plane_points @ basis, p.hull_margin, p.hull_cell)
-    coarse.reshape(-1)[coarse_indices[~inside]] = False
-    return coarse
+    extent = plane_extent(plane_points @ basis, p.hull_margin, p.hull_cell)
+    if extent is None:
+        return np.zeros(heights.shape, dtype=bool)
+    raster, low = extent
+    return standing_candidates(
+        heights, mask[::step, ::step], coarse_points, basis, raster, low, p.hull_cell, p.min_height, p.max_height
+    )
 
 
 def full_resolution_segments(
@@ -212,37 +206,31 @@ def full_resolution_segments(
     x0, y0, x1, y1 = box
     fy0, fx0 = y0 * step, x0 * step
     fy1, fx1 = min(y1 * step, rows), min(x1 * step, cols)
-    height, width = fy1 - fy0, fx1 - fx0
-    fine = np.repeat(np.repeat(labels, step, axis=0), step, axis=1)[:height, :width]
-    sampled_depth = np.repeat(np.repeat(coarse_depth, step, axis=0), step, axis=1)[:height, :width]
+    width = fx1 - fx0
     fine_points = points[fy0:fy1, fx0:fx1]
-    same_surface = ~depth_jump(fine_points[..., 2], sampled_depth, p.jump_absolute, p.jump_relative)
     heights = plane_distances(fine_points, model)
     candidates = _between_heights(heights, mask[fy0:fy1, fx0:fx1], p)
-    fine = fine * (candidates & same_surface)
-    sizes = np.bincount(fine.reshape(-1))
+    core = upsampled_labels(  # the pixels the segmentation labelled itself: the point indices
+        labels, coarse_depth, fine_points[..., 2], candidates, step, p.jump_absolute, p.jump_relative
+    )
+    core_pixels, core_starts, boxes = label_pixels(core)
+    sizes = np.diff(core_starts)
     kept = [label for label in range(1, sizes.size) if sizes[label] >= p.min_points]  # judged before refining
-    core = fine  # the pixels the segmentation labelled itself: the point indices
+    pixels, starts = core_pixels, core_starts
     if refine is not None:
-        fine = refine(fine, fine_points, heights, candidates)
-    boxes = ndimage.find_objects(fine)
+        pixels, starts, boxes = label_pixels(refine(core, fine_points, heights, candidates))
     masks = np.zeros((len(kept), rows, cols), dtype=bool)  # one allocation for all masks
     segments = []
     for object_mask, label in zip(masks, kept, strict=True):
-        box_rows, box_cols = boxes[label - 1]
-        own = fine[box_rows, box_cols] == label
-        top, left = box_rows.start + fy0, box_cols.start + fx0
-        object_mask[top : box_rows.stop + fy0, left : box_cols.stop + fx0] = own
-        r, c = np.nonzero(core[box_rows, box_cols] == label)
-        roi = (left, top, box_cols.stop + fx0, box_rows.stop + fy0)
-        segments.append(Segment(indices=(r + top) * cols + c + left, mask=object_mask, roi=roi))
+        own = pixels[starts[label] : starts[label + 1]]
+        object_mask.reshape(-1)[(own // width + fy0) * cols + own % width + fx0] = True
+        labelled = core_pixels[core_starts[label] : core_starts[label + 1]]
+        indices = (labelled // width + fy0) * cols + labelled % width + fx0
+        left, top, right, bottom = boxes[label].tolist()
+        roi = (left + fx0, top + fy0, right + fx0, bottom + fy0)
+        segments.append(Segment(indices=indices, mask=object_mask, roi=roi))
     segments.sort(key=lambda s: -s.indices.size)
     return segments
-
-
-def _candidates(points: np.ndarray, mask: np.ndarray, model: np.ndarray, p: ClusterParameters) -> np.ndarray:
-    """Points of interest between ``min_height`` and ``max_height`` above the plane."""
-    return _between_heights(plane_distances(points, model), mask, p)
 
 
 def _between_heights(heights: np.ndarray, mask: np.ndarray, p: ClusterParameters) -> np.ndarray:

@@ -38,6 +38,7 @@ from annotators.cloud.normals import grid_normals
 from annotators.cloud.plane import plane_basis
 from annotators.geometry.border_pixels import BorderRules, claim_border_pixels, plane_noise
 from annotators.geometry.convexity import ConvexityRules, convex_groups, dense_labels, grid_patches, split_by_normals
+from annotators.geometry.grid_kernels import object_pieces
 from annotators.geometry.grid_segmentation import (
     MergeRules,
     boundaries,
@@ -176,12 +177,9 @@ def split_by_color(
     objects = labels > 0
     edges = color_edges(colors, p.edge_low, p.edge_high) & objects
     parts = label_parts(objects & ~edges, max(1, p.min_part_points // (step * step)))
-    key = labels.astype(np.int64) * (int(parts.max(initial=0)) + 1) + parts
-    pieces = dense_labels(np.where(parts > 0, key, 0))
-    owner = np.zeros(int(pieces.max(initial=0)) + 1, dtype=np.int64)
-    owner[pieces[parts > 0]] = labels[parts > 0]
+    pieces, owner, piece_sizes = object_pieces(np.ascontiguousarray(labels), parts)
     # only an object with two pieces that could each be an object (min_points) can split
-    large = np.bincount(pieces.reshape(-1), minlength=owner.size) * step * step >= p.min_points
+    large = piece_sizes * step * step >= p.min_points
     pieces_of = np.bincount(owner[1:], weights=large[1:], minlength=int(labels.max()) + 1)
     if pieces_of.max(initial=0) < 2:
         return labels

@@ -15,7 +15,8 @@ import cv2
 import numpy as np
 
 from annotators.cloud.point_cloud import cloud_problem
-from annotators.geometry.grid_segmentation import bounding_box, depth_jump
+from annotators.geometry.grid_kernels import organized_normals
+from annotators.geometry.grid_segmentation import bounding_box
 from robokudo.core.annotator import Annotator
 from robokudo.core.capability import Capability
 from robokudo.core.types import CasType, Normals, PointCloud
@@ -29,49 +30,8 @@ def grid_normals(
     jump_relative: float = 0.02,
 ) -> np.ndarray:
     """HxWx3 float32 unit normals (facing the camera at the origin) of an organized HxWx3 cloud; NaN where unknown."""
-    height, width = points.shape[:2]
-    normals = np.full(points.shape, np.nan, dtype=np.float32)
-    if height <= 2 * step or width <= 2 * step:
-        return normals
-    inner = (slice(step, -step), slice(step, -step))
-    x, y, z = (np.ascontiguousarray(points[..., i], dtype=np.float32) for i in range(3))
-    shifts = {
-        "left": (slice(step, -step), slice(0, -2 * step)),
-        "right": (slice(step, -step), slice(2 * step, None)),
-        "up": (slice(0, -2 * step), slice(step, -step)),
-        "down": (slice(2 * step, None), slice(step, -step)),
-    }
-    centre_z = z[inner]
-    with np.errstate(invalid="ignore"):
-        broken = ~np.isfinite(centre_z)
-        for where in shifts.values():
-            broken |= depth_jump(centre_z, z[where], jump_absolute, jump_relative)
-            broken |= ~np.isfinite(z[where])
-    h = [c[shifts["right"]] - c[shifts["left"]] for c in (x, y, z)]
-    v = [c[shifts["down"]] - c[shifts["up"]] for c in (x, y, z)]
-    components = [h[1] * v[2] - h[2] * v[1], h[2] * v[0] - h[0] * v[2], h[0] * v[1] - h[1] * v[0]]
-    with np.errstate(invalid="ignore"):
-        facing = components[0] * x[inner] + components[1] * y[inner] + components[2] * centre_z
-    sign = np.where(broken, np.float32(0.0), np.where(facing > 0, np.float32(-1.0), np.float32(1.0)))
-    sign /= _length(components)
-    n = cv2.merge([np.nan_to_num(c * sign, copy=False) for c in components])
-    if smoothing > 1:
-        n = cv2.boxFilter(n, -1, (smoothing, smoothing), normalize=False, borderType=cv2.BORDER_CONSTANT)
-        channels = cv2.split(n)
-        scale = np.where(broken, np.float32(np.nan), np.float32(1.0)) / _length(channels)
-        n = cv2.merge([c * scale for c in channels])
-    else:
-        n[broken] = np.nan
-    normals[inner] = n
-    return normals
-
-
-def _length(components: list[np.ndarray] | tuple[np.ndarray, ...]) -> np.ndarray:
-    """The per-pixel length of a vector field given as three HxW float32 components (1 where it is 0 or NaN)."""
-    length = cv2.magnitude(np.nan_to_num(components[0]), np.nan_to_num(components[1]))
-    length = cv2.magnitude(length, np.nan_to_num(components[2]))
-    length[length == 0] = 1.0
-    return length
+    grid = np.ascontiguousarray(points, dtype=np.float32)
+    return organized_normals(grid, step, smoothing, jump_absolute, jump_relative)
 
 
 class NormalEstimator(Annotator):

@@ -18,27 +18,30 @@ import numpy as np
 from scipy import sparse
 from scipy.sparse import csgraph
 
+from annotators.geometry.grid_kernels import (
+    cell_patches,
+    dense_keys,
+    label_centres,
+    label_moments,
+    labelled_values,
+    normal_halves,
+    symmetric_eigen,
+)
 from annotators.geometry.grid_segmentation import grow_labels, join_unless_apart, pixel_footprint, touching_pairs
 
 
 def grid_patches(surfaces: np.ndarray, cell: int) -> np.ndarray:
     """Patch labels (int32, 0 = none, 1..n): each labelled surface of ``surfaces`` cut into ``cell`` x ``cell``
     grid cells; a cell that two surfaces share gives one patch to each."""
-    rows, cols = surfaces.shape
-    across = -(-cols // cell)
-    cell_id = (np.arange(rows)[:, None] // cell) * across + (np.arange(cols)[None, :] // cell)
-    key = surfaces.astype(np.int64) * (across * (-(-rows // cell))) + cell_id
-    return dense_labels(np.where(surfaces > 0, key + 1, 0))
+    return cell_patches(np.ascontiguousarray(surfaces), cell)
 
 
 def dense_labels(keys: np.ndarray) -> np.ndarray:
     """Non-negative integer keys (0 = none) renumbered 1..n in increasing order, as int32; by a lookup table over
     the key range (linear time) rather than by sorting."""
-    present = np.zeros(int(keys.max(initial=0)) + 1, dtype=bool)
-    present[keys.reshape(-1)] = True
-    present[0] = False
-    renumber = np.cumsum(present, dtype=np.int32) * present
-    return renumber[keys]
+    if keys.ndim != 2:
+        return dense_keys(keys.reshape(1, -1)).reshape(keys.shape)
+    return dense_keys(keys)
 
 
 def split_by_normals(patches: np.ndarray, normals: np.ndarray, spread: float) -> np.ndarray:
@@ -47,23 +50,16 @@ def split_by_normals(patches: np.ndarray, normals: np.ndarray, spread: float) ->
     of a box or across the crease between two objects so becomes two patches, one per surface. Pixels without a
     normal are left out (0). Labels 1..n."""
     count = int(patches.max(initial=0)) + 1
-    known = (patches > 0) & np.isfinite(normals[..., 0])
-    labels = patches[known]
-    unit = np.ascontiguousarray(normals[known].T, dtype=np.float64)  # 3xN: each component's values contiguous
-    sizes = np.maximum(np.bincount(labels, minlength=count), 1).astype(np.float64)
-    mean = np.stack([np.bincount(labels, unit[i], count) for i in range(3)], axis=1) / sizes[:, None]
-    centred = unit - mean[labels].T
-    second = np.empty((count, 3, 3))
-    for i in range(3):
-        for j in range(i, 3):
-            second[:, i, j] = second[:, j, i] = np.bincount(labels, centred[i] * centred[j], count) / sizes
-    values, vectors = np.linalg.eigh(second)
-    wide = np.sqrt(np.clip(values.sum(axis=1), 0, None)) > spread
-    direction = vectors[:, :, 2]
-    side = (centred * direction[labels].T).sum(axis=0) > 0
-    split = np.zeros(patches.shape, dtype=np.int64)
-    split[known] = labels * 2 + (side & wide[labels]) + 1
-    return dense_labels(split)
+    labels, unit = labelled_values(patches, normals, True)  # 3xN: each component's values contiguous
+    pixels, sums, _ = label_moments(labels, unit, np.zeros((count, 3)), count)
+    sizes = np.maximum(pixels, 1).astype(np.float64)
+    mean = sums / sizes[:, None]
+    second = _symmetric(label_moments(labels, unit, mean, count)[2] / sizes[:, None])
+    # the spread is the root of the trace (the sum of the eigenvalues); the direction is needed in wide patches
+    wide = np.sqrt(np.clip(second[:, 0, 0] + second[:, 1, 1] + second[:, 2, 2], 0, None)) > spread
+    direction = np.zeros((count, 3))
+    direction[wide] = symmetric_eigen(second[wide])[1][:, :, 2]
+    return dense_labels(normal_halves(patches, normals, mean, direction, wide))
 
 
 @dataclass(frozen=True)
@@ -108,26 +104,31 @@ class PatchPlanes:
 def patch_planes(patches: np.ndarray, points: np.ndarray) -> PatchPlanes:
     """Plane fits of all patches at once (sums by ``bincount``, one batched 3x3 eigen-decomposition)."""
     count = int(patches.max(initial=0))
-    inside = patches > 0
-    labels = patches[inside] - 1
-    xyz = np.ascontiguousarray(points[inside].T, dtype=np.float64)  # 3xN: each coordinate's values contiguous
+    labels, xyz = labelled_values(patches, points, False)  # 3xN: each coordinate's values contiguous
+    labels -= 1
     shift = xyz.mean(axis=1) if xyz.size else np.zeros(3)
     xyz -= shift[:, None]
-    counts = np.bincount(labels, minlength=count).astype(np.float64)
+    pixels, sums, products = label_moments(labels, xyz, np.zeros((count, 3)), count)
+    counts = pixels.astype(np.float64)
     safe = np.maximum(counts, 1.0)
-    means = np.stack([np.bincount(labels, xyz[i], count) for i in range(3)], axis=1) / safe[:, None]
-    second = np.empty((count, 3, 3))
-    for i in range(3):
-        for j in range(i, 3):
-            second[:, i, j] = second[:, j, i] = np.bincount(labels, xyz[i] * xyz[j], count) / safe
+    means = sums / safe[:, None]
+    second = _symmetric(products / safe[:, None])
     covariance = second - means[:, :, None] * means[:, None, :]
-    values, vectors = np.linalg.eigh(covariance)
+    values, vectors = symmetric_eigen(covariance)
     normals = vectors[:, :, 0]
     centroids = means + shift
     normals *= np.where(np.einsum("ij,ij->i", normals, centroids) > 0, -1.0, 1.0)[:, None]
     thickness = np.clip(values[:, 0], 0, None) / np.maximum(values[:, 1], 1e-12)
     width = np.clip(values[:, 1], 0, None) / np.maximum(values[:, 2], 1e-12)
     return PatchPlanes(counts.astype(np.int64), centroids, normals, thickness, width)
+
+
+def _symmetric(products: np.ndarray) -> np.ndarray:
+    """Kx3x3 symmetric matrices from their Kx6 entries 00, 01, 02, 11, 12, 22."""
+    matrices = np.empty((products.shape[0], 3, 3))
+    for k, (i, j) in enumerate(((0, 0), (0, 1), (0, 2), (1, 1), (1, 2), (2, 2))):
+        matrices[:, i, j] = matrices[:, j, i] = products[:, k]
+    return matrices
 
 
 def connection_bending(planes: PatchPlanes, pairs: np.ndarray) -> np.ndarray:
@@ -149,12 +150,8 @@ def close_in_space(
     Patches touching on the grid across a depth jump (an object and what is behind it) are not."""
     if pairs.size == 0:
         return np.zeros(0, dtype=bool)
-    inside = patches > 0
-    rows, cols = np.nonzero(inside)
-    labels = patches[inside]
-    counts = np.maximum(np.bincount(labels, minlength=planes.counts.size + 1), 1)
-    pixel = np.stack([np.bincount(labels, rows, counts.size), np.bincount(labels, cols, counts.size)], axis=1)
-    pixel /= counts[:, None]
+    counts, pixel = label_centres(np.ascontiguousarray(patches), planes.counts.size + 1)
+    pixel /= np.maximum(counts, 1)[:, None]
     a, b = pairs[:, 0], pairs[:, 1]
     on_grid = np.linalg.norm(pixel[a] - pixel[b], axis=1)
     depth = np.minimum(planes.centroids[a - 1, 2], planes.centroids[b - 1, 2])

@@ -1,7 +1,8 @@
 """Segmentation primitives on the organized pixel grid: cuts, labelling, growing and merging of parts.
 
-All functions take HxW (or HxWx3) arrays of one region of the image and work with whole-array operations
-and OpenCV, never with per-point Python loops; labels are int32 with 0 meaning "no part".
+All functions take HxW (or HxWx3) arrays of one region of the image and work with whole-array operations,
+OpenCV and the compiled loops of :mod:`annotators.geometry.grid_kernels`, never with per-point Python loops; labels
+are int32 with 0 meaning "no part".
 """
 
 from __future__ import annotations
@@ -11,13 +12,14 @@ from dataclasses import dataclass
 
 import cv2
 import numpy as np
-from scipy import sparse
-from scipy.sparse import csgraph
 
-
-def _neighbour_views(array: np.ndarray) -> list[tuple[np.ndarray, np.ndarray]]:
-    """The (first, second) views of every horizontally and vertically adjacent pixel pair."""
-    return [(array[:, :-1], array[:, 1:]), (array[:-1, :], array[1:, :])]
+from annotators.geometry.grid_kernels import (
+    boundary_pairs,
+    connected_parts,
+    seam_pixels,
+    surface_growth,
+    touching_keys,
+)
 
 
 def depth_jump(z_a: np.ndarray, z_b: np.ndarray, absolute: float, relative: float) -> np.ndarray:
@@ -39,16 +41,7 @@ def depth_seams(depth: np.ndarray, candidates: np.ndarray, absolute: float, rela
     Only the far pixel of such a pair is marked, so an occluding object keeps its full outline while the
     pixel behind it is cut away; 4-connected labelling then cannot cross the discontinuity.
     """
-    seams = np.zeros(candidates.shape, dtype=bool)
-    seam_views = _neighbour_views(seams)
-    for (z_a, z_b), (c_a, c_b), (s_a, s_b) in zip(
-        _neighbour_views(depth), _neighbour_views(candidates), seam_views, strict=True
-    ):
-        broken = c_a & c_b & depth_jump(z_a, z_b, absolute, relative)
-        a_farther = z_a > z_b
-        s_a |= broken & a_farther
-        s_b |= broken & ~a_farther
-    return seams
+    return seam_pixels(np.ascontiguousarray(depth, dtype=np.float32), candidates, absolute, relative)
 
 
 def _read_only(array: np.ndarray) -> np.ndarray:
@@ -91,32 +84,33 @@ def color_edges(colors: np.ndarray, low: float, high: float) -> np.ndarray:
 
 def label_parts(region: np.ndarray, min_points: int) -> np.ndarray:
     """4-connected components of ``region`` with at least ``min_points`` pixels, labelled 1..n (int32)."""
-    _, labels, stats, _ = cv2.connectedComponentsWithStats(np.ascontiguousarray(region).view(np.uint8), connectivity=4)
-    keep = stats[:, cv2.CC_STAT_AREA] >= min_points
-    keep[0] = False
-    renumber = (np.cumsum(keep) * keep).astype(np.int32)
-    return renumber[labels]
+    return connected_parts(np.ascontiguousarray(region, dtype=bool), min_points)
 
 
 def grow_labels(labels: np.ndarray, region: np.ndarray, max_distance: float) -> np.ndarray:
-    """Give every unlabelled pixel of ``region`` the label of the nearest labelled pixel within ``max_distance`` px."""
+    """Give every unlabelled pixel of ``region`` the label of the nearest labelled pixel within ``max_distance`` px.
+
+    The distance transform runs on the box of those pixels grown by the farthest a seed within ``max_distance``
+    can lie (its 3x3 chamfer distance is at least 0.955 times the larger coordinate difference), so every pixel
+    it gives a label sees the same seeds and paths as on the whole grid.
+    """
     unlabelled = region & (labels == 0)
     if not unlabelled.any() or not labels.any():
         return labels
+    x0, y0, x1, y1 = bounding_box(unlabelled, margin=int(np.ceil(max_distance / 0.95)) + 2)
+    window = labels[y0:y1, x0:x1]
+    seeds = window > 0
+    if not seeds.any():
+        return labels
     distance, nearest = cv2.distanceTransformWithLabels(
-        (labels == 0).view(np.uint8), cv2.DIST_L2, 3, labelType=cv2.DIST_LABEL_PIXEL
+        (~seeds).view(np.uint8), cv2.DIST_L2, 3, labelType=cv2.DIST_LABEL_PIXEL
     )
     lookup = np.zeros(int(nearest.max()) + 1, dtype=labels.dtype)
-    seeds = labels > 0
-    lookup[nearest[seeds]] = labels[seeds]
-    reach = unlabelled & (distance <= max_distance)
+    lookup[nearest[seeds]] = window[seeds]
+    reach = unlabelled[y0:y1, x0:x1] & (distance <= max_distance)
     grown = labels.copy()
-    grown[reach] = lookup[nearest[reach]]
+    grown[y0:y1, x0:x1][reach] = lookup[nearest[reach]]
     return grown
-
-
-_NEIGHBOURS: tuple[tuple[int, int], ...] = ((0, -1), (0, 1), (-1, 0), (1, 0))
-"""Row and column steps to the left, right, upper and lower 4-neighbour, in the order they are tried."""
 
 
 def grow_on_surface(
@@ -129,41 +123,14 @@ def grow_on_surface(
     labels of the round before; a pixel takes its left, right, upper or lower neighbour's label, the first that
     qualifies. Only the unlabelled pixels are visited.
     """
-    grown = labels.copy()
-    rows, cols = labels.shape
-    flat = grown.reshape(-1)
-    flat_depth = np.ascontiguousarray(depth).reshape(-1)
-    for _ in range(rounds):
-        open_ = np.flatnonzero(region & (grown == 0))
-        if open_.size == 0:
-            break
-        before = flat.copy()
-        row, col = open_ // cols, open_ % cols
-        open_depth = flat_depth[open_]
-        waiting = np.ones(open_.size, dtype=bool)
-        for step_row, step_col in _NEIGHBOURS:
-            beside_row, beside_col = row + step_row, col + step_col
-            inside = waiting & (beside_row >= 0) & (beside_row < rows) & (beside_col >= 0) & (beside_col < cols)
-            beside = np.where(inside, beside_row * cols + beside_col, 0)
-            value = before[beside]
-            take = inside & (value > 0) & ~depth_jump(open_depth, flat_depth[beside], absolute, relative)
-            flat[open_[take]] = value[take]
-            waiting &= ~take
-    return grown
+    return surface_growth(labels, region, np.asarray(depth, dtype=np.float32), absolute, relative, rounds)
 
 
 def touching_pairs(labels: np.ndarray) -> np.ndarray:
     """Kx2 int array of the distinct label pairs ``(a, b)``, ``0 < a < b``, that touch as 4-neighbours."""
-    found = []
-    for l_a, l_b in _neighbour_views(labels):
-        touching = (l_a != l_b) & (l_a > 0) & (l_b > 0)
-        a, b = l_a[touching], l_b[touching]
-        found.append(np.column_stack([np.minimum(a, b), np.maximum(a, b)]))
-    pairs = np.concatenate(found).astype(np.int64)
-    if pairs.shape[0] == 0:
-        return pairs.reshape(0, 2)
-    keys = np.unique(pairs[:, 0] * (int(labels.max()) + 1) + pairs[:, 1])
-    return np.column_stack([keys // (int(labels.max()) + 1), keys % (int(labels.max()) + 1)])
+    base = int(labels.max(initial=0)) + 1
+    keys = np.unique(touching_keys(np.ascontiguousarray(labels), base))
+    return np.column_stack([keys // base, keys % base])
 
 
 def label_groups(labels: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
@@ -240,21 +207,33 @@ def _filled(vertices: np.ndarray, box: Sequence[int]) -> np.ndarray:
 def join_labels(labels: np.ndarray, pairs: list[tuple[int, int]]) -> np.ndarray:
     """Labels with every connected group of ``pairs`` joined, renumbered 1..n in order of first label."""
     count = int(labels.max(initial=0)) + 1
-    rows = [a for a, _ in pairs]
-    cols = [b for _, b in pairs]
-    graph = sparse.csr_matrix((np.ones(len(pairs)), (rows, cols)), shape=(count, count))
-    _, component = csgraph.connected_components(graph, directed=False)
-    present = np.flatnonzero(np.bincount(labels.reshape(-1), minlength=count))
-    present = present[present > 0]
+    root = list(range(count))  # union-find over the few labels; each group's root is its smallest label
+
+    def find(node: int) -> int:
+        while root[node] != node:
+            root[node] = root[root[node]]
+            node = root[node]
+        return node
+
+    for a, b in pairs:
+        ra, rb = find(int(a)), find(int(b))
+        if ra != rb:
+            root[max(ra, rb)] = min(ra, rb)
+    present = np.bincount(labels.reshape(-1), minlength=count) > 0
     renumber = np.zeros(count, dtype=np.int32)
-    _, dense = np.unique(component[present], return_inverse=True)
-    renumber[present] = dense.reshape(-1) + 1
+    numbers: dict[int, int] = {}
+    for label in np.flatnonzero(present[1:]).tolist():
+        renumber[label + 1] = numbers.setdefault(find(label + 1), len(numbers) + 1)
     return renumber[labels]
 
 
 def _range(values: np.ndarray, low: float, high: float) -> tuple[float, float]:
     """The ``low`` and ``high`` quantiles (0..1) of a 1-D array, by sorting (cheap for a few hundred values)."""
-    ordered = np.sort(values)
+    return _sorted_range(np.sort(values), low, high)
+
+
+def _sorted_range(ordered: np.ndarray, low: float, high: float) -> tuple[float, float]:
+    """:func:`_range` of values already sorted."""
     last = ordered.size - 1
     return float(ordered[round(low * last)]), float(ordered[round(high * last)])
 
@@ -271,8 +250,13 @@ def heights_nest(first: np.ndarray, second: np.ndarray, tolerance: float) -> boo
     above it. A part in the rim band (:data:`RIM_BAND`) may reach up to the other's top instead of its 95 % height;
     a neighbour of about the same height never counts as in the rim band, so its top must nest strictly.
     """
-    ranges = [_range(heights, 0.05, 0.95) for heights in (first, second)]
-    tops = [_range(heights, 0.05, 0.99)[1] for heights in (first, second)]
+    return _sorted_heights_nest(np.sort(first), np.sort(second), tolerance)
+
+
+def _sorted_heights_nest(first: np.ndarray, second: np.ndarray, tolerance: float) -> bool:
+    """:func:`heights_nest` of heights already sorted."""
+    ranges = [_sorted_range(heights, 0.05, 0.95) for heights in (first, second)]
+    tops = [_sorted_range(heights, 0.05, 0.99)[1] for heights in (first, second)]
     for inner, outer in ((0, 1), (1, 0)):
         (low_in, high_in), (low_out, high_out) = ranges[inner], ranges[outer]
         in_band = high_in - low_in <= RIM_BAND * (high_out - low_out)
@@ -300,14 +284,21 @@ def is_floor_within(
     (:data:`FLOOR_FLATNESS`), lies within the other's hull (:data:`FLOOR_INSIDE` of its footprint) and no higher
     than the other's lowest heights (5 %, with ``rules.nest_tolerance``).
     """
+    return _sorted_floor_within(np.sort(first, axis=0), np.sort(second, axis=0), hull_first, hull_second, rules)
+
+
+def _sorted_floor_within(
+    first: np.ndarray, second: np.ndarray, hull_first: np.ndarray, hull_second: np.ndarray, rules: MergeRules
+) -> bool:
+    """:func:`is_floor_within` of plane coordinates whose columns are each sorted."""
     for floor, walls, floor_hull, walls_hull in (
         (first, second, hull_first, hull_second),
         (second, first, hull_second, hull_first),
     ):
-        low, high = _range(floor[:, 2], 0.05, 0.95)
-        if high > _range(walls[:, 2], 0.05, 0.95)[0] + rules.nest_tolerance:
+        low, high = _sorted_range(floor[:, 2], 0.05, 0.95)
+        if high > _sorted_range(walls[:, 2], 0.05, 0.95)[0] + rules.nest_tolerance:
             continue
-        width = float(np.max([np.subtract(*_range(floor[:, axis], 0.95, 0.05)) for axis in (0, 1)]))
+        width = float(np.max([np.subtract(*_sorted_range(floor[:, axis], 0.95, 0.05)) for axis in (0, 1)]))
         if high - low > FLOOR_FLATNESS * width:
             continue
         if _inside_share(floor_hull, walls_hull, rules.cell) >= FLOOR_INSIDE:
@@ -413,6 +404,7 @@ class _Parts:
         self.plane_coordinates = plane_coordinates
         self._coordinates: dict[int, np.ndarray] = {}
         self._hulls: dict[int, np.ndarray] = {}
+        self._sorted: dict[int, np.ndarray] = {}
         self._depths: dict[int, float] = {}
         self._outsides: dict[tuple[int, float], ContainerOutside | None] = {}
 
@@ -425,6 +417,12 @@ class _Parts:
             own = self.own(label)
             self._coordinates[label] = self.plane_coordinates(own[:: max(1, own.size // 400)])
         return self._coordinates[label]
+
+    def sorted_coordinates(self, label: int) -> np.ndarray:
+        """:meth:`coordinates` with each column sorted (for quantiles)."""
+        if label not in self._sorted:
+            self._sorted[label] = np.sort(self.coordinates(label), axis=0)
+        return self._sorted[label]
 
     def hull(self, label: int) -> np.ndarray:
         """The convex hull of the part's footprint (Kx2)."""
@@ -479,32 +477,6 @@ def pixel_footprint(points: np.ndarray) -> float:
     return float(_median(steps)) if steps.size else 0.0
 
 
-def _touching_pixels(labels: np.ndarray, reach: int) -> list[tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]]:
-    """For horizontal, then vertical 4-neighbour pairs of different non-zero labels: the flat indices of the first
-    and second pixel (row-major order) and of the pixels ``reach`` further out on each side (left of the left
-    pixel and right of the right one, above / below for vertical pairs; -1 where that lies off the grid)."""
-    rows, cols = labels.shape
-    found = []
-    for down, right in ((0, 1), (1, 0)):
-        l_a, l_b = labels[: rows - down, : cols - right], labels[down:, right:]
-        r, c = np.nonzero((l_a != l_b) & (l_a > 0) & (l_b > 0))
-        first = r * cols + c
-        second = first + (down * cols + right)
-        before_r, before_c = r - reach * down, c - reach * right
-        after_r, after_c = r + (reach + 1) * down, c + (reach + 1) * right
-        before = np.where((before_r >= 0) & (before_c >= 0), before_r * cols + before_c, -1)
-        after = np.where((after_r < rows) & (after_c < cols), after_r * cols + after_c, -1)
-        found.append((first, second, before, after))
-    return found
-
-
-def _gather(flat: np.ndarray, indices: np.ndarray, fill: float) -> np.ndarray:
-    """``flat[indices]`` with ``fill`` where an index is -1 (off the grid)."""
-    values = flat[np.maximum(indices, 0)]
-    values[indices < 0] = fill
-    return values
-
-
 def boundaries(
     labels: np.ndarray,
     points: np.ndarray,
@@ -522,30 +494,19 @@ def boundaries(
     across it. Only the boundary pixels and those beside them are read.
     """
     footprint = pixel_footprint(points)
-    keys, jumps, dots, convex, near = [], [], [], [], []
-    base = int(labels.max(initial=0)) + 1
-    flat_labels, flat_points, flat_normals = labels.reshape(-1), points.reshape(-1, 3), normals.reshape(-1, 3)
-    for first, second, before, after in _touching_pixels(labels, reach):
-        a, b = flat_labels[first].astype(np.int64), flat_labels[second].astype(np.int64)
-        keys.append(np.minimum(a, b) * base + np.maximum(a, b))
-        pa, pb = flat_points[first], flat_points[second]
-        jumps.append(depth_jump(pa[:, 2], pb[:, 2], absolute, relative))
-        with np.errstate(invalid="ignore"):
-            near.append(np.linalg.norm(pa - pb, axis=1) <= close_factor * footprint * np.fmin(pa[:, 2], pb[:, 2]))
-        same = (_gather(flat_labels, before, 0) == a) & (_gather(flat_labels, after, 0) == b)
-        na, nb = _gather(flat_normals, before, np.nan), _gather(flat_normals, after, np.nan)
-        offset = _gather(flat_points, before, np.nan) - _gather(flat_points, after, np.nan)
-        with np.errstate(invalid="ignore", divide="ignore"):
-            dots.append(np.where(same, np.einsum("ij,ij->i", na, nb), np.nan))
-            convex.append(
-                np.where(same, np.einsum("ij,ij->i", na - nb, offset) / np.linalg.norm(offset, axis=1), np.nan)
-            )
-    key = np.concatenate(keys)
+    key, jump, near, dot, convexity = boundary_pairs(
+        np.ascontiguousarray(labels),
+        np.ascontiguousarray(points, dtype=np.float32),
+        np.ascontiguousarray(normals, dtype=np.float32),
+        reach,
+        absolute,
+        relative,
+        close_factor * footprint,
+    )
     if key.size == 0:
         empty = np.zeros(0)
         return Boundaries(np.zeros((0, 2), np.int64), empty, empty, empty, empty, empty, empty, empty)
     unique, inverse = np.unique(key, return_inverse=True)
-    jump, dot, convexity = np.concatenate(jumps), np.concatenate(dots), np.concatenate(convex)
     length = np.bincount(inverse, minlength=unique.size).astype(np.float64)
     smooth = ~jump
     known = smooth & np.isfinite(dot) & np.isfinite(convexity)
@@ -555,7 +516,8 @@ def boundaries(
         mean_convexity = np.bincount(inverse, weights=np.where(known, convexity, 0.0), minlength=unique.size)
         mean_convexity /= known_count
     continuous = np.bincount(inverse, weights=smooth, minlength=unique.size) / length
-    close = np.bincount(inverse, weights=np.concatenate(near), minlength=unique.size) / length
+    close = np.bincount(inverse, weights=near, minlength=unique.size) / length
+    base = int(labels.max(initial=0)) + 1
     pairs = np.column_stack([unique // base, unique % base])
     crease_length = np.bincount(inverse, weights=known & (convexity < -crease), minlength=unique.size)
     with np.errstate(invalid="ignore", divide="ignore"):
@@ -667,13 +629,11 @@ def merge_parts(
             continue
         stacked = False
         if (first, second) in overlapping:
-            heights = (parts.coordinates(first)[:, 2], parts.coordinates(second)[:, 2])
+            ordered = (parts.sorted_coordinates(first), parts.sorted_coordinates(second))
             if (
                 not rules.nested
-                or heights_nest(*heights, rules.nest_tolerance)
-                or is_floor_within(
-                    parts.coordinates(first), parts.coordinates(second), parts.hull(first), parts.hull(second), rules
-                )
+                or _sorted_heights_nest(ordered[0][:, 2], ordered[1][:, 2], rules.nest_tolerance)
+                or _sorted_floor_within(*ordered, parts.hull(first), parts.hull(second), rules)
             ):
                 allowed.append((first, second))
                 continue

@@ -22,12 +22,13 @@ behind an occluder):
 
 from __future__ import annotations
 
+import functools
 from dataclasses import dataclass
 
-import cv2
 import numpy as np
 from scipy import ndimage
 
+from annotators.geometry.grid_kernels import grouped_pixels, piece_near, shadowed_near
 from annotators.geometry.grid_segmentation import depth_jump, join_labels, touching_pairs
 
 
@@ -47,14 +48,26 @@ class OcclusionRules:
 
 @dataclass(frozen=True, eq=False)
 class _Piece:
-    """A piece near an occluder: its pixels there (flat indices), their finite 3-D points and centroid, and their
-    image centroid."""
+    """A piece near an occluder: its pixels there (flat indices), their finite 3-D points and centroid, their
+    image centroid, and their finite normals and plane coordinates ``(u, v, height)``."""
 
     label: int
     band: np.ndarray
     points: np.ndarray
     centre: np.ndarray
     pixel: np.ndarray
+    normals: np.ndarray
+    section: np.ndarray
+
+    @functools.cached_property
+    def middle(self) -> np.ndarray:
+        """The median plane position ``(u, v)`` of the band."""
+        return np.median(self.section[:, :2], axis=0)
+
+    @functools.cached_property
+    def heights(self) -> np.ndarray:
+        """The 5 % and 95 % heights of the band above the plane."""
+        return np.quantile(self.section[:, 2], (0.05, 0.95))
 
 
 def join_occluded(
@@ -75,13 +88,12 @@ def join_occluded(
     if count < 3:
         return labels
     depth = points[..., 2]
-    flat_points = points.reshape(-1, 3)
     flat_labels = labels.reshape(-1)
-    kernel = np.ones((2 * rules.band + 1, 2 * rules.band + 1), np.uint8)
-    wide = np.ones((6 * rules.band + 1, 6 * rules.band + 1), np.uint8)
+    flat_normals, flat_plane = normals.reshape(-1, 3), on_plane.reshape(-1, 3)
     sizes = np.bincount(flat_labels, minlength=count + 1)
     boxes = ndimage.find_objects(labels, max_label=count)
-    measured = np.isfinite(depth.reshape(-1)) & (flat_labels > 0)
+    unmeasured = ~np.isfinite(depth)
+    measured = ~unmeasured.reshape(-1) & (flat_labels > 0)
     sums = np.bincount(flat_labels[measured], depth.reshape(-1)[measured], minlength=count + 1)
     mean_depth = sums / np.maximum(np.bincount(flat_labels[measured], minlength=count + 1), 1)
     touching: set[tuple[int, int]] | None = None
@@ -103,9 +115,9 @@ def join_occluded(
             continue  # the farther objects near it all touch one another: nothing to join
         occluding = window == occluder
         window_depth = depth[y0:y1, x0:x1]
-        near = cv2.dilate(_with_shadow(occluding, window_depth, wide).view(np.uint8), kernel) > 0
+        near = shadowed_near(occluding, unmeasured[y0:y1, x0:x1], 3 * rules.band, rules.band)
         # the farther objects with enough pixels near the occluder; two of them must be apart to join anything
-        near_pixels, near_starts = _grouped(near & (window > 0), window, count)
+        near_pixels, near_starts = grouped_pixels(window, near, count)
         band_sizes = np.diff(near_starts)
         candidates = _apart_from_another(farther[band_sizes[farther] >= rules.min_points].tolist(), touching)
         if len(candidates) < 2:
@@ -114,36 +126,27 @@ def join_occluded(
         behind = []
         for piece in candidates:
             own = near_pixels[near_starts[piece] : near_starts[piece + 1]]
-            rows, cols = own // window.shape[1], own % window.shape[1]
-            # the occluder's pixels within reach of the band, found in the band's box grown by the reach
-            r0, c0 = max(int(rows.min()) - reach, 0), max(int(cols.min()) - reach, 0)
-            r1, c1 = int(rows.max()) + reach + 1, int(cols.max()) + reach + 1
-            band = np.zeros((min(r1, window.shape[0]) - r0, min(c1, window.shape[1]) - c0), dtype=np.uint8)
-            band[rows - r0, cols - c0] = 1
-            facing = (cv2.dilate(band, wide) > 0) & occluding[r0:r1, c0:c1]
-            if np.count_nonzero(facing) < rules.min_points:
-                continue
-            piece_depth = _finite_mean(window_depth[rows, cols])
-            occluder_depth = _finite_mean(window_depth[r0:r1, c0:c1][facing])
+            facing, piece_depth, occluder_depth, flat, xyz, centre, pixel = piece_near(
+                own, (window.shape[1], y0, x0), occluding, window_depth, reach, points
+            )
+            if facing < rules.min_points:
+                continue  # too few of the occluder's pixels within reach of the band
             if not depth_jump(np.float32(piece_depth), np.float32(occluder_depth), absolute, relative):
                 continue
-            if piece_depth <= occluder_depth:
+            if piece_depth <= occluder_depth or xyz.shape[0] < rules.min_points:
                 continue
-            flat = (rows + y0) * labels.shape[1] + cols + x0
-            xyz = flat_points[flat]
-            xyz = xyz[np.isfinite(xyz).all(axis=1)]
-            if xyz.shape[0] < rules.min_points:
-                continue
-            pixel = np.array([rows.mean() + y0, cols.mean() + x0])
-            behind.append(_Piece(piece, flat, xyz, xyz.mean(axis=0), pixel))
+            band_normals, section = flat_normals[flat], flat_plane[flat]
+            band_normals = band_normals[np.isfinite(band_normals).all(axis=1)]
+            section = section[np.isfinite(section).all(axis=1)]
+            behind.append(_Piece(piece, flat, xyz, centre, pixel, band_normals, section))
         for index, first in enumerate(behind):
             for second in behind[index + 1 :]:
                 key = (min(first.label, second.label), max(first.label, second.label))
                 if key in touching:
                     continue
                 if (
-                    _continues(first, second, normals, rules)
-                    and _same_section(first, second, on_plane, rules)
+                    _continues(first, second, rules)
+                    and _same_section(first, second, rules)
                     and _across(flat_labels, depth, labels.shape, occluder, first, second) >= rules.through_occluder
                 ):
                     joined.append(key)
@@ -158,30 +161,6 @@ def _coplanar(first: _Piece, second: _Piece, flat: float) -> bool:
     return bool(np.sqrt(max(smallest, 0.0)) <= flat)
 
 
-def _finite_mean(values: np.ndarray) -> float:
-    """The mean of the finite values (NaN when there is none)."""
-    finite = values[np.isfinite(values)]
-    return float(finite.mean()) if finite.size else float("nan")
-
-
-def _with_shadow(occluder: np.ndarray, depth: np.ndarray, reach: np.ndarray) -> np.ndarray:
-    """The occluder's mask and the unmeasured pixels (no depth) beside it, within ``reach`` (a kernel) of it:
-    a depth sensor sees no depth in the shadow an occluding edge casts on what is behind it."""
-    unmeasured = ~np.isfinite(depth)
-    if not unmeasured.any():
-        return occluder
-    beside = cv2.dilate(occluder.view(np.uint8), np.ones((3, 3), np.uint8)) > 0
-    shadow_seeds = beside & unmeasured
-    if not shadow_seeds.any():
-        return occluder  # no unmeasured pixel touches the occluder: no shadow beside it
-    count, parts = cv2.connectedComponents(unmeasured.view(np.uint8), connectivity=4)
-    touching = np.zeros(count, dtype=bool)
-    touching[parts[shadow_seeds]] = True
-    touching[0] = False
-    within = cv2.dilate(occluder.view(np.uint8), reach) > 0
-    return occluder | (touching[parts] & within)
-
-
 def _grown(box: tuple[slice, slice], shape: tuple[int, int], margin: int) -> tuple[int, int, int, int]:
     """``(x0, y0, x1, y1)`` (exclusive) of a ``find_objects`` box, grown by ``margin`` and clipped to ``shape``."""
     rows, cols = box
@@ -193,18 +172,7 @@ def _grown(box: tuple[slice, slice], shape: tuple[int, int], margin: int) -> tup
     )
 
 
-def _grouped(where: np.ndarray, labels: np.ndarray, count: int) -> tuple[np.ndarray, np.ndarray]:
-    """The flat indices of the ``where`` pixels sorted by their label (row-major within one label) and ``starts``
-    so label k owns ``pixels[starts[k]:starts[k + 1]]`` (k = 0..count)."""
-    index = np.flatnonzero(where)
-    values = labels[where]
-    if count < 1 << 16:
-        values = values.astype(np.uint16)  # a stable sort of 16-bit keys is a radix sort: linear time
-    order = np.argsort(values, kind="stable")
-    return index[order], np.searchsorted(values[order], np.arange(count + 2))
-
-
-def _continues(first: _Piece, second: _Piece, normals: np.ndarray, rules: OcclusionRules) -> bool:
+def _continues(first: _Piece, second: _Piece, rules: OcclusionRules) -> bool:
     """Does the line between the pieces' centroids lie in the tangent planes of both (for at least
     ``rules.tangent_share`` of the pixels with a normal of each)?"""
     offset = second.centre - first.centre
@@ -213,10 +181,8 @@ def _continues(first: _Piece, second: _Piece, normals: np.ndarray, rules: Occlus
         return False
     direction = offset / length
     sine = np.sin(np.radians(rules.degrees))
-    flat_normals = normals.reshape(-1, 3)
     for piece in (first, second):
-        known = flat_normals[piece.band]
-        known = known[np.isfinite(known).all(axis=1)]
+        known = piece.normals
         if known.shape[0] < rules.min_points:
             return False
         if np.count_nonzero(np.abs(known @ direction) <= sine) < rules.tangent_share * known.shape[0]:
@@ -224,12 +190,10 @@ def _continues(first: _Piece, second: _Piece, normals: np.ndarray, rules: Occlus
     return True
 
 
-def _same_section(first: _Piece, second: _Piece, on_plane: np.ndarray, rules: OcclusionRules) -> bool:
+def _same_section(first: _Piece, second: _Piece, rules: OcclusionRules) -> bool:
     """Seen along the line between them, do the pieces reach the same height and span the same width?"""
-    flat = on_plane.reshape(-1, 3)
-    a, b = flat[first.band], flat[second.band]
-    a, b = a[np.isfinite(a).all(axis=1)], b[np.isfinite(b).all(axis=1)]
-    along = np.median(b[:, :2], axis=0) - np.median(a[:, :2], axis=0)
+    a, b = first.section, second.section
+    along = second.middle - first.middle
     norm = float(np.linalg.norm(along))
     if norm < 1e-6:
         return False
@@ -237,8 +201,7 @@ def _same_section(first: _Piece, second: _Piece, on_plane: np.ndarray, rules: Oc
     slack = lambda low_a, high_a, low_b, high_b: max(  # noqa: E731
         rules.tolerance, rules.relative * max(high_a - low_a, high_b - low_b)
     )
-    low_a, high_a = np.quantile(a[:, 2], (0.05, 0.95))
-    low_b, high_b = np.quantile(b[:, 2], (0.05, 0.95))
+    (low_a, high_a), (low_b, high_b) = first.heights, second.heights
     if abs(high_a - high_b) > slack(low_a, high_a, low_b, high_b):
         return False  # one reaches higher than the other
     if _coplanar(first, second, rules.flat):

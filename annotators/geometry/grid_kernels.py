@@ -1,0 +1,214 @@
+"""Compiled loops over the organized grid for the segmentation primitives: passes over pixels or pixel pairs that
+whole-array numpy would make with many temporaries, and loops over a few pieces that numpy would make call by call.
+
+The kernels give exactly what the numpy or OpenCV expressions they replace give (integer and boolean results,
+values picked from the input unchanged, sums added in the same order), except :func:`symmetric_eigen`, which
+agrees with ``np.linalg.eigh`` to rounding. They are compiled by numba on first use (numba is imported then, not
+with this module) and the machine code is cached on disk next to this file.
+"""
+
+from __future__ import annotations
+
+import functools
+from types import ModuleType
+
+import numpy as np
+
+
+@functools.cache
+def _loops() -> ModuleType:
+    """:mod:`annotators.geometry.grid_loops`, imported (and numba with it) on first use."""
+    from annotators.geometry import grid_loops
+
+    return grid_loops
+
+
+def touching_keys(labels: np.ndarray, base: int) -> np.ndarray:
+    """``min(a, b) * base + max(a, b)`` (int64) of every horizontally or vertically adjacent pixel pair of
+    different non-zero labels ``a``, ``b`` (HxW integer labels), once per pixel pair, in no particular order."""
+    return _loops().touching_keys(labels, base)
+
+
+def facing_values(
+    rows: np.ndarray, cols: np.ndarray, target: np.ndarray, values: np.ndarray, radius: int
+) -> np.ndarray:
+    """The ``values`` (HxW) of the ``target`` pixels (HxW bool) within ``radius`` pixels (a square window) of any
+    of the marked pixels ``rows``, ``cols`` (distinct, at least one), in row-major order: what
+    ``values[box][cv2.dilate(marked, ones(2 radius + 1)) & target[box]]`` gives on the box of the marked pixels
+    grown by ``radius``."""
+    return _loops().facing_values(rows, cols, target, values, radius)
+
+
+def shadowed_near(occluding: np.ndarray, unmeasured: np.ndarray, shadow_radius: int, near_radius: int) -> np.ndarray:
+    """HxW bool: the pixels within ``near_radius`` (a square window) of an occluder (``occluding``, HxW bool) or
+    of its shadow - the 4-connected unmeasured regions (``unmeasured``) that touch it (8-neighbours), where they
+    lie within ``shadow_radius`` of it. What ``cv2.dilate`` with square kernels of ones and
+    ``cv2.connectedComponents`` give."""
+    return _loops().shadowed_near(occluding, unmeasured, shadow_radius, near_radius)
+
+
+def upsampled_labels(
+    labels: np.ndarray,
+    coarse_depth: np.ndarray,
+    depth: np.ndarray,
+    keep: np.ndarray,
+    step: int,
+    absolute: float,
+    relative: float,
+) -> np.ndarray:
+    """HxW int32 (the shape of ``depth``, float32): each pixel's label in ``labels`` (every ``step``-th pixel's)
+    where ``keep`` (HxW bool) allows it and no depth jump (:func:`depth_jump`'s float32 arithmetic) parts it from
+    its coarse sample's depth ``coarse_depth``; 0 elsewhere."""
+    return _loops().upsampled_labels(labels, coarse_depth, depth, keep, step, absolute, relative)
+
+
+def label_pixels(labels: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """The flat indices of the labelled pixels of HxW ``labels`` sorted by label (increasing within one), ``starts``
+    so label k owns ``pixels[starts[k]:starts[k + 1]]``, and each label's box ``(x0, y0, x1, y1)`` (exclusive;
+    row k for label k, zeros for a label without pixels)."""
+    return _loops().label_pixels(labels)
+
+
+def label_moments(
+    labels: np.ndarray, values: np.ndarray, means: np.ndarray, count: int
+) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """Per label ``0..count-1`` of N ``labels``: the number of values, the sums of the 3xN ``values`` (float64) and
+    the sums of the products ``(v_i - m_i) (v_j - m_j)`` for ``i <= j`` in the order 00, 01, 02, 11, 12, 22, with
+    ``m`` the label's row of ``means`` (Kx3; zeros for plain second moments). Added up in the order of the values,
+    as ``np.bincount`` adds its weights, so the sums are the same."""
+    return _loops().label_moments(labels, values, means, count)
+
+
+def label_centres(labels: np.ndarray, count: int) -> tuple[np.ndarray, np.ndarray]:
+    """Per label ``0..count-1`` of HxW ``labels`` (label 0 counted too): the number of pixels and the sums of
+    their rows and columns (Kx2 float64; exact, they are integers)."""
+    return _loops().label_centres(labels, count)
+
+
+def grouped_pixels(labels: np.ndarray, where: np.ndarray, count: int) -> tuple[np.ndarray, np.ndarray]:
+    """The flat indices of the ``where`` pixels (HxW bool) with a label 1..count in HxW ``labels``, sorted by label
+    (row-major within one), and ``starts`` (count + 2) so label k owns ``pixels[starts[k]:starts[k + 1]]``."""
+    return _loops().grouped_pixels(labels, where, count)
+
+
+def symmetric_eigen(matrices: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """Eigenvalues (Kx3, increasing) and unit eigenvectors (Kx3x3, column i for value i) of K symmetric 3x3
+    matrices, by cyclic Jacobi rotations to full double precision: ``np.linalg.eigh`` for many small matrices
+    without a LAPACK call each (the values agree to rounding; a vector's sign may differ)."""
+    return _loops().symmetric_eigen(matrices)
+
+
+def organized_normals(points: np.ndarray, step: int, smoothing: int, absolute: float, relative: float) -> np.ndarray:
+    """HxWx3 float32 unit normals facing the camera of an organized HxWx3 float32 cloud (NaN where unknown):
+    the cross product of the central differences across ``step`` pixels, summed over a ``smoothing`` x
+    ``smoothing`` window (each raw normal of unit length; none where a neighbour is missing or across a depth jump
+    of more than ``absolute + relative * nearer depth``), then normalised. The grid ``step`` pixels wide along the
+    border gets none (see :func:`annotators.cloud.normals.grid_normals`)."""
+    return _loops().organized_normals(points, step, smoothing, absolute, relative)
+
+
+def piece_near(
+    own: np.ndarray,
+    window: tuple[int, int, int],
+    occluding: np.ndarray,
+    depth: np.ndarray,
+    radius: int,
+    points: np.ndarray,
+) -> tuple[int, float, float, np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
+    """What :func:`annotators.geometry.occlusion.join_occluded` needs of one piece's band near an occluder.
+
+    ``own`` are the band's flat indices in a window of ``window = (width, y0, x0)`` (its width and its corner in
+    the HxWx3 ``points`` grid); ``occluding`` and ``depth`` are the window's occluder mask and depths. Gives the
+    number of the occluder's pixels within ``radius`` of the band (:func:`facing_values`), the mean finite depth
+    of the band and of those occluder pixels (NaN when there is none), the band's flat indices in the grid, its
+    finite points (Nx3 float32), their centroid and the band's mean pixel (row, column) in the grid."""
+    return _loops().piece_near(own, window, occluding, depth, radius, points)
+
+
+def boundary_pairs(
+    labels: np.ndarray,
+    points: np.ndarray,
+    normals: np.ndarray,
+    reach: int,
+    absolute: float,
+    relative: float,
+    near_factor: float,
+) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
+    """Per 4-neighbour pixel pair of different non-zero labels ``a``, ``b`` (HxW ``labels``; horizontal pairs in
+    row-major order, then vertical ones): the key ``min * (max label + 1) + max``, whether a depth jump
+    (``absolute + relative * nearer depth``) parts them, whether their points (HxWx3 float32) are at most
+    ``near_factor`` times the nearer depth apart, and - where the pixels ``reach`` further out on either side
+    still carry ``a`` and ``b`` - the dot product of those pixels' normals and ``(n_a - n_b) . (p_a - p_b) /
+    |p_a - p_b|`` (float32, NaN elsewhere): the per-pair values :func:`~annotators.geometry.grid_segmentation.
+    boundaries` sums up per label pair."""
+    return _loops().boundary_pairs(labels, points, normals, reach, absolute, relative, near_factor)
+
+
+def standing_candidates(
+    heights: np.ndarray,
+    mask: np.ndarray,
+    points: np.ndarray,
+    basis: np.ndarray,
+    raster: np.ndarray,
+    low: np.ndarray,
+    cell: float,
+    min_height: float,
+    max_height: float,
+) -> np.ndarray:
+    """HxW bool: the ``mask`` pixels whose height above the plane (``heights``, float32) lies strictly between
+    ``min_height`` and ``max_height`` and whose foot on the plane (the point, HxWx3 float32, times the 3x2 float32
+    ``basis``) falls in a non-zero cell of ``raster`` (cells of ``cell`` metres, corner ``low``; rows along the
+    second coordinate)."""
+    return _loops().standing_candidates(heights, mask, points, basis, raster, low, cell, min_height, max_height)
+
+
+def connected_parts(region: np.ndarray, min_points: int) -> np.ndarray:
+    """HxW int32: the 4-connected parts of the HxW bool ``region`` with at least ``min_points`` pixels, labelled
+    1..n in the raster order of their first pixels (as ``cv2.connectedComponents`` numbers them); 0 elsewhere."""
+    return _loops().connected_parts(region, min_points)
+
+
+def object_pieces(labels: np.ndarray, parts: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """The pieces objects are cut into: HxW int32 labels 1..n of the pixels of each (object, part) pair of
+    ``labels`` and ``parts`` (HxW; parts lie within objects), numbered in increasing (object, part) order; each
+    piece's object (``owner``, index 0 for no piece) and pixel count (index 0 for the pixels of no piece)."""
+    return _loops().object_pieces(labels, parts)
+
+
+def labelled_values(labels: np.ndarray, values: np.ndarray, finite_only: bool) -> tuple[np.ndarray, np.ndarray]:
+    """The labels (1-D) and the HxWx3 ``values`` (3xN float64) of the pixels with a label (HxW, > 0) - and a
+    finite first value, with ``finite_only`` - in row-major order: ``labels[where]``, ``values[where].T``."""
+    return _loops().labelled_values(labels, values, finite_only)
+
+
+def normal_halves(
+    patches: np.ndarray, normals: np.ndarray, mean: np.ndarray, direction: np.ndarray, wide: np.ndarray
+) -> np.ndarray:
+    """HxW int64: ``2 patch + 1``, plus one where the patch is ``wide`` and the pixel's normal lies on the positive
+    side of its patch's ``mean`` normal along the patch's ``direction`` (Kx3 float64 each); 0 for the pixels
+    without a patch or a normal."""
+    return _loops().normal_halves(patches, normals, mean, direction, wide)
+
+
+def seam_pixels(depth: np.ndarray, candidates: np.ndarray, absolute: float, relative: float) -> np.ndarray:
+    """:func:`~annotators.geometry.grid_segmentation.depth_seams` (HxW float32 ``depth``, HxW bool ``candidates``)
+    in one pass over the 4-neighbour pairs."""
+    return _loops().seam_pixels(depth, candidates, absolute, relative)
+
+
+def surface_growth(
+    labels: np.ndarray, region: np.ndarray, depth: np.ndarray, absolute: float, relative: float, rounds: int
+) -> np.ndarray:
+    """:func:`~annotators.geometry.grid_segmentation.grow_on_surface` in one pass per round over the pixels."""
+    return _loops().surface_growth(labels, region, depth, absolute, relative, rounds)
+
+
+def dense_keys(keys: np.ndarray) -> np.ndarray:
+    """HxW non-negative integer ``keys`` (0 = none) renumbered 1..n in increasing order, as int32."""
+    return _loops().dense_keys(keys)
+
+
+def cell_patches(surfaces: np.ndarray, cell: int) -> np.ndarray:
+    """:func:`~annotators.geometry.convexity.grid_patches`: each labelled surface cut into ``cell`` x ``cell``
+    cells, the (surface, cell) pairs numbered 1..n in increasing order of surface, then cell (row-major)."""
+    return _loops().cell_patches(surfaces, cell)

@@ -1,0 +1,144 @@
+"""The compiled grid kernels give what the numpy and OpenCV expressions they replace give."""
+
+from __future__ import annotations
+
+import cv2
+import numpy as np
+import pytest
+
+from annotators.geometry.grid_kernels import (
+    connected_parts,
+    facing_values,
+    grouped_pixels,
+    label_pixels,
+    shadowed_near,
+    symmetric_eigen,
+    touching_keys,
+)
+from annotators.geometry.grid_segmentation import depth_seams, grow_on_surface
+
+
+def _blobs(seed: int, shape: tuple[int, int] = (40, 50), labels: int = 6) -> np.ndarray:
+    """Random int32 labels 0..labels in blocky patches, with holes."""
+    rng = np.random.default_rng(seed)
+    coarse = rng.integers(0, labels + 1, (shape[0] // 4 + 1, shape[1] // 4 + 1))
+    grid = np.kron(coarse, np.ones((4, 4), dtype=np.int64))[: shape[0], : shape[1]]
+    grid[rng.random(shape) < 0.1] = 0
+    return grid.astype(np.int32)
+
+
+@pytest.mark.parametrize("seed", range(5))
+def test_connected_parts_number_parts_as_opencv(seed: int) -> None:
+    region = _blobs(seed) > 0
+    _, reference, stats, _ = cv2.connectedComponentsWithStats(region.view(np.uint8), connectivity=4)
+    keep = stats[:, cv2.CC_STAT_AREA] >= 5
+    keep[0] = False
+    expected = (np.cumsum(keep) * keep).astype(np.int32)[reference]
+    assert np.array_equal(connected_parts(region, 5), expected)
+
+
+@pytest.mark.parametrize("seed", range(5))
+def test_touching_keys_find_every_adjacent_pair(seed: int) -> None:
+    labels = _blobs(seed)
+    base = int(labels.max()) + 1
+    expected = []
+    for a, b in ((labels[:, :-1], labels[:, 1:]), (labels[:-1, :], labels[1:, :])):
+        touching = (a != b) & (a > 0) & (b > 0)
+        expected.append(np.minimum(a, b)[touching] * base + np.maximum(a, b)[touching])
+    assert np.array_equal(np.sort(touching_keys(labels, base)), np.sort(np.concatenate(expected)))
+
+
+@pytest.mark.parametrize("seed", range(3))
+def test_pixels_grouped_by_label_in_raster_order(seed: int) -> None:
+    labels = _blobs(seed)
+    where = np.random.default_rng(seed).random(labels.shape) < 0.5
+    pixels, starts = grouped_pixels(labels, where, int(labels.max()))
+    flat = labels.reshape(-1)
+    chosen = np.flatnonzero(where.reshape(-1) & (flat > 0))
+    assert np.array_equal(pixels, chosen[np.argsort(flat[chosen], kind="stable")])
+    assert np.array_equal(np.diff(starts)[1:], np.bincount(flat[chosen], minlength=labels.max() + 1)[1:])
+    all_pixels, all_starts, boxes = label_pixels(labels)
+    for label in range(1, int(labels.max()) + 1):
+        own = np.flatnonzero(flat == label)
+        assert np.array_equal(all_pixels[all_starts[label] : all_starts[label + 1]], own)
+        rows, cols = own // labels.shape[1], own % labels.shape[1]
+        assert boxes[label].tolist() == [cols.min(), rows.min(), cols.max() + 1, rows.max() + 1]
+
+
+def test_facing_values_are_the_dilated_band_on_the_target() -> None:
+    rng = np.random.default_rng(1)
+    target = rng.random((60, 70)) < 0.3
+    values = rng.random((60, 70)).astype(np.float32)
+    rows, cols = np.array([20, 21, 30]), np.array([10, 11, 40])
+    radius = 6
+    r0, c0 = max(rows.min() - radius, 0), max(cols.min() - radius, 0)
+    r1, c1 = rows.max() + radius + 1, cols.max() + radius + 1
+    band = np.zeros((min(r1, 60) - r0, min(c1, 70) - c0), dtype=np.uint8)
+    band[rows - r0, cols - c0] = 1
+    facing = (cv2.dilate(band, np.ones((2 * radius + 1, 2 * radius + 1), np.uint8)) > 0) & target[r0:r1, c0:c1]
+    assert np.array_equal(facing_values(rows, cols, target, values, radius), values[r0:r1, c0:c1][facing])
+
+
+def test_shadowed_near_matches_dilations_and_components() -> None:
+    rng = np.random.default_rng(2)
+    occluding = np.zeros((50, 60), dtype=bool)
+    occluding[20:30, 25:35] = True
+    unmeasured = (rng.random((50, 60)) < 0.45) & ~occluding
+    shadow, near = 8, 3
+    beside = cv2.dilate(occluding.view(np.uint8), np.ones((3, 3), np.uint8)) > 0
+    count, parts = cv2.connectedComponents(unmeasured.view(np.uint8), connectivity=4)
+    touching = np.zeros(count, dtype=bool)
+    touching[parts[beside & unmeasured]] = True
+    touching[0] = False
+    within = cv2.dilate(occluding.view(np.uint8), np.ones((2 * shadow + 1,) * 2, np.uint8)) > 0
+    region = occluding | (touching[parts] & within)
+    expected = cv2.dilate(region.view(np.uint8), np.ones((2 * near + 1,) * 2, np.uint8)) > 0
+    assert np.array_equal(shadowed_near(occluding, unmeasured, shadow, near), expected)
+
+
+def test_symmetric_eigen_agrees_with_lapack() -> None:
+    rng = np.random.default_rng(3)
+    points = rng.normal(size=(200, 15, 3)) * np.array([1.0, 0.2, 0.001])
+    matrices = np.einsum("kni,knj->kij", points, points) / 15
+    values, vectors = symmetric_eigen(matrices)
+    expected_values, expected_vectors = np.linalg.eigh(matrices)
+    assert np.allclose(values, expected_values, rtol=1e-9, atol=1e-15)
+    assert np.allclose(np.abs(np.einsum("kij,kij->kj", vectors, expected_vectors)), 1.0, atol=1e-6)
+
+
+def _jump(a: float, b: float, absolute: float, relative: float) -> bool:
+    return abs(a - b) > absolute + relative * min(a, b)
+
+
+def test_depth_seams_mark_the_far_pixel_of_each_jump() -> None:
+    rng = np.random.default_rng(4)
+    depth = (1.0 + 0.05 * rng.integers(0, 3, (12, 15))).astype(np.float32)
+    candidates = rng.random((12, 15)) < 0.8
+    expected = np.zeros((12, 15), dtype=bool)
+    for r in range(12):
+        for c in range(15):
+            for nr, nc in ((r, c + 1), (r + 1, c)):
+                both = nr < 12 and nc < 15 and candidates[r, c] and candidates[nr, nc]
+                if both and _jump(float(depth[r, c]), float(depth[nr, nc]), 0.01, 0.01):
+                    expected[(r, c) if depth[r, c] > depth[nr, nc] else (nr, nc)] = True
+    assert np.array_equal(depth_seams(depth, candidates, 0.01, 0.01), expected)
+
+
+def test_grow_on_surface_takes_the_first_neighbour_on_the_same_surface() -> None:
+    rng = np.random.default_rng(5)
+    labels = np.where(rng.random((12, 15)) < 0.4, rng.integers(1, 4, (12, 15)), 0).astype(np.int32)
+    depth = (1.0 + 0.05 * rng.integers(0, 2, (12, 15))).astype(np.float32)
+    region = rng.random((12, 15)) < 0.9
+    expected = labels.copy()
+    for _ in range(2):
+        before = expected.copy()
+        for r in range(12):
+            for c in range(15):
+                if not region[r, c] or before[r, c]:
+                    continue
+                for nr, nc in ((r, c - 1), (r, c + 1), (r - 1, c), (r + 1, c)):
+                    labelled = 0 <= nr < 12 and 0 <= nc < 15 and before[nr, nc] > 0
+                    if labelled and not _jump(float(depth[r, c]), float(depth[nr, nc]), 0.01, 0.01):
+                        expected[r, c] = before[nr, nc]
+                        break
+    assert np.array_equal(grow_on_surface(labels, region, depth, 0.01, 0.01), expected)
