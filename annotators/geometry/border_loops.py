@@ -28,38 +28,40 @@ def _continues(z_a: np.float32, z_b: np.float32, absolute: np.float32, relative:
 
 
 @njit(cache=True, nogil=True)
+def _span(
+    points: np.ndarray, row: int, col: int, k: int, step: int, absolute: np.float32, relative: np.float32
+) -> tuple[np.float32, np.float32, np.float32, bool]:
+    """The point ``step`` pixels away from ``(row, col)`` toward the ``k``-th 4-neighbour (left, right, up, down)
+    when it lies on the pixel's surface, else the pixel's own point; and whether it does."""
+    r, c = row + _ROW_STEPS[k] * step, col + _COL_STEPS[k] * step
+    inside = 0 <= r < points.shape[0] and 0 <= c < points.shape[1]
+    if inside and _continues(points[row, col, 2], points[r, c, 2], absolute, relative):
+        return points[r, c, 0], points[r, c, 1], points[r, c, 2], True
+    return points[row, col, 0], points[row, col, 1], points[row, col, 2], False
+
+
+@njit(cache=True, nogil=True)
 def _normal(
-    points: np.ndarray, row: int, col: int, step: int, absolute: np.float32, relative: np.float32, out: np.ndarray
-) -> None:
-    """The unit normal (facing the camera) at ``(row, col)`` of the HxWx3 ``points`` into ``out``: each axis spanned
-    by the points ``step`` pixels to either side on the pixel's surface, or by the pixel and the one side that is;
-    NaN where neither side is."""
-    height, width = points.shape[0], points.shape[1]
-    z = points[row, col, 2]
-    spans = np.empty((2, 3), dtype=np.float32)
-    for axis in range(2):
-        ends = np.empty((2, 3), dtype=np.float32)
-        any_side = False
-        for side in range(2):
-            k = 2 * axis + side
-            r, c = row + _ROW_STEPS[k] * step, col + _COL_STEPS[k] * step
-            same = 0 <= r < height and 0 <= c < width and _continues(z, points[r, c, 2], absolute, relative)
-            any_side |= same
-            for i in range(3):
-                ends[side, i] = points[r, c, i] if same else points[row, col, i]
-        for i in range(3):
-            spans[axis, i] = np.float32(ends[1, i] - ends[0, i]) if any_side else np.float32(np.nan)
-    ux, uy, uz = spans[0, 0], spans[0, 1], spans[0, 2]
-    vx, vy, vz = spans[1, 0], spans[1, 1], spans[1, 2]
-    out[0] = np.float32(uy * vz) - np.float32(uz * vy)
-    out[1] = np.float32(uz * vx) - np.float32(ux * vz)
-    out[2] = np.float32(ux * vy) - np.float32(uy * vx)
-    length = np.float32(np.sqrt(_dot(out[0], out[1], out[2], out[0], out[1], out[2])))
-    for i in range(3):
-        out[i] = np.float32(out[i] / length)
-    if _dot(out[0], out[1], out[2], points[row, col, 0], points[row, col, 1], points[row, col, 2]) > 0:
-        for i in range(3):
-            out[i] = -out[i]
+    points: np.ndarray, row: int, col: int, step: int, absolute: np.float32, relative: np.float32
+) -> tuple[np.float32, np.float32, np.float32]:
+    """The unit normal (facing the camera) at ``(row, col)`` of the HxWx3 ``points``: each axis spanned by the
+    points ``step`` pixels to either side on the pixel's surface, or by the pixel and the one side that is; NaN
+    where neither side is."""
+    lx, ly, lz, left = _span(points, row, col, 0, step, absolute, relative)
+    rx, ry, rz, right = _span(points, row, col, 1, step, absolute, relative)
+    tx, ty, tz, up = _span(points, row, col, 2, step, absolute, relative)
+    bx, by, bz, down = _span(points, row, col, 3, step, absolute, relative)
+    nan = np.float32(np.nan)
+    ux, uy, uz = (np.float32(rx - lx), np.float32(ry - ly), np.float32(rz - lz)) if left or right else (nan, nan, nan)
+    vx, vy, vz = (np.float32(bx - tx), np.float32(by - ty), np.float32(bz - tz)) if up or down else (nan, nan, nan)
+    nx = np.float32(np.float32(uy * vz) - np.float32(uz * vy))
+    ny = np.float32(np.float32(uz * vx) - np.float32(ux * vz))
+    nz = np.float32(np.float32(ux * vy) - np.float32(uy * vx))
+    length = np.float32(np.sqrt(_dot(nx, ny, nz, nx, ny, nz)))
+    nx, ny, nz = np.float32(nx / length), np.float32(ny / length), np.float32(nz / length)
+    if _dot(nx, ny, nz, points[row, col, 0], points[row, col, 1], points[row, col, 2]) > 0:
+        return -nx, -ny, -nz
+    return nx, ny, nz
 
 
 @njit(cache=True, nogil=True)
@@ -92,7 +94,6 @@ def claim_outline(
     claimed = np.empty(open_.size, dtype=np.int64)
     given = np.empty(open_.size, dtype=labels.dtype)
     count = 0
-    own, theirs = np.empty(3, dtype=np.float32), np.empty(3, dtype=np.float32)
     for pixel in open_:
         row, col = pixel // width, pixel % width
         z = points[row, col, 2]
@@ -110,18 +111,15 @@ def claim_outline(
                 highest, lowest = max(highest, label), min(lowest, label)
         if highest <= 0 or lowest != highest:
             continue
-        _normal(points, row, col, normal_step, absolute32, relative32, own)
-        _normal(points, beside_row, beside_col, normal_step, absolute32, relative32, theirs)
-        aligned = np.float64(_dot(own[0], own[1], own[2], theirs[0], theirs[1], theirs[2])) >= smooth_cosine
-        if not aligned:
-            offset = np.empty(3, dtype=np.float32)
-            bend = np.empty(3, dtype=np.float32)
-            for i in range(3):
-                offset[i] = np.float32(points[row, col, i] - points[beside_row, beside_col, i])
-                bend[i] = np.float32(own[i] - theirs[i])
-            length = np.float32(np.sqrt(_dot(offset[0], offset[1], offset[2], offset[0], offset[1], offset[2])))
-            convexity = np.float32(_dot(bend[0], bend[1], bend[2], offset[0], offset[1], offset[2]) / length)
-            if not (convexity >= crease32):
+        ox, oy, oz = _normal(points, row, col, normal_step, absolute32, relative32)
+        tx, ty, tz = _normal(points, beside_row, beside_col, normal_step, absolute32, relative32)
+        if not np.float64(_dot(ox, oy, oz, tx, ty, tz)) >= smooth_cosine:  # not aligned: a convex bend?
+            dx = np.float32(points[row, col, 0] - points[beside_row, beside_col, 0])
+            dy = np.float32(points[row, col, 1] - points[beside_row, beside_col, 1])
+            dz = np.float32(points[row, col, 2] - points[beside_row, beside_col, 2])
+            length = np.float32(np.sqrt(_dot(dx, dy, dz, dx, dy, dz)))
+            bend = _dot(np.float32(ox - tx), np.float32(oy - ty), np.float32(oz - tz), dx, dy, dz)
+            if not np.float32(bend / length) >= crease32:
                 continue
         claimed[count], given[count] = pixel, labels[beside_row, beside_col]
         count += 1
@@ -156,11 +154,10 @@ def claim_foot(
     height, width = labels.shape
     size = pixels.size
     absolute32, relative32 = np.float32(absolute), np.float32(relative)
-    node = np.full(height * width, -1, dtype=np.int64)
-    for i in range(size):
-        node[pixels[i]] = i
     targets = np.full((size, 4), -1, dtype=np.int64)
     label = np.zeros(size, dtype=labels.dtype)
+    steps = np.array([-1, 1, -width, width], dtype=np.int64)
+    found = np.array([0, 0, 0, 0], dtype=np.int64)  # where each neighbour would sit among the sorted pixels
     for i in range(size):
         row, col = pixels[i] // width, pixels[i] % width
         z = points[row, col, 2]
@@ -168,8 +165,11 @@ def claim_foot(
             r, c = row + _ROW_STEPS[k], col + _COL_STEPS[k]
             if not (0 <= r < height and 0 <= c < width) or not _continues(z, points[r, c, 2], absolute32, relative32):
                 continue
-            j = node[r * width + c]
-            if j >= 0:
+            # the neighbours' flat indices grow with i: a pointer for each finds them in one sweep
+            while found[k] < size and pixels[found[k]] < pixels[i] + steps[k]:
+                found[k] += 1
+            j = found[k]
+            if j < size and pixels[j] == pixels[i] + steps[k]:
                 cosine = _dot(normals[i, 0], normals[i, 1], normals[i, 2], normals[j, 0], normals[j, 1], normals[j, 2])
                 if np.float64(cosine) >= smooth_cosine:
                     targets[i, k] = j
@@ -222,3 +222,24 @@ def _spread(label: np.ndarray, targets: np.ndarray, rounds: int) -> None:
                 order[kept] = reached[q]
                 kept += 1
         front = order[:kept][::-1].copy()
+
+
+@njit(cache=True, nogil=True)
+def foot_candidates(
+    near: np.ndarray, labels: np.ndarray, candidates: np.ndarray, heights: np.ndarray, floor: float, top: float
+) -> np.ndarray:
+    """Flat indices, ascending, of the pixels ``near`` a segment (HxW uint8) that are unlabelled, no candidates of
+    the segmentation and between ``floor`` and ``top`` above the plane (exclusive; compared in ``heights``' single
+    precision)."""
+    height, width = labels.shape
+    floor32, top32 = np.float32(floor), np.float32(top)
+    pixels = np.empty(height * width, dtype=np.int64)
+    count = 0
+    for row in range(height):
+        for col in range(width):
+            if near[row, col] and labels[row, col] == 0 and not candidates[row, col]:
+                above = heights[row, col]
+                if above > floor32 and above < top32:
+                    pixels[count] = row * width + col
+                    count += 1
+    return pixels[:count].copy()

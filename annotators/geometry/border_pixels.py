@@ -34,7 +34,7 @@ from dataclasses import dataclass
 import cv2
 import numpy as np
 
-from annotators.geometry.border_loops import claim_foot, claim_outline
+from annotators.geometry.border_loops import claim_foot, claim_outline, foot_candidates
 
 _CROSS = np.array([[0, 1, 0], [1, 1, 1], [0, 1, 0]], dtype=np.uint8)
 """The 4-neighbourhood as a structuring element."""
@@ -89,9 +89,8 @@ def _foot_reach(points: np.ndarray, pixels: np.ndarray, min_height: float) -> in
     height over the pitch of a pixel at the nearest depth (the angle between neighbouring pixels times the depth)."""
     width = points.shape[1]
     sample = pixels[:: max(1, pixels.size // SAMPLE)]
-    sample = sample[sample % width < width - 1]
-    flat = points.reshape(-1, 3)
-    here, right = flat[sample], flat[sample + 1]
+    rows, cols = np.divmod(sample[sample % width < width - 1], width)
+    here, right = points[rows, cols], points[rows, cols + 1]
     with np.errstate(invalid="ignore", divide="ignore"):
         angles = np.abs(here[:, 0] / here[:, 2] - right[:, 0] / right[:, 2])
     angles = angles[np.isfinite(angles) & (angles > 0)]
@@ -121,13 +120,8 @@ def _claim_foot(
     (the foot spans no more), gives every pixel reached the label of its nearest start.
     """
     kernel = np.ones((2 * reach + 1, 2 * reach + 1), dtype=np.uint8)
-    near = cv2.dilate((labels > 0).view(np.uint8), kernel).view(bool)
-    near &= labels == 0
-    near &= ~candidates
-    with np.errstate(invalid="ignore"):
-        near &= heights > floor
-        near &= heights < rules.min_height
-    pixels = np.flatnonzero(near)
+    near = cv2.dilate((labels > 0).view(np.uint8), kernel)
+    pixels = foot_candidates(near, labels, candidates, heights, floor, rules.min_height)
     if pixels.size == 0:
         return
     smooth_cosine = np.cos(np.radians(rules.smooth_degrees))
@@ -172,7 +166,6 @@ def claim_border_pixels(
     if not cv2.countNonZero(occupied):
         return labels
     claimed = labels.copy()
-    points = np.ascontiguousarray(points)  # one copy of a window's points, so that every flat view is free
     outline = np.zeros(0, dtype=np.int64)
     smooth_cosine = float(np.cos(np.radians(rules.smooth_degrees)))
     args = (rules.jump_absolute, rules.jump_relative, rules.normal_step, smooth_cosine, rules.crease)
