@@ -132,8 +132,9 @@ def claim_outline(
 def claim_foot(
     labels: np.ndarray,
     points: np.ndarray,
-    pixels: np.ndarray,
-    normals: np.ndarray,
+    foot: np.ndarray,
+    foot_normals: np.ndarray,
+    facing_away: np.ndarray,
     coarse_normals: np.ndarray,
     stride: int,
     absolute: float,
@@ -141,8 +142,9 @@ def claim_foot(
     smooth_cosine: float,
     reach: int,
 ) -> None:
-    """Give the foot ``pixels`` (sorted flat indices of the HxW ``labels``, with their Nx3 ``normals``) the label of
-    the nearest segment they continue, at most ``reach`` links away, in place.
+    """Give the ``foot`` pixels (sorted flat indices of the HxW ``labels``, with their Nx3 ``foot_normals``) that
+    are ``facing_away`` from the plane the label of the nearest segment they continue, at most ``reach`` links
+    away, in place.
 
     Neighbouring foot pixels are linked when no depth jump lies between them and their normals are within the
     smoothness angle; a pixel touching a segment's pixel the same way (that pixel's normal is its cell's in
@@ -152,6 +154,8 @@ def claim_foot(
     front (ascending pixels in the first), each in the order left, right, up, down.
     """
     height, width = labels.shape
+    nodes = np.flatnonzero(facing_away)
+    pixels, normals = foot[nodes], foot_normals[nodes]
     size = pixels.size
     absolute32, relative32 = np.float32(absolute), np.float32(relative)
     targets = np.full((size, 4), -1, dtype=np.int64)
@@ -226,11 +230,18 @@ def _spread(label: np.ndarray, targets: np.ndarray, rounds: int) -> None:
 
 @njit(cache=True, nogil=True)
 def foot_candidates(
-    near: np.ndarray, labels: np.ndarray, candidates: np.ndarray, heights: np.ndarray, floor: float, top: float
-) -> np.ndarray:
+    near: np.ndarray,
+    labels: np.ndarray,
+    candidates: np.ndarray,
+    heights: np.ndarray,
+    floor: float,
+    top: float,
+    coarse_normals: np.ndarray,
+    stride: int,
+) -> tuple[np.ndarray, np.ndarray]:
     """Flat indices, ascending, of the pixels ``near`` a segment (HxW uint8) that are unlabelled, no candidates of
     the segmentation and between ``floor`` and ``top`` above the plane (exclusive; compared in ``heights``' single
-    precision)."""
+    precision), and their Nx3 normals: their cells' in ``coarse_normals`` (every ``stride``-th pixel)."""
     height, width = labels.shape
     floor32, top32 = np.float32(floor), np.float32(top)
     pixels = np.empty(height * width, dtype=np.int64)
@@ -242,4 +253,9 @@ def foot_candidates(
                 if above > floor32 and above < top32:
                     pixels[count] = row * width + col
                     count += 1
-    return pixels[:count].copy()
+    normals = np.empty((count, 3), dtype=coarse_normals.dtype)
+    for i in range(count):
+        row, col = pixels[i] // width // stride, pixels[i] % width // stride
+        for axis in range(3):
+            normals[i, axis] = coarse_normals[row, col, axis]
+    return pixels[:count].copy(), normals

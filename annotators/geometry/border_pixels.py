@@ -121,21 +121,20 @@ def _claim_foot(
     """
     kernel = np.ones((2 * reach + 1, 2 * reach + 1), dtype=np.uint8)
     near = cv2.dilate((labels > 0).view(np.uint8), kernel)
-    pixels = foot_candidates(near, labels, candidates, heights, floor, rules.min_height)
+    pixels, normals = foot_candidates(
+        near, labels, candidates, heights, floor, rules.min_height, coarse_normals, rules.stride
+    )
     if pixels.size == 0:
         return
     smooth_cosine = np.cos(np.radians(rules.smooth_degrees))
-    normals = _sampled(coarse_normals, pixels, labels.shape[1], rules.stride)
     with np.errstate(invalid="ignore"):
         facing_away = np.abs(normals @ plane[:3]) < smooth_cosine
-    pixels, normals = pixels[facing_away], normals[facing_away]
-    if pixels.size == 0:
-        return
     claim_foot(
         labels,
         points,
         pixels,
-        np.ascontiguousarray(normals),
+        normals,
+        facing_away,
         coarse_normals,
         rules.stride,
         rules.jump_absolute,
