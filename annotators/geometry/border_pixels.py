@@ -24,7 +24,8 @@ shared between them.
 
 Only the pixels within that reach of a segment are examined and normals are estimated only at the outline's pixels,
 so the step's cost grows with the length of the outlines and the area of the feet, not with the frame
-(``bench/bench_border_pixels.py``).
+(``bench/bench_border_pixels.py``). The per-pixel work runs in compiled passes (:mod:`annotators.geometry.border_loops`)
+in the cloud's single precision (``points`` are ``float32``).
 """
 
 from __future__ import annotations
@@ -34,7 +35,7 @@ from dataclasses import dataclass
 import cv2
 import numpy as np
 
-from annotators.geometry.grid_segmentation import depth_jump
+from annotators.geometry.border_loops import claim_foot, claim_outline, foot_candidates
 
 _CROSS = np.array([[0, 1, 0], [1, 1, 1], [0, 1, 0]], dtype=np.uint8)
 """The 4-neighbourhood as a structuring element."""
@@ -67,51 +68,6 @@ class BorderRules:
     stride: int
 
 
-def _neighbours(pixels: np.ndarray, shape: tuple[int, ...], step: int = 1) -> tuple[np.ndarray, np.ndarray]:
-    """The left, right, upper and lower neighbours ``step`` pixels away of the flat ``pixels`` on a grid of
-    ``shape``: Nx4 flat indices (0 where off the grid) and Nx4 bool, which lie on the grid."""
-    height, width = shape[:2]
-    rows, cols = np.divmod(pixels[:, None], width)
-    row_steps = np.array([[0, 0, -step, step]])
-    col_steps = np.array([[-step, step, 0, 0]])
-    inside = (rows + row_steps >= 0) & (rows + row_steps < height) & (cols + col_steps >= 0)
-    inside &= cols + col_steps < width
-    neighbours = pixels[:, None] + (row_steps * width + col_steps)
-    neighbours[~inside] = 0
-    return neighbours, inside
-
-
-def _on_surface(flat_points: np.ndarray, pixels: np.ndarray, neighbours: np.ndarray, rules: BorderRules) -> np.ndarray:
-    """NxK bool: which ``neighbours`` (NxK flat indices) of the ``pixels`` are measured and on their surface."""
-    with np.errstate(invalid="ignore"):
-        other = flat_points[neighbours, 2]
-        return ~depth_jump(flat_points[pixels, 2][:, None], other, rules.jump_absolute, rules.jump_relative) & (
-            np.isfinite(other)
-        )
-
-
-def normals_at(points: np.ndarray, pixels: np.ndarray, rules: BorderRules) -> np.ndarray:
-    """Nx3 unit normals (facing the camera) of an organized HxWx3 cloud at the flat ``pixels``.
-
-    Each axis is spanned by the points ``rules.normal_step`` pixels to either side, or by the pixel itself and the
-    one side on its own surface (no depth jump) at an outline; NaN where neither side is on its surface.
-    """
-    flat = points.reshape(-1, 3)
-    neighbours, inside = _neighbours(pixels, points.shape, rules.normal_step)
-    same = inside & _on_surface(flat, pixels, neighbours, rules)
-    centre = flat[pixels]
-    ends = np.where(same[..., None], flat[neighbours], centre[:, None, :])  # Nx4x3: left, right, up, down
-    spans = ends[:, 1::2] - ends[:, 0::2]  # Nx2x3: left to right, up to down
-    spans[~(same[:, 0::2] | same[:, 1::2])] = np.nan
-    (ux, uy, uz), (vx, vy, vz) = spans[:, 0].T, spans[:, 1].T
-    normals = np.column_stack([uy * vz - uz * vy, uz * vx - ux * vz, ux * vy - uy * vx])
-    with np.errstate(invalid="ignore", divide="ignore"):
-        normals /= np.sqrt(np.einsum("ij,ij->i", normals, normals))[:, None]
-        away = np.einsum("ij,ij->i", normals, centre) > 0
-    normals[away] *= -1
-    return normals
-
-
 def plane_noise(points: np.ndarray, plane: np.ndarray, plane_indices: np.ndarray) -> float:
     """How far (metres) the supporting plane's own points scatter off it: the :data:`NOISE_SHARE` quantile of the
     distances of its inliers (flat indices ``plane_indices`` of the HxWx3 ``points``, at most :data:`SAMPLE`)."""
@@ -120,33 +76,6 @@ def plane_noise(points: np.ndarray, plane: np.ndarray, plane_indices: np.ndarray
         distances = np.abs(sample.astype(np.float64) @ np.asarray(plane[:3], dtype=np.float64) + float(plane[3]))
     distances = distances[np.isfinite(distances)]
     return float(np.quantile(distances, NOISE_SHARE)) if distances.size else 0.0
-
-
-def _claim_outline(labels: np.ndarray, points: np.ndarray, open_: np.ndarray, rules: BorderRules) -> np.ndarray:
-    """Give each pixel of ``open_`` (flat indices of unlabelled pixels) the label of the one segment whose surface
-    it continues, in place; returns the pixels claimed. Normals are estimated at the pixels themselves: along an
-    outline the grid's are unknown (a depth jump lies within their span)."""
-    flat_labels, flat_points = labels.reshape(-1), points.reshape(-1, 3)
-    neighbours, inside = _neighbours(open_, labels.shape)
-    label = np.where(inside, flat_labels[neighbours], 0)
-    on_surface = (label > 0) & _on_surface(flat_points, open_, neighbours, rules)
-    highest = np.where(on_surface, label, 0).max(axis=1)
-    lowest = np.where(on_surface, label, np.iinfo(label.dtype).max).min(axis=1)
-    one = (highest > 0) & (lowest == highest)
-    beside = neighbours[one, np.argmax(on_surface[one], axis=1)]  # the first labelled neighbour on its surface
-    open_ = open_[one]
-    if open_.size == 0:
-        return open_
-    normals = normals_at(points, np.concatenate([open_, beside]), rules)
-    own, theirs = normals[: open_.size], normals[open_.size :]
-    offset = flat_points[open_] - flat_points[beside]
-    with np.errstate(invalid="ignore", divide="ignore"):
-        aligned = np.einsum("ij,ij->i", own, theirs) >= np.cos(np.radians(rules.smooth_degrees))
-        convexity = np.einsum("ij,ij->i", own - theirs, offset) / np.linalg.norm(offset, axis=1)
-        continues = aligned | (convexity >= -rules.crease)
-    claimed = open_[continues]
-    flat_labels[claimed] = flat_labels[beside[continues]]
-    return claimed
 
 
 def _sampled(coarse: np.ndarray, pixels: np.ndarray, width: int, stride: int) -> np.ndarray:
@@ -161,9 +90,8 @@ def _foot_reach(points: np.ndarray, pixels: np.ndarray, min_height: float) -> in
     height over the pitch of a pixel at the nearest depth (the angle between neighbouring pixels times the depth)."""
     width = points.shape[1]
     sample = pixels[:: max(1, pixels.size // SAMPLE)]
-    sample = sample[sample % width < width - 1]
-    flat = points.reshape(-1, 3)
-    here, right = flat[sample], flat[sample + 1]
+    rows, cols = np.divmod(sample[sample % width < width - 1], width)
+    here, right = points[rows, cols], points[rows, cols + 1]
     with np.errstate(invalid="ignore", divide="ignore"):
         angles = np.abs(here[:, 0] / here[:, 2] - right[:, 0] / right[:, 2])
     angles = angles[np.isfinite(angles) & (angles > 0)]
@@ -193,60 +121,28 @@ def _claim_foot(
     (the foot spans no more), gives every pixel reached the label of its nearest start.
     """
     kernel = np.ones((2 * reach + 1, 2 * reach + 1), dtype=np.uint8)
-    near = cv2.dilate((labels > 0).view(np.uint8), kernel).view(bool)
-    near &= labels == 0
-    near &= ~candidates
-    with np.errstate(invalid="ignore"):
-        near &= heights > floor
-        near &= heights < rules.min_height
-    pixels = np.flatnonzero(near)
-    flat_points, flat_labels = points.reshape(-1, 3), labels.reshape(-1)
+    near = cv2.dilate((labels > 0).view(np.uint8), kernel)
+    pixels, normals = foot_candidates(
+        near, labels, candidates, heights, floor, rules.min_height, coarse_normals, rules.stride
+    )
     if pixels.size == 0:
         return
     smooth_cosine = np.cos(np.radians(rules.smooth_degrees))
-    normals = _sampled(coarse_normals, pixels, labels.shape[1], rules.stride)
     with np.errstate(invalid="ignore"):
         facing_away = np.abs(normals @ plane[:3]) < smooth_cosine
-    pixels, normals = pixels[facing_away], normals[facing_away]
-    if pixels.size == 0:
-        return
-    neighbours, inside = _neighbours(pixels, labels.shape)
-    on_surface = inside & _on_surface(flat_points, pixels, neighbours, rules)
-    # links between neighbouring foot pixels, and contacts of foot pixels with the segment pixels they touch
-    other = np.minimum(np.searchsorted(pixels, neighbours), pixels.size - 1)  # pixels are sorted
-    linked = on_surface & (pixels[other] == neighbours)
-    touching = on_surface & (flat_labels[neighbours] > 0)
-    node = np.broadcast_to(np.arange(pixels.size)[:, None], other.shape)
-    first, second = node[linked], other[linked]
-    touching_node, segment_pixels = node[touching], neighbours[touching]
-    theirs = _sampled(coarse_normals, segment_pixels, labels.shape[1], rules.stride)
-    with np.errstate(invalid="ignore"):
-        linked[linked] = np.einsum("ij,ij->i", normals[first], normals[second]) >= smooth_cosine
-        touches = np.einsum("ij,ij->i", normals[touching_node], theirs) >= smooth_cosine
-    label = np.zeros(pixels.size, dtype=flat_labels.dtype)
-    label[touching_node[touches]] = flat_labels[segment_pixels[touches]]
-    _spread(label, other, linked, reach)
-    reached = label > 0
-    flat_labels[pixels[reached]] = label[reached]
-
-
-def _spread(label: np.ndarray, other: np.ndarray, linked: np.ndarray, rounds: int) -> None:
-    """Breadth-first, in place, for at most ``rounds`` links: each unlabelled node takes the label of a linked node
-    one round after it got one (``other`` Nx4 node indices, ``linked`` Nx4 bool, symmetric), so every node reached
-    ends up with the label of a nearest labelled node."""
-    size = label.size
-    targets = np.where(linked, other, size)  # node ``size`` is a sentinel that counts as labelled
-    labels = np.append(label, np.ones(1, dtype=label.dtype))
-    frontier = np.flatnonzero(label)
-    for _ in range(rounds):
-        reached = targets[frontier]
-        fresh = labels[reached] == 0
-        if not fresh.any():
-            break
-        sources = np.broadcast_to(frontier[:, None], reached.shape)[fresh]
-        frontier = reached[fresh]  # a node reached from several sides appears more than once: harmless
-        labels[frontier] = labels[sources]
-    label[:] = labels[:size]
+    claim_foot(
+        labels,
+        points,
+        pixels,
+        normals,
+        facing_away,
+        coarse_normals,
+        rules.stride,
+        rules.jump_absolute,
+        rules.jump_relative,
+        float(smooth_cosine),
+        reach,
+    )
 
 
 def claim_border_pixels(
@@ -270,14 +166,15 @@ def claim_border_pixels(
     if not cv2.countNonZero(occupied):
         return labels
     claimed = labels.copy()
-    points = np.ascontiguousarray(points)  # one copy of a window's points, so that every flat view is free
     outline = np.zeros(0, dtype=np.int64)
+    smooth_cosine = float(np.cos(np.radians(rules.smooth_degrees)))
+    args = (rules.jump_absolute, rules.jump_relative, rules.normal_step, smooth_cosine, rules.crease)
     for _ in range(rules.stride - 1):
         ring = cv2.dilate((claimed > 0).view(np.uint8), _CROSS).view(bool)
         ring &= candidates
         ring &= claimed == 0
         outline = np.flatnonzero(ring)
-        if _claim_outline(claimed, points, outline, rules).size == 0:
+        if claim_outline(claimed, points, outline, *args) == 0:
             break
     # the reach of the foot at the depths of the segments' outline (their own pixels when no outline was examined)
     reach = _foot_reach(points, outline if outline.size else np.flatnonzero(occupied), rules.min_height)
