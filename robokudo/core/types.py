@@ -194,7 +194,9 @@ class ObjectHypothesis(Annotation):
     """A segment believed to be one object, with the annotations experts attached to it.
 
     ``point_indices`` are flat indices into the organized grid, ``mask`` is HxW bool and ``roi`` is the image
-    box ``(x0, y0, x1, y1)`` in pixels, x1/y1 exclusive.
+    box ``(x0, y0, x1, y1)`` of the mask in pixels, x1/y1 exclusive. The mask holds every point index; it may
+    hold more pixels (a segmenter's claimed outline and foot), which the image experts see and the 3-D experts
+    do not measure.
     """
 
     point_indices: np.ndarray
