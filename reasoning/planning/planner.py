@@ -35,6 +35,8 @@ from reasoning.knowledge.knowledge_base import KnowledgeBase
 from reasoning.knowledge.model import AnnotatorSpec, Conditions, Kind
 from reasoning.planning.plan import Alternatives, Plan, Step, Task, Unit
 
+NEEDED_BY = "needed by "  # a reason naming the provider that reads a type
+
 
 class PlanningError(Exception):
     """No tree can satisfy the query; the message says which requirement failed and why."""
@@ -492,7 +494,8 @@ class _Assignment:
         self.by_rounds = by_rounds
         self.requirements = requirements
         self.values = {r.annotation_type: r.value for r in requirements}
-        self.reasons: dict[str, list[str]] = {}
+        self.reasons: dict[str, list[str]] = {}  # type -> why it is needed, other than by a provider
+        self.consumers: dict[str, list[str]] = {}  # type -> the chosen providers that read it, in planning order
         for requirement in requirements:
             self._note(requirement.annotation_type, requirement.reason)
         self.units: dict[str, _UnitChoice] = {}
@@ -514,9 +517,19 @@ class _Assignment:
         self._prune()
 
     def _note(self, type_name: str, reason: str) -> None:
+        if reason.startswith(NEEDED_BY):
+            self._note_consumer(type_name, reason.removeprefix(NEEDED_BY))
+            return
         reasons = self.reasons.setdefault(type_name, [])
         if reason and reason not in reasons:
             reasons.append(reason)
+
+    def _note_consumer(self, type_name: str, annotator: str) -> None:
+        noted = self.consumers.get(type_name)
+        if noted is None:
+            self.consumers[type_name] = [annotator]
+        elif annotator not in noted:
+            noted.append(annotator)
 
     def _check_feasible(self) -> None:
         for requirement in self.requirements:
@@ -816,15 +829,10 @@ class _Assignment:
             insort(self._order, (self.catalog.rounds.get(type_name, 0), type_name))
             self._add_guaranteed(type_name)
             self.above[type_name] = set(above)
-            reasons = self.reasons
+            note = self._note_consumer
             for spec in free:
-                why = f"needed by {spec.name}"
                 for needed in spec.inputs:
-                    noted = reasons.get(needed)
-                    if noted is None:
-                        reasons[needed] = [why]
-                    elif why not in noted:
-                        noted.append(why)
+                    note(needed, spec.name)
                     queue.append((needed, type_name))
 
     def _prune(self) -> None:
@@ -949,7 +957,7 @@ class _Layout:
                     self.final[type_name] = f"type:{owner_type}"
         self.unrefined = dict(self.final)
         self.refinements = self._refinements()
-        self._unit_inputs = self._branch_inputs()
+        self._unit_inputs = self._branch_inputs(absorbed)
         self._settle()
         # a type whose unit moved into a Fallback's branch exists only when that branch ran: a refiner outside
         # reading it is left out
@@ -993,8 +1001,7 @@ class _Layout:
                 previous = key
         final = self.final
         edges, dependencies = self.optional_edges, self.dependencies
-        for type_name, (required_types, optional_types) in self._unit_inputs.items():
-            key = f"type:{type_name}"
+        for key, (required_types, optional_types) in self._unit_inputs.items():
             deps = {final[t] for t in required_types if t in final}
             if optional_types:
                 optional = {final[t] for t in optional_types if t in final} - deps
@@ -1004,18 +1011,20 @@ class _Layout:
             deps.discard(key)
             dependencies[key] = deps
 
-    def _branch_inputs(self) -> dict[str, tuple[tuple[str, ...], tuple[str, ...]]]:
-        """Per provider unit not absorbed into a branch: the required and the optional input types its
-        branches read from outside themselves (they do not change with the refinements)."""
-        absorbed = {t for owned in self.branches.values() for types in owned.values() for t in types}
+    def _branch_inputs(self, absorbed: set[str]) -> dict[str, tuple[tuple[str, ...], tuple[str, ...]]]:
+        """Per provider unit not ``absorbed`` into a branch, by its key: the required and the optional input types
+        its branches read from outside themselves (they do not change with the refinements; read as sets)."""
         found: dict[str, tuple[tuple[str, ...], tuple[str, ...]]] = {}
-        for type_name in self.units:  # (read by type: the order is no matter)
+        for type_name, unit in self.units.items():  # (read by key: the order is no matter)
             if type_name in absorbed:
+                continue
+            branches = self.branches.get(type_name)
+            if len(unit.providers) == 1 and not (branches and branches.get(unit.providers[0].name)):
+                found[f"type:{type_name}"] = (unit.providers[0].inputs, unit.providers[0].optional_inputs)
                 continue
             required: dict[str, None] = {}
             optional: dict[str, None] = {}
-            branches = self.branches.get(type_name)
-            for spec in self.units[type_name].providers:
+            for spec in unit.providers:
                 if not branches or not branches.get(spec.name):  # the alternative alone in its branch
                     required.update(dict.fromkeys(spec.inputs))
                     optional.update(dict.fromkeys(spec.optional_inputs))
@@ -1024,7 +1033,7 @@ class _Layout:
                 inside = set(branches[spec.name])
                 required.update(dict.fromkeys(t for m in members for t in m.inputs if t not in inside))
                 optional.update(dict.fromkeys(t for m in members for t in m.optional_inputs if t not in inside))
-            found[type_name] = (tuple(required), tuple(optional))
+            found[f"type:{type_name}"] = (tuple(required), tuple(optional))
         return found
 
     def _refinements(self) -> dict[str, list[AnnotatorSpec]]:
@@ -1079,23 +1088,21 @@ class _Layout:
         multiple = sorted(t for t, unit in self.units.items() if len(unit.providers) > 1)
         if not multiple:
             return {}
-        consumers: dict[str, set[str]] = {}
         specs = [s for unit in self.units.values() for s in unit.providers]
         for type_name in set(self.units) | self.catalog.sensors:  # (sets of readers: the order is no matter)
             specs += self.catalog.refiners(type_name)
+        guaranteed = self.assignment.guaranteed_by()
+        # per unit: who reads what it guarantees (units nobody reads are left out)
+        readers: dict[str, set[str]] = {}
         for spec in specs:
             for needed in spec.inputs:
-                found = consumers.get(needed)
-                if found is None:
-                    consumers[needed] = {spec.name}
-                else:
-                    found.add(spec.name)
-        guaranteed = self.assignment.guaranteed_by()
-        guarantees: dict[str, list[str]] = {}
-        for type_name, key in guaranteed.items():
-            guarantees.setdefault(key, []).append(type_name)
-        # per unit: who reads what it guarantees
-        readers = {key: set().union(*(consumers.get(t, ()) for t in types)) for key, types in guarantees.items()}
+                key = guaranteed.get(needed)
+                if key is not None:
+                    found = readers.get(key)
+                    if found is None:
+                        readers[key] = {spec.name}
+                    else:
+                        found.add(spec.name)
         branches: dict[str, dict[str, list[str]]] = {}
         for type_name in multiple:
             unit = self.units[type_name]
@@ -1108,7 +1115,7 @@ class _Layout:
                 consumer in members or (consumer in rivals and key in shared[consumer][0])
                 for owned, members in shared.values()
                 for key in owned
-                for consumer in readers[key]
+                for consumer in readers.get(key, ())
             ):
                 shared = {
                     spec.name: self._owned(spec, type_name, guaranteed, readers, set()) for spec in unit.providers
@@ -1126,7 +1133,7 @@ class _Layout:
     ) -> tuple[list[str], set[str]]:
         """The units that move into the branch of alternative ``spec`` of ``type_name`` (and the branch's
         annotators): single-provider units whose outputs only the branch (or the ``rivals``) read (``readers``: who
-        reads what each unit guarantees)."""
+        reads what each unit guarantees, read units only)."""
         owned: list[str] = []
         members = {spec.name}
         allowed = members | rivals  # who may read what moves into the branch
@@ -1136,7 +1143,7 @@ class _Layout:
             key = guaranteed.get(needed)
             if key is None or key in owned or key == type_name or len(self.units[key].providers) != 1:
                 continue
-            if not readers[key] <= allowed:
+            if key in readers and not readers[key] <= allowed:
                 continue
             owned.append(key)
             inner = self.units[key].providers[0]
@@ -1221,15 +1228,11 @@ class _Layout:
         )
 
     def _why(self, type_name: str) -> str:
-        consumers: list[str] = []
-        others: list[str] = []
-        for reason in self.assignment.reasons.get(type_name, ()):
-            if reason.startswith("needed by "):
-                consumers.append(reason.removeprefix("needed by "))
-            else:
-                others.append(reason)
+        others = self.assignment.reasons.get(type_name)
+        consumers = self.assignment.consumers.get(type_name)
         if consumers:
-            others.append(f"{type_name} is needed by {', '.join(consumers)}")
+            needed = f"{type_name} is needed by {', '.join(consumers)}"
+            return "; ".join([*others, needed]) if others else needed
         return "; ".join(others) if others else f"provides {type_name}"
 
     def _unit(self, key: str) -> Unit:
