@@ -153,6 +153,8 @@ class OntologyIndex:
     written_types: Mapping[str, frozenset[str]] = field(default_factory=dict)
     """Annotator -> what it makes present for others: its outputs and their supertypes minus its inputs and theirs
     (annotators with a port type outside the class closure are left out)."""
+    written_sorted: Mapping[str, tuple[str, ...]] = field(default_factory=dict)
+    """``written_types`` of each annotator, sorted."""
     makers: Mapping[str, tuple[AnnotatorSpec, ...]] = field(default_factory=dict)
     """CAS type -> its ranked providers that have inputs and do not read it (not sensor readers, not refiners)."""
     refiners: Mapping[str, tuple[AnnotatorSpec, ...]] = field(default_factory=dict)
@@ -162,7 +164,9 @@ class OntologyIndex:
     bit_types: tuple[str, ...] = ()
     """The CAS types by bit position: ``type_bits[bit_types[i]] == 1 << i``."""
     rule_ports: tuple[tuple[str, int, int, int], ...] = ()
-    """The annotators with inputs (not sensor readers) in rank order, each with its ``port_masks``."""
+    """The annotators with inputs (not sensor readers) in rank order, each with its inputs, its outputs and the
+    types it provides (``port_masks``), the last two without its inputs (a provider does not provide what it
+    reads)."""
     class_annotators: Mapping[str, frozenset[str]] = field(default_factory=dict)
     """Object class -> the annotators with a class domain naming it (``class_domain`` by class)."""
     rank_notes: Mapping[str, str] = field(default_factory=dict)
@@ -234,6 +238,7 @@ class _Builder:
         bit_types = tuple(sorted(cas_types))
         type_bits = {name: 1 << i for i, name in enumerate(bit_types)}
         port_masks = self._port_masks(annotators, providers, type_bits)
+        written_types = self._written_types(annotators)
         needing: dict[str, set[str]] = defaultdict(set)
         for name, keys in annotator_conditions.items():
             for key in keys:
@@ -273,14 +278,20 @@ class _Builder:
             look_alikes=self._look_alikes(profiles),
             size_bounds=size_bounds,
             inspected_types=inspected_types,
-            written_types=self._written_types(annotators),
+            written_types=written_types,
+            written_sorted={name: tuple(sorted(types)) for name, types in written_types.items()},
             makers={t: tuple(s for s in specs if s.inputs and t not in s.inputs) for t, specs in providers.items()},
             refiners={
                 t: tuple(sorted((s for s in specs if t in s.inputs), key=lambda s: (s.cost_ms, s.name)))
                 for t, specs in providers.items()
             },
             bit_types=bit_types,
-            rule_ports=tuple((s.name, *port_masks[s.name]) for s in ranked if s.inputs),
+            rule_ports=tuple(
+                (s.name, inputs, outputs & ~inputs, written & ~inputs)
+                for s in ranked
+                if s.inputs
+                for inputs, outputs, written in [port_masks[s.name]]
+            ),
             class_annotators=self._class_annotators(ranked),
             rank_notes={s.name: f"{s.name} (reliability {s.reliability:g}, {s.cost_ms:g} ms)" for s in ranked},
         )

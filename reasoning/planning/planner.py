@@ -140,12 +140,13 @@ class _Catalog:
         self._excluded, self._own_types_only = index.provider_exclusions(object_class, conditions)
         excluded, own_types_only = self._excluded, self._own_types_only
         rules: dict[int, int] = {}  # the usable providers' rules, merged per inputs: inputs -> what they provide
-        # annotators without inputs (sensor readers) are not in ``rule_ports``; a provider does not provide what it
-        # reads (a refiner)
-        for name, inputs, outputs, written in self.ontology.rule_ports:
+        # annotators without inputs (sensor readers) are not in ``rule_ports``, whose masks of what a provider makes
+        # leave out what it reads (a refiner)
+        for name, inputs, outputs, provided in self.ontology.rule_ports:
             if name in excluded:
                 continue
-            provided = (outputs if name in own_types_only else written) & ~inputs
+            if name in own_types_only:
+                provided = outputs
             if provided:
                 rules[inputs] = rules.get(inputs, 0) | provided
         self._sensor_mask = self.ontology.mask(self.sensors)
@@ -455,6 +456,7 @@ class _UnitChoice:
         self.value = value
         self._written = catalog.written
         self._written_types = catalog.ontology.written_types
+        self._written_sorted = catalog.ontology.written_sorted
         self._input_round = catalog.input_round
         self.choose(providers)
 
@@ -462,8 +464,12 @@ class _UnitChoice:
         """Make ``providers`` (best first) the unit's alternatives."""
         self.providers = providers
         known = self._written_types
-        self._guaranteed = frozenset.intersection(*[known.get(s.name) or self._written(s) for s in providers])
-        self.guaranteed_sorted = tuple(sorted(self._guaranteed))
+        if len(providers) == 1 and providers[0].name in known:
+            name = providers[0].name
+            self._guaranteed, self.guaranteed_sorted = known[name], self._written_sorted[name]
+        else:
+            self._guaranteed = frozenset.intersection(*[known.get(s.name) or self._written(s) for s in providers])
+            self.guaranteed_sorted = tuple(sorted(self._guaranteed))
         # the types some alternative reads
         self.read: frozenset[str] | tuple[str, ...] = (
             frozenset(t for s in providers for t in s.inputs) if len(providers) > 1 else providers[0].inputs
@@ -1178,9 +1184,10 @@ class _Layout:
         depth = self._depth if self._depth is not None else _depths(self.dependencies)
         assert depth is not None, "the dependencies were checked for cycles"
         by_level: dict[int, list[str]] = {}
-        for key in sorted(self.dependencies):
+        for key in sorted(self.dependencies):  # each level's keys sorted
             by_level.setdefault(depth[key], []).append(key)
-        return tuple(tuple(self._unit(key) for key in sorted(keys)) for _, keys in sorted(by_level.items()))
+        unit = self._unit
+        return tuple(tuple([unit(key) for key in keys]) for _, keys in sorted(by_level.items()))
 
     def _label(self, key: str) -> str:
         found = self._labels.get(key)
@@ -1194,7 +1201,8 @@ class _Layout:
         kind, name = key.split(":", 1)
         if kind == "refine":
             return name
-        return " / ".join(s.name for s in self.units[name].providers)
+        providers = self.units[name].providers
+        return providers[0].name if len(providers) == 1 else " / ".join([s.name for s in providers])
 
     def _step(
         self, spec: AnnotatorSpec, why: str, provides: str = "", inside_types: frozenset[str] = frozenset()
@@ -1202,13 +1210,14 @@ class _Layout:
         """The step of ``spec``, its reason naming what feeds each input (``inside_types``: the types made by the
         units moved into its branch)."""
         final, made = self.final, self._made_by
+        refined = self.refines_output_of.get(spec.name)  # what a refiner's step reads of the type it refines
         feeds = []
         for needed in spec.inputs:
             if inside_types and needed in inside_types:
                 maker = self.units[self.assignment.guaranteed_by()[needed]].providers[0].name
                 feeds.append(f"{needed} from {maker}")
-            elif needed in spec.outputs and spec.name in self.refines_output_of:
-                feeds.append(f"{needed} from {self._label(self.refines_output_of[spec.name])}")
+            elif refined is not None and needed in spec.outputs:
+                feeds.append(f"{needed} from {self._label(refined)}")
             elif needed in final:
                 feed = made.get(needed)
                 if feed is None:
@@ -1220,8 +1229,8 @@ class _Layout:
         return Step(
             spec.name,
             spec.implemented_by,
-            tuple(spec.inputs),
-            tuple(spec.outputs),
+            spec.inputs,
+            spec.outputs,
             tuple(sorted(parameters.items())) if parameters else (),
             reason,
             provides,
