@@ -250,11 +250,10 @@ class _Catalog:
                     if s.name not in excluded and (s.name not in own_types_only or type_name in s.outputs)
                 )
             else:
-                admitted = (
-                    self._admitted(type_name)
-                    if value is None
-                    else self.index.providers(type_name, value, self.object_class, self.conditions)
-                )
+                # ``index.providers(type_name, value, ...)`` for this catalog's object class and conditions
+                admitted = self._admitted(type_name)
+                if value is not None:
+                    admitted = self.index.serving_value(type_name, value, admitted)
                 # annotators without inputs are sensor readers: the plan's source is chosen by its input, not here
                 found = tuple(s for s in admitted if s.inputs and type_name not in s.inputs)
             self._providers[key] = found
