@@ -994,18 +994,25 @@ class _Layout:
         self._depth: dict[str, int] | None = None
         self.optional_edges: set[tuple[str, str]] = set()
         self.refines_output_of: dict[str, str] = {}
-        for type_name, specs in sorted(self.refinements.items()):
+        final = self.final
+        edges, dependencies = self.optional_edges, self.dependencies
+        for type_name, specs in self.refinements.items():  # (by type, sorted)
             previous = self.unrefined[type_name]
             for spec in specs:
                 key = f"refine:{spec.name}"
                 self.refines_output_of[spec.name] = previous
-                required = {previous} | self._producers([t for t in spec.inputs if t != type_name])
-                optional = self._producers(spec.optional_inputs) - required
-                self.optional_edges |= {(key, dep) for dep in optional}
-                self.dependencies[key] = (required | optional) - {key}
+                deps = {previous}
+                for t in spec.inputs:
+                    if t != type_name and t in final:
+                        deps.add(final[t])
+                if spec.optional_inputs:
+                    optional = {final[t] for t in spec.optional_inputs if t in final} - deps
+                    if optional:
+                        edges.update((key, dep) for dep in optional)
+                        deps |= optional
+                deps.discard(key)
+                dependencies[key] = deps
                 previous = key
-        final = self.final
-        edges, dependencies = self.optional_edges, self.dependencies
         for key, (required_types, optional_types) in self._unit_inputs.items():
             deps = {final[t] for t in required_types if t in final}
             if optional_types:
@@ -1058,11 +1065,10 @@ class _Layout:
             ]
             # refiners made for a situation (with preconditions, which hold) all apply; of the general-purpose
             # ones only the cheapest does, so two interchangeable crops are never chained
-            specs = [s for s in usable if s.preconditions]
+            specs = [s for s in usable if s.preconditions]  # (cheapest first, as the candidates)
             general = [s for s in usable if not s.preconditions]
             if general:
-                specs.append(min(general, key=lambda s: (s.cost_ms, -s.reliability, s.name)))
-            specs.sort(key=lambda s: (s.cost_ms, s.name))
+                insort(specs, min(general, key=_by_rank_among_crops), key=_by_cost)
             if specs:
                 found[type_name] = specs
                 used |= {s.name for s in specs}
@@ -1273,6 +1279,16 @@ class _Layout:
             branches=tuple(branches),
             reason=f"{len(unit.providers)} annotators can provide {name}; tried in rank order: {ranking}",
         )
+
+
+def _by_cost(spec: AnnotatorSpec) -> tuple[float, str]:
+    """Cheapest first (the order of refiners)."""
+    return spec.cost_ms, spec.name
+
+
+def _by_rank_among_crops(spec: AnnotatorSpec) -> tuple[float, float, str]:
+    """The general-purpose refiner that runs: the cheapest, then the most reliable."""
+    return spec.cost_ms, -spec.reliability, spec.name
 
 
 def _topological(keys: list[str], units: Mapping[str, _UnitChoice]) -> list[str]:
