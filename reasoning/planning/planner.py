@@ -319,20 +319,27 @@ class _Catalog:
         what is left when nothing more can be peeled lies on or behind a cycle.
         """
         done = self._sensor_mask
-        pending = [(inputs, provided & ~done) for inputs, provided in self._rules if provided & ~done]
-        while pending:
+        pending = self._rules
+        while True:
             blocked = ready = 0
+            left = ~done
+            rest = []  # the rules that still provide types not peeled off, with only those
             for inputs, provided in pending:
+                provided &= left
+                if not provided:
+                    continue
+                rest.append((inputs, provided))
                 if inputs & done == inputs:
                     ready |= provided
                 else:
                     blocked |= provided
+            if not rest:
+                return False
             ready &= ~blocked
             if not ready:
                 return True
             done |= ready
-            pending = [(inputs, provided & ~done) for inputs, provided in pending if provided & ~done]
-        return False
+            pending = rest
 
     def producible_without(self, forbidden: frozenset[str]) -> int:
         """What can be produced when the ``forbidden`` types may not be used, as a mask of types."""
@@ -823,21 +830,27 @@ class _Assignment:
                 queue.extend((needed, type_name) for spec in again for needed in spec.inputs)
                 continue
             valid = self.catalog.valid(type_name, value, frozenset(above), self.by_rounds)
-            owners = self._owners  # read here only, before the units change
+            owners = self._owners  # annotator -> its unit
             free = [s for s in valid if s.name not in owners]
             if not free:
                 if not self._take_over(type_name, valid, consumer, above):
                     raise _OrderingError(f"cannot produce {type_name}: {self.catalog.why_not(type_name, value)}")
                 continue
             self.units[type_name] = _UnitChoice(type_name, free, value, self.catalog)
-            self._owners.update(dict.fromkeys((spec.name for spec in free), type_name))
+            for spec in free:
+                owners[spec.name] = type_name
             insort(self._order, (self.catalog.rounds.get(type_name, 0), type_name))
             self._add_guaranteed(type_name)
             self.above[type_name] = set(above)
-            note = self._note_consumer
+            consumers = self.consumers  # (:meth:`_note_consumer` inline: many inputs per plan)
             for spec in free:
+                name = spec.name
                 for needed in spec.inputs:
-                    note(needed, spec.name)
+                    noted = consumers.get(needed)
+                    if noted is None:
+                        consumers[needed] = [name]
+                    elif name not in noted:
+                        noted.append(name)
                     queue.append((needed, type_name))
 
     def _prune(self) -> None:
