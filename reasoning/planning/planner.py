@@ -1228,7 +1228,8 @@ class _Layout:
         """The step of ``spec``, its reason naming what feeds each input (``inside_types``: the types made by the
         units moved into its branch)."""
         final, made = self.final, self._made_by
-        refined = self.refines_output_of.get(spec.name)  # what a refiner's step reads of the type it refines
+        name = spec.name
+        refined = self.refines_output_of.get(name)  # what a refiner's step reads of the type it refines
         feeds = []
         for needed in spec.inputs:
             if inside_types and needed in inside_types:
@@ -1236,21 +1237,21 @@ class _Layout:
                 feeds.append(f"{needed} from {maker}")
             elif refined is not None and needed in spec.outputs:
                 feeds.append(f"{needed} from {self._label(refined)}")
-            elif needed in final:
+            else:
                 feed = made.get(needed)
-                if feed is None:
+                if feed is None and needed in final:
                     feed = made[needed] = f"{needed} from {self._label(final[needed])}"
-                feeds.append(feed)
-        reason = f"{spec.name}: {why}; needs {', '.join(feeds)}" if feeds else f"{spec.name}: {why}"
-        parameters = self.parameters.get(spec.name)
+                if feed is not None:
+                    feeds.append(feed)
+        parameters = self.parameters.get(name)
         # positional (many steps per plan): annotator, implemented_by, inputs, outputs, parameters, reason, provides
         return Step(
-            spec.name,
+            name,
             spec.implemented_by,
             spec.inputs,
             spec.outputs,
             tuple(sorted(parameters.items())) if parameters else (),
-            reason,
+            f"{name}: {why}; needs {', '.join(feeds)}" if feeds else f"{name}: {why}",
             provides,
         )
 
@@ -1263,21 +1264,22 @@ class _Layout:
         return "; ".join(others) if others else f"provides {type_name}"
 
     def _unit(self, key: str) -> Unit:
-        if key == "reader":
+        if key.startswith("type:"):
+            name = key[5:]
+        elif key == "reader":
             return self.source.step
-        kind, name = key.split(":", 1)
-        if kind == "refine":
-            refined, spec = self._refiner_of[name]
+        else:
+            refined, spec = self._refiner_of[key.removeprefix("refine:")]
             return self._step(spec, f"refines {refined} before it is used ({_precondition_note(spec)})")
         unit = self.units[name]
         if len(unit.providers) == 1:
-            return self._step(unit.providers[0], self._why(name), provides=name)
+            return self._step(unit.providers[0], self._why(name), name)
         branches = []
         why = self._why(name)
         for spec in unit.providers:
             owned = self.branches[name][spec.name]
             if not owned:
-                branches.append((self._step(spec, why, provides=name),))
+                branches.append((self._step(spec, why, name),))
                 continue
             inside = frozenset(t for key in owned for t in self.units[key].guaranteed())
             inner = tuple(
@@ -1286,7 +1288,7 @@ class _Layout:
             )
             branches.append((*inner, self._step(spec, why, provides=name, inside_types=inside)))
         notes = self.catalog.ontology.rank_notes
-        ranking = ", ".join(notes[s.name] for s in unit.providers)
+        ranking = ", ".join([notes[s.name] for s in unit.providers])
         return Alternatives(
             provides=name,
             branches=tuple(branches),
