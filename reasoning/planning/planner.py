@@ -418,20 +418,25 @@ class _Catalog:
         producible = self._known_by_round[-1]
         found: tuple[int, int, tuple[AnnotatorSpec, ...], tuple[AnnotatorSpec, ...]] | None = None
         chosen: list[AnnotatorSpec] = []
-        rounds: list[int] = []  # a provider's input round is the one before its rule fires (:meth:`input_round`)
+        first: list[AnnotatorSpec] = []  # those whose rule fires earliest
+        # a provider's input round is the one before its rule fires (:meth:`input_round`)
+        earliest = latest = 0
         for spec in providers:
             inputs = masks[spec.name][0]
             fires = fired.get(inputs)
             if fires is not None:
+                if not chosen or fires < earliest:
+                    earliest, first = fires, [spec]
+                elif fires == earliest:
+                    first.append(spec)
+                if fires > latest:
+                    latest = fires
                 chosen.append(spec)
-                rounds.append(fires)
             elif inputs & producible == inputs:  # reads only producible types, yet its rule never fires
-                rounds = []
+                chosen = []
                 break
-        if rounds:
-            earliest = min(rounds)
-            first = tuple(s for s, r in zip(chosen, rounds, strict=True) if r == earliest)
-            found = (earliest - 1, max(rounds) - 1, first, tuple(chosen))
+        if chosen:
+            found = (earliest - 1, latest - 1, tuple(first), tuple(chosen))
         self._grouped[key] = found
         return found
 
@@ -865,7 +870,8 @@ class _Assignment:
                 if key is None or key in needed:
                     continue
                 needed.add(key)
-                frontier.extend(t for s in self.units[key].providers for t in s.inputs)
+                for spec in self.units[key].providers:
+                    frontier += spec.inputs
             unneeded = set(self.units) - needed
             if not unneeded:
                 return
@@ -1047,17 +1053,17 @@ class _Layout:
             if len(unit.providers) == 1 and not (branches and branches.get(unit.providers[0].name)):
                 found[f"type:{type_name}"] = (unit.providers[0].inputs, unit.providers[0].optional_inputs)
                 continue
-            required: dict[str, None] = {}
-            optional: dict[str, None] = {}
+            required: set[str] = set()
+            optional: set[str] = set()
             for spec in unit.providers:
                 if not branches or not branches.get(spec.name):  # the alternative alone in its branch
-                    required.update(dict.fromkeys(spec.inputs))
-                    optional.update(dict.fromkeys(spec.optional_inputs))
+                    required.update(spec.inputs)
+                    optional.update(spec.optional_inputs)
                     continue
                 members = self._members(type_name, spec)
                 inside = set(branches[spec.name])
-                required.update(dict.fromkeys(t for m in members for t in m.inputs if t not in inside))
-                optional.update(dict.fromkeys(t for m in members for t in m.optional_inputs if t not in inside))
+                required.update(t for m in members for t in m.inputs if t not in inside)
+                optional.update(t for m in members for t in m.optional_inputs if t not in inside)
             found[f"type:{type_name}"] = (tuple(required), tuple(optional))
         return found
 
