@@ -613,22 +613,45 @@ class _Assignment:
         """Update the type -> unit mapping for the new unit ``key`` (when the mapping by unit order is known): the
         types it guarantees that no unit earlier in the order does are now its."""
         by_order = self._by_order
+        previous = self._guaranteed  # the mapping from ``by_order`` (while that is known)
         self._invalidate()
-        if by_order is None:
+        if by_order is None or previous is None:
             return
         rounds = self.catalog.rounds
         unit = self.units[key]
-        latest = unit.latest_round
+        by_rounds = self.by_rounds
+        latest = unit.latest_round if by_rounds else 0
         place = (rounds.get(key, 0), key)
+        taken = []  # the types that map to the new unit by unit order now
         for type_name in unit.guaranteed_sorted:
-            if self.by_rounds and latest >= rounds.get(type_name, 0):
+            if by_rounds and latest >= rounds.get(type_name, 0):
                 continue
             present = by_order.get(type_name)
             if present is None or (rounds.get(present, 0), present) > place:
                 by_order[type_name] = key
+                taken.append(type_name)
         self._by_order = by_order
         # the new unit's own type maps to it now (it did not before): the mapping changed
-        self._guaranteed = self._last_guaranteed = self._overridden(by_order)
+        self._guaranteed = self._last_guaranteed = self._with_unit(previous, key, taken)
+
+    def _with_unit(self, previous: dict[str, str], key: str, taken: list[str]) -> dict[str, str]:
+        """:meth:`_overridden` of the mapping by unit order after the new unit ``key`` took the types ``taken``, from
+        ``previous`` (that of the mapping before): pinned types and units' own types keep their units."""
+        found = dict(previous)
+        units, pinned = self.units, self.pinned
+        for type_name in taken:
+            if type_name in units:
+                continue  # a unit's own type (the new unit's: below)
+            pin = pinned.get(type_name)
+            if pin is not None and pin != key and pin in units and type_name in units[pin].guaranteed():
+                continue
+            found[type_name] = key
+        guaranteed = units[key].guaranteed()
+        for type_name, pin in pinned.items():
+            if pin == key and type_name in guaranteed:
+                found[type_name] = key
+        found[key] = key
+        return found
 
     def _overridden(self, by_order: dict[str, str]) -> dict[str, str]:
         """The mapping by unit order with the pinned types and each unit's own type put to their units."""
