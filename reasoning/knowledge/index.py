@@ -12,6 +12,7 @@ from collections import defaultdict, deque
 from collections.abc import Container, Iterable, Mapping
 from dataclasses import dataclass, field
 from decimal import Decimal
+from itertools import repeat
 from pathlib import Path
 
 from rdflib import BNode, Graph, Literal, URIRef
@@ -175,6 +176,8 @@ class OntologyIndex:
     def mask(self, types: Iterable[str]) -> int:
         """The bit mask of CAS types (names that are no CAS type are left out)."""
         bits = self.type_bits
+        if isinstance(types, set | frozenset):  # distinct names: the sum of their bits is their union
+            return sum(map(bits.get, types, repeat(0)))
         found = 0
         for name in types:
             found |= bits.get(name, 0)

@@ -483,7 +483,7 @@ class _UnitChoice:
             self.guaranteed_sorted = tuple(sorted(self._guaranteed))
         # the types some alternative reads
         self.read: frozenset[str] | tuple[str, ...] = (
-            frozenset(t for s in providers for t in s.inputs) if len(providers) > 1 else providers[0].inputs
+            frozenset().union(*[s.inputs for s in providers]) if len(providers) > 1 else providers[0].inputs
         )
         self._latest_round: int | None = None
 
