@@ -154,8 +154,6 @@ class OntologyIndex:
     written_types: Mapping[str, frozenset[str]] = field(default_factory=dict)
     """Annotator -> what it makes present for others: its outputs and their supertypes minus its inputs and theirs
     (annotators with a port type outside the class closure are left out)."""
-    written_sorted: Mapping[str, tuple[str, ...]] = field(default_factory=dict)
-    """``written_types`` of each annotator, sorted."""
     makers: Mapping[str, tuple[AnnotatorSpec, ...]] = field(default_factory=dict)
     """CAS type -> its ranked providers that have inputs and do not read it (not sensor readers, not refiners)."""
     refiners: Mapping[str, tuple[AnnotatorSpec, ...]] = field(default_factory=dict)
@@ -241,7 +239,6 @@ class _Builder:
         bit_types = tuple(sorted(cas_types))
         type_bits = {name: 1 << i for i, name in enumerate(bit_types)}
         port_masks = self._port_masks(annotators, providers, type_bits)
-        written_types = self._written_types(annotators)
         needing: dict[str, set[str]] = defaultdict(set)
         for name, keys in annotator_conditions.items():
             for key in keys:
@@ -281,8 +278,7 @@ class _Builder:
             look_alikes=self._look_alikes(profiles),
             size_bounds=size_bounds,
             inspected_types=inspected_types,
-            written_types=written_types,
-            written_sorted={name: tuple(sorted(types)) for name, types in written_types.items()},
+            written_types=self._written_types(annotators),
             makers={t: tuple(s for s in specs if s.inputs and t not in s.inputs) for t, specs in providers.items()},
             refiners={
                 t: tuple(sorted((s for s in specs if t in s.inputs), key=lambda s: (s.cost_ms, s.name)))

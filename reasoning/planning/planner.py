@@ -467,7 +467,6 @@ class _UnitChoice:
         self.value = value
         self._written = catalog.written
         self._written_types = catalog.ontology.written_types
-        self._written_sorted = catalog.ontology.written_sorted
         self._input_round = catalog.input_round
         self.choose(providers)
 
@@ -475,12 +474,10 @@ class _UnitChoice:
         """Make ``providers`` (best first) the unit's alternatives."""
         self.providers = providers
         known = self._written_types
-        if len(providers) == 1 and providers[0].name in known:
-            name = providers[0].name
-            self._guaranteed, self.guaranteed_sorted = known[name], self._written_sorted[name]
+        if len(providers) == 1:
+            self._guaranteed = known.get(providers[0].name) or self._written(providers[0])
         else:
             self._guaranteed = frozenset.intersection(*[known.get(s.name) or self._written(s) for s in providers])
-            self.guaranteed_sorted = tuple(sorted(self._guaranteed))
         # the types some alternative reads
         self.read: frozenset[str] | tuple[str, ...] = (
             frozenset().union(*[s.inputs for s in providers]) if len(providers) > 1 else providers[0].inputs
@@ -599,8 +596,8 @@ class _Assignment:
         units = self.units
         for _, key in self._order:
             unit = units[key]
-            latest = unit.latest_round
-            for type_name in unit.guaranteed_sorted:
+            latest = unit.latest_round if by_rounds else 0
+            for type_name in unit.guaranteed():  # (each type on its own: the order is no matter)
                 if type_name in found:
                     continue
                 if by_rounds and latest >= rounds.get(type_name, 0):
@@ -623,7 +620,7 @@ class _Assignment:
         latest = unit.latest_round if by_rounds else 0
         place = (rounds.get(key, 0), key)
         taken = []  # the types that map to the new unit by unit order now
-        for type_name in unit.guaranteed_sorted:
+        for type_name in unit.guaranteed():  # (each type on its own: the order is no matter)
             if by_rounds and latest >= rounds.get(type_name, 0):
                 continue
             present = by_order.get(type_name)
@@ -1187,9 +1184,21 @@ class _Layout:
         """The units that move into the branch of alternative ``spec`` of ``type_name`` (and the branch's
         annotators): single-provider units whose outputs only the branch (or the ``rivals``) read (``readers``: who
         reads what each unit guarantees, read units only)."""
-        owned: list[str] = []
         members = {spec.name}
         allowed = members | rivals  # who may read what moves into the branch
+        units = self.units
+        for needed in spec.inputs:  # the branch owns nothing unless it can own a unit making one of its inputs
+            key = guaranteed.get(needed)
+            if (
+                key is not None
+                and key != type_name
+                and len(units[key].providers) == 1
+                and (key not in readers or readers[key] <= allowed)
+            ):
+                break
+        else:
+            return [], members
+        owned: list[str] = []
         frontier = list(spec.inputs)
         while frontier:
             needed = frontier.pop(0)
