@@ -876,7 +876,8 @@ class _Assignment:
                         consumers[needed] = [name]
                     elif name not in noted:
                         noted.append(name)
-                    queue.append((needed, type_name))
+                    if needed not in sensors:  # (a sensor type needs no unit: it would be skipped)
+                        queue.append((needed, type_name))
 
     def _prune(self) -> None:
         """Drop units that no requirement needs any more (after a unit was committed to one provider)."""
