@@ -168,6 +168,8 @@ class OntologyIndex:
     reads)."""
     class_annotators: Mapping[str, frozenset[str]] = field(default_factory=dict)
     """Object class -> the annotators with a class domain naming it (``class_domain`` by class)."""
+    class_domain_names: frozenset[str] = frozenset()
+    """The names of the annotators with a class domain (``class_domain``)."""
     rank_notes: Mapping[str, str] = field(default_factory=dict)
     """Annotator -> its name with its rank: ``Name (reliability 0.9, 12 ms)`` (for the reasons of alternatives)."""
 
@@ -292,6 +294,7 @@ class _Builder:
                 for inputs, outputs, written in [port_masks[s.name]]
             ),
             class_annotators=self._class_annotators(ranked),
+            class_domain_names=frozenset(spec.name for spec in ranked if spec.classes),
             rank_notes={s.name: f"{s.name} (reliability {s.reliability:g}, {s.cost_ms:g} ms)" for s in ranked},
         )
 

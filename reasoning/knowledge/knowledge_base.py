@@ -514,7 +514,7 @@ class KnowledgeBase:
         # class-domain annotators naming no superclass (or the class itself) serve only their own types, and those
         # naming no subclass either serve none
         domains = index.class_annotators
-        own_types = {spec.name for spec in index.class_domain}
+        own_types = set(index.class_domain_names)
         if object_up is not None and object_down is not None:
             own_types.difference_update(*(domains.get(c, ()) for c in object_up))
             everywhere |= own_types.difference(*(domains.get(c, ()) for c in object_down))
