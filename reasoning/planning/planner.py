@@ -29,6 +29,7 @@ from __future__ import annotations
 from bisect import insort
 from collections import deque
 from collections.abc import Iterable, Mapping, Sequence
+from collections.abc import Set as AbstractSet
 from dataclasses import dataclass
 
 from reasoning.knowledge.knowledge_base import KnowledgeBase
@@ -341,7 +342,7 @@ class _Catalog:
             done |= ready
             pending = rest
 
-    def producible_without(self, forbidden: frozenset[str]) -> int:
+    def producible_without(self, forbidden: AbstractSet[str]) -> int:
         """What can be produced when the ``forbidden`` types may not be used, as a mask of types."""
         key = self.ontology.mask(forbidden) & self._forbiddable
         found = self._without.get(key)
@@ -350,7 +351,7 @@ class _Catalog:
         return found
 
     def valid(
-        self, type_name: str, value: str | None, above: frozenset[str] = frozenset(), by_rounds: bool = False
+        self, type_name: str, value: str | None, above: AbstractSet[str] = frozenset(), by_rounds: bool = False
     ) -> list[AnnotatorSpec]:
         """Providers of ``type_name`` whose inputs can be produced without it and without the types ``above`` it
         (those that need it), so that choosing them cannot create a cycle; ``by_rounds`` keeps only those whose
@@ -854,7 +855,7 @@ class _Assignment:
                 self.above[type_name] = combined
                 queue.extend((needed, type_name) for spec in again for needed in spec.inputs)
                 continue
-            valid = self.catalog.valid(type_name, value, frozenset(above), self.by_rounds)
+            valid = self.catalog.valid(type_name, value, above, self.by_rounds)
             owners = self._owners  # annotator -> its unit
             free = [s for s in valid if s.name not in owners]
             if not free:
@@ -866,7 +867,7 @@ class _Assignment:
                 owners[spec.name] = type_name
             insort(self._order, (self.catalog.rounds.get(type_name, 0), type_name))
             self._add_guaranteed(type_name)
-            self.above[type_name] = set(above)
+            self.above[type_name] = above  # (a set of this round's own)
             consumers = self.consumers  # (:meth:`_note_consumer` inline: many inputs per plan)
             for spec in free:
                 name = spec.name
