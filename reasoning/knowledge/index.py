@@ -12,6 +12,7 @@ from collections import defaultdict, deque
 from collections.abc import Container, Iterable, Mapping
 from dataclasses import dataclass, field
 from decimal import Decimal
+from itertools import repeat
 from pathlib import Path
 
 from rdflib import BNode, Graph, Literal, URIRef
@@ -162,15 +163,21 @@ class OntologyIndex:
     bit_types: tuple[str, ...] = ()
     """The CAS types by bit position: ``type_bits[bit_types[i]] == 1 << i``."""
     rule_ports: tuple[tuple[str, int, int, int], ...] = ()
-    """The annotators with inputs (not sensor readers) in rank order, each with its ``port_masks``."""
+    """The annotators with inputs (not sensor readers) in rank order, each with its inputs, its outputs and the
+    types it provides (``port_masks``), the last two without its inputs (a provider does not provide what it
+    reads)."""
     class_annotators: Mapping[str, frozenset[str]] = field(default_factory=dict)
     """Object class -> the annotators with a class domain naming it (``class_domain`` by class)."""
+    class_domain_names: frozenset[str] = frozenset()
+    """The names of the annotators with a class domain (``class_domain``)."""
     rank_notes: Mapping[str, str] = field(default_factory=dict)
     """Annotator -> its name with its rank: ``Name (reliability 0.9, 12 ms)`` (for the reasons of alternatives)."""
 
     def mask(self, types: Iterable[str]) -> int:
         """The bit mask of CAS types (names that are no CAS type are left out)."""
         bits = self.type_bits
+        if isinstance(types, set | frozenset):  # distinct names: the sum of their bits is their union
+            return sum(map(bits.get, types, repeat(0)))
         found = 0
         for name in types:
             found |= bits.get(name, 0)
@@ -280,8 +287,14 @@ class _Builder:
                 for t, specs in providers.items()
             },
             bit_types=bit_types,
-            rule_ports=tuple((s.name, *port_masks[s.name]) for s in ranked if s.inputs),
+            rule_ports=tuple(
+                (s.name, inputs, outputs & ~inputs, written & ~inputs)
+                for s in ranked
+                if s.inputs
+                for inputs, outputs, written in [port_masks[s.name]]
+            ),
             class_annotators=self._class_annotators(ranked),
+            class_domain_names=frozenset(spec.name for spec in ranked if spec.classes),
             rank_notes={s.name: f"{s.name} (reliability {s.reliability:g}, {s.cost_ms:g} ms)" for s in ranked},
         )
 

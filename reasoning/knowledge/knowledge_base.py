@@ -436,11 +436,8 @@ class KnowledgeBase:
             close = difflib.get_close_matches(annotation_type, list(index.cas_types), n=3, cutoff=0.6)
             raise UnknownTermError(annotation_type, "CAS type", close)
         candidates = index.providers.get(annotation_type, ())
-        value_kind = index.value_domains.get(annotation_type)
-        value_up = value_down = None
-        if value is not None and value_kind is not None:
-            value_name = self._name(value, (value_kind,))
-            value_up, value_down = index.up[value_name], index.down[value_name]
+        if value is not None:
+            candidates = self.serving_value(annotation_type, value, candidates)
         object_up = object_down = None
         transparent = False
         if object_class is not None:
@@ -451,10 +448,6 @@ class KnowledgeBase:
         transparent = transparent or conditions.transparent
         chosen: list[AnnotatorSpec] = []
         for spec in candidates:
-            if value_up is not None and value_down is not None:
-                domain = spec.domain(value_kind)
-                if domain and domain.isdisjoint(value_up) and domain.isdisjoint(value_down):
-                    continue
             if (
                 object_up is not None
                 and object_down is not None
@@ -480,6 +473,25 @@ class KnowledgeBase:
             chosen.append(spec)
         return chosen
 
+    def serving_value(
+        self, annotation_type: str, value: str, candidates: Sequence[AnnotatorSpec]
+    ) -> Sequence[AnnotatorSpec]:
+        """Of ``candidates`` (providers of ``annotation_type``), those whose declared domain holds ``value``, a
+        subclass of it or a superclass of it, or is empty (any value), in their order (:meth:`providers`)."""
+        index = self._index
+        value_kind = index.value_domains.get(annotation_type)
+        if value_kind is None:
+            return candidates
+        value_name = self._name(value, (value_kind,))
+        value_up, value_down = index.up[value_name], index.down[value_name]
+        return [
+            spec
+            for spec in candidates
+            if not (domain := spec.domain(value_kind))
+            or not domain.isdisjoint(value_up)
+            or not domain.isdisjoint(value_down)
+        ]
+
     def provider_exclusions(
         self, object_class: str | None = None, conditions: Conditions | None = None
     ) -> tuple[frozenset[str], frozenset[str]]:
@@ -502,7 +514,7 @@ class KnowledgeBase:
         # class-domain annotators naming no superclass (or the class itself) serve only their own types, and those
         # naming no subclass either serve none
         domains = index.class_annotators
-        own_types = {spec.name for spec in index.class_domain}
+        own_types = set(index.class_domain_names)
         if object_up is not None and object_down is not None:
             own_types.difference_update(*(domains.get(c, ()) for c in object_up))
             everywhere |= own_types.difference(*(domains.get(c, ()) for c in object_down))

@@ -57,6 +57,28 @@ class Step:
     reason: str = ""
     provides: str = ""
 
+    def __init__(
+        self,
+        annotator: str,
+        implemented_by: str,
+        inputs: tuple[str, ...],
+        outputs: tuple[str, ...],
+        parameters: tuple[tuple[str, Any], ...] = (),
+        reason: str = "",
+        provides: str = "",
+    ) -> None:
+        # the fields set in one update (a plan builds dozens of steps; the frozen dataclass's own __init__ sets each
+        # field through object.__setattr__, twice as slow)
+        self.__dict__.update(
+            annotator=annotator,
+            implemented_by=implemented_by,
+            inputs=inputs,
+            outputs=outputs,
+            parameters=parameters,
+            reason=reason,
+            provides=provides,
+        )
+
 
 @dataclass(frozen=True)
 class Alternatives:

@@ -29,11 +29,14 @@ from __future__ import annotations
 from bisect import insort
 from collections import deque
 from collections.abc import Iterable, Mapping, Sequence
+from collections.abc import Set as AbstractSet
 from dataclasses import dataclass
 
 from reasoning.knowledge.knowledge_base import KnowledgeBase
 from reasoning.knowledge.model import AnnotatorSpec, Conditions, Kind
 from reasoning.planning.plan import Alternatives, Plan, Step, Task, Unit
+
+NEEDED_BY = "needed by "  # a reason naming the provider that reads a type
 
 
 class PlanningError(Exception):
@@ -138,12 +141,13 @@ class _Catalog:
         self._excluded, self._own_types_only = index.provider_exclusions(object_class, conditions)
         excluded, own_types_only = self._excluded, self._own_types_only
         rules: dict[int, int] = {}  # the usable providers' rules, merged per inputs: inputs -> what they provide
-        # annotators without inputs (sensor readers) are not in ``rule_ports``; a provider does not provide what it
-        # reads (a refiner)
-        for name, inputs, outputs, written in self.ontology.rule_ports:
+        # annotators without inputs (sensor readers) are not in ``rule_ports``, whose masks of what a provider makes
+        # leave out what it reads (a refiner)
+        for name, inputs, outputs, provided in self.ontology.rule_ports:
             if name in excluded:
                 continue
-            provided = (outputs if name in own_types_only else written) & ~inputs
+            if name in own_types_only:
+                provided = outputs
             if provided:
                 rules[inputs] = rules.get(inputs, 0) | provided
         self._sensor_mask = self.ontology.mask(self.sensors)
@@ -247,11 +251,10 @@ class _Catalog:
                     if s.name not in excluded and (s.name not in own_types_only or type_name in s.outputs)
                 )
             else:
-                admitted = (
-                    self._admitted(type_name)
-                    if value is None
-                    else self.index.providers(type_name, value, self.object_class, self.conditions)
-                )
+                # ``index.providers(type_name, value, ...)`` for this catalog's object class and conditions
+                admitted = self._admitted(type_name)
+                if value is not None:
+                    admitted = self.index.serving_value(type_name, value, admitted)
                 # annotators without inputs are sensor readers: the plan's source is chosen by its input, not here
                 found = tuple(s for s in admitted if s.inputs and type_name not in s.inputs)
             self._providers[key] = found
@@ -317,22 +320,29 @@ class _Catalog:
         what is left when nothing more can be peeled lies on or behind a cycle.
         """
         done = self._sensor_mask
-        pending = [(inputs, provided & ~done) for inputs, provided in self._rules if provided & ~done]
-        while pending:
+        pending = self._rules
+        while True:
             blocked = ready = 0
+            left = ~done
+            rest = []  # the rules that still provide types not peeled off, with only those
             for inputs, provided in pending:
+                provided &= left
+                if not provided:
+                    continue
+                rest.append((inputs, provided))
                 if inputs & done == inputs:
                     ready |= provided
                 else:
                     blocked |= provided
+            if not rest:
+                return False
             ready &= ~blocked
             if not ready:
                 return True
             done |= ready
-            pending = [(inputs, provided & ~done) for inputs, provided in pending if provided & ~done]
-        return False
+            pending = rest
 
-    def producible_without(self, forbidden: frozenset[str]) -> int:
+    def producible_without(self, forbidden: AbstractSet[str]) -> int:
         """What can be produced when the ``forbidden`` types may not be used, as a mask of types."""
         key = self.ontology.mask(forbidden) & self._forbiddable
         found = self._without.get(key)
@@ -341,7 +351,7 @@ class _Catalog:
         return found
 
     def valid(
-        self, type_name: str, value: str | None, above: frozenset[str] = frozenset(), by_rounds: bool = False
+        self, type_name: str, value: str | None, above: AbstractSet[str] = frozenset(), by_rounds: bool = False
     ) -> list[AnnotatorSpec]:
         """Providers of ``type_name`` whose inputs can be produced without it and without the types ``above`` it
         (those that need it), so that choosing them cannot create a cycle; ``by_rounds`` keeps only those whose
@@ -409,20 +419,25 @@ class _Catalog:
         producible = self._known_by_round[-1]
         found: tuple[int, int, tuple[AnnotatorSpec, ...], tuple[AnnotatorSpec, ...]] | None = None
         chosen: list[AnnotatorSpec] = []
-        rounds: list[int] = []  # a provider's input round is the one before its rule fires (:meth:`input_round`)
+        first: list[AnnotatorSpec] = []  # those whose rule fires earliest
+        # a provider's input round is the one before its rule fires (:meth:`input_round`)
+        earliest = latest = 0
         for spec in providers:
             inputs = masks[spec.name][0]
             fires = fired.get(inputs)
             if fires is not None:
+                if not chosen or fires < earliest:
+                    earliest, first = fires, [spec]
+                elif fires == earliest:
+                    first.append(spec)
+                if fires > latest:
+                    latest = fires
                 chosen.append(spec)
-                rounds.append(fires)
             elif inputs & producible == inputs:  # reads only producible types, yet its rule never fires
-                rounds = []
+                chosen = []
                 break
-        if rounds:
-            earliest = min(rounds)
-            first = tuple(s for s, r in zip(chosen, rounds, strict=True) if r == earliest)
-            found = (earliest - 1, max(rounds) - 1, first, tuple(chosen))
+        if chosen:
+            found = (earliest - 1, latest - 1, tuple(first), tuple(chosen))
         self._grouped[key] = found
         return found
 
@@ -460,11 +475,13 @@ class _UnitChoice:
         """Make ``providers`` (best first) the unit's alternatives."""
         self.providers = providers
         known = self._written_types
-        self._guaranteed = frozenset.intersection(*[known.get(s.name) or self._written(s) for s in providers])
-        self.guaranteed_sorted = tuple(sorted(self._guaranteed))
+        if len(providers) == 1:
+            self._guaranteed = known.get(providers[0].name) or self._written(providers[0])
+        else:
+            self._guaranteed = frozenset.intersection(*[known.get(s.name) or self._written(s) for s in providers])
         # the types some alternative reads
         self.read: frozenset[str] | tuple[str, ...] = (
-            frozenset(t for s in providers for t in s.inputs) if len(providers) > 1 else providers[0].inputs
+            frozenset().union(*[s.inputs for s in providers]) if len(providers) > 1 else providers[0].inputs
         )
         self._latest_round: int | None = None
 
@@ -492,7 +509,8 @@ class _Assignment:
         self.by_rounds = by_rounds
         self.requirements = requirements
         self.values = {r.annotation_type: r.value for r in requirements}
-        self.reasons: dict[str, list[str]] = {}
+        self.reasons: dict[str, list[str]] = {}  # type -> why it is needed, other than by a provider
+        self.consumers: dict[str, list[str]] = {}  # type -> the chosen providers that read it, in planning order
         for requirement in requirements:
             self._note(requirement.annotation_type, requirement.reason)
         self.units: dict[str, _UnitChoice] = {}
@@ -514,9 +532,19 @@ class _Assignment:
         self._prune()
 
     def _note(self, type_name: str, reason: str) -> None:
+        if reason.startswith(NEEDED_BY):
+            self._note_consumer(type_name, reason.removeprefix(NEEDED_BY))
+            return
         reasons = self.reasons.setdefault(type_name, [])
         if reason and reason not in reasons:
             reasons.append(reason)
+
+    def _note_consumer(self, type_name: str, annotator: str) -> None:
+        noted = self.consumers.get(type_name)
+        if noted is None:
+            self.consumers[type_name] = [annotator]
+        elif annotator not in noted:
+            noted.append(annotator)
 
     def _check_feasible(self) -> None:
         for requirement in self.requirements:
@@ -569,8 +597,8 @@ class _Assignment:
         units = self.units
         for _, key in self._order:
             unit = units[key]
-            latest = unit.latest_round
-            for type_name in unit.guaranteed_sorted:
+            latest = unit.latest_round if by_rounds else 0
+            for type_name in unit.guaranteed():  # (each type on its own: the order is no matter)
                 if type_name in found:
                     continue
                 if by_rounds and latest >= rounds.get(type_name, 0):
@@ -583,22 +611,45 @@ class _Assignment:
         """Update the type -> unit mapping for the new unit ``key`` (when the mapping by unit order is known): the
         types it guarantees that no unit earlier in the order does are now its."""
         by_order = self._by_order
+        previous = self._guaranteed  # the mapping from ``by_order`` (while that is known)
         self._invalidate()
-        if by_order is None:
+        if by_order is None or previous is None:
             return
         rounds = self.catalog.rounds
         unit = self.units[key]
-        latest = unit.latest_round
+        by_rounds = self.by_rounds
+        latest = unit.latest_round if by_rounds else 0
         place = (rounds.get(key, 0), key)
-        for type_name in unit.guaranteed_sorted:
-            if self.by_rounds and latest >= rounds.get(type_name, 0):
+        taken = []  # the types that map to the new unit by unit order now
+        for type_name in unit.guaranteed():  # (each type on its own: the order is no matter)
+            if by_rounds and latest >= rounds.get(type_name, 0):
                 continue
             present = by_order.get(type_name)
             if present is None or (rounds.get(present, 0), present) > place:
                 by_order[type_name] = key
+                taken.append(type_name)
         self._by_order = by_order
         # the new unit's own type maps to it now (it did not before): the mapping changed
-        self._guaranteed = self._last_guaranteed = self._overridden(by_order)
+        self._guaranteed = self._last_guaranteed = self._with_unit(previous, key, taken)
+
+    def _with_unit(self, previous: dict[str, str], key: str, taken: list[str]) -> dict[str, str]:
+        """:meth:`_overridden` of the mapping by unit order after the new unit ``key`` took the types ``taken``, from
+        ``previous`` (that of the mapping before): pinned types and units' own types keep their units."""
+        found = dict(previous)
+        units, pinned = self.units, self.pinned
+        for type_name in taken:
+            if type_name in units:
+                continue  # a unit's own type (the new unit's: below)
+            pin = pinned.get(type_name)
+            if pin is not None and pin != key and pin in units and type_name in units[pin].guaranteed():
+                continue
+            found[type_name] = key
+        guaranteed = units[key].guaranteed()
+        for type_name, pin in pinned.items():
+            if pin == key and type_name in guaranteed:
+                found[type_name] = key
+        found[key] = key
+        return found
 
     def _overridden(self, by_order: dict[str, str]) -> dict[str, str]:
         """The mapping by unit order with the pinned types and each unit's own type put to their units."""
@@ -804,28 +855,30 @@ class _Assignment:
                 self.above[type_name] = combined
                 queue.extend((needed, type_name) for spec in again for needed in spec.inputs)
                 continue
-            valid = self.catalog.valid(type_name, value, frozenset(above), self.by_rounds)
-            owners = self._owners  # read here only, before the units change
+            valid = self.catalog.valid(type_name, value, above, self.by_rounds)
+            owners = self._owners  # annotator -> its unit
             free = [s for s in valid if s.name not in owners]
             if not free:
                 if not self._take_over(type_name, valid, consumer, above):
                     raise _OrderingError(f"cannot produce {type_name}: {self.catalog.why_not(type_name, value)}")
                 continue
             self.units[type_name] = _UnitChoice(type_name, free, value, self.catalog)
-            self._owners.update(dict.fromkeys((spec.name for spec in free), type_name))
+            for spec in free:
+                owners[spec.name] = type_name
             insort(self._order, (self.catalog.rounds.get(type_name, 0), type_name))
             self._add_guaranteed(type_name)
-            self.above[type_name] = set(above)
-            reasons = self.reasons
+            self.above[type_name] = above  # (a set of this round's own)
+            consumers = self.consumers  # (:meth:`_note_consumer` inline: many inputs per plan)
             for spec in free:
-                why = f"needed by {spec.name}"
+                name = spec.name
                 for needed in spec.inputs:
-                    noted = reasons.get(needed)
+                    noted = consumers.get(needed)
                     if noted is None:
-                        reasons[needed] = [why]
-                    elif why not in noted:
-                        noted.append(why)
-                    queue.append((needed, type_name))
+                        consumers[needed] = [name]
+                    elif name not in noted:
+                        noted.append(name)
+                    if needed not in sensors:  # (a sensor type needs no unit: it would be skipped)
+                        queue.append((needed, type_name))
 
     def _prune(self) -> None:
         """Drop units that no requirement needs any more (after a unit was committed to one provider)."""
@@ -839,7 +892,8 @@ class _Assignment:
                 if key is None or key in needed:
                     continue
                 needed.add(key)
-                frontier.extend(t for s in self.units[key].providers for t in s.inputs)
+                for spec in self.units[key].providers:
+                    frontier += spec.inputs
             unneeded = set(self.units) - needed
             if not unneeded:
                 return
@@ -949,7 +1003,7 @@ class _Layout:
                     self.final[type_name] = f"type:{owner_type}"
         self.unrefined = dict(self.final)
         self.refinements = self._refinements()
-        self._unit_inputs = self._branch_inputs()
+        self._unit_inputs = self._branch_inputs(absorbed)
         self._settle()
         # a type whose unit moved into a Fallback's branch exists only when that branch ran: a refiner outside
         # reading it is left out
@@ -981,20 +1035,26 @@ class _Layout:
         self._depth: dict[str, int] | None = None
         self.optional_edges: set[tuple[str, str]] = set()
         self.refines_output_of: dict[str, str] = {}
-        for type_name, specs in sorted(self.refinements.items()):
+        final = self.final
+        edges, dependencies = self.optional_edges, self.dependencies
+        for type_name, specs in self.refinements.items():  # (by type, sorted)
             previous = self.unrefined[type_name]
             for spec in specs:
                 key = f"refine:{spec.name}"
                 self.refines_output_of[spec.name] = previous
-                required = {previous} | self._producers([t for t in spec.inputs if t != type_name])
-                optional = self._producers(spec.optional_inputs) - required
-                self.optional_edges |= {(key, dep) for dep in optional}
-                self.dependencies[key] = (required | optional) - {key}
+                deps = {previous}
+                for t in spec.inputs:
+                    if t != type_name and t in final:
+                        deps.add(final[t])
+                if spec.optional_inputs:
+                    optional = {final[t] for t in spec.optional_inputs if t in final} - deps
+                    if optional:
+                        edges.update((key, dep) for dep in optional)
+                        deps |= optional
+                deps.discard(key)
+                dependencies[key] = deps
                 previous = key
-        final = self.final
-        edges, dependencies = self.optional_edges, self.dependencies
-        for type_name, (required_types, optional_types) in self._unit_inputs.items():
-            key = f"type:{type_name}"
+        for key, (required_types, optional_types) in self._unit_inputs.items():
             deps = {final[t] for t in required_types if t in final}
             if optional_types:
                 optional = {final[t] for t in optional_types if t in final} - deps
@@ -1004,27 +1064,29 @@ class _Layout:
             deps.discard(key)
             dependencies[key] = deps
 
-    def _branch_inputs(self) -> dict[str, tuple[tuple[str, ...], tuple[str, ...]]]:
-        """Per provider unit not absorbed into a branch: the required and the optional input types its
-        branches read from outside themselves (they do not change with the refinements)."""
-        absorbed = {t for owned in self.branches.values() for types in owned.values() for t in types}
+    def _branch_inputs(self, absorbed: set[str]) -> dict[str, tuple[tuple[str, ...], tuple[str, ...]]]:
+        """Per provider unit not ``absorbed`` into a branch, by its key: the required and the optional input types
+        its branches read from outside themselves (they do not change with the refinements; read as sets)."""
         found: dict[str, tuple[tuple[str, ...], tuple[str, ...]]] = {}
-        for type_name in self.units:  # (read by type: the order is no matter)
+        for type_name, unit in self.units.items():  # (read by key: the order is no matter)
             if type_name in absorbed:
                 continue
-            required: dict[str, None] = {}
-            optional: dict[str, None] = {}
             branches = self.branches.get(type_name)
-            for spec in self.units[type_name].providers:
+            if len(unit.providers) == 1 and not (branches and branches.get(unit.providers[0].name)):
+                found[f"type:{type_name}"] = (unit.providers[0].inputs, unit.providers[0].optional_inputs)
+                continue
+            required: set[str] = set()
+            optional: set[str] = set()
+            for spec in unit.providers:
                 if not branches or not branches.get(spec.name):  # the alternative alone in its branch
-                    required.update(dict.fromkeys(spec.inputs))
-                    optional.update(dict.fromkeys(spec.optional_inputs))
+                    required.update(spec.inputs)
+                    optional.update(spec.optional_inputs)
                     continue
                 members = self._members(type_name, spec)
                 inside = set(branches[spec.name])
-                required.update(dict.fromkeys(t for m in members for t in m.inputs if t not in inside))
-                optional.update(dict.fromkeys(t for m in members for t in m.optional_inputs if t not in inside))
-            found[type_name] = (tuple(required), tuple(optional))
+                required.update(t for m in members for t in m.inputs if t not in inside)
+                optional.update(t for m in members for t in m.optional_inputs if t not in inside)
+            found[f"type:{type_name}"] = (tuple(required), tuple(optional))
         return found
 
     def _refinements(self) -> dict[str, list[AnnotatorSpec]]:
@@ -1044,11 +1106,10 @@ class _Layout:
             ]
             # refiners made for a situation (with preconditions, which hold) all apply; of the general-purpose
             # ones only the cheapest does, so two interchangeable crops are never chained
-            specs = [s for s in usable if s.preconditions]
+            specs = [s for s in usable if s.preconditions]  # (cheapest first, as the candidates)
             general = [s for s in usable if not s.preconditions]
             if general:
-                specs.append(min(general, key=lambda s: (s.cost_ms, -s.reliability, s.name)))
-            specs.sort(key=lambda s: (s.cost_ms, s.name))
+                insort(specs, min(general, key=_by_rank_among_crops), key=_by_cost)
             if specs:
                 found[type_name] = specs
                 used |= {s.name for s in specs}
@@ -1079,23 +1140,21 @@ class _Layout:
         multiple = sorted(t for t, unit in self.units.items() if len(unit.providers) > 1)
         if not multiple:
             return {}
-        consumers: dict[str, set[str]] = {}
         specs = [s for unit in self.units.values() for s in unit.providers]
         for type_name in set(self.units) | self.catalog.sensors:  # (sets of readers: the order is no matter)
             specs += self.catalog.refiners(type_name)
+        guaranteed = self.assignment.guaranteed_by()
+        # per unit: who reads what it guarantees (units nobody reads are left out)
+        readers: dict[str, set[str]] = {}
         for spec in specs:
             for needed in spec.inputs:
-                found = consumers.get(needed)
-                if found is None:
-                    consumers[needed] = {spec.name}
-                else:
-                    found.add(spec.name)
-        guaranteed = self.assignment.guaranteed_by()
-        guarantees: dict[str, list[str]] = {}
-        for type_name, key in guaranteed.items():
-            guarantees.setdefault(key, []).append(type_name)
-        # per unit: who reads what it guarantees
-        readers = {key: set().union(*(consumers.get(t, ()) for t in types)) for key, types in guarantees.items()}
+                key = guaranteed.get(needed)
+                if key is not None:
+                    found = readers.get(key)
+                    if found is None:
+                        readers[key] = {spec.name}
+                    else:
+                        found.add(spec.name)
         branches: dict[str, dict[str, list[str]]] = {}
         for type_name in multiple:
             unit = self.units[type_name]
@@ -1108,7 +1167,7 @@ class _Layout:
                 consumer in members or (consumer in rivals and key in shared[consumer][0])
                 for owned, members in shared.values()
                 for key in owned
-                for consumer in readers[key]
+                for consumer in readers.get(key, ())
             ):
                 shared = {
                     spec.name: self._owned(spec, type_name, guaranteed, readers, set()) for spec in unit.providers
@@ -1126,17 +1185,29 @@ class _Layout:
     ) -> tuple[list[str], set[str]]:
         """The units that move into the branch of alternative ``spec`` of ``type_name`` (and the branch's
         annotators): single-provider units whose outputs only the branch (or the ``rivals``) read (``readers``: who
-        reads what each unit guarantees)."""
-        owned: list[str] = []
+        reads what each unit guarantees, read units only)."""
         members = {spec.name}
         allowed = members | rivals  # who may read what moves into the branch
+        units = self.units
+        for needed in spec.inputs:  # the branch owns nothing unless it can own a unit making one of its inputs
+            key = guaranteed.get(needed)
+            if (
+                key is not None
+                and key != type_name
+                and len(units[key].providers) == 1
+                and (key not in readers or readers[key] <= allowed)
+            ):
+                break
+        else:
+            return [], members
+        owned: list[str] = []
         frontier = list(spec.inputs)
         while frontier:
             needed = frontier.pop(0)
             key = guaranteed.get(needed)
             if key is None or key in owned or key == type_name or len(self.units[key].providers) != 1:
                 continue
-            if not readers[key] <= allowed:
+            if key in readers and not readers[key] <= allowed:
                 continue
             owned.append(key)
             inner = self.units[key].providers[0]
@@ -1171,9 +1242,10 @@ class _Layout:
         depth = self._depth if self._depth is not None else _depths(self.dependencies)
         assert depth is not None, "the dependencies were checked for cycles"
         by_level: dict[int, list[str]] = {}
-        for key in sorted(self.dependencies):
+        for key in sorted(self.dependencies):  # each level's keys sorted
             by_level.setdefault(depth[key], []).append(key)
-        return tuple(tuple(self._unit(key) for key in sorted(keys)) for _, keys in sorted(by_level.items()))
+        unit = self._unit
+        return tuple(tuple([unit(key) for key in keys]) for _, keys in sorted(by_level.items()))
 
     def _label(self, key: str) -> str:
         found = self._labels.get(key)
@@ -1187,7 +1259,8 @@ class _Layout:
         kind, name = key.split(":", 1)
         if kind == "refine":
             return name
-        return " / ".join(s.name for s in self.units[name].providers)
+        providers = self.units[name].providers
+        return providers[0].name if len(providers) == 1 else " / ".join([s.name for s in providers])
 
     def _step(
         self, spec: AnnotatorSpec, why: str, provides: str = "", inside_types: frozenset[str] = frozenset()
@@ -1195,59 +1268,58 @@ class _Layout:
         """The step of ``spec``, its reason naming what feeds each input (``inside_types``: the types made by the
         units moved into its branch)."""
         final, made = self.final, self._made_by
+        name = spec.name
+        refined = self.refines_output_of.get(name)  # what a refiner's step reads of the type it refines
         feeds = []
         for needed in spec.inputs:
             if inside_types and needed in inside_types:
                 maker = self.units[self.assignment.guaranteed_by()[needed]].providers[0].name
                 feeds.append(f"{needed} from {maker}")
-            elif needed in spec.outputs and spec.name in self.refines_output_of:
-                feeds.append(f"{needed} from {self._label(self.refines_output_of[spec.name])}")
-            elif needed in final:
+            elif refined is not None and needed in spec.outputs:
+                feeds.append(f"{needed} from {self._label(refined)}")
+            else:
                 feed = made.get(needed)
-                if feed is None:
+                if feed is None and needed in final:
                     feed = made[needed] = f"{needed} from {self._label(final[needed])}"
-                feeds.append(feed)
-        reason = f"{spec.name}: {why}; needs {', '.join(feeds)}" if feeds else f"{spec.name}: {why}"
-        parameters = self.parameters.get(spec.name)
+                if feed is not None:
+                    feeds.append(feed)
+        parameters = self.parameters.get(name)
         # positional (many steps per plan): annotator, implemented_by, inputs, outputs, parameters, reason, provides
         return Step(
-            spec.name,
+            name,
             spec.implemented_by,
-            tuple(spec.inputs),
-            tuple(spec.outputs),
+            spec.inputs,
+            spec.outputs,
             tuple(sorted(parameters.items())) if parameters else (),
-            reason,
+            f"{name}: {why}; needs {', '.join(feeds)}" if feeds else f"{name}: {why}",
             provides,
         )
 
     def _why(self, type_name: str) -> str:
-        consumers: list[str] = []
-        others: list[str] = []
-        for reason in self.assignment.reasons.get(type_name, ()):
-            if reason.startswith("needed by "):
-                consumers.append(reason.removeprefix("needed by "))
-            else:
-                others.append(reason)
+        others = self.assignment.reasons.get(type_name)
+        consumers = self.assignment.consumers.get(type_name)
         if consumers:
-            others.append(f"{type_name} is needed by {', '.join(consumers)}")
+            needed = f"{type_name} is needed by {', '.join(consumers)}"
+            return "; ".join([*others, needed]) if others else needed
         return "; ".join(others) if others else f"provides {type_name}"
 
     def _unit(self, key: str) -> Unit:
-        if key == "reader":
+        if key.startswith("type:"):
+            name = key[5:]
+        elif key == "reader":
             return self.source.step
-        kind, name = key.split(":", 1)
-        if kind == "refine":
-            refined, spec = self._refiner_of[name]
+        else:
+            refined, spec = self._refiner_of[key.removeprefix("refine:")]
             return self._step(spec, f"refines {refined} before it is used ({_precondition_note(spec)})")
         unit = self.units[name]
         if len(unit.providers) == 1:
-            return self._step(unit.providers[0], self._why(name), provides=name)
+            return self._step(unit.providers[0], self._why(name), name)
         branches = []
         why = self._why(name)
         for spec in unit.providers:
             owned = self.branches[name][spec.name]
             if not owned:
-                branches.append((self._step(spec, why, provides=name),))
+                branches.append((self._step(spec, why, name),))
                 continue
             inside = frozenset(t for key in owned for t in self.units[key].guaranteed())
             inner = tuple(
@@ -1256,12 +1328,22 @@ class _Layout:
             )
             branches.append((*inner, self._step(spec, why, provides=name, inside_types=inside)))
         notes = self.catalog.ontology.rank_notes
-        ranking = ", ".join(notes[s.name] for s in unit.providers)
+        ranking = ", ".join([notes[s.name] for s in unit.providers])
         return Alternatives(
             provides=name,
             branches=tuple(branches),
             reason=f"{len(unit.providers)} annotators can provide {name}; tried in rank order: {ranking}",
         )
+
+
+def _by_cost(spec: AnnotatorSpec) -> tuple[float, str]:
+    """Cheapest first (the order of refiners)."""
+    return spec.cost_ms, spec.name
+
+
+def _by_rank_among_crops(spec: AnnotatorSpec) -> tuple[float, float, str]:
+    """The general-purpose refiner that runs: the cheapest, then the most reliable."""
+    return spec.cost_ms, -spec.reliability, spec.name
 
 
 def _topological(keys: list[str], units: Mapping[str, _UnitChoice]) -> list[str]:
