@@ -35,20 +35,27 @@ def back_project_grid(depth: np.ndarray, x_factor: np.ndarray, y_factor: np.ndar
 @njit(cache=True, nogil=True)
 def plane_band(points: np.ndarray, valid: np.ndarray, step: int, model: np.ndarray, band: np.float32) -> np.ndarray:
     """On every ``step``-th row and column: the valid points whose float32 distance to the plane ``model``
-    (a, b, c, d; float64) is below ``band`` - the mask ``valid & (abs(plane_distances(points, model)) < band)``."""
-    rows, cols = (valid.shape[0] + step - 1) // step, (valid.shape[1] + step - 1) // step
-    near = np.zeros((rows, cols), dtype=np.bool_)
+    (a, b, c, d; float64) is below ``band`` - the mask ``valid & (abs(plane_distances(points, model)) < band)``.
+    ``points`` (HxWx3 float32) and ``valid`` (HxW) must be C-contiguous."""
+    height, width = valid.shape
+    rows, cols = (height + step - 1) // step, (width + step - 1) // step
+    flat_points, flat_valid = points.reshape(-1), valid.reshape(-1)
+    near = np.empty(rows * cols, dtype=np.bool_)
     a, b, c, d = model[0], model[1], model[2], model[3]
-    for r in range(rows):
-        for k in range(cols):
-            if not valid[r * step, k * step]:
-                continue
-            x = points[r * step, k * step, 0]
-            y = points[r * step, k * step, 1]
-            z = points[r * step, k * step, 2]
+    if step == 1:  # one flat loop the compiler vectorises
+        for i in range(rows * cols):
+            x, y, z = flat_points[3 * i], flat_points[3 * i + 1], flat_points[3 * i + 2]
             distance = np.float32(a * np.float64(x) + b * np.float64(y) + c * np.float64(z) + d)
-            near[r, k] = abs(distance) < band
-    return near
+            near[i] = flat_valid[i] & (abs(distance) < band)
+        return near.reshape(rows, cols)
+    for r in range(rows):
+        start = r * step * width
+        for k in range(cols):
+            i = start + k * step
+            x, y, z = flat_points[3 * i], flat_points[3 * i + 1], flat_points[3 * i + 2]
+            distance = np.float32(a * np.float64(x) + b * np.float64(y) + c * np.float64(z) + d)
+            near[r * cols + k] = flat_valid[i] & (abs(distance) < band)  # NaN points are never near
+    return near.reshape(rows, cols)
 
 
 @njit(cache=True, nogil=True)

@@ -116,6 +116,7 @@ def ransac_support_plane(
     """
     with np.errstate(invalid="ignore"):
         valid = mask & np.isfinite(points[..., 2])
+    points = np.ascontiguousarray(points, dtype=np.float32)  # the compiled passes read it flat
     flat = points.reshape(-1, 3)
     valid_indices = np.flatnonzero(valid)
     if valid_indices.size < MIN_PLANE_POINTS:
