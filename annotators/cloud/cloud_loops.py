@@ -85,3 +85,15 @@ def centred_scatter(points: np.ndarray, step: int, indices: np.ndarray) -> tuple
         scatter[2, 2] += dz * dz
     scatter[1, 0], scatter[2, 0], scatter[2, 1] = scatter[0, 1], scatter[0, 2], scatter[1, 2]
     return centre, scatter
+
+
+@njit(cache=True, nogil=True)
+def depth_range(points: np.ndarray, mask: np.ndarray, low: np.floating, high: np.floating) -> np.ndarray:
+    """``mask & (z >= low) & (z <= high)`` for the HxWx3 ``points`` (C-contiguous) and HxW ``mask``, with ``low``
+    and ``high`` of the points' dtype; NaN depths drop out."""
+    flat_points, flat_mask = points.reshape(-1), mask.reshape(-1)
+    kept = np.empty(flat_mask.size, dtype=np.bool_)
+    for i in range(flat_mask.size):
+        z = flat_points[3 * i + 2]
+        kept[i] = flat_mask[i] & (z >= low) & (z <= high)
+    return kept.reshape(mask.shape)
