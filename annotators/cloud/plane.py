@@ -168,10 +168,10 @@ def largest_region_mask(mask: np.ndarray, step: int = 2) -> np.ndarray:
     """``mask`` (HxW bool) reduced to its largest 8-connected region, found on every ``step``-th pixel as in
     :func:`largest_region` (a pixel stays when its coarse cell or a neighbour belongs to the largest region)."""
     coarse = np.ascontiguousarray(mask[::step, ::step]).view(np.uint8)
-    count, labels, stats, _ = cv2.connectedComponentsWithStats(coarse, connectivity=8)
+    count, labels = cv2.connectedComponents(coarse, connectivity=8)  # several times faster than ...WithStats
     if count <= 2:
         return mask
-    biggest = 1 + int(np.argmax(stats[1:, cv2.CC_STAT_AREA]))
+    biggest = 1 + int(np.argmax(np.bincount(labels.reshape(-1), minlength=count)[1:]))  # the largest area
     keep = cv2.dilate((labels == biggest).view(np.uint8), np.ones((3, 3), np.uint8))
     rows, cols = mask.shape
     keep = cv2.resize(keep, (keep.shape[1] * step, keep.shape[0] * step), interpolation=cv2.INTER_NEAREST)
