@@ -23,6 +23,7 @@ def test_range_mask_matches_numpy_comparison_in_the_same_precision(dtype: type, 
     points, mask = _cloud(1, dtype)
     low, high = bounds
     points[0, :4, 2] = [np.float32(low), np.float32(high), np.nextafter(np.float32(low), 0), np.inf]
+    mask[0, :4] = True
     with np.errstate(invalid="ignore"):
         expected = mask & (points[..., 2] >= low) & (points[..., 2] <= high)
     assert np.array_equal(range_mask(points, mask, low, high), expected)
