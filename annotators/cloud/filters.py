@@ -12,6 +12,7 @@ from typing import ClassVar
 
 import numpy as np
 
+from annotators.cloud.cloud_loops import depth_range
 from annotators.cloud.point_cloud import cloud_problem
 from robokudo.core.annotator import Annotator
 from robokudo.core.capability import Capability
@@ -19,10 +20,17 @@ from robokudo.core.types import CameraInfo, CasType, PointCloud
 
 
 def range_mask(points: np.ndarray, mask: np.ndarray, min_depth: float, max_depth: float) -> np.ndarray:
-    """``mask`` narrowed to points whose depth (z) lies in [min_depth, max_depth] (NaN points drop out)."""
-    z = points[..., 2]
-    with np.errstate(invalid="ignore"):
-        return mask & (z >= min_depth) & (z <= max_depth)
+    """``mask`` narrowed to points whose depth (z) lies in [min_depth, max_depth] (NaN points drop out); the
+    bounds are compared in the points' precision."""
+    points = np.ascontiguousarray(points)
+    organized = points.ndim == 3 and points.shape[2] == 3 and np.shape(mask) == points.shape[:2]
+    if not organized or points.dtype not in (np.float32, np.float64):
+        z = points[..., 2]
+        with np.errstate(invalid="ignore"):
+            return mask & (z >= min_depth) & (z <= max_depth)
+    # the compiled pass, comparing in the precision NumPy would (a Python float bound: the points' precision)
+    low, high = (np.result_type(points.dtype, bound).type(bound) for bound in (min_depth, max_depth))
+    return depth_range(points, np.ascontiguousarray(mask, dtype=bool), low, high)
 
 
 def voxel_mask(points: np.ndarray, mask: np.ndarray, voxel_size: float) -> np.ndarray:

@@ -6,6 +6,7 @@ from typing import ClassVar
 
 import numpy as np
 
+from annotators.cloud.cloud_loops import back_project_grid
 from robokudo.core.annotator import Annotator
 from robokudo.core.capability import Capability
 from robokudo.core.types import CameraInfo, CameraIntrinsics, CasType, ColorImage, DepthImage, PointCloud
@@ -21,15 +22,16 @@ def pixel_rays(intrinsics: CameraIntrinsics) -> tuple[np.ndarray, np.ndarray]:
 
 def back_project(depth: np.ndarray, rays: tuple[np.ndarray, np.ndarray]) -> np.ndarray:
     """An HxWx3 float32 cloud from depth (metres) and :func:`pixel_rays`; NaN where depth is 0 or not finite."""
+    return organized_cloud(depth, rays)[0]
+
+
+def organized_cloud(depth: np.ndarray, rays: tuple[np.ndarray, np.ndarray]) -> tuple[np.ndarray, np.ndarray]:
+    """:func:`back_project` and the HxW mask of the cloud's finite points, in one pass over the depth image."""
     x_factor, y_factor = rays
     z = np.asarray(depth, dtype=np.float32)
-    points = np.empty((*z.shape, 3), dtype=np.float32)
-    valid = np.isfinite(z) & (z > 0)
-    zv = np.where(valid, z, np.float32(np.nan))
-    np.multiply(zv, x_factor, out=points[..., 0])
-    np.multiply(zv, y_factor, out=points[..., 1])
-    points[..., 2] = zv
-    return points
+    columns = np.ascontiguousarray(np.broadcast_to(x_factor, (1, z.shape[1]))[0], dtype=np.float32)
+    rows = np.ascontiguousarray(np.broadcast_to(y_factor, (z.shape[0], 1))[:, 0], dtype=np.float32)
+    return back_project_grid(z, columns, rows)
 
 
 def intrinsics_problem(intrinsics: CameraIntrinsics, shape: tuple[int, ...]) -> str | None:
@@ -96,8 +98,7 @@ class PointCloudGenerator(Annotator):
             colors = color_view.image
             if colors.shape[:2] != depth.shape or colors.ndim != 3:
                 self.fail(f"colour image {colors.shape} and depth image {depth.shape} sizes differ")
-        points = back_project(depth, self.rays_for(intrinsics))
-        mask = np.isfinite(points[..., 2])
+        points, mask = organized_cloud(depth, self.rays_for(intrinsics))
         if not mask.any():
             self.fail("the depth image has no valid pixel (all zero or NaN)")
         self.write(PointCloud(points=points, mask=mask, colors=colors))

@@ -7,6 +7,7 @@ from typing import ClassVar
 import numpy as np
 
 from annotators.cloud.cloud_expert import CloudExpert
+from annotators.cloud.cloud_loops import finite_rows
 from annotators.geometry.boxes import finite_points, object_boxes_of_rows
 from robokudo.core.capability import Capability
 from robokudo.core.geometry import quaternion_from_matrix
@@ -27,15 +28,10 @@ def hypotheses_rows(cloud: PointCloud, hypotheses: list[ObjectHypothesis], max_p
     picked = []
     for hypothesis in hypotheses:
         indices = np.asarray(hypothesis.point_indices)
-        indices = indices[:: max(1, indices.size // max_points)]
-        picked.append(indices[(indices >= 0) & (indices < cloud.mask.size)])
-    sizes = np.array([indices.size for indices in picked])
-    every = np.concatenate(picked) if picked else np.zeros(0, dtype=np.intp)
-    points = np.take(cloud.points.reshape(-1, 3), every, axis=0)
-    finite = np.isfinite(points)
-    finite = finite[:, 0] & finite[:, 1] & finite[:, 2]
-    rows = np.array(np.compress(finite, points, axis=0).T, dtype=np.float64, order="C")
-    kept = np.bincount(np.repeat(np.arange(sizes.size), sizes)[finite], minlength=sizes.size)
+        picked.append(indices[:: max(1, indices.size // max_points)])
+    sizes = np.array([indices.size for indices in picked], dtype=np.int64)
+    every = np.concatenate(picked).astype(np.intp, copy=False) if picked else np.zeros(0, dtype=np.intp)
+    rows, kept = finite_rows(np.ascontiguousarray(cloud.points).reshape(-1, 3), every, sizes)
     return np.split(rows, np.cumsum(kept)[:-1], axis=1)
 
 
