@@ -220,12 +220,13 @@ def full_resolution_segments(
     if refine is not None:
         pixels, starts, boxes = label_pixels(refine(core, fine_points, heights, candidates))
     masks = np.zeros((len(kept), rows, cols), dtype=bool)  # one allocation for all masks
+    # the region's flat pixel indices as flat indices of the whole grid, all labels at once
+    core_indices = (core_pixels // width + fy0) * cols + core_pixels % width + fx0
+    mask_indices = core_indices if pixels is core_pixels else (pixels // width + fy0) * cols + pixels % width + fx0
     segments = []
     for object_mask, label in zip(masks, kept, strict=True):
-        own = pixels[starts[label] : starts[label + 1]]
-        object_mask.reshape(-1)[(own // width + fy0) * cols + own % width + fx0] = True
-        labelled = core_pixels[core_starts[label] : core_starts[label + 1]]
-        indices = (labelled // width + fy0) * cols + labelled % width + fx0
+        object_mask.reshape(-1)[mask_indices[starts[label] : starts[label + 1]]] = True
+        indices = core_indices[core_starts[label] : core_starts[label + 1]]
         left, top, right, bottom = boxes[label].tolist()
         roi = (left + fx0, top + fy0, right + fx0, bottom + fy0)
         segments.append(Segment(indices=indices, mask=object_mask, roi=roi))

@@ -26,9 +26,8 @@ import functools
 from dataclasses import dataclass
 
 import numpy as np
-from scipy import ndimage
 
-from annotators.geometry.grid_kernels import grouped_pixels, piece_near, shadowed_near
+from annotators.geometry.grid_kernels import grouped_pixels, label_pixels, piece_near, shadowed_near
 from annotators.geometry.grid_segmentation import depth_jump, join_labels, touching_pairs
 
 
@@ -90,8 +89,8 @@ def join_occluded(
     depth = points[..., 2]
     flat_labels = labels.reshape(-1)
     flat_normals, flat_plane = normals.reshape(-1, 3), on_plane.reshape(-1, 3)
-    sizes = np.bincount(flat_labels, minlength=count + 1)
-    boxes = ndimage.find_objects(labels, max_label=count)
+    _, starts, boxes = label_pixels(np.ascontiguousarray(labels))  # boxes (x0, y0, x1, y1) of labels 0..count
+    sizes = np.diff(starts)
     unmeasured = ~np.isfinite(depth)
     measured = ~unmeasured.reshape(-1) & (flat_labels > 0)
     sums = np.bincount(flat_labels[measured], depth.reshape(-1)[measured], minlength=count + 1)
@@ -103,7 +102,7 @@ def join_occluded(
         farther = np.flatnonzero(mean_depth > mean_depth[occluder])
         if sizes[occluder] < rules.min_points or farther.size < 2:
             continue
-        x0, y0, x1, y1 = _grown(boxes[occluder - 1], labels.shape, 3 * rules.band + 1)
+        x0, y0, x1, y1 = _grown(boxes[occluder].tolist(), labels.shape, 3 * rules.band + 1)
         window = labels[y0:y1, x0:x1]
         # a piece's band near the occluder lies in the window: only pieces with enough pixels there can join
         possible = farther[np.bincount(window.reshape(-1), minlength=count + 1)[farther] >= rules.min_points]
@@ -161,15 +160,10 @@ def _coplanar(first: _Piece, second: _Piece, flat: float) -> bool:
     return bool(np.sqrt(max(smallest, 0.0)) <= flat)
 
 
-def _grown(box: tuple[slice, slice], shape: tuple[int, int], margin: int) -> tuple[int, int, int, int]:
-    """``(x0, y0, x1, y1)`` (exclusive) of a ``find_objects`` box, grown by ``margin`` and clipped to ``shape``."""
-    rows, cols = box
-    return (
-        max(cols.start - margin, 0),
-        max(rows.start - margin, 0),
-        min(cols.stop + margin, shape[1]),
-        min(rows.stop + margin, shape[0]),
-    )
+def _grown(box: list[int], shape: tuple[int, int], margin: int) -> tuple[int, int, int, int]:
+    """The box ``(x0, y0, x1, y1)`` (exclusive), grown by ``margin`` and clipped to ``shape``."""
+    x0, y0, x1, y1 = box
+    return max(x0 - margin, 0), max(y0 - margin, 0), min(x1 + margin, shape[1]), min(y1 + margin, shape[0])
 
 
 def _continues(first: _Piece, second: _Piece, rules: OcclusionRules) -> bool:
