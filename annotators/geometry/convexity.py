@@ -15,12 +15,11 @@ from __future__ import annotations
 from dataclasses import dataclass
 
 import numpy as np
-from scipy import sparse
-from scipy.sparse import csgraph
 
 from annotators.geometry.grid_kernels import (
     cell_patches,
     dense_keys,
+    graph_components,
     label_centres,
     label_moments,
     labelled_values,
@@ -259,5 +258,4 @@ def planes_sizes(planes: PatchPlanes, count: int) -> np.ndarray:
 
 def _components(pairs: np.ndarray, count: int) -> np.ndarray:
     """The connected component of each of ``count`` nodes of the graph with the edges ``pairs`` (Kx2)."""
-    graph = sparse.csr_matrix((np.ones(pairs.shape[0]), (pairs[:, 0], pairs[:, 1])), shape=(count, count))
-    return csgraph.connected_components(graph, directed=False)[1].astype(np.int64)
+    return graph_components(pairs, count)

@@ -212,3 +212,10 @@ def cell_patches(surfaces: np.ndarray, cell: int) -> np.ndarray:
     """:func:`~annotators.geometry.convexity.grid_patches`: each labelled surface cut into ``cell`` x ``cell``
     cells, the (surface, cell) pairs numbered 1..n in increasing order of surface, then cell (row-major)."""
     return _loops().cell_patches(surfaces, cell)
+
+
+def graph_components(pairs: np.ndarray, count: int) -> np.ndarray:
+    """The connected component (int64) of each of ``count`` nodes of the undirected graph with the edges ``pairs``
+    (Kx2 integer), numbered 0.. in order of each component's smallest node - as
+    ``scipy.sparse.csgraph.connected_components`` numbers them."""
+    return _loops().graph_components(np.ascontiguousarray(pairs, dtype=np.int64).reshape(-1, 2), count)

@@ -681,3 +681,31 @@ def cell_patches(surfaces: np.ndarray, cell: int) -> np.ndarray:
             if surfaces[r, c] > 0:
                 keys[r, c] = np.int64(surfaces[r, c]) * (across * down) + (r // cell) * across + c // cell + 1
     return dense_keys(keys)
+
+
+@njit(cache=True, nogil=True)
+def _root(parent: np.ndarray, node: int) -> int:
+    """The root of ``node`` in the union-find forest ``parent``, halving the path on the way."""
+    while parent[node] != node:
+        parent[node] = parent[parent[node]]
+        node = parent[node]
+    return node
+
+
+@njit(cache=True, nogil=True)
+def graph_components(pairs: np.ndarray, count: int) -> np.ndarray:
+    """See :func:`annotators.geometry.grid_kernels.graph_components`."""
+    parent = np.arange(count)
+    for k in range(pairs.shape[0]):
+        a, b = _root(parent, pairs[k, 0]), _root(parent, pairs[k, 1])
+        parent[max(a, b)] = min(a, b)  # each root is the smallest node of its component
+    components = np.empty(count, dtype=np.int64)
+    number = 0
+    for node in range(count):
+        root = _root(parent, node)
+        if root == node:
+            components[node] = number
+            number += 1
+        else:
+            components[node] = components[root]
+    return components

@@ -5,10 +5,13 @@ from __future__ import annotations
 import cv2
 import numpy as np
 import pytest
+from scipy import sparse
+from scipy.sparse import csgraph
 
 from annotators.geometry.grid_kernels import (
     connected_parts,
     facing_values,
+    graph_components,
     grouped_pixels,
     label_pixels,
     shadowed_near,
@@ -142,3 +145,14 @@ def test_grow_on_surface_takes_the_first_neighbour_on_the_same_surface() -> None
                         expected[r, c] = before[nr, nc]
                         break
     assert np.array_equal(grow_on_surface(labels, region, depth, 0.01, 0.01), expected)
+
+
+@pytest.mark.parametrize("seed", range(5))
+def test_graph_components_number_components_as_scipy_does(seed: int) -> None:
+    rng = np.random.default_rng(seed)
+    for _ in range(50):
+        count = int(rng.integers(1, 40))
+        pairs = rng.integers(0, count, (int(rng.integers(0, 40)), 2))
+        graph = sparse.csr_matrix((np.ones(pairs.shape[0]), (pairs[:, 0], pairs[:, 1])), shape=(count, count))
+        expected = csgraph.connected_components(graph, directed=False)[1]
+        np.testing.assert_array_equal(graph_components(pairs, count), expected)
