@@ -167,7 +167,8 @@ def standing_region(
     step = max(1, p.stride)
     basis = plane_basis(np.asarray(model[:3], dtype=np.float64)).T.astype(np.float32)
     coarse_points = points[::step, ::step]
-    heights = plane_distances(coarse_points, model)
+    # on the whole grid, which needs no copy of strided points (each point's distance is the same either way)
+    heights = np.ascontiguousarray(plane_distances(points, model)[::step, ::step])
     flat = points.reshape(-1, 3)
     plane_points = flat[plane_indices[:: max(1, plane_indices.size // 2000)]]
     plane_points = plane_points[np.isfinite(plane_points).all(axis=1)]
@@ -208,7 +209,7 @@ def full_resolution_segments(
     fy1, fx1 = min(y1 * step, rows), min(x1 * step, cols)
     width = fx1 - fx0
     fine_points = points[fy0:fy1, fx0:fx1]
-    heights = plane_distances(fine_points, model)
+    heights = np.ascontiguousarray(plane_distances(points, model)[fy0:fy1, fx0:fx1])  # no copy of the region's points
     candidates = _between_heights(heights, mask[fy0:fy1, fx0:fx1], p)
     core = upsampled_labels(  # the pixels the segmentation labelled itself: the point indices
         labels, coarse_depth, fine_points[..., 2], candidates, step, p.jump_absolute, p.jump_relative
