@@ -219,3 +219,18 @@ def graph_components(pairs: np.ndarray, count: int) -> np.ndarray:
     (Kx2 integer), numbered 0.. in order of each component's smallest node - as
     ``scipy.sparse.csgraph.connected_components`` numbers them."""
     return _loops().graph_components(np.ascontiguousarray(pairs, dtype=np.int64).reshape(-1, 2), count)
+
+
+def nearest_seed_labels(
+    window: np.ndarray,
+    unlabelled: np.ndarray,
+    distance: np.ndarray,
+    nearest: np.ndarray,
+    max_distance: float,
+    grown: np.ndarray,
+) -> None:
+    """After ``cv2.distanceTransformWithLabels`` of the unlabelled pixels of the HxW labels ``window`` (one label
+    per seed pixel, ``DIST_LABEL_PIXEL``): the ``unlabelled`` pixels within ``max_distance`` (compared in float32,
+    as numpy compares the float32 ``distance``) take the label of their nearest seed, written into ``grown`` (HxW,
+    may be ``window`` itself or a copy)."""
+    _loops().nearest_seed_labels(window, unlabelled, distance, nearest, np.float32(max_distance), grown)

@@ -709,3 +709,29 @@ def graph_components(pairs: np.ndarray, count: int) -> np.ndarray:
         else:
             components[node] = components[root]
     return components
+
+
+@njit(cache=True, nogil=True)
+def nearest_seed_labels(
+    window: np.ndarray,
+    unlabelled: np.ndarray,
+    distance: np.ndarray,
+    nearest: np.ndarray,
+    max_distance: np.float32,
+    grown: np.ndarray,
+) -> None:
+    """See :func:`annotators.geometry.grid_kernels.nearest_seed_labels`."""
+    rows, cols = window.shape
+    count = 0
+    for r in range(rows):
+        for c in range(cols):
+            count = max(count, nearest[r, c])
+    lookup = np.zeros(count + 1, dtype=window.dtype)
+    for r in range(rows):
+        for c in range(cols):
+            if window[r, c] > 0:
+                lookup[nearest[r, c]] = window[r, c]
+    for r in range(rows):
+        for c in range(cols):
+            if unlabelled[r, c] and distance[r, c] <= max_distance:
+                grown[r, c] = lookup[nearest[r, c]]

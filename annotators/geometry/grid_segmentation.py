@@ -16,6 +16,7 @@ import numpy as np
 from annotators.geometry.grid_kernels import (
     boundary_pairs,
     connected_parts,
+    nearest_seed_labels,
     seam_pixels,
     surface_growth,
     touching_keys,
@@ -105,11 +106,8 @@ def grow_labels(labels: np.ndarray, region: np.ndarray, max_distance: float) -> 
     distance, nearest = cv2.distanceTransformWithLabels(
         (~seeds).view(np.uint8), cv2.DIST_L2, 3, labelType=cv2.DIST_LABEL_PIXEL
     )
-    lookup = np.zeros(int(nearest.max()) + 1, dtype=labels.dtype)
-    lookup[nearest[seeds]] = window[seeds]
-    reach = unlabelled[y0:y1, x0:x1] & (distance <= max_distance)
     grown = labels.copy()
-    grown[y0:y1, x0:x1][reach] = lookup[nearest[reach]]
+    nearest_seed_labels(window, unlabelled[y0:y1, x0:x1], distance, nearest, max_distance, grown[y0:y1, x0:x1])
     return grown
 
 

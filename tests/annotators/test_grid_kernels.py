@@ -14,6 +14,7 @@ from annotators.geometry.grid_kernels import (
     graph_components,
     grouped_pixels,
     label_pixels,
+    nearest_seed_labels,
     shadowed_near,
     symmetric_eigen,
     touching_keys,
@@ -156,3 +157,24 @@ def test_graph_components_number_components_as_scipy_does(seed: int) -> None:
         graph = sparse.csr_matrix((np.ones(pairs.shape[0]), (pairs[:, 0], pairs[:, 1])), shape=(count, count))
         expected = csgraph.connected_components(graph, directed=False)[1]
         np.testing.assert_array_equal(graph_components(pairs, count), expected)
+
+
+@pytest.mark.parametrize("seed", range(5))
+def test_nearest_seed_labels_give_what_the_numpy_lookup_gives(seed: int) -> None:
+    labels = _blobs(seed)
+    labels[labels == 3] = 0  # a large unlabelled area, partly beyond reach
+    unlabelled = (labels == 0) & (np.random.default_rng(seed).random(labels.shape) < 0.8)
+    seeds = labels > 0
+    distance, nearest = cv2.distanceTransformWithLabels(
+        (~seeds).view(np.uint8), cv2.DIST_L2, 3, labelType=cv2.DIST_LABEL_PIXEL
+    )
+    max_distance = 2.1  # not a float32 value: compared in float32, as numpy compares it
+    lookup = np.zeros(int(nearest.max()) + 1, dtype=labels.dtype)
+    lookup[nearest[seeds]] = labels[seeds]
+    reach = unlabelled & (distance <= max_distance)
+    expected = labels.copy()
+    expected[reach] = lookup[nearest[reach]]
+    grown = labels.copy()
+    nearest_seed_labels(labels, unlabelled, distance, nearest, max_distance, grown)
+    np.testing.assert_array_equal(grown, expected)
+    assert np.count_nonzero(grown != labels) > 0
