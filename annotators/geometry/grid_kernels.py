@@ -234,3 +234,11 @@ def nearest_seed_labels(
     as numpy compares the float32 ``distance``) take the label of their nearest seed, written into ``grown`` (HxW,
     may be ``window`` itself or a copy)."""
     _loops().nearest_seed_labels(window, unlabelled, distance, nearest, np.float32(max_distance), grown)
+
+
+def unlabelled_box(labels: np.ndarray, region: np.ndarray, margin: int) -> tuple[np.ndarray, np.ndarray, bool]:
+    """The pixels of ``region`` (HxW bool) that HxW ``labels`` leave at 0, their box ``(x0, y0, x1, y1)``
+    (exclusive) grown by ``margin`` and clipped to the grid, and whether there is anything to grow (such a pixel
+    and a labelled one): ``region & (labels == 0)`` and its :func:`~annotators.geometry.grid_segmentation.bounding_box`
+    in one pass."""
+    return _loops().unlabelled_box(labels, np.ascontiguousarray(region, dtype=bool), margin)

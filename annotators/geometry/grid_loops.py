@@ -735,3 +735,25 @@ def nearest_seed_labels(
         for c in range(cols):
             if unlabelled[r, c] and distance[r, c] <= max_distance:
                 grown[r, c] = lookup[nearest[r, c]]
+
+
+@njit(cache=True, nogil=True)
+def unlabelled_box(labels: np.ndarray, region: np.ndarray, margin: int) -> tuple[np.ndarray, np.ndarray, bool]:
+    """See :func:`annotators.geometry.grid_kernels.unlabelled_box`."""
+    rows, cols = labels.shape
+    unlabelled = np.zeros((rows, cols), dtype=np.bool_)
+    box = np.array([cols, rows, -1, -1], dtype=np.int64)
+    labelled = False
+    for r in range(rows):
+        for c in range(cols):
+            if labels[r, c] != 0:
+                labelled = True
+            elif region[r, c]:
+                unlabelled[r, c] = True
+                box[0], box[1] = min(box[0], c), min(box[1], r)
+                box[2], box[3] = max(box[2], c + 1), max(box[3], r + 1)
+    if box[2] < 0 or not labelled:
+        return unlabelled, np.zeros(4, dtype=np.int64), False
+    box[0], box[1] = max(box[0] - margin, 0), max(box[1] - margin, 0)
+    box[2], box[3] = min(box[2] + margin, cols), min(box[3] + margin, rows)
+    return unlabelled, box, True

@@ -20,6 +20,7 @@ from annotators.geometry.grid_kernels import (
     seam_pixels,
     surface_growth,
     touching_keys,
+    unlabelled_box,
 )
 
 
@@ -95,10 +96,10 @@ def grow_labels(labels: np.ndarray, region: np.ndarray, max_distance: float) -> 
     can lie (its 3x3 chamfer distance is at least 0.955 times the larger coordinate difference), so every pixel
     it gives a label sees the same seeds and paths as on the whole grid.
     """
-    unlabelled = region & (labels == 0)
-    if not unlabelled.any() or not labels.any():
+    unlabelled, box, growing = unlabelled_box(labels, region, int(np.ceil(max_distance / 0.95)) + 2)
+    if not growing:
         return labels
-    x0, y0, x1, y1 = bounding_box(unlabelled, margin=int(np.ceil(max_distance / 0.95)) + 2)
+    x0, y0, x1, y1 = box.tolist()
     window = labels[y0:y1, x0:x1]
     seeds = window > 0
     if not seeds.any():

@@ -18,8 +18,9 @@ from annotators.geometry.grid_kernels import (
     shadowed_near,
     symmetric_eigen,
     touching_keys,
+    unlabelled_box,
 )
-from annotators.geometry.grid_segmentation import depth_seams, grow_on_surface
+from annotators.geometry.grid_segmentation import bounding_box, depth_seams, grow_on_surface
 
 
 def _blobs(seed: int, shape: tuple[int, int] = (40, 50), labels: int = 6) -> np.ndarray:
@@ -178,3 +179,16 @@ def test_nearest_seed_labels_give_what_the_numpy_lookup_gives(seed: int) -> None
     nearest_seed_labels(labels, unlabelled, distance, nearest, max_distance, grown)
     np.testing.assert_array_equal(grown, expected)
     assert np.count_nonzero(grown != labels) > 0
+
+
+@pytest.mark.parametrize("seed", range(5))
+def test_unlabelled_box_is_the_box_of_the_unlabelled_region(seed: int) -> None:
+    labels = _blobs(seed)
+    region = np.zeros(labels.shape, dtype=bool)
+    region[5:30, 8 + seed : 40] = True
+    unlabelled, box, growing = unlabelled_box(labels, region, 3)
+    np.testing.assert_array_equal(unlabelled, region & (labels == 0))
+    assert growing
+    assert tuple(box.tolist()) == bounding_box(region & (labels == 0), margin=3)
+    assert not unlabelled_box(labels, np.zeros(labels.shape, dtype=bool), 3)[2]
+    assert not unlabelled_box(np.zeros_like(labels), region, 3)[2]
