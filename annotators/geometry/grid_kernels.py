@@ -242,3 +242,9 @@ def unlabelled_box(labels: np.ndarray, region: np.ndarray, margin: int) -> tuple
     and a labelled one): ``region & (labels == 0)`` and its :func:`~annotators.geometry.grid_segmentation.bounding_box`
     in one pass."""
     return _loops().unlabelled_box(labels, np.ascontiguousarray(region, dtype=bool), margin)
+
+
+def finite_rows(values: np.ndarray, indices: np.ndarray) -> np.ndarray:
+    """The rows ``indices`` of NxK ``values`` whose entries are all finite, in the order given:
+    ``values[indices][np.isfinite(values[indices]).all(axis=1)]`` in one pass."""
+    return _loops().finite_rows(values, indices)

@@ -757,3 +757,18 @@ def unlabelled_box(labels: np.ndarray, region: np.ndarray, margin: int) -> tuple
     box[0], box[1] = max(box[0] - margin, 0), max(box[1] - margin, 0)
     box[2], box[3] = min(box[2] + margin, cols), min(box[3] + margin, rows)
     return unlabelled, box, True
+
+
+@njit(cache=True, nogil=True)
+def finite_rows(values: np.ndarray, indices: np.ndarray) -> np.ndarray:
+    """See :func:`annotators.geometry.grid_kernels.finite_rows`."""
+    rows = np.empty((indices.size, values.shape[1]), dtype=values.dtype)
+    kept = 0
+    for index in indices:
+        finite = True
+        for column in range(values.shape[1]):
+            finite = finite and np.isfinite(values[index, column])
+        if finite:
+            rows[kept] = values[index]
+            kept += 1
+    return rows[:kept]

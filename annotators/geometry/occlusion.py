@@ -27,7 +27,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from annotators.geometry.grid_kernels import grouped_pixels, label_pixels, piece_near, shadowed_near
+from annotators.geometry.grid_kernels import finite_rows, grouped_pixels, label_pixels, piece_near, shadowed_near
 from annotators.geometry.grid_segmentation import depth_jump, join_labels, touching_pairs
 
 
@@ -134,9 +134,7 @@ def join_occluded(
                 continue
             if piece_depth <= occluder_depth or xyz.shape[0] < rules.min_points:
                 continue
-            band_normals, section = flat_normals[flat], flat_plane[flat]
-            band_normals = band_normals[np.isfinite(band_normals).all(axis=1)]
-            section = section[np.isfinite(section).all(axis=1)]
+            band_normals, section = finite_rows(flat_normals, flat), finite_rows(flat_plane, flat)
             behind.append(_Piece(piece, flat, xyz, centre, pixel, band_normals, section))
         for index, first in enumerate(behind):
             for second in behind[index + 1 :]:

@@ -11,6 +11,7 @@ from scipy.sparse import csgraph
 from annotators.geometry.grid_kernels import (
     connected_parts,
     facing_values,
+    finite_rows,
     graph_components,
     grouped_pixels,
     label_pixels,
@@ -192,3 +193,15 @@ def test_unlabelled_box_is_the_box_of_the_unlabelled_region(seed: int) -> None:
     assert tuple(box.tolist()) == bounding_box(region & (labels == 0), margin=3)
     assert not unlabelled_box(labels, np.zeros(labels.shape, dtype=bool), 3)[2]
     assert not unlabelled_box(np.zeros_like(labels), region, 3)[2]
+
+
+def test_finite_rows_keep_the_rows_without_nan_or_inf_in_order() -> None:
+    rng = np.random.default_rng(0)
+    values = rng.normal(size=(200, 3)).astype(np.float32)
+    values[rng.random((200, 3)) < 0.1] = np.nan
+    values[7, 1] = np.inf
+    indices = rng.permutation(200)[:120]
+    expected = values[indices][np.isfinite(values[indices]).all(axis=1)]
+    found = finite_rows(values, indices)
+    np.testing.assert_array_equal(found, expected)
+    assert found.dtype == values.dtype and 0 < found.shape[0] < indices.size
