@@ -248,10 +248,3 @@ def finite_rows(values: np.ndarray, indices: np.ndarray) -> np.ndarray:
     """The rows ``indices`` of NxK ``values`` whose entries are all finite, in the order given:
     ``values[indices][np.isfinite(values[indices]).all(axis=1)]`` in one pass."""
     return _loops().finite_rows(values, indices)
-
-
-def sampled_medians(values: np.ndarray, pixels: np.ndarray, starts: np.ndarray, sample: int) -> np.ndarray:
-    """Per label k of ``pixels``/``starts`` (as :func:`label_pixels` gives them): the median of the float
-    ``values`` (flat) at every ``max(1, n // sample)``-th of its n pixels, as ``np.median`` gives it (NaN when one
-    of them is NaN or there are none), in the values' dtype."""
-    return _loops().sampled_medians(values, pixels, starts, sample, values.dtype.type(2))

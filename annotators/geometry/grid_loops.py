@@ -772,20 +772,3 @@ def finite_rows(values: np.ndarray, indices: np.ndarray) -> np.ndarray:
             rows[kept] = values[index]
             kept += 1
     return rows[:kept]
-
-
-@njit(cache=True, nogil=True)
-def sampled_medians(values: np.ndarray, pixels: np.ndarray, starts: np.ndarray, sample: int, two: float) -> np.ndarray:
-    """See :func:`annotators.geometry.grid_kernels.sampled_medians` (``two`` is 2 in the values' dtype)."""
-    count = starts.size - 1
-    medians = np.empty(count, dtype=values.dtype)
-    for label in range(count):
-        size = starts[label + 1] - starts[label]
-        step = max(1, size // sample)
-        taken = values[pixels[starts[label] : starts[label + 1] : step]]
-        if taken.size == 0 or np.isnan(taken).any():
-            medians[label] = np.nan
-            continue
-        ordered = np.sort(taken)
-        medians[label] = (ordered[(taken.size - 1) // 2] + ordered[taken.size // 2]) / two
-    return medians

@@ -17,7 +17,6 @@ from annotators.geometry.grid_kernels import (
     boundary_pairs,
     connected_parts,
     nearest_seed_labels,
-    sampled_medians,
     seam_pixels,
     surface_growth,
     touching_keys,
@@ -405,7 +404,7 @@ class _Parts:
         self._coordinates: dict[int, np.ndarray] = {}
         self._hulls: dict[int, np.ndarray] = {}
         self._sorted: dict[int, np.ndarray] = {}
-        self._depths: list[float] | None = None
+        self._depths: dict[int, float] = {}
         self._outsides: dict[tuple[int, float], ContainerOutside | None] = {}
 
     def own(self, label: int) -> np.ndarray:
@@ -437,9 +436,10 @@ class _Parts:
         return self._outsides[label, tolerance]
 
     def depth_of(self, label: int) -> float:
-        """The median depth of the part (of about 500 of its pixels, evenly sampled; all parts' at once)."""
-        if self._depths is None:
-            self._depths = sampled_medians(self.depth, self.pixels, self.starts, 500).tolist()
+        """The median depth of the part."""
+        if label not in self._depths:
+            own = self.own(label)
+            self._depths[label] = float(_median(self.depth[own[:: max(1, own.size // 500)]]))
         return self._depths[label]
 
 

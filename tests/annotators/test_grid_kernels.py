@@ -16,7 +16,6 @@ from annotators.geometry.grid_kernels import (
     grouped_pixels,
     label_pixels,
     nearest_seed_labels,
-    sampled_medians,
     shadowed_near,
     symmetric_eigen,
     touching_keys,
@@ -206,17 +205,3 @@ def test_finite_rows_keep_the_rows_without_nan_or_inf_in_order() -> None:
     found = finite_rows(values, indices)
     np.testing.assert_array_equal(found, expected)
     assert found.dtype == values.dtype and 0 < found.shape[0] < indices.size
-
-
-@pytest.mark.parametrize("dtype", [np.float32, np.float64])
-def test_sampled_medians_are_numpy_medians_of_the_sample(dtype: type) -> None:
-    labels = _blobs(3, shape=(80, 90), labels=8)
-    values = np.random.default_rng(3).normal(1.0, 0.3, labels.size).astype(dtype)
-    values[labels.reshape(-1) == 5] = np.nan
-    pixels, starts, _ = label_pixels(labels)
-    medians = sampled_medians(values, pixels, starts, 50)
-    assert medians.dtype == dtype
-    for label in range(1, starts.size - 1):
-        own = pixels[starts[label] : starts[label + 1]]
-        expected = np.median(values[own[:: max(1, own.size // 50)]])
-        assert medians[label] == expected or (np.isnan(expected) and np.isnan(medians[label]))
