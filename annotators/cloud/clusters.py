@@ -207,23 +207,20 @@ def full_resolution_segments(
     x0, y0, x1, y1 = box
     fy0, fx0 = y0 * step, x0 * step
     fy1, fx1 = min(y1 * step, rows), min(x1 * step, cols)
-    width = fx1 - fx0
     fine_points = points[fy0:fy1, fx0:fx1]
     heights = np.ascontiguousarray(plane_distances(points, model)[fy0:fy1, fx0:fx1])  # no copy of the region's points
     candidates = _between_heights(heights, mask[fy0:fy1, fx0:fx1], p)
     core = upsampled_labels(  # the pixels the segmentation labelled itself: the point indices
         labels, coarse_depth, fine_points[..., 2], candidates, step, p.jump_absolute, p.jump_relative
     )
-    core_pixels, core_starts, boxes = label_pixels(core)
+    # flat indices of the whole grid, sorted by label
+    core_indices, core_starts, boxes = label_pixels(core, (fy0, fx0), cols)
     sizes = np.diff(core_starts)
     kept = [label for label in range(1, sizes.size) if sizes[label] >= p.min_points]  # judged before refining
-    pixels, starts = core_pixels, core_starts
+    mask_indices, starts = core_indices, core_starts
     if refine is not None:
-        pixels, starts, boxes = label_pixels(refine(core, fine_points, heights, candidates))
+        mask_indices, starts, boxes = label_pixels(refine(core, fine_points, heights, candidates), (fy0, fx0), cols)
     masks = np.zeros((len(kept), rows, cols), dtype=bool)  # one allocation for all masks
-    # the region's flat pixel indices as flat indices of the whole grid, all labels at once
-    core_indices = (core_pixels // width + fy0) * cols + core_pixels % width + fx0
-    mask_indices = core_indices if pixels is core_pixels else (pixels // width + fy0) * cols + pixels % width + fx0
     segments = []
     for object_mask, label in zip(masks, kept, strict=True):
         object_mask.reshape(-1)[mask_indices[starts[label] : starts[label + 1]]] = True

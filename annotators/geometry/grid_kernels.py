@@ -62,11 +62,16 @@ def upsampled_labels(
     return _loops().upsampled_labels(labels, coarse_depth, depth, keep, step, absolute, relative)
 
 
-def label_pixels(labels: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+def label_pixels(
+    labels: np.ndarray, origin: tuple[int, int] = (0, 0), width: int | None = None
+) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
     """The flat indices of the labelled pixels of HxW ``labels`` sorted by label (increasing within one), ``starts``
     so label k owns ``pixels[starts[k]:starts[k + 1]]``, and each label's box ``(x0, y0, x1, y1)`` (exclusive;
-    row k for label k, zeros for a label without pixels)."""
-    return _loops().label_pixels(labels)
+    row k for label k, zeros for a label without pixels). With ``origin`` ``(row, column)`` and ``width``, the
+    labels are a window of a grid that wide at that origin and the indices are flat indices of that grid (the
+    boxes stay in the window's coordinates)."""
+    top, left = origin
+    return _loops().label_pixels(labels, top, left, labels.shape[1] if width is None else width)
 
 
 def label_moments(

@@ -137,7 +137,7 @@ def upsampled_labels(
 
 
 @njit(cache=True, nogil=True)
-def label_pixels(labels: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+def label_pixels(labels: np.ndarray, top: int, left: int, width: int) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
     """See :func:`annotators.geometry.grid_kernels.label_pixels`."""
     rows, cols = labels.shape
     count = 0
@@ -162,7 +162,7 @@ def label_pixels(labels: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray
         for c in range(cols):
             label = labels[r, c]
             if label > 0:
-                pixels[filled[label]] = r * cols + c
+                pixels[filled[label]] = (r + top) * width + c + left
                 filled[label] += 1
     for label in range(count + 1):
         if starts[label + 1] == starts[label]:

@@ -69,6 +69,12 @@ def test_pixels_grouped_by_label_in_raster_order(seed: int) -> None:
         assert np.array_equal(all_pixels[all_starts[label] : all_starts[label + 1]], own)
         rows, cols = own // labels.shape[1], own % labels.shape[1]
         assert boxes[label].tolist() == [cols.min(), rows.min(), cols.max() + 1, rows.max() + 1]
+    grid = np.zeros((labels.shape[0] + 7, labels.shape[1] + 9), dtype=labels.dtype)
+    grid[5 : 5 + labels.shape[0], 3 : 3 + labels.shape[1]] = labels  # labels as a window of a larger grid
+    in_grid, grid_starts, window_boxes = label_pixels(labels, (5, 3), grid.shape[1])
+    expected, _, _ = label_pixels(grid)
+    assert np.array_equal(in_grid, expected) and np.array_equal(grid_starts, all_starts)
+    assert np.array_equal(window_boxes, boxes)
 
 
 def test_facing_values_are_the_dilated_band_on_the_target() -> None:
