@@ -253,3 +253,15 @@ def finite_rows(values: np.ndarray, indices: np.ndarray) -> np.ndarray:
     """The rows ``indices`` of NxK ``values`` whose entries are all finite, in the order given:
     ``values[indices][np.isfinite(values[indices]).all(axis=1)]`` in one pass."""
     return _loops().finite_rows(values, indices)
+
+
+def jump_between(z_a: float, z_b: float, absolute: float, relative: float) -> bool:
+    """:func:`~annotators.geometry.grid_segmentation.depth_jump` of two depths, both taken as float32 (float32
+    arithmetic, as numpy does it for two float32 scalars)."""
+    return _loops().jump_between(np.float32(z_a), np.float32(z_b), absolute, relative)
+
+
+def window_counts(labels: np.ndarray, count: int) -> np.ndarray:
+    """The number of pixels of each label ``0..count`` in HxW ``labels`` (any strides, e.g. a window of a larger
+    grid; labels at most ``count``): ``np.bincount(labels.reshape(-1), minlength=count + 1)`` without a copy."""
+    return _loops().window_counts(labels, count)

@@ -772,3 +772,20 @@ def finite_rows(values: np.ndarray, indices: np.ndarray) -> np.ndarray:
             rows[kept] = values[index]
             kept += 1
     return rows[:kept]
+
+
+@njit(cache=True, nogil=True)
+def jump_between(z_a: np.float32, z_b: np.float32, absolute: float, relative: float) -> bool:
+    """See :func:`annotators.geometry.grid_kernels.jump_between`."""
+    return _jump(np.float32(z_a), np.float32(z_b), np.float32(absolute), np.float32(relative))
+
+
+@njit(cache=True, nogil=True)
+def window_counts(labels: np.ndarray, count: int) -> np.ndarray:
+    """See :func:`annotators.geometry.grid_kernels.window_counts`."""
+    counts = np.zeros(count + 1, dtype=np.int64)
+    rows, cols = labels.shape
+    for r in range(rows):
+        for c in range(cols):
+            counts[labels[r, c]] += 1
+    return counts

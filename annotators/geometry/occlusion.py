@@ -27,8 +27,16 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from annotators.geometry.grid_kernels import finite_rows, grouped_pixels, label_pixels, piece_near, shadowed_near
-from annotators.geometry.grid_segmentation import depth_jump, join_labels, touching_pairs
+from annotators.geometry.grid_kernels import (
+    finite_rows,
+    grouped_pixels,
+    jump_between,
+    label_pixels,
+    piece_near,
+    shadowed_near,
+    window_counts,
+)
+from annotators.geometry.grid_segmentation import join_labels, touching_pairs
 
 
 @dataclass(frozen=True)
@@ -105,7 +113,7 @@ def join_occluded(
         x0, y0, x1, y1 = _grown(boxes[occluder].tolist(), labels.shape, 3 * rules.band + 1)
         window = labels[y0:y1, x0:x1]
         # a piece's band near the occluder lies in the window: only pieces with enough pixels there can join
-        possible = farther[np.bincount(window.reshape(-1), minlength=count + 1)[farther] >= rules.min_points]
+        possible = farther[window_counts(window, count)[farther] >= rules.min_points]
         if possible.size < 2:
             continue  # fewer than two farther objects near this one
         if touching is None:
@@ -130,7 +138,7 @@ def join_occluded(
             )
             if facing < rules.min_points:
                 continue  # too few of the occluder's pixels within reach of the band
-            if not depth_jump(np.float32(piece_depth), np.float32(occluder_depth), absolute, relative):
+            if not jump_between(piece_depth, occluder_depth, absolute, relative):
                 continue
             if piece_depth <= occluder_depth or xyz.shape[0] < rules.min_points:
                 continue

@@ -14,14 +14,16 @@ from annotators.geometry.grid_kernels import (
     finite_rows,
     graph_components,
     grouped_pixels,
+    jump_between,
     label_pixels,
     nearest_seed_labels,
     shadowed_near,
     symmetric_eigen,
     touching_keys,
     unlabelled_box,
+    window_counts,
 )
-from annotators.geometry.grid_segmentation import bounding_box, depth_seams, grow_on_surface
+from annotators.geometry.grid_segmentation import bounding_box, depth_jump, depth_seams, grow_on_surface
 
 
 def _blobs(seed: int, shape: tuple[int, int] = (40, 50), labels: int = 6) -> np.ndarray:
@@ -211,3 +213,20 @@ def test_finite_rows_keep_the_rows_without_nan_or_inf_in_order() -> None:
     found = finite_rows(values, indices)
     np.testing.assert_array_equal(found, expected)
     assert found.dtype == values.dtype and 0 < found.shape[0] < indices.size
+
+
+def test_jump_between_is_depth_jump_of_two_float32_depths() -> None:
+    rng = np.random.default_rng(2)
+    depths = rng.uniform(0.3, 2.0, (2000, 2))
+    depths[1::7, 1] = depths[1::7, 0] * (1 + rng.uniform(0.0, 0.03, depths[1::7].shape[0]))  # near the threshold
+    depths[5, 0] = np.nan
+    for z_a, z_b in depths:
+        expected = depth_jump(np.float32(z_a), np.float32(z_b), 0.02, 0.01)
+        assert jump_between(z_a, z_b, 0.02, 0.01) == bool(expected)
+
+
+def test_window_counts_count_the_labels_of_a_window_in_place() -> None:
+    labels = _blobs(4)
+    window = labels[3:30:2, 5:41]
+    counts = window_counts(window, int(labels.max()))
+    np.testing.assert_array_equal(counts, np.bincount(window.reshape(-1), minlength=int(labels.max()) + 1))
