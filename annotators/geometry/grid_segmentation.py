@@ -176,6 +176,7 @@ def footprint_overlaps(firsts: Sequence[np.ndarray], seconds: Sequence[np.ndarra
     corner = np.minimum.reduceat(vertices, starts, axis=0)
     far_corner = np.maximum.reduceat(vertices, starts, axis=0) + 1
     boxes = np.column_stack([corner, far_corner - corner]).tolist()  # x, y, width, height of the cells spanned
+    vertices -= np.repeat(corner, sizes, axis=0)  # each polygon's vertices on its own raster
     ends = (starts + sizes).tolist()
     starts = starts.tolist()
     for pair in np.flatnonzero(near).tolist():
@@ -196,10 +197,10 @@ def footprint_overlaps(firsts: Sequence[np.ndarray], seconds: Sequence[np.ndarra
 
 
 def _filled(vertices: np.ndarray, box: Sequence[int]) -> np.ndarray:
-    """The cells (uint8, 1 = covered) a convex polygon with integer ``vertices`` covers, on the raster of its
-    bounding ``box`` ``(x, y, width, height)``."""
+    """The cells (uint8, 1 = covered) a convex polygon covers on the raster of its bounding ``box`` ``(x, y, width,
+    height)``, its integer ``vertices`` given relative to the box's corner."""
     raster = np.zeros((box[3], box[2]), dtype=np.uint8)
-    cv2.fillConvexPoly(raster, vertices - np.array(box[:2], dtype=np.int32), 1)
+    cv2.fillConvexPoly(raster, vertices, 1)
     return raster
 
 
