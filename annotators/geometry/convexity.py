@@ -26,7 +26,13 @@ from annotators.geometry.grid_kernels import (
     normal_halves,
     symmetric_eigen,
 )
-from annotators.geometry.grid_segmentation import grow_labels, join_unless_apart, pixel_footprint, touching_pairs
+from annotators.geometry.grid_segmentation import (
+    distinct_keys,
+    grow_labels,
+    join_unless_apart,
+    pixel_footprint,
+    touching_pairs,
+)
 
 
 def grid_patches(surfaces: np.ndarray, cell: int) -> np.ndarray:
@@ -223,7 +229,7 @@ def _join_faces(
     face_a, face_b = faces[pairs[:, 0]], faces[pairs[:, 1]]
     apart = face_a != face_b
     low, high = np.minimum(face_a, face_b)[apart], np.maximum(face_a, face_b)[apart]
-    keys, inverse = np.unique(low * count + high, return_inverse=True)
+    keys, inverse = distinct_keys(low * count + high)
     votes = np.maximum(np.bincount(inverse, minlength=keys.size), 1)
     share = np.bincount(inverse, weights=convex[apart], minlength=keys.size) / votes
     concave_votes = np.bincount(inverse, weights=concave[apart], minlength=keys.size)

@@ -125,10 +125,26 @@ def grow_on_surface(
     return surface_growth(labels, region, np.asarray(depth, dtype=np.float32), absolute, relative, rounds)
 
 
+def distinct_keys(keys: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """``np.unique(keys, return_inverse=True)`` of 1-D integer keys: the distinct keys in increasing order and the
+    index of each key among them, by a stable sort (which is much faster than numpy's default one on integers that
+    come in runs, as the keys of pixel pairs along a boundary do)."""
+    order = np.argsort(keys, kind="stable")
+    ordered = keys[order]
+    first = np.ones(ordered.size, dtype=bool)
+    np.not_equal(ordered[1:], ordered[:-1], out=first[1:])
+    inverse = np.empty(keys.size, dtype=np.intp)
+    inverse[order] = np.cumsum(first) - 1
+    return ordered[first], inverse
+
+
 def touching_pairs(labels: np.ndarray) -> np.ndarray:
     """Kx2 int array of the distinct label pairs ``(a, b)``, ``0 < a < b``, that touch as 4-neighbours."""
     base = int(labels.max(initial=0)) + 1
-    keys = np.unique(touching_keys(np.ascontiguousarray(labels), base))
+    ordered = np.sort(touching_keys(np.ascontiguousarray(labels), base), kind="stable")  # see distinct_keys
+    first = np.ones(ordered.size, dtype=bool)
+    np.not_equal(ordered[1:], ordered[:-1], out=first[1:])
+    keys = ordered[first]
     return np.column_stack([keys // base, keys % base])
 
 
@@ -506,7 +522,7 @@ def boundaries(
     if key.size == 0:
         empty = np.zeros(0)
         return Boundaries(np.zeros((0, 2), np.int64), empty, empty, empty, empty, empty, empty, empty)
-    unique, inverse = np.unique(key, return_inverse=True)
+    unique, inverse = distinct_keys(key)
     length = np.bincount(inverse, minlength=unique.size).astype(np.float64)
     smooth = ~jump
     known = smooth & np.isfinite(dot) & np.isfinite(convexity)

@@ -12,6 +12,7 @@ from annotators.geometry.boxes import object_box, principal_box, upright_box
 from annotators.geometry.grid_segmentation import (
     MergeRules,
     boundaries,
+    distinct_keys,
     footprint_overlap,
     footprint_overlaps,
     heights_nest,
@@ -193,3 +194,12 @@ def test_footprint_overlaps_of_many_pairs_are_those_of_each_pair_alone() -> None
     assert shares[2] == 1.0  # the small square lies within the large one
     assert shares.tolist() == [footprint_overlap(a, b, 0.005) for a, b in zip(firsts, seconds, strict=True)]
     assert footprint_overlaps([], [], 0.005).shape == (0,)
+
+
+@pytest.mark.parametrize("size", [0, 1, 7, 3000])
+def test_distinct_keys_are_numpy_unique_with_inverse(size: int) -> None:
+    keys = np.repeat(np.random.default_rng(size).integers(0, 500, size), 3)[:size]  # runs, as along boundaries
+    unique, inverse = distinct_keys(keys)
+    expected, expected_inverse = np.unique(keys, return_inverse=True)
+    np.testing.assert_array_equal(unique, expected)
+    np.testing.assert_array_equal(inverse, expected_inverse)
