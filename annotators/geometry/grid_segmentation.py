@@ -59,9 +59,9 @@ _VALUE_WEIGHT = _read_only(np.clip((np.arange(256, dtype=np.float32) - 25) / 40,
 
 
 def chroma_image(colors: np.ndarray) -> np.ndarray:
-    """A shading-invariant 3-channel uint8 image: hue as an angle scaled by saturation, faded out on dark pixels.
+    """A shading-invariant 2-channel uint8 image: hue as an angle scaled by saturation, faded out on dark pixels.
 
-    Channels 0 and 1 are ``128 + 127 * s * w * (cos h, sin h)`` with ``w`` ramping from 0 to 1 between values
+    The channels are ``128 + 127 * s * w * (cos h, sin h)`` with ``w`` ramping from 0 to 1 between values
     25 and 65, so shading of one surface (same hue and saturation) gives no edge while a change of hue does.
     The trigonometry and the ramp are table look-ups over the 256 hue and value levels.
     """
@@ -70,7 +70,7 @@ def chroma_image(colors: np.ndarray) -> np.ndarray:
     weight = cv2.LUT(value, _VALUE_WEIGHT)
     weight *= saturation
     weight *= np.float32(127 / 255)
-    chroma = np.full(colors.shape, 128, dtype=np.uint8)
+    chroma = np.empty((*colors.shape[:2], 2), dtype=np.uint8)
     for channel, table in ((0, _HUE_COS), (1, _HUE_SIN)):
         value = cv2.LUT(hue, table)
         value *= weight
@@ -80,7 +80,8 @@ def chroma_image(colors: np.ndarray) -> np.ndarray:
 
 
 def color_edges(colors: np.ndarray, low: float, high: float) -> np.ndarray:
-    """HxW bool: Canny edges (thresholds ``low``/``high``) of the :func:`chroma_image` - changes of hue."""
+    """HxW bool: Canny edges (thresholds ``low``/``high``) of the :func:`chroma_image` - changes of hue (Canny
+    follows, at each pixel, the channel with the larger gradient)."""
     return cv2.Canny(chroma_image(np.ascontiguousarray(colors)), low, high) > 0
 
 

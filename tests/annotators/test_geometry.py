@@ -12,6 +12,8 @@ from annotators.geometry.boxes import object_box, principal_box, upright_box
 from annotators.geometry.grid_segmentation import (
     MergeRules,
     boundaries,
+    chroma_image,
+    color_edges,
     distinct_keys,
     footprint_overlap,
     footprint_overlaps,
@@ -203,3 +205,15 @@ def test_distinct_keys_are_numpy_unique_with_inverse(size: int) -> None:
     expected, expected_inverse = np.unique(keys, return_inverse=True)
     np.testing.assert_array_equal(unique, expected)
     np.testing.assert_array_equal(inverse, expected_inverse)
+
+
+def test_color_edges_are_the_canny_edges_of_the_chroma_channels() -> None:
+    rng = np.random.default_rng(5)
+    colors = cv2.resize(rng.integers(0, 256, (12, 16, 3), dtype=np.uint8), (160, 120), interpolation=cv2.INTER_NEAREST)
+    colors = cv2.add(colors, rng.integers(0, 12, colors.shape, dtype=np.uint8))  # sensor noise
+    chroma = chroma_image(colors)
+    assert chroma.shape == (120, 160, 2)
+    with_constant = np.dstack([chroma, np.full((120, 160), 128, dtype=np.uint8)])  # a flat third channel adds none
+    edges = color_edges(colors, 40.0, 100.0)
+    np.testing.assert_array_equal(edges, cv2.Canny(with_constant, 40.0, 100.0) > 0)
+    assert edges.any()
