@@ -265,3 +265,12 @@ def window_counts(labels: np.ndarray, count: int) -> np.ndarray:
     """The number of pixels of each label ``0..count`` in HxW ``labels`` (any strides, e.g. a window of a larger
     grid; labels at most ``count``): ``np.bincount(labels.reshape(-1), minlength=count + 1)`` without a copy."""
     return _loops().window_counts(labels, count)
+
+
+def strided_crop(values: np.ndarray, step: int, box: tuple[int, int, int, int]) -> np.ndarray:
+    """``np.ascontiguousarray(values[::step, ::step][y0:y1, x0:x1])`` of HxW or HxWxC ``values`` for the ``box``
+    ``(x0, y0, x1, y1)`` (exclusive, within the subsampled grid), in one pass."""
+    x0, y0, x1, y1 = box
+    if values.ndim == 2:
+        return _loops().strided_crop(values[..., None], step, x0, y0, x1, y1)[..., 0]
+    return _loops().strided_crop(values, step, x0, y0, x1, y1)

@@ -789,3 +789,15 @@ def window_counts(labels: np.ndarray, count: int) -> np.ndarray:
         for c in range(cols):
             counts[labels[r, c]] += 1
     return counts
+
+
+@njit(cache=True, nogil=True)
+def strided_crop(values: np.ndarray, step: int, x0: int, y0: int, x1: int, y1: int) -> np.ndarray:
+    """See :func:`annotators.geometry.grid_kernels.strided_crop`."""
+    channels = values.shape[2]
+    crop = np.empty((y1 - y0, x1 - x0, channels), dtype=values.dtype)
+    for r in range(y1 - y0):
+        for c in range(x1 - x0):
+            for k in range(channels):
+                crop[r, c, k] = values[(r + y0) * step, (c + x0) * step, k]
+    return crop

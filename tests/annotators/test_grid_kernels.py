@@ -18,6 +18,7 @@ from annotators.geometry.grid_kernels import (
     label_pixels,
     nearest_seed_labels,
     shadowed_near,
+    strided_crop,
     symmetric_eigen,
     touching_keys,
     unlabelled_box,
@@ -230,3 +231,14 @@ def test_window_counts_count_the_labels_of_a_window_in_place() -> None:
     window = labels[3:30:2, 5:41]
     counts = window_counts(window, int(labels.max()))
     np.testing.assert_array_equal(counts, np.bincount(window.reshape(-1), minlength=int(labels.max()) + 1))
+
+
+@pytest.mark.parametrize("channels", [0, 3])
+def test_strided_crop_is_the_contiguous_copy_of_the_subsampled_window(channels: int) -> None:
+    shape = (47, 61, channels) if channels else (47, 61)
+    values = np.random.default_rng(channels).random(shape).astype(np.float32)
+    values[3, 4] = np.nan
+    crop = strided_crop(values, 2, (3, 1, 29, 22))
+    expected = np.ascontiguousarray(values[::2, ::2][1:22, 3:29])
+    np.testing.assert_array_equal(crop, expected)
+    assert crop.shape == expected.shape and crop.flags.c_contiguous
