@@ -125,7 +125,7 @@ def join_occluded(
         near = shadowed_near(occluding, unmeasured[y0:y1, x0:x1], 3 * rules.band, rules.band)
         # the farther objects with enough pixels near the occluder; two of them must be apart to join anything
         near_pixels, near_starts = grouped_pixels(window, near, count)
-        band_sizes = np.diff(near_starts)
+        band_sizes = near_starts[1:] - near_starts[:-1]
         candidates = _apart_from_another(farther[band_sizes[farther] >= rules.min_points].tolist(), touching)
         if len(candidates) < 2:
             continue
@@ -217,7 +217,13 @@ def _same_section(first: _Piece, second: _Piece, rules: OcclusionRules) -> bool:
 
 def _apart_from_another(labels: list[int], touching: set[tuple[int, int]]) -> list[int]:
     """The (increasing) ``labels`` that do not touch at least one of the others: only those can be joined."""
-    return [a for a in labels if any((min(a, b), max(a, b)) not in touching for b in labels if b != a)]
+    apart = []
+    for a in labels:
+        for b in labels:
+            if b != a and ((a, b) if a < b else (b, a)) not in touching:
+                apart.append(a)
+                break
+    return apart
 
 
 def _touching(labels: np.ndarray) -> set[tuple[int, int]]:
