@@ -167,7 +167,8 @@ def standing_region(
     step = max(1, p.stride)
     basis = plane_basis(np.asarray(model[:3], dtype=np.float64)).T.astype(np.float32)
     coarse_points = points[::step, ::step]
-    heights = plane_distances(coarse_points, model)
+    # on the whole grid, which needs no copy of strided points (each point's distance is the same either way)
+    heights = np.ascontiguousarray(plane_distances(points, model)[::step, ::step])
     flat = points.reshape(-1, 3)
     plane_points = flat[plane_indices[:: max(1, plane_indices.size // 2000)]]
     plane_points = plane_points[np.isfinite(plane_points).all(axis=1)]
@@ -206,26 +207,24 @@ def full_resolution_segments(
     x0, y0, x1, y1 = box
     fy0, fx0 = y0 * step, x0 * step
     fy1, fx1 = min(y1 * step, rows), min(x1 * step, cols)
-    width = fx1 - fx0
     fine_points = points[fy0:fy1, fx0:fx1]
-    heights = plane_distances(fine_points, model)
+    heights = np.ascontiguousarray(plane_distances(points, model)[fy0:fy1, fx0:fx1])  # no copy of the region's points
     candidates = _between_heights(heights, mask[fy0:fy1, fx0:fx1], p)
     core = upsampled_labels(  # the pixels the segmentation labelled itself: the point indices
         labels, coarse_depth, fine_points[..., 2], candidates, step, p.jump_absolute, p.jump_relative
     )
-    core_pixels, core_starts, boxes = label_pixels(core)
+    # flat indices of the whole grid, sorted by label
+    core_indices, core_starts, boxes = label_pixels(core, (fy0, fx0), cols)
     sizes = np.diff(core_starts)
     kept = [label for label in range(1, sizes.size) if sizes[label] >= p.min_points]  # judged before refining
-    pixels, starts = core_pixels, core_starts
+    mask_indices, starts = core_indices, core_starts
     if refine is not None:
-        pixels, starts, boxes = label_pixels(refine(core, fine_points, heights, candidates))
+        mask_indices, starts, boxes = label_pixels(refine(core, fine_points, heights, candidates), (fy0, fx0), cols)
     masks = np.zeros((len(kept), rows, cols), dtype=bool)  # one allocation for all masks
     segments = []
     for object_mask, label in zip(masks, kept, strict=True):
-        own = pixels[starts[label] : starts[label + 1]]
-        object_mask.reshape(-1)[(own // width + fy0) * cols + own % width + fx0] = True
-        labelled = core_pixels[core_starts[label] : core_starts[label + 1]]
-        indices = (labelled // width + fy0) * cols + labelled % width + fx0
+        object_mask.reshape(-1)[mask_indices[starts[label] : starts[label + 1]]] = True
+        indices = core_indices[core_starts[label] : core_starts[label + 1]]
         left, top, right, bottom = boxes[label].tolist()
         roi = (left + fx0, top + fy0, right + fx0, bottom + fy0)
         segments.append(Segment(indices=indices, mask=object_mask, roi=roi))

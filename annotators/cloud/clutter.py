@@ -38,7 +38,7 @@ from annotators.cloud.normals import grid_normals
 from annotators.cloud.plane import plane_basis
 from annotators.geometry.border_pixels import BorderRules, claim_border_pixels, plane_noise
 from annotators.geometry.convexity import ConvexityRules, convex_groups, dense_labels, grid_patches, split_by_normals
-from annotators.geometry.grid_kernels import object_pieces
+from annotators.geometry.grid_kernels import object_pieces, strided_crop
 from annotators.geometry.grid_segmentation import (
     MergeRules,
     boundaries,
@@ -129,7 +129,7 @@ def segment_clutter(
         return []
     x0, y0, x1, y1 = bounding_box(coarse, margin=2)
     region = coarse[y0:y1, x0:x1]
-    grid = np.ascontiguousarray(points[::step, ::step][y0:y1, x0:x1])
+    grid = strided_crop(points, step, (x0, y0, x1, y1))
     depth = grid[..., 2]
     seams = depth_seams(depth, region, p.jump_absolute, p.jump_relative)
     normals = grid_normals(grid, p.normal_step, p.normal_smoothing, p.jump_absolute, p.jump_relative)
@@ -145,7 +145,7 @@ def segment_clutter(
     plane_grid = grid.reshape(-1, 3) @ to_plane + offset  # (u, v, height) of every grid point on the plane
     labels = merge_parts(labels, depth, plane_grid.__getitem__, p.merge_rules())
     if colors is not None and p.use_color:
-        colors_crop = np.ascontiguousarray(colors[::step, ::step][y0:y1, x0:x1])
+        colors_crop = strided_crop(colors, step, (x0, y0, x1, y1))
         labels = split_by_color(labels, grid, normals, colors_crop, p)
     if p.complete_occluded:
         labels = join_occluded(

@@ -15,19 +15,24 @@ from __future__ import annotations
 from dataclasses import dataclass
 
 import numpy as np
-from scipy import sparse
-from scipy.sparse import csgraph
 
 from annotators.geometry.grid_kernels import (
     cell_patches,
     dense_keys,
+    graph_components,
     label_centres,
     label_moments,
     labelled_values,
     normal_halves,
     symmetric_eigen,
 )
-from annotators.geometry.grid_segmentation import grow_labels, join_unless_apart, pixel_footprint, touching_pairs
+from annotators.geometry.grid_segmentation import (
+    distinct_keys,
+    grow_labels,
+    join_unless_apart,
+    pixel_footprint,
+    touching_pairs,
+)
 
 
 def grid_patches(surfaces: np.ndarray, cell: int) -> np.ndarray:
@@ -224,7 +229,7 @@ def _join_faces(
     face_a, face_b = faces[pairs[:, 0]], faces[pairs[:, 1]]
     apart = face_a != face_b
     low, high = np.minimum(face_a, face_b)[apart], np.maximum(face_a, face_b)[apart]
-    keys, inverse = np.unique(low * count + high, return_inverse=True)
+    keys, inverse = distinct_keys(low * count + high)
     votes = np.maximum(np.bincount(inverse, minlength=keys.size), 1)
     share = np.bincount(inverse, weights=convex[apart], minlength=keys.size) / votes
     concave_votes = np.bincount(inverse, weights=concave[apart], minlength=keys.size)
@@ -259,5 +264,4 @@ def planes_sizes(planes: PatchPlanes, count: int) -> np.ndarray:
 
 def _components(pairs: np.ndarray, count: int) -> np.ndarray:
     """The connected component of each of ``count`` nodes of the graph with the edges ``pairs`` (Kx2)."""
-    graph = sparse.csr_matrix((np.ones(pairs.shape[0]), (pairs[:, 0], pairs[:, 1])), shape=(count, count))
-    return csgraph.connected_components(graph, directed=False)[1].astype(np.int64)
+    return graph_components(pairs, count)

@@ -62,11 +62,16 @@ def upsampled_labels(
     return _loops().upsampled_labels(labels, coarse_depth, depth, keep, step, absolute, relative)
 
 
-def label_pixels(labels: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+def label_pixels(
+    labels: np.ndarray, origin: tuple[int, int] = (0, 0), width: int | None = None
+) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
     """The flat indices of the labelled pixels of HxW ``labels`` sorted by label (increasing within one), ``starts``
     so label k owns ``pixels[starts[k]:starts[k + 1]]``, and each label's box ``(x0, y0, x1, y1)`` (exclusive;
-    row k for label k, zeros for a label without pixels)."""
-    return _loops().label_pixels(labels)
+    row k for label k, zeros for a label without pixels). With ``origin`` ``(row, column)`` and ``width``, the
+    labels are a window of a grid that wide at that origin and the indices are flat indices of that grid (the
+    boxes stay in the window's coordinates)."""
+    top, left = origin
+    return _loops().label_pixels(labels, top, left, labels.shape[1] if width is None else width)
 
 
 def label_moments(
@@ -212,3 +217,60 @@ def cell_patches(surfaces: np.ndarray, cell: int) -> np.ndarray:
     """:func:`~annotators.geometry.convexity.grid_patches`: each labelled surface cut into ``cell`` x ``cell``
     cells, the (surface, cell) pairs numbered 1..n in increasing order of surface, then cell (row-major)."""
     return _loops().cell_patches(surfaces, cell)
+
+
+def graph_components(pairs: np.ndarray, count: int) -> np.ndarray:
+    """The connected component (int64) of each of ``count`` nodes of the undirected graph with the edges ``pairs``
+    (Kx2 integer), numbered 0.. in order of each component's smallest node - as
+    ``scipy.sparse.csgraph.connected_components`` numbers them."""
+    return _loops().graph_components(np.ascontiguousarray(pairs, dtype=np.int64).reshape(-1, 2), count)
+
+
+def nearest_seed_labels(
+    window: np.ndarray,
+    unlabelled: np.ndarray,
+    distance: np.ndarray,
+    nearest: np.ndarray,
+    max_distance: float,
+    grown: np.ndarray,
+) -> None:
+    """After ``cv2.distanceTransformWithLabels`` of the unlabelled pixels of the HxW labels ``window`` (one label
+    per seed pixel, ``DIST_LABEL_PIXEL``): the ``unlabelled`` pixels within ``max_distance`` (compared in float32,
+    as numpy compares the float32 ``distance``) take the label of their nearest seed, written into ``grown`` (HxW,
+    may be ``window`` itself or a copy)."""
+    _loops().nearest_seed_labels(window, unlabelled, distance, nearest, np.float32(max_distance), grown)
+
+
+def unlabelled_box(labels: np.ndarray, region: np.ndarray, margin: int) -> tuple[np.ndarray, np.ndarray, bool]:
+    """The pixels of ``region`` (HxW bool) that HxW ``labels`` leave at 0, their box ``(x0, y0, x1, y1)``
+    (exclusive) grown by ``margin`` and clipped to the grid, and whether there is anything to grow (such a pixel
+    and a labelled one): ``region & (labels == 0)`` and its :func:`~annotators.geometry.grid_segmentation.bounding_box`
+    in one pass."""
+    return _loops().unlabelled_box(labels, np.ascontiguousarray(region, dtype=bool), margin)
+
+
+def finite_rows(values: np.ndarray, indices: np.ndarray) -> np.ndarray:
+    """The rows ``indices`` of NxK ``values`` whose entries are all finite, in the order given:
+    ``values[indices][np.isfinite(values[indices]).all(axis=1)]`` in one pass."""
+    return _loops().finite_rows(values, indices)
+
+
+def jump_between(z_a: float, z_b: float, absolute: float, relative: float) -> bool:
+    """:func:`~annotators.geometry.grid_segmentation.depth_jump` of two depths, both taken as float32 (float32
+    arithmetic, as numpy does it for two float32 scalars)."""
+    return _loops().jump_between(np.float32(z_a), np.float32(z_b), absolute, relative)
+
+
+def window_counts(labels: np.ndarray, count: int) -> np.ndarray:
+    """The number of pixels of each label ``0..count`` in HxW ``labels`` (any strides, e.g. a window of a larger
+    grid; labels at most ``count``): ``np.bincount(labels.reshape(-1), minlength=count + 1)`` without a copy."""
+    return _loops().window_counts(labels, count)
+
+
+def strided_crop(values: np.ndarray, step: int, box: tuple[int, int, int, int]) -> np.ndarray:
+    """``np.ascontiguousarray(values[::step, ::step][y0:y1, x0:x1])`` of HxW or HxWxC ``values`` for the ``box``
+    ``(x0, y0, x1, y1)`` (exclusive, within the subsampled grid), in one pass."""
+    x0, y0, x1, y1 = box
+    if values.ndim == 2:
+        return _loops().strided_crop(values[..., None], step, x0, y0, x1, y1)[..., 0]
+    return _loops().strided_crop(values, step, x0, y0, x1, y1)

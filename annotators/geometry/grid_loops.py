@@ -137,7 +137,7 @@ def upsampled_labels(
 
 
 @njit(cache=True, nogil=True)
-def label_pixels(labels: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+def label_pixels(labels: np.ndarray, top: int, left: int, width: int) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
     """See :func:`annotators.geometry.grid_kernels.label_pixels`."""
     rows, cols = labels.shape
     count = 0
@@ -162,7 +162,7 @@ def label_pixels(labels: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray
         for c in range(cols):
             label = labels[r, c]
             if label > 0:
-                pixels[filled[label]] = r * cols + c
+                pixels[filled[label]] = (r + top) * width + c + left
                 filled[label] += 1
     for label in range(count + 1):
         if starts[label + 1] == starts[label]:
@@ -681,3 +681,123 @@ def cell_patches(surfaces: np.ndarray, cell: int) -> np.ndarray:
             if surfaces[r, c] > 0:
                 keys[r, c] = np.int64(surfaces[r, c]) * (across * down) + (r // cell) * across + c // cell + 1
     return dense_keys(keys)
+
+
+@njit(cache=True, nogil=True)
+def _root(parent: np.ndarray, node: int) -> int:
+    """The root of ``node`` in the union-find forest ``parent``, halving the path on the way."""
+    while parent[node] != node:
+        parent[node] = parent[parent[node]]
+        node = parent[node]
+    return node
+
+
+@njit(cache=True, nogil=True)
+def graph_components(pairs: np.ndarray, count: int) -> np.ndarray:
+    """See :func:`annotators.geometry.grid_kernels.graph_components`."""
+    parent = np.arange(count)
+    for k in range(pairs.shape[0]):
+        a, b = _root(parent, pairs[k, 0]), _root(parent, pairs[k, 1])
+        parent[max(a, b)] = min(a, b)  # each root is the smallest node of its component
+    components = np.empty(count, dtype=np.int64)
+    number = 0
+    for node in range(count):
+        root = _root(parent, node)
+        if root == node:
+            components[node] = number
+            number += 1
+        else:
+            components[node] = components[root]
+    return components
+
+
+@njit(cache=True, nogil=True)
+def nearest_seed_labels(
+    window: np.ndarray,
+    unlabelled: np.ndarray,
+    distance: np.ndarray,
+    nearest: np.ndarray,
+    max_distance: np.float32,
+    grown: np.ndarray,
+) -> None:
+    """See :func:`annotators.geometry.grid_kernels.nearest_seed_labels`."""
+    rows, cols = window.shape
+    count = 0
+    for r in range(rows):
+        for c in range(cols):
+            count = max(count, nearest[r, c])
+    lookup = np.zeros(count + 1, dtype=window.dtype)
+    for r in range(rows):
+        for c in range(cols):
+            if window[r, c] > 0:
+                lookup[nearest[r, c]] = window[r, c]
+    for r in range(rows):
+        for c in range(cols):
+            if unlabelled[r, c] and distance[r, c] <= max_distance:
+                grown[r, c] = lookup[nearest[r, c]]
+
+
+@njit(cache=True, nogil=True)
+def unlabelled_box(labels: np.ndarray, region: np.ndarray, margin: int) -> tuple[np.ndarray, np.ndarray, bool]:
+    """See :func:`annotators.geometry.grid_kernels.unlabelled_box`."""
+    rows, cols = labels.shape
+    unlabelled = np.zeros((rows, cols), dtype=np.bool_)
+    box = np.array([cols, rows, -1, -1], dtype=np.int64)
+    labelled = False
+    for r in range(rows):
+        for c in range(cols):
+            if labels[r, c] != 0:
+                labelled = True
+            elif region[r, c]:
+                unlabelled[r, c] = True
+                box[0], box[1] = min(box[0], c), min(box[1], r)
+                box[2], box[3] = max(box[2], c + 1), max(box[3], r + 1)
+    if box[2] < 0 or not labelled:
+        return unlabelled, np.zeros(4, dtype=np.int64), False
+    box[0], box[1] = max(box[0] - margin, 0), max(box[1] - margin, 0)
+    box[2], box[3] = min(box[2] + margin, cols), min(box[3] + margin, rows)
+    return unlabelled, box, True
+
+
+@njit(cache=True, nogil=True)
+def finite_rows(values: np.ndarray, indices: np.ndarray) -> np.ndarray:
+    """See :func:`annotators.geometry.grid_kernels.finite_rows`."""
+    rows = np.empty((indices.size, values.shape[1]), dtype=values.dtype)
+    kept = 0
+    for index in indices:
+        finite = True
+        for column in range(values.shape[1]):
+            finite = finite and np.isfinite(values[index, column])
+        if finite:
+            rows[kept] = values[index]
+            kept += 1
+    return rows[:kept]
+
+
+@njit(cache=True, nogil=True)
+def jump_between(z_a: np.float32, z_b: np.float32, absolute: float, relative: float) -> bool:
+    """See :func:`annotators.geometry.grid_kernels.jump_between`."""
+    return _jump(np.float32(z_a), np.float32(z_b), np.float32(absolute), np.float32(relative))
+
+
+@njit(cache=True, nogil=True)
+def window_counts(labels: np.ndarray, count: int) -> np.ndarray:
+    """See :func:`annotators.geometry.grid_kernels.window_counts`."""
+    counts = np.zeros(count + 1, dtype=np.int64)
+    rows, cols = labels.shape
+    for r in range(rows):
+        for c in range(cols):
+            counts[labels[r, c]] += 1
+    return counts
+
+
+@njit(cache=True, nogil=True)
+def strided_crop(values: np.ndarray, step: int, x0: int, y0: int, x1: int, y1: int) -> np.ndarray:
+    """See :func:`annotators.geometry.grid_kernels.strided_crop`."""
+    channels = values.shape[2]
+    crop = np.empty((y1 - y0, x1 - x0, channels), dtype=values.dtype)
+    for r in range(y1 - y0):
+        for c in range(x1 - x0):
+            for k in range(channels):
+                crop[r, c, k] = values[(r + y0) * step, (c + x0) * step, k]
+    return crop

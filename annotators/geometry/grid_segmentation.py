@@ -16,9 +16,11 @@ import numpy as np
 from annotators.geometry.grid_kernels import (
     boundary_pairs,
     connected_parts,
+    nearest_seed_labels,
     seam_pixels,
     surface_growth,
     touching_keys,
+    unlabelled_box,
 )
 
 
@@ -57,9 +59,9 @@ _VALUE_WEIGHT = _read_only(np.clip((np.arange(256, dtype=np.float32) - 25) / 40,
 
 
 def chroma_image(colors: np.ndarray) -> np.ndarray:
-    """A shading-invariant 3-channel uint8 image: hue as an angle scaled by saturation, faded out on dark pixels.
+    """A shading-invariant 2-channel uint8 image: hue as an angle scaled by saturation, faded out on dark pixels.
 
-    Channels 0 and 1 are ``128 + 127 * s * w * (cos h, sin h)`` with ``w`` ramping from 0 to 1 between values
+    The channels are ``128 + 127 * s * w * (cos h, sin h)`` with ``w`` ramping from 0 to 1 between values
     25 and 65, so shading of one surface (same hue and saturation) gives no edge while a change of hue does.
     The trigonometry and the ramp are table look-ups over the 256 hue and value levels.
     """
@@ -68,7 +70,7 @@ def chroma_image(colors: np.ndarray) -> np.ndarray:
     weight = cv2.LUT(value, _VALUE_WEIGHT)
     weight *= saturation
     weight *= np.float32(127 / 255)
-    chroma = np.full(colors.shape, 128, dtype=np.uint8)
+    chroma = np.empty((*colors.shape[:2], 2), dtype=np.uint8)
     for channel, table in ((0, _HUE_COS), (1, _HUE_SIN)):
         value = cv2.LUT(hue, table)
         value *= weight
@@ -78,7 +80,8 @@ def chroma_image(colors: np.ndarray) -> np.ndarray:
 
 
 def color_edges(colors: np.ndarray, low: float, high: float) -> np.ndarray:
-    """HxW bool: Canny edges (thresholds ``low``/``high``) of the :func:`chroma_image` - changes of hue."""
+    """HxW bool: Canny edges (thresholds ``low``/``high``) of the :func:`chroma_image` - changes of hue (Canny
+    follows, at each pixel, the channel with the larger gradient)."""
     return cv2.Canny(chroma_image(np.ascontiguousarray(colors)), low, high) > 0
 
 
@@ -94,10 +97,10 @@ def grow_labels(labels: np.ndarray, region: np.ndarray, max_distance: float) -> 
     can lie (its 3x3 chamfer distance is at least 0.955 times the larger coordinate difference), so every pixel
     it gives a label sees the same seeds and paths as on the whole grid.
     """
-    unlabelled = region & (labels == 0)
-    if not unlabelled.any() or not labels.any():
+    unlabelled, box, growing = unlabelled_box(labels, region, int(np.ceil(max_distance / 0.95)) + 2)
+    if not growing:
         return labels
-    x0, y0, x1, y1 = bounding_box(unlabelled, margin=int(np.ceil(max_distance / 0.95)) + 2)
+    x0, y0, x1, y1 = box.tolist()
     window = labels[y0:y1, x0:x1]
     seeds = window > 0
     if not seeds.any():
@@ -105,11 +108,8 @@ def grow_labels(labels: np.ndarray, region: np.ndarray, max_distance: float) -> 
     distance, nearest = cv2.distanceTransformWithLabels(
         (~seeds).view(np.uint8), cv2.DIST_L2, 3, labelType=cv2.DIST_LABEL_PIXEL
     )
-    lookup = np.zeros(int(nearest.max()) + 1, dtype=labels.dtype)
-    lookup[nearest[seeds]] = window[seeds]
-    reach = unlabelled[y0:y1, x0:x1] & (distance <= max_distance)
     grown = labels.copy()
-    grown[y0:y1, x0:x1][reach] = lookup[nearest[reach]]
+    nearest_seed_labels(window, unlabelled[y0:y1, x0:x1], distance, nearest, max_distance, grown[y0:y1, x0:x1])
     return grown
 
 
@@ -126,10 +126,26 @@ def grow_on_surface(
     return surface_growth(labels, region, np.asarray(depth, dtype=np.float32), absolute, relative, rounds)
 
 
+def distinct_keys(keys: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """``np.unique(keys, return_inverse=True)`` of 1-D integer keys: the distinct keys in increasing order and the
+    index of each key among them, by a stable sort (which is much faster than numpy's default one on integers that
+    come in runs, as the keys of pixel pairs along a boundary do)."""
+    order = np.argsort(keys, kind="stable")
+    ordered = keys[order]
+    first = np.ones(ordered.size, dtype=bool)
+    np.not_equal(ordered[1:], ordered[:-1], out=first[1:])
+    inverse = np.empty(keys.size, dtype=np.intp)
+    inverse[order] = np.cumsum(first) - 1
+    return ordered[first], inverse
+
+
 def touching_pairs(labels: np.ndarray) -> np.ndarray:
     """Kx2 int array of the distinct label pairs ``(a, b)``, ``0 < a < b``, that touch as 4-neighbours."""
     base = int(labels.max(initial=0)) + 1
-    keys = np.unique(touching_keys(np.ascontiguousarray(labels), base))
+    ordered = np.sort(touching_keys(np.ascontiguousarray(labels), base), kind="stable")  # see distinct_keys
+    first = np.ones(ordered.size, dtype=bool)
+    np.not_equal(ordered[1:], ordered[:-1], out=first[1:])
+    keys = ordered[first]
     return np.column_stack([keys // base, keys % base])
 
 
@@ -177,6 +193,7 @@ def footprint_overlaps(firsts: Sequence[np.ndarray], seconds: Sequence[np.ndarra
     corner = np.minimum.reduceat(vertices, starts, axis=0)
     far_corner = np.maximum.reduceat(vertices, starts, axis=0) + 1
     boxes = np.column_stack([corner, far_corner - corner]).tolist()  # x, y, width, height of the cells spanned
+    vertices -= np.repeat(corner, sizes, axis=0)  # each polygon's vertices on its own raster
     ends = (starts + sizes).tolist()
     starts = starts.tolist()
     for pair in np.flatnonzero(near).tolist():
@@ -197,10 +214,10 @@ def footprint_overlaps(firsts: Sequence[np.ndarray], seconds: Sequence[np.ndarra
 
 
 def _filled(vertices: np.ndarray, box: Sequence[int]) -> np.ndarray:
-    """The cells (uint8, 1 = covered) a convex polygon with integer ``vertices`` covers, on the raster of its
-    bounding ``box`` ``(x, y, width, height)``."""
+    """The cells (uint8, 1 = covered) a convex polygon covers on the raster of its bounding ``box`` ``(x, y, width,
+    height)``, its integer ``vertices`` given relative to the box's corner."""
     raster = np.zeros((box[3], box[2]), dtype=np.uint8)
-    cv2.fillConvexPoly(raster, vertices - np.array(box[:2], dtype=np.int32), 1)
+    cv2.fillConvexPoly(raster, vertices, 1)
     return raster
 
 
@@ -506,7 +523,7 @@ def boundaries(
     if key.size == 0:
         empty = np.zeros(0)
         return Boundaries(np.zeros((0, 2), np.int64), empty, empty, empty, empty, empty, empty, empty)
-    unique, inverse = np.unique(key, return_inverse=True)
+    unique, inverse = distinct_keys(key)
     length = np.bincount(inverse, minlength=unique.size).astype(np.float64)
     smooth = ~jump
     known = smooth & np.isfinite(dot) & np.isfinite(convexity)

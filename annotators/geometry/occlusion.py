@@ -26,10 +26,17 @@ import functools
 from dataclasses import dataclass
 
 import numpy as np
-from scipy import ndimage
 
-from annotators.geometry.grid_kernels import grouped_pixels, piece_near, shadowed_near
-from annotators.geometry.grid_segmentation import depth_jump, join_labels, touching_pairs
+from annotators.geometry.grid_kernels import (
+    finite_rows,
+    grouped_pixels,
+    jump_between,
+    label_pixels,
+    piece_near,
+    shadowed_near,
+    window_counts,
+)
+from annotators.geometry.grid_segmentation import join_labels, touching_pairs
 
 
 @dataclass(frozen=True)
@@ -90,8 +97,8 @@ def join_occluded(
     depth = points[..., 2]
     flat_labels = labels.reshape(-1)
     flat_normals, flat_plane = normals.reshape(-1, 3), on_plane.reshape(-1, 3)
-    sizes = np.bincount(flat_labels, minlength=count + 1)
-    boxes = ndimage.find_objects(labels, max_label=count)
+    _, starts, boxes = label_pixels(np.ascontiguousarray(labels))  # boxes (x0, y0, x1, y1) of labels 0..count
+    sizes = np.diff(starts)
     unmeasured = ~np.isfinite(depth)
     measured = ~unmeasured.reshape(-1) & (flat_labels > 0)
     sums = np.bincount(flat_labels[measured], depth.reshape(-1)[measured], minlength=count + 1)
@@ -103,10 +110,10 @@ def join_occluded(
         farther = np.flatnonzero(mean_depth > mean_depth[occluder])
         if sizes[occluder] < rules.min_points or farther.size < 2:
             continue
-        x0, y0, x1, y1 = _grown(boxes[occluder - 1], labels.shape, 3 * rules.band + 1)
+        x0, y0, x1, y1 = _grown(boxes[occluder].tolist(), labels.shape, 3 * rules.band + 1)
         window = labels[y0:y1, x0:x1]
         # a piece's band near the occluder lies in the window: only pieces with enough pixels there can join
-        possible = farther[np.bincount(window.reshape(-1), minlength=count + 1)[farther] >= rules.min_points]
+        possible = farther[window_counts(window, count)[farther] >= rules.min_points]
         if possible.size < 2:
             continue  # fewer than two farther objects near this one
         if touching is None:
@@ -118,7 +125,7 @@ def join_occluded(
         near = shadowed_near(occluding, unmeasured[y0:y1, x0:x1], 3 * rules.band, rules.band)
         # the farther objects with enough pixels near the occluder; two of them must be apart to join anything
         near_pixels, near_starts = grouped_pixels(window, near, count)
-        band_sizes = np.diff(near_starts)
+        band_sizes = near_starts[1:] - near_starts[:-1]
         candidates = _apart_from_another(farther[band_sizes[farther] >= rules.min_points].tolist(), touching)
         if len(candidates) < 2:
             continue
@@ -131,13 +138,11 @@ def join_occluded(
             )
             if facing < rules.min_points:
                 continue  # too few of the occluder's pixels within reach of the band
-            if not depth_jump(np.float32(piece_depth), np.float32(occluder_depth), absolute, relative):
+            if not jump_between(piece_depth, occluder_depth, absolute, relative):
                 continue
             if piece_depth <= occluder_depth or xyz.shape[0] < rules.min_points:
                 continue
-            band_normals, section = flat_normals[flat], flat_plane[flat]
-            band_normals = band_normals[np.isfinite(band_normals).all(axis=1)]
-            section = section[np.isfinite(section).all(axis=1)]
+            band_normals, section = finite_rows(flat_normals, flat), finite_rows(flat_plane, flat)
             behind.append(_Piece(piece, flat, xyz, centre, pixel, band_normals, section))
         for index, first in enumerate(behind):
             for second in behind[index + 1 :]:
@@ -161,15 +166,10 @@ def _coplanar(first: _Piece, second: _Piece, flat: float) -> bool:
     return bool(np.sqrt(max(smallest, 0.0)) <= flat)
 
 
-def _grown(box: tuple[slice, slice], shape: tuple[int, int], margin: int) -> tuple[int, int, int, int]:
-    """``(x0, y0, x1, y1)`` (exclusive) of a ``find_objects`` box, grown by ``margin`` and clipped to ``shape``."""
-    rows, cols = box
-    return (
-        max(cols.start - margin, 0),
-        max(rows.start - margin, 0),
-        min(cols.stop + margin, shape[1]),
-        min(rows.stop + margin, shape[0]),
-    )
+def _grown(box: list[int], shape: tuple[int, int], margin: int) -> tuple[int, int, int, int]:
+    """The box ``(x0, y0, x1, y1)`` (exclusive), grown by ``margin`` and clipped to ``shape``."""
+    x0, y0, x1, y1 = box
+    return max(x0 - margin, 0), max(y0 - margin, 0), min(x1 + margin, shape[1]), min(y1 + margin, shape[0])
 
 
 def _continues(first: _Piece, second: _Piece, rules: OcclusionRules) -> bool:
@@ -217,7 +217,13 @@ def _same_section(first: _Piece, second: _Piece, rules: OcclusionRules) -> bool:
 
 def _apart_from_another(labels: list[int], touching: set[tuple[int, int]]) -> list[int]:
     """The (increasing) ``labels`` that do not touch at least one of the others: only those can be joined."""
-    return [a for a in labels if any((min(a, b), max(a, b)) not in touching for b in labels if b != a)]
+    apart = []
+    for a in labels:
+        for b in labels:
+            if b != a and ((a, b) if a < b else (b, a)) not in touching:
+                apart.append(a)
+                break
+    return apart
 
 
 def _touching(labels: np.ndarray) -> set[tuple[int, int]]:

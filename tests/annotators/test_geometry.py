@@ -12,6 +12,9 @@ from annotators.geometry.boxes import object_box, principal_box, upright_box
 from annotators.geometry.grid_segmentation import (
     MergeRules,
     boundaries,
+    chroma_image,
+    color_edges,
+    distinct_keys,
     footprint_overlap,
     footprint_overlaps,
     heights_nest,
@@ -193,3 +196,24 @@ def test_footprint_overlaps_of_many_pairs_are_those_of_each_pair_alone() -> None
     assert shares[2] == 1.0  # the small square lies within the large one
     assert shares.tolist() == [footprint_overlap(a, b, 0.005) for a, b in zip(firsts, seconds, strict=True)]
     assert footprint_overlaps([], [], 0.005).shape == (0,)
+
+
+@pytest.mark.parametrize("size", [0, 1, 7, 3000])
+def test_distinct_keys_are_numpy_unique_with_inverse(size: int) -> None:
+    keys = np.repeat(np.random.default_rng(size).integers(0, 500, size), 3)[:size]  # runs, as along boundaries
+    unique, inverse = distinct_keys(keys)
+    expected, expected_inverse = np.unique(keys, return_inverse=True)
+    np.testing.assert_array_equal(unique, expected)
+    np.testing.assert_array_equal(inverse, expected_inverse)
+
+
+def test_color_edges_are_the_canny_edges_of_the_chroma_channels() -> None:
+    rng = np.random.default_rng(5)
+    colors = cv2.resize(rng.integers(0, 256, (12, 16, 3), dtype=np.uint8), (160, 120), interpolation=cv2.INTER_NEAREST)
+    colors = cv2.add(colors, rng.integers(0, 12, colors.shape, dtype=np.uint8))  # sensor noise
+    chroma = chroma_image(colors)
+    assert chroma.shape == (120, 160, 2)
+    with_constant = np.dstack([chroma, np.full((120, 160), 128, dtype=np.uint8)])  # a flat third channel adds none
+    edges = color_edges(colors, 40.0, 100.0)
+    np.testing.assert_array_equal(edges, cv2.Canny(with_constant, 40.0, 100.0) > 0)
+    assert edges.any()

@@ -5,17 +5,26 @@ from __future__ import annotations
 import cv2
 import numpy as np
 import pytest
+from scipy import sparse
+from scipy.sparse import csgraph
 
 from annotators.geometry.grid_kernels import (
     connected_parts,
     facing_values,
+    finite_rows,
+    graph_components,
     grouped_pixels,
+    jump_between,
     label_pixels,
+    nearest_seed_labels,
     shadowed_near,
+    strided_crop,
     symmetric_eigen,
     touching_keys,
+    unlabelled_box,
+    window_counts,
 )
-from annotators.geometry.grid_segmentation import depth_seams, grow_on_surface
+from annotators.geometry.grid_segmentation import bounding_box, depth_jump, depth_seams, grow_on_surface
 
 
 def _blobs(seed: int, shape: tuple[int, int] = (40, 50), labels: int = 6) -> np.ndarray:
@@ -63,6 +72,12 @@ def test_pixels_grouped_by_label_in_raster_order(seed: int) -> None:
         assert np.array_equal(all_pixels[all_starts[label] : all_starts[label + 1]], own)
         rows, cols = own // labels.shape[1], own % labels.shape[1]
         assert boxes[label].tolist() == [cols.min(), rows.min(), cols.max() + 1, rows.max() + 1]
+    grid = np.zeros((labels.shape[0] + 7, labels.shape[1] + 9), dtype=labels.dtype)
+    grid[5 : 5 + labels.shape[0], 3 : 3 + labels.shape[1]] = labels  # labels as a window of a larger grid
+    in_grid, grid_starts, window_boxes = label_pixels(labels, (5, 3), grid.shape[1])
+    expected, _, _ = label_pixels(grid)
+    assert np.array_equal(in_grid, expected) and np.array_equal(grid_starts, all_starts)
+    assert np.array_equal(window_boxes, boxes)
 
 
 def test_facing_values_are_the_dilated_band_on_the_target() -> None:
@@ -142,3 +157,88 @@ def test_grow_on_surface_takes_the_first_neighbour_on_the_same_surface() -> None
                         expected[r, c] = before[nr, nc]
                         break
     assert np.array_equal(grow_on_surface(labels, region, depth, 0.01, 0.01), expected)
+
+
+@pytest.mark.parametrize("seed", range(5))
+def test_graph_components_number_components_as_scipy_does(seed: int) -> None:
+    rng = np.random.default_rng(seed)
+    for _ in range(50):
+        count = int(rng.integers(1, 40))
+        pairs = rng.integers(0, count, (int(rng.integers(0, 40)), 2))
+        graph = sparse.csr_matrix((np.ones(pairs.shape[0]), (pairs[:, 0], pairs[:, 1])), shape=(count, count))
+        expected = csgraph.connected_components(graph, directed=False)[1]
+        np.testing.assert_array_equal(graph_components(pairs, count), expected)
+
+
+@pytest.mark.parametrize("seed", range(5))
+def test_nearest_seed_labels_give_what_the_numpy_lookup_gives(seed: int) -> None:
+    labels = _blobs(seed)
+    labels[labels == 3] = 0  # a large unlabelled area, partly beyond reach
+    unlabelled = (labels == 0) & (np.random.default_rng(seed).random(labels.shape) < 0.8)
+    seeds = labels > 0
+    distance, nearest = cv2.distanceTransformWithLabels(
+        (~seeds).view(np.uint8), cv2.DIST_L2, 3, labelType=cv2.DIST_LABEL_PIXEL
+    )
+    max_distance = 2.1  # not a float32 value: compared in float32, as numpy compares it
+    lookup = np.zeros(int(nearest.max()) + 1, dtype=labels.dtype)
+    lookup[nearest[seeds]] = labels[seeds]
+    reach = unlabelled & (distance <= max_distance)
+    expected = labels.copy()
+    expected[reach] = lookup[nearest[reach]]
+    grown = labels.copy()
+    nearest_seed_labels(labels, unlabelled, distance, nearest, max_distance, grown)
+    np.testing.assert_array_equal(grown, expected)
+    assert np.count_nonzero(grown != labels) > 0
+
+
+@pytest.mark.parametrize("seed", range(5))
+def test_unlabelled_box_is_the_box_of_the_unlabelled_region(seed: int) -> None:
+    labels = _blobs(seed)
+    region = np.zeros(labels.shape, dtype=bool)
+    region[5:30, 8 + seed : 40] = True
+    unlabelled, box, growing = unlabelled_box(labels, region, 3)
+    np.testing.assert_array_equal(unlabelled, region & (labels == 0))
+    assert growing
+    assert tuple(box.tolist()) == bounding_box(region & (labels == 0), margin=3)
+    assert not unlabelled_box(labels, np.zeros(labels.shape, dtype=bool), 3)[2]
+    assert not unlabelled_box(np.zeros_like(labels), region, 3)[2]
+
+
+def test_finite_rows_keep_the_rows_without_nan_or_inf_in_order() -> None:
+    rng = np.random.default_rng(0)
+    values = rng.normal(size=(200, 3)).astype(np.float32)
+    values[rng.random((200, 3)) < 0.1] = np.nan
+    values[7, 1] = np.inf
+    indices = rng.permutation(200)[:120]
+    expected = values[indices][np.isfinite(values[indices]).all(axis=1)]
+    found = finite_rows(values, indices)
+    np.testing.assert_array_equal(found, expected)
+    assert found.dtype == values.dtype and 0 < found.shape[0] < indices.size
+
+
+def test_jump_between_is_depth_jump_of_two_float32_depths() -> None:
+    rng = np.random.default_rng(2)
+    depths = rng.uniform(0.3, 2.0, (2000, 2))
+    depths[1::7, 1] = depths[1::7, 0] * (1 + rng.uniform(0.0, 0.03, depths[1::7].shape[0]))  # near the threshold
+    depths[5, 0] = np.nan
+    for z_a, z_b in depths:
+        expected = depth_jump(np.float32(z_a), np.float32(z_b), 0.02, 0.01)
+        assert jump_between(z_a, z_b, 0.02, 0.01) == bool(expected)
+
+
+def test_window_counts_count_the_labels_of_a_window_in_place() -> None:
+    labels = _blobs(4)
+    window = labels[3:30:2, 5:41]
+    counts = window_counts(window, int(labels.max()))
+    np.testing.assert_array_equal(counts, np.bincount(window.reshape(-1), minlength=int(labels.max()) + 1))
+
+
+@pytest.mark.parametrize("channels", [0, 3])
+def test_strided_crop_is_the_contiguous_copy_of_the_subsampled_window(channels: int) -> None:
+    shape = (47, 61, channels) if channels else (47, 61)
+    values = np.random.default_rng(channels).random(shape).astype(np.float32)
+    values[3, 4] = np.nan
+    crop = strided_crop(values, 2, (3, 1, 29, 22))
+    expected = np.ascontiguousarray(values[::2, ::2][1:22, 3:29])
+    np.testing.assert_array_equal(crop, expected)
+    assert crop.shape == expected.shape and crop.flags.c_contiguous
