@@ -135,9 +135,9 @@ def segment_clutter(
     normals = grid_normals(grid, p.normal_step, p.normal_smoothing, p.jump_absolute, p.jump_relative)
     surfaces = label_parts(region & ~seams, 1)
     patches = split_by_normals(grid_patches(surfaces, p.cell), normals, p.normal_spread)
-    labels, _ = convex_groups(patches, grid, p.convexity_rules(), region & ~seams)
     # patches without a trustworthy plane (a face seen edge-on, a few points) go with the object beside them
-    labels = grow_labels(labels, region & ~seams, max(2.0 * p.cell, p.grow_distance / step))
+    reach = max(2.0 * p.cell, p.grow_distance / step)
+    labels, _ = convex_groups(patches, grid, p.convexity_rules(), region & ~seams, grow=reach)
     labels = grow_on_surface(labels, region, depth, p.jump_absolute, p.jump_relative)
     basis = plane_basis(np.asarray(model[:3], dtype=np.float64)).T.astype(np.float32)
     to_plane = np.column_stack([basis, np.asarray(model[:3], dtype=np.float32)])

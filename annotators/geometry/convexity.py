@@ -28,9 +28,10 @@ from annotators.geometry.grid_kernels import (
 )
 from annotators.geometry.grid_segmentation import (
     distinct_keys,
-    grow_labels,
+    grow_from_seeds,
     join_unless_apart,
     pixel_footprint,
+    seed_distances,
     touching_pairs,
 )
 
@@ -169,6 +170,7 @@ def convex_groups(
     points: np.ndarray,
     rules: ConvexityRules,
     between: np.ndarray | None = None,
+    grow: float = 0.0,
 ) -> tuple[np.ndarray, np.ndarray]:
     """Object labels and face labels (int32, 0 = none, 1..n) from surface patches in two steps.
 
@@ -185,6 +187,9 @@ def convex_groups(
     pixels between them that ``between`` allows (HxW bool; default: every pixel with a point) and their centroids
     are close in 3-D (:func:`close_in_space`). Patches without a trustworthy plane (fewer than ``rules.min_patch``
     points, thicker than ``rules.max_thickness`` or narrower than ``rules.min_width``) are left out (0).
+    With ``grow`` > 0 the object labels are grown by up to ``grow`` pixels into the unlabelled pixels of ``between``
+    (what :func:`~annotators.geometry.grid_segmentation.grow_labels` gives), from the distance transform of the
+    gap growth (the objects cover the kept patches' pixels).
     """
     planes = patch_planes(patches, points)
     count = planes.counts.size + 1
@@ -192,14 +197,18 @@ def convex_groups(
     usable = np.concatenate([[False], (planes.counts >= rules.min_patch) & trusted])
     kept = np.where(usable[patches], patches, 0)
     between = np.isfinite(points[..., 2]) if between is None else between
-    pairs = touching_pairs(grow_labels(kept, between | (kept > 0), rules.gap_width))
+    seeds = seed_distances(kept, between | (kept > 0), max(rules.gap_width, grow))
+    pairs = touching_pairs(grow_from_seeds(kept, seeds, rules.gap_width))
     pairs = pairs[close_in_space(patches, planes, pairs, pixel_footprint(points), rules.close_factor)]
     parallel, in_planes = _alignment(planes, pairs, rules.smooth_degrees)
     concave = connection_bending(planes, pairs) < -rules.concave_bending
     continuous = parallel & in_planes & ~concave
     faces = _components(pairs[continuous], count)
     objects = _join_faces(faces, pairs, ~concave & (continuous | ~parallel), concave, planes, rules)
-    return _dense(objects[faces], usable)[kept], _dense(faces, usable)[kept]
+    labels = _dense(objects[faces], usable)[kept]
+    if grow > 0:
+        labels = grow_from_seeds(labels, seeds, grow)
+    return labels, _dense(faces, usable)[kept]
 
 
 def _alignment(planes: PatchPlanes, pairs: np.ndarray, degrees: float) -> tuple[np.ndarray, np.ndarray]:

@@ -98,19 +98,53 @@ def grow_labels(labels: np.ndarray, region: np.ndarray, max_distance: float) -> 
     can lie (its 3x3 chamfer distance is at least 0.955 times the larger coordinate difference), so every pixel
     it gives a label sees the same seeds and paths as on the whole grid.
     """
+    return grow_from_seeds(labels, seed_distances(labels, region, max_distance), max_distance)
+
+
+@dataclass(frozen=True)
+class SeedDistances:
+    """The distance transform :func:`grow_labels` runs, kept to grow other labels on the same labelled pixels:
+    the unlabelled pixels of the region (HxW bool), the box ``(x0, y0, x1, y1)`` the transform covers, and per
+    pixel of the box the distance to and the index of the nearest labelled pixel (OpenCV's pixel labels)."""
+
+    unlabelled: np.ndarray
+    box: tuple[int, int, int, int]
+    distance: np.ndarray
+    nearest: np.ndarray
+
+
+def seed_distances(labels: np.ndarray, region: np.ndarray, max_distance: float) -> SeedDistances | None:
+    """The distance transform :func:`grow_labels` runs to grow ``labels`` into ``region`` by up to ``max_distance``
+    px; None when nothing can grow (no unlabelled pixel of the region, or no labelled pixel within its box)."""
     unlabelled, box, growing = unlabelled_box(labels, region, int(np.ceil(max_distance / 0.95)) + 2)
     if not growing:
-        return labels
+        return None
     x0, y0, x1, y1 = box.tolist()
-    window = labels[y0:y1, x0:x1]
-    seeds = window > 0
+    seeds = labels[y0:y1, x0:x1] > 0
     if not seeds.any():
-        return labels
+        return None
     distance, nearest = cv2.distanceTransformWithLabels(
         (~seeds).view(np.uint8), cv2.DIST_L2, 3, labelType=cv2.DIST_LABEL_PIXEL
     )
+    return SeedDistances(unlabelled, (x0, y0, x1, y1), distance, nearest)
+
+
+def grow_from_seeds(labels: np.ndarray, seeds: SeedDistances | None, max_distance: float) -> np.ndarray:
+    """:func:`grow_labels` from a transform :func:`seed_distances` made for labels with the same labelled pixels
+    as ``labels`` (any label values) and a ``max_distance`` at least this one: a box that covers every seed within
+    the farther reach covers those within the nearer one, so the labels grow as on the whole grid."""
+    if seeds is None:
+        return labels
+    x0, y0, x1, y1 = seeds.box
     grown = labels.copy()
-    nearest_seed_labels(window, unlabelled[y0:y1, x0:x1], distance, nearest, max_distance, grown[y0:y1, x0:x1])
+    nearest_seed_labels(
+        labels[y0:y1, x0:x1],
+        seeds.unlabelled[y0:y1, x0:x1],
+        seeds.distance,
+        seeds.nearest,
+        max_distance,
+        grown[y0:y1, x0:x1],
+    )
     return grown
 
 

@@ -10,6 +10,7 @@ from annotators.cloud.clutter import segment_clutter
 from annotators.cloud.filters import range_mask
 from annotators.cloud.plane import ransac_support_plane
 from annotators.geometry.convexity import dense_labels
+from annotators.geometry.grid_segmentation import grow_from_seeds, grow_labels, seed_distances
 
 Box = tuple[tuple[float, float, float], tuple[float, float, float]]  # (size, corner)
 
@@ -78,3 +79,19 @@ def test_every_box_is_one_segment_whether_apart_touching_or_stacked(name: str) -
 def test_dense_labels_number_present_keys_in_order() -> None:
     keys = np.array([[0, 7, 7], [30, 0, 2]])
     assert dense_labels(keys).tolist() == [[0, 2, 2], [3, 0, 1]]
+
+
+@pytest.mark.parametrize("seed", range(4))
+def test_labels_grow_alike_from_a_transform_made_for_a_farther_reach(seed: int) -> None:
+    rng = np.random.default_rng(seed)
+    labels = np.zeros((120, 160), dtype=np.int32)  # blocky parts with gaps, away from the grid's border
+    coarse = rng.integers(0, 6, (12, 16))
+    labels[30:78, 40:104] = np.kron(coarse, np.ones((4, 4), dtype=np.int64)).astype(np.int32)
+    labels[rng.random(labels.shape) < 0.15] = 0
+    region = np.zeros(labels.shape, dtype=bool)  # the transforms' boxes differ with the reach
+    region[20:88, 30:114] = rng.random((68, 84)) < 0.8
+    renamed = np.where(labels > 0, rng.permutation(np.arange(1, 7))[labels - 1] + 10, 0).astype(np.int32)
+    for near, far in ((2.0, 12.0), (3.0, 3.0), (1.5, 7.0)):
+        expected = grow_labels(renamed, region, near)
+        assert np.array_equal(grow_from_seeds(renamed, seed_distances(labels, region, far), near), expected)
+        assert np.count_nonzero(expected) > np.count_nonzero(renamed)  # something grew
