@@ -125,14 +125,19 @@ def upsampled_labels(
     absolute32, relative32 = np.float32(absolute), np.float32(relative)
     fine = np.zeros((rows, cols), dtype=np.int32)
     for r in range(rows):
-        for c in range(cols):
-            label = labels[r // step, c // step]
-            if label == 0 or not keep[r, c]:
+        coarse_row = r // step
+        for coarse_col in range((cols + step - 1) // step):  # cell by cell: an unlabelled cell is skipped whole
+            label = labels[coarse_row, coarse_col]
+            if label == 0:
                 continue
-            z, sample = depth[r, c], coarse_depth[r // step, c // step]
-            nearer = sample if np.isnan(z) else (z if np.isnan(sample) else min(z, sample))
-            if not abs(z - sample) > nearer * relative32 + absolute32:
-                fine[r, c] = label
+            sample = coarse_depth[coarse_row, coarse_col]
+            for c in range(coarse_col * step, min(coarse_col * step + step, cols)):
+                if not keep[r, c]:
+                    continue
+                z = depth[r, c]
+                nearer = sample if np.isnan(z) else (z if np.isnan(sample) else min(z, sample))
+                if not abs(z - sample) > nearer * relative32 + absolute32:
+                    fine[r, c] = label
     return fine
 
 

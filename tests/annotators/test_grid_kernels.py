@@ -23,6 +23,7 @@ from annotators.geometry.grid_kernels import (
     symmetric_eigen,
     touching_keys,
     unlabelled_box,
+    upsampled_labels,
     window_counts,
 )
 from annotators.geometry.grid_segmentation import bounding_box, depth_jump, depth_seams, grow_on_surface
@@ -265,3 +266,20 @@ def test_row_step_middle_are_the_middle_steps_numpy_partitions_out(dtype: type) 
             continue
         ordered = np.partition(steps, ((steps.size - 1) // 2, steps.size // 2))
         assert middle.tolist() == [ordered[(steps.size - 1) // 2], ordered[steps.size // 2]]
+
+
+@pytest.mark.parametrize("step", [1, 2, 3])
+def test_upsampled_labels_keep_the_cell_label_where_no_depth_jump_parts_them(step: int) -> None:
+    rng = np.random.default_rng(step)
+    rows, cols = 37, 53  # not multiples of the step: the last cells are cut
+    labels = _blobs(step, ((rows + step - 1) // step, (cols + step - 1) // step))
+    coarse_depth = rng.uniform(0.5, 1.5, labels.shape).astype(np.float32)
+    depth = (np.kron(coarse_depth, np.ones((step, step), dtype=np.float32))[:rows, :cols]
+             + rng.normal(0.0, 0.02, (rows, cols)).astype(np.float32))  # fmt: skip
+    depth[rng.random(depth.shape) < 0.05] = np.nan
+    coarse_depth[rng.random(coarse_depth.shape) < 0.05] = np.nan
+    keep = rng.random((rows, cols)) < 0.8
+    cell_rows, cell_cols = np.arange(rows)[:, None] // step, np.arange(cols)[None, :] // step
+    jump = depth_jump(depth, coarse_depth[cell_rows, cell_cols], 0.01, 0.01)
+    expected = np.where(keep & ~jump, labels[cell_rows, cell_cols], 0)
+    assert np.array_equal(upsampled_labels(labels, coarse_depth, depth, keep, step, 0.01, 0.01), expected)
