@@ -267,13 +267,6 @@ def window_counts(labels: np.ndarray, count: int) -> np.ndarray:
     return _loops().window_counts(labels, count)
 
 
-def row_step_middle(points: np.ndarray) -> np.ndarray:
-    """The two middle values (``(n - 1) // 2``-th and ``n // 2``-th smallest, in the points' dtype; empty when
-    n = 0) of the n finite, positive steps ``|x/z - x'/z'|`` between horizontally adjacent points of the HxWx3
-    organized ``points`` (any strides): what ``np.partition`` of the steps ``np.diff`` gives, in one pass."""
-    return _loops().row_step_middle(points)
-
-
 def strided_crop(values: np.ndarray, step: int, box: tuple[int, int, int, int]) -> np.ndarray:
     """``np.ascontiguousarray(values[::step, ::step][y0:y1, x0:x1])`` of HxW or HxWxC ``values`` for the ``box``
     ``(x0, y0, x1, y1)`` (exclusive, within the subsampled grid), in one pass."""

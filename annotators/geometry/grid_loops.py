@@ -806,31 +806,3 @@ def strided_crop(values: np.ndarray, step: int, x0: int, y0: int, x1: int, y1: i
             for k in range(channels):
                 crop[r, c, k] = values[(r + y0) * step, (c + x0) * step, k]
     return crop
-
-
-@njit(cache=True, nogil=True, error_model="numpy")
-def row_step_middle(points: np.ndarray) -> np.ndarray:
-    """See :func:`annotators.geometry.grid_kernels.row_step_middle`."""
-    rows, cols = points.shape[0], points.shape[1]
-    steps = np.empty(rows * max(cols - 1, 0), dtype=points.dtype)
-    count = 0
-    for r in range(rows):
-        before = points[r, 0, 0] / points[r, 0, 2]
-        for c in range(1, cols):
-            ratio = points[r, c, 0] / points[r, c, 2]
-            step = abs(ratio - before)
-            before = ratio
-            if np.isfinite(step) and step > 0:
-                steps[count] = step
-                count += 1
-    middle = np.empty(0, dtype=points.dtype)
-    if count == 0:
-        return middle
-    low, high = (count - 1) // 2, count // 2
-    ordered = np.partition(steps[:count], high)
-    middle = np.empty(2, dtype=points.dtype)
-    middle[1] = ordered[high]
-    middle[0] = ordered[high]
-    if low < high:
-        middle[0] = ordered[:high].max()
-    return middle

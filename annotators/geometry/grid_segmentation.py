@@ -17,7 +17,6 @@ from annotators.geometry.grid_kernels import (
     boundary_pairs,
     connected_parts,
     nearest_seed_labels,
-    row_step_middle,
     seam_pixels,
     surface_growth,
     touching_keys,
@@ -522,8 +521,11 @@ class Boundaries:
 
 def pixel_footprint(points: np.ndarray) -> float:
     """The angle (radians) between horizontally adjacent pixels of an organized cloud: ``step / fx``."""
-    middle = row_step_middle(points)
-    return float((middle[0] + middle[1]) / middle.dtype.type(2)) if middle.size else 0.0
+    with np.errstate(invalid="ignore", divide="ignore"):
+        ratio = points[..., 0] / points[..., 2]
+        steps = np.abs(np.diff(ratio, axis=1))
+    steps = steps[np.isfinite(steps) & (steps > 0)]
+    return float(_median(steps)) if steps.size else 0.0
 
 
 def boundaries(

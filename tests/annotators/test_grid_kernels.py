@@ -17,7 +17,6 @@ from annotators.geometry.grid_kernels import (
     jump_between,
     label_pixels,
     nearest_seed_labels,
-    row_step_middle,
     shadowed_near,
     strided_crop,
     symmetric_eigen,
@@ -244,28 +243,6 @@ def test_strided_crop_is_the_contiguous_copy_of_the_subsampled_window(channels: 
     expected = np.ascontiguousarray(values[::2, ::2][1:22, 3:29])
     np.testing.assert_array_equal(crop, expected)
     assert crop.shape == expected.shape and crop.flags.c_contiguous
-
-
-@pytest.mark.parametrize("dtype", [np.float32, np.float64])
-def test_row_step_middle_are_the_middle_steps_numpy_partitions_out(dtype: type) -> None:
-    rng = np.random.default_rng(3)
-    for _ in range(200):
-        points = rng.normal(size=(int(rng.integers(1, 9)), int(rng.integers(1, 9)), 3)).astype(dtype)
-        points[rng.random(points.shape) < 0.2] = np.nan
-        points[..., 2][rng.random(points.shape[:2]) < 0.1] = 0.0
-        points[..., 0][rng.random(points.shape[:2]) < 0.1] = np.inf
-        window = points[:, ::-1] if rng.random() < 0.5 else points  # any strides
-        with np.errstate(invalid="ignore", divide="ignore"):
-            points[:, 1::2, 0] = points[:, :-1:2, 0] * (points[:, 1::2, 2] / points[:, :-1:2, 2])  # equal ratios
-            steps = np.abs(np.diff(window[..., 0] / window[..., 2], axis=1))
-        steps = steps[np.isfinite(steps) & (steps > 0)]
-        middle = row_step_middle(window)
-        assert middle.dtype == dtype
-        if steps.size == 0:
-            assert middle.size == 0
-            continue
-        ordered = np.partition(steps, ((steps.size - 1) // 2, steps.size // 2))
-        assert middle.tolist() == [ordered[(steps.size - 1) // 2], ordered[steps.size // 2]]
 
 
 @pytest.mark.parametrize("step", [1, 2, 3])
