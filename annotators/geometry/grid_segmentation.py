@@ -547,8 +547,8 @@ def boundaries(
     footprint = pixel_footprint(points)
     key, jump, near, dot, convexity = boundary_pairs(
         np.ascontiguousarray(labels),
-        np.ascontiguousarray(points, dtype=np.float32),
-        np.ascontiguousarray(normals, dtype=np.float32),
+        np.asarray(points, dtype=np.float32),  # a window of a larger grid is read in place, not copied
+        np.asarray(normals, dtype=np.float32),
         reach,
         absolute,
         relative,
