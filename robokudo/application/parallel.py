@@ -4,9 +4,12 @@ Used by ``robokudo eval ... --workers N [--address ...]``: each scene is a Ray t
 cluster (default) or the one at the address, with a progress bar on a terminal. The tasks run the same code as
 the sequential loop, so the figures are the same. An exception a task raises is raised here as itself.
 
-The tasks run in a placement group of N one-CPU bundles, so at most N run at once on any cluster, and twice as
-many are handed to Ray as run: the next item is waiting on a worker's node when its task ends (no round trip
-to this process between two items). Ray reuses its worker processes, so each loads the code once.
+On a given cluster (``--address``, which may grow) or a local one with more CPUs than N the tasks run in a
+placement group of N one-CPU bundles, so at most N run at once; on a local cluster of N CPUs or fewer (the one
+``--workers N`` starts) one-CPU tasks cannot run more than N at once anyway, and no group is made: Ray returns
+a removed group's resources asynchronously, so a group made right after another waits 0.5-1 s for them. Twice
+as many tasks are handed to Ray as run: the next item is waiting on a worker's node when its task ends (no round
+trip to this process between two items). Ray reuses its worker processes, so each loads the code once.
 """
 
 from __future__ import annotations
@@ -51,13 +54,17 @@ def map_on_cluster(
     label: str = "",
     purpose: str = "running tasks on a cluster",
 ) -> list[R]:
-    """``function(item, *extra)`` for each item as Ray tasks, at most ``workers`` at once (a placement group of
-    ``workers`` one-CPU bundles), on the cluster at
+    """``function(item, *extra)`` for each item as Ray tasks, at most ``workers`` at once (one CPU each, and a
+    placement group of ``workers`` one-CPU bundles on a given cluster or a bigger one), on the cluster at
     ``address`` (None: a local one with ``workers`` CPUs); the results in the items' order. The task's own
     exception when one fails; ClusterError without Ray (``PURPOSE needs Ray``) or a cluster."""
     if workers < 1:
         raise ValueError(f"workers must be at least 1, got {workers}")
     with ray_cluster(address, num_cpus=workers, purpose=purpose) as ray:
+        shared = [ray.put(value) for value in extra]
+        if address is None and ray.cluster_resources().get("CPU", 0.0) <= workers:  # a given cluster may grow
+            task = ray.remote(function).options(num_cpus=1, max_retries=RETRIES)
+            return _in_order(ray, task, items, shared, 2 * workers, label)
         from ray.util.placement_group import placement_group, remove_placement_group
         from ray.util.scheduling_strategies import PlacementGroupSchedulingStrategy
 
@@ -67,7 +74,7 @@ def map_on_cluster(
             task = ray.remote(function).options(
                 num_cpus=1, max_retries=RETRIES, scheduling_strategy=PlacementGroupSchedulingStrategy(group)
             )
-            return _in_order(ray, task, items, [ray.put(value) for value in extra], 2 * workers, label)
+            return _in_order(ray, task, items, shared, 2 * workers, label)
         finally:
             remove_placement_group(group)
 

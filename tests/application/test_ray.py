@@ -11,6 +11,7 @@ missing Ray fails them. The messages the options give without Ray are tested by 
 from __future__ import annotations
 
 import contextlib
+import itertools
 import json
 import logging
 import os
@@ -32,6 +33,7 @@ from py_trees.common import Status
 
 from annotators.image.color import SemanticColorAnnotator
 from robokudo.application import cli
+from robokudo.application.parallel import map_on_cluster
 from robokudo.core import compiled_call
 from robokudo.core.annotator import Annotator
 from robokudo.core.cas import CAS
@@ -383,6 +385,19 @@ def figures(capsys: pytest.CaptureFixture[str], *argv: str) -> dict:
     for scene in document["scenes"]:
         assert scene.pop("milliseconds") >= 0  # a time, measured where the scene ran
     return document
+
+
+def nap(seconds: float) -> tuple[float, float]:
+    """A task that sleeps, returning when it started and ended (CLOCK_MONOTONIC: one clock for all processes)."""
+    start = time.monotonic()
+    time.sleep(seconds)
+    return start, time.monotonic()
+
+
+def test_fewer_workers_than_the_cluster_has_cpus_run_one_task_at_a_time(cluster: ModuleType) -> None:
+    """The 2-CPU cluster could run two one-CPU tasks at once; ``workers=1`` holds it to one (a placement group)."""
+    spans = sorted(map_on_cluster(nap, [0.2] * 4, workers=1))
+    assert all(end <= next_start for (_, end), (next_start, _) in itertools.pairwise(spans))
 
 
 @pytest.mark.real_data
