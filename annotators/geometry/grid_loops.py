@@ -9,6 +9,17 @@ from numba import njit
 
 
 @njit(cache=True, nogil=True)
+def _looked_up(table: np.ndarray, keys: np.ndarray) -> np.ndarray:
+    """HxW int32: ``table[keys[r, c]]`` at every pixel (a renumbering of HxW ``keys``)."""
+    rows, cols = keys.shape
+    labels = np.empty((rows, cols), dtype=np.int32)
+    for r in range(rows):
+        for c in range(cols):
+            labels[r, c] = table[keys[r, c]]
+    return labels
+
+
+@njit(cache=True, nogil=True)
 def touching_keys(labels: np.ndarray, base: int) -> np.ndarray:
     """See :func:`annotators.geometry.grid_kernels.touching_keys`."""
     keys = np.empty(2 * labels.size, dtype=np.int64)
@@ -517,11 +528,7 @@ def connected_parts(region: np.ndarray, min_points: int) -> np.ndarray:
         if parent[label] == label and sizes[label] >= min_points:
             number += 1
             final[label] = number
-    labels = np.empty((rows, cols), dtype=np.int32)
-    for r in range(rows):
-        for c in range(cols):
-            labels[r, c] = final[provisional[r, c]]
-    return labels
+    return _looked_up(final, provisional)
 
 
 @njit(cache=True, nogil=True)
@@ -668,11 +675,7 @@ def dense_keys(keys: np.ndarray) -> np.ndarray:
         if number[key]:
             count += 1
             number[key] = count
-    labels = np.empty((rows, cols), dtype=np.int32)
-    for r in range(rows):
-        for c in range(cols):
-            labels[r, c] = number[keys[r, c]]
-    return labels
+    return _looked_up(number, keys)
 
 
 @njit(cache=True, nogil=True)
