@@ -40,7 +40,13 @@ from a plastic one still say bowl). Otherwise the query's class (``expected``) m
 a match of that class that fits and scores as high as the best fitting one (within ``margin``: equal but for
 rounding, so the cues cannot tell the two classes apart) is asserted with its own
 (low) calibrated probability - the query never lifts a poor fit (a class named by printed text fits only when its
-text was read; the root class breaks no tie). Everything
+text was read; the root class breaks no tie), and it decides only what the cues cannot tell, not what a form cue
+measured without full confidence may still tell: the pick must stay the best fitting class (within ``margin``)
+however the unsettled form cues (said with confidence below 1) turn out (:func:`cue_outcomes`): the open top as the
+form expert said it, and the handle either way, as a view hides or shows it by chance. A mug whose handle the form
+expert could not make out ties with a cup, but its handle seen would make it a mug, so "find a cup" does not answer
+it; nor is a can seen closed, though not surely, and with a handle, though not surely, a mug for "find all mugs"
+(the closed top made sure would make it a can). Everything
 else is classified :data:`UNKNOWN_CLASS` ("unknown object") with confidence 1 - probability (how sure the
 classifier is that naming the best candidate would be wrong).
 """
@@ -49,7 +55,7 @@ from __future__ import annotations
 
 import re
 from collections.abc import Mapping, Sequence
-from dataclasses import dataclass
+from dataclasses import dataclass, replace
 from types import MappingProxyType
 from typing import ClassVar
 
@@ -326,6 +332,33 @@ def choose_expected(matches: Sequence[Match], expected: str, min_score: float, m
     return max(candidates, key=lambda m: (m.score, -len(m.profile.ancestors)), default=None)
 
 
+def cue_outcomes(cues: Cues) -> list[Cues]:
+    """The ways the unsettled form cues (said with confidence below 1) could turn out. A handle is what a view hides
+    or shows by chance: as the form expert said it, with full confidence, and the other way with the confidence it
+    left (1 - its confidence). An open top is seen from the same view either way: as said, with full confidence.
+    None for settled or missing cues."""
+    outcomes = []
+    if cues.handle is not None and cues.handle[1] < 1.0:
+        seen, confidence = bool(cues.handle[0]), max(float(cues.handle[1]), 0.0)
+        outcomes += [replace(cues, handle=(seen, 1.0)), replace(cues, handle=(not seen, 1.0 - confidence))]
+    if cues.open_top is not None and cues.open_top[1] < 1.0:
+        outcomes.append(replace(cues, open_top=(bool(cues.open_top[0]), 1.0)))
+    return outcomes
+
+
+def holds_up(pick: Match, outcomes: Sequence[Sequence[Match]], min_score: float, margin: float) -> bool:
+    """True when ``pick``'s class stays within ``margin`` of every fitting class not related to it in each of the
+    ``outcomes`` (the matches of the same profiles under each way the unsettled cues could turn out)."""
+    for matches in outcomes:
+        own = next(m.score for m in matches if m.profile == pick.profile)
+        rivals = [
+            m.score for m in matches if m.score >= min_score and not m.unread and not m.profile.related(pick.profile)
+        ]
+        if rivals and max(rivals) > own + margin:
+            return False
+    return True
+
+
 @dataclass(frozen=True)
 class Decision:
     """What the classifier says about one hypothesis and why.
@@ -352,8 +385,11 @@ def decide(
     expected: str | None = None,
     calibration: Calibration = FITTED,
     assert_probability: float = ASSERT_PROBABILITY,
+    outcomes: Sequence[Sequence[Match]] = (),
 ) -> Decision:
-    """The class of one hypothesis from its matches (see the module docstring); ValueError without matches."""
+    """The class of one hypothesis from its matches (see the module docstring); ValueError without matches.
+    ``outcomes`` are the matches of the same profiles under each way the unsettled form cues could turn out
+    (:func:`cue_outcomes`): the query's class decides only when it holds up in all of them."""
     if not matches:
         raise ValueError("no profile matches to decide from")
     best = best_match(matches)
@@ -377,6 +413,16 @@ def decide(
         )
     if expected:
         pick = choose_expected(matches, expected, min_score, margin)
+        if pick is not None and not holds_up(pick, outcomes, min_score, margin):
+            return Decision(
+                UNKNOWN_CLASS,
+                1.0 - p,
+                best,
+                best_lead,
+                p,
+                f"{pick.profile.class_name} fits (score {pick.score:.2f}) as well as any other class, but an unsettled "
+                f"form cue could make another class fit better: the query's class does not decide",
+            )
         if pick is not None:
             pick_lead = lead(pick, matches)
             return Decision(
@@ -444,7 +490,10 @@ class KnowledgeClassifier(Annotator):
     def decide(self, cues: Cues) -> Decision:
         """The decision for one hypothesis' cues with this classifier's profiles and parameters."""
         matches = [score(profile, cues) for profile in self.profiles]
-        return decide(matches, min_score=self.min_score, margin=self.margin, expected=self.expected)
+        outcomes = (
+            [[score(profile, c) for profile in self.profiles] for c in cue_outcomes(cues)] if self.expected else []
+        )
+        return decide(matches, min_score=self.min_score, margin=self.margin, expected=self.expected, outcomes=outcomes)
 
     def analyse(self) -> None:
         """Attach a Classification to every hypothesis that carries cues: its class when one fits clearly, else
