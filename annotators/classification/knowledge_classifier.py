@@ -40,13 +40,13 @@ from a plastic one still say bowl). Otherwise the query's class (``expected``) m
 a match of that class that fits and scores as high as the best fitting one (within ``margin``: equal but for
 rounding, so the cues cannot tell the two classes apart) is asserted with its own
 (low) calibrated probability - the query never lifts a poor fit (a class named by printed text fits only when its
-text was read; the root class breaks no tie), and it decides only what the cues cannot tell, not what a form cue
-measured without full confidence may still tell: the pick must stay the best fitting class (within ``margin``)
-however the unsettled form cues (said with confidence below 1) turn out (:func:`cue_outcomes`): the open top as the
-form expert said it, and the handle either way, as a view hides or shows it by chance. A mug whose handle the form
-expert could not make out ties with a cup, but its handle seen would make it a mug, so "find a cup" does not answer
-it; nor is a can seen closed, though not surely, and with a handle, though not surely, a mug for "find all mugs"
-(the closed top made sure would make it a can). Everything
+text was read; the root class breaks no tie), and it decides only what the form cues leave open: no settled form
+cue (said with confidence 1) may speak against it - a mug seen surely closed is no mug, whatever else ties with it -
+and it must stay the best fitting class (within ``margin``) however the unsettled ones turn out
+(:func:`cue_outcomes`): the open top as the form expert said it, and the handle either way, as a view hides or shows
+it by chance. A mug whose handle the form expert could not make out ties with a cup, but its handle seen would make
+it a mug, so "find a cup" does not answer it; nor is half a bowl, flaring like a handle, a mug for "find all mugs"
+(surely without a handle it would be a cup). Everything
 else is classified :data:`UNKNOWN_CLASS` ("unknown object") with confidence 1 - probability (how sure the
 classifier is that naming the best candidate would be wrong).
 """
@@ -346,13 +346,34 @@ def cue_outcomes(cues: Cues) -> list[Cues]:
     return outcomes
 
 
-def holds_up(pick: Match, outcomes: Sequence[Sequence[Match]], min_score: float, margin: float) -> bool:
-    """True when ``pick``'s class stays within ``margin`` of every fitting class not related to it in each of the
-    ``outcomes`` (the matches of the same profiles under each way the unsettled cues could turn out)."""
-    for matches in outcomes:
-        own = next(m.score for m in matches if m.profile == pick.profile)
+def contradicted(profile: Profile, cues: Cues) -> bool:
+    """True when a settled form cue (said with confidence 1) says what the profile rules out: an open top seen on a
+    closed class or the other way, a handle seen on a class without one (a handle not seen may be behind)."""
+    handle, open_top = cues.handle, cues.open_top
+    if handle is not None and handle[1] >= 1.0 and handle[0] and profile.handle is False:
+        return True
+    return (
+        open_top is not None and open_top[1] >= 1.0 and profile.open_top is not None and profile.open_top != open_top[0]
+    )
+
+
+def holds_up(pick: Match, matches: Sequence[Match], cues: Cues | None, min_score: float, margin: float) -> bool:
+    """True when the query may decide for ``pick``: however the unsettled form cues turn out (:func:`cue_outcomes`,
+    the same profiles as ``matches`` scored again), and as the settled ones are, no form cue rules its class out
+    (:func:`contradicted`) and it stays within ``margin`` of every fitting class not related to it; always without
+    ``cues``."""
+    if cues is None:
+        return True
+    if contradicted(pick.profile, cues):
+        return False
+    for outcome in cue_outcomes(cues):
+        if contradicted(pick.profile, outcome):
+            return False
+        own = score(pick.profile, outcome).score
         rivals = [
-            m.score for m in matches if m.score >= min_score and not m.unread and not m.profile.related(pick.profile)
+            m.score
+            for m in (score(match.profile, outcome) for match in matches)
+            if m.score >= min_score and not m.unread and not m.profile.related(pick.profile)
         ]
         if rivals and max(rivals) > own + margin:
             return False
@@ -385,11 +406,11 @@ def decide(
     expected: str | None = None,
     calibration: Calibration = FITTED,
     assert_probability: float = ASSERT_PROBABILITY,
-    outcomes: Sequence[Sequence[Match]] = (),
+    cues: Cues | None = None,
 ) -> Decision:
     """The class of one hypothesis from its matches (see the module docstring); ValueError without matches.
-    ``outcomes`` are the matches of the same profiles under each way the unsettled form cues could turn out
-    (:func:`cue_outcomes`): the query's class decides only when it holds up in all of them."""
+    With the ``cues`` the matches were scored on, the query's class decides only when it holds up against them
+    (:func:`holds_up`)."""
     if not matches:
         raise ValueError("no profile matches to decide from")
     best = best_match(matches)
@@ -413,15 +434,16 @@ def decide(
         )
     if expected:
         pick = choose_expected(matches, expected, min_score, margin)
-        if pick is not None and not holds_up(pick, outcomes, min_score, margin):
+        if pick is not None and not holds_up(pick, matches, cues, min_score, margin):
             return Decision(
                 UNKNOWN_CLASS,
                 1.0 - p,
                 best,
                 best_lead,
                 p,
-                f"{pick.profile.class_name} fits (score {pick.score:.2f}) as well as any other class, but an unsettled "
-                f"form cue could make another class fit better: the query's class does not decide",
+                f"{pick.profile.class_name} fits (score {pick.score:.2f}) as well as any other class, but a form cue "
+                f"speaks against it or, unsettled, could make another class fit better: the query's class does not "
+                f"decide",
             )
         if pick is not None:
             pick_lead = lead(pick, matches)
@@ -490,10 +512,7 @@ class KnowledgeClassifier(Annotator):
     def decide(self, cues: Cues) -> Decision:
         """The decision for one hypothesis' cues with this classifier's profiles and parameters."""
         matches = [score(profile, cues) for profile in self.profiles]
-        outcomes = (
-            [[score(profile, c) for profile in self.profiles] for c in cue_outcomes(cues)] if self.expected else []
-        )
-        return decide(matches, min_score=self.min_score, margin=self.margin, expected=self.expected, outcomes=outcomes)
+        return decide(matches, min_score=self.min_score, margin=self.margin, expected=self.expected, cues=cues)
 
     def analyse(self) -> None:
         """Attach a Classification to every hypothesis that carries cues: its class when one fits clearly, else

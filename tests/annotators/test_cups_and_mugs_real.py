@@ -4,8 +4,8 @@ A mug is told from a cup, a bowl and a can by its features (a handle, an open to
 query's class: the blue mug is ranked Mug by the classifier before any query names a class, the handle-less purple
 cup is not made a mug by "find the mug", "find the green mug" answers nothing on a table without one, the white
 mugs are seen open and a closed can is not made a cup by "find a cup". Nor does the query decide what an unsettled
-form cue may still tell: a mug whose handle the form expert cannot make out is no cup for "find a cup", and half a
-bowl is no mug for "find all mugs" (a handle seen or surely absent would decide). The
+form cue may still tell: a mug whose handle the form expert cannot make out is no cup for "find a cup"; half a bowl,
+or a can with a stray handle seen closed though not surely, is no mug for "find all mugs". The
 queries run through ``robokudo query`` on the frames in ../shared/data, read in place. Pixels are read off the
 colour images (tests/data/labels/real_objects.json labels the same objects).
 """
@@ -166,11 +166,14 @@ def test_find_a_cup_answers_no_mug_whose_handle_is_not_made_out(
 
 
 @pytest.mark.real_data
+@pytest.mark.parametrize("frame", [1, 3])
 def test_find_all_mugs_answers_the_blue_mug_and_no_bowl_can_or_box(
-    uoc_folder: Path, store: Path, capsys: pytest.CaptureFixture
+    uoc_folder: Path, store: Path, capsys: pytest.CaptureFixture, frame: int
 ) -> None:
-    objects = ask(capsys, store, "find all mugs", uoc_folder, 3)  # the teal bowl is cut in half by the can in it
-    assert covering(objects, BLUE_MUG[3]), objects
+    # frame 1: the soup can is cut with a neighbour that sticks out like a handle, its top seen closed though not
+    # surely; frame 3: the teal bowl is cut in half by the can in it, and its flaring side may be a handle
+    objects = ask(capsys, store, "find all mugs", uoc_folder, frame)
+    assert covering(objects, BLUE_MUG[frame]), objects
     assert all(o["class"]["label"] == "mug" for o in objects), objects
-    for name, pixel in NOT_MUGS[3].items():
+    for name, pixel in {**NOT_MUGS[frame], **CANS[frame]}.items():
         assert not covering(objects, pixel), name

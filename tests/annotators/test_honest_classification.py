@@ -19,6 +19,7 @@ from annotators.classification.knowledge_classifier import (
     Cues,
     KnowledgeClassifier,
     Profile,
+    contradicted,
     cue_outcomes,
     decide,
     score,
@@ -177,6 +178,21 @@ def test_the_query_does_not_decide_against_an_open_top_seen_closed() -> None:
     assert max(matches, key=lambda m: m.score).profile.class_name == "Mug"  # the handle outweighs the closed top
     assert form_decision(can, "Mug") == UNKNOWN_CLASS
     assert form_decision(replace(can, open_top=(True, 0.7)), "Mug") == "Mug"  # seen open: nothing speaks against it
+    # a handle surely seen ties it with a can, but closed for sure it would be no mug at all
+    assert form_decision(replace(can, handle=(True, 1.0)), "Mug") == UNKNOWN_CLASS
     settled_handle = replace(can, handle=(True, 1.0))
     assert cue_outcomes(settled_handle) == [replace(settled_handle, open_top=(False, 1.0))]
     assert cue_outcomes(replace(settled_handle, open_top=(False, 1.0))) == []  # settled cues have no other outcome
+
+
+def test_the_query_does_not_decide_for_a_class_a_settled_form_cue_rules_out() -> None:
+    # a handle and a closed top, both sure: a mug and a can fit equally badly, and the query makes it neither
+    odd = Cues(shape=("cylinder", 0.9), size=("small", 1.0), handle=(True, 1.0), open_top=(False, 1.0))
+    scores = {m.profile.class_name: m.score for m in (score(p, odd) for p in FORM_PROFILES)}
+    assert scores["Mug"] == pytest.approx(scores["CannedFood"])
+    assert form_decision(odd, "Mug") == UNKNOWN_CLASS
+    assert form_decision(odd, "CannedFood") == UNKNOWN_CLASS
+    # a handle not seen rules nothing out (it may be behind): a surely closed can without one is a can
+    can = replace(odd, handle=(False, 1.0))
+    assert form_decision(can, "CannedFood") == "CannedFood"
+    assert contradicted(FORM_PROFILES[0], replace(odd, open_top=(True, 1.0), handle=(False, 1.0))) is False
