@@ -2,7 +2,7 @@
 
 The planner passes one profile per candidate class as plain data::
 
-    {"class": "Milk", "colors": ("white",), "shape": "box", "size": ("medium",), "texts": ("milk",),
+    {"class": "Milk", "colors": ("white",), "shape": "box", "size": "medium", "texts": ("milk",),
      "handle": False, "open_top": False, "height_to_width": (1.2, 4.0),
      "ancestors": ("Milk", "Drink", "FoodOrDrink", "PhysicalObject")}
 
@@ -14,8 +14,7 @@ Scoring. For every cue the hypothesis carries (its most confident SemanticColor,
 when read, Text) a profile gets an agreement in [0, 1]:
 
 * colour / shape: 1 when the profile lists the observed value, 0 when it lists others, 0.5 when it says nothing;
-* size class: 1 when the profile lists it (a class may have several sizes: a can is small or medium), 0.25 when
-  the nearest listed is one class apart, 0 when two apart, 0.5 when the profile says nothing;
+* size class: 1 when equal, 0.25 when one class apart, 0 when two apart, 0.5 when the profile says nothing;
 * handle: 1 when both say there is one, 0 when one is seen on a class without, ``HANDLE_HIDDEN`` when none is
   seen on a class with one (it may be behind), ``NO_HANDLE`` when neither has one, 0.5 when the profile says
   nothing;
@@ -156,7 +155,7 @@ class Profile:
     class_name: str
     colors: tuple[str, ...] = ()
     shape: str | None = None
-    sizes: tuple[str, ...] = ()
+    size: str | None = None
     texts: tuple[str, ...] = ()
     ancestors: frozenset[str] = frozenset()
     handle: bool | None = None
@@ -176,7 +175,7 @@ class Profile:
             class_name=name,
             colors=_names(data.get("colors")),
             shape=shapes[0] if shapes else None,
-            sizes=sizes,
+            size=sizes[0] if sizes else None,
             texts=tuple(t for t in (compact(t) for t in _names(data.get("texts"))) if t),
             ancestors=frozenset(_names(data.get("ancestors"))) | {name.lower()},
             handle=_flag(data, "handle"),
@@ -222,11 +221,10 @@ def _value_agreement(observed: str, listed: Sequence[str]) -> float:
     return 0.5 if not listed else (1.0 if observed.lower() in listed else 0.0)
 
 
-def _size_agreement(observed: str, listed: Sequence[str]) -> float:
-    known = [SIZE_CLASSES.index(size) for size in listed if size in SIZE_CLASSES]
-    if not known or observed not in SIZE_CLASSES:
+def _size_agreement(observed: str, listed: str | None) -> float:
+    if listed is None or listed not in SIZE_CLASSES or observed not in SIZE_CLASSES:
         return 0.5
-    return (1.0, 0.25, 0.0)[min(abs(SIZE_CLASSES.index(observed) - size) for size in known)]
+    return (1.0, 0.25, 0.0)[abs(SIZE_CLASSES.index(observed) - SIZE_CLASSES.index(listed))]
 
 
 def _handle_agreement(seen: bool, listed: bool | None) -> float:
@@ -258,7 +256,7 @@ def score(profile: Profile, cues: Cues) -> Match:
         total += WEIGHTS["shape"] * _toward_neutral(_value_agreement(cues.shape[0], shapes), cues.shape[1])
         weight += WEIGHTS["shape"]
     if cues.size is not None:
-        total += WEIGHTS["size"] * _toward_neutral(_size_agreement(cues.size[0], profile.sizes), cues.size[1])
+        total += WEIGHTS["size"] * _toward_neutral(_size_agreement(cues.size[0], profile.size), cues.size[1])
         weight += WEIGHTS["size"]
     if cues.handle is not None:
         agreement = _handle_agreement(cues.handle[0], profile.handle)
@@ -324,22 +322,13 @@ def choose_expected(matches: Sequence[Match], expected: str, min_score: float, m
     """The query's class breaking a tie: among the fitting matches within ``margin`` of the best fitting
     score, the best one of the expected class (or a subclass); None otherwise, and always for the root class
     (a query for any object prefers none). A match fits when it scores at least ``min_score`` and, for a class
-    named by printed text, its text was read; such a class with its text unread does not fit, but when it scores
-    higher than a candidate not related to it the cues prefer it (a yellow bottle whose mustard label went unread
-    is no can for "find a can")."""
+    named by printed text, its text was read."""
     fitting = [m for m in matches if m.score >= min_score and not m.unread]
     wanted = expected.lower()
     if not fitting or wanted == UNKNOWN_CLASS.lower():
         return None
     top = max(m.score for m in fitting)
-    unread = [m for m in matches if m.unread and m.score >= min_score]
-    candidates = [
-        m
-        for m in fitting
-        if top - m.score <= margin
-        and wanted in m.profile.ancestors
-        and all(u.score - m.score <= margin for u in unread if not u.profile.related(m.profile))
-    ]
+    candidates = [m for m in fitting if top - m.score <= margin and wanted in m.profile.ancestors]
     return max(candidates, key=lambda m: (m.score, -len(m.profile.ancestors)), default=None)
 
 

@@ -67,6 +67,7 @@ PRECONDITION_KEYS: frozenset[str] = frozenset({"depth", "region", "opaque", "mod
 
 _SINGLE_FIELDS = (
     "shape",
+    "size_class",
     "material",
     "stored_in",
     "transparent",
@@ -219,8 +220,7 @@ class _Builder:
         self._kinds()
         self._disjointness()
         self._types_of_individuals()
-        size_bounds = self._size_bounds()
-        profiles = self._profiles(size_bounds)
+        profiles = self._profiles()
         hypothesis_types = self._hypothesis_types()
         regions = self._regions()
         query_keys = self._query_keys()
@@ -228,6 +228,7 @@ class _Builder:
         preconditions = self._preconditions()
         annotators = self._annotators(preconditions)
         words, word_labels = self._words(regions)
+        size_bounds = self._size_bounds()
         inspected_types = self._inspected_types()
         if self.problems:
             raise OntologyError(sorted(set(self.problems)))
@@ -530,10 +531,7 @@ class _Builder:
                 self.problems.append(f"{name}: declares several values for {field_name}: {values}")
         return own
 
-    def _profiles(self, size_bounds: Mapping[str, float]) -> dict[str, ObjectProfile]:
-        """Each object class's profile, its fields inherited from the nearest classes declaring them. A class may
-        declare several size classes (a can may be small or medium): ``size_classes`` holds them all, smallest
-        first (by ``rk:largestExtentBelow``), ``size_class`` the smallest (the typical one)."""
+    def _profiles(self) -> dict[str, ObjectProfile]:
         object_classes = sorted(self.down.get("PhysicalObject", ()))
         own = {name: self._own_properties(name) for name in object_classes}
         profiles: dict[str, ObjectProfile] = {}
@@ -541,14 +539,11 @@ class _Builder:
             levels = self._levels(name)
             values: dict[str, object] = {}
             origins: list[tuple[str, str]] = []
-            for field_name in ("colors", "size_class", *_SINGLE_FIELDS):
+            for field_name in ("colors", *_SINGLE_FIELDS):
                 for level in levels:
                     found = sorted(c for c in level if field_name in own.get(c, {}))
                     if found:
                         merged = sorted({v for c in found for v in own[c][field_name]}, key=str)
-                        if field_name == "size_class":
-                            merged.sort(key=lambda size: (size_bounds.get(str(size), float("inf")), str(size)))
-                            values["size_classes"] = tuple(merged)
                         values[field_name] = tuple(merged) if field_name == "colors" else merged[0]
                         origins.append((field_name, found[0]))
                         break
@@ -569,7 +564,6 @@ class _Builder:
                 colors=values.get("colors", ()),  # type: ignore[arg-type]
                 shape=values.get("shape"),  # type: ignore[arg-type]
                 size_class=values.get("size_class"),  # type: ignore[arg-type]
-                size_classes=values.get("size_classes", ()),  # type: ignore[arg-type]
                 material=values.get("material"),  # type: ignore[arg-type]
                 transparent=values.get("transparent"),  # type: ignore[arg-type]
                 stored_in=values.get("stored_in"),  # type: ignore[arg-type]

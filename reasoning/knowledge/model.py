@@ -58,8 +58,6 @@ class ObjectProfile:
     open_top: bool | None = None
     height_to_width: tuple[float, float] | None = None
     """Form features: a handle on the side, open at the top, the (min, max) of height over width; None: any."""
-    size_classes: tuple[str, ...] = ()
-    """Every size class the class may have, smallest first (``size_class`` is the first: the typical one)."""
 
     def origin(self, field: str) -> str | None:
         """The class that declares ``field`` for this profile (None when the field is unset)."""

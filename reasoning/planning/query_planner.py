@@ -39,8 +39,7 @@ def region_parameters(box: RegionBox) -> dict[str, object]:
 def class_profiles(kb: KnowledgeBase) -> tuple[dict[str, object], ...]:
     """What every object class typically looks like, as plain data for a knowledge-based classifier.
 
-    Colours, shape and size classes are the ontology's lower-case labels (a class may have several sizes); classes
-    that say nothing visible are left out.
+    Colours, shape and size are the ontology's lower-case labels; classes that say nothing visible are left out.
     """
     profiles = []
     for name in kb.names_of_kind("class"):
@@ -52,7 +51,7 @@ def class_profiles(kb: KnowledgeBase) -> tuple[dict[str, object], ...]:
                 "class": name,
                 "colors": tuple(kb.label(c) for c in profile.colors),
                 "shape": kb.label(profile.shape) if profile.shape else None,
-                "size": tuple(kb.label(size) for size in profile.size_classes) or None,
+                "size": kb.label(profile.size_class) if profile.size_class else None,
                 "texts": profile.texts,
                 "handle": profile.handle,
                 "open_top": profile.open_top,

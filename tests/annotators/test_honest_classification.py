@@ -196,18 +196,3 @@ def test_the_query_does_not_decide_for_a_class_a_settled_form_cue_rules_out() ->
     can = replace(odd, handle=(False, 1.0))
     assert form_decision(can, "CannedFood") == "CannedFood"
     assert contradicted(FORM_PROFILES[0], replace(odd, open_top=(True, 1.0), handle=(False, 1.0))) is False
-
-
-def test_a_class_whose_text_went_unread_still_outscores_the_query_class() -> None:
-    # a yellow bottle: mustard, by its colour, but its label was not read; the query cannot make it a can instead
-    mustard = Profile.from_mapping(
-        {"class": "Mustard", "colors": ("yellow",), "shape": "cylinder", "size": "medium", "texts": ("mustard",)}
-    )
-    can = Profile.from_mapping({"class": "CannedFood", "shape": "cylinder", "size": ("small", "medium")})
-    bottle = Cues(color=("yellow", 0.9), shape=("cylinder", 0.9), size=("medium", 1.0))
-    matches = [score(p, bottle) for p in (mustard, can)]
-    assert matches[0].unread and matches[0].score > matches[1].score
-    assert decide(matches, expected="CannedFood").class_name == UNKNOWN_CLASS
-    # without the yellow, nothing prefers mustard: the query's class decides the tie
-    grey = Cues(shape=("cylinder", 0.9), size=("medium", 1.0))
-    assert decide([score(p, grey) for p in (mustard, can)], expected="CannedFood").class_name == "CannedFood"

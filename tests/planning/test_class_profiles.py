@@ -73,22 +73,3 @@ def test_a_closed_cylinder_is_no_cup_and_a_squat_open_one_is_a_bowl(profiles: di
     assert can.index("CannedFood") < min(can.index("Cup"), can.index("Mug"), can.index("Glass"))
     bowl = Cues(shape=("sphere", 0.6), size=("medium", 1.0), handle=(False, 1.0), open_top=(True, 1.0))
     assert ranked(profiles, Cues(**{**bowl.__dict__, "height_to_width": 0.4}))[0] in {"Bowl", "PlasticBowl"}
-
-
-def test_a_can_may_be_small_or_medium(profiles: dict[str, Profile], tmp_path_factory: pytest.TempPathFactory) -> None:
-    kb = KnowledgeBase.load(tmp_path_factory.mktemp("user") / "user.ttl")
-    can = kb.object_profile("CannedSoup")  # inherited from CannedFood
-    assert can.size_classes == ("Small", "Medium") and can.size_class == "Small"  # smallest first: the typical one
-    assert kb.object_profile("Jar").size_classes == ("Medium",)
-    assert profiles["CannedFood"].sizes == ("small", "medium") and profiles["Mug"].sizes == ("small",)
-    # a squat, closed, medium cylinder (a can of nuts) is a can before a jar: jars are not that squat
-    nuts = Cues(
-        color=("brown", 0.3),
-        shape=("cylinder", 0.75),
-        size=("medium", 1.0),
-        handle=(False, 1.0),
-        open_top=(False, 0.98),
-        height_to_width=0.64,
-    )
-    order = ranked(profiles, nuts)
-    assert order.index("CannedFood") < order.index("Jar")
