@@ -401,7 +401,7 @@ def tints(lab: np.ndarray, parameters: NamingParameters) -> np.ndarray:
 
 def tint(lab: np.ndarray, parameters: NamingParameters = DEFAULT_PARAMETERS) -> float:
     """How far one colour (CIELAB) is from neutral relative to the achromatic ellipse (see :func:`tints`)."""
-    lightness, a, b = np.asarray(lab, dtype=np.float64).reshape(3).tolist()
+    lightness, a, b = lab.tolist() if isinstance(lab, np.ndarray) and lab.shape == (3,) else np.reshape(lab, 3).tolist()
     radius_a = min(parameters.achromatic_chroma, parameters.dark_tint_ratio * (lightness + 16.0))
     radius_b = min(parameters.daylight_chroma, 1.5 * parameters.dark_tint_ratio * (lightness + 16.0))
     return math.hypot(a / radius_a, b / radius_b)
