@@ -352,12 +352,12 @@ def _sorted_floor_within(
         width = float(np.max([np.subtract(*_sorted_range(floor[:, axis], 0.95, 0.05)) for axis in (0, 1)]))
         if high - low > FLOOR_FLATNESS * width:
             continue
-        if _inside_share(floor_hull, walls_hull, rules.cell) >= FLOOR_INSIDE:
+        if inside_share(floor_hull, walls_hull, rules.cell) >= FLOOR_INSIDE:
             return True
     return False
 
 
-def _inside_share(inner: np.ndarray, outer: np.ndarray, cell: float) -> float:
+def inside_share(inner: np.ndarray, outer: np.ndarray, cell: float) -> float:
     """The share of convex polygon ``inner``'s cells (Nx2, metres, on a ``cell`` raster) inside ``outer``."""
     low = np.minimum(inner.min(axis=0), outer.min(axis=0))
     vertices = [np.round((hull - low) / cell).astype(np.int32) for hull in (inner, outer)]
