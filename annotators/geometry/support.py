@@ -18,7 +18,13 @@ from dataclasses import dataclass
 import cv2
 import numpy as np
 
-from annotators.geometry.grid_segmentation import inside_share, join_labels, label_groups, touching_pairs
+from annotators.geometry.grid_segmentation import (
+    Boundaries,
+    inside_share,
+    join_labels,
+    label_groups,
+    touching_pairs,
+)
 
 
 @dataclass(frozen=True)
@@ -42,12 +48,13 @@ class _Heights:
 
     low: np.ndarray
     high: np.ndarray
+    top: np.ndarray
 
 
 def _heights(pixels: np.ndarray, starts: np.ndarray, plane_points: np.ndarray, samples: int) -> _Heights:
+    """The 5 %, 95 % and 99 % heights of every label."""
     count = starts.size - 1
-    low = np.full(count, np.nan)
-    high = np.full(count, np.nan)
+    low, high, top = np.full(count, np.nan), np.full(count, np.nan), np.full(count, np.nan)
     for label in range(1, count):
         own = pixels[starts[label] : starts[label + 1]]
         heights = plane_points[own[:: max(1, own.size // samples)], 2]
@@ -55,7 +62,8 @@ def _heights(pixels: np.ndarray, starts: np.ndarray, plane_points: np.ndarray, s
         if heights.size:
             last = heights.size - 1
             low[label], high[label] = heights[round(0.05 * last)], heights[round(0.95 * last)]
-    return _Heights(low, high)
+            top[label] = heights[round(0.99 * last)]
+    return _Heights(low, high, top)
 
 
 def _hull(pixels: np.ndarray, starts: np.ndarray, plane_points: np.ndarray, label: int, samples: int) -> np.ndarray:
@@ -108,3 +116,57 @@ def join_unsupported(labels: np.ndarray, plane_points: np.ndarray, rules: Suppor
             break
         labels = join_labels(labels, joins)
     return labels
+
+
+@dataclass(frozen=True)
+class AppendageRules:
+    """Thresholds of :func:`join_appendages`: a piece at most ``small_share`` of its neighbour's size, touching it
+    in 3-D (close, see :class:`~annotators.geometry.grid_segmentation.Boundaries`) along at least ``close_share``
+    of their shared border and ``boundary_share`` times the square root of its size (at least ``min_boundary``
+    pixel pairs), its heights (5 %-95 %) within the neighbour's (5 %-99 %, ``tolerance`` metres of slack)."""
+
+    small_share: float = 0.25
+    close_share: float = 0.6
+    boundary_share: float = 0.6
+    min_boundary: int = 3
+    tolerance: float = 0.003
+    samples: int = 400
+
+
+def appendage_owners(
+    labels: np.ndarray, plane_points: np.ndarray, surface: Boundaries, rules: AppendageRules
+) -> list[tuple[int, int]]:
+    """``(piece, owner)`` pairs of :func:`join_appendages`: each small piece with the neighbour it touches along
+    the longest close border among those that qualify."""
+    if surface.pairs.shape[0] == 0:
+        return []
+    pixels, starts = label_groups(labels)
+    sizes = np.diff(starts)
+    heights = _heights(pixels, starts, plane_points.reshape(-1, 3), rules.samples)
+    both = np.concatenate([surface.pairs, surface.pairs[:, ::-1]])
+    close_length = np.tile(surface.close * surface.length, 2)
+    with np.errstate(invalid="ignore"):
+        qualifies = (
+            (np.tile(surface.close, 2) >= rules.close_share)
+            & (close_length >= np.maximum(rules.min_boundary, rules.boundary_share * np.sqrt(sizes[both[:, 0]])))
+            & (sizes[both[:, 0]] <= rules.small_share * sizes[both[:, 1]])
+            & (heights.low[both[:, 0]] >= heights.low[both[:, 1]] - rules.tolerance)
+            & (heights.high[both[:, 0]] <= heights.top[both[:, 1]] + rules.tolerance)
+        )
+    best: dict[int, tuple[float, int]] = {}
+    for (piece, owner), length in zip(both[qualifies].tolist(), close_length[qualifies].tolist(), strict=True):
+        if length > best.get(piece, (-1.0, 0))[0]:
+            best[piece] = (length, owner)
+    return [(piece, owner) for piece, (_, owner) in best.items()]
+
+
+def join_appendages(
+    labels: np.ndarray, plane_points: np.ndarray, surface: Boundaries, rules: AppendageRules | None = None
+) -> np.ndarray:
+    """Labels with every small piece joined to the larger neighbour it sticks out of (see :class:`AppendageRules`):
+    a piece a quarter of a neighbour's size or less whose surface touches the neighbour's in 3-D along most of
+    their shared border, and which lies within the neighbour's heights - a drill's chuck cut off at the concave
+    fold where it leaves the body, a bowl's floor inside its walls. Objects standing side by side touch along a
+    line at most; along the rest of their shared border in the image one hides the other (a depth jump)."""
+    joins = appendage_owners(labels, plane_points, surface, rules or AppendageRules())
+    return join_labels(labels, joins) if joins else labels
