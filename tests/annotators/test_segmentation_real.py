@@ -8,7 +8,8 @@
   The power drill (orange body, black grip, battery below) is one hypothesis in frame 2; in frame 3 its grip folds
   inward like an object standing on another and it comes out in pieces (a known limit, marked xfail).
 * the white mug in frames 0 and 1 is one hypothesis with its inside (seen over the rim) and its handle: a body
-  without its handle reads as a paper cup.
+  without its handle reads as a paper cup; in frame 3 the drill's chuck stays with its body (alone, it reads as a
+  cup).
 """
 
 from __future__ import annotations
@@ -189,3 +190,13 @@ def test_the_white_mug_is_one_hypothesis_with_its_inside_and_handle(uoc_folder: 
     others = {hypothesis_at(hypotheses, x, y) for name, (x, y) in UOC_OBJECTS[frame].items() if name != "white mug"}
     assert len(set(mug.values())) == 1 and 0 not in mug.values(), f"the mug's parts are in hypotheses {mug}"
     assert not set(mug.values()) & others, "the mug shares its hypothesis with another object"
+
+
+def test_the_drill_chuck_stays_with_the_drill_body(uoc_folder: Path) -> None:
+    root = create_pipeline(reader_for(str(uoc_folder), 3))
+    assert Engine(root).tick() is Status.SUCCESS, [(c.name, c.feedback_message) for c in root.children]
+    hypotheses = root.cas.annotations(ObjectHypothesis)
+    drill = {hypothesis_at(hypotheses, x, y) for x, y in ((370, 115), (365, 150), (420, 115))}  # body, grip, chuck
+    others = {hypothesis_at(hypotheses, x, y) for x, y in UOC_OBJECTS[3].values()}
+    assert len(drill) == 1 and 0 not in drill, f"the drill's body, grip and chuck are in hypotheses {drill}"
+    assert not drill & others, "the drill shares its hypothesis with another object"

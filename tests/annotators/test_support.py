@@ -1,10 +1,20 @@
-"""join_unsupported: a piece that could not stand by itself joins the object whose footprint holds it."""
+"""join_unsupported: a piece that could not stand by itself joins the object whose footprint holds it;
+join_appendages: a small piece touching a larger one in 3-D along most of their border, within its heights, joins
+it."""
 
 from __future__ import annotations
 
 import numpy as np
 
-from annotators.geometry.support import SupportRules, join_unsupported, unsupported_holders
+from annotators.geometry.grid_segmentation import Boundaries
+from annotators.geometry.support import (
+    AppendageRules,
+    SupportRules,
+    appendage_owners,
+    join_appendages,
+    join_unsupported,
+    unsupported_holders,
+)
 
 CELL = 0.005  # metres per grid pixel in these plane coordinates
 
@@ -47,3 +57,40 @@ def test_objects_standing_beside_on_or_in_others_stay_apart() -> None:
     points[10:30, 10:40, 1] = np.linspace(0.07, 0.10, 20, dtype=np.float32)[:, None]
     points[30:36, 20:30, 0] = np.linspace(0.04, 0.21, 10, dtype=np.float32)[None, :]  # its feet around the can's
     assert unsupported_holders(labels, points, SupportRules()) == []
+
+
+def border(pairs: list[tuple[int, int]], length: float, close: float) -> Boundaries:
+    """Boundaries of ``pairs``, each ``length`` pixel pairs long with a ``close`` share touching in 3-D."""
+    count = len(pairs)
+    ones = np.ones(count)
+    return Boundaries(
+        np.array(pairs, dtype=np.int64).reshape(-1, 2),
+        length * ones,
+        ones,
+        close * ones,
+        ones * 0.5,
+        -0.5 * ones,
+        ones,
+        length * ones,
+    )
+
+
+def test_a_small_piece_touching_a_larger_one_along_its_border_within_its_heights_joins_it() -> None:
+    # a body 1-5 cm high and a chuck a tenth of its size, 1.5-4.5 cm high, its surface going on into the body's
+    labels, points = scene({1: ((10, 10, 40, 30), (0.01, 0.05)), 2: ((40, 15, 46, 25), (0.015, 0.045))})
+    assert appendage_owners(labels, points, border([(1, 2)], 10, 0.9), AppendageRules()) == [(2, 1)]
+    joined = join_appendages(labels, points, border([(1, 2)], 10, 0.9))
+    assert joined.max() == 1
+
+
+def test_pieces_hidden_behind_taller_or_as_large_stay_apart() -> None:
+    body = ((10, 10, 40, 30), (0.01, 0.05))
+    # mostly a depth jump between them: one hides the other
+    labels, points = scene({1: body, 2: ((40, 15, 46, 25), (0.015, 0.045))})
+    assert appendage_owners(labels, points, border([(1, 2)], 10, 0.3), AppendageRules()) == []
+    # taller than the body: an object standing beside it, not a part sticking out of it
+    labels, points = scene({1: body, 2: ((40, 15, 46, 25), (0.015, 0.09))})
+    assert appendage_owners(labels, points, border([(1, 2)], 10, 0.9), AppendageRules()) == []
+    # half the body's size: an object of its own
+    labels, points = scene({1: body, 2: ((40, 10, 55, 30), (0.015, 0.045))})
+    assert appendage_owners(labels, points, border([(1, 2)], 20, 0.9), AppendageRules()) == []
