@@ -58,7 +58,7 @@ from annotators.geometry.grid_segmentation import (
     merge_parts,
 )
 from annotators.geometry.occlusion import OcclusionRules, join_occluded
-from annotators.geometry.support import AppendageRules, SupportRules, join_appendages, join_unsupported
+from annotators.geometry.support import AppendageRules, SupportRules, join_pieces
 from robokudo.core.annotator import Annotator
 from robokudo.core.capability import Capability
 from robokudo.core.types import CasType, ObjectHypothesis, Plane, PointCloud
@@ -104,13 +104,15 @@ class ClutterParameters(ClusterParameters):
 
     def appendage_rules(self) -> AppendageRules:
         """The thresholds of :func:`annotators.geometry.support.join_appendages`: the merge rules' share of a
-        border that must be close and its length, and their height slack."""
+        border that must be close and its length, their height slack, and the depth jumps."""
         rules = self.merge_rules()
         return AppendageRules(
             close_share=rules.continuous,
             boundary_share=rules.boundary_share,
             min_boundary=rules.min_boundary,
             tolerance=rules.nest_tolerance,
+            jump_absolute=self.jump_absolute,
+            jump_relative=self.jump_relative,
         )
 
     def border_rules(self) -> BorderRules:
@@ -173,11 +175,9 @@ def segment_clutter(
         labels = join_occluded(
             labels, grid, normals, plane_grid.reshape(grid.shape), p.jump_absolute, p.jump_relative, OcclusionRules()
         )
-    if p.join_unsupported:
-        labels = join_unsupported(labels, plane_grid, SupportRules())
-    if p.join_appendages:
-        surface = boundaries(labels, grid, normals, p.jump_absolute, p.jump_relative)
-        labels = join_appendages(labels, plane_grid, surface, p.appendage_rules())
+    support = SupportRules() if p.join_unsupported else None
+    appendages = p.appendage_rules() if p.join_appendages else None
+    labels = join_pieces(labels, grid, normals, plane_grid, support, appendages)
     refine = None
     if p.claim_borders:
         floor = plane_noise(points, model, plane_indices)

@@ -19,10 +19,10 @@ import cv2
 import numpy as np
 
 from annotators.geometry.grid_segmentation import (
-    Boundaries,
+    boundaries,
+    bounding_box,
     inside_share,
     join_labels,
-    label_groups,
     touching_pairs,
 )
 
@@ -30,73 +30,85 @@ from annotators.geometry.grid_segmentation import (
 @dataclass(frozen=True)
 class SupportRules:
     """Thresholds of :func:`join_unsupported`: the share of a piece's footprint that must lie within its holder's
-    hull (``held_share``; a handle beside the body may take up the rest), the height noise (metres) by which its
-    lowest heights must exceed the holder's (``tolerance``), the share of the holder's heights (from its 5 % to its
-    95 % height) its lowest heights must lie below (``reach_down``), the raster cell of the footprints (metres) and
-    the points sampled per piece."""
+    hull (``held_share``: most of it; a handle beside the body may take up the rest), the height noise (metres) by
+    which its lowest heights must exceed the holder's (``tolerance``), the share of the holder's heights (from its
+    5 % to its 95 % height) its lowest heights must lie below (``reach_down``), the raster cell of the footprints
+    (metres) and
+    the spacing of the grid pixels sampled for heights and footprints (``sample_step``)."""
 
-    held_share: float = 0.4
+    held_share: float = 0.5
     tolerance: float = 0.003
     reach_down: float = 0.5
     cell: float = 0.005
-    samples: int = 400
+    sample_step: int = 2
 
 
 @dataclass(frozen=True)
-class _Heights:
-    """The 5 % and 95 % heights above the plane of each label (NaN where a label has no finite point)."""
+class PieceSummary:
+    """Per label (index 0 unused) of a labelling: its ``sizes`` in grid pixels and its 5 %, 95 % and 99 % heights
+    above the plane (``low``, ``high``, ``top``; NaN without a sampled point)."""
 
+    sizes: np.ndarray
     low: np.ndarray
     high: np.ndarray
     top: np.ndarray
 
 
-def _heights(pixels: np.ndarray, starts: np.ndarray, plane_points: np.ndarray, samples: int) -> _Heights:
-    """The 5 %, 95 % and 99 % heights of every label."""
-    count = starts.size - 1
-    low, high, top = np.full(count, np.nan), np.full(count, np.nan), np.full(count, np.nan)
-    for label in range(1, count):
-        own = pixels[starts[label] : starts[label + 1]]
-        heights = plane_points[own[:: max(1, own.size // samples)], 2]
-        heights = np.sort(heights[np.isfinite(heights)])
-        if heights.size:
-            last = heights.size - 1
-            low[label], high[label] = heights[round(0.05 * last)], heights[round(0.95 * last)]
-            top[label] = heights[round(0.99 * last)]
-    return _Heights(low, high, top)
+def summarize_pieces(labels: np.ndarray, plane_points: np.ndarray, sample_step: int) -> PieceSummary:
+    """The :class:`PieceSummary` of ``labels`` from the ``(u, v, height)`` plane coordinates of its pixels
+    (``plane_points``, HxWx3 or (H*W)x3), heights read on every ``sample_step``-th pixel, with one sort."""
+    count = int(labels.max(initial=0)) + 1
+    sizes = np.bincount(labels.reshape(-1), minlength=count)
+    step = max(1, sample_step)
+    sampled = labels[::step, ::step]
+    heights = plane_points.reshape(*labels.shape, 3)[::step, ::step, 2]
+    where = (sampled > 0) & np.isfinite(heights)
+    owners = sampled[where]
+    # one sort by label, then height: heights (metres, within +-0.49 of the plane) as the fraction of the key
+    ordered = np.sort(owners + (np.clip(heights[where], -0.49, 0.49) + 0.5))
+    starts = np.searchsorted(ordered, np.arange(count + 1, dtype=np.float64))
+    counts = np.diff(starts)
+    quantiles = []
+    for share in (0.05, 0.95, 0.99):
+        index = np.minimum(starts[:-1] + np.round(share * np.maximum(counts - 1, 0)).astype(np.intp), ordered.size - 1)
+        values = ordered[np.maximum(index, 0)] - np.arange(count) - 0.5 if ordered.size else np.zeros(count)
+        quantiles.append(np.where(counts > 0, values, np.nan))
+    return PieceSummary(sizes, *quantiles)
 
 
-def _hull(pixels: np.ndarray, starts: np.ndarray, plane_points: np.ndarray, label: int, samples: int) -> np.ndarray:
-    own = pixels[starts[label] : starts[label + 1]]
-    feet = plane_points[own[:: max(1, own.size // samples)], :2]
+def footprint_hull(labels: np.ndarray, plane_points: np.ndarray, label: int, sample_step: int) -> np.ndarray:
+    """The convex hull (Kx2) of the feet (plane coordinates) of a label's pixels, every ``sample_step``-th one."""
+    step = max(1, sample_step)
+    feet = plane_points.reshape(*labels.shape, 3)[::step, ::step][labels[::step, ::step] == label, :2]
     feet = np.ascontiguousarray(feet[np.isfinite(feet).all(axis=1)], dtype=np.float32)
     return cv2.convexHull(feet).reshape(-1, 2) if feet.shape[0] >= 3 else feet
 
 
-def unsupported_holders(labels: np.ndarray, plane_points: np.ndarray, rules: SupportRules) -> list[tuple[int, int]]:
+def unsupported_holders(
+    labels: np.ndarray, plane_points: np.ndarray, rules: SupportRules, pieces: PieceSummary | None = None
+) -> list[tuple[int, int]]:
     """``(piece, holder)`` pairs: each piece that cannot stand by itself with the touching neighbour whose hull
     holds the largest share of its footprint (see the module docstring); ``plane_points`` are the ``(u, v,
-    height)`` plane coordinates of every pixel of ``labels`` (HxWx3 or (H*W)x3)."""
+    height)`` plane coordinates of every pixel of ``labels`` (HxWx3 or (H*W)x3), ``pieces`` their summary when
+    already made."""
     pairs = touching_pairs(labels)
     if pairs.shape[0] == 0:
         return []
-    flat_points = plane_points.reshape(-1, 3)
-    pixels, starts = label_groups(labels)
-    heights = _heights(pixels, starts, flat_points, rules.samples)
+    pieces = pieces or summarize_pieces(labels, plane_points, rules.sample_step)
     both = np.concatenate([pairs, pairs[:, ::-1]])  # (piece, holder) both ways round
-    piece_low, holder_low, holder_high = heights.low[both[:, 0]], heights.low[both[:, 1]], heights.high[both[:, 1]]
+    piece_low, holder_low, holder_high = pieces.low[both[:, 0]], pieces.low[both[:, 1]], pieces.high[both[:, 1]]
     with np.errstate(invalid="ignore"):
-        candidates = (piece_low > holder_low + rules.tolerance) & (
-            piece_low < holder_low + rules.reach_down * (holder_high - holder_low)
+        candidates = (
+            (piece_low > holder_low + rules.tolerance)
+            & (piece_low < holder_low + rules.reach_down * (holder_high - holder_low))
+            & (pieces.sizes[both[:, 1]] >= pieces.sizes[both[:, 0]])  # a piece of an object is smaller than the rest
         )
     hulls: dict[int, np.ndarray] = {}
     best: dict[int, tuple[float, int]] = {}
-    sizes = np.diff(starts)
-    candidates &= sizes[both[:, 1]] >= sizes[both[:, 0]]  # a piece of an object is smaller than the rest of it
     for piece, holder in both[candidates].tolist():
         for label in (piece, holder):
             if label not in hulls:
-                hulls[label] = _hull(pixels, starts, flat_points, label, rules.samples)
+                hulls[label] = footprint_hull(labels, plane_points, label, rules.sample_step)
         if hulls[piece].shape[0] < 3 or hulls[holder].shape[0] < 3:
             continue
         share = inside_share(hulls[piece], hulls[holder], rules.cell)
@@ -109,13 +121,21 @@ def join_unsupported(labels: np.ndarray, plane_points: np.ndarray, rules: Suppor
     """Labels with every piece that cannot stand by itself joined to the neighbour that holds it, repeated while
     a join makes another piece held (a mug's inside first joins its outside, whose footprint then holds the rim
     and handle); renumbered 1..n when anything joined."""
-    r = rules or SupportRules()
+    return _join_unsupported(labels, plane_points, rules or SupportRules())[0]
+
+
+def _join_unsupported(
+    labels: np.ndarray, plane_points: np.ndarray, rules: SupportRules
+) -> tuple[np.ndarray, PieceSummary]:
+    """:func:`join_unsupported` and the summary of the labels it returns."""
+    pieces = summarize_pieces(labels, plane_points, rules.sample_step)
     for _ in range(int(labels.max(initial=0))):
-        joins = unsupported_holders(labels, plane_points, r)
+        joins = unsupported_holders(labels, plane_points, rules, pieces)
         if not joins:
             break
         labels = join_labels(labels, joins)
-    return labels
+        pieces = summarize_pieces(labels, plane_points, rules.sample_step)
+    return labels, pieces
 
 
 @dataclass(frozen=True)
@@ -123,50 +143,110 @@ class AppendageRules:
     """Thresholds of :func:`join_appendages`: a piece at most ``small_share`` of its neighbour's size, touching it
     in 3-D (close, see :class:`~annotators.geometry.grid_segmentation.Boundaries`) along at least ``close_share``
     of their shared border and ``boundary_share`` times the square root of its size (at least ``min_boundary``
-    pixel pairs), its heights (5 %-95 %) within the neighbour's (5 %-99 %, ``tolerance`` metres of slack)."""
+    pixel pairs), its heights (5 %-95 %) within the neighbour's (5 %-99 %, ``tolerance`` metres of slack); depth
+    jumps as the segmenter's (``jump_absolute + jump_relative * nearer depth``); heights sampled on every
+    ``sample_step``-th pixel."""
 
     small_share: float = 0.25
     close_share: float = 0.6
     boundary_share: float = 0.6
     min_boundary: int = 3
     tolerance: float = 0.003
-    samples: int = 400
+    jump_absolute: float = 0.01
+    jump_relative: float = 0.01
+    sample_step: int = 2
+
+
+_BORDER_REACH = 2
+"""Pixels beside a border that :func:`~annotators.geometry.grid_segmentation.boundaries` reads on either side."""
 
 
 def appendage_owners(
-    labels: np.ndarray, plane_points: np.ndarray, surface: Boundaries, rules: AppendageRules
+    labels: np.ndarray,
+    points: np.ndarray,
+    normals: np.ndarray,
+    plane_points: np.ndarray,
+    rules: AppendageRules,
+    pieces: PieceSummary | None = None,
 ) -> list[tuple[int, int]]:
     """``(piece, owner)`` pairs of :func:`join_appendages`: each small piece with the neighbour it touches along
-    the longest close border among those that qualify."""
+    the longest close border among those that qualify (``pieces``: the labels' summary when already made). Sizes
+    and heights are checked first; the borders are measured only in the window around the pieces that pass."""
+    pairs = touching_pairs(labels)
+    if pairs.shape[0] == 0:
+        return []
+    pieces = pieces or summarize_pieces(labels, plane_points, rules.sample_step)
+    both = np.concatenate([pairs, pairs[:, ::-1]])
+    with np.errstate(invalid="ignore"):
+        fits = (
+            (pieces.sizes[both[:, 0]] <= rules.small_share * pieces.sizes[both[:, 1]])
+            & (pieces.low[both[:, 0]] >= pieces.low[both[:, 1]] - rules.tolerance)
+            & (pieces.high[both[:, 0]] <= pieces.top[both[:, 1]] + rules.tolerance)
+        )
+    if not fits.any():
+        return []
+    small = np.zeros(pieces.sizes.size, dtype=bool)
+    small[both[fits, 0]] = True
+    x0, y0, x1, y1 = bounding_box(small[labels], margin=_BORDER_REACH + 1)
+    surface = boundaries(
+        labels[y0:y1, x0:x1],
+        points[y0:y1, x0:x1],
+        normals[y0:y1, x0:x1],
+        rules.jump_absolute,
+        rules.jump_relative,
+        reach=_BORDER_REACH,
+    )
     if surface.pairs.shape[0] == 0:
         return []
-    pixels, starts = label_groups(labels)
-    sizes = np.diff(starts)
-    heights = _heights(pixels, starts, plane_points.reshape(-1, 3), rules.samples)
-    both = np.concatenate([surface.pairs, surface.pairs[:, ::-1]])
-    close_length = np.tile(surface.close * surface.length, 2)
-    with np.errstate(invalid="ignore"):
-        qualifies = (
-            (np.tile(surface.close, 2) >= rules.close_share)
-            & (close_length >= np.maximum(rules.min_boundary, rules.boundary_share * np.sqrt(sizes[both[:, 0]])))
-            & (sizes[both[:, 0]] <= rules.small_share * sizes[both[:, 1]])
-            & (heights.low[both[:, 0]] >= heights.low[both[:, 1]] - rules.tolerance)
-            & (heights.high[both[:, 0]] <= heights.top[both[:, 1]] + rules.tolerance)
-        )
+    fitting = {(int(a), int(b)) for a, b in both[fits].tolist()}
+    sizes = pieces.sizes
     best: dict[int, tuple[float, int]] = {}
-    for (piece, owner), length in zip(both[qualifies].tolist(), close_length[qualifies].tolist(), strict=True):
-        if length > best.get(piece, (-1.0, 0))[0]:
-            best[piece] = (length, owner)
+    for (a, b), close, length in zip(surface.pairs.tolist(), surface.close, surface.length, strict=True):
+        along = float(close * length)
+        for piece, owner in ((a, b), (b, a)):
+            if (
+                (piece, owner) in fitting
+                and close >= rules.close_share
+                and along >= max(rules.min_boundary, rules.boundary_share * np.sqrt(sizes[piece]))
+                and along > best.get(piece, (-1.0, 0))[0]
+            ):
+                best[piece] = (along, owner)
     return [(piece, owner) for piece, (_, owner) in best.items()]
 
 
 def join_appendages(
-    labels: np.ndarray, plane_points: np.ndarray, surface: Boundaries, rules: AppendageRules | None = None
+    labels: np.ndarray,
+    points: np.ndarray,
+    normals: np.ndarray,
+    plane_points: np.ndarray,
+    rules: AppendageRules | None = None,
 ) -> np.ndarray:
-    """Labels with every small piece joined to the larger neighbour it sticks out of (see :class:`AppendageRules`):
-    a piece a quarter of a neighbour's size or less whose surface touches the neighbour's in 3-D along most of
-    their shared border, and which lies within the neighbour's heights - a drill's chuck cut off at the concave
-    fold where it leaves the body, a bowl's floor inside its walls. Objects standing side by side touch along a
-    line at most; along the rest of their shared border in the image one hides the other (a depth jump)."""
-    joins = appendage_owners(labels, plane_points, surface, rules or AppendageRules())
+    """Labels with every small piece joined to the larger neighbour it sticks out of (see :class:`AppendageRules`;
+    ``points`` and ``normals`` HxWx3 in the camera frame, ``plane_points`` the pixels' ``(u, v, height)``): a piece
+    a quarter of a neighbour's size or less whose surface touches the neighbour's in 3-D along most of their shared
+    border, and which lies within the neighbour's heights - a drill's chuck cut off at the concave fold where it
+    leaves the body, a cup's far inner wall. Objects standing side by side touch along a line at most; along the
+    rest of their shared border in the image one hides the other (a depth jump)."""
+    joins = appendage_owners(labels, points, normals, plane_points, rules or AppendageRules())
+    return join_labels(labels, joins) if joins else labels
+
+
+def join_pieces(
+    labels: np.ndarray,
+    points: np.ndarray,
+    normals: np.ndarray,
+    plane_points: np.ndarray,
+    support: SupportRules | None,
+    appendages: AppendageRules | None,
+) -> np.ndarray:
+    """:func:`join_unsupported` (unless ``support`` is None), then :func:`join_appendages` (unless ``appendages``
+    is None), summarizing the pieces once where the first joined nothing."""
+    pieces = None
+    if support is not None:
+        labels, pieces = _join_unsupported(labels, plane_points, support)
+        if appendages is not None and appendages.sample_step != support.sample_step:
+            pieces = None
+    if appendages is None:
+        return labels
+    joins = appendage_owners(labels, points, normals, plane_points, appendages, pieces)
     return join_labels(labels, joins) if joins else labels

@@ -6,7 +6,6 @@ from __future__ import annotations
 
 import numpy as np
 
-from annotators.geometry.grid_segmentation import Boundaries
 from annotators.geometry.support import (
     AppendageRules,
     SupportRules,
@@ -59,38 +58,38 @@ def test_objects_standing_beside_on_or_in_others_stay_apart() -> None:
     assert unsupported_holders(labels, points, SupportRules()) == []
 
 
-def border(pairs: list[tuple[int, int]], length: float, close: float) -> Boundaries:
-    """Boundaries of ``pairs``, each ``length`` pixel pairs long with a ``close`` share touching in 3-D."""
-    count = len(pairs)
-    ones = np.ones(count)
-    return Boundaries(
-        np.array(pairs, dtype=np.int64).reshape(-1, 2),
-        length * ones,
-        ones,
-        close * ones,
-        ones * 0.5,
-        -0.5 * ones,
-        ones,
-        length * ones,
-    )
+def camera_points(labels: np.ndarray, depths: dict[int, float]) -> tuple[np.ndarray, np.ndarray]:
+    """Camera-frame points and normals of a wall facing the camera: each label's pixels at its depth (metres)."""
+    rows, cols = np.mgrid[0 : labels.shape[0], 0 : labels.shape[1]].astype(np.float32)
+    depth = np.ones(labels.shape, dtype=np.float32)
+    for label, z in depths.items():
+        depth[labels == label] = z
+    points = np.stack([(cols - 30) * 0.002 * depth, (rows - 20) * 0.002 * depth, depth], axis=-1)
+    normals = np.zeros_like(points)
+    normals[..., 2] = -1.0
+    return points, normals
 
 
 def test_a_small_piece_touching_a_larger_one_along_its_border_within_its_heights_joins_it() -> None:
-    # a body 1-5 cm high and a chuck a tenth of its size, 1.5-4.5 cm high, its surface going on into the body's
-    labels, points = scene({1: ((10, 10, 40, 30), (0.01, 0.05)), 2: ((40, 15, 46, 25), (0.015, 0.045))})
-    assert appendage_owners(labels, points, border([(1, 2)], 10, 0.9), AppendageRules()) == [(2, 1)]
-    joined = join_appendages(labels, points, border([(1, 2)], 10, 0.9))
-    assert joined.max() == 1
+    # a body 1-5 cm high and a chuck an eighth of its size, 1.5-4.5 cm high, its surface going on into the body's
+    labels, plane_points = scene({1: ((10, 10, 40, 30), (0.01, 0.05)), 2: ((40, 15, 46, 25), (0.015, 0.045))})
+    points, normals = camera_points(labels, {1: 1.0, 2: 1.0})
+    assert appendage_owners(labels, points, normals, plane_points, AppendageRules()) == [(2, 1)]
+    assert join_appendages(labels, points, normals, plane_points).max() == 1
 
 
 def test_pieces_hidden_behind_taller_or_as_large_stay_apart() -> None:
     body = ((10, 10, 40, 30), (0.01, 0.05))
-    # mostly a depth jump between them: one hides the other
-    labels, points = scene({1: body, 2: ((40, 15, 46, 25), (0.015, 0.045))})
-    assert appendage_owners(labels, points, border([(1, 2)], 10, 0.3), AppendageRules()) == []
+    chuck = ((40, 15, 46, 25), (0.015, 0.045))
+    # 20 cm behind the body: the body hides it, their surfaces do not touch
+    labels, plane_points = scene({1: body, 2: chuck})
+    points, normals = camera_points(labels, {1: 1.0, 2: 1.2})
+    assert appendage_owners(labels, points, normals, plane_points, AppendageRules()) == []
     # taller than the body: an object standing beside it, not a part sticking out of it
-    labels, points = scene({1: body, 2: ((40, 15, 46, 25), (0.015, 0.09))})
-    assert appendage_owners(labels, points, border([(1, 2)], 10, 0.9), AppendageRules()) == []
+    labels, plane_points = scene({1: body, 2: ((40, 15, 46, 25), (0.015, 0.09))})
+    points, normals = camera_points(labels, {1: 1.0, 2: 1.0})
+    assert appendage_owners(labels, points, normals, plane_points, AppendageRules()) == []
     # half the body's size: an object of its own
-    labels, points = scene({1: body, 2: ((40, 10, 55, 30), (0.015, 0.045))})
-    assert appendage_owners(labels, points, border([(1, 2)], 20, 0.9), AppendageRules()) == []
+    labels, plane_points = scene({1: body, 2: ((40, 10, 55, 30), (0.015, 0.045))})
+    points, normals = camera_points(labels, {1: 1.0, 2: 1.0})
+    assert appendage_owners(labels, points, normals, plane_points, AppendageRules()) == []
