@@ -23,6 +23,7 @@ from annotators.geometry.grid_segmentation import (
     bounding_box,
     inside_share,
     join_labels,
+    pixel_footprint,
     touching_pairs,
 )
 
@@ -45,13 +46,21 @@ class SupportRules:
 
 @dataclass(frozen=True)
 class PieceSummary:
-    """Per label (index 0 unused) of a labelling: its ``sizes`` in grid pixels and its 5 %, 95 % and 99 % heights
-    above the plane (``low``, ``high``, ``top``; NaN without a sampled point)."""
+    """Per label (index 0 unused) of a labelling: its ``sizes`` in grid pixels, its 5 %, 95 % and 99 % heights
+    above the plane (``low``, ``high``, ``top``; NaN without a sampled point) and its sampled ``feet`` (Nx2 plane
+    coordinates grouped by label: label k owns ``feet[starts[k]:starts[k + 1]]``)."""
 
     sizes: np.ndarray
     low: np.ndarray
     high: np.ndarray
     top: np.ndarray
+    feet: np.ndarray
+    starts: np.ndarray
+
+    def hull(self, label: int) -> np.ndarray:
+        """The convex hull (Kx2) of the label's sampled feet."""
+        feet = self.feet[self.starts[label] : self.starts[label + 1]]
+        return cv2.convexHull(feet).reshape(-1, 2) if feet.shape[0] >= 3 else feet
 
 
 def summarize_pieces(labels: np.ndarray, plane_points: np.ndarray, sample_step: int) -> PieceSummary:
@@ -61,11 +70,13 @@ def summarize_pieces(labels: np.ndarray, plane_points: np.ndarray, sample_step: 
     sizes = np.bincount(labels.reshape(-1), minlength=count)
     step = max(1, sample_step)
     sampled = labels[::step, ::step]
-    heights = plane_points.reshape(*labels.shape, 3)[::step, ::step, 2]
-    where = (sampled > 0) & np.isfinite(heights)
-    owners = sampled[where]
+    grid = plane_points.reshape(*labels.shape, 3)[::step, ::step]
+    where = (sampled > 0) & np.isfinite(grid[..., 2])
+    chosen = grid[where]
     # one sort by label, then height: heights (metres, within +-0.49 of the plane) as the fraction of the key
-    ordered = np.sort(owners + (np.clip(heights[where], -0.49, 0.49) + 0.5))
+    keys = sampled[where] + (np.clip(chosen[:, 2], -0.49, 0.49) + 0.5)
+    order = np.argsort(keys)
+    ordered = keys[order]
     starts = np.searchsorted(ordered, np.arange(count + 1, dtype=np.float64))
     counts = np.diff(starts)
     quantiles = []
@@ -73,15 +84,8 @@ def summarize_pieces(labels: np.ndarray, plane_points: np.ndarray, sample_step: 
         index = np.minimum(starts[:-1] + np.round(share * np.maximum(counts - 1, 0)).astype(np.intp), ordered.size - 1)
         values = ordered[np.maximum(index, 0)] - np.arange(count) - 0.5 if ordered.size else np.zeros(count)
         quantiles.append(np.where(counts > 0, values, np.nan))
-    return PieceSummary(sizes, *quantiles)
-
-
-def footprint_hull(labels: np.ndarray, plane_points: np.ndarray, label: int, sample_step: int) -> np.ndarray:
-    """The convex hull (Kx2) of the feet (plane coordinates) of a label's pixels, every ``sample_step``-th one."""
-    step = max(1, sample_step)
-    feet = plane_points.reshape(*labels.shape, 3)[::step, ::step][labels[::step, ::step] == label, :2]
-    feet = np.ascontiguousarray(feet[np.isfinite(feet).all(axis=1)], dtype=np.float32)
-    return cv2.convexHull(feet).reshape(-1, 2) if feet.shape[0] >= 3 else feet
+    feet = np.ascontiguousarray(chosen[order, :2], dtype=np.float32)
+    return PieceSummary(sizes, *quantiles, feet, starts)
 
 
 def unsupported_holders(
@@ -108,7 +112,7 @@ def unsupported_holders(
     for piece, holder in both[candidates].tolist():
         for label in (piece, holder):
             if label not in hulls:
-                hulls[label] = footprint_hull(labels, plane_points, label, rules.sample_step)
+                hulls[label] = pieces.hull(label)
         if hulls[piece].shape[0] < 3 or hulls[holder].shape[0] < 3:
             continue
         share = inside_share(hulls[piece], hulls[holder], rules.cell)
@@ -160,6 +164,9 @@ class AppendageRules:
 _BORDER_REACH = 2
 """Pixels beside a border that :func:`~annotators.geometry.grid_segmentation.boundaries` reads on either side."""
 
+_FOOTPRINT_ROWS = 8
+"""The pixel footprint (the angle between neighbouring pixels) is measured on every this many rows of the grid."""
+
 
 def appendage_owners(
     labels: np.ndarray,
@@ -185,21 +192,22 @@ def appendage_owners(
         )
     if not fits.any():
         return []
+    involved = np.zeros(pieces.sizes.size, dtype=bool)
+    involved[both[fits].reshape(-1)] = True
     small = np.zeros(pieces.sizes.size, dtype=bool)
     small[both[fits, 0]] = True
     x0, y0, x1, y1 = bounding_box(small[labels], margin=_BORDER_REACH + 1)
+    window = labels[y0:y1, x0:x1]
     surface = boundaries(
-        labels[y0:y1, x0:x1],
+        np.where(involved[window], window, 0),  # only the borders of the small pieces and their owners
         points[y0:y1, x0:x1],
         normals[y0:y1, x0:x1],
         rules.jump_absolute,
         rules.jump_relative,
         reach=_BORDER_REACH,
+        footprint=pixel_footprint(points[::_FOOTPRINT_ROWS]),
     )
-    if surface.pairs.shape[0] == 0:
-        return []
     fitting = {(int(a), int(b)) for a, b in both[fits].tolist()}
-    sizes = pieces.sizes
     best: dict[int, tuple[float, int]] = {}
     for (a, b), close, length in zip(surface.pairs.tolist(), surface.close, surface.length, strict=True):
         along = float(close * length)
@@ -207,7 +215,7 @@ def appendage_owners(
             if (
                 (piece, owner) in fitting
                 and close >= rules.close_share
-                and along >= max(rules.min_boundary, rules.boundary_share * np.sqrt(sizes[piece]))
+                and along >= max(rules.min_boundary, rules.boundary_share * np.sqrt(pieces.sizes[piece]))
                 and along > best.get(piece, (-1.0, 0))[0]
             ):
                 best[piece] = (along, owner)

@@ -8,8 +8,9 @@
   The power drill (orange body, black grip, battery below) is one hypothesis in frame 2; in frame 3 its grip folds
   inward like an object standing on another and it comes out in pieces (a known limit, marked xfail).
 * the white mug in frame 0 is one hypothesis with its inside (seen over the rim) and its handle: a body without
-  its handle reads as a paper cup (in frame 1 the handle comes with the body's right side, down to the table, and
-  stays apart: marked xfail); in frame 3 the drill's chuck stays with its body (alone, it reads as a
+  its handle reads as a paper cup (in frame 1 the mug comes out in three pieces - the inside's left half, the
+  body, and the handle with the inside's right half and the body's right side down to the table - which no rule
+  joins yet: marked xfail); in frame 3 the drill's chuck stays with its body (alone, it reads as a
   cup).
 """
 
