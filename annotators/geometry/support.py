@@ -1,4 +1,4 @@
-"""Support on the organized grid: pieces that could not stand by themselves join the object that holds them.
+"""Pieces that are no object by themselves, on the organized grid: they join the object they belong to.
 
 Every object rests on something: the support plane, or another object it stands on. A piece of a segmentation
 that does neither is part of an object it touches. Such a piece is smaller than that neighbour, much of its
@@ -8,7 +8,13 @@ down into the lower part of the neighbour's heights, so it cannot rest on the ne
 of a mug or bowl seen over its rim together with the rim and the handle's top is such a piece: the convexity
 grouping cuts it from the outside along the concave fold of the inner wall. Two solid objects standing side by
 side have footprints apart, an object standing on another starts at the other's top, and a can standing in a bowl
-is larger than the piece of the bowl's outside it touches; none of them is joined.
+is larger than the piece of the bowl's outside it touches; none of them is joined (:func:`join_unsupported`).
+
+A small piece can also stick out of a larger one: a drill's chuck leaves the body's front face at a concave fold,
+where the convexity grouping cuts it off. A piece at most a quarter of a neighbour's size whose surface touches the
+neighbour's in 3-D along most of their shared border, and whose heights lie within the neighbour's, joins it
+(:func:`join_appendages`). An object standing beside another touches it along a line at most; along the rest of
+their shared border in the image one hides the other behind a depth jump.
 """
 
 from __future__ import annotations
