@@ -25,6 +25,7 @@ from reasoning.beliefs.answer import (
     class_label,
     designator,
 )
+from reasoning.beliefs.ranking import best_first
 from reasoning.beliefs.store import BeliefFilter, BeliefStore
 from reasoning.fusion.association import CameraModel
 from reasoning.fusion.frame import FUSED_TYPES, WORLD_FRAME, FrameContext, FrameObject, frame_objects
@@ -66,7 +67,8 @@ class AnswerStep(Annotator):
     ``store`` is a store, a path, a factory, or None for :meth:`BeliefStore.default_path`; it is opened on the
     first run. ``tracker`` (class test, regions, gates) defaults to the store's. The query's filter is
     ``belief_filter``, or ``filter_for(query)`` of the CAS's QueryView, or everything seen. The answer holds
-    the matching objects seen in this frame, most confident first, with their image ROI (an object an expert only
+    the matching objects seen in this frame, most confident first (under a limit, the most likely to be what was
+    asked: :mod:`reasoning.beliefs.ranking`), with their image ROI (an object an expert only
     guessed to be of the asked class is a candidate too, see :meth:`_guessed`); when a tracker wrote the frame's
     TargetTrack (a continuous task), only the tracked object, with the track; ``label_of`` names classes (e.g.
     the knowledge base's labels). Objects whose geometry is in doubt confirm known beliefs but create none. With
@@ -158,9 +160,10 @@ class AnswerStep(Annotator):
         matching = store.query(replace(belief_filter, ids=tuple(seen), limit=None))
         guesses = self._guessed(store, belief_filter, seen, {b.id for b in matching})
         matching += guesses.values()
-        matching.sort(key=lambda b: (-b.confidence, b.id))
-        if belief_filter.limit is not None:
-            matching = matching[: belief_filter.limit]
+        if belief_filter.limit is not None:  # asked for N objects: the N most likely to be what was asked
+            matching = best_first(matching, belief_filter)
+        else:
+            matching.sort(key=lambda b: (-b.confidence, b.id))
         pointing = self._pointing(seen, info)
         if pointing is not None:  # a pointing query answers with the pointed object (none for a region)
             matching = [

@@ -14,7 +14,13 @@ Works like :mod:`annotators.cloud.clusters` on every ``stride``-th pixel of the 
    standing flush on a can is one convex surface but two colours with a crease between);
 5. pieces that an occluder in front splits apart join when they continue one plane behind it
    (:func:`annotators.geometry.occlusion.join_occluded`);
-6. at full resolution, the outline pixels the coarse grid left unlabelled and the foot below the candidates'
+6. a piece that could not stand by itself - smaller than a neighbour whose footprint holds much of its own, not
+   reaching the table and reaching down too far into the neighbour's heights to rest on its top - joins it: the
+   inside of a mug seen over its rim, cut off with the rim and the handle along the inner wall's concave fold
+   (:func:`annotators.geometry.support.join_unsupported`); a piece a quarter of a neighbour's size or less that
+   touches it in 3-D along most of their shared border and lies within its heights joins it too: a drill's chuck
+   cut off at the concave fold where it leaves the body (:func:`annotators.geometry.support.join_appendages`);
+7. at full resolution, the outline pixels the coarse grid left unlabelled and the foot below the candidates'
    lowest height join the object whose surface they continue
    (:func:`annotators.geometry.border_pixels.claim_border_pixels`).
 """
@@ -52,6 +58,7 @@ from annotators.geometry.grid_segmentation import (
     merge_parts,
 )
 from annotators.geometry.occlusion import OcclusionRules, join_occluded
+from annotators.geometry.support import AppendageRules, SupportRules, join_pieces
 from robokudo.core.annotator import Annotator
 from robokudo.core.capability import Capability
 from robokudo.core.types import CasType, ObjectHypothesis, Plane, PointCloud
@@ -63,7 +70,9 @@ class ClutterParameters(ClusterParameters):
     merging), the normals (``normal_step`` / ``normal_smoothing`` coarse pixels), the patches (``cell`` x ``cell``
     coarse pixels, split when their normals spread by more than ``normal_spread``), the grouping
     (:class:`~annotators.geometry.convexity.ConvexityRules`) and the share of a boundary that must be creased for a
-    hue edge to split an object (``creased_share``); ``claim_borders`` gives the outline pixels the coarse grid
+    hue edge to split an object (``creased_share``); ``join_unsupported`` joins the pieces that could not stand by
+    themselves to the object that holds them and ``join_appendages`` the small pieces sticking out of a larger one;
+    ``claim_borders`` gives the outline pixels the coarse grid
     left unlabelled and each object's foot (below ``min_height``) to the object they continue."""
 
     jump_relative: float = 0.01
@@ -85,11 +94,26 @@ class ClutterParameters(ClusterParameters):
     creased_share: float = 0.2
     use_color: bool = True
     complete_occluded: bool = True
+    join_unsupported: bool = True
+    join_appendages: bool = True
     claim_borders: bool = True
 
     def convexity_rules(self) -> ConvexityRules:
         """The thresholds of :func:`annotators.geometry.convexity.convex_groups`."""
         return ConvexityRules(**{f.name: getattr(self, f.name) for f in fields(ConvexityRules)})
+
+    def appendage_rules(self) -> AppendageRules:
+        """The thresholds of :func:`annotators.geometry.support.join_appendages`: the merge rules' share of a
+        border that must be close and its length, their height slack, and the depth jumps."""
+        rules = self.merge_rules()
+        return AppendageRules(
+            close_share=rules.continuous,
+            boundary_share=rules.boundary_share,
+            min_boundary=rules.min_boundary,
+            tolerance=rules.nest_tolerance,
+            jump_absolute=self.jump_absolute,
+            jump_relative=self.jump_relative,
+        )
 
     def border_rules(self) -> BorderRules:
         """The thresholds of :func:`annotators.geometry.border_pixels.claim_border_pixels` at full resolution: the
@@ -151,6 +175,9 @@ def segment_clutter(
         labels = join_occluded(
             labels, grid, normals, plane_grid.reshape(grid.shape), p.jump_absolute, p.jump_relative, OcclusionRules()
         )
+    support = SupportRules() if p.join_unsupported else None
+    appendages = p.appendage_rules() if p.join_appendages else None
+    labels = join_pieces(labels, grid, normals, plane_grid, support, appendages)
     refine = None
     if p.claim_borders:
         floor = plane_noise(points, model, plane_indices)

@@ -352,12 +352,12 @@ def _sorted_floor_within(
         width = float(np.max([np.subtract(*_sorted_range(floor[:, axis], 0.95, 0.05)) for axis in (0, 1)]))
         if high - low > FLOOR_FLATNESS * width:
             continue
-        if _inside_share(floor_hull, walls_hull, rules.cell) >= FLOOR_INSIDE:
+        if inside_share(floor_hull, walls_hull, rules.cell) >= FLOOR_INSIDE:
             return True
     return False
 
 
-def _inside_share(inner: np.ndarray, outer: np.ndarray, cell: float) -> float:
+def inside_share(inner: np.ndarray, outer: np.ndarray, cell: float) -> float:
     """The share of convex polygon ``inner``'s cells (Nx2, metres, on a ``cell`` raster) inside ``outer``."""
     low = np.minimum(inner.min(axis=0), outer.min(axis=0))
     vertices = [np.round((hull - low) / cell).astype(np.int32) for hull in (inner, outer)]
@@ -537,14 +537,17 @@ def boundaries(
     close_factor: float = 2.5,
     reach: int = 2,
     crease: float = 0.15,
+    footprint: float | None = None,
 ) -> Boundaries:
     """The :class:`Boundaries` of every touching pair of parts (``points``/``normals`` HxWx3, camera frame).
 
     Normals and positions for ``alignment`` and ``convexity`` are taken ``reach`` pixels away from the boundary on
     either side (where those pixels still belong to the two parts), since normals right at a crease are blurred
-    across it. Only the boundary pixels and those beside them are read.
+    across it. Only the boundary pixels and those beside them are read. ``footprint`` is the
+    :func:`pixel_footprint` of ``points`` when the caller has measured it.
     """
-    footprint = pixel_footprint(points)
+    if footprint is None:
+        footprint = pixel_footprint(points)
     key, jump, near, dot, convexity = boundary_pairs(
         np.ascontiguousarray(labels),
         np.asarray(points, dtype=np.float32),  # a window of a larger grid is read in place, not copied

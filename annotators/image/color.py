@@ -255,13 +255,19 @@ def name_objects_colors(
     found = objects_surfaces(objects, light, parameters)
     vote_labs = [[_vote_lab(surface, parameters) for surface in surfaces] for surfaces, _ in found]
     voted = [lab for labs in vote_labs for lab in labs if lab is not None]
-    all_votes = iter(_term_votes(np.array(voted), parameters) if voted else ())
+    vote_rows = _term_votes(np.array(voted), parameters) if voted else np.zeros((0, len(CHROMATIC_TERMS)))
+    winners = vote_rows.argmax(axis=1)  # each voted surface's name, as _name_of_votes picks it
+    all_votes = iter(vote_rows)
+    all_names = iter(
+        SurfaceName(CHROMATIC_TERMS[best], share)
+        for best, share in zip(winners.tolist(), vote_rows[np.arange(len(voted)), winners].tolist(), strict=True)
+    )
     named = []
     for (surfaces, _), labs in zip(found, vote_labs, strict=True):
         votes = [None if lab is None else next(all_votes) for lab in labs]
         names = [
-            _lightness_name(surface, light.surround, parameters) if vote is None else _name_of_votes(vote)
-            for surface, vote in zip(surfaces, votes, strict=True)
+            _lightness_name(surface, light.surround, parameters) if lab is None else next(all_names)
+            for surface, lab in zip(surfaces, labs, strict=True)
         ]
         named.append((votes, names))
     lit_labs = [

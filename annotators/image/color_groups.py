@@ -39,33 +39,31 @@ def _round_half_even(value: float) -> int:
 
 @njit(cache=True, nogil=True)
 def _select(values: np.ndarray, rank: int) -> float:
-    """The ``rank``-th smallest of ``values`` (reordered in place): quickselect with median-of-three pivots."""
+    """The ``rank``-th smallest of ``values`` (reordered in place): quickselect with median-of-three pivots and
+    branch-free partitions (the values below the pivot to the front, then those equal to it), whose run time
+    does not hang on guessing comparisons' outcomes."""
     low, high = 0, values.size - 1
     while high > low:
-        middle = (low + high) // 2
-        if values[middle] < values[low]:
-            values[middle], values[low] = values[low], values[middle]
-        if values[high] < values[low]:
-            values[high], values[low] = values[low], values[high]
-        if values[high] < values[middle]:
-            values[high], values[middle] = values[middle], values[high]
-        pivot = values[middle]
-        i, j = low, high
-        while i <= j:
-            while values[i] < pivot:
-                i += 1
-            while pivot < values[j]:
-                j -= 1
-            if i <= j:
-                values[i], values[j] = values[j], values[i]
-                i += 1
-                j -= 1
-        if rank <= j:
-            high = j
-        elif rank >= i:
-            low = i
-        else:
-            break
+        first, middle, last = values[low], values[(low + high) // 2], values[high]
+        pivot = max(min(first, middle), min(max(first, middle), last))
+        below = low
+        for i in range(low, high + 1):
+            value = values[i]
+            values[i] = values[below]
+            values[below] = value
+            below += value < pivot
+        if rank < below:
+            high = below - 1
+            continue
+        equal = below
+        for i in range(below, high + 1):
+            value = values[i]
+            values[i] = values[equal]
+            values[equal] = value
+            equal += value <= pivot
+        if rank < equal:
+            return float(pivot)
+        low = equal
     return float(values[rank])
 
 

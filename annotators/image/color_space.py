@@ -27,6 +27,9 @@ D65_WHITE = SRGB_TO_XYZ.sum(axis=1)
 _RELATIVE_XYZ = SRGB_TO_XYZ.T / D65_WHITE
 """Linear sRGB (rows) to XYZ relative to the white: ``linear @ _RELATIVE_XYZ``."""
 
+RELATIVE_XYZ32 = _RELATIVE_XYZ.astype(np.float32)
+""":data:`_RELATIVE_XYZ` in single precision, as :func:`linear_to_lab` converts single-precision colours."""
+
 
 def _decode(values: np.ndarray) -> np.ndarray:
     return np.where(values <= 0.04045, values / 12.92, ((values + 0.055) / 1.055) ** 2.4)
@@ -56,8 +59,15 @@ def linear_to_lab(linear: np.ndarray) -> np.ndarray:
     single precision for single-precision input, else in double."""
     values = np.asarray(linear)
     dtype = np.float32 if values.dtype == np.float32 else np.float64
-    xyz = values.astype(dtype, copy=False) @ _RELATIVE_XYZ.astype(dtype, copy=False)
     epsilon, kappa = 216 / 24389, 24389 / 27
+    if values.shape == (3,) and dtype == np.float64:  # one colour: the same operations on Python floats
+        xyz = values.astype(dtype, copy=False) @ _RELATIVE_XYZ
+        fx, fy, fz = (
+            root if value > epsilon else (kappa * value + 16) / 116
+            for value, root in zip(xyz.tolist(), np.cbrt(xyz).tolist(), strict=True)
+        )
+        return np.array([116 * fy - 16, 500 * (fx - fy), 200 * (fy - fz)])
+    xyz = values.astype(dtype, copy=False) @ (RELATIVE_XYZ32 if dtype == np.float32 else _RELATIVE_XYZ)
     f = np.cbrt(xyz)
     dim = xyz <= epsilon  # the linear segment near black (the cube root elsewhere)
     if np.any(dim):

@@ -13,8 +13,9 @@ highlight on it, or a white part its colour bleeds into on a small or blurred ob
 highlight when it is mostly that colour, else the white it is mixed with (:func:`_merge_white_blends`); and a
 darker group of nearly the same hue and saturation as a larger one is its shaded side.
 
-The grouping and the groups' order statistics run compiled, for all the objects of a frame in one call
-(:mod:`annotators.image.color_groups`); the pixels are held in single precision.
+The per-pixel steps (:mod:`annotators.image.color_pixels`), the grouping and the groups' order statistics
+(:mod:`annotators.image.color_groups`) run compiled, for all the objects of a frame at once; the pixels are held in
+single precision (:func:`chroma_plane` and :func:`tints` are the NumPy form of the per-pixel steps).
 """
 
 from __future__ import annotations
@@ -26,7 +27,7 @@ from dataclasses import dataclass
 import cv2
 import numpy as np
 
-from annotators.image.color_space import UINT8_TO_LINEAR32, linear_to_lab
+from annotators.image.color_space import RELATIVE_XYZ32, UINT8_TO_LINEAR32, linear_to_lab
 from annotators.image.white_balance import LUMINANCE, NEUTRAL_LIGHT, FrameLight
 from robokudo.core.types import ObjectHypothesis
 
@@ -138,21 +139,6 @@ def chroma_plane(lab: np.ndarray, softness: float) -> np.ndarray:
     chroma = np.hypot(lab[:, 1], lab[:, 2])
     scale = np.log1p(chroma / softness) / np.maximum(chroma, 1e-9)
     return lab[:, 1:] * scale[:, None]
-
-
-def _rows(array: np.ndarray, where: np.ndarray) -> np.ndarray:
-    """The rows of ``array`` where ``where`` is set (as ``array[where]``, faster for rows of a few values)."""
-    return array.compress(where, axis=0)
-
-
-def _pixel_rows(lab: np.ndarray, linear: np.ndarray) -> np.ndarray:
-    """Pixels (CIELAB and linear RGB, Nx3 each) as 6xN rows: L*, a*/(L*+16), b*/(L*+16) (a chromaticity that a
-    uniform change of light leaves alone), and linear R, G, B."""
-    rows = np.empty((6, lab.shape[0]), dtype=lab.dtype)
-    rows[0] = lab[:, 0]
-    np.multiply(lab[:, 1:].T, 1.0 / (lab[:, 0] + 16.0), out=rows[1:3])
-    rows[3:] = linear.T
-    return rows
 
 
 def _rg(linear: np.ndarray) -> np.ndarray:
@@ -305,6 +291,27 @@ DARK_GROUP = 1
 """The kind of a dark pool's row in :func:`~annotators.image.color_groups.all_groups`' result."""
 
 
+def pixel_settings(parameters: NamingParameters) -> np.ndarray:
+    """The constants :func:`~annotators.image.color_pixels.pixel_features` takes the pixels' steps with, in its
+    order."""
+    return np.array(
+        [
+            parameters.edge_step,
+            parameters.min_interior_share,
+            parameters.clipped_level,
+            parameters.highlight_floor,
+            parameters.highlight_tint,
+            parameters.highlight_keep_share,
+            parameters.dark_lightness,
+            parameters.chroma_softness,
+            parameters.group_radius,
+            parameters.achromatic_chroma,
+            parameters.daylight_chroma,
+            parameters.dark_tint_ratio,
+        ]
+    )
+
+
 def group_settings(parameters: NamingParameters) -> np.ndarray:
     """The constants :func:`~annotators.image.color_groups.all_groups` groups pixels with, in its order."""
     return np.array(
@@ -317,32 +324,6 @@ def group_settings(parameters: NamingParameters) -> np.ndarray:
             parameters.daylight_chroma,
             parameters.dark_tint_ratio,
         ]
-    )
-
-
-def _groups(
-    rows: np.ndarray,
-    features: np.ndarray,
-    regular: np.ndarray,
-    dark: np.ndarray,
-    ends: np.ndarray,
-    parameters: NamingParameters,
-) -> np.ndarray:
-    """The surface groups of the objects whose pixels (:func:`_pixel_rows`, log-chroma ``features``, which are
-    ``regular`` or ``dark``) end at ``ends``: :func:`~annotators.image.color_groups.all_groups`' rows."""
-    from annotators.image.color_groups import all_groups  # numba is loaded with the first objects named
-
-    cells = np.floor(features.T / np.float32(parameters.group_radius / 2))
-    return all_groups(
-        rows,
-        np.ascontiguousarray(features[:, 0]),
-        np.ascontiguousarray(features[:, 1]),
-        np.ascontiguousarray(cells, dtype=np.int64),
-        regular,
-        dark,
-        ends,
-        group_settings(parameters),
-        parameters.max_groups,
     )
 
 
@@ -372,34 +353,24 @@ def objects_surfaces(
         return []
     if sizes.min() == 0:
         raise ValueError("no pixels to name a colour for")
-    rgb = np.concatenate(rgb_parts)
-    owner = np.repeat(np.arange(len(objects)), sizes)
+    from annotators.image.color_groups import all_groups  # numba is loaded with the first objects named
+    from annotators.image.color_pixels import pixel_features
+
     edge_parts = [
-        np.zeros(size, dtype=np.float32) if edges is None else np.asarray(edges).reshape(-1)
+        np.zeros(size, dtype=np.float32) if edges is None else np.asarray(edges, dtype=np.float32).reshape(-1)
         for (_, edges), size in zip(objects, sizes, strict=True)
     ]
-    interior = np.concatenate(edge_parts) <= parameters.edge_step
-    interior_counts = np.bincount(owner[interior], minlength=len(objects))
-    keep = interior | (interior_counts < parameters.min_interior_share * sizes)[owner]
-    rgb, owner = _rows(rgb, keep), owner[keep]
-    counts = np.bincount(owner, minlength=len(objects))
-    linear = UINT8_TO_LINEAR32[rgb] * np.asarray(light.gains, dtype=np.float32)  # single precision from here on
-    lab = linear_to_lab(linear)
-    red, green, blue = rgb[:, 0], rgb[:, 1], rgb[:, 2]
-    brightest, darkest = np.maximum(np.maximum(red, green), blue), np.minimum(np.minimum(red, green), blue)
-    highlight = (brightest >= parameters.clipped_level) & (darkest >= parameters.highlight_floor)
-    highlight[highlight] = tints(_rows(lab, highlight), parameters) <= parameters.highlight_tint
-    dark = ~highlight & (lab[:, 0] < parameters.dark_lightness)
-    regular = ~highlight & ~dark
-    # an over-exposed white surface: its clipped pixels are white, and group with its unclipped ones
-    white = np.bincount(owner[highlight], minlength=len(objects)) >= parameters.highlight_keep_share * counts
-    whitened = highlight & white[owner]
-    lab[whitened] = WHITE_LAB
-    regular |= whitened
-    features = chroma_plane(lab, parameters.chroma_softness)
-    rows = _pixel_rows(lab, linear)
+    rows, px, py, cells, regular, dark, highlight, counts = pixel_features(
+        np.concatenate(rgb_parts),
+        np.concatenate(edge_parts),
+        sizes,
+        UINT8_TO_LINEAR32,
+        np.asarray(light.gains, dtype=np.float32),
+        RELATIVE_XYZ32,
+        pixel_settings(parameters),
+    )
     ends = np.cumsum(counts)
-    groups = _groups(rows, features, regular, dark, ends, parameters)
+    groups = all_groups(rows, px, py, cells, regular, dark, ends, group_settings(parameters), parameters.max_groups)
     firsts = np.searchsorted(groups[:, 0], np.arange(len(objects) + 1))
     result = []
     for index, count in enumerate(counts.tolist()):
@@ -430,7 +401,7 @@ def tints(lab: np.ndarray, parameters: NamingParameters) -> np.ndarray:
 
 def tint(lab: np.ndarray, parameters: NamingParameters = DEFAULT_PARAMETERS) -> float:
     """How far one colour (CIELAB) is from neutral relative to the achromatic ellipse (see :func:`tints`)."""
-    lightness, a, b = np.asarray(lab, dtype=np.float64).reshape(3).tolist()
+    lightness, a, b = lab.tolist() if isinstance(lab, np.ndarray) and lab.shape == (3,) else np.reshape(lab, 3).tolist()
     radius_a = min(parameters.achromatic_chroma, parameters.dark_tint_ratio * (lightness + 16.0))
     radius_b = min(parameters.daylight_chroma, 1.5 * parameters.dark_tint_ratio * (lightness + 16.0))
     return math.hypot(a / radius_a, b / radius_b)

@@ -70,33 +70,32 @@ def mask_pixels(
     of those, every ``max(1, count // max_pixels)``-th in raster order."""
     height, width = y1 - y0, x1 - x0
     # runs[r, c]: the mask's pixels c-1, c, c+1 of box row r are all set (those outside the box count as set)
-    runs = np.zeros((height, width), dtype=np.bool_)
-    keep = np.zeros((height, width), dtype=np.bool_)
-    total = inner = 0
+    runs = np.empty((height, width), dtype=np.bool_)
     for r in range(height):
         row = mask[y0 + r, x0:x1]
         for c in range(width):
             runs[r, c] = row[c] and (c == 0 or row[c - 1]) and (c == width - 1 or row[c + 1])
+    total = inner = 0
     for r in range(height):
-        above, below = runs[max(r - 1, 0)], runs[min(r + 1, height - 1)]
+        row, above, here, below = mask[y0 + r, x0:x1], runs[max(r - 1, 0)], runs[r], runs[min(r + 1, height - 1)]
         for c in range(width):
-            if mask[y0 + r, x0 + c]:
-                total += 1
-                if runs[r, c] and above[c] and below[c]:
-                    keep[r, c] = True
-                    inner += 1
+            total += row[c]
+            inner += here[c] & above[c] & below[c]  # a set run implies the pixel is set
     use_inner = inner >= max(min_inner, total // 3)
     count = inner if use_inner else total
     step = max(1, count // max_pixels)
     picked = (count + step - 1) // step
     rows = np.empty(picked, dtype=np.int64)
     cols = np.empty(picked, dtype=np.int64)
-    seen = taken = 0
-    for row in range(y0, y1):
-        for col in range(x0, x1):
-            if keep[row - y0, col - x0] if use_inner else mask[row, col]:
-                if seen % step == 0:
-                    rows[taken], cols[taken] = row, col
+    taken = 0
+    wait = 0  # picked pixels to pass over before the next is taken
+    for r in range(height):
+        row, above, here, below = mask[y0 + r, x0:x1], runs[max(r - 1, 0)], runs[r], runs[min(r + 1, height - 1)]
+        for c in range(width):
+            if here[c] & above[c] & below[c] if use_inner else row[c]:
+                if wait == 0:
+                    rows[taken], cols[taken] = y0 + r, x0 + c
                     taken += 1
-                seen += 1
+                    wait = step
+                wait -= 1
     return rows, cols

@@ -13,9 +13,10 @@ import functools
 import json
 import re
 from collections.abc import Callable
-from dataclasses import dataclass
+from dataclasses import dataclass, replace
 from typing import Any
 
+from reasoning.beliefs.ranking import answer_order
 from reasoning.beliefs.store import BeliefFilter, BeliefStore
 from reasoning.fusion.rule import CLASS_ATTRIBUTE, ClassTest, FusedAttribute, fuse_values
 from reasoning.fusion.tracking import ObjectBelief
@@ -439,8 +440,14 @@ def _designate(
 
 
 def answer_from_memory(store: BeliefStore, belief_filter: BeliefFilter, query: str = "", **options: Any) -> Answer:
-    """Answer a query from the store alone (no perception): the matching known objects, most confident first."""
-    views = store.query_views(belief_filter, _belief_view)
-    views.sort(key=lambda v: (-v.confidence, v.belief.id))
+    """Answer a query from the store alone (no perception): the matching known objects, most confident first; with
+    a ``limit``, the ones most likely to be what was asked (:func:`~reasoning.beliefs.ranking.answer_order`)."""
+    if belief_filter.limit is not None:
+        views = store.query_views(replace(belief_filter, limit=None), _belief_view)
+        views.sort(key=lambda v: answer_order(v.belief, belief_filter))
+        views = views[: belief_filter.limit]
+    else:
+        views = store.query_views(belief_filter, _belief_view)
+        views.sort(key=lambda v: (-v.confidence, v.belief.id))
     designators = tuple(_designate(v, class_test=belief_filter.class_test, **options) for v in views)
     return Answer(query=query, objects=designators, from_memory=True)

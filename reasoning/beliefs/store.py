@@ -628,7 +628,8 @@ class BeliefStore:
             return int(conn.execute("SELECT COUNT(*) FROM objects WHERE status = ?", (PRESENT,)).fetchone()[0])
 
     def query(self, belief_filter: BeliefFilter) -> list[ObjectBelief]:
-        """The beliefs matching ``belief_filter`` (class subsumption, region, attributes), by id."""
+        """The beliefs matching ``belief_filter`` (class subsumption, region, attributes), by id; a ``limit`` keeps
+        the first by id (answers rank before they cut: :mod:`reasoning.beliefs.ranking`)."""
         return [_belief_from_row(row) for row in self._select(belief_filter)]
 
     def query_views(self, belief_filter: BeliefFilter, view: Callable[[ObjectBelief], T]) -> list[T]:

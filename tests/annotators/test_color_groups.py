@@ -60,3 +60,24 @@ def test_objects_are_grouped_apart_and_few_pixels_make_one_surface() -> None:
     assert list(groups[:, 0]) == [0, 1]
     assert list(groups[:, 8]) == [300, 2]
     np.testing.assert_allclose(groups[1, 2:], _expected(rows[:, 300:], 80.0), rtol=1e-12)
+
+
+@pytest.mark.parametrize("seed", range(3))
+def test_select_finds_every_rank_with_ties_and_sorted_runs(seed: int) -> None:
+    from annotators.image.color_groups import _select
+
+    rng = np.random.default_rng(seed)
+    arrays = [
+        rng.normal(0, 1, 257).astype(np.float32),
+        rng.integers(0, 4, 100).astype(np.float32),  # many ties
+        np.sort(rng.normal(0, 1, 64)).astype(np.float32),
+        np.sort(rng.normal(0, 1, 64))[::-1].astype(np.float32).copy(),
+        np.full(9, 2.5, dtype=np.float32),
+        np.array([1.0], dtype=np.float32),
+    ]
+    for values in arrays:
+        expected = np.sort(values)
+        for rank in range(values.size):
+            shuffled = values.copy()
+            assert _select(shuffled, rank) == expected[rank]
+            np.testing.assert_array_equal(np.sort(shuffled), expected)  # reordered, nothing lost

@@ -9,7 +9,7 @@ from hypothesis import strategies as st
 
 from annotators.image.color import CHROMATIC_TERMS
 from annotators.image.color_prototypes import basic_term, prototypes, survey_colors
-from annotators.image.color_space import delta_e_2000, linear_to_srgb, srgb_to_lab, srgb_to_linear
+from annotators.image.color_space import delta_e_2000, linear_to_lab, linear_to_srgb, srgb_to_lab, srgb_to_linear
 
 # Pairs from the supplementary test data of Sharma, Wu and Dalal (2005), Color Res. Appl. 30(1), table 1.
 SHARMA_PAIRS = [
@@ -79,3 +79,14 @@ def test_every_chromatic_term_has_prototypes_and_a_new_term_would_get_its_own() 
     assert "teal" in teal_terms and "dark teal" in teal_names and "teal green" not in teal_names
     with pytest.raises(ValueError, match="mauvish"):
         prototypes(("mauvish",))
+
+
+def test_one_colour_converts_as_a_row_of_colours_does() -> None:
+    """The single-colour path of linear_to_lab (Python floats) gives the array path's values exactly, on both
+    sides of the linear segment near black and above white."""
+    rng = np.random.default_rng(0)
+    colours = np.concatenate([rng.random((300, 3)), rng.random((300, 3)) * 0.02, rng.random((50, 3)) * 3.0])
+    colours[:5] = 0.0
+    for colour in colours:
+        np.testing.assert_array_equal(linear_to_lab(colour), linear_to_lab(colour[None, :])[0])
+    assert linear_to_lab(np.float32([0.2, 0.3, 0.1])).dtype == np.float32

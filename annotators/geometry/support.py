@@ -1,0 +1,266 @@
+"""Pieces that are no object by themselves, on the organized grid: they join the object they belong to.
+
+Every object rests on something: the support plane, or another object it stands on. A piece of a segmentation
+that does neither is part of an object it touches. Such a piece is smaller than that neighbour, much of its
+footprint lies within the neighbour's (its points over the area the neighbour's convex hull covers on the plane),
+its lowest heights are above the neighbour's - it does not reach the table beside the neighbour - and they reach
+down into the lower part of the neighbour's heights, so it cannot rest on the neighbour's top either. The inside
+of a mug or bowl seen over its rim together with the rim and the handle's top is such a piece: the convexity
+grouping cuts it from the outside along the concave fold of the inner wall. Two solid objects standing side by
+side have footprints apart, an object standing on another starts at the other's top, and a can standing in a bowl
+is larger than the piece of the bowl's outside it touches; none of them is joined (:func:`join_unsupported`).
+
+A small piece can also stick out of a larger one: a drill's chuck leaves the body's front face at a concave fold,
+where the convexity grouping cuts it off. A piece at most a quarter of a neighbour's size whose surface touches the
+neighbour's in 3-D along most of their shared border, and whose heights lie within the neighbour's, joins it
+(:func:`join_appendages`). An object standing beside another touches it along a line at most; along the rest of
+their shared border in the image one hides the other behind a depth jump.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import cv2
+import numpy as np
+
+from annotators.geometry.grid_segmentation import (
+    boundaries,
+    bounding_box,
+    inside_share,
+    join_labels,
+    pixel_footprint,
+    touching_pairs,
+)
+
+
+@dataclass(frozen=True)
+class SupportRules:
+    """Thresholds of :func:`join_unsupported`: the share of a piece's footprint that must lie within its holder's
+    hull (``held_share``: most of it; a handle beside the body may take up the rest), the height noise (metres) by
+    which its lowest heights must exceed the holder's (``tolerance``), the share of the holder's heights (from its
+    5 % to its 95 % height) its lowest heights must lie below (``reach_down``), the raster cell of the footprints
+    (metres) and
+    the spacing of the grid pixels sampled for heights and footprints (``sample_step``)."""
+
+    held_share: float = 0.5
+    tolerance: float = 0.003
+    reach_down: float = 0.5
+    cell: float = 0.005
+    sample_step: int = 2
+
+
+@dataclass(frozen=True)
+class PieceSummary:
+    """Per label (index 0 unused) of a labelling: its ``sizes`` in grid pixels, its 5 %, 95 % and 99 % heights
+    above the plane (``low``, ``high``, ``top``; NaN without a sampled point) and its sampled ``feet`` (Nx2 plane
+    coordinates grouped by label: label k owns ``feet[starts[k]:starts[k + 1]]``)."""
+
+    sizes: np.ndarray
+    low: np.ndarray
+    high: np.ndarray
+    top: np.ndarray
+    feet: np.ndarray
+    starts: np.ndarray
+
+    def hull(self, label: int) -> np.ndarray:
+        """The convex hull (Kx2) of the label's sampled feet."""
+        feet = self.feet[self.starts[label] : self.starts[label + 1]]
+        return cv2.convexHull(feet).reshape(-1, 2) if feet.shape[0] >= 3 else feet
+
+
+def summarize_pieces(labels: np.ndarray, plane_points: np.ndarray, sample_step: int) -> PieceSummary:
+    """The :class:`PieceSummary` of ``labels`` from the ``(u, v, height)`` plane coordinates of its pixels
+    (``plane_points``, HxWx3 or (H*W)x3), heights read on every ``sample_step``-th pixel, with one sort."""
+    count = int(labels.max(initial=0)) + 1
+    sizes = np.bincount(labels.reshape(-1), minlength=count)
+    step = max(1, sample_step)
+    sampled = labels[::step, ::step]
+    grid = plane_points.reshape(*labels.shape, 3)[::step, ::step]
+    where = (sampled > 0) & np.isfinite(grid[..., 2])
+    chosen = grid[where]
+    # one sort by label, then height: heights (metres, within +-0.49 of the plane) as the fraction of the key
+    keys = sampled[where] + (np.clip(chosen[:, 2], -0.49, 0.49) + 0.5)
+    order = np.argsort(keys)
+    ordered = keys[order]
+    starts = np.searchsorted(ordered, np.arange(count + 1, dtype=np.float64))
+    counts = np.diff(starts)
+    quantiles = []
+    for share in (0.05, 0.95, 0.99):
+        index = np.minimum(starts[:-1] + np.round(share * np.maximum(counts - 1, 0)).astype(np.intp), ordered.size - 1)
+        values = ordered[np.maximum(index, 0)] - np.arange(count) - 0.5 if ordered.size else np.zeros(count)
+        quantiles.append(np.where(counts > 0, values, np.nan))
+    feet = np.ascontiguousarray(chosen[order, :2], dtype=np.float32)
+    return PieceSummary(sizes, *quantiles, feet, starts)
+
+
+def unsupported_holders(
+    labels: np.ndarray, plane_points: np.ndarray, rules: SupportRules, pieces: PieceSummary | None = None
+) -> list[tuple[int, int]]:
+    """``(piece, holder)`` pairs: each piece that cannot stand by itself with the touching neighbour whose hull
+    holds the largest share of its footprint (see the module docstring); ``plane_points`` are the ``(u, v,
+    height)`` plane coordinates of every pixel of ``labels`` (HxWx3 or (H*W)x3), ``pieces`` their summary when
+    already made."""
+    pairs = touching_pairs(labels)
+    if pairs.shape[0] == 0:
+        return []
+    pieces = pieces or summarize_pieces(labels, plane_points, rules.sample_step)
+    both = np.concatenate([pairs, pairs[:, ::-1]])  # (piece, holder) both ways round
+    piece_low, holder_low, holder_high = pieces.low[both[:, 0]], pieces.low[both[:, 1]], pieces.high[both[:, 1]]
+    with np.errstate(invalid="ignore"):
+        candidates = (
+            (piece_low > holder_low + rules.tolerance)
+            & (piece_low < holder_low + rules.reach_down * (holder_high - holder_low))
+            & (pieces.sizes[both[:, 1]] >= pieces.sizes[both[:, 0]])  # a piece of an object is smaller than the rest
+        )
+    hulls: dict[int, np.ndarray] = {}
+    best: dict[int, tuple[float, int]] = {}
+    for piece, holder in both[candidates].tolist():
+        for label in (piece, holder):
+            if label not in hulls:
+                hulls[label] = pieces.hull(label)
+        if hulls[piece].shape[0] < 3 or hulls[holder].shape[0] < 3:
+            continue
+        share = inside_share(hulls[piece], hulls[holder], rules.cell)
+        if share >= rules.held_share and share > best.get(piece, (-1.0, 0))[0]:
+            best[piece] = (share, holder)
+    return [(piece, holder) for piece, (_, holder) in best.items()]
+
+
+def join_unsupported(labels: np.ndarray, plane_points: np.ndarray, rules: SupportRules | None = None) -> np.ndarray:
+    """Labels with every piece that cannot stand by itself joined to the neighbour that holds it, repeated while
+    a join makes another piece held (a mug's inside first joins its outside, whose footprint then holds the rim
+    and handle); renumbered 1..n when anything joined."""
+    return _join_unsupported(labels, plane_points, rules or SupportRules())[0]
+
+
+def _join_unsupported(
+    labels: np.ndarray, plane_points: np.ndarray, rules: SupportRules
+) -> tuple[np.ndarray, PieceSummary]:
+    """:func:`join_unsupported` and the summary of the labels it returns."""
+    pieces = summarize_pieces(labels, plane_points, rules.sample_step)
+    for _ in range(int(labels.max(initial=0))):
+        joins = unsupported_holders(labels, plane_points, rules, pieces)
+        if not joins:
+            break
+        labels = join_labels(labels, joins)
+        pieces = summarize_pieces(labels, plane_points, rules.sample_step)
+    return labels, pieces
+
+
+@dataclass(frozen=True)
+class AppendageRules:
+    """Thresholds of :func:`join_appendages`: a piece at most ``small_share`` of its neighbour's size, touching it
+    in 3-D (close, see :class:`~annotators.geometry.grid_segmentation.Boundaries`) along at least ``close_share``
+    of their shared border and ``boundary_share`` times the square root of its size (at least ``min_boundary``
+    pixel pairs), its heights (5 %-95 %) within the neighbour's (5 %-99 %, ``tolerance`` metres of slack); depth
+    jumps as the segmenter's (``jump_absolute + jump_relative * nearer depth``); heights sampled on every
+    ``sample_step``-th pixel."""
+
+    small_share: float = 0.25
+    close_share: float = 0.6
+    boundary_share: float = 0.6
+    min_boundary: int = 3
+    tolerance: float = 0.003
+    jump_absolute: float = 0.01
+    jump_relative: float = 0.01
+    sample_step: int = 2
+
+
+_BORDER_REACH = 2
+"""Pixels beside a border that :func:`~annotators.geometry.grid_segmentation.boundaries` reads on either side."""
+
+_FOOTPRINT_ROWS = 8
+"""The pixel footprint (the angle between neighbouring pixels) is measured on every this many rows of the grid."""
+
+
+def appendage_owners(
+    labels: np.ndarray,
+    points: np.ndarray,
+    normals: np.ndarray,
+    plane_points: np.ndarray,
+    rules: AppendageRules,
+    pieces: PieceSummary | None = None,
+) -> list[tuple[int, int]]:
+    """``(piece, owner)`` pairs of :func:`join_appendages`: each small piece with the neighbour it touches along
+    the longest close border among those that qualify (``pieces``: the labels' summary when already made). Sizes
+    and heights are checked first; the borders are measured only in the window around the pieces that pass."""
+    pairs = touching_pairs(labels)
+    if pairs.shape[0] == 0:
+        return []
+    pieces = pieces or summarize_pieces(labels, plane_points, rules.sample_step)
+    both = np.concatenate([pairs, pairs[:, ::-1]])
+    with np.errstate(invalid="ignore"):
+        fits = (
+            (pieces.sizes[both[:, 0]] <= rules.small_share * pieces.sizes[both[:, 1]])
+            & (pieces.low[both[:, 0]] >= pieces.low[both[:, 1]] - rules.tolerance)
+            & (pieces.high[both[:, 0]] <= pieces.top[both[:, 1]] + rules.tolerance)
+        )
+    if not fits.any():
+        return []
+    involved = np.zeros(pieces.sizes.size, dtype=bool)
+    involved[both[fits].reshape(-1)] = True
+    small = np.zeros(pieces.sizes.size, dtype=bool)
+    small[both[fits, 0]] = True
+    x0, y0, x1, y1 = bounding_box(small[labels], margin=_BORDER_REACH + 1)
+    window = labels[y0:y1, x0:x1]
+    surface = boundaries(
+        np.where(involved[window], window, 0),  # only the borders of the small pieces and their owners
+        points[y0:y1, x0:x1],
+        normals[y0:y1, x0:x1],
+        rules.jump_absolute,
+        rules.jump_relative,
+        reach=_BORDER_REACH,
+        footprint=pixel_footprint(points[::_FOOTPRINT_ROWS]),
+    )
+    fitting = {(int(a), int(b)) for a, b in both[fits].tolist()}
+    best: dict[int, tuple[float, int]] = {}
+    for (a, b), close, length in zip(surface.pairs.tolist(), surface.close, surface.length, strict=True):
+        along = float(close * length)
+        for piece, owner in ((a, b), (b, a)):
+            if (
+                (piece, owner) in fitting
+                and close >= rules.close_share
+                and along >= max(rules.min_boundary, rules.boundary_share * np.sqrt(pieces.sizes[piece]))
+                and along > best.get(piece, (-1.0, 0))[0]
+            ):
+                best[piece] = (along, owner)
+    return [(piece, owner) for piece, (_, owner) in best.items()]
+
+
+def join_appendages(
+    labels: np.ndarray,
+    points: np.ndarray,
+    normals: np.ndarray,
+    plane_points: np.ndarray,
+    rules: AppendageRules | None = None,
+) -> np.ndarray:
+    """Labels with every small piece joined to the larger neighbour it sticks out of (see :class:`AppendageRules`;
+    ``points`` and ``normals`` HxWx3 in the camera frame, ``plane_points`` the pixels' ``(u, v, height)``): a piece
+    a quarter of a neighbour's size or less whose surface touches the neighbour's in 3-D along most of their shared
+    border, and which lies within the neighbour's heights - a drill's chuck cut off at the concave fold where it
+    leaves the body, a cup's far inner wall. Objects standing side by side touch along a line at most; along the
+    rest of their shared border in the image one hides the other (a depth jump)."""
+    joins = appendage_owners(labels, points, normals, plane_points, rules or AppendageRules())
+    return join_labels(labels, joins) if joins else labels
+
+
+def join_pieces(
+    labels: np.ndarray,
+    points: np.ndarray,
+    normals: np.ndarray,
+    plane_points: np.ndarray,
+    support: SupportRules | None,
+    appendages: AppendageRules | None,
+) -> np.ndarray:
+    """:func:`join_unsupported` (unless ``support`` is None), then :func:`join_appendages` (unless ``appendages``
+    is None), summarizing the pieces once where the first joined nothing."""
+    pieces = None
+    if support is not None:
+        labels, pieces = _join_unsupported(labels, plane_points, support)
+        if appendages is not None and appendages.sample_step != support.sample_step:
+            pieces = None
+    if appendages is None:
+        return labels
+    joins = appendage_owners(labels, points, normals, plane_points, appendages, pieces)
+    return join_labels(labels, joins) if joins else labels
