@@ -131,8 +131,8 @@ def profile_handle(points: np.ndarray, bottom: float, height: float) -> tuple[bo
     if profile is None or np.count_nonzero(middle) < 20:
         return False, 0.0
     offsets = points[middle, :2] - profile.centre
-    excess = np.linalg.norm(offsets, axis=1) - profile.radius_at(z[middle])
     radius = profile.radius_at(z[middle])
+    excess = np.linalg.norm(offsets, axis=1) - radius
     out = excess > np.maximum(0.01, HANDLE_GAP * radius)
     if np.count_nonzero(out) < max(8, HANDLE_MIN_SHARE * out.size):
         return False, 0.0
