@@ -4,8 +4,19 @@ Measured on the hypothesis' points in the upright support frame (:mod:`annotator
 
 * **height over width**: the height (top at the 98 % height quantile; bottom at the support, or the 2 % quantile
   without one) over the footprint's longer extent (2 % to 98 % along its principal axes);
-* **handle**: the body is the circle fitted to the footprint of the lowest part (up to ``BODY_SLICE`` of the
-  height), where a handle never is. A handle is a clump of points of the middle part sticking out of that circle
+* **handle**: looked for on the points that are not grazing (:mod:`annotators.geometry.grazing`: the streaks of
+  stray points along an object's outline, where lines of sight cross a depth jump, stick out of it like a handle).
+  The body is modelled twice, and a handle sticking out of either is one:
+
+  - as a surface of revolution (:mod:`annotators.cloud.body_profile`: one axis, a radius per height band, which
+    follows a tapered mug or a wider base). A handle is a clump of points of the middle part sticking out of it by
+    more than ``HANDLE_GAP`` of the radius at their height (and at least 1 cm), in a narrow direction (circular
+    spread under ``HANDLE_SPREAD``), that makes up at least ``HANDLE_SECTOR_SHARE`` of the middle part seen within
+    ``HANDLE_SECTOR`` of that direction (a handle stands out of what is seen there; the corner of a box or the
+    flat side of an oblong bottle is a small fringe of a broad face);
+  - as the circle fitted to the footprint of the lowest part (up to ``BODY_SLICE`` of the height), where a handle
+    never is (seen as a half arc, this circle often comes out too wide, but it still finds a small handle seen
+    end-on, which the profile absorbs). A handle is a clump of points of the middle part sticking out of that circle
   by more than ``HANDLE_GAP`` of its radius, in a narrow direction (circular spread under ``HANDLE_SPREAD``),
   while the lowest part does not stick out there (a wider base is no handle). Its confidence grows with its
   points up to ``HANDLE_POINTS``; the confidence that there is none grows with how much of the middle part was
@@ -39,8 +50,10 @@ from typing import ClassVar
 import numpy as np
 from scipy.spatial import ConvexHull, QhullError
 
+from annotators.cloud.body_profile import body_profile
 from annotators.cloud.cloud_expert import CloudExpert
 from annotators.cloud.shape import circle_fit
+from annotators.geometry.grazing import grazing_pixels
 from annotators.geometry.support_frame import SupportFrame, sampled_indices, support_frame, usable_plane
 from robokudo.core.capability import Capability
 from robokudo.core.types import CameraInfo, CasType, FormFeatures, ObjectHypothesis, Plane, PointCloud
@@ -53,6 +66,10 @@ HANDLE_GAP = 0.25
 """A handle point lies farther than (1 + this) body radii (and at least 1 cm more) from the body's axis."""
 HANDLE_SPREAD = np.radians(40.0)
 """A handle's points point in one direction: their circular standard deviation around the axis is below this."""
+HANDLE_SECTOR = np.radians(30.0)
+"""The directions within this angle of a handle's are where it is seen (for ``HANDLE_SECTOR_SHARE``)."""
+HANDLE_SECTOR_SHARE = 0.25
+"""A handle sticking out of the body profile makes up at least this share of the middle part seen in its sector."""
 HANDLE_MIN_SHARE = 0.02
 """A handle holds at least this share of the middle part's points (and 8 points)."""
 HANDLE_POINTS = 20
@@ -101,8 +118,47 @@ def _circular_spread(angles: np.ndarray) -> float:
     return float(np.sqrt(-2.0 * np.log(max(length, 1e-12))))
 
 
+def _angle_to(angles: np.ndarray, direction: float) -> np.ndarray:
+    return np.abs(np.angle(np.exp(1j * (angles - direction))))
+
+
+def profile_handle(points: np.ndarray, bottom: float, height: float) -> tuple[bool, float]:
+    """Whether a handle sticks out of the body profile (see the module docstring), and the confidence that it does
+    (0 without)."""
+    profile = body_profile(points, bottom, height)
+    z = points[:, 2] - bottom
+    middle = (z >= HANDLE_BAND[0] * height) & (z <= HANDLE_BAND[1] * height)
+    if profile is None or np.count_nonzero(middle) < 20:
+        return False, 0.0
+    offsets = points[middle, :2] - profile.centre
+    radius = profile.radius_at(z[middle])
+    excess = np.linalg.norm(offsets, axis=1) - radius
+    out = excess > np.maximum(0.01, HANDLE_GAP * radius)
+    if np.count_nonzero(out) < max(8, HANDLE_MIN_SHARE * out.size):
+        return False, 0.0
+    angles = np.arctan2(offsets[:, 1], offsets[:, 0])
+    if _circular_spread(angles[out]) > HANDLE_SPREAD:
+        return False, 0.0
+    direction = float(np.arctan2(np.sin(angles[out]).mean(), np.cos(angles[out]).mean()))
+    sector = _angle_to(angles, direction) < HANDLE_SECTOR
+    if np.count_nonzero(out & sector) < HANDLE_SECTOR_SHARE * np.count_nonzero(sector):
+        return False, 0.0
+    return True, min(1.0, np.count_nonzero(out) / HANDLE_POINTS)
+
+
 def handle_evidence(points: np.ndarray, bottom: float, height: float) -> tuple[bool, float]:
-    """Whether a handle sticks out of the body's side, and the confidence of that (see the module docstring)."""
+    """Whether a handle sticks out of the body's side, and the confidence of that (see the module docstring); the
+    points should hold no grazing ones."""
+    found, confidence = profile_handle(points, bottom, height)
+    circle = foot_circle_handle(points, bottom, height)
+    if found and not circle[0]:
+        return True, confidence
+    return circle
+
+
+def foot_circle_handle(points: np.ndarray, bottom: float, height: float) -> tuple[bool, float]:
+    """Whether a handle sticks out of the circle fitted to the foot, and the confidence of that (see the module
+    docstring)."""
     z = points[:, 2] - bottom
     body = points[z <= BODY_SLICE * height, :2]
     middle = points[(z >= HANDLE_BAND[0] * height) & (z <= HANDLE_BAND[1] * height), :2]
@@ -192,9 +248,9 @@ def open_evidence(points: np.ndarray, bottom: float, height: float, camera: np.n
     return share > OPEN_SHARE, clearness * min(1.0, points.shape[0] / FULL_EVIDENCE)
 
 
-def measure_form(points: np.ndarray, frame: SupportFrame) -> Form | None:
+def measure_form(points: np.ndarray, frame: SupportFrame, grazing: np.ndarray | None = None) -> Form | None:
     """The form features of an object's Nx3 points in ``frame`` (upright); None for fewer than 20 points or no
-    height or width."""
+    height or width. ``grazing`` marks the points left out of the handle cue (:mod:`annotators.geometry.grazing`)."""
     if points.shape[0] < 20:
         return None
     z = points[:, 2]
@@ -203,7 +259,8 @@ def measure_form(points: np.ndarray, frame: SupportFrame) -> Form | None:
     width = _extent(points[:, :2])
     if height <= 0.0 or width <= 0.0:
         return None
-    handle, handle_confidence = handle_evidence(points, bottom, height)
+    seen = points if grazing is None else points[~grazing]
+    handle, handle_confidence = handle_evidence(seen, bottom, height)
     open_top, open_confidence = open_evidence(points, bottom, height, frame.camera_to_frame[:3, 3])
     return Form(height / width, handle, handle_confidence, open_top, open_confidence)
 
@@ -241,7 +298,8 @@ class FormAnnotator(CloudExpert):
         measured = 0
         for hypothesis in hypotheses:
             indices = sampled_indices(cloud, hypothesis, self.max_points)
-            form = measure_form(frame.points(flat[indices].astype(np.float64)), frame)
+            grazing = grazing_pixels(cloud.points, indices)
+            form = measure_form(frame.points(flat[indices].astype(np.float64)), frame, grazing)
             if form is None:
                 continue
             self.attach(

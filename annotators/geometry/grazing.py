@@ -1,0 +1,35 @@
+"""Grazing points: measured pixels whose surface runs nearly along the camera's line of sight.
+
+Where a line of sight grazes a surface, or crosses a depth jump (a pixel mixing the depth of an object's outline
+with the depth behind or in front of it), the points of neighbouring pixels lie one behind the other along the line
+of sight instead of side by side: streaks of stray points that stick out of an object's outline seen from above.
+A pixel is grazing when, to one of its 4-neighbours on the grid, the step between their points runs more than
+``ratio`` times as far along its line of sight as across it (the surface is within ``atan(1 / ratio)`` of the line of
+sight); no surface is measured reliably at such an angle.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+
+GRAZING_RATIO = 5.0
+"""A surface seen within about 11 degrees (atan(1/5)) of the line of sight is grazing."""
+
+
+def grazing_pixels(points: np.ndarray, pixels: np.ndarray, ratio: float = GRAZING_RATIO) -> np.ndarray:
+    """Which of the flat ``pixels`` of the HxWx3 camera-frame ``points`` are grazing (see the module docstring);
+    a pixel without a finite point, or whose neighbours have none, is not."""
+    height, width = points.shape[:2]
+    rows, cols = np.divmod(np.asarray(pixels, dtype=np.int64), width)
+    here = points[rows, cols].astype(np.float64)
+    with np.errstate(invalid="ignore", divide="ignore"):
+        sight = here / np.linalg.norm(here, axis=1, keepdims=True)
+    grazing = np.zeros(rows.size, dtype=bool)
+    for step_row, step_col in ((0, 1), (0, -1), (1, 0), (-1, 0)):
+        other = points[np.clip(rows + step_row, 0, height - 1), np.clip(cols + step_col, 0, width - 1)]
+        step = other.astype(np.float64) - here
+        along = (step * sight).sum(axis=1)
+        across = np.linalg.norm(step - along[:, None] * sight, axis=1)
+        with np.errstate(invalid="ignore"):
+            grazing |= np.abs(along) > ratio * np.maximum(across, 1e-9)
+    return grazing
