@@ -809,3 +809,30 @@ def strided_crop(values: np.ndarray, step: int, x0: int, y0: int, x1: int, y1: i
             for k in range(channels):
                 crop[r, c, k] = values[(r + y0) * step, (c + x0) * step, k]
     return crop
+
+
+@njit(cache=True, nogil=True)
+def groups_unless_apart(count: int, pairs: np.ndarray, apart: np.ndarray) -> np.ndarray:
+    """See :func:`annotators.geometry.grid_kernels.groups_unless_apart`."""
+    parent = np.arange(count)
+    apart_roots = apart.copy()  # the groups of the two nodes of every apart pair, kept up to date
+    for k in range(pairs.shape[0]):
+        first, second = _root(parent, pairs[k, 0]), _root(parent, pairs[k, 1])
+        if first == second:
+            continue
+        kept_apart = False
+        for m in range(apart_roots.shape[0]):
+            a, b = apart_roots[m, 0], apart_roots[m, 1]
+            if (a == first and b == second) or (a == second and b == first):
+                kept_apart = True
+                break
+        if kept_apart:
+            continue
+        parent[second] = first
+        for m in range(apart_roots.shape[0]):
+            for side in range(2):
+                if apart_roots[m, side] == second:
+                    apart_roots[m, side] = first
+    for node in range(count):
+        parent[node] = _root(parent, node)
+    return parent

@@ -16,6 +16,7 @@ import numpy as np
 from annotators.geometry.grid_kernels import (
     boundary_pairs,
     connected_parts,
+    groups_unless_apart,
     nearest_seed_labels,
     seam_pixels,
     surface_growth,
@@ -717,34 +718,9 @@ def merge_parts(
 def join_unless_apart(count: int, pairs: np.ndarray, apart: np.ndarray) -> np.ndarray:
     """Group labels of ``count`` nodes: the ``pairs`` (Kx2) joined in the order given, except where joining would
     put the two nodes of an ``apart`` pair (Mx2) into one group (direct evidence that two parts are separate
-    outweighs an indirect path between them)."""
-    parent = list(range(count))
-    keep_apart: dict[int, set[int]] = {}
-    for a, b in apart.tolist():
-        keep_apart.setdefault(a, set()).add(b)
-        keep_apart.setdefault(b, set()).add(a)
-
-    def root(node: int) -> int:
-        while parent[node] != node:
-            parent[node] = parent[parent[node]]
-            node = parent[node]
-        return node
-
-    for a, b in pairs.tolist():
-        ra, rb = root(a), root(b)
-        if ra == rb:
-            continue
-        against_a, against_b = keep_apart.get(ra, set()), keep_apart.get(rb, set())
-        if any(root(n) == rb for n in against_a) or any(root(n) == ra for n in against_b):
-            continue
-        parent[rb] = ra
-        keep_apart[ra] = against_a | against_b
-    roots = np.array(parent, dtype=np.int64)
-    while True:  # follow the parent pointers to the roots, all nodes at once
-        above = roots[roots]
-        if np.array_equal(above, roots):
-            return roots
-        roots = above
+    outweighs an indirect path between them). Each node's group is its root node (int64), the first node of the
+    pair that founded or extended the group."""
+    return groups_unless_apart(count, pairs, apart)
 
 
 def bounding_box(mask: np.ndarray, margin: int = 0) -> tuple[int, int, int, int]:

@@ -14,6 +14,7 @@ from annotators.geometry.grid_kernels import (
     finite_rows,
     graph_components,
     grouped_pixels,
+    groups_unless_apart,
     jump_between,
     label_pixels,
     nearest_seed_labels,
@@ -260,3 +261,44 @@ def test_upsampled_labels_keep_the_cell_label_where_no_depth_jump_parts_them(ste
     jump = depth_jump(depth, coarse_depth[cell_rows, cell_cols], 0.01, 0.01)
     expected = np.where(keep & ~jump, labels[cell_rows, cell_cols], 0)
     assert np.array_equal(upsampled_labels(labels, coarse_depth, depth, keep, step, 0.01, 0.01), expected)
+
+
+def _groups_unless_apart_in_python(count: int, pairs: np.ndarray, apart: np.ndarray) -> np.ndarray:
+    """The union-find with a set of kept-apart nodes per group that :func:`groups_unless_apart` replaces."""
+    parent = list(range(count))
+    keep_apart: dict[int, set[int]] = {}
+    for a, b in apart.tolist():
+        keep_apart.setdefault(a, set()).add(b)
+        keep_apart.setdefault(b, set()).add(a)
+
+    def root(node: int) -> int:
+        while parent[node] != node:
+            parent[node] = parent[parent[node]]
+            node = parent[node]
+        return node
+
+    for a, b in pairs.tolist():
+        ra, rb = root(a), root(b)
+        if ra == rb:
+            continue
+        against_a, against_b = keep_apart.get(ra, set()), keep_apart.get(rb, set())
+        if any(root(n) == rb for n in against_a) or any(root(n) == ra for n in against_b):
+            continue
+        parent[rb] = ra
+        keep_apart[ra] = against_a | against_b
+    return np.array([root(node) for node in range(count)], dtype=np.int64)
+
+
+@pytest.mark.parametrize("seed", range(5))
+def test_groups_unless_apart_give_what_the_python_union_find_gives(seed: int) -> None:
+    rng = np.random.default_rng(seed)
+    kept_apart = 0
+    for _ in range(60):
+        count = int(rng.integers(1, 60))
+        pairs = rng.integers(0, count, (int(rng.integers(0, 80)), 2))
+        apart = rng.integers(0, count, (int(rng.integers(0, 12)), 2))
+        expected = _groups_unless_apart_in_python(count, pairs, apart)
+        np.testing.assert_array_equal(groups_unless_apart(count, pairs, apart), expected)
+        joined_regardless = _groups_unless_apart_in_python(count, pairs, apart[:0])
+        kept_apart += int(np.unique(expected).size > np.unique(joined_regardless).size)
+    assert kept_apart > 0  # some apart pairs did keep groups apart
