@@ -285,3 +285,10 @@ def groups_unless_apart(count: int, pairs: np.ndarray, apart: np.ndarray) -> np.
         np.ascontiguousarray(pairs, dtype=np.int64).reshape(-1, 2),
         np.ascontiguousarray(apart, dtype=np.int64).reshape(-1, 2),
     )
+
+
+def median_pixel_step(points: np.ndarray) -> float:
+    """The median of the non-zero finite ``|x / z|`` differences of horizontally adjacent pixels of an organized
+    cloud (HxWx3, float32 or float64, computed in its precision), 0.0 when there are none: what
+    ``np.median(np.abs(np.diff(x / z, axis=1)))`` over those differences gives."""
+    return _loops().median_pixel_step(points)

@@ -17,6 +17,7 @@ from annotators.geometry.grid_kernels import (
     boundary_pairs,
     connected_parts,
     groups_unless_apart,
+    median_pixel_step,
     nearest_seed_labels,
     seam_pixels,
     surface_growth,
@@ -522,11 +523,7 @@ class Boundaries:
 
 def pixel_footprint(points: np.ndarray) -> float:
     """The angle (radians) between horizontally adjacent pixels of an organized cloud: ``step / fx``."""
-    with np.errstate(invalid="ignore", divide="ignore"):
-        ratio = points[..., 0] / points[..., 2]
-        steps = np.abs(np.diff(ratio, axis=1))
-    steps = steps[np.isfinite(steps) & (steps > 0)]
-    return float(_median(steps)) if steps.size else 0.0
+    return median_pixel_step(points)
 
 
 def boundaries(
