@@ -862,3 +862,32 @@ def median_pixel_step(points: np.ndarray) -> float:
     upper = ordered[high]
     lower = upper if low == high else ordered[:high].max()
     return float((lower + upper) / 2)  # the sum in the points' precision; halving it is exact
+
+
+@njit(cache=True, nogil=True)
+def joined_labels(labels: np.ndarray, pairs: np.ndarray) -> np.ndarray:
+    """See :func:`annotators.geometry.grid_kernels.joined_labels`."""
+    rows, cols = labels.shape
+    count = 1
+    for r in range(rows):
+        for c in range(cols):
+            count = max(count, labels[r, c] + 1)
+    parent = np.arange(count)
+    for k in range(pairs.shape[0]):
+        a, b = _root(parent, pairs[k, 0]), _root(parent, pairs[k, 1])
+        parent[max(a, b)] = min(a, b)  # each group's root is its smallest label
+    present = np.zeros(count, dtype=np.bool_)
+    for r in range(rows):
+        for c in range(cols):
+            present[labels[r, c]] = True
+    number = np.zeros(count, dtype=np.int32)  # each root's new label, in order of the groups' first present label
+    renumber = np.zeros(count, dtype=np.int32)
+    numbered = 0
+    for label in range(1, count):
+        if present[label]:
+            root = _root(parent, label)
+            if number[root] == 0:
+                numbered += 1
+                number[root] = numbered
+            renumber[label] = number[root]
+    return _looked_up(renumber, labels)

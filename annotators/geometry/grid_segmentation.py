@@ -17,6 +17,7 @@ from annotators.geometry.grid_kernels import (
     boundary_pairs,
     connected_parts,
     groups_unless_apart,
+    joined_labels,
     median_pixel_step,
     nearest_seed_labels,
     seam_pixels,
@@ -259,25 +260,7 @@ def _filled(vertices: np.ndarray, box: Sequence[int]) -> np.ndarray:
 
 def join_labels(labels: np.ndarray, pairs: list[tuple[int, int]]) -> np.ndarray:
     """Labels with every connected group of ``pairs`` joined, renumbered 1..n in order of first label."""
-    count = int(labels.max(initial=0)) + 1
-    root = list(range(count))  # union-find over the few labels; each group's root is its smallest label
-
-    def find(node: int) -> int:
-        while root[node] != node:
-            root[node] = root[root[node]]
-            node = root[node]
-        return node
-
-    for a, b in pairs:
-        ra, rb = find(int(a)), find(int(b))
-        if ra != rb:
-            root[max(ra, rb)] = min(ra, rb)
-    present = np.bincount(labels.reshape(-1), minlength=count) > 0
-    renumber = np.zeros(count, dtype=np.int32)
-    numbers: dict[int, int] = {}
-    for label in np.flatnonzero(present[1:]).tolist():
-        renumber[label + 1] = numbers.setdefault(find(label + 1), len(numbers) + 1)
-    return renumber[labels]
+    return joined_labels(np.asarray(labels), np.asarray(pairs, dtype=np.int64))
 
 
 def _range(values: np.ndarray, low: float, high: float) -> tuple[float, float]:

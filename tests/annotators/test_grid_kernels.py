@@ -15,6 +15,7 @@ from annotators.geometry.grid_kernels import (
     graph_components,
     grouped_pixels,
     groups_unless_apart,
+    joined_labels,
     jump_between,
     label_pixels,
     median_pixel_step,
@@ -330,3 +331,40 @@ def test_median_pixel_step_gives_what_numpy_gives(seed: int, dtype: type) -> Non
 def test_median_pixel_step_of_a_cloud_without_steps_is_zero() -> None:
     assert median_pixel_step(np.full((4, 1, 3), 1.0, dtype=np.float32)) == 0.0
     assert median_pixel_step(np.full((3, 5, 3), np.nan, dtype=np.float32)) == 0.0
+
+
+def _joined_labels_in_python(labels: np.ndarray, pairs: np.ndarray) -> np.ndarray:
+    """The Python union-find and numpy renumbering :func:`joined_labels` replaces."""
+    count = int(labels.max(initial=0)) + 1
+    root = list(range(count))
+
+    def find(node: int) -> int:
+        while root[node] != node:
+            root[node] = root[root[node]]
+            node = root[node]
+        return node
+
+    for a, b in pairs.tolist():
+        ra, rb = find(a), find(b)
+        if ra != rb:
+            root[max(ra, rb)] = min(ra, rb)
+    present = np.bincount(labels.reshape(-1), minlength=count) > 0
+    renumber = np.zeros(count, dtype=np.int32)
+    numbers: dict[int, int] = {}
+    for label in np.flatnonzero(present[1:]).tolist():
+        renumber[label + 1] = numbers.setdefault(find(label + 1), len(numbers) + 1)
+    return renumber[labels]
+
+
+@pytest.mark.parametrize("seed", range(5))
+def test_joined_labels_give_what_the_python_union_find_gives(seed: int) -> None:
+    rng = np.random.default_rng(seed)
+    labels = _blobs(seed)
+    labels[labels == 2] = 0  # a label missing from the image, which pairs may still name
+    count = int(labels.max()) + 1
+    for size in (0, 1, 3, 8):
+        pairs = rng.integers(1, count, (size, 2))
+        joined = joined_labels(labels, pairs)
+        assert joined.dtype == np.int32
+        np.testing.assert_array_equal(joined, _joined_labels_in_python(labels, pairs))
+    np.testing.assert_array_equal(joined_labels(np.zeros((3, 4), np.int32), np.zeros((0, 2))), np.zeros((3, 4)))
