@@ -287,13 +287,6 @@ def groups_unless_apart(count: int, pairs: np.ndarray, apart: np.ndarray) -> np.
     )
 
 
-def median_pixel_step(points: np.ndarray) -> float:
-    """The median of the non-zero finite ``|x / z|`` differences of horizontally adjacent pixels of an organized
-    cloud (HxWx3, float32 or float64, computed in its precision), 0.0 when there are none: what
-    ``np.median(np.abs(np.diff(x / z, axis=1)))`` over those differences gives."""
-    return _loops().median_pixel_step(points)
-
-
 def joined_labels(labels: np.ndarray, pairs: np.ndarray) -> np.ndarray:
     """HxW int32: ``labels`` (HxW, non-negative integers) with every connected group of the label ``pairs`` (Kx2)
     joined, renumbered 1..n in order of each group's smallest present label (0 stays 0)."""

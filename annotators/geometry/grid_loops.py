@@ -838,32 +838,6 @@ def groups_unless_apart(count: int, pairs: np.ndarray, apart: np.ndarray) -> np.
     return parent
 
 
-@njit(cache=True, nogil=True, error_model="numpy")  # x / 0 is inf or NaN, as in numpy
-def median_pixel_step(points: np.ndarray) -> float:
-    """See :func:`annotators.geometry.grid_kernels.median_pixel_step`."""
-    rows, cols = points.shape[0], points.shape[1]
-    steps = np.empty(rows * max(cols - 1, 0), dtype=points.dtype)
-    count = 0
-    for r in range(rows):
-        if cols < 2:
-            break
-        before = points[r, 0, 0] / points[r, 0, 2]
-        for c in range(1, cols):
-            ratio = points[r, c, 0] / points[r, c, 2]
-            step = abs(ratio - before)
-            if np.isfinite(step) and step > 0:
-                steps[count] = step
-                count += 1
-            before = ratio
-    if count == 0:
-        return 0.0
-    low, high = (count - 1) // 2, count // 2
-    ordered = np.partition(steps[:count], high)
-    upper = ordered[high]
-    lower = upper if low == high else ordered[:high].max()
-    return float((lower + upper) / 2)  # the sum in the points' precision; halving it is exact
-
-
 @njit(cache=True, nogil=True)
 def joined_labels(labels: np.ndarray, pairs: np.ndarray) -> np.ndarray:
     """See :func:`annotators.geometry.grid_kernels.joined_labels`."""

@@ -18,7 +18,6 @@ from annotators.geometry.grid_kernels import (
     connected_parts,
     groups_unless_apart,
     joined_labels,
-    median_pixel_step,
     nearest_seed_labels,
     seam_pixels,
     surface_growth,
@@ -506,7 +505,11 @@ class Boundaries:
 
 def pixel_footprint(points: np.ndarray) -> float:
     """The angle (radians) between horizontally adjacent pixels of an organized cloud: ``step / fx``."""
-    return median_pixel_step(points)
+    with np.errstate(invalid="ignore", divide="ignore"):
+        ratio = points[..., 0] / points[..., 2]
+        steps = np.abs(np.diff(ratio, axis=1))
+    steps = steps[np.isfinite(steps) & (steps > 0)]
+    return float(_median(steps)) if steps.size else 0.0
 
 
 def boundaries(

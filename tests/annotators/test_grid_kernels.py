@@ -18,7 +18,6 @@ from annotators.geometry.grid_kernels import (
     joined_labels,
     jump_between,
     label_pixels,
-    median_pixel_step,
     nearest_seed_labels,
     shadowed_near,
     strided_crop,
@@ -304,33 +303,6 @@ def test_groups_unless_apart_give_what_the_python_union_find_gives(seed: int) ->
         joined_regardless = _groups_unless_apart_in_python(count, pairs, apart[:0])
         kept_apart += int(np.unique(expected).size > np.unique(joined_regardless).size)
     assert kept_apart > 0  # some apart pairs did keep groups apart
-
-
-def _median_pixel_step_in_numpy(points: np.ndarray) -> float:
-    """The whole-array form :func:`median_pixel_step` replaces."""
-    with np.errstate(invalid="ignore", divide="ignore"):
-        steps = np.abs(np.diff(points[..., 0] / points[..., 2], axis=1))
-    steps = steps[np.isfinite(steps) & (steps > 0)]
-    return float(np.median(steps)) if steps.size else 0.0
-
-
-@pytest.mark.parametrize("seed", range(6))
-@pytest.mark.parametrize("dtype", [np.float32, np.float64])
-def test_median_pixel_step_gives_what_numpy_gives(seed: int, dtype: type) -> None:
-    rng = np.random.default_rng(seed)
-    rows, cols = int(rng.integers(1, 40)), int(rng.integers(1, 50))
-    points = rng.normal(0.0, 0.3, (rows, cols, 3)).astype(dtype)
-    points[..., 2] = rng.uniform(0.4, 2.0, (rows, cols))
-    points[rng.random((rows, cols)) < 0.2] = np.nan
-    points[rng.random((rows, cols)) < 0.05, 2] = 0.0  # an infinite ratio
-    points[:, : cols // 3] = points[:, :1]  # equal neighbours: steps of zero, left out
-    for view in (points, points[::2], points[1::3, 1:]):
-        assert median_pixel_step(view) == _median_pixel_step_in_numpy(view)
-
-
-def test_median_pixel_step_of_a_cloud_without_steps_is_zero() -> None:
-    assert median_pixel_step(np.full((4, 1, 3), 1.0, dtype=np.float32)) == 0.0
-    assert median_pixel_step(np.full((3, 5, 3), np.nan, dtype=np.float32)) == 0.0
 
 
 def _joined_labels_in_python(labels: np.ndarray, pairs: np.ndarray) -> np.ndarray:
