@@ -18,6 +18,7 @@ from annotators.geometry.grid_kernels import (
     connected_parts,
     groups_unless_apart,
     joined_labels,
+    label_pixels,
     nearest_seed_labels,
     seam_pixels,
     surface_growth,
@@ -186,14 +187,9 @@ def touching_pairs(labels: np.ndarray) -> np.ndarray:
 
 
 def label_groups(labels: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
-    """Flat pixel indices sorted by label and ``starts`` so label k owns ``pixels[starts[k]:starts[k + 1]]``."""
-    flat = labels.reshape(-1)
-    pixels = np.flatnonzero(flat)
-    values = flat[pixels]
-    if values.size and values.max() < 1 << 16:
-        values = values.astype(np.uint16)  # a stable sort of 16-bit keys is a radix sort: linear time
-    pixels = pixels[np.argsort(values, kind="stable")]
-    starts = np.searchsorted(flat[pixels], np.arange(int(flat.max(initial=0)) + 2))
+    """Flat pixel indices sorted by label (increasing within one) and ``starts`` so label k owns
+    ``pixels[starts[k]:starts[k + 1]]``."""
+    pixels, starts, _ = label_pixels(np.ascontiguousarray(labels))
     return pixels, starts
 
 

@@ -27,7 +27,7 @@ from annotators.geometry.grid_kernels import (
     upsampled_labels,
     window_counts,
 )
-from annotators.geometry.grid_segmentation import bounding_box, depth_jump, depth_seams, grow_on_surface
+from annotators.geometry.grid_segmentation import bounding_box, depth_jump, depth_seams, grow_on_surface, label_groups
 
 
 def _blobs(seed: int, shape: tuple[int, int] = (40, 50), labels: int = 6) -> np.ndarray:
@@ -340,3 +340,16 @@ def test_joined_labels_give_what_the_python_union_find_gives(seed: int) -> None:
         assert joined.dtype == np.int32
         np.testing.assert_array_equal(joined, _joined_labels_in_python(labels, pairs))
     np.testing.assert_array_equal(joined_labels(np.zeros((3, 4), np.int32), np.zeros((0, 2))), np.zeros((3, 4)))
+
+
+@pytest.mark.parametrize("seed", range(3))
+def test_label_groups_are_the_stable_sort_of_the_labelled_pixels(seed: int) -> None:
+    labels = _blobs(seed)
+    labels[labels == 4] = 0  # a label missing in between
+    flat = labels.reshape(-1)
+    pixels = np.flatnonzero(flat)
+    pixels = pixels[np.argsort(flat[pixels], kind="stable")]
+    starts = np.searchsorted(flat[pixels], np.arange(int(flat.max()) + 2))
+    grouped, grouped_starts = label_groups(labels)
+    np.testing.assert_array_equal(grouped, pixels)
+    np.testing.assert_array_equal(grouped_starts, starts)
