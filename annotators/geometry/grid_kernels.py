@@ -274,3 +274,20 @@ def strided_crop(values: np.ndarray, step: int, box: tuple[int, int, int, int]) 
     if values.ndim == 2:
         return _loops().strided_crop(values[..., None], step, x0, y0, x1, y1)[..., 0]
     return _loops().strided_crop(values, step, x0, y0, x1, y1)
+
+
+def groups_unless_apart(count: int, pairs: np.ndarray, apart: np.ndarray) -> np.ndarray:
+    """The group (its root node, int64) of each of ``count`` nodes: the ``pairs`` (Kx2) joined in the order given,
+    the second's group under the first's root, except where that would put the two nodes of an ``apart`` pair (Mx2)
+    into one group."""
+    return _loops().groups_unless_apart(
+        count,
+        np.ascontiguousarray(pairs, dtype=np.int64).reshape(-1, 2),
+        np.ascontiguousarray(apart, dtype=np.int64).reshape(-1, 2),
+    )
+
+
+def joined_labels(labels: np.ndarray, pairs: np.ndarray) -> np.ndarray:
+    """HxW int32: ``labels`` (HxW, non-negative integers) with every connected group of the label ``pairs`` (Kx2)
+    joined, renumbered 1..n in order of each group's smallest present label (0 stays 0)."""
+    return _loops().joined_labels(labels, np.ascontiguousarray(pairs, dtype=np.int64).reshape(-1, 2))

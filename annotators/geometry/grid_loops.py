@@ -809,3 +809,59 @@ def strided_crop(values: np.ndarray, step: int, x0: int, y0: int, x1: int, y1: i
             for k in range(channels):
                 crop[r, c, k] = values[(r + y0) * step, (c + x0) * step, k]
     return crop
+
+
+@njit(cache=True, nogil=True)
+def groups_unless_apart(count: int, pairs: np.ndarray, apart: np.ndarray) -> np.ndarray:
+    """See :func:`annotators.geometry.grid_kernels.groups_unless_apart`."""
+    parent = np.arange(count)
+    apart_roots = apart.copy()  # the groups of the two nodes of every apart pair, kept up to date
+    for k in range(pairs.shape[0]):
+        first, second = _root(parent, pairs[k, 0]), _root(parent, pairs[k, 1])
+        if first == second:
+            continue
+        kept_apart = False
+        for m in range(apart_roots.shape[0]):
+            a, b = apart_roots[m, 0], apart_roots[m, 1]
+            if (a == first and b == second) or (a == second and b == first):
+                kept_apart = True
+                break
+        if kept_apart:
+            continue
+        parent[second] = first
+        for m in range(apart_roots.shape[0]):
+            for side in range(2):
+                if apart_roots[m, side] == second:
+                    apart_roots[m, side] = first
+    for node in range(count):
+        parent[node] = _root(parent, node)
+    return parent
+
+
+@njit(cache=True, nogil=True)
+def joined_labels(labels: np.ndarray, pairs: np.ndarray) -> np.ndarray:
+    """See :func:`annotators.geometry.grid_kernels.joined_labels`."""
+    rows, cols = labels.shape
+    count = 1
+    for r in range(rows):
+        for c in range(cols):
+            count = max(count, labels[r, c] + 1)
+    parent = np.arange(count)
+    for k in range(pairs.shape[0]):
+        a, b = _root(parent, pairs[k, 0]), _root(parent, pairs[k, 1])
+        parent[max(a, b)] = min(a, b)  # each group's root is its smallest label
+    present = np.zeros(count, dtype=np.bool_)
+    for r in range(rows):
+        for c in range(cols):
+            present[labels[r, c]] = True
+    number = np.zeros(count, dtype=np.int32)  # each root's new label, in order of the groups' first present label
+    renumber = np.zeros(count, dtype=np.int32)
+    numbered = 0
+    for label in range(1, count):
+        if present[label]:
+            root = _root(parent, label)
+            if number[root] == 0:
+                numbered += 1
+                number[root] = numbered
+            renumber[label] = number[root]
+    return _looked_up(renumber, labels)

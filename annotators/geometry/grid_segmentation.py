@@ -16,6 +16,9 @@ import numpy as np
 from annotators.geometry.grid_kernels import (
     boundary_pairs,
     connected_parts,
+    groups_unless_apart,
+    joined_labels,
+    label_pixels,
     nearest_seed_labels,
     seam_pixels,
     surface_growth,
@@ -184,14 +187,9 @@ def touching_pairs(labels: np.ndarray) -> np.ndarray:
 
 
 def label_groups(labels: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
-    """Flat pixel indices sorted by label and ``starts`` so label k owns ``pixels[starts[k]:starts[k + 1]]``."""
-    flat = labels.reshape(-1)
-    pixels = np.flatnonzero(flat)
-    values = flat[pixels]
-    if values.size and values.max() < 1 << 16:
-        values = values.astype(np.uint16)  # a stable sort of 16-bit keys is a radix sort: linear time
-    pixels = pixels[np.argsort(values, kind="stable")]
-    starts = np.searchsorted(flat[pixels], np.arange(int(flat.max(initial=0)) + 2))
+    """Flat pixel indices sorted by label (increasing within one) and ``starts`` so label k owns
+    ``pixels[starts[k]:starts[k + 1]]``."""
+    pixels, starts, _ = label_pixels(np.ascontiguousarray(labels))
     return pixels, starts
 
 
@@ -257,25 +255,7 @@ def _filled(vertices: np.ndarray, box: Sequence[int]) -> np.ndarray:
 
 def join_labels(labels: np.ndarray, pairs: list[tuple[int, int]]) -> np.ndarray:
     """Labels with every connected group of ``pairs`` joined, renumbered 1..n in order of first label."""
-    count = int(labels.max(initial=0)) + 1
-    root = list(range(count))  # union-find over the few labels; each group's root is its smallest label
-
-    def find(node: int) -> int:
-        while root[node] != node:
-            root[node] = root[root[node]]
-            node = root[node]
-        return node
-
-    for a, b in pairs:
-        ra, rb = find(int(a)), find(int(b))
-        if ra != rb:
-            root[max(ra, rb)] = min(ra, rb)
-    present = np.bincount(labels.reshape(-1), minlength=count) > 0
-    renumber = np.zeros(count, dtype=np.int32)
-    numbers: dict[int, int] = {}
-    for label in np.flatnonzero(present[1:]).tolist():
-        renumber[label + 1] = numbers.setdefault(find(label + 1), len(numbers) + 1)
-    return renumber[labels]
+    return joined_labels(np.asarray(labels), np.asarray(pairs, dtype=np.int64))
 
 
 def _range(values: np.ndarray, low: float, high: float) -> tuple[float, float]:
@@ -717,34 +697,9 @@ def merge_parts(
 def join_unless_apart(count: int, pairs: np.ndarray, apart: np.ndarray) -> np.ndarray:
     """Group labels of ``count`` nodes: the ``pairs`` (Kx2) joined in the order given, except where joining would
     put the two nodes of an ``apart`` pair (Mx2) into one group (direct evidence that two parts are separate
-    outweighs an indirect path between them)."""
-    parent = list(range(count))
-    keep_apart: dict[int, set[int]] = {}
-    for a, b in apart.tolist():
-        keep_apart.setdefault(a, set()).add(b)
-        keep_apart.setdefault(b, set()).add(a)
-
-    def root(node: int) -> int:
-        while parent[node] != node:
-            parent[node] = parent[parent[node]]
-            node = parent[node]
-        return node
-
-    for a, b in pairs.tolist():
-        ra, rb = root(a), root(b)
-        if ra == rb:
-            continue
-        against_a, against_b = keep_apart.get(ra, set()), keep_apart.get(rb, set())
-        if any(root(n) == rb for n in against_a) or any(root(n) == ra for n in against_b):
-            continue
-        parent[rb] = ra
-        keep_apart[ra] = against_a | against_b
-    roots = np.array(parent, dtype=np.int64)
-    while True:  # follow the parent pointers to the roots, all nodes at once
-        above = roots[roots]
-        if np.array_equal(above, roots):
-            return roots
-        roots = above
+    outweighs an indirect path between them). Each node's group is its root node (int64), the first node of the
+    pair that founded or extended the group."""
+    return groups_unless_apart(count, pairs, apart)
 
 
 def bounding_box(mask: np.ndarray, margin: int = 0) -> tuple[int, int, int, int]:

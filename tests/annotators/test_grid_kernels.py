@@ -14,6 +14,8 @@ from annotators.geometry.grid_kernels import (
     finite_rows,
     graph_components,
     grouped_pixels,
+    groups_unless_apart,
+    joined_labels,
     jump_between,
     label_pixels,
     nearest_seed_labels,
@@ -25,7 +27,7 @@ from annotators.geometry.grid_kernels import (
     upsampled_labels,
     window_counts,
 )
-from annotators.geometry.grid_segmentation import bounding_box, depth_jump, depth_seams, grow_on_surface
+from annotators.geometry.grid_segmentation import bounding_box, depth_jump, depth_seams, grow_on_surface, label_groups
 
 
 def _blobs(seed: int, shape: tuple[int, int] = (40, 50), labels: int = 6) -> np.ndarray:
@@ -260,3 +262,94 @@ def test_upsampled_labels_keep_the_cell_label_where_no_depth_jump_parts_them(ste
     jump = depth_jump(depth, coarse_depth[cell_rows, cell_cols], 0.01, 0.01)
     expected = np.where(keep & ~jump, labels[cell_rows, cell_cols], 0)
     assert np.array_equal(upsampled_labels(labels, coarse_depth, depth, keep, step, 0.01, 0.01), expected)
+
+
+def _groups_unless_apart_in_python(count: int, pairs: np.ndarray, apart: np.ndarray) -> np.ndarray:
+    """The union-find with a set of kept-apart nodes per group that :func:`groups_unless_apart` replaces."""
+    parent = list(range(count))
+    keep_apart: dict[int, set[int]] = {}
+    for a, b in apart.tolist():
+        keep_apart.setdefault(a, set()).add(b)
+        keep_apart.setdefault(b, set()).add(a)
+
+    def root(node: int) -> int:
+        while parent[node] != node:
+            parent[node] = parent[parent[node]]
+            node = parent[node]
+        return node
+
+    for a, b in pairs.tolist():
+        ra, rb = root(a), root(b)
+        if ra == rb:
+            continue
+        against_a, against_b = keep_apart.get(ra, set()), keep_apart.get(rb, set())
+        if any(root(n) == rb for n in against_a) or any(root(n) == ra for n in against_b):
+            continue
+        parent[rb] = ra
+        keep_apart[ra] = against_a | against_b
+    return np.array([root(node) for node in range(count)], dtype=np.int64)
+
+
+@pytest.mark.parametrize("seed", range(5))
+def test_groups_unless_apart_give_what_the_python_union_find_gives(seed: int) -> None:
+    rng = np.random.default_rng(seed)
+    kept_apart = 0
+    for _ in range(60):
+        count = int(rng.integers(1, 60))
+        pairs = rng.integers(0, count, (int(rng.integers(0, 80)), 2))
+        apart = rng.integers(0, count, (int(rng.integers(0, 12)), 2))
+        expected = _groups_unless_apart_in_python(count, pairs, apart)
+        np.testing.assert_array_equal(groups_unless_apart(count, pairs, apart), expected)
+        joined_regardless = _groups_unless_apart_in_python(count, pairs, apart[:0])
+        kept_apart += int(np.unique(expected).size > np.unique(joined_regardless).size)
+    assert kept_apart > 0  # some apart pairs did keep groups apart
+
+
+def _joined_labels_in_python(labels: np.ndarray, pairs: np.ndarray) -> np.ndarray:
+    """The Python union-find and numpy renumbering :func:`joined_labels` replaces."""
+    count = int(labels.max(initial=0)) + 1
+    root = list(range(count))
+
+    def find(node: int) -> int:
+        while root[node] != node:
+            root[node] = root[root[node]]
+            node = root[node]
+        return node
+
+    for a, b in pairs.tolist():
+        ra, rb = find(a), find(b)
+        if ra != rb:
+            root[max(ra, rb)] = min(ra, rb)
+    present = np.bincount(labels.reshape(-1), minlength=count) > 0
+    renumber = np.zeros(count, dtype=np.int32)
+    numbers: dict[int, int] = {}
+    for label in np.flatnonzero(present[1:]).tolist():
+        renumber[label + 1] = numbers.setdefault(find(label + 1), len(numbers) + 1)
+    return renumber[labels]
+
+
+@pytest.mark.parametrize("seed", range(5))
+def test_joined_labels_give_what_the_python_union_find_gives(seed: int) -> None:
+    rng = np.random.default_rng(seed)
+    labels = _blobs(seed)
+    labels[labels == 2] = 0  # a label missing from the image, which pairs may still name
+    count = int(labels.max()) + 1
+    for size in (0, 1, 3, 8):
+        pairs = rng.integers(1, count, (size, 2))
+        joined = joined_labels(labels, pairs)
+        assert joined.dtype == np.int32
+        np.testing.assert_array_equal(joined, _joined_labels_in_python(labels, pairs))
+    np.testing.assert_array_equal(joined_labels(np.zeros((3, 4), np.int32), np.zeros((0, 2))), np.zeros((3, 4)))
+
+
+@pytest.mark.parametrize("seed", range(3))
+def test_label_groups_are_the_stable_sort_of_the_labelled_pixels(seed: int) -> None:
+    labels = _blobs(seed)
+    labels[labels == 4] = 0  # a label missing in between
+    flat = labels.reshape(-1)
+    pixels = np.flatnonzero(flat)
+    pixels = pixels[np.argsort(flat[pixels], kind="stable")]
+    starts = np.searchsorted(flat[pixels], np.arange(int(flat.max()) + 2))
+    grouped, grouped_starts = label_groups(labels)
+    np.testing.assert_array_equal(grouped, pixels)
+    np.testing.assert_array_equal(grouped_starts, starts)
