@@ -1,0 +1,223 @@
+"""The compiled loops behind the batched box fits of :mod:`annotators.geometry.boxes` (numba, machine code cached
+on disk next to this file). Importing this module imports numba; :mod:`~annotators.geometry.boxes` reaches it on
+first use only.
+
+Every loop works on point sets stored one after another as 3xN float64 rows (x, y and z each contiguous), the
+sets' sizes given in order, and gives what the NumPy expressions of :mod:`~annotators.geometry.boxes` give: order
+statistics are picked from the input unchanged, and sums are added in NumPy's order (its pairwise summation).
+"""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+from numba import njit
+
+_BLOCK = 128
+"""NumPy's pairwise-summation block: shorter runs are added with eight interleaved accumulators."""
+
+
+@njit(cache=True, nogil=True)
+def _pairwise_sum(values: np.ndarray, start: int, count: int) -> float:
+    """The sum of ``values[start:start + count]`` added in the order of NumPy's pairwise summation."""
+    if count < 8:
+        total = -0.0
+        for i in range(start, start + count):
+            total += values[i]
+        return total
+    if count <= _BLOCK:
+        r0, r1, r2, r3 = values[start], values[start + 1], values[start + 2], values[start + 3]
+        r4, r5, r6, r7 = values[start + 4], values[start + 5], values[start + 6], values[start + 7]
+        i = 8
+        whole = count - count % 8
+        while i < whole:
+            at = start + i
+            r0 += values[at]
+            r1 += values[at + 1]
+            r2 += values[at + 2]
+            r3 += values[at + 3]
+            r4 += values[at + 4]
+            r5 += values[at + 5]
+            r6 += values[at + 6]
+            r7 += values[at + 7]
+            i += 8
+        total = ((r0 + r1) + (r2 + r3)) + ((r4 + r5) + (r6 + r7))
+        while i < count:
+            total += values[start + i]
+            i += 1
+        return total
+    half = count // 2
+    half -= half % 8
+    return _pairwise_sum(values, start, half) + _pairwise_sum(values, start + half, count - half)
+
+
+@njit(cache=True, nogil=True)
+def reduced_sum(values: np.ndarray, start: int, count: int) -> float:
+    """``np.add.reduce(values[start:start + count])`` (count >= 1) as NumPy adds it: the first value plus the
+    pairwise sum of the rest."""
+    return values[start] + _pairwise_sum(values, start + 1, count - 1)
+
+
+@njit(cache=True, nogil=True)
+def _select(values: np.ndarray, first: int, end: int, rank: int) -> float:
+    """The value of rank ``rank`` among ``values[first:end]`` (no NaN), found by quickselect in place: afterwards
+    no value before position ``rank`` is greater and no value after it is less."""
+    while end - first > 1:
+        middle = (first + end) // 2
+        a, b, c = values[first], values[middle], values[end - 1]
+        pivot = max(min(a, b), min(max(a, b), c))  # the median of three
+        i, j = first, end - 1
+        while i <= j:
+            while values[i] < pivot:
+                i += 1
+            while values[j] > pivot:
+                j -= 1
+            if i <= j:
+                values[i], values[j] = values[j], values[i]
+                i += 1
+                j -= 1
+        if rank <= j:
+            end = j + 1
+        elif rank >= i:
+            first = i
+        else:
+            return values[rank]  # between j and i everything equals the pivot
+    return values[rank]
+
+
+@njit(cache=True, nogil=True)
+def _least(values: np.ndarray, first: int, end: int) -> float:
+    """The least of ``values[first:end]`` (not empty)."""
+    least = values[first]
+    for i in range(first + 1, end):
+        least = min(least, values[i])
+    return least
+
+
+@njit(cache=True, nogil=True)
+def _greatest(values: np.ndarray, first: int, end: int) -> float:
+    """The greatest of ``values[first:end]`` (not empty)."""
+    greatest = values[first]
+    for i in range(first + 1, end):
+        greatest = max(greatest, values[i])
+    return greatest
+
+
+@njit(cache=True, nogil=True)
+def _quartiles(values: np.ndarray) -> tuple[float, float]:
+    """See :func:`annotators.geometry.boxes._quartiles` (``values``, 8 or more of them, are reordered)."""
+    count = values.size
+    positions = ((count - 1) * 0.25, (count - 1) * 0.75)
+    upper = math.floor(positions[1])
+    pairs = np.empty((2, 2))
+    pairs[1, 0] = _select(values, 0, count, upper)
+    pairs[1, 1] = _least(values, upper + 1, count)
+    lower = math.floor(positions[0])
+    pairs[0, 0] = _select(values, 0, upper, lower)  # lower < upper: it lies among the values below rank upper
+    pairs[0, 1] = _least(values, lower + 1, upper) if lower + 1 < upper else pairs[1, 0]
+    quartiles = np.empty(2)
+    for k in range(2):
+        position = positions[k]
+        low, high = pairs[k, 0], pairs[k, 1]
+        weight = position - math.floor(position)
+        step = high - low
+        quartiles[k] = high - step * (1.0 - weight) if weight >= 0.5 else low + step * weight
+    return quartiles[0], quartiles[1]
+
+
+@njit(cache=True, nogil=True)
+def compact_sets(rows: np.ndarray, sizes: np.ndarray, fence: float) -> tuple[np.ndarray, np.ndarray]:
+    """:func:`annotators.geometry.boxes._compact` of every set: the kept points (3xM rows, sets in order) and how
+    many each set kept. A set of fewer than 8 points keeps them all."""
+    kept_rows = np.empty_like(rows)
+    kept = np.zeros(sizes.size, dtype=np.int64)
+    start, column = 0, 0
+    for group in range(sizes.size):
+        count = sizes[group]
+        if count < 8:
+            for i in range(start, start + count):
+                for axis in range(3):
+                    kept_rows[axis, column] = rows[axis, i]
+                column += 1
+            kept[group] = count
+            start += count
+            continue
+        low, high = (count - 1) // 2, count // 2
+        median = np.empty(3)
+        for axis in range(3):
+            ranked = rows[axis, start : start + count].copy()
+            middle = _select(ranked, 0, count, high)
+            below = _greatest(ranked, 0, high) if low != high else middle  # the value of rank low
+            median[axis] = (below + middle) / 2.0
+        distances = np.empty(count)
+        for i in range(count):
+            dx = rows[0, start + i] - median[0]
+            dy = rows[1, start + i] - median[1]
+            dz = rows[2, start + i] - median[2]
+            distances[i] = math.sqrt(dx * dx + dy * dy + dz * dz)
+        q1, q3 = _quartiles(distances.copy())
+        limit = q3 + fence * (q3 - q1)
+        for i in range(count):
+            if distances[i] <= limit:
+                for axis in range(3):
+                    kept_rows[axis, column] = rows[axis, start + i]
+                column += 1
+                kept[group] += 1
+        start += count
+    return kept_rows[:, :column].copy(), kept
+
+
+@njit(cache=True, nogil=True)
+def set_moments(rows: np.ndarray, sizes: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """Each set's mean (3xS) and the sums of the products of its centred coordinates xx, xy, xz, yy, yz, zz (6xS):
+    ``np.add.reduceat(rows, starts, axis=1) / sizes`` and ``np.add.reduceat`` of the products of
+    ``rows - mean[:, owner]``. Every set has at least one point."""
+    means = np.empty((3, sizes.size))
+    products = np.empty((6, sizes.size))
+    first = (0, 0, 0, 1, 1, 2)
+    second = (0, 1, 2, 1, 2, 2)
+    start = 0
+    for group in range(sizes.size):
+        count = sizes[group]
+        for axis in range(3):
+            means[axis, group] = reduced_sum(rows[axis], start, count) / count
+        centred = np.empty((3, count))
+        for axis in range(3):
+            mean = means[axis, group]
+            for i in range(count):
+                centred[axis, i] = rows[axis, start + i] - mean
+        product = np.empty(count)
+        for k in range(6):
+            a, b = first[k], second[k]
+            for i in range(count):
+                product[i] = centred[a, i] * centred[b, i]
+            products[k, group] = reduced_sum(product, 0, count)
+        start += count
+    return means, products
+
+
+@njit(cache=True, nogil=True)
+def set_extents(
+    rows: np.ndarray, sizes: np.ndarray, means: np.ndarray, rotations: np.ndarray
+) -> tuple[np.ndarray, np.ndarray]:
+    """The least and greatest coordinates (each Sx3) of every set's centred points along the axes of its rotation
+    (Sx3x3, columns are the axes): the minima and maxima of ``rotations[s].T @ (set - mean)``."""
+    low = np.empty((sizes.size, 3))
+    high = np.empty((sizes.size, 3))
+    start = 0
+    for group in range(sizes.size):
+        count = sizes[group]
+        for axis in range(3):
+            a0, a1, a2 = rotations[group, 0, axis], rotations[group, 1, axis], rotations[group, 2, axis]
+            least, greatest = np.inf, -np.inf
+            for i in range(start, start + count):
+                x = rows[0, i] - means[0, group]
+                y = rows[1, i] - means[1, group]
+                z = rows[2, i] - means[2, group]
+                value = a0 * x + a1 * y + a2 * z
+                least = min(least, value)
+                greatest = max(greatest, value)
+            low[group, axis], high[group, axis] = least, greatest
+        start += count
+    return low, high
