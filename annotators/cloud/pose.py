@@ -8,9 +8,8 @@ import numpy as np
 
 from annotators.cloud.cloud_expert import CloudExpert
 from annotators.cloud.cloud_loops import finite_rows
-from annotators.geometry.boxes import finite_points, object_boxes_of_sets
+from annotators.geometry.boxes import box_orientations, finite_points, object_boxes_of_sets
 from robokudo.core.capability import Capability
-from robokudo.core.geometry import quaternion_from_matrix
 from robokudo.core.types import CameraInfo, CasType, ObjectHypothesis, PointCloud, Pose
 
 
@@ -67,6 +66,6 @@ class PoseAnnotator(CloudExpert):
         if not posed:
             self.fail("no object hypothesis has a valid 3-D point")
         boxes = object_boxes_of_sets(rows, sizes[sizes > 0], cam_to_world)
-        for hypothesis, (box, frame) in zip(posed, boxes, strict=True):
-            orientation = quaternion_from_matrix(box.rotation)
-            self.attach(hypothesis, Pose(position=box.centre, orientation=orientation, frame=frame))
+        orientations = box_orientations([box for box, _ in boxes])
+        for hypothesis, (box, frame), orientation in zip(posed, boxes, orientations, strict=True):
+            self.attach(hypothesis, Pose(position=box.centre, orientation=orientation.copy(), frame=frame))

@@ -75,10 +75,17 @@ def reduced_sum(values: np.ndarray, start: int, count: int) -> float:
 @njit(cache=True, nogil=True)
 def _select(values: np.ndarray, first: int, end: int, rank: int) -> float:
     """The value of rank ``rank`` among ``values[first:end]`` (no NaN), found by quickselect in place: afterwards
-    no value before position ``rank`` is greater and no value after it is less."""
+    no value before position ``rank`` is greater and no value after it is less. The pivot is the median of three
+    values at pseudo-random positions (a fixed sequence), since points in pixel order are far from random: their
+    distances to the centre fall and rise again, which defeats pivots taken at fixed positions."""
+    state = np.uint64(0x9E3779B97F4A7C15)
     while end - first > 1:
-        middle = (first + end) // 2
-        a, b, c = values[first], values[middle], values[end - 1]
+        span = end - first
+        picks = np.empty(3)
+        for k in range(3):
+            state = state * np.uint64(6364136223846793005) + np.uint64(1442695040888963407)  # Knuth's LCG
+            picks[k] = values[first + int((state >> np.uint64(33)) % np.uint64(span))]
+        a, b, c = picks[0], picks[1], picks[2]
         pivot = max(min(a, b), min(max(a, b), c))  # the median of three
         i, j = first, end - 1
         while i <= j:
@@ -236,3 +243,41 @@ def set_extents(
             low[group, axis], high[group, axis] = least, greatest
         start += count
     return low, high
+
+
+@njit(cache=True, nogil=True)
+def rotation_quaternions(rotations: np.ndarray) -> np.ndarray:
+    """:func:`robokudo.core.geometry.quaternion_from_matrix` of K 3x3 rotations (Kx3x3 float64) as Kx4 (x, y, z,
+    w), with the same arithmetic in the same order."""
+    quaternions = np.empty((rotations.shape[0], 4))
+    q = np.empty(4)
+    for k in range(rotations.shape[0]):
+        m = rotations[k]
+        m00, m01, m02 = m[0, 0], m[0, 1], m[0, 2]
+        m10, m11, m12 = m[1, 0], m[1, 1], m[1, 2]
+        m20, m21, m22 = m[2, 0], m[2, 1], m[2, 2]
+        finite = True
+        for value in (m00, m01, m02, m10, m11, m12, m20, m21, m22):
+            finite = finite and math.isfinite(value)
+        determinant = m00 * (m11 * m22 - m12 * m21) - m01 * (m10 * m22 - m12 * m20) + m02 * (m10 * m21 - m11 * m20)
+        if not finite or determinant <= 1e-6:
+            quaternions[k] = (0.0, 0.0, 0.0, 1.0)
+            continue
+        trace = m00 + m11 + m22
+        if trace > 0:
+            s = 2.0 * math.sqrt(trace + 1.0)
+            q[0], q[1], q[2], q[3] = (m21 - m12) / s, (m02 - m20) / s, (m10 - m01) / s, 0.25 * s
+        elif m00 >= m11 and m00 >= m22:
+            s = 2.0 * math.sqrt(max(1.0 + m00 - m11 - m22, 1e-12))
+            q[0], q[1], q[2], q[3] = 0.25 * s, (m01 + m10) / s, (m02 + m20) / s, (m21 - m12) / s
+        elif m11 >= m22:
+            s = 2.0 * math.sqrt(max(1.0 + m11 - m00 - m22, 1e-12))
+            q[0], q[1], q[2], q[3] = (m01 + m10) / s, 0.25 * s, (m12 + m21) / s, (m02 - m20) / s
+        else:
+            s = 2.0 * math.sqrt(max(1.0 + m22 - m00 - m11, 1e-12))
+            q[0], q[1], q[2], q[3] = (m02 + m20) / s, (m12 + m21) / s, 0.25 * s, (m10 - m01) / s
+        norm = math.sqrt(q[0] * q[0] + q[1] * q[1] + q[2] * q[2] + q[3] * q[3])
+        sign = 1.0 if q[3] / norm >= 0 else -1.0
+        for i in range(4):
+            quaternions[k, i] = sign * (q[i] / norm)
+    return quaternions

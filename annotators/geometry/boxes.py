@@ -187,6 +187,14 @@ def _principal_boxes(rows: np.ndarray, sizes: np.ndarray) -> list[OrientedBox]:
     return [box if box is not None else next(boxes_fitted) for box in boxes]
 
 
+def box_orientations(boxes: list[OrientedBox]) -> np.ndarray:
+    """The unit quaternions (Kx4: x, y, z, w) of the boxes' rotations, each what
+    :func:`robokudo.core.geometry.quaternion_from_matrix` gives, converted at once."""
+    if not boxes:
+        return np.zeros((0, 4))
+    return _loops().rotation_quaternions(np.stack([box.rotation for box in boxes]).astype(np.float64, copy=False))
+
+
 def object_boxes_of_sets(
     rows: np.ndarray, sizes: np.ndarray, cam_to_world: np.ndarray | None
 ) -> list[tuple[OrientedBox, str]]:
