@@ -81,11 +81,12 @@ def _select(values: np.ndarray, first: int, end: int, rank: int) -> float:
     state = np.uint64(0x9E3779B97F4A7C15)
     while end - first > 1:
         span = end - first
-        picks = np.empty(3)
-        for k in range(3):
-            state = state * np.uint64(6364136223846793005) + np.uint64(1442695040888963407)  # Knuth's LCG
-            picks[k] = values[first + int((state >> np.uint64(33)) % np.uint64(span))]
-        a, b, c = picks[0], picks[1], picks[2]
+        state = state * np.uint64(6364136223846793005) + np.uint64(1442695040888963407)  # Knuth's LCG
+        a = values[first + int((state >> np.uint64(33)) % np.uint64(span))]
+        state = state * np.uint64(6364136223846793005) + np.uint64(1442695040888963407)
+        b = values[first + int((state >> np.uint64(33)) % np.uint64(span))]
+        state = state * np.uint64(6364136223846793005) + np.uint64(1442695040888963407)
+        c = values[first + int((state >> np.uint64(33)) % np.uint64(span))]
         pivot = max(min(a, b), min(max(a, b), c))  # the median of three
         i, j = first, end - 1
         while i <= j:
@@ -115,32 +116,51 @@ def _least(values: np.ndarray, first: int, end: int) -> float:
     return least
 
 
-@njit(cache=True, nogil=True)
-def _greatest(values: np.ndarray, first: int, end: int) -> float:
-    """The greatest of ``values[first:end]`` (not empty)."""
-    greatest = values[first]
-    for i in range(first + 1, end):
-        greatest = max(greatest, values[i])
-    return greatest
+_SAMPLE = 64
+"""Values sampled to bracket a rank before the pass that counts and gathers the values near it."""
+_MARGIN = 10
+"""Sample slots either side of a rank's expected slot that bracket it (about 2.5 standard deviations)."""
 
 
 @njit(cache=True, nogil=True)
-def _quartiles(values: np.ndarray) -> tuple[float, float]:
-    """See :func:`annotators.geometry.boxes._quartiles` (``values``, 8 or more of them, are reordered)."""
+def _rank_pair(values: np.ndarray, rank: int, scratch: np.ndarray) -> tuple[float, float]:
+    """The values of rank ``rank`` and ``rank + 1`` (0-based, ascending, ``rank + 1 < values.size``) of 1-D
+    ``values`` (no NaN; left unchanged), using ``scratch`` (at least ``values.size`` long).
+
+    Values sampled at even steps bracket the rank; one branch-free pass counts the values below the bracket and
+    gathers those inside, and a quickselect among these few finds the pair. When the bracket misses the rank (rare),
+    a quickselect over all values does."""
     count = values.size
-    positions = ((count - 1) * 0.25, (count - 1) * 0.75)
-    upper = math.floor(positions[1])
-    pairs = np.empty((2, 2))
-    pairs[1, 0] = _select(values, 0, count, upper)
-    pairs[1, 1] = _least(values, upper + 1, count)
-    lower = math.floor(positions[0])
-    pairs[0, 0] = _select(values, 0, upper, lower)  # lower < upper: it lies among the values below rank upper
-    pairs[0, 1] = _least(values, lower + 1, upper) if lower + 1 < upper else pairs[1, 0]
+    if count >= 4 * _SAMPLE:
+        sample = np.empty(_SAMPLE)
+        for k in range(_SAMPLE):
+            sample[k] = values[(k * count) // _SAMPLE]
+        slot = (rank * _SAMPLE) // count
+        low = _select(sample, 0, _SAMPLE, slot - _MARGIN) if slot - _MARGIN >= 0 else -np.inf
+        high = _select(sample, 0, _SAMPLE, slot + _MARGIN + 1) if slot + _MARGIN + 1 < _SAMPLE else np.inf
+        below, inside = 0, 0
+        for i in range(count):
+            value = values[i]
+            below += value < low
+            scratch[inside] = value
+            inside += (value >= low) & (value <= high)
+        if below <= rank and rank + 1 < below + inside:
+            first = _select(scratch, 0, inside, rank - below)
+            return first, _least(scratch, rank - below + 1, inside)
+    scratch[:count] = values
+    first = _select(scratch, 0, count, rank)
+    return first, _least(scratch, rank + 1, count)
+
+
+@njit(cache=True, nogil=True)
+def _quartiles(values: np.ndarray, scratch: np.ndarray) -> tuple[float, float]:
+    """See :func:`annotators.geometry.boxes._quartiles` (8 or more ``values``; ``scratch`` as long)."""
     quartiles = np.empty(2)
     for k in range(2):
-        position = positions[k]
-        low, high = pairs[k, 0], pairs[k, 1]
-        weight = position - math.floor(position)
+        position = (values.size - 1) * (0.25 if k == 0 else 0.75)
+        rank = math.floor(position)
+        low, high = _rank_pair(values, rank, scratch)
+        weight = position - rank
         step = high - low
         quartiles[k] = high - step * (1.0 - weight) if weight >= 0.5 else low + step * weight
     return quartiles[0], quartiles[1]
@@ -165,18 +185,17 @@ def compact_sets(rows: np.ndarray, sizes: np.ndarray, fence: float) -> tuple[np.
             continue
         low, high = (count - 1) // 2, count // 2
         median = np.empty(3)
+        scratch = np.empty(count)
         for axis in range(3):
-            ranked = rows[axis, start : start + count].copy()
-            middle = _select(ranked, 0, count, high)
-            below = _greatest(ranked, 0, high) if low != high else middle  # the value of rank low
-            median[axis] = (below + middle) / 2.0
+            before, middle = _rank_pair(rows[axis, start : start + count], high - 1, scratch)
+            median[axis] = ((before if low != high else middle) + middle) / 2.0
         distances = np.empty(count)
         for i in range(count):
             dx = rows[0, start + i] - median[0]
             dy = rows[1, start + i] - median[1]
             dz = rows[2, start + i] - median[2]
             distances[i] = math.sqrt(dx * dx + dy * dy + dz * dz)
-        q1, q3 = _quartiles(distances.copy())
+        q1, q3 = _quartiles(distances, scratch)
         limit = q3 + fence * (q3 - q1)
         for i in range(count):
             if distances[i] <= limit:
