@@ -167,44 +167,77 @@ def _quartiles(values: np.ndarray, scratch: np.ndarray) -> tuple[float, float]:
 
 
 @njit(cache=True, nogil=True)
+def _compact_into(rows: np.ndarray, start: int, count: int, out: np.ndarray, column: int, fence: float) -> int:
+    """:func:`annotators.geometry.boxes._compact` of the set ``rows[:, start:start + count]`` (3xN float64),
+    written to ``out`` from ``column`` on; returns the column after the last kept point."""
+    if count < 8:
+        for i in range(start, start + count):
+            for axis in range(3):
+                out[axis, column] = rows[axis, i]
+            column += 1
+        return column
+    low, high = (count - 1) // 2, count // 2
+    median = np.empty(3)
+    scratch = np.empty(count)
+    for axis in range(3):
+        before, middle = _rank_pair(rows[axis, start : start + count], high - 1, scratch)
+        median[axis] = ((before if low != high else middle) + middle) / 2.0
+    distances = np.empty(count)
+    for i in range(count):
+        dx = rows[0, start + i] - median[0]
+        dy = rows[1, start + i] - median[1]
+        dz = rows[2, start + i] - median[2]
+        distances[i] = math.sqrt(dx * dx + dy * dy + dz * dz)
+    q1, q3 = _quartiles(distances, scratch)
+    limit = q3 + fence * (q3 - q1)
+    for i in range(count):
+        if distances[i] <= limit:
+            for axis in range(3):
+                out[axis, column] = rows[axis, start + i]
+            column += 1
+    return column
+
+
+@njit(cache=True, nogil=True)
 def compact_sets(rows: np.ndarray, sizes: np.ndarray, fence: float) -> tuple[np.ndarray, np.ndarray]:
     """:func:`annotators.geometry.boxes._compact` of every set: the kept points (3xM rows, sets in order) and how
     many each set kept. A set of fewer than 8 points keeps them all."""
-    kept_rows = np.empty_like(rows)
+    out = np.empty_like(rows)
     kept = np.zeros(sizes.size, dtype=np.int64)
     start, column = 0, 0
     for group in range(sizes.size):
-        count = sizes[group]
-        if count < 8:
-            for i in range(start, start + count):
-                for axis in range(3):
-                    kept_rows[axis, column] = rows[axis, i]
-                column += 1
-            kept[group] = count
-            start += count
-            continue
-        low, high = (count - 1) // 2, count // 2
-        median = np.empty(3)
-        scratch = np.empty(count)
-        for axis in range(3):
-            before, middle = _rank_pair(rows[axis, start : start + count], high - 1, scratch)
-            median[axis] = ((before if low != high else middle) + middle) / 2.0
-        distances = np.empty(count)
-        for i in range(count):
-            dx = rows[0, start + i] - median[0]
-            dy = rows[1, start + i] - median[1]
-            dz = rows[2, start + i] - median[2]
-            distances[i] = math.sqrt(dx * dx + dy * dy + dz * dz)
-        q1, q3 = _quartiles(distances, scratch)
-        limit = q3 + fence * (q3 - q1)
-        for i in range(count):
-            if distances[i] <= limit:
-                for axis in range(3):
-                    kept_rows[axis, column] = rows[axis, start + i]
-                column += 1
-                kept[group] += 1
-        start += count
-    return kept_rows[:, :column].copy(), kept
+        end = _compact_into(rows, start, sizes[group], out, column, fence)
+        kept[group] = end - column
+        start, column = start + sizes[group], end
+    return out[:, :column], kept
+
+
+@njit(cache=True, nogil=True)
+def gathered_compact_sets(
+    points: np.ndarray, indices: np.ndarray, sizes: np.ndarray, fence: float
+) -> tuple[np.ndarray, np.ndarray]:
+    """:func:`compact_sets` of the finite points among ``points[indices]`` (Nx3; indices outside the array are
+    skipped), each set gathered from a consecutive group of ``sizes`` indices: the kept points as 3xM float64
+    rows and how many each set kept (0 for a set without finite points)."""
+    total = points.shape[0]
+    out = np.empty((3, indices.size))
+    kept = np.zeros(sizes.size, dtype=np.int64)
+    gathered = np.empty((3, sizes.max() if sizes.size else 0))
+    position, column = 0, 0
+    for group in range(sizes.size):
+        count = 0
+        for i in range(position, position + sizes[group]):
+            index = indices[i]
+            if 0 <= index < total:
+                x, y, z = points[index, 0], points[index, 1], points[index, 2]
+                if np.isfinite(x) and np.isfinite(y) and np.isfinite(z):
+                    gathered[0, count], gathered[1, count], gathered[2, count] = x, y, z
+                    count += 1
+        position += sizes[group]
+        end = _compact_into(gathered, 0, count, out, column, fence)
+        kept[group] = end - column
+        column = end
+    return out[:, :column], kept
 
 
 @njit(cache=True, nogil=True)

@@ -195,6 +195,28 @@ def box_orientations(boxes: list[OrientedBox]) -> np.ndarray:
     return _loops().rotation_quaternions(np.stack([box.rotation for box in boxes]).astype(np.float64, copy=False))
 
 
+def object_boxes_of_indexed(
+    points: np.ndarray, indices: np.ndarray, sizes: np.ndarray, cam_to_world: np.ndarray | None
+) -> tuple[list[tuple[OrientedBox, str]], np.ndarray]:
+    """:func:`object_box` of several objects whose camera-frame points are ``points[indices]`` (Nx3, C-contiguous;
+    indices outside the array and points not finite are skipped), each object's a consecutive group of ``sizes``
+    indices; and which objects had a finite point (the boxes are theirs, in order)."""
+    rows, kept = _loops().gathered_compact_sets(points, indices, np.asarray(sizes, dtype=np.int64), STRAY_FENCE)
+    posed = kept > 0
+    return _boxes_of_compact(rows, kept[posed], cam_to_world), posed
+
+
+def _boxes_of_compact(
+    rows: np.ndarray, sizes: np.ndarray, cam_to_world: np.ndarray | None
+) -> list[tuple[OrientedBox, str]]:
+    """:func:`object_box` of compacted sets (3xN float64 rows, sets one after another, none empty)."""
+    if cam_to_world is not None:
+        transform = np.asarray(cam_to_world, dtype=np.float64)
+        parts = np.split(rows, np.cumsum(sizes)[:-1], axis=1)
+        return [(upright_box(part.T @ transform[:3, :3].T + transform[:3, 3]), "world") for part in parts]
+    return [(box, "camera") for box in _principal_boxes(rows, sizes)]
+
+
 def object_boxes_of_sets(
     rows: np.ndarray, sizes: np.ndarray, cam_to_world: np.ndarray | None
 ) -> list[tuple[OrientedBox, str]]:
@@ -202,11 +224,7 @@ def object_boxes_of_sets(
     float64 rows (C-contiguous), each object's number of points (at least one) in ``sizes``."""
     sizes = np.asarray(sizes, dtype=np.int64)
     rows, sizes = _loops().compact_sets(np.ascontiguousarray(rows, dtype=np.float64), sizes, STRAY_FENCE)
-    if cam_to_world is not None:
-        transform = np.asarray(cam_to_world, dtype=np.float64)
-        parts = np.split(rows, np.cumsum(sizes)[:-1], axis=1)
-        return [(upright_box(part.T @ transform[:3, :3].T + transform[:3, 3]), "world") for part in parts]
-    return [(box, "camera") for box in _principal_boxes(rows, sizes)]
+    return _boxes_of_compact(rows, sizes, cam_to_world)
 
 
 def object_boxes_of_rows(rows: list[np.ndarray], cam_to_world: np.ndarray | None) -> list[tuple[OrientedBox, str]]:

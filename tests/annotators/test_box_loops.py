@@ -92,3 +92,18 @@ def test_rotation_quaternions_equal_quaternion_from_matrix() -> None:
     quaternions = box_loops.rotation_quaternions(np.stack(rotations))
     for rotation, quaternion in zip(rotations, quaternions, strict=True):
         assert np.array_equal(quaternion, quaternion_from_matrix(rotation))
+
+
+def test_gathered_compact_sets_compact_the_finite_indexed_points() -> None:
+    rng = np.random.default_rng(4)
+    points = np.concatenate(point_sets(4, [3000]), axis=1).T.astype(np.float32)
+    points[rng.integers(0, 3000, size=300), rng.integers(0, 3, size=300)] = np.nan
+    sizes = np.array([0, 5, 12, 900, 40, 1], dtype=np.int64)
+    indices = rng.integers(-20, 3020, size=sizes.sum())
+    rows, kept = box_loops.gathered_compact_sets(points, indices, sizes, STRAY_FENCE)
+    expected = []
+    for group in np.split(indices, np.cumsum(sizes)[:-1]):
+        chosen = points[group[(group >= 0) & (group < 3000)]].astype(np.float64)
+        expected.append(_compact(chosen[np.isfinite(chosen).all(axis=1)].T))
+    assert kept.tolist() == [part.shape[1] for part in expected]
+    assert np.array_equal(rows, np.concatenate(expected, axis=1))
