@@ -225,12 +225,3 @@ def object_boxes_of_sets(
     sizes = np.asarray(sizes, dtype=np.int64)
     rows, sizes = _loops().compact_sets(np.ascontiguousarray(rows, dtype=np.float64), sizes, STRAY_FENCE)
     return _boxes_of_compact(rows, sizes, cam_to_world)
-
-
-def object_boxes_of_rows(rows: list[np.ndarray], cam_to_world: np.ndarray | None) -> list[tuple[OrientedBox, str]]:
-    """:func:`object_box` of several objects whose finite camera-frame points are given as 3xN float64 rows (each
-    with at least one point)."""
-    if not rows:
-        return []
-    sizes = np.array([part.shape[1] for part in rows], dtype=np.int64)
-    return object_boxes_of_sets(np.concatenate(rows, axis=1), sizes, cam_to_world)
