@@ -99,7 +99,11 @@ def _degenerate_box(points: np.ndarray) -> OrientedBox:
 
 def upright_box(points: np.ndarray) -> OrientedBox:
     """The box with a vertical (+z) axis around Nx3 points given in a z-up frame; yaw from the footprint."""
-    points = finite_points(points)
+    return _upright(finite_points(points))
+
+
+def _upright(points: np.ndarray) -> OrientedBox:
+    """:func:`upright_box` of finite Nx3 float64 points."""
     if points.shape[0] < 3:
         return _degenerate_box(points)
     (cx, cy), (width, depth), angle = cv2.minAreaRect(points[:, :2].astype(np.float32))
@@ -212,8 +216,9 @@ def _boxes_of_compact(
     """:func:`object_box` of compacted sets (3xN float64 rows, sets one after another, none empty)."""
     if cam_to_world is not None:
         transform = np.asarray(cam_to_world, dtype=np.float64)
-        parts = np.split(rows, np.cumsum(sizes)[:-1], axis=1)
-        return [(upright_box(part.T @ transform[:3, :3].T + transform[:3, 3]), "world") for part in parts]
+        world = rows.T @ transform[:3, :3].T + transform[:3, 3]  # all the sets at once
+        fit = _upright if np.isfinite(world).all() else upright_box  # only an overflow makes a point infinite
+        return [(fit(part), "world") for part in np.split(world, np.cumsum(sizes)[:-1])]
     return [(box, "camera") for box in _principal_boxes(rows, sizes)]
 
 
