@@ -3,6 +3,11 @@
 Two fits: :func:`upright_box` when the up direction is known (the box stands on the floor: z is up and the yaw
 comes from the minimum-area rectangle of the footprint), and :func:`principal_box` otherwise (axes from the
 principal components of the points).
+
+:func:`object_boxes_of_indexed` and :func:`object_boxes_of_sets` fit many objects at once (the pose annotator's
+path): the gathering, stray removal, moments and extents run as compiled loops over all the sets
+(:mod:`annotators.geometry.box_loops`, loaded on first use) and give the same boxes as :func:`object_box` of each
+set, bit for bit on this machine's BLAS (see :func:`annotators.geometry.box_loops.set_extents`).
 """
 
 from __future__ import annotations

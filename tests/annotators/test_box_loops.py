@@ -107,3 +107,24 @@ def test_gathered_compact_sets_compact_the_finite_indexed_points() -> None:
         expected.append(_compact(chosen[np.isfinite(chosen).all(axis=1)].T))
     assert kept.tolist() == [part.shape[1] for part in expected]
     assert np.array_equal(rows, np.concatenate(expected, axis=1))
+
+
+@pytest.mark.parametrize(
+    "values",
+    [
+        np.arange(1000.0),
+        np.arange(1000.0)[::-1].copy(),
+        np.full(700, 2.5),
+        np.repeat([1.0, 2.0, 3.0], 300),
+        np.concatenate([np.zeros(990), np.full(10, 1e9)]),
+        np.random.default_rng(8).normal(size=1301),
+        np.random.default_rng(9).integers(0, 20, size=50).astype(np.float64),
+    ],
+)
+def test_rank_pair_finds_the_values_of_two_neighbouring_ranks(values: np.ndarray) -> None:
+    ranked = np.sort(values)
+    scratch = np.empty(values.size)
+    original = values.copy()
+    for rank in sorted({0, 1, values.size // 4, values.size // 2, values.size - 2}):
+        assert box_loops._rank_pair(values, rank, scratch) == (ranked[rank], ranked[rank + 1])
+    assert np.array_equal(values, original)
