@@ -6,8 +6,8 @@ principal components of the points).
 
 :func:`object_boxes_of_indexed` and :func:`object_boxes_of_sets` fit many objects at once (the pose annotator's
 path): the gathering, stray removal, moments and extents run as compiled loops over all the sets
-(:mod:`annotators.geometry.box_loops`, loaded on first use) and give the same boxes as :func:`object_box` of each
-set, bit for bit on this machine's BLAS (see :func:`annotators.geometry.box_loops.set_extents`).
+(:mod:`annotators.geometry.box_loops`, loaded on first use) with the arithmetic of the NumPy reductions they
+replace; the boxes agree with :func:`object_box` of each set to rounding (its sums are added in another order).
 """
 
 from __future__ import annotations
