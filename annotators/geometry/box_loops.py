@@ -281,19 +281,21 @@ def set_extents(
     high = np.empty((sizes.size, 3))
     start = 0
     for group in range(sizes.size):
-        count = sizes[group]
-        for axis in range(3):
-            a0, a1, a2 = rotations[group, 0, axis], rotations[group, 1, axis], rotations[group, 2, axis]
-            least, greatest = np.inf, -np.inf
-            for i in range(start, start + count):
-                x = rows[0, i] - means[0, group]
-                y = rows[1, i] - means[1, group]
-                z = rows[2, i] - means[2, group]
-                value = _fused_multiply_add(a2, z, _fused_multiply_add(a1, y, a0 * x))
-                least = min(least, value)
-                greatest = max(greatest, value)
-            low[group, axis], high[group, axis] = least, greatest
-        start += count
+        r = rotations[group]
+        mx, my, mz = means[0, group], means[1, group], means[2, group]
+        low0 = low1 = low2 = np.inf
+        high0 = high1 = high2 = -np.inf
+        for i in range(start, start + sizes[group]):
+            x, y, z = rows[0, i] - mx, rows[1, i] - my, rows[2, i] - mz
+            v0 = _fused_multiply_add(r[2, 0], z, _fused_multiply_add(r[1, 0], y, r[0, 0] * x))
+            v1 = _fused_multiply_add(r[2, 1], z, _fused_multiply_add(r[1, 1], y, r[0, 1] * x))
+            v2 = _fused_multiply_add(r[2, 2], z, _fused_multiply_add(r[1, 2], y, r[0, 2] * x))
+            low0, high0 = min(low0, v0), max(high0, v0)
+            low1, high1 = min(low1, v1), max(high1, v1)
+            low2, high2 = min(low2, v2), max(high2, v2)
+        low[group, 0], low[group, 1], low[group, 2] = low0, low1, low2
+        high[group, 0], high[group, 1], high[group, 2] = high0, high1, high2
+        start += sizes[group]
     return low, high
 
 
