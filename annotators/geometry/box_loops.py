@@ -74,12 +74,14 @@ def reduced_sum(values: np.ndarray, start: int, count: int) -> float:
 
 @njit(cache=True, nogil=True)
 def _select(values: np.ndarray, first: int, end: int, rank: int) -> float:
-    """The value of rank ``rank`` among ``values[first:end]`` (no NaN), found by quickselect in place: afterwards
-    no value before position ``rank`` is greater and no value after it is less. The pivot is the median of three
-    values at pseudo-random positions (a fixed sequence), since points in pixel order are far from random: their
-    distances to the centre fall and rise again, which defeats pivots taken at fixed positions."""
+    """The value of rank ``rank`` among ``values[first:end]`` (no NaN), found by quickselect in place.
+
+    Each partition is branch-free (every value is swapped, the boundary advances by the comparison), so its cost
+    does not depend on how well the processor guesses the comparisons. The pivot is the median of three values at
+    pseudo-random positions (a fixed sequence), since points in pixel order are far from random: their distances
+    to the centre fall and rise again, which defeats pivots taken at fixed positions."""
     state = np.uint64(0x9E3779B97F4A7C15)
-    while end - first > 1:
+    while end - first > 16:
         span = end - first
         state = state * np.uint64(6364136223846793005) + np.uint64(1442695040888963407)  # Knuth's LCG
         a = values[first + int((state >> np.uint64(33)) % np.uint64(span))]
@@ -88,22 +90,32 @@ def _select(values: np.ndarray, first: int, end: int, rank: int) -> float:
         state = state * np.uint64(6364136223846793005) + np.uint64(1442695040888963407)
         c = values[first + int((state >> np.uint64(33)) % np.uint64(span))]
         pivot = max(min(a, b), min(max(a, b), c))  # the median of three
-        i, j = first, end - 1
-        while i <= j:
-            while values[i] < pivot:
-                i += 1
-            while values[j] > pivot:
-                j -= 1
-            if i <= j:
-                values[i], values[j] = values[j], values[i]
-                i += 1
-                j -= 1
-        if rank <= j:
-            end = j + 1
-        elif rank >= i:
-            first = i
+        store = first
+        for i in range(first, end):  # the values below the pivot to the front
+            value = values[i]
+            values[i] = values[store]
+            values[store] = value
+            store += value < pivot
+        if store == first:  # none below: the pivot is the least, split off the values equal to it
+            for i in range(first, end):
+                value = values[i]
+                values[i] = values[store]
+                values[store] = value
+                store += value <= pivot
+            if rank < store:
+                return pivot
+            first = store
+        elif rank < store:
+            end = store
         else:
-            return values[rank]  # between j and i everything equals the pivot
+            first = store
+    for i in range(first + 1, end):  # insertion sort of the few left
+        value = values[i]
+        j = i - 1
+        while j >= first and values[j] > value:
+            values[j + 1] = values[j]
+            j -= 1
+        values[j + 1] = value
     return values[rank]
 
 
