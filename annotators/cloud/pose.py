@@ -7,10 +7,8 @@ from typing import ClassVar
 import numpy as np
 
 from annotators.cloud.cloud_expert import CloudExpert
-from annotators.cloud.cloud_loops import finite_rows
-from annotators.geometry.boxes import finite_points, object_boxes_of_rows
+from annotators.geometry.boxes import box_orientations, finite_points, object_boxes_of_indexed
 from robokudo.core.capability import Capability
-from robokudo.core.geometry import quaternion_from_matrix
 from robokudo.core.types import CameraInfo, CasType, ObjectHypothesis, PointCloud, Pose
 
 
@@ -22,17 +20,16 @@ def hypothesis_points(cloud: PointCloud, hypothesis: ObjectHypothesis, max_point
     return finite_points(cloud.points.reshape(-1, 3)[indices])
 
 
-def hypotheses_rows(cloud: PointCloud, hypotheses: list[ObjectHypothesis], max_points: int) -> list[np.ndarray]:
-    """:func:`hypothesis_points` of several hypotheses, gathered at once, each as 3xN float64 rows (x, y and z
-    each contiguous)."""
+def sampled_indices(hypotheses: list[ObjectHypothesis], max_points: int) -> tuple[np.ndarray, np.ndarray]:
+    """The point indices :func:`hypothesis_points` samples of each hypothesis (about ``max_points`` evenly
+    spaced), all of them one hypothesis after another, and how many each hypothesis has."""
     picked = []
     for hypothesis in hypotheses:
         indices = np.asarray(hypothesis.point_indices)
         picked.append(indices[:: max(1, indices.size // max_points)])
     sizes = np.array([indices.size for indices in picked], dtype=np.int64)
     every = np.concatenate(picked).astype(np.intp, copy=False) if picked else np.zeros(0, dtype=np.intp)
-    rows, kept = finite_rows(np.ascontiguousarray(cloud.points).reshape(-1, 3), every, sizes)
-    return np.split(rows, np.cumsum(kept)[:-1], axis=1)
+    return every, sizes
 
 
 class PoseAnnotator(CloudExpert):
@@ -61,11 +58,12 @@ class PoseAnnotator(CloudExpert):
         cam_to_world = camera.cam_to_world if camera is not None else None
         if cam_to_world is not None and (np.shape(cam_to_world) != (4, 4) or not np.all(np.isfinite(cam_to_world))):
             self.fail(f"camera pose must be a finite 4x4 matrix, got shape {np.shape(cam_to_world)}")
-        rows = hypotheses_rows(cloud, hypotheses, self.max_points)
-        posed = [(h, part) for h, part in zip(hypotheses, rows, strict=True) if part.shape[1]]
+        indices, sizes = sampled_indices(hypotheses, self.max_points)
+        points = np.ascontiguousarray(cloud.points).reshape(-1, 3)
+        boxes, has_points = object_boxes_of_indexed(points, indices, sizes, cam_to_world)
+        posed = [hypothesis for hypothesis, kept in zip(hypotheses, has_points.tolist(), strict=True) if kept]
         if not posed:
             self.fail("no object hypothesis has a valid 3-D point")
-        boxes = object_boxes_of_rows([part for _, part in posed], cam_to_world)
-        for (hypothesis, _), (box, frame) in zip(posed, boxes, strict=True):
-            orientation = quaternion_from_matrix(box.rotation)
-            self.attach(hypothesis, Pose(position=box.centre, orientation=orientation, frame=frame))
+        orientations = box_orientations([box for box, _ in boxes])
+        for hypothesis, (box, frame), orientation in zip(posed, boxes, orientations, strict=True):
+            self.attach(hypothesis, Pose(position=box.centre, orientation=orientation.copy(), frame=frame))

@@ -3,12 +3,19 @@
 Two fits: :func:`upright_box` when the up direction is known (the box stands on the floor: z is up and the yaw
 comes from the minimum-area rectangle of the footprint), and :func:`principal_box` otherwise (axes from the
 principal components of the points).
+
+:func:`object_boxes_of_indexed` and :func:`object_boxes_of_sets` fit many objects at once (the pose annotator's
+path): the gathering, stray removal, moments and extents run as compiled loops over all the sets
+(:mod:`annotators.geometry.box_loops`, loaded on first use) with the arithmetic of the NumPy reductions they
+replace; the boxes agree with :func:`object_box` of each set to rounding (its sums are added in another order).
 """
 
 from __future__ import annotations
 
+import functools
 import math
 from dataclasses import dataclass
+from types import ModuleType
 
 import cv2
 import numpy as np
@@ -97,7 +104,11 @@ def _degenerate_box(points: np.ndarray) -> OrientedBox:
 
 def upright_box(points: np.ndarray) -> OrientedBox:
     """The box with a vertical (+z) axis around Nx3 points given in a z-up frame; yaw from the footprint."""
-    points = finite_points(points)
+    return _upright(finite_points(points))
+
+
+def _upright(points: np.ndarray) -> OrientedBox:
+    """:func:`upright_box` of finite Nx3 float64 points."""
     if points.shape[0] < 3:
         return _degenerate_box(points)
     (cx, cy), (width, depth), angle = cv2.minAreaRect(points[:, :2].astype(np.float32))
@@ -147,38 +158,80 @@ def object_box(points_camera: np.ndarray, cam_to_world: np.ndarray | None) -> tu
     return _principal(rows), "camera"
 
 
-def _principal_boxes(parts: list[np.ndarray]) -> list[OrientedBox]:
-    """:func:`principal_box` of several point sets (each finite 3xN float64 rows) at once: the means, covariances
-    and eigen-decompositions of all the sets in one pass each, then each set's extents along its axes."""
-    boxes: list[OrientedBox | None] = [None if part.shape[1] >= 3 else _degenerate_box(part.T) for part in parts]
-    sets = [part for part in parts if part.shape[1] >= 3]
-    if not sets:
-        return [box for box in boxes if box is not None]
-    sizes = np.array([part.shape[1] for part in sets])
+@functools.cache
+def _loops() -> ModuleType:
+    """:mod:`annotators.geometry.box_loops`, imported (and numba with it) on first use."""
+    from annotators.geometry import box_loops
+
+    return box_loops
+
+
+def _principal_boxes(rows: np.ndarray, sizes: np.ndarray) -> list[OrientedBox]:
+    """:func:`principal_box` of several sets of finite points stored one after another as 3xN float64 rows (each
+    set's size in ``sizes``, every set non-empty), at once: the means and covariances of all the sets in one
+    compiled pass, their eigen-decompositions in one LAPACK call, then each set's extents along its axes in
+    another compiled pass."""
+    loops = _loops()
     starts = np.cumsum(sizes) - sizes
-    owner = np.repeat(np.arange(sizes.size), sizes)
-    rows = np.concatenate(sets, axis=1)
-    mean = np.add.reduceat(rows, starts, axis=1) / sizes  # 3 x sets
-    centred = rows - mean[:, owner]
-    products = np.add.reduceat(centred[[0, 0, 0, 1, 1, 2]] * centred[[0, 1, 2, 1, 2, 2]], starts, axis=1)
+    fitted = sizes >= 3
+    boxes: list[OrientedBox | None] = [
+        None if fit else _degenerate_box(rows[:, start : start + size].T)
+        for fit, start, size in zip(fitted.tolist(), starts.tolist(), sizes.tolist(), strict=True)
+    ]
+    if not fitted.any():
+        return [box for box in boxes if box is not None]
+    if not fitted.all():
+        chosen = zip(starts[fitted].tolist(), sizes[fitted].tolist(), strict=True)
+        rows = np.concatenate([rows[:, start : start + size] for start, size in chosen], axis=1)
+        sizes = sizes[fitted]
+    mean, products = loops.set_moments(rows, sizes)  # 3 x sets, 6 x sets
     covariance = products[[0, 1, 2, 1, 3, 4, 2, 4, 5]].T.reshape(-1, 3, 3)
     _, vectors = np.linalg.eigh(covariance)
     rotation = vectors[:, :, ::-1].copy()  # largest spread first
     rotation[np.linalg.det(rotation) < 0, :, 2] *= -1
-    low, high = np.empty((sizes.size, 3)), np.empty((sizes.size, 3))
-    for index, (start, size) in enumerate(zip(starts.tolist(), sizes.tolist(), strict=True)):
-        local = rotation[index].T @ centred[:, start : start + size]  # the set in its box's axes
-        low[index], high[index] = local.min(axis=1), local.max(axis=1)
+    low, high = loops.set_extents(rows, sizes, mean, rotation)  # the sets in their boxes' axes
     centres = mean.T + np.einsum("sij,sj->si", rotation, (low + high) / 2)
     extents = high - low
-    fitted = iter(OrientedBox(c, r, e) for c, r, e in zip(centres, rotation, extents, strict=True))
-    return [box if box is not None else next(fitted) for box in boxes]
+    boxes_fitted = iter(OrientedBox(c, r, e) for c, r, e in zip(centres, rotation, extents, strict=True))
+    return [box if box is not None else next(boxes_fitted) for box in boxes]
 
 
-def object_boxes_of_rows(rows: list[np.ndarray], cam_to_world: np.ndarray | None) -> list[tuple[OrientedBox, str]]:
-    """:func:`object_box` of several objects whose finite camera-frame points are given as 3xN float64 rows."""
-    parts = [_compact(part) for part in rows]
+def box_orientations(boxes: list[OrientedBox]) -> np.ndarray:
+    """The unit quaternions (Kx4: x, y, z, w) of the boxes' rotations, each what
+    :func:`robokudo.core.geometry.quaternion_from_matrix` gives, converted at once."""
+    if not boxes:
+        return np.zeros((0, 4))
+    return _loops().rotation_quaternions(np.stack([box.rotation for box in boxes]).astype(np.float64, copy=False))
+
+
+def object_boxes_of_indexed(
+    points: np.ndarray, indices: np.ndarray, sizes: np.ndarray, cam_to_world: np.ndarray | None
+) -> tuple[list[tuple[OrientedBox, str]], np.ndarray]:
+    """:func:`object_box` of several objects whose camera-frame points are ``points[indices]`` (Nx3, C-contiguous;
+    indices outside the array and points not finite are skipped), each object's a consecutive group of ``sizes``
+    indices; and which objects had a finite point (the boxes are theirs, in order)."""
+    rows, kept = _loops().gathered_compact_sets(points, indices, np.asarray(sizes, dtype=np.int64), STRAY_FENCE)
+    posed = kept > 0
+    return _boxes_of_compact(rows, kept[posed], cam_to_world), posed
+
+
+def _boxes_of_compact(
+    rows: np.ndarray, sizes: np.ndarray, cam_to_world: np.ndarray | None
+) -> list[tuple[OrientedBox, str]]:
+    """:func:`object_box` of compacted sets (3xN float64 rows, sets one after another, none empty)."""
     if cam_to_world is not None:
         transform = np.asarray(cam_to_world, dtype=np.float64)
-        return [(upright_box(part.T @ transform[:3, :3].T + transform[:3, 3]), "world") for part in parts]
-    return [(box, "camera") for box in _principal_boxes(parts)]
+        world = rows.T @ transform[:3, :3].T + transform[:3, 3]  # all the sets at once
+        fit = _upright if np.isfinite(world).all() else upright_box  # only an overflow makes a point infinite
+        return [(fit(part), "world") for part in np.split(world, np.cumsum(sizes)[:-1])]
+    return [(box, "camera") for box in _principal_boxes(rows, sizes)]
+
+
+def object_boxes_of_sets(
+    rows: np.ndarray, sizes: np.ndarray, cam_to_world: np.ndarray | None
+) -> list[tuple[OrientedBox, str]]:
+    """:func:`object_box` of several objects whose finite camera-frame points are stored one after another as 3xN
+    float64 rows (C-contiguous), each object's number of points (at least one) in ``sizes``."""
+    sizes = np.asarray(sizes, dtype=np.int64)
+    rows, sizes = _loops().compact_sets(np.ascontiguousarray(rows, dtype=np.float64), sizes, STRAY_FENCE)
+    return _boxes_of_compact(rows, sizes, cam_to_world)
