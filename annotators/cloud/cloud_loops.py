@@ -97,30 +97,3 @@ def depth_range(points: np.ndarray, mask: np.ndarray, low: np.floating, high: np
         z = flat_points[3 * i + 2]
         kept[i] = flat_mask[i] & (z >= low) & (z <= high)
     return kept.reshape(mask.shape)
-
-
-@njit(cache=True, nogil=True)
-def finite_rows(points: np.ndarray, indices: np.ndarray, sizes: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
-    """The finite points among ``points[indices]`` (Nx3; indices outside the array are skipped) as 3xM float64
-    rows, in order, and how many of them each consecutive group of ``sizes`` indices kept."""
-    total = points.shape[0]
-    kept = np.zeros(sizes.size, dtype=np.int64)
-    keep = np.zeros(indices.size, dtype=np.bool_)
-    position = 0
-    for group in range(sizes.size):
-        for i in range(position, position + sizes[group]):
-            index = indices[i]
-            if 0 <= index < total:
-                x, y, z = points[index, 0], points[index, 1], points[index, 2]
-                if np.isfinite(x) and np.isfinite(y) and np.isfinite(z):
-                    keep[i] = True
-                    kept[group] += 1
-        position += sizes[group]
-    rows = np.empty((3, kept.sum()), dtype=np.float64)
-    column = 0
-    for i in range(indices.size):
-        if keep[i]:
-            for axis in range(3):
-                rows[axis, column] = points[indices[i], axis]
-            column += 1
-    return rows, kept

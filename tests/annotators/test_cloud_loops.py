@@ -5,7 +5,7 @@ from __future__ import annotations
 import numpy as np
 import pytest
 
-from annotators.cloud.cloud_loops import centred_scatter, finite_rows, plane_band
+from annotators.cloud.cloud_loops import centred_scatter, plane_band
 from annotators.cloud.filters import range_mask
 from annotators.cloud.plane import plane_distances
 
@@ -51,18 +51,3 @@ def test_centred_scatter_matches_the_gathered_points_scatter() -> None:
     centred = picked - picked.mean(axis=0)
     assert np.allclose(centre, picked.mean(axis=0), rtol=0, atol=1e-12)
     assert np.allclose(scatter, centred.T @ centred, rtol=1e-12, atol=1e-12)
-
-
-def test_finite_rows_keeps_finite_in_range_points_in_order_per_group() -> None:
-    points, _ = _cloud(4)
-    flat = points.reshape(-1, 3)
-    indices = np.array([5, -1, 7, flat.shape[0], 3, 900, 2, 2], dtype=np.int64)
-    sizes = np.array([3, 0, 4, 1])
-    rows, kept = finite_rows(flat, indices, sizes)
-    inside = indices[(indices >= 0) & (indices < flat.shape[0])]
-    finite = inside[np.isfinite(flat[inside]).all(axis=1)]
-    assert np.array_equal(rows, flat[finite].T.astype(np.float64))
-    groups = np.repeat(np.arange(sizes.size), sizes)
-    in_range = (indices >= 0) & (indices < flat.shape[0])
-    expected = [int(np.isfinite(flat[indices[in_range & (groups == g)]]).all(axis=1).sum()) for g in range(sizes.size)]
-    assert kept.tolist() == expected
