@@ -44,7 +44,9 @@ Measured on the hypothesis' points in the upright support frame (:mod:`annotator
 
 from __future__ import annotations
 
+import functools
 from dataclasses import dataclass
+from types import ModuleType
 from typing import ClassVar
 
 import numpy as np
@@ -188,6 +190,14 @@ def foot_circle_handle(points: np.ndarray, bottom: float, height: float) -> tupl
     return True, min(1.0, np.count_nonzero(out) / HANDLE_POINTS)
 
 
+@functools.cache
+def _loops() -> ModuleType:
+    """:mod:`annotators.cloud.form_loops`, imported (and numba with it) on first use."""
+    from annotators.cloud import form_loops
+
+    return form_loops
+
+
 def lines_of_sight(points: np.ndarray, tested: np.ndarray, camera: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
     """For each of the Mx3 ``tested`` points (some of the Nx3 ``points``): how far (metres) its line of sight towards
     ``camera`` runs inside the convex hull of ``points``, and the height (z) at which it leaves the hull. A flat hull
@@ -198,12 +208,10 @@ def lines_of_sight(points: np.ndarray, tested: np.ndarray, camera: np.ndarray) -
         return np.zeros(tested.shape[0]), tested[:, 2].copy()
     sight = camera - tested
     sight /= np.maximum(np.linalg.norm(sight, axis=1, keepdims=True), 1e-12)
-    normals, offsets = hull.equations[:, :3], hull.equations[:, 3]
-    inside = -(tested @ normals.T + offsets)  # distance to each face's plane, >= 0 inside
-    toward = sight @ normals.T  # > 0: the line of sight runs towards that face
-    with np.errstate(divide="ignore", invalid="ignore"):
-        reach = np.where(toward > 1e-12, inside / toward, np.inf)
-    run = np.maximum(reach.min(axis=1), 0.0)
+    normals, offsets = hull.equations[:, :3], np.ascontiguousarray(hull.equations[:, 3])
+    # -(tested . normal + offset): the distance to each face's plane, >= 0 inside; divided by sight . normal (> 0:
+    # the line of sight runs towards that face) it is how far the line of sight runs to that face
+    run = _loops().sight_runs(tested @ normals.T, sight @ normals.T, offsets)
     return run, tested[:, 2] + run * sight[:, 2]
 
 

@@ -10,15 +10,32 @@ sight); no surface is measured reliably at such an angle.
 
 from __future__ import annotations
 
+import functools
+from types import ModuleType
+
 import numpy as np
 
 GRAZING_RATIO = 5.0
 """A surface seen within about 11 degrees (atan(1/5)) of the line of sight is grazing."""
 
 
+@functools.cache
+def _loops() -> ModuleType:
+    """:mod:`annotators.geometry.grazing_loops`, imported (and numba with it) on first use."""
+    from annotators.geometry import grazing_loops
+
+    return grazing_loops
+
+
 def grazing_pixels(points: np.ndarray, pixels: np.ndarray, ratio: float = GRAZING_RATIO) -> np.ndarray:
     """Which of the flat ``pixels`` of the HxWx3 camera-frame ``points`` are grazing (see the module docstring);
-    a pixel without a finite point, or whose neighbours have none, is not."""
+    a pixel without a finite point, or whose neighbours have none, is not. Compiled (what
+    :func:`grazing_pixels_numpy` gives, per pixel in one pass)."""
+    return _loops().grazing_pixels(points, np.asarray(pixels, dtype=np.int64).reshape(-1), float(ratio))
+
+
+def grazing_pixels_numpy(points: np.ndarray, pixels: np.ndarray, ratio: float = GRAZING_RATIO) -> np.ndarray:
+    """:func:`grazing_pixels` in whole-array NumPy (the reference its compiled loop is tested against)."""
     height, width = points.shape[:2]
     rows, cols = np.divmod(np.asarray(pixels, dtype=np.int64), width)
     here = points[rows, cols].astype(np.float64)
