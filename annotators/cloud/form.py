@@ -111,7 +111,7 @@ def _extent(xy: np.ndarray) -> float:
     centred = xy - xy.mean(axis=0)
     _, _, axes = np.linalg.svd(centred, full_matrices=False)
     along = centred @ axes.T
-    low, high = np.quantile(along, 0.02, axis=0), np.quantile(along, 0.98, axis=0)
+    low, high = np.quantile(along, (0.02, 0.98), axis=0)
     return float((high - low).max())
 
 
@@ -240,9 +240,12 @@ def far_inside_top(points: np.ndarray, tested: np.ndarray, rim_height: float, ca
     return inside & ((tested[:, :2] - middle) @ away > 0.0)
 
 
-def open_evidence(points: np.ndarray, bottom: float, height: float, camera: np.ndarray) -> tuple[bool, float]:
-    """Whether the object is open at the top, and the confidence of that (see the module docstring)."""
-    extent = _extent(points[:, :2])
+def open_evidence(
+    points: np.ndarray, bottom: float, height: float, camera: np.ndarray, extent: float | None = None
+) -> tuple[bool, float]:
+    """Whether the object is open at the top, and the confidence of that (see the module docstring); ``extent``:
+    the footprint's longer extent when already measured (as :func:`measure_form` does)."""
+    extent = _extent(points[:, :2]) if extent is None else extent
     if points.shape[0] < 20 or extent <= 0.0 or height <= 0.0:
         return False, 0.0
     tested = points[:: max(1, points.shape[0] // THROUGH_TESTED)]
@@ -262,14 +265,15 @@ def measure_form(points: np.ndarray, frame: SupportFrame, grazing: np.ndarray | 
     if points.shape[0] < 20:
         return None
     z = points[:, 2]
-    bottom = 0.0 if frame.on_plane else float(np.quantile(z, 0.02))
-    height = float(np.quantile(z, 0.98)) - bottom
+    low, high = np.quantile(z, (0.02, 0.98))
+    bottom = 0.0 if frame.on_plane else float(low)
+    height = float(high) - bottom
     width = _extent(points[:, :2])
     if height <= 0.0 or width <= 0.0:
         return None
     seen = points if grazing is None else points[~grazing]
     handle, handle_confidence = handle_evidence(seen, bottom, height)
-    open_top, open_confidence = open_evidence(points, bottom, height, frame.camera_to_frame[:3, 3])
+    open_top, open_confidence = open_evidence(points, bottom, height, frame.camera_to_frame[:3, 3], width)
     return Form(height / width, handle, handle_confidence, open_top, open_confidence)
 
 
