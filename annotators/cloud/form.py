@@ -151,11 +151,11 @@ def profile_handle(points: np.ndarray, bottom: float, height: float) -> tuple[bo
 def handle_evidence(points: np.ndarray, bottom: float, height: float) -> tuple[bool, float]:
     """Whether a handle sticks out of the body's side, and the confidence of that (see the module docstring); the
     points should hold no grazing ones."""
-    found, confidence = profile_handle(points, bottom, height)
     circle = foot_circle_handle(points, bottom, height)
-    if found and not circle[0]:
-        return True, confidence
-    return circle
+    if circle[0]:  # the circle's handle (and confidence) stands whatever the profile finds
+        return circle
+    found, confidence = profile_handle(points, bottom, height)
+    return (True, confidence) if found else circle
 
 
 def foot_circle_handle(points: np.ndarray, bottom: float, height: float) -> tuple[bool, float]:
@@ -208,10 +208,9 @@ def lines_of_sight(points: np.ndarray, tested: np.ndarray, camera: np.ndarray) -
         return np.zeros(tested.shape[0]), tested[:, 2].copy()
     sight = camera - tested
     sight /= np.maximum(np.linalg.norm(sight, axis=1, keepdims=True), 1e-12)
-    normals, offsets = hull.equations[:, :3], np.ascontiguousarray(hull.equations[:, 3])
     # -(tested . normal + offset): the distance to each face's plane, >= 0 inside; divided by sight . normal (> 0:
     # the line of sight runs towards that face) it is how far the line of sight runs to that face
-    run = _loops().sight_runs(tested @ normals.T, sight @ normals.T, offsets)
+    run = _loops().sight_runs(np.ascontiguousarray(tested), sight, hull.equations)
     return run, tested[:, 2] + run * sight[:, 2]
 
 
@@ -228,7 +227,7 @@ def far_inside_top(points: np.ndarray, tested: np.ndarray, rim_height: float, ca
         hull = ConvexHull(top)
     except QhullError:  # the top is a line or a point: it encloses nothing
         return none
-    inside = (tested[:, :2] @ hull.equations[:, :2].T + hull.equations[:, 2]).max(axis=1) <= THROUGH_MIN
+    inside = _loops().within_outline(np.ascontiguousarray(tested[:, :2]), hull.equations, THROUGH_MIN)
     centre = np.median(top, axis=0)
     away = centre - camera[:2]
     length = float(np.linalg.norm(away))
