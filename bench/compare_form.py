@@ -57,8 +57,9 @@ def dump(target: Path) -> None:
             cloud = cas.view(PointCloud)
             frame_ = support_frame(usable_plane(cas.annotations(Plane)), cas.view(CameraInfo))
             indices = [sampled_indices(cloud, h, MAX_POINTS) for h in cas.annotations(ObjectHypothesis)]
-            inputs.append({"name": f"{Path(path).name}#{frame}", "points": cloud.points, "indices": indices,
-                           "frame": frame_})
+            inputs.append(
+                {"name": f"{Path(path).name}#{frame}", "points": cloud.points, "indices": indices, "frame": frame_}
+            )
             print(f"{Path(path).name}#{frame}: {len(indices)} hypotheses", file=sys.stderr)
     target.write_bytes(pickle.dumps(inputs))
 
@@ -78,11 +79,18 @@ def measure(source: Path, target: Path) -> None:
             forms = []
             for indices in entry["indices"]:
                 grazing = form.grazing_pixels(entry["points"], indices)
-                forms.append(form.measure_form(entry["frame"].points(flat[indices].astype(np.float64)), entry["frame"],
-                                               grazing))
+                forms.append(
+                    form.measure_form(entry["frame"].points(flat[indices].astype(np.float64)), entry["frame"], grazing)
+                )
         seconds.append(time.perf_counter() - start)
-        results.append([None if f is None else (f.height_to_width, f.has_handle, f.handle_confidence, f.open_top,
-                                                 f.open_confidence) for f in forms])
+        results.append(
+            [
+                None
+                if f is None
+                else (f.height_to_width, f.has_handle, f.handle_confidence, f.open_top, f.open_confidence)
+                for f in forms
+            ]
+        )
     target.write_bytes(pickle.dumps({"tree": form.__file__, "forms": results[1:], "seconds": seconds[1:]}))
 
 
@@ -94,11 +102,16 @@ def compare(source: Path, other: Path, rounds: int) -> None:
             for name, tree in (("this", ROOT), ("other", other)):
                 out = Path(tmp) / f"{name}{number}.pkl"
                 env = {**os.environ, "PYTHONPATH": str(tree)}
-                subprocess.run([sys.executable, str(Path(__file__).resolve()), "measure", str(source), str(out)],
-                               env=env, check=True)
+                subprocess.run(
+                    [sys.executable, str(Path(__file__).resolve()), "measure", str(source), str(out)],
+                    env=env,
+                    check=True,
+                )
                 runs[name].append(pickle.loads(out.read_bytes()))
-    per_frame = {name: [statistics.median(r["seconds"][i] for r in rs) * 1000 for i in range(len(rs[0]["seconds"]))]
-                 for name, rs in runs.items()}
+    per_frame = {
+        name: [statistics.median(r["seconds"][i] for r in rs) * 1000 for i in range(len(rs[0]["seconds"]))]
+        for name, rs in runs.items()
+    }
     names = [entry["name"] for entry in pickle.loads(source.read_bytes())]
     print(f"{'frame':24} {'this ms':>8} {'other ms':>9}  hypotheses")
     ours, theirs = runs["this"][0]["forms"], runs["other"][0]["forms"]
@@ -113,8 +126,15 @@ def compare(source: Path, other: Path, rounds: int) -> None:
     mean_this, mean_other = statistics.mean(per_frame["this"]), statistics.mean(per_frame["other"])
     speedup = mean_other / mean_this
     print(f"trees: this {runs['this'][0]['tree']}, other {runs['other'][0]['tree']}; load {os.getloadavg()[0]:.2f}")
-    print(f"mean ms per frame: this {mean_this:.1f}, other {mean_other:.1f}: {speedup:.2f}x "
-          f"(goal >= 2x: {'met' if speedup >= 2.0 else 'NOT met'})")
+    print(
+        f"mean ms per frame: this {mean_this:.1f}, other {mean_other:.1f}: {speedup:.2f}x "
+        f"(goal >= 2x: {'met' if speedup >= 2.0 else 'NOT met'})"
+    )
+    uoc = [i for i, name in enumerate(names) if name.startswith("uoc")]
+    print(
+        f"uoc frames: this {statistics.mean(per_frame['this'][i] for i in uoc):.1f} ms, "
+        f"other {statistics.mean(per_frame['other'][i] for i in uoc):.1f} ms per frame"
+    )
     print(f"identical cues: {same}/{total} hypotheses ({'met' if same == total else 'NOT met'})")
 
 

@@ -10,7 +10,7 @@ import numpy as np
 from numba import njit
 
 
-@njit(cache=True, nogil=True)
+@njit(cache=True, nogil=True, error_model="numpy")  # x / 0 gives inf or NaN, as in NumPy
 def grazing_pixels(points: np.ndarray, pixels: np.ndarray, ratio: float) -> np.ndarray:
     """See :func:`annotators.geometry.grazing.grazing_pixels`: the same arithmetic, in the same order, per pixel."""
     height, width = points.shape[0], points.shape[1]
