@@ -291,7 +291,7 @@ class FormAnnotator(CloudExpert):
         label="form annotator",
         synonyms=("handle detector",),
         preconditions=("NeedsDepth",),
-        cost_ms=4.0,
+        cost_ms=35.0,  # per frame: ~20 hypotheses of a RealSense tabletop frame (bench/compare_form.py, loaded)
         reliability=0.7,
     )
 
