@@ -10,7 +10,9 @@ wide (the camera sees only a half arc of it).
 
 from __future__ import annotations
 
+import functools
 from dataclasses import dataclass
+from types import ModuleType
 
 import numpy as np
 
@@ -38,6 +40,14 @@ class BodyProfile:
         return np.interp(z, self.heights[known], self.radii[known])
 
 
+@functools.cache
+def _loops() -> ModuleType:
+    """:mod:`annotators.cloud.body_profile_loops`, imported (and numba with it) on first use."""
+    from annotators.cloud import body_profile_loops
+
+    return body_profile_loops
+
+
 def body_profile(points: np.ndarray, bottom: float, height: float) -> BodyProfile | None:
     """The body profile of Nx3 upright ``points`` between ``bottom`` and ``bottom + height``; None when fewer than
     two bands hold points or the fit is degenerate."""
@@ -48,20 +58,15 @@ def body_profile(points: np.ndarray, bottom: float, height: float) -> BodyProfil
     band = np.clip(np.searchsorted(edges, z, side="right") - 1, 0, BANDS - 1)
     keep = np.ones(z.size, dtype=bool)
     squares = (xy**2).sum(axis=1)
+    loops = _loops()
     profile = None
     for _ in range(ROUNDS):
-        counts = np.bincount(band[keep], minlength=BANDS).astype(np.float64)
+        # the band offsets taken out by centring each band (the same least-squares solution, a 2x2 system)
+        counts, means, matrix, rhs = loops.band_system(xy, squares, band, keep, BANDS)
         present = counts > 0
         if np.count_nonzero(present) < 2 or np.count_nonzero(keep) < 3 + np.count_nonzero(present):
             break
-        # the band offsets taken out by centring each band (the same least-squares solution, a 2x2 system)
-        with np.errstate(invalid="ignore", divide="ignore"):
-            means = np.stack(
-                [np.bincount(band[keep], values, minlength=BANDS) / counts for values in (*xy[keep].T, squares[keep])],
-                axis=1,
-            )
-        centred = xy[keep] - means[band[keep], :2]
-        solution, *_ = np.linalg.lstsq(2.0 * centred, squares[keep] - means[band[keep], 2], rcond=None)
+        solution, *_ = np.linalg.lstsq(matrix, rhs, rcond=None)
         centre = solution
         if not np.all(np.isfinite(centre)):
             break
@@ -69,7 +74,7 @@ def body_profile(points: np.ndarray, bottom: float, height: float) -> BodyProfil
         offsets = means[present, 2] - 2.0 * means[present, :2] @ centre
         radii[present] = np.sqrt(np.maximum(offsets + centre @ centre, 0.0))
         profile = BodyProfile(centre, (edges[:-1] + edges[1:]) / 2.0, radii)
-        off = np.abs(np.linalg.norm(xy - centre, axis=1) - np.where(np.isfinite(radii[band]), radii[band], np.inf))
+        off = loops.surface_offsets(xy, band, centre, radii)
         spread = max(1.4826 * float(np.median(off[keep])), MIN_SPREAD)
         keep = off < OUTLIER_SPREAD * spread
     return profile

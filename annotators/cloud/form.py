@@ -44,7 +44,9 @@ Measured on the hypothesis' points in the upright support frame (:mod:`annotator
 
 from __future__ import annotations
 
+import functools
 from dataclasses import dataclass
+from types import ModuleType
 from typing import ClassVar
 
 import numpy as np
@@ -109,7 +111,7 @@ def _extent(xy: np.ndarray) -> float:
     centred = xy - xy.mean(axis=0)
     _, _, axes = np.linalg.svd(centred, full_matrices=False)
     along = centred @ axes.T
-    low, high = np.quantile(along, 0.02, axis=0), np.quantile(along, 0.98, axis=0)
+    low, high = np.quantile(along, (0.02, 0.98), axis=0)
     return float((high - low).max())
 
 
@@ -149,11 +151,11 @@ def profile_handle(points: np.ndarray, bottom: float, height: float) -> tuple[bo
 def handle_evidence(points: np.ndarray, bottom: float, height: float) -> tuple[bool, float]:
     """Whether a handle sticks out of the body's side, and the confidence of that (see the module docstring); the
     points should hold no grazing ones."""
-    found, confidence = profile_handle(points, bottom, height)
     circle = foot_circle_handle(points, bottom, height)
-    if found and not circle[0]:
-        return True, confidence
-    return circle
+    if circle[0]:  # the circle's handle (and confidence) stands whatever the profile finds
+        return circle
+    found, confidence = profile_handle(points, bottom, height)
+    return (True, confidence) if found else circle
 
 
 def foot_circle_handle(points: np.ndarray, bottom: float, height: float) -> tuple[bool, float]:
@@ -188,6 +190,14 @@ def foot_circle_handle(points: np.ndarray, bottom: float, height: float) -> tupl
     return True, min(1.0, np.count_nonzero(out) / HANDLE_POINTS)
 
 
+@functools.cache
+def _loops() -> ModuleType:
+    """:mod:`annotators.cloud.form_loops`, imported (and numba with it) on first use."""
+    from annotators.cloud import form_loops
+
+    return form_loops
+
+
 def lines_of_sight(points: np.ndarray, tested: np.ndarray, camera: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
     """For each of the Mx3 ``tested`` points (some of the Nx3 ``points``): how far (metres) its line of sight towards
     ``camera`` runs inside the convex hull of ``points``, and the height (z) at which it leaves the hull. A flat hull
@@ -198,12 +208,9 @@ def lines_of_sight(points: np.ndarray, tested: np.ndarray, camera: np.ndarray) -
         return np.zeros(tested.shape[0]), tested[:, 2].copy()
     sight = camera - tested
     sight /= np.maximum(np.linalg.norm(sight, axis=1, keepdims=True), 1e-12)
-    normals, offsets = hull.equations[:, :3], hull.equations[:, 3]
-    inside = -(tested @ normals.T + offsets)  # distance to each face's plane, >= 0 inside
-    toward = sight @ normals.T  # > 0: the line of sight runs towards that face
-    with np.errstate(divide="ignore", invalid="ignore"):
-        reach = np.where(toward > 1e-12, inside / toward, np.inf)
-    run = np.maximum(reach.min(axis=1), 0.0)
+    # -(tested . normal + offset): the distance to each face's plane, >= 0 inside; divided by sight . normal (> 0:
+    # the line of sight runs towards that face) it is how far the line of sight runs to that face
+    run = _loops().sight_runs(np.ascontiguousarray(tested), sight, hull.equations)
     return run, tested[:, 2] + run * sight[:, 2]
 
 
@@ -220,7 +227,7 @@ def far_inside_top(points: np.ndarray, tested: np.ndarray, rim_height: float, ca
         hull = ConvexHull(top)
     except QhullError:  # the top is a line or a point: it encloses nothing
         return none
-    inside = (tested[:, :2] @ hull.equations[:, :2].T + hull.equations[:, 2]).max(axis=1) <= THROUGH_MIN
+    inside = _loops().within_outline(np.ascontiguousarray(tested[:, :2]), hull.equations, THROUGH_MIN)
     centre = np.median(top, axis=0)
     away = centre - camera[:2]
     length = float(np.linalg.norm(away))
@@ -232,9 +239,12 @@ def far_inside_top(points: np.ndarray, tested: np.ndarray, rim_height: float, ca
     return inside & ((tested[:, :2] - middle) @ away > 0.0)
 
 
-def open_evidence(points: np.ndarray, bottom: float, height: float, camera: np.ndarray) -> tuple[bool, float]:
-    """Whether the object is open at the top, and the confidence of that (see the module docstring)."""
-    extent = _extent(points[:, :2])
+def open_evidence(
+    points: np.ndarray, bottom: float, height: float, camera: np.ndarray, extent: float | None = None
+) -> tuple[bool, float]:
+    """Whether the object is open at the top, and the confidence of that (see the module docstring); ``extent``:
+    the footprint's longer extent when already measured (as :func:`measure_form` does)."""
+    extent = _extent(points[:, :2]) if extent is None else extent
     if points.shape[0] < 20 or extent <= 0.0 or height <= 0.0:
         return False, 0.0
     tested = points[:: max(1, points.shape[0] // THROUGH_TESTED)]
@@ -254,14 +264,15 @@ def measure_form(points: np.ndarray, frame: SupportFrame, grazing: np.ndarray | 
     if points.shape[0] < 20:
         return None
     z = points[:, 2]
-    bottom = 0.0 if frame.on_plane else float(np.quantile(z, 0.02))
-    height = float(np.quantile(z, 0.98)) - bottom
+    low, high = np.quantile(z, (0.02, 0.98))
+    bottom = 0.0 if frame.on_plane else float(low)
+    height = float(high) - bottom
     width = _extent(points[:, :2])
     if height <= 0.0 or width <= 0.0:
         return None
     seen = points if grazing is None else points[~grazing]
     handle, handle_confidence = handle_evidence(seen, bottom, height)
-    open_top, open_confidence = open_evidence(points, bottom, height, frame.camera_to_frame[:3, 3])
+    open_top, open_confidence = open_evidence(points, bottom, height, frame.camera_to_frame[:3, 3], width)
     return Form(height / width, handle, handle_confidence, open_top, open_confidence)
 
 
@@ -280,7 +291,7 @@ class FormAnnotator(CloudExpert):
         label="form annotator",
         synonyms=("handle detector",),
         preconditions=("NeedsDepth",),
-        cost_ms=4.0,
+        cost_ms=35.0,  # per frame: ~20 hypotheses of a RealSense tabletop frame (bench/compare_form.py, loaded)
         reliability=0.7,
     )
 

@@ -10,26 +10,25 @@ sight); no surface is measured reliably at such an angle.
 
 from __future__ import annotations
 
+import functools
+from types import ModuleType
+
 import numpy as np
 
 GRAZING_RATIO = 5.0
 """A surface seen within about 11 degrees (atan(1/5)) of the line of sight is grazing."""
 
 
+@functools.cache
+def _loops() -> ModuleType:
+    """:mod:`annotators.geometry.grazing_loops`, imported (and numba with it) on first use."""
+    from annotators.geometry import grazing_loops
+
+    return grazing_loops
+
+
 def grazing_pixels(points: np.ndarray, pixels: np.ndarray, ratio: float = GRAZING_RATIO) -> np.ndarray:
     """Which of the flat ``pixels`` of the HxWx3 camera-frame ``points`` are grazing (see the module docstring);
-    a pixel without a finite point, or whose neighbours have none, is not."""
-    height, width = points.shape[:2]
-    rows, cols = np.divmod(np.asarray(pixels, dtype=np.int64), width)
-    here = points[rows, cols].astype(np.float64)
-    with np.errstate(invalid="ignore", divide="ignore"):
-        sight = here / np.linalg.norm(here, axis=1, keepdims=True)
-    grazing = np.zeros(rows.size, dtype=bool)
-    for step_row, step_col in ((0, 1), (0, -1), (1, 0), (-1, 0)):
-        other = points[np.clip(rows + step_row, 0, height - 1), np.clip(cols + step_col, 0, width - 1)]
-        step = other.astype(np.float64) - here
-        along = (step * sight).sum(axis=1)
-        across = np.linalg.norm(step - along[:, None] * sight, axis=1)
-        with np.errstate(invalid="ignore"):
-            grazing |= np.abs(along) > ratio * np.maximum(across, 1e-9)
-    return grazing
+    a pixel without a finite point, or whose neighbours have none, is not. A compiled loop over the pixels
+    (:mod:`annotators.geometry.grazing_loops`)."""
+    return _loops().grazing_pixels(points, np.asarray(pixels, dtype=np.int64).reshape(-1), float(ratio))
