@@ -32,6 +32,7 @@ from annotators.geometry.grid_segmentation import (
     pixel_footprint,
     touching_pairs,
 )
+from annotators.geometry.support_kernels import piece_summary
 
 
 @dataclass(frozen=True)
@@ -71,7 +72,13 @@ class PieceSummary:
 
 def summarize_pieces(labels: np.ndarray, plane_points: np.ndarray, sample_step: int) -> PieceSummary:
     """The :class:`PieceSummary` of ``labels`` from the ``(u, v, height)`` plane coordinates of its pixels
-    (``plane_points``, HxWx3 or (H*W)x3), heights read on every ``sample_step``-th pixel, with one sort."""
+    (``plane_points``, HxWx3 or (H*W)x3), heights read on every ``sample_step``-th pixel, in one compiled pass."""
+    return PieceSummary(*piece_summary(labels, plane_points.reshape(*labels.shape, 3), sample_step))
+
+
+def summarize_pieces_numpy(labels: np.ndarray, plane_points: np.ndarray, sample_step: int) -> PieceSummary:
+    """:func:`summarize_pieces` in whole-array numpy with one sort (feet ordered by height within a label): the
+    reference form its compiled pass is tested against."""
     count = int(labels.max(initial=0)) + 1
     sizes = np.bincount(labels.reshape(-1), minlength=count)
     step = max(1, sample_step)

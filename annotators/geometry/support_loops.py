@@ -1,0 +1,57 @@
+"""The compiled loops behind :mod:`annotators.geometry.support_kernels` (numba, machine code cached on disk next to
+this file). Importing this module imports numba; :mod:`~annotators.geometry.support` reaches it through
+:mod:`~annotators.geometry.support_kernels` only, on first use."""
+
+from __future__ import annotations
+
+import numpy as np
+from numba import njit
+
+
+@njit(cache=True, nogil=True)
+def piece_summary(
+    labels: np.ndarray, plane: np.ndarray, step: int
+) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
+    """See :func:`annotators.geometry.support_kernels.piece_summary`."""
+    rows, cols = labels.shape
+    count = 0
+    for r in range(rows):
+        for c in range(cols):
+            count = max(count, labels[r, c])
+    count += 1
+    sizes = np.zeros(count, dtype=np.int64)
+    for r in range(rows):
+        for c in range(cols):
+            sizes[labels[r, c]] += 1
+    starts = np.zeros(count + 1, dtype=np.int64)
+    for r in range(0, rows, step):
+        for c in range(0, cols, step):
+            label = labels[r, c]
+            if label > 0 and np.isfinite(plane[r, c, 2]):
+                starts[label + 1] += 1
+    for label in range(1, count + 1):
+        starts[label] += starts[label - 1]
+    feet = np.empty((starts[count], 2), dtype=np.float32)
+    heights = np.empty(starts[count], dtype=np.float64)
+    filled = starts[:-1].copy()
+    floor, ceiling, half = np.float32(-0.49), np.float32(0.49), np.float32(0.5)
+    for r in range(0, rows, step):
+        for c in range(0, cols, step):
+            label = labels[r, c]
+            height = plane[r, c, 2]
+            if label > 0 and np.isfinite(height):
+                index = filled[label]
+                feet[index, 0], feet[index, 1] = plane[r, c, 0], plane[r, c, 1]
+                # the height as the float32 fraction of the numpy form's sort key, read back in float64
+                shifted = np.float32(np.float32(min(max(height, floor), ceiling)) + half)
+                heights[index] = np.float64(shifted) - 0.5
+                filled[label] = index + 1
+    quantiles = np.full((3, count), np.nan)
+    shares = (0.05, 0.95, 0.99)
+    for label in range(1, count):
+        size = starts[label + 1] - starts[label]
+        if size > 0:
+            ordered = np.sort(heights[starts[label] : starts[label + 1]])
+            for q in range(3):
+                quantiles[q, label] = ordered[int(np.rint(shares[q] * (size - 1)))]
+    return sizes, quantiles[0], quantiles[1], quantiles[2], feet, starts
