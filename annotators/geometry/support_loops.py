@@ -10,8 +10,8 @@ from numba import njit
 
 @njit(cache=True, nogil=True)
 def piece_summary(
-    labels: np.ndarray, plane: np.ndarray, step: int
-) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
+    labels: np.ndarray, plane: np.ndarray, step: int, max_touching: int
+) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray, np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
     """See :func:`annotators.geometry.support_kernels.piece_summary`."""
     rows, cols = labels.shape
     count = 0
@@ -20,9 +20,40 @@ def piece_summary(
             count = max(count, labels[r, c])
     count += 1
     sizes = np.zeros(count, dtype=np.int64)
+    boxes = np.zeros((count, 4), dtype=np.int64)
+    boxes[:, 0], boxes[:, 1] = cols, rows
+    side = count if count <= max_touching else 0
+    touching = np.zeros((side, side), dtype=np.bool_)
     for r in range(rows):
         for c in range(cols):
-            sizes[labels[r, c]] += 1
+            label = labels[r, c]
+            sizes[label] += 1
+            if label > 0:
+                boxes[label, 0], boxes[label, 1] = min(boxes[label, 0], c), min(boxes[label, 1], r)
+                boxes[label, 2], boxes[label, 3] = max(boxes[label, 2], c + 1), max(boxes[label, 3], r + 1)
+                if side > 0:
+                    if c + 1 < cols:
+                        other = labels[r, c + 1]
+                        if other > 0 and other != label:
+                            touching[min(label, other), max(label, other)] = True
+                    if r + 1 < rows:
+                        other = labels[r + 1, c]
+                        if other > 0 and other != label:
+                            touching[min(label, other), max(label, other)] = True
+    pair_count = 0
+    for a in range(side):
+        for b in range(side):
+            pair_count += touching[a, b]
+    pairs = np.empty((pair_count, 2), dtype=np.int64)
+    pair_count = 0
+    for a in range(side):
+        for b in range(side):
+            if touching[a, b]:
+                pairs[pair_count, 0], pairs[pair_count, 1] = a, b
+                pair_count += 1
+    for label in range(count):
+        if sizes[label] == 0 or label == 0:
+            boxes[label] = 0
     starts = np.zeros(count + 1, dtype=np.int64)
     for r in range(0, rows, step):
         for c in range(0, cols, step):
@@ -54,4 +85,25 @@ def piece_summary(
             ordered = np.sort(heights[starts[label] : starts[label + 1]])
             for q in range(3):
                 quantiles[q, label] = ordered[int(np.rint(shares[q] * (size - 1)))]
-    return sizes, quantiles[0], quantiles[1], quantiles[2], feet, starts
+    return sizes, quantiles[0], quantiles[1], quantiles[2], feet, starts, boxes, pairs
+
+
+@njit(cache=True, nogil=True, error_model="numpy")
+def footprint_steps(points: np.ndarray) -> np.ndarray:
+    """The finite, positive ``|x / z|`` differences (float32) of horizontally adjacent pixels of HxWx3 ``points``
+    (float32), row-major: what :func:`~annotators.geometry.grid_segmentation.pixel_footprint` takes the median of."""
+    rows, cols = points.shape[0], points.shape[1]
+    steps = np.empty(max(rows * (cols - 1), 0), dtype=np.float32)
+    count = 0
+    for r in range(rows):
+        for c in range(cols - 1):
+            step = np.float32(
+                abs(
+                    np.float32(points[r, c + 1, 0] / points[r, c + 1, 2])
+                    - np.float32(points[r, c, 0] / points[r, c, 2])
+                )
+            )
+            if np.isfinite(step) and step > 0:
+                steps[count] = step
+                count += 1
+    return steps[:count]
