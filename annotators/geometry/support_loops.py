@@ -25,21 +25,23 @@ def piece_summary(
     side = count if count <= max_touching else 0
     touching = np.zeros((side, side), dtype=np.bool_)
     for r in range(rows):
-        for c in range(cols):
-            label = labels[r, c]
-            sizes[label] += 1
-            if label > 0:
-                boxes[label, 0], boxes[label, 1] = min(boxes[label, 0], c), min(boxes[label, 1], r)
-                boxes[label, 2], boxes[label, 3] = max(boxes[label, 2], c + 1), max(boxes[label, 3], r + 1)
-                if side > 0:
-                    if c + 1 < cols:
-                        other = labels[r, c + 1]
-                        if other > 0 and other != label:
-                            touching[min(label, other), max(label, other)] = True
-                    if r + 1 < rows:
-                        other = labels[r + 1, c]
-                        if other > 0 and other != label:
-                            touching[min(label, other), max(label, other)] = True
+        # runs of one label along the row: its size and box grow once per run
+        label, start = labels[r, 0], 0
+        for c in range(1, cols + 1):
+            following = labels[r, c] if c < cols else -1
+            if following != label:
+                sizes[label] += c - start
+                if label > 0:
+                    boxes[label, 0], boxes[label, 1] = min(boxes[label, 0], start), min(boxes[label, 1], r)
+                    boxes[label, 2], boxes[label, 3] = max(boxes[label, 2], c), r + 1
+                    if side > 0 and following > 0:
+                        touching[min(label, following), max(label, following)] = True
+                label, start = following, c
+        if side > 0 and r + 1 < rows:
+            for c in range(cols):
+                above, below = labels[r, c], labels[r + 1, c]
+                if above != below and above > 0 and below > 0:
+                    touching[min(above, below), max(above, below)] = True
     pair_count = 0
     for a in range(side):
         for b in range(side):
@@ -82,7 +84,8 @@ def piece_summary(
     for label in range(1, count):
         size = starts[label + 1] - starts[label]
         if size > 0:
-            ordered = np.sort(heights[starts[label] : starts[label + 1]])
+            ordered = heights[starts[label] : starts[label + 1]]
+            ordered.sort()
             for q in range(3):
                 quantiles[q, label] = ordered[int(np.rint(shares[q] * (size - 1)))]
     return sizes, quantiles[0], quantiles[1], quantiles[2], feet, starts, boxes, pairs

@@ -1,0 +1,88 @@
+"""The compiled forms in annotators.geometry.support give what their numpy / OpenCV forms give."""
+
+from __future__ import annotations
+
+import cv2
+import numpy as np
+import pytest
+
+from annotators.geometry.grid_segmentation import boundaries, inside_share, pixel_footprint
+from annotators.geometry.support import (
+    AppendageRules,
+    close_borders,
+    held_share,
+    summarize_pieces,
+    summarize_pieces_numpy,
+)
+from annotators.geometry.support_kernels import pixel_footprint as compiled_footprint
+
+
+def blocky_scene(seed: int, shape=(37, 53), count: int = 9) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """Labels of random overlapping rectangles (some labels absent, gaps of 0), camera points and (u, v, height)
+    plane coordinates with missing heights, repeated heights and heights beyond +-0.49 m."""
+    rng = np.random.default_rng(seed)
+    labels = np.zeros(shape, dtype=np.int32)
+    for label in range(1, count + 1):
+        if label == 4:
+            continue  # an absent label
+        y0, x0 = rng.integers(0, shape[0] - 3), rng.integers(0, shape[1] - 3)
+        labels[y0 : y0 + rng.integers(2, 15), x0 : x0 + rng.integers(2, 20)] = label
+    plane = rng.normal(0.0, 0.2, (*shape, 3)).astype(np.float32)
+    plane[..., 2] = np.round(plane[..., 2], 2)  # ties
+    plane[rng.random(shape) < 0.1, 2] = np.nan
+    plane[0, 0, 2], plane[2, 2, 2] = 0.7, -0.8
+    rows, cols = np.mgrid[0 : shape[0], 0 : shape[1]]
+    depth = (1.0 + 0.01 * rng.random(shape)).astype(np.float32)
+    depth[labels == 2] += 0.3  # a depth jump around one label
+    points = np.stack([(cols - 26) * 0.002 * depth, (rows - 18) * 0.002 * depth, depth], axis=-1).astype(np.float32)
+    points[rng.random(shape) < 0.03] = np.nan
+    return labels, points, plane
+
+
+@pytest.mark.parametrize("seed", range(6))
+@pytest.mark.parametrize("step", [1, 2, 3])
+def test_the_compiled_piece_summary_is_the_numpy_one(seed: int, step: int) -> None:
+    labels, _, plane = blocky_scene(seed)
+    compiled, reference = summarize_pieces(labels, plane, step), summarize_pieces_numpy(labels, plane, step)
+    for name in ("sizes", "low", "high", "top", "starts", "boxes", "touching"):
+        assert np.array_equal(getattr(compiled, name), getattr(reference, name), equal_nan=True), name
+    assert compiled.low.shape == (labels.max() + 1,) and compiled.touching.shape[0] > 0
+    assert np.isfinite(compiled.low).sum() >= 5
+    for label in range(1, labels.max() + 1):
+        mine, theirs = compiled.hull(label), reference.hull(label)
+        assert np.array_equal(np.unique(mine, axis=0), np.unique(theirs, axis=0))  # the same points, any order
+
+
+def test_the_compiled_footprint_is_the_numpy_one() -> None:
+    for seed in range(4):
+        _, points, _ = blocky_scene(seed)
+        points[3, :, 2] = 0.0  # a row of zero depths: infinite ratios
+        assert compiled_footprint(points) == pixel_footprint(points)
+    assert compiled_footprint(np.full((3, 4, 3), np.nan, dtype=np.float32)) == pixel_footprint(
+        np.full((3, 4, 3), np.nan, dtype=np.float32)
+    )
+
+
+def test_the_held_share_is_the_inside_share() -> None:
+    rng = np.random.default_rng(5)
+    for _ in range(200):
+        inner = rng.normal(0.0, 0.03, (int(rng.integers(3, 9)), 2)).astype(np.float32)
+        outer = (rng.normal(0.0, 0.05, (int(rng.integers(3, 9)), 2)) + rng.normal(0.0, 0.03, 2)).astype(np.float32)
+        inner, outer = cv2.convexHull(inner).reshape(-1, 2), cv2.convexHull(outer).reshape(-1, 2)
+        assert held_share(inner, outer, 0.005) == inside_share(inner, outer, 0.005)
+
+
+@pytest.mark.parametrize("seed", range(4))
+def test_the_close_borders_are_those_of_the_boundaries(seed: int) -> None:
+    labels, points, _ = blocky_scene(seed)
+    normals = np.zeros_like(points)
+    normals[..., 2] = -1.0
+    rules = AppendageRules()
+    footprint = pixel_footprint(points)
+    pairs, close, length = close_borders(labels, points, normals, rules, footprint)
+    reference = boundaries(
+        labels, points, normals, rules.jump_absolute, rules.jump_relative, reach=2, footprint=footprint
+    )
+    assert pairs.shape[0] > 0
+    assert np.array_equal(pairs, reference.pairs)
+    assert np.array_equal(close, reference.close) and np.array_equal(length, reference.length)
