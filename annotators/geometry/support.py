@@ -58,7 +58,8 @@ class PieceSummary:
     above the plane (``low``, ``high``, ``top``; NaN without a sampled point) and its sampled ``feet`` (Nx2 plane
     coordinates grouped by label: label k owns ``feet[starts[k]:starts[k + 1]]``), its pixel ``boxes``
     (``(x0, y0, x1, y1)``, exclusive; zeros for label 0 and absent labels) and the ``touching`` label pairs
-    (:func:`~annotators.geometry.grid_segmentation.touching_pairs`; None when not found with the summary)."""
+    (:func:`~annotators.geometry.grid_segmentation.touching_pairs`) with the number of 4-neighbour pixel pairs
+    along each one's shared ``border`` (both None when not found with the summary)."""
 
     sizes: np.ndarray
     low: np.ndarray
@@ -68,6 +69,7 @@ class PieceSummary:
     starts: np.ndarray
     boxes: np.ndarray
     touching: np.ndarray | None
+    border: np.ndarray | None
 
     def touching_pairs(self, labels: np.ndarray) -> np.ndarray:
         """The touching label pairs of ``labels`` (the labelling summarized), found now unless known."""
@@ -111,7 +113,17 @@ def summarize_pieces_numpy(labels: np.ndarray, plane_points: np.ndarray, sample_
     for label in np.flatnonzero(sizes[1:]) + 1:
         x0, y0, x1, y1 = bounding_box(labels == label)
         boxes[label] = x0, y0, x1, y1
-    return PieceSummary(sizes, *quantiles, feet, starts, boxes, touching_pairs(labels))
+    touching = touching_pairs(labels)
+    key = np.minimum(labels[:, 1:], labels[:, :-1]) * count + np.maximum(labels[:, 1:], labels[:, :-1])
+    down = np.minimum(labels[1:], labels[:-1]) * count + np.maximum(labels[1:], labels[:-1])
+    apart = np.concatenate(
+        [
+            key[(labels[:, 1:] != labels[:, :-1]) & (labels[:, 1:] > 0) & (labels[:, :-1] > 0)],
+            down[(labels[1:] != labels[:-1]) & (labels[1:] > 0) & (labels[:-1] > 0)],
+        ]
+    )
+    border = np.array([np.count_nonzero(apart == a * count + b) for a, b in touching.tolist()], dtype=np.int64)
+    return PieceSummary(sizes, *quantiles, feet, starts, boxes, touching, border)
 
 
 def held_share(inner: np.ndarray, outer: np.ndarray, cell: float) -> float:
@@ -262,6 +274,9 @@ def appendage_owners(
             & (pieces.low[both[:, 0]] >= pieces.low[both[:, 1]] - rules.tolerance)
             & (pieces.high[both[:, 0]] <= pieces.top[both[:, 1]] + rules.tolerance)
         )
+    if pieces.border is not None:  # a close border at least as long as asked needs as many pixel pairs
+        length = np.concatenate([pieces.border, pieces.border])
+        fits &= length >= np.maximum(rules.min_boundary, rules.boundary_share * np.sqrt(pieces.sizes[both[:, 0]]))
     if not fits.any():
         return []
     involved = np.zeros(pieces.sizes.size, dtype=bool)

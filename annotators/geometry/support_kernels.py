@@ -22,27 +22,37 @@ def _loops() -> ModuleType:
     return support_loops
 
 
-MAX_TOUCHING = 1024
+MAX_TOUCHING = 512
 """Up to this many labels :func:`piece_summary` finds the touching pairs too (on a label x label table)."""
 
 
 def piece_summary(
     labels: np.ndarray, plane_points: np.ndarray, step: int
-) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray, np.ndarray, np.ndarray, np.ndarray, np.ndarray | None]:
-    """``(sizes, low, high, top, feet, starts, boxes, pairs)`` of HxW non-negative integer ``labels``: each
+) -> tuple[
+    np.ndarray,
+    np.ndarray,
+    np.ndarray,
+    np.ndarray,
+    np.ndarray,
+    np.ndarray,
+    np.ndarray,
+    np.ndarray | None,
+    np.ndarray | None,
+]:
+    """``(sizes, low, high, top, feet, starts, boxes, pairs, border)`` of HxW non-negative integer ``labels``: each
     label's pixel count (int64), the 5 %, 95 % and 99 % of the heights (``plane_points[..., 2]``, HxWx3 float32,
     clipped to +-0.49 metres and rounded as float32 ``height + 0.5``; NaN without one) on every ``step``-th pixel
     with a finite height, and those pixels' ``(u, v)`` (Nx2 float32, row-major within a label; label k owns
     ``feet[starts[k]:starts[k + 1]]``), each label's pixel box ``(x0, y0, x1, y1)`` (exclusive; zeros for label 0
     and absent labels) and the distinct 4-neighbour label pairs ``(a, b)``, ``0 < a < b``, in increasing order
-    (what :func:`~annotators.geometry.grid_segmentation.touching_pairs` gives; None above :data:`MAX_TOUCHING`
-    labels)."""
+    (what :func:`~annotators.geometry.grid_segmentation.touching_pairs` gives) with the number of 4-neighbour pixel
+    pairs along each one's shared ``border`` (both None above :data:`MAX_TOUCHING` labels)."""
     labels = np.ascontiguousarray(labels)
-    *summary, pairs = _loops().piece_summary(
+    *summary, pairs, border = _loops().piece_summary(
         labels, np.ascontiguousarray(plane_points, dtype=np.float32), max(1, int(step)), MAX_TOUCHING
     )
     many = int(summary[0].size) > MAX_TOUCHING
-    return (*summary, None if many else pairs)
+    return (*summary, None if many else pairs, None if many else border)
 
 
 def pixel_footprint(points: np.ndarray) -> float:

@@ -11,7 +11,7 @@ from numba import njit
 @njit(cache=True, nogil=True)
 def piece_summary(
     labels: np.ndarray, plane: np.ndarray, step: int, max_touching: int
-) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray, np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
+) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray, np.ndarray, np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
     """See :func:`annotators.geometry.support_kernels.piece_summary`."""
     rows, cols = labels.shape
     count = 0
@@ -23,7 +23,7 @@ def piece_summary(
     boxes = np.zeros((count, 4), dtype=np.int64)
     boxes[:, 0], boxes[:, 1] = cols, rows
     side = count if count <= max_touching else 0
-    touching = np.zeros((side, side), dtype=np.bool_)
+    touching = np.zeros((side, side), dtype=np.int64)
     for r in range(rows):
         # runs of one label along the row: its size and box grow once per run
         label, start = labels[r, 0], 0
@@ -35,23 +35,25 @@ def piece_summary(
                     boxes[label, 0], boxes[label, 1] = min(boxes[label, 0], start), min(boxes[label, 1], r)
                     boxes[label, 2], boxes[label, 3] = max(boxes[label, 2], c), r + 1
                     if side > 0 and following > 0:
-                        touching[min(label, following), max(label, following)] = True
+                        touching[min(label, following), max(label, following)] += 1
                 label, start = following, c
         if side > 0 and r + 1 < rows:
             for c in range(cols):
                 above, below = labels[r, c], labels[r + 1, c]
                 if above != below and above > 0 and below > 0:
-                    touching[min(above, below), max(above, below)] = True
+                    touching[min(above, below), max(above, below)] += 1
     pair_count = 0
     for a in range(side):
         for b in range(side):
-            pair_count += touching[a, b]
+            pair_count += touching[a, b] > 0
     pairs = np.empty((pair_count, 2), dtype=np.int64)
+    border = np.empty(pair_count, dtype=np.int64)
     pair_count = 0
     for a in range(side):
         for b in range(side):
-            if touching[a, b]:
+            if touching[a, b] > 0:
                 pairs[pair_count, 0], pairs[pair_count, 1] = a, b
+                border[pair_count] = touching[a, b]
                 pair_count += 1
     for label in range(count):
         if sizes[label] == 0 or label == 0:
@@ -88,7 +90,7 @@ def piece_summary(
             ordered.sort()
             for q in range(3):
                 quantiles[q, label] = ordered[int(np.rint(shares[q] * (size - 1)))]
-    return sizes, quantiles[0], quantiles[1], quantiles[2], feet, starts, boxes, pairs
+    return sizes, quantiles[0], quantiles[1], quantiles[2], feet, starts, boxes, pairs, border
 
 
 @njit(cache=True, nogil=True, error_model="numpy")

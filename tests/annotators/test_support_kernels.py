@@ -44,7 +44,7 @@ def blocky_scene(seed: int, shape=(37, 53), count: int = 9) -> tuple[np.ndarray,
 def test_the_compiled_piece_summary_is_the_numpy_one(seed: int, step: int) -> None:
     labels, _, plane = blocky_scene(seed)
     compiled, reference = summarize_pieces(labels, plane, step), summarize_pieces_numpy(labels, plane, step)
-    for name in ("sizes", "low", "high", "top", "starts", "boxes", "touching"):
+    for name in ("sizes", "low", "high", "top", "starts", "boxes", "touching", "border"):
         assert np.array_equal(getattr(compiled, name), getattr(reference, name), equal_nan=True), name
     assert compiled.low.shape == (labels.max() + 1,) and compiled.touching.shape[0] > 0
     assert np.isfinite(compiled.low).sum() >= 5
