@@ -58,29 +58,33 @@ def piece_summary(
     for label in range(count):
         if sizes[label] == 0 or label == 0:
             boxes[label] = 0
+    # the sampled pixels with a height, read once in row-major order, then grouped by label (a counting sort)
+    most = ((rows + step - 1) // step) * ((cols + step - 1) // step)
+    sampled = np.empty(most, dtype=np.int64)
+    read = np.empty((most, 3), dtype=np.float32)
+    found = 0
     starts = np.zeros(count + 1, dtype=np.int64)
     for r in range(0, rows, step):
         for c in range(0, cols, step):
             label = labels[r, c]
             if label > 0 and np.isfinite(plane[r, c, 2]):
+                sampled[found] = label
+                read[found, 0], read[found, 1], read[found, 2] = plane[r, c, 0], plane[r, c, 1], plane[r, c, 2]
+                found += 1
                 starts[label + 1] += 1
     for label in range(1, count + 1):
         starts[label] += starts[label - 1]
-    feet = np.empty((starts[count], 2), dtype=np.float32)
-    heights = np.empty(starts[count], dtype=np.float64)
+    feet = np.empty((found, 2), dtype=np.float32)
+    heights = np.empty(found, dtype=np.float64)
     filled = starts[:-1].copy()
     floor, ceiling, half = np.float32(-0.49), np.float32(0.49), np.float32(0.5)
-    for r in range(0, rows, step):
-        for c in range(0, cols, step):
-            label = labels[r, c]
-            height = plane[r, c, 2]
-            if label > 0 and np.isfinite(height):
-                index = filled[label]
-                feet[index, 0], feet[index, 1] = plane[r, c, 0], plane[r, c, 1]
-                # the height as the float32 fraction of the numpy form's sort key, read back in float64
-                shifted = np.float32(np.float32(min(max(height, floor), ceiling)) + half)
-                heights[index] = np.float64(shifted) - 0.5
-                filled[label] = index + 1
+    for k in range(found):
+        index = filled[sampled[k]]
+        feet[index, 0], feet[index, 1] = read[k, 0], read[k, 1]
+        # the height as the float32 fraction of the numpy form's sort key, read back in float64
+        shifted = np.float32(np.float32(min(max(read[k, 2], floor), ceiling)) + half)
+        heights[index] = np.float64(shifted) - 0.5
+        filled[sampled[k]] = index + 1
     quantiles = np.full((3, count), np.nan)
     shares = (0.05, 0.95, 0.99)
     for label in range(1, count):
