@@ -162,14 +162,17 @@ def unsupported_holders(
     hulls: dict[int, np.ndarray] = {}
     best: dict[int, tuple[float, int]] = {}
     for piece, holder in both[candidates].tolist():
+        if best.get(piece, (-1.0, 0))[0] >= 1.0:
+            continue  # held whole already: no later holder can hold more of it
         for label in (piece, holder):
             if label not in hulls:
                 hulls[label] = pieces.hull(label)
-        if hulls[piece].shape[0] < 3 or hulls[holder].shape[0] < 3:
-            continue
-        share = held_share(hulls[piece], hulls[holder], rules.cell)
-        if share >= rules.held_share and share > best.get(piece, (-1.0, 0))[0]:
-            best[piece] = (share, holder)
+            if hulls[label].shape[0] < 3:
+                break
+        else:
+            share = held_share(hulls[piece], hulls[holder], rules.cell)
+            if share >= rules.held_share and share > best.get(piece, (-1.0, 0))[0]:
+                best[piece] = (share, holder)
     return [(piece, holder) for piece, (_, holder) in best.items()]
 
 
