@@ -32,7 +32,7 @@ from annotators.geometry.grid_segmentation import (
     pixel_footprint,
     touching_pairs,
 )
-from annotators.geometry.support_kernels import piece_summary
+from annotators.geometry.support_kernels import appendage_candidates, piece_summary, unsupported_candidates
 from annotators.geometry.support_kernels import pixel_footprint as footprint_angle
 
 
@@ -151,17 +151,11 @@ def unsupported_holders(
     pairs = pieces.touching_pairs(labels)
     if pairs.shape[0] == 0:
         return []
-    both = np.concatenate([pairs, pairs[:, ::-1]])  # (piece, holder) both ways round
-    piece_low, holder_low, holder_high = pieces.low[both[:, 0]], pieces.low[both[:, 1]], pieces.high[both[:, 1]]
-    with np.errstate(invalid="ignore"):
-        candidates = (
-            (piece_low > holder_low + rules.tolerance)
-            & (piece_low < holder_low + rules.reach_down * (holder_high - holder_low))
-            & (pieces.sizes[both[:, 1]] >= pieces.sizes[both[:, 0]])  # a piece of an object is smaller than the rest
-        )
+    # a piece of an object is smaller than the rest; it starts above the holder's foot, below its middle
+    candidates = unsupported_candidates(pairs, pieces.sizes, pieces.low, pieces.high, rules.tolerance, rules.reach_down)
     hulls: dict[int, np.ndarray] = {}
     best: dict[int, tuple[float, int]] = {}
-    for piece, holder in both[candidates].tolist():
+    for piece, holder in candidates.tolist():
         if best.get(piece, (-1.0, 0))[0] >= 1.0:
             continue  # held whole already: no later holder can hold more of it
         for label in (piece, holder):
@@ -270,21 +264,25 @@ def appendage_owners(
     pairs = pieces.touching_pairs(labels)
     if pairs.shape[0] == 0:
         return []
-    both = np.concatenate([pairs, pairs[:, ::-1]])
-    with np.errstate(invalid="ignore"):
-        fits = (
-            (pieces.sizes[both[:, 0]] <= rules.small_share * pieces.sizes[both[:, 1]])
-            & (pieces.low[both[:, 0]] >= pieces.low[both[:, 1]] - rules.tolerance)
-            & (pieces.high[both[:, 0]] <= pieces.top[both[:, 1]] + rules.tolerance)
-        )
-    if pieces.border is not None:  # a close border at least as long as asked needs as many pixel pairs
-        length = np.concatenate([pieces.border, pieces.border])
-        fits &= length >= np.maximum(rules.min_boundary, rules.boundary_share * np.sqrt(pieces.sizes[both[:, 0]]))
-    if not fits.any():
+    # a close border at least as long as asked needs as many pixel pairs
+    border = pieces.border if pieces.border is not None else np.full(pairs.shape[0], np.inf)
+    fitting_pairs = appendage_candidates(
+        pairs,
+        border,
+        pieces.sizes,
+        pieces.low,
+        pieces.high,
+        pieces.top,
+        rules.small_share,
+        rules.tolerance,
+        rules.min_boundary,
+        rules.boundary_share,
+    )
+    if fitting_pairs.shape[0] == 0:
         return []
     involved = np.zeros(pieces.sizes.size, dtype=bool)
-    involved[both[fits].reshape(-1)] = True
-    boxes = pieces.boxes[np.unique(both[fits, 0])]  # those of the small pieces, grown by the border reach
+    involved[fitting_pairs.reshape(-1)] = True
+    boxes = pieces.boxes[fitting_pairs[:, 0]]  # those of the small pieces, grown by the border reach
     margin = _BORDER_REACH + 1
     x0, y0 = max(int(boxes[:, 0].min()) - margin, 0), max(int(boxes[:, 1].min()) - margin, 0)
     x1, y1 = (
@@ -299,7 +297,7 @@ def appendage_owners(
         rules,
         _footprint(points[::_FOOTPRINT_ROWS]),
     )
-    fitting = {(int(a), int(b)) for a, b in both[fits].tolist()}
+    fitting = set(map(tuple, fitting_pairs.tolist()))
     best: dict[int, tuple[float, int]] = {}
     for (a, b), close, length in zip(pairs.tolist(), close_shares, lengths, strict=True):
         along = float(close * length)

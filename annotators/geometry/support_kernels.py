@@ -64,3 +64,46 @@ def pixel_footprint(points: np.ndarray) -> float:
     low, high = (steps.size - 1) // 2, steps.size // 2
     ordered = np.partition(steps, (low, high))
     return float((ordered[low] + ordered[high]) / np.float32(2))
+
+
+def unsupported_candidates(
+    pairs: np.ndarray, sizes: np.ndarray, low: np.ndarray, high: np.ndarray, tolerance: float, reach_down: float
+) -> np.ndarray:
+    """Mx2 ``(piece, holder)`` of the touching ``pairs`` (Kx2), each way round (all pairs as given, then all
+    reversed), whose piece's 5 % height ``low`` lies above the holder's by more than ``tolerance`` and below
+    ``reach_down`` of the way from its 5 % to its 95 % height (``high``), and whose holder is at least as large
+    (``sizes``): the candidates of :func:`~annotators.geometry.support.unsupported_holders`."""
+    return _loops().unsupported_candidates(
+        np.ascontiguousarray(pairs, dtype=np.int64), sizes, low, high, float(tolerance), float(reach_down)
+    )
+
+
+def appendage_candidates(
+    pairs: np.ndarray,
+    border: np.ndarray,
+    sizes: np.ndarray,
+    low: np.ndarray,
+    high: np.ndarray,
+    top: np.ndarray,
+    small_share: float,
+    tolerance: float,
+    min_boundary: float,
+    boundary_share: float,
+) -> np.ndarray:
+    """Mx2 ``(piece, owner)`` of the touching ``pairs`` (Kx2), each way round (all pairs as given, then all
+    reversed), with the piece at most ``small_share`` of the owner's size, its heights (``low``-``high``) within
+    the owner's (``low``-``top``, ``tolerance`` of slack) and a shared ``border`` (pixel pairs, per pair) at least
+    ``max(min_boundary, boundary_share * sqrt(piece size))`` long: the candidates of
+    :func:`~annotators.geometry.support.appendage_owners`."""
+    return _loops().appendage_candidates(
+        np.ascontiguousarray(pairs, dtype=np.int64),
+        np.asarray(border, dtype=np.float64),
+        sizes,
+        low,
+        high,
+        top,
+        float(small_share),
+        float(tolerance),
+        float(min_boundary),
+        float(boundary_share),
+    )

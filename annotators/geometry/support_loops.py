@@ -116,3 +116,53 @@ def footprint_steps(points: np.ndarray) -> np.ndarray:
                 steps[count] = step
                 count += 1
     return steps[:count]
+
+
+@njit(cache=True, nogil=True)
+def unsupported_candidates(
+    pairs: np.ndarray, sizes: np.ndarray, low: np.ndarray, high: np.ndarray, tolerance: float, reach_down: float
+) -> np.ndarray:
+    """See :func:`annotators.geometry.support_kernels.unsupported_candidates`."""
+    chosen = np.empty((2 * pairs.shape[0], 2), dtype=np.int64)
+    count = 0
+    for way in range(2):
+        for k in range(pairs.shape[0]):
+            piece, holder = pairs[k, way], pairs[k, 1 - way]
+            if (
+                low[piece] > low[holder] + tolerance
+                and low[piece] < low[holder] + reach_down * (high[holder] - low[holder])
+                and sizes[holder] >= sizes[piece]
+            ):
+                chosen[count, 0], chosen[count, 1] = piece, holder
+                count += 1
+    return chosen[:count]
+
+
+@njit(cache=True, nogil=True)
+def appendage_candidates(
+    pairs: np.ndarray,
+    border: np.ndarray,
+    sizes: np.ndarray,
+    low: np.ndarray,
+    high: np.ndarray,
+    top: np.ndarray,
+    small_share: float,
+    tolerance: float,
+    min_boundary: float,
+    boundary_share: float,
+) -> np.ndarray:
+    """See :func:`annotators.geometry.support_kernels.appendage_candidates`."""
+    chosen = np.empty((2 * pairs.shape[0], 2), dtype=np.int64)
+    count = 0
+    for way in range(2):
+        for k in range(pairs.shape[0]):
+            piece, owner = pairs[k, way], pairs[k, 1 - way]
+            if (
+                sizes[piece] <= small_share * sizes[owner]
+                and low[piece] >= low[owner] - tolerance
+                and high[piece] <= top[owner] + tolerance
+                and border[k] >= max(min_boundary, boundary_share * np.sqrt(np.float64(sizes[piece])))
+            ):
+                chosen[count, 0], chosen[count, 1] = piece, owner
+                count += 1
+    return chosen[:count]

@@ -14,6 +14,7 @@ from annotators.geometry.support import (
     summarize_pieces,
     summarize_pieces_numpy,
 )
+from annotators.geometry.support_kernels import appendage_candidates, unsupported_candidates
 from annotators.geometry.support_kernels import pixel_footprint as compiled_footprint
 
 
@@ -86,3 +87,31 @@ def test_the_close_borders_are_those_of_the_boundaries(seed: int) -> None:
     assert pairs.shape[0] > 0
     assert np.array_equal(pairs, reference.pairs)
     assert np.array_equal(close, reference.close) and np.array_equal(length, reference.length)
+
+
+@pytest.mark.parametrize("seed", range(6))
+def test_the_compiled_candidates_are_the_numpy_ones(seed: int) -> None:
+    labels, _, plane = blocky_scene(seed)
+    plane[..., 2] = np.abs(plane[..., 2]) * 0.3  # heights over the table, so that some pieces qualify
+    pieces = summarize_pieces(labels, plane, 1)
+    pairs = pieces.touching
+    both = np.concatenate([pairs, pairs[:, ::-1]])
+    sizes, low, high, top = pieces.sizes, pieces.low, pieces.high, pieces.top
+    with np.errstate(invalid="ignore"):
+        held = (
+            (low[both[:, 0]] > low[both[:, 1]] + 0.003)
+            & (low[both[:, 0]] < low[both[:, 1]] + 0.5 * (high[both[:, 1]] - low[both[:, 1]]))
+            & (sizes[both[:, 1]] >= sizes[both[:, 0]])
+        )
+    assert np.array_equal(unsupported_candidates(pairs, sizes, low, high, 0.003, 0.5), both[held])
+    border = np.concatenate([pieces.border, pieces.border])
+    for small_share in (0.25, 1.0):
+        with np.errstate(invalid="ignore"):
+            fits = (
+                (sizes[both[:, 0]] <= small_share * sizes[both[:, 1]])
+                & (low[both[:, 0]] >= low[both[:, 1]] - 0.003)
+                & (high[both[:, 0]] <= top[both[:, 1]] + 0.003)
+                & (border >= np.maximum(3, 0.6 * np.sqrt(sizes[both[:, 0]])))
+            )
+        found = appendage_candidates(pairs, pieces.border, sizes, low, high, top, small_share, 0.003, 3, 0.6)
+        assert np.array_equal(found, both[fits])
