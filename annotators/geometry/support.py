@@ -32,7 +32,12 @@ from annotators.geometry.grid_segmentation import (
     pixel_footprint,
     touching_pairs,
 )
-from annotators.geometry.support_kernels import appendage_candidates, piece_summary, unsupported_candidates
+from annotators.geometry.support_kernels import (
+    appendage_candidates,
+    piece_summary,
+    raster_vertices,
+    unsupported_candidates,
+)
 from annotators.geometry.support_kernels import pixel_footprint as footprint_angle
 
 
@@ -130,10 +135,8 @@ def held_share(inner: np.ndarray, outer: np.ndarray, cell: float) -> float:
     """:func:`~annotators.geometry.grid_segmentation.inside_share` (the share of convex polygon ``inner``'s cells,
     Nx2 float32 metres on a ``cell`` raster, inside ``outer``) on one raster: ``inner`` filled, then ``outer``
     cleared from it - the cells of ``inner`` it cleared are those inside it."""
-    both = np.concatenate([inner, outer])
-    vertices = np.round((both - both.min(axis=0)) / cell).astype(np.int32)
-    width, height = vertices.max(axis=0) + 1
-    raster = np.zeros((int(height), int(width)), dtype=np.uint8)
+    vertices, width, height = raster_vertices(inner, outer, cell)
+    raster = np.zeros((height, width), dtype=np.uint8)
     cv2.fillConvexPoly(raster, vertices[: inner.shape[0]], 1)
     filled = cv2.countNonZero(raster)
     cv2.fillConvexPoly(raster, vertices[inner.shape[0] :], 0)

@@ -107,3 +107,13 @@ def appendage_candidates(
         float(min_boundary),
         float(boundary_share),
     )
+
+
+def raster_vertices(inner: np.ndarray, outer: np.ndarray, cell: float) -> tuple[np.ndarray, int, int]:
+    """The vertices of two polygons (Nx2 and Mx2 float32, metres) on a common ``cell`` raster whose origin is
+    their lowest ``u`` and ``v`` (``(N+M)x2`` int32, ``inner``'s first; float32 arithmetic, rounded half to even,
+    as numpy rounds ``(polygon - low) / cell``) and the raster's width and height in cells."""
+    vertices, width, height = _loops().raster_vertices(
+        np.ascontiguousarray(inner, dtype=np.float32), np.ascontiguousarray(outer, dtype=np.float32), float(cell)
+    )
+    return vertices, int(width), int(height)

@@ -166,3 +166,25 @@ def appendage_candidates(
                 chosen[count, 0], chosen[count, 1] = piece, owner
                 count += 1
     return chosen[:count]
+
+
+@njit(cache=True, nogil=True)
+def raster_vertices(inner: np.ndarray, outer: np.ndarray, cell: float) -> tuple[np.ndarray, int, int]:
+    """See :func:`annotators.geometry.support_kernels.raster_vertices`."""
+    count = inner.shape[0] + outer.shape[0]
+    low_u, low_v = np.float32(np.inf), np.float32(np.inf)
+    for polygon in (inner, outer):
+        for k in range(polygon.shape[0]):
+            low_u, low_v = min(low_u, polygon[k, 0]), min(low_v, polygon[k, 1])
+    step = np.float32(cell)
+    vertices = np.empty((count, 2), dtype=np.int32)
+    width, height = 0, 0
+    index = 0
+    for polygon in (inner, outer):
+        for k in range(polygon.shape[0]):
+            u = np.int32(np.rint(np.float32(np.float32(polygon[k, 0] - low_u) / step)))
+            v = np.int32(np.rint(np.float32(np.float32(polygon[k, 1] - low_v) / step)))
+            vertices[index, 0], vertices[index, 1] = u, v
+            width, height = max(width, u + 1), max(height, v + 1)
+            index += 1
+    return vertices, width, height
