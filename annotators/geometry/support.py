@@ -34,6 +34,7 @@ from annotators.geometry.grid_segmentation import (
 )
 from annotators.geometry.support_kernels import (
     appendage_candidates,
+    kept_labels,
     piece_summary,
     raster_vertices,
     unsupported_candidates,
@@ -294,7 +295,7 @@ def appendage_owners(
     )
     window = labels[y0:y1, x0:x1]
     pairs, close_shares, lengths = close_borders(
-        np.where(involved[window], window, 0),  # only the borders of the small pieces and their owners
+        kept_labels(window, involved),  # only the borders of the small pieces and their owners
         points[y0:y1, x0:x1],
         normals[y0:y1, x0:x1],
         rules,

@@ -117,3 +117,9 @@ def raster_vertices(inner: np.ndarray, outer: np.ndarray, cell: float) -> tuple[
         np.ascontiguousarray(inner, dtype=np.float32), np.ascontiguousarray(outer, dtype=np.float32), float(cell)
     )
     return vertices, int(width), int(height)
+
+
+def kept_labels(labels: np.ndarray, keep: np.ndarray) -> np.ndarray:
+    """HxW ``labels`` (any strides, e.g. a window of a larger grid) with every label ``k`` not ``keep[k]`` (bool per
+    label) set to 0, in a new C-ordered array: ``np.where(keep[labels], labels, 0)``."""
+    return _loops().kept_labels(labels, keep)

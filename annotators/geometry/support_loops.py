@@ -188,3 +188,15 @@ def raster_vertices(inner: np.ndarray, outer: np.ndarray, cell: float) -> tuple[
             width, height = max(width, u + 1), max(height, v + 1)
             index += 1
     return vertices, width, height
+
+
+@njit(cache=True, nogil=True)
+def kept_labels(labels: np.ndarray, keep: np.ndarray) -> np.ndarray:
+    """See :func:`annotators.geometry.support_kernels.kept_labels`."""
+    rows, cols = labels.shape
+    kept = np.empty((rows, cols), dtype=labels.dtype)
+    for r in range(rows):
+        for c in range(cols):
+            label = labels[r, c]
+            kept[r, c] = label if keep[label] else 0
+    return kept

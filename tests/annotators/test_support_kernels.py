@@ -14,7 +14,7 @@ from annotators.geometry.support import (
     summarize_pieces,
     summarize_pieces_numpy,
 )
-from annotators.geometry.support_kernels import appendage_candidates, unsupported_candidates
+from annotators.geometry.support_kernels import appendage_candidates, kept_labels, unsupported_candidates
 from annotators.geometry.support_kernels import pixel_footprint as compiled_footprint
 
 
@@ -115,3 +115,13 @@ def test_the_compiled_candidates_are_the_numpy_ones(seed: int) -> None:
             )
         found = appendage_candidates(pairs, pieces.border, sizes, low, high, top, small_share, 0.003, 3, 0.6)
         assert np.array_equal(found, both[fits])
+
+
+def test_kept_labels_are_those_numpy_keeps() -> None:
+    labels, _, _ = blocky_scene(2)
+    keep = np.zeros(labels.max() + 1, dtype=bool)
+    keep[[2, 5, 7]] = True
+    window = labels[3:30, 5:40]
+    kept = kept_labels(window, keep)
+    assert np.array_equal(kept, np.where(keep[window], window, 0)) and kept.dtype == window.dtype
+    assert kept.flags.c_contiguous and np.count_nonzero(kept) > 0
