@@ -34,6 +34,7 @@ from annotators.geometry.grid_segmentation import (
 )
 from annotators.geometry.support_kernels import (
     appendage_candidates,
+    hull_candidates,
     kept_labels,
     piece_summary,
     raster_vertices,
@@ -56,6 +57,11 @@ class SupportRules:
     reach_down: float = 0.5
     cell: float = 0.005
     sample_step: int = 2
+
+
+_FEW_FEET = 16
+"""Feet of a piece are handed to the convex hull as they are up to this many; more are thinned to those that can
+be corners first."""
 
 
 @dataclass(frozen=True)
@@ -84,7 +90,9 @@ class PieceSummary:
     def hull(self, label: int) -> np.ndarray:
         """The convex hull (Kx2) of the label's sampled feet."""
         feet = self.feet[self.starts[label] : self.starts[label + 1]]
-        return cv2.convexHull(feet).reshape(-1, 2) if feet.shape[0] >= 3 else feet
+        if feet.shape[0] < 3:
+            return feet
+        return cv2.convexHull(hull_candidates(feet) if feet.shape[0] >= _FEW_FEET else feet).reshape(-1, 2)
 
 
 def summarize_pieces(labels: np.ndarray, plane_points: np.ndarray, sample_step: int) -> PieceSummary:

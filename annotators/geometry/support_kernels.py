@@ -123,3 +123,10 @@ def kept_labels(labels: np.ndarray, keep: np.ndarray) -> np.ndarray:
     """HxW ``labels`` (any strides, e.g. a window of a larger grid) with every label ``k`` not ``keep[k]`` (bool per
     label) set to 0, in a new C-ordered array: ``np.where(keep[labels], labels, 0)``."""
     return _loops().kept_labels(labels, keep)
+
+
+def hull_candidates(points: np.ndarray) -> np.ndarray:
+    """The points (Nx2 float32, N >= 1) that can be corners of their convex hull, in the same order: those strictly
+    inside the quadrilateral of the leftmost, lowest, rightmost and highest points are dropped (by a margin, so
+    that a point rounding could put on an edge stays), and the convex hull of the rest is theirs."""
+    return _loops().hull_candidates(np.ascontiguousarray(points, dtype=np.float32))

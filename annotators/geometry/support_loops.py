@@ -200,3 +200,49 @@ def kept_labels(labels: np.ndarray, keep: np.ndarray) -> np.ndarray:
             label = labels[r, c]
             kept[r, c] = label if keep[label] else 0
     return kept
+
+
+_INSIDE_MARGIN = 1e-12
+"""A point lies strictly inside an edge only this far (cross product, square metres) or more: points nearer an
+edge than rounding could blur are kept."""
+
+
+@njit(cache=True, nogil=True)
+def hull_candidates(points: np.ndarray) -> np.ndarray:
+    """See :func:`annotators.geometry.support_kernels.hull_candidates`."""
+    count = points.shape[0]
+    left, bottom, right, top = 0, 0, 0, 0
+    for k in range(1, count):
+        u, v = points[k, 0], points[k, 1]
+        if u < points[left, 0]:
+            left = k
+        if v < points[bottom, 1]:
+            bottom = k
+        if u > points[right, 0]:
+            right = k
+        if v > points[top, 1]:
+            top = k
+    corner = np.empty((4, 2), dtype=np.float64)  # counter-clockwise: leftmost, lowest, rightmost, highest
+    for d, index in enumerate((left, bottom, right, top)):
+        corner[d, 0], corner[d, 1] = points[index, 0], points[index, 1]
+    keep = np.ones(count, dtype=np.bool_)
+    kept = count
+    for k in range(count):
+        u, v = np.float64(points[k, 0]), np.float64(points[k, 1])
+        inside = True
+        for d in range(4):
+            following = (d + 1) % 4
+            eu, ev = corner[following, 0] - corner[d, 0], corner[following, 1] - corner[d, 1]
+            if eu * (v - corner[d, 1]) - ev * (u - corner[d, 0]) <= _INSIDE_MARGIN:
+                inside = False
+                break
+        if inside:
+            keep[k] = False
+            kept -= 1
+    candidates = np.empty((kept, 2), dtype=points.dtype)
+    index = 0
+    for k in range(count):
+        if keep[k]:
+            candidates[index, 0], candidates[index, 1] = points[k, 0], points[k, 1]
+            index += 1
+    return candidates

@@ -14,7 +14,12 @@ from annotators.geometry.support import (
     summarize_pieces,
     summarize_pieces_numpy,
 )
-from annotators.geometry.support_kernels import appendage_candidates, kept_labels, unsupported_candidates
+from annotators.geometry.support_kernels import (
+    appendage_candidates,
+    hull_candidates,
+    kept_labels,
+    unsupported_candidates,
+)
 from annotators.geometry.support_kernels import pixel_footprint as compiled_footprint
 
 
@@ -125,3 +130,18 @@ def test_kept_labels_are_those_numpy_keeps() -> None:
     kept = kept_labels(window, keep)
     assert np.array_equal(kept, np.where(keep[window], window, 0)) and kept.dtype == window.dtype
     assert kept.flags.c_contiguous and np.count_nonzero(kept) > 0
+
+
+def test_the_hull_candidates_have_the_hull_of_all_points() -> None:
+    rng = np.random.default_rng(11)
+    for trial in range(300):
+        points = rng.normal(0.0, 0.05, (int(rng.integers(4, 300)), 2)).astype(np.float32)
+        if trial % 3 == 1:
+            points = np.round(points / 0.01).astype(np.float32) * np.float32(0.01)  # duplicates, collinear runs
+        if trial % 3 == 2:
+            points[:, 1] = points[:, 0] * np.float32(0.5)  # all on one line
+        candidates = hull_candidates(points)
+        assert candidates.shape[0] <= points.shape[0]
+        mine, theirs = cv2.convexHull(candidates).reshape(-1, 2), cv2.convexHull(points).reshape(-1, 2)
+        assert np.array_equal(np.unique(mine, axis=0), np.unique(theirs, axis=0))
+    assert hull_candidates(rng.normal(0.0, 0.05, (500, 2)).astype(np.float32)).shape[0] < 250  # it does thin
