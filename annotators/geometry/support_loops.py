@@ -9,6 +9,32 @@ from numba import njit
 
 
 @njit(cache=True, nogil=True)
+def _select(values: np.ndarray, first: int, last: int, rank: int) -> None:
+    """Reorder ``values[first:last]`` (no NaN) in place so that ``values[rank]`` is the value of that rank in sorted
+    order, none larger before it and none smaller after it (quickselect, median-of-three pivots)."""
+    low, high = first, last - 1
+    while low < high:
+        a, b, c = values[low], values[(low + high) // 2], values[high]
+        pivot = max(min(a, b), min(max(a, b), c))
+        i, j = low, high
+        while i <= j:
+            while values[i] < pivot:
+                i += 1
+            while values[j] > pivot:
+                j -= 1
+            if i <= j:
+                values[i], values[j] = values[j], values[i]
+                i += 1
+                j -= 1
+        if rank <= j:
+            high = j
+        elif rank >= i:
+            low = i
+        else:
+            return
+
+
+@njit(cache=True, nogil=True)
 def piece_summary(
     labels: np.ndarray, plane: np.ndarray, step: int, max_touching: int
 ) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray, np.ndarray, np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
@@ -90,10 +116,12 @@ def piece_summary(
     for label in range(1, count):
         size = starts[label + 1] - starts[label]
         if size > 0:
-            ordered = heights[starts[label] : starts[label + 1]]
-            ordered.sort()
-            for q in range(3):
-                quantiles[q, label] = ordered[int(np.rint(shares[q] * (size - 1)))]
+            lowest = starts[label]
+            for q in range(3):  # ranks increase: each lies among the values at or above the one before
+                rank = starts[label] + int(np.rint(shares[q] * (size - 1)))
+                _select(heights, lowest, starts[label + 1], rank)
+                quantiles[q, label] = heights[rank]
+                lowest = rank
     return sizes, quantiles[0], quantiles[1], quantiles[2], feet, starts, boxes, pairs, border
 
 

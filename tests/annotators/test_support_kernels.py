@@ -145,3 +145,15 @@ def test_the_hull_candidates_have_the_hull_of_all_points() -> None:
         mine, theirs = cv2.convexHull(candidates).reshape(-1, 2), cv2.convexHull(points).reshape(-1, 2)
         assert np.array_equal(np.unique(mine, axis=0), np.unique(theirs, axis=0))
     assert hull_candidates(rng.normal(0.0, 0.05, (500, 2)).astype(np.float32)).shape[0] < 250  # it does thin
+
+
+@pytest.mark.parametrize("seed", range(5))
+def test_the_height_quantiles_of_many_small_tied_pieces_are_the_numpy_ones(seed: int) -> None:
+    rng = np.random.default_rng(100 + seed)
+    labels = rng.integers(0, 60, (24, 31)).astype(np.int32)  # pieces of 0 to ~20 pixels, scattered
+    plane = rng.normal(0.0, 0.1, (24, 31, 3)).astype(np.float32)
+    plane[..., 2] = np.round(plane[..., 2], 1 + seed % 2)  # many equal heights
+    plane[rng.random((24, 31)) < 0.2, 2] = np.nan
+    compiled, reference = summarize_pieces(labels, plane, 1), summarize_pieces_numpy(labels, plane, 1)
+    for name in ("low", "high", "top"):
+        assert np.array_equal(getattr(compiled, name), getattr(reference, name), equal_nan=True), name
