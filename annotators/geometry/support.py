@@ -24,14 +24,23 @@ from dataclasses import dataclass
 import cv2
 import numpy as np
 
+from annotators.geometry.grid_kernels import boundary_pairs
 from annotators.geometry.grid_segmentation import (
-    boundaries,
     bounding_box,
-    inside_share,
+    distinct_keys,
     join_labels,
     pixel_footprint,
     touching_pairs,
 )
+from annotators.geometry.support_kernels import (
+    appendage_candidates,
+    hull_candidates,
+    kept_labels,
+    piece_summary,
+    raster_vertices,
+    unsupported_candidates,
+)
+from annotators.geometry.support_kernels import pixel_footprint as footprint_angle
 
 
 @dataclass(frozen=True)
@@ -50,11 +59,19 @@ class SupportRules:
     sample_step: int = 2
 
 
+_FEW_FEET = 16
+"""Feet of a piece are handed to the convex hull as they are up to this many; more are thinned to those that can
+be corners first."""
+
+
 @dataclass(frozen=True)
 class PieceSummary:
     """Per label (index 0 unused) of a labelling: its ``sizes`` in grid pixels, its 5 %, 95 % and 99 % heights
     above the plane (``low``, ``high``, ``top``; NaN without a sampled point) and its sampled ``feet`` (Nx2 plane
-    coordinates grouped by label: label k owns ``feet[starts[k]:starts[k + 1]]``)."""
+    coordinates grouped by label: label k owns ``feet[starts[k]:starts[k + 1]]``), its pixel ``boxes``
+    (``(x0, y0, x1, y1)``, exclusive; zeros for label 0 and absent labels) and the ``touching`` label pairs
+    (:func:`~annotators.geometry.grid_segmentation.touching_pairs`) with the number of 4-neighbour pixel pairs
+    along each one's shared ``border`` (both None when not found with the summary)."""
 
     sizes: np.ndarray
     low: np.ndarray
@@ -62,16 +79,31 @@ class PieceSummary:
     top: np.ndarray
     feet: np.ndarray
     starts: np.ndarray
+    boxes: np.ndarray
+    touching: np.ndarray | None
+    border: np.ndarray | None
+
+    def touching_pairs(self, labels: np.ndarray) -> np.ndarray:
+        """The touching label pairs of ``labels`` (the labelling summarized), found now unless known."""
+        return self.touching if self.touching is not None else touching_pairs(labels)
 
     def hull(self, label: int) -> np.ndarray:
         """The convex hull (Kx2) of the label's sampled feet."""
         feet = self.feet[self.starts[label] : self.starts[label + 1]]
-        return cv2.convexHull(feet).reshape(-1, 2) if feet.shape[0] >= 3 else feet
+        if feet.shape[0] < 3:
+            return feet
+        return cv2.convexHull(hull_candidates(feet) if feet.shape[0] >= _FEW_FEET else feet).reshape(-1, 2)
 
 
 def summarize_pieces(labels: np.ndarray, plane_points: np.ndarray, sample_step: int) -> PieceSummary:
     """The :class:`PieceSummary` of ``labels`` from the ``(u, v, height)`` plane coordinates of its pixels
-    (``plane_points``, HxWx3 or (H*W)x3), heights read on every ``sample_step``-th pixel, with one sort."""
+    (``plane_points``, HxWx3 or (H*W)x3), heights read on every ``sample_step``-th pixel, in one compiled pass."""
+    return PieceSummary(*piece_summary(labels, plane_points.reshape(*labels.shape, 3), sample_step))
+
+
+def summarize_pieces_numpy(labels: np.ndarray, plane_points: np.ndarray, sample_step: int) -> PieceSummary:
+    """:func:`summarize_pieces` in whole-array numpy with one sort (feet ordered by height within a label): the
+    reference form its compiled pass is tested against."""
     count = int(labels.max(initial=0)) + 1
     sizes = np.bincount(labels.reshape(-1), minlength=count)
     step = max(1, sample_step)
@@ -91,7 +123,33 @@ def summarize_pieces(labels: np.ndarray, plane_points: np.ndarray, sample_step: 
         values = ordered[np.maximum(index, 0)] - np.arange(count) - 0.5 if ordered.size else np.zeros(count)
         quantiles.append(np.where(counts > 0, values, np.nan))
     feet = np.ascontiguousarray(chosen[order, :2], dtype=np.float32)
-    return PieceSummary(sizes, *quantiles, feet, starts)
+    boxes = np.zeros((count, 4), dtype=np.int64)
+    for label in np.flatnonzero(sizes[1:]) + 1:
+        x0, y0, x1, y1 = bounding_box(labels == label)
+        boxes[label] = x0, y0, x1, y1
+    touching = touching_pairs(labels)
+    key = np.minimum(labels[:, 1:], labels[:, :-1]) * count + np.maximum(labels[:, 1:], labels[:, :-1])
+    down = np.minimum(labels[1:], labels[:-1]) * count + np.maximum(labels[1:], labels[:-1])
+    apart = np.concatenate(
+        [
+            key[(labels[:, 1:] != labels[:, :-1]) & (labels[:, 1:] > 0) & (labels[:, :-1] > 0)],
+            down[(labels[1:] != labels[:-1]) & (labels[1:] > 0) & (labels[:-1] > 0)],
+        ]
+    )
+    border = np.array([np.count_nonzero(apart == a * count + b) for a, b in touching.tolist()], dtype=np.int64)
+    return PieceSummary(sizes, *quantiles, feet, starts, boxes, touching, border)
+
+
+def held_share(inner: np.ndarray, outer: np.ndarray, cell: float) -> float:
+    """:func:`~annotators.geometry.grid_segmentation.inside_share` (the share of convex polygon ``inner``'s cells,
+    Nx2 float32 metres on a ``cell`` raster, inside ``outer``) on one raster: ``inner`` filled, then ``outer``
+    cleared from it - the cells of ``inner`` it cleared are those inside it."""
+    vertices, width, height = raster_vertices(inner, outer, cell)
+    raster = np.zeros((height, width), dtype=np.uint8)
+    cv2.fillConvexPoly(raster, vertices[: inner.shape[0]], 1)
+    filled = cv2.countNonZero(raster)
+    cv2.fillConvexPoly(raster, vertices[inner.shape[0] :], 0)
+    return (filled - cv2.countNonZero(raster)) / max(1, filled)
 
 
 def unsupported_holders(
@@ -101,29 +159,26 @@ def unsupported_holders(
     holds the largest share of its footprint (see the module docstring); ``plane_points`` are the ``(u, v,
     height)`` plane coordinates of every pixel of ``labels`` (HxWx3 or (H*W)x3), ``pieces`` their summary when
     already made."""
-    pairs = touching_pairs(labels)
+    pieces = pieces or summarize_pieces(labels, plane_points, rules.sample_step)
+    pairs = pieces.touching_pairs(labels)
     if pairs.shape[0] == 0:
         return []
-    pieces = pieces or summarize_pieces(labels, plane_points, rules.sample_step)
-    both = np.concatenate([pairs, pairs[:, ::-1]])  # (piece, holder) both ways round
-    piece_low, holder_low, holder_high = pieces.low[both[:, 0]], pieces.low[both[:, 1]], pieces.high[both[:, 1]]
-    with np.errstate(invalid="ignore"):
-        candidates = (
-            (piece_low > holder_low + rules.tolerance)
-            & (piece_low < holder_low + rules.reach_down * (holder_high - holder_low))
-            & (pieces.sizes[both[:, 1]] >= pieces.sizes[both[:, 0]])  # a piece of an object is smaller than the rest
-        )
+    # a piece of an object is smaller than the rest; it starts above the holder's foot, below its middle
+    candidates = unsupported_candidates(pairs, pieces.sizes, pieces.low, pieces.high, rules.tolerance, rules.reach_down)
     hulls: dict[int, np.ndarray] = {}
     best: dict[int, tuple[float, int]] = {}
-    for piece, holder in both[candidates].tolist():
+    for piece, holder in candidates.tolist():
+        if best.get(piece, (-1.0, 0))[0] >= 1.0:
+            continue  # held whole already: no later holder can hold more of it
         for label in (piece, holder):
             if label not in hulls:
                 hulls[label] = pieces.hull(label)
-        if hulls[piece].shape[0] < 3 or hulls[holder].shape[0] < 3:
-            continue
-        share = inside_share(hulls[piece], hulls[holder], rules.cell)
-        if share >= rules.held_share and share > best.get(piece, (-1.0, 0))[0]:
-            best[piece] = (share, holder)
+            if hulls[label].shape[0] < 3:
+                break
+        else:
+            share = held_share(hulls[piece], hulls[holder], rules.cell)
+            if share >= rules.held_share and share > best.get(piece, (-1.0, 0))[0]:
+                best[piece] = (share, holder)
     return [(piece, holder) for piece, (_, holder) in best.items()]
 
 
@@ -170,8 +225,40 @@ class AppendageRules:
 _BORDER_REACH = 2
 """Pixels beside a border that :func:`~annotators.geometry.grid_segmentation.boundaries` reads on either side."""
 
+_CLOSE_FACTOR = 2.5
+"""Points at most this many pixel footprints apart are close (the default of
+:func:`~annotators.geometry.grid_segmentation.boundaries`)."""
+
 _FOOTPRINT_ROWS = 8
 """The pixel footprint (the angle between neighbouring pixels) is measured on every this many rows of the grid."""
+
+
+def close_borders(
+    labels: np.ndarray, points: np.ndarray, normals: np.ndarray, rules: AppendageRules, footprint: float
+) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """``pairs``, ``close`` and ``length`` of :func:`~annotators.geometry.grid_segmentation.boundaries` (its
+    default close factor, :data:`_BORDER_REACH`, the depth jumps of ``rules``), without its other measures."""
+    key, _, near, _, _ = boundary_pairs(
+        np.ascontiguousarray(labels),
+        np.asarray(points, dtype=np.float32),
+        np.asarray(normals, dtype=np.float32),
+        _BORDER_REACH,
+        rules.jump_absolute,
+        rules.jump_relative,
+        _CLOSE_FACTOR * footprint,
+    )
+    if key.size == 0:
+        return np.zeros((0, 2), np.int64), np.zeros(0), np.zeros(0)
+    unique, inverse = distinct_keys(key)
+    length = np.bincount(inverse, minlength=unique.size).astype(np.float64)
+    close = np.bincount(inverse, weights=near, minlength=unique.size) / length
+    base = int(labels.max(initial=0)) + 1
+    return np.column_stack([unique // base, unique % base]), close, length
+
+
+def _footprint(points: np.ndarray) -> float:
+    """:func:`~annotators.geometry.grid_segmentation.pixel_footprint`, compiled for float32 points."""
+    return footprint_angle(points) if points.dtype == np.float32 else pixel_footprint(points)
 
 
 def appendage_owners(
@@ -185,37 +272,46 @@ def appendage_owners(
     """``(piece, owner)`` pairs of :func:`join_appendages`: each small piece with the neighbour it touches along
     the longest close border among those that qualify (``pieces``: the labels' summary when already made). Sizes
     and heights are checked first; the borders are measured only in the window around the pieces that pass."""
-    pairs = touching_pairs(labels)
+    pieces = pieces or summarize_pieces(labels, plane_points, rules.sample_step)
+    pairs = pieces.touching_pairs(labels)
     if pairs.shape[0] == 0:
         return []
-    pieces = pieces or summarize_pieces(labels, plane_points, rules.sample_step)
-    both = np.concatenate([pairs, pairs[:, ::-1]])
-    with np.errstate(invalid="ignore"):
-        fits = (
-            (pieces.sizes[both[:, 0]] <= rules.small_share * pieces.sizes[both[:, 1]])
-            & (pieces.low[both[:, 0]] >= pieces.low[both[:, 1]] - rules.tolerance)
-            & (pieces.high[both[:, 0]] <= pieces.top[both[:, 1]] + rules.tolerance)
-        )
-    if not fits.any():
+    # a close border at least as long as asked needs as many pixel pairs
+    border = pieces.border if pieces.border is not None else np.full(pairs.shape[0], np.inf)
+    fitting_pairs = appendage_candidates(
+        pairs,
+        border,
+        pieces.sizes,
+        pieces.low,
+        pieces.high,
+        pieces.top,
+        rules.small_share,
+        rules.tolerance,
+        rules.min_boundary,
+        rules.boundary_share,
+    )
+    if fitting_pairs.shape[0] == 0:
         return []
     involved = np.zeros(pieces.sizes.size, dtype=bool)
-    involved[both[fits].reshape(-1)] = True
-    small = np.zeros(pieces.sizes.size, dtype=bool)
-    small[both[fits, 0]] = True
-    x0, y0, x1, y1 = bounding_box(small[labels], margin=_BORDER_REACH + 1)
+    involved[fitting_pairs.reshape(-1)] = True
+    boxes = pieces.boxes[fitting_pairs[:, 0]]  # those of the small pieces, grown by the border reach
+    margin = _BORDER_REACH + 1
+    x0, y0 = max(int(boxes[:, 0].min()) - margin, 0), max(int(boxes[:, 1].min()) - margin, 0)
+    x1, y1 = (
+        min(int(boxes[:, 2].max()) + margin, labels.shape[1]),
+        min(int(boxes[:, 3].max()) + margin, labels.shape[0]),
+    )
     window = labels[y0:y1, x0:x1]
-    surface = boundaries(
-        np.where(involved[window], window, 0),  # only the borders of the small pieces and their owners
+    pairs, close_shares, lengths = close_borders(
+        kept_labels(window, involved),  # only the borders of the small pieces and their owners
         points[y0:y1, x0:x1],
         normals[y0:y1, x0:x1],
-        rules.jump_absolute,
-        rules.jump_relative,
-        reach=_BORDER_REACH,
-        footprint=pixel_footprint(points[::_FOOTPRINT_ROWS]),
+        rules,
+        _footprint(points[::_FOOTPRINT_ROWS]),
     )
-    fitting = {(int(a), int(b)) for a, b in both[fits].tolist()}
+    fitting = set(map(tuple, fitting_pairs.tolist()))
     best: dict[int, tuple[float, int]] = {}
-    for (a, b), close, length in zip(surface.pairs.tolist(), surface.close, surface.length, strict=True):
+    for (a, b), close, length in zip(pairs.tolist(), close_shares, lengths, strict=True):
         along = float(close * length)
         for piece, owner in ((a, b), (b, a)):
             if (
