@@ -17,9 +17,12 @@ Works like :mod:`annotators.cloud.clusters` on every ``stride``-th pixel of the 
 6. a piece that could not stand by itself - smaller than a neighbour whose footprint holds much of its own, not
    reaching the table and reaching down too far into the neighbour's heights to rest on its top - joins it: the
    inside of a mug seen over its rim, cut off with the rim and the handle along the inner wall's concave fold
-   (:func:`annotators.geometry.support.join_unsupported`); a piece a quarter of a neighbour's size or less that
-   touches it in 3-D along most of their shared border and lies within its heights joins it too: a drill's chuck
-   cut off at the concave fold where it leaves the body (:func:`annotators.geometry.support.join_appendages`);
+   (:func:`annotators.geometry.support.join_unsupported`); such a piece that two neighbours hold only together,
+   the three touching one another in 3-D, joins both: a mug cut in three, its inside lying half over its front
+   and half over its side with the handle (:func:`annotators.geometry.support.join_jointly_held`); a piece a
+   quarter of a neighbour's size or less that touches it in 3-D along most of their shared border and lies within
+   its heights joins it too: a drill's chuck cut off at the concave fold where it leaves the body
+   (:func:`annotators.geometry.support.join_appendages`);
 7. at full resolution, the outline pixels the coarse grid left unlabelled and the foot below the candidates'
    lowest height join the object whose surface they continue
    (:func:`annotators.geometry.border_pixels.claim_border_pixels`).
@@ -58,7 +61,7 @@ from annotators.geometry.grid_segmentation import (
     merge_parts,
 )
 from annotators.geometry.occlusion import OcclusionRules, join_occluded
-from annotators.geometry.support import AppendageRules, SupportRules, join_pieces
+from annotators.geometry.support import AppendageRules, JointRules, SupportRules, join_pieces
 from robokudo.core.annotator import Annotator
 from robokudo.core.capability import Capability
 from robokudo.core.types import CasType, ObjectHypothesis, Plane, PointCloud
@@ -71,7 +74,8 @@ class ClutterParameters(ClusterParameters):
     coarse pixels, split when their normals spread by more than ``normal_spread``), the grouping
     (:class:`~annotators.geometry.convexity.ConvexityRules`) and the share of a boundary that must be creased for a
     hue edge to split an object (``creased_share``); ``join_unsupported`` joins the pieces that could not stand by
-    themselves to the object that holds them and ``join_appendages`` the small pieces sticking out of a larger one;
+    themselves to the object that holds them, ``join_jointly_held`` those two touching neighbours hold only
+    together, and ``join_appendages`` the small pieces sticking out of a larger one;
     ``claim_borders`` gives the outline pixels the coarse grid
     left unlabelled and each object's foot (below ``min_height``) to the object they continue."""
 
@@ -96,6 +100,7 @@ class ClutterParameters(ClusterParameters):
     complete_occluded: bool = True
     join_unsupported: bool = True
     join_appendages: bool = True
+    join_jointly_held: bool = True
     claim_borders: bool = True
 
     def convexity_rules(self) -> ConvexityRules:
@@ -111,6 +116,17 @@ class ClutterParameters(ClusterParameters):
             boundary_share=rules.boundary_share,
             min_boundary=rules.min_boundary,
             tolerance=rules.nest_tolerance,
+            jump_absolute=self.jump_absolute,
+            jump_relative=self.jump_relative,
+        )
+
+    def joint_rules(self) -> JointRules:
+        """The thresholds of :func:`annotators.geometry.support.join_jointly_held`: those of
+        ``join_unsupported``, the merge rules' shortest trusted border as the close pixel pairs along which pieces
+        must touch in 3-D, and the depth jumps."""
+        return JointRules(
+            support=SupportRules(),
+            min_close=self.merge_rules().min_boundary,
             jump_absolute=self.jump_absolute,
             jump_relative=self.jump_relative,
         )
@@ -177,7 +193,8 @@ def segment_clutter(
         )
     support = SupportRules() if p.join_unsupported else None
     appendages = p.appendage_rules() if p.join_appendages else None
-    labels = join_pieces(labels, grid, normals, plane_grid, support, appendages)
+    joint = p.joint_rules() if p.join_jointly_held else None
+    labels = join_pieces(labels, grid, normals, plane_grid, support, appendages, joint)
     refine = None
     if p.claim_borders:
         floor = plane_noise(points, model, plane_indices)

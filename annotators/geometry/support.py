@@ -10,6 +10,12 @@ grouping cuts it from the outside along the concave fold of the inner wall. Two 
 side have footprints apart, an object standing on another starts at the other's top, and a can standing in a bowl
 is larger than the piece of the bowl's outside it touches; none of them is joined (:func:`join_unsupported`).
 
+The grouping can also cut a container in three: the inside seen over the rim, the outside's front, and its side
+with the handle, the side reaching the table too. The inside then lies half over each outside piece: neither holds
+it, their two footprints together do. Such a piece joins both when the three surfaces touch one another in 3-D
+along their shared borders - one continuous object, not two standing side by side, which a depth jump parts where
+one hides the other (:func:`join_jointly_held`).
+
 A small piece can also stick out of a larger one: a drill's chuck leaves the body's front face at a concave fold,
 where the convexity grouping cuts it off. A piece at most a quarter of a neighbour's size whose surface touches the
 neighbour's in 3-D along most of their shared border, and whose heights lie within the neighbour's, joins it
@@ -341,6 +347,134 @@ def join_appendages(
     return join_labels(labels, joins) if joins else labels
 
 
+@dataclass(frozen=True)
+class JointRules:
+    """Thresholds of :func:`join_jointly_held`: those of :func:`join_unsupported` (``support``: a piece that cannot
+    stand by itself, and the share of its footprint its holders' hull must hold), the pixel pairs along which two
+    pieces' surfaces must touch in 3-D (``min_close``; see :func:`close_borders`) and the depth jumps
+    (``jump_absolute + jump_relative * nearer depth``)."""
+
+    support: SupportRules = SupportRules()
+    min_close: int = 3
+    jump_absolute: float = 0.01
+    jump_relative: float = 0.01
+
+
+def jointly_held(
+    labels: np.ndarray,
+    points: np.ndarray,
+    normals: np.ndarray,
+    plane_points: np.ndarray,
+    rules: JointRules,
+    pieces: PieceSummary | None = None,
+) -> list[tuple[int, int, int]]:
+    """``(piece, first, second)`` triples of :func:`join_jointly_held`: each piece that cannot stand by itself (as
+    for :func:`join_unsupported`) beside both holders, held by neither alone but by the hull of the two together,
+    where the piece and its two holders touch one another in 3-D, each pair along at least ``min_close`` close
+    pixel pairs; the pair whose joint hull holds the largest share of the piece (``pieces``: the labels' summary
+    when already made)."""
+    support = rules.support
+    pieces = pieces or summarize_pieces(labels, plane_points, support.sample_step)
+    pairs = pieces.touching_pairs(labels)
+    if pairs.shape[0] < 3:
+        return []
+    candidates = unsupported_candidates(
+        pairs, pieces.sizes, pieces.low, pieces.high, support.tolerance, support.reach_down
+    )
+    holders: dict[int, list[int]] = {}
+    for piece, holder in candidates.tolist():
+        holders.setdefault(piece, []).append(holder)
+    touching = set(map(tuple, pairs.tolist()))
+    triples = [
+        (piece, first, second)
+        for piece, around in holders.items()
+        for k, first in enumerate(around)
+        for second in around[k + 1 :]
+        if (min(first, second), max(first, second)) in touching
+    ]
+    if not triples:
+        return []
+    involved = np.zeros(pieces.sizes.size, dtype=bool)
+    involved[np.array(triples).reshape(-1)] = True
+    boxes = pieces.boxes[involved]
+    margin = _BORDER_REACH + 1
+    x0, y0 = max(int(boxes[:, 0].min()) - margin, 0), max(int(boxes[:, 1].min()) - margin, 0)
+    x1 = min(int(boxes[:, 2].max()) + margin, labels.shape[1])
+    y1 = min(int(boxes[:, 3].max()) + margin, labels.shape[0])
+    touch_rules = AppendageRules(jump_absolute=rules.jump_absolute, jump_relative=rules.jump_relative)
+    border_pairs, close_shares, lengths = close_borders(
+        kept_labels(labels[y0:y1, x0:x1], involved),
+        points[y0:y1, x0:x1],
+        normals[y0:y1, x0:x1],
+        touch_rules,
+        _footprint(points[::_FOOTPRINT_ROWS]),
+    )
+    attached = {
+        tuple(pair)
+        for pair, close, length in zip(border_pairs.tolist(), close_shares, lengths, strict=True)
+        if close * length >= rules.min_close
+    }
+
+    def touch(a: int, b: int) -> bool:
+        return (min(a, b), max(a, b)) in attached
+
+    best: dict[int, tuple[float, int, int]] = {}
+    for piece, first, second in triples:
+        if not (touch(piece, first) and touch(piece, second) and touch(first, second)):
+            continue
+        hull = pieces.hull(piece)
+        if hull.shape[0] < 3:
+            continue
+        alone = max(held_share(hull, pieces.hull(holder), support.cell) for holder in (first, second))
+        if alone >= support.held_share:
+            continue  # one holder holds it: join_unsupported's case
+        share = held_share(hull, joint_hull(pieces, first, second), support.cell)
+        if share >= support.held_share and share > best.get(piece, (-1.0, 0, 0))[0]:
+            best[piece] = (share, first, second)
+    return [(piece, first, second) for piece, (_, first, second) in best.items()]
+
+
+def joint_hull(pieces: PieceSummary, first: int, second: int) -> np.ndarray:
+    """The convex hull (Kx2) of the sampled feet of two labels together."""
+    feet = np.concatenate([pieces.feet[pieces.starts[label] : pieces.starts[label + 1]] for label in (first, second)])
+    if feet.shape[0] < 3:
+        return feet
+    return cv2.convexHull(hull_candidates(feet) if feet.shape[0] >= _FEW_FEET else feet).reshape(-1, 2)
+
+
+def join_jointly_held(
+    labels: np.ndarray,
+    points: np.ndarray,
+    normals: np.ndarray,
+    plane_points: np.ndarray,
+    rules: JointRules | None = None,
+) -> np.ndarray:
+    """Labels with every piece that cannot stand by itself, and that two touching neighbours hold only together,
+    joined with both (see :func:`jointly_held`; ``points`` and ``normals`` HxWx3 in the camera frame,
+    ``plane_points`` the pixels' ``(u, v, height)``): an open container cut along its inner wall's concave fold
+    into three - the inside seen over the rim hangs between the outside's front and its side with the handle, and
+    lies half over each. The three surfaces meet in 3-D along their shared borders, one continuous object; two
+    objects standing side by side are parted by a depth jump where one hides the other, and an object standing on
+    others starts at their tops."""
+    return _join_jointly_held(labels, points, normals, plane_points, rules or JointRules())[0]
+
+
+def _join_jointly_held(
+    labels: np.ndarray,
+    points: np.ndarray,
+    normals: np.ndarray,
+    plane_points: np.ndarray,
+    rules: JointRules,
+    pieces: PieceSummary | None = None,
+) -> tuple[np.ndarray, bool]:
+    """:func:`join_jointly_held` and whether anything joined."""
+    triples = jointly_held(labels, points, normals, plane_points, rules, pieces)
+    if not triples:
+        return labels, False
+    joins = [(piece, holder) for piece, first, second in triples for holder in (first, second)]
+    return join_labels(labels, joins), True
+
+
 def join_pieces(
     labels: np.ndarray,
     points: np.ndarray,
@@ -348,15 +482,25 @@ def join_pieces(
     plane_points: np.ndarray,
     support: SupportRules | None,
     appendages: AppendageRules | None,
+    joint: JointRules | None = None,
 ) -> np.ndarray:
-    """:func:`join_unsupported` (unless ``support`` is None), then :func:`join_appendages` (unless ``appendages``
-    is None), summarizing the pieces once where the first joined nothing."""
-    pieces = None
+    """:func:`join_unsupported` (unless ``support`` is None), :func:`join_jointly_held` (unless ``joint`` is None;
+    then :func:`join_unsupported` again where it joined), then :func:`join_appendages` (unless ``appendages`` is
+    None), summarizing the pieces once where a step joined nothing."""
+    pieces, step = None, 0
     if support is not None:
         labels, pieces = _join_unsupported(labels, plane_points, support)
-        if appendages is not None and appendages.sample_step != support.sample_step:
+        step = support.sample_step
+    if joint is not None:
+        if joint.support.sample_step != step:
             pieces = None
+        labels, joined = _join_jointly_held(labels, points, normals, plane_points, joint, pieces)
+        if joined:
+            labels, pieces = _join_unsupported(labels, plane_points, support or joint.support)
+            step = (support or joint.support).sample_step
     if appendages is None:
         return labels
+    if appendages.sample_step != step:
+        pieces = None
     joins = appendage_owners(labels, points, normals, plane_points, appendages, pieces)
     return join_labels(labels, joins) if joins else labels

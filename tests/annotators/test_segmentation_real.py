@@ -7,10 +7,10 @@
   the spam can in frames 2 and 3 - and the red Cheez-It box is named red and OCR reads "CHEEZ" inside its image box.
   The power drill (orange body, black grip, battery below) is one hypothesis in frame 2; in frame 3 its grip folds
   inward like an object standing on another and it comes out in pieces (a known limit, marked xfail).
-* the white mug in frame 0 is one hypothesis with its inside (seen over the rim) and its handle: a body without
-  its handle reads as a paper cup (in frame 1 the mug comes out in three pieces - the inside's left half, the
-  body, and the handle with the inside's right half and the body's right side down to the table - which no rule
-  joins yet: marked xfail); in frame 3 the drill's chuck stays with its body (alone, it reads as a
+* the white mug in frames 0 and 1 is one hypothesis with its inside (seen over the rim) and its handle: a body
+  without its handle reads as a paper cup (in frame 1 the grouping cuts it in three - the inside's left half, the
+  body, and the handle with the inside's right half and the body's right side down to the table - which the
+  jointly-held join puts together); in frame 3 the drill's chuck stays with its body (alone, it reads as a
   cup).
 """
 
@@ -183,19 +183,7 @@ WHITE_MUG = {  # the outside below the rim, the inner wall seen over the rim, th
 }
 
 
-@pytest.mark.parametrize(
-    "frame",
-    [
-        0,
-        pytest.param(
-            1,
-            marks=pytest.mark.xfail(
-                strict=True,
-                reason="the handle's piece holds the body's right side down to the table: it could stand by itself",
-            ),
-        ),
-    ],
-)
+@pytest.mark.parametrize("frame", [0, 1])
 def test_the_white_mug_is_one_hypothesis_with_its_inside_and_handle(uoc_folder: Path, frame: int) -> None:
     root = create_pipeline(reader_for(str(uoc_folder), frame))
     assert Engine(root).tick() is Status.SUCCESS, [(c.name, c.feedback_message) for c in root.children]

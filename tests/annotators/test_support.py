@@ -1,6 +1,7 @@
 """join_unsupported: a piece that could not stand by itself joins the object whose footprint holds it;
-join_appendages: a small piece touching a larger one in 3-D along most of their border, within its heights, joins
-it."""
+join_jointly_held: such a piece that two touching neighbours hold only together joins both, when the three
+touch in 3-D; join_appendages: a small piece touching a larger one in 3-D along most of their border, within its
+heights, joins it."""
 
 from __future__ import annotations
 
@@ -8,10 +9,13 @@ import numpy as np
 
 from annotators.geometry.support import (
     AppendageRules,
+    JointRules,
     SupportRules,
     appendage_owners,
     join_appendages,
+    join_jointly_held,
     join_unsupported,
+    jointly_held,
     unsupported_holders,
 )
 
@@ -93,3 +97,31 @@ def test_pieces_hidden_behind_taller_or_as_large_stay_apart() -> None:
     labels, plane_points = scene({1: body, 2: ((40, 10, 55, 30), (0.015, 0.045))})
     points, normals = camera_points(labels, {1: 1.0, 2: 1.0})
     assert appendage_owners(labels, points, normals, plane_points, AppendageRules()) == []
+
+
+def cut_mug(depths: dict[int, float]) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
+    """A mug cut in three: its front (1) and its side (2), both 1-8 cm high and side by side, and its inside seen
+    over the rim (3), 3.5-9 cm high, whose feet lie half over each and reach past their far edge; ``depths`` per
+    label as :func:`camera_points`."""
+    labels, plane_points = scene(
+        {1: ((10, 10, 30, 30), (0.01, 0.08)), 2: ((30, 10, 50, 30), (0.01, 0.08)), 3: ((15, 30, 45, 36), (0.035, 0.09))}
+    )
+    plane_points[30:36, 15:45, 0] = np.linspace(0.04, 0.255, 30, dtype=np.float32)[None, :]
+    plane_points[30:36, 15:45, 1] = np.linspace(0.10, 0.16, 6, dtype=np.float32)[:, None]
+    points, normals = camera_points(labels, depths)
+    return labels, plane_points, points, normals
+
+
+def test_a_piece_two_touching_neighbours_hold_only_together_joins_both() -> None:
+    labels, plane_points, points, normals = cut_mug({1: 1.0, 2: 1.0, 3: 1.0})
+    assert unsupported_holders(labels, plane_points, SupportRules()) == []  # neither holds it alone
+    assert jointly_held(labels, points, normals, plane_points, JointRules()) == [(3, 1, 2)]
+    joined = join_jointly_held(labels, points, normals, plane_points)
+    assert joined.max() == 1 and np.array_equal(joined > 0, labels > 0)
+
+
+def test_a_piece_held_together_by_neighbours_apart_in_depth_stays_apart() -> None:
+    # the side 20 cm behind the front and the inside: one hides the other, their surfaces do not touch
+    labels, plane_points, points, normals = cut_mug({1: 1.0, 2: 1.2, 3: 1.0})
+    assert jointly_held(labels, points, normals, plane_points, JointRules()) == []
+    assert np.array_equal(join_jointly_held(labels, points, normals, plane_points), labels)
