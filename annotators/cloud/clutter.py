@@ -23,7 +23,10 @@ Works like :mod:`annotators.cloud.clusters` on every ``stride``-th pixel of the 
    quarter of a neighbour's size or less that touches it in 3-D along most of their shared border and lies within
    its heights joins it too: a drill's chuck cut off at the concave fold where it leaves the body
    (:func:`annotators.geometry.support.join_appendages`);
-7. at full resolution, the outline pixels the coarse grid left unlabelled and the foot below the candidates'
+7. touching pieces that fill one slab - their lowest heights and tops agree, no depth jump along most of their
+   shared border - join: a drill lying on its side, cut where its grip ends behind the battery's raised edge
+   (:func:`annotators.geometry.slabs.join_slab_pieces`);
+8. at full resolution, the outline pixels the coarse grid left unlabelled and the foot below the candidates'
    lowest height join the object whose surface they continue
    (:func:`annotators.geometry.border_pixels.claim_border_pixels`).
 """
@@ -61,6 +64,7 @@ from annotators.geometry.grid_segmentation import (
     merge_parts,
 )
 from annotators.geometry.occlusion import OcclusionRules, join_occluded
+from annotators.geometry.slabs import SlabRules, join_slab_pieces
 from annotators.geometry.support import AppendageRules, JointRules, SupportRules, join_pieces
 from robokudo.core.annotator import Annotator
 from robokudo.core.capability import Capability
@@ -76,6 +80,7 @@ class ClutterParameters(ClusterParameters):
     hue edge to split an object (``creased_share``); ``join_unsupported`` joins the pieces that could not stand by
     themselves to the object that holds them, ``join_jointly_held`` those two touching neighbours hold only
     together, and ``join_appendages`` the small pieces sticking out of a larger one;
+    ``join_slabs`` joins touching pieces of one slab (same lowest heights and tops, no depth jump between them);
     ``claim_borders`` gives the outline pixels the coarse grid
     left unlabelled and each object's foot (below ``min_height``) to the object they continue."""
 
@@ -101,6 +106,7 @@ class ClutterParameters(ClusterParameters):
     join_unsupported: bool = True
     join_appendages: bool = True
     join_jointly_held: bool = True
+    join_slabs: bool = True
     claim_borders: bool = True
 
     def convexity_rules(self) -> ConvexityRules:
@@ -127,6 +133,18 @@ class ClutterParameters(ClusterParameters):
         return JointRules(
             support=SupportRules(),
             min_close=self.merge_rules().min_boundary,
+            jump_absolute=self.jump_absolute,
+            jump_relative=self.jump_relative,
+        )
+
+    def slab_rules(self) -> SlabRules:
+        """The thresholds of :func:`annotators.geometry.slabs.join_slab_pieces`: the merge rules' share of a border
+        that must be continuous and its length, and the depth jumps."""
+        rules = self.merge_rules()
+        return SlabRules(
+            continuous=rules.continuous,
+            boundary_share=rules.boundary_share,
+            min_boundary=rules.min_boundary,
             jump_absolute=self.jump_absolute,
             jump_relative=self.jump_relative,
         )
@@ -195,6 +213,8 @@ def segment_clutter(
     appendages = p.appendage_rules() if p.join_appendages else None
     joint = p.joint_rules() if p.join_jointly_held else None
     labels = join_pieces(labels, grid, normals, plane_grid, support, appendages, joint)
+    if p.join_slabs:
+        labels = join_slab_pieces(labels, grid, normals, plane_grid, p.slab_rules())
     refine = None
     if p.claim_borders:
         floor = plane_noise(points, model, plane_indices)
