@@ -22,7 +22,11 @@ Measured on the hypothesis' points in the upright support frame (:mod:`annotator
   points up to ``HANDLE_POINTS``; the confidence that there is none grows with how much of the middle part was
   seen but falls with the share of it that sticks out without forming a handle, to 0 at ``HANDLE_SHARE`` (about
   what a handle seen from the side holds: a handle seen end-on or cut apart by the segmenter looks like that, a
-  plain cup's or can's side does not);
+  plain cup's or can's side does not).
+  "None" means none in view: a handle straight behind the body shows at most as a sliver over the far rim, a few
+  pixels high from a tabletop view (the blue mug of the first RealSense frame), which the depth image does not
+  resolve. From the elevations of a tabletop view a handle hides behind a round body in about a quarter of the
+  directions around it, whatever the object; that it may be there is the classifier's to weigh, not this cue's;
 * **open top**: by visibility. Every seen point of a closed (convex) object is seen from outside: the line of
   sight from it to the camera leaves the object's convex hull at once. The inside of an open object (a cup's
   far inner wall, a bowl's bottom) is seen through the opening: its line of sight crosses the hull for a good part
