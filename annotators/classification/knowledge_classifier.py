@@ -14,16 +14,24 @@ Scoring. For every cue the hypothesis carries (its most confident SemanticColor,
 when read, Text) a profile gets an agreement in [0, 1]:
 
 * colour / shape: 1 when the profile lists the observed value, 0 when it lists others, 0.5 when it says nothing;
-* size class: 1 when equal, 0.25 when one class apart, 0 when two apart, 0.5 when the profile says nothing;
+* size class: from the largest extent the size expert measured, 1 inside the profile's size class bounds, falling
+  to 0 at ``SIZE_FALLOFF`` times beyond a bound (a 13 cm can is nearly small, a 30 cm box is not); without an
+  extent 1 when equal, 0.25 when one class apart, 0 when two apart; 0.5 when the profile says nothing;
 * handle: 1 when both say there is one, 0 when one is seen on a class without, ``HANDLE_HIDDEN`` when none is
   seen on a class with one (it may be behind), ``NO_HANDLE`` when neither has one, 0.5 when the profile says
   nothing;
 * open top: 1 when equal, 0 when not, 0.5 when the profile says nothing;
 * height over width: 1 inside the profile's range, falling to 0 at ``RATIO_FALLOFF`` times beyond a bound;
+* printed label (``rk:printedLabel``), when the object shows several colours (a second colour named, or the
+  dominant one short of ``PLAIN_SHARE``; one colour says nothing, a label may be mostly one colour): 1 for a
+  profile with a printed label, 0 for a plain one; counted only for profiles that say either (most classes, a
+  jar's or a mug's, may be both, and a cue every other profile is neutral about would only pull their scores
+  toward 0.5). This is what tells a labelled can from a jar or a plain plastic tub of the same size, form and
+  proportions;
 * text: the share of the profile's texts found in the read text (case and punctuation ignored), ``TEXT_NONE``
   when the profile has no texts.
 
-Colour, shape, size, handle and open-top agreements are pulled toward 0.5 by the expert's confidence
+Colour, shape, size, handle, open-top and printed-label agreements are pulled toward 0.5 by the expert's confidence
 (``0.5 + (a - 0.5) * c``), so uncertain evidence counts less. The score is the weighted mean over the observed
 cues with :data:`WEIGHTS`
 (text is strong evidence). The best match is the top score (among related profiles with that score, the most
@@ -103,11 +111,6 @@ PLAIN_SHARE = 0.8
 """Share of an object's named pixels its dominant colour covers from which the object looks one-coloured (plain);
 below it, or with a second colour reported, it shows several colours (a printed label). The colour expert already
 discounts shadows, highlights and edge pixels, so a plain surface is named nearly all one colour."""
-
-ONE_COLOUR_CONFIDENCE = 0.5
-"""How sure one colour makes it that an object carries no printed label: a label may be mostly one colour (a soup
-can's white half, a white tin with small flowers), so one colour speaks for a plain surface only half as surely as
-several colours speak for print."""
 
 TEXT_NONE = 0.4
 """Text agreement of a profile without texts when the object has readable text."""
@@ -303,8 +306,8 @@ def score(profile: Profile, cues: Cues) -> Match:
     if cues.height_to_width is not None:
         total += WEIGHTS["ratio"] * _ratio_agreement(cues.height_to_width, profile.height_to_width)
         weight += WEIGHTS["ratio"]
-    if cues.printed is not None:
-        agreement = 0.5 if profile.printed is None else float(profile.printed == cues.printed[0])
+    if cues.printed is not None and profile.printed is not None:
+        agreement = float(profile.printed == cues.printed[0])
         total += WEIGHTS["printed"] * _toward_neutral(agreement, cues.printed[1])
         weight += WEIGHTS["printed"]
     if cues.text:
@@ -502,15 +505,12 @@ def decide(
 
 
 def printed_cue(colors: Sequence[SemanticColor]) -> tuple[bool, float] | None:
-    """Whether an object shows several colours (a printed label) and how sure that is, from its colour names: a
-    second colour reported, or a dominant one covering less than :data:`PLAIN_SHARE`, is print (sure); one colour
-    covering the rest is a plain surface (:data:`ONE_COLOUR_CONFIDENCE`); None without colour names."""
-    if not colors:
-        return None
-    dominant = max(colors, key=lambda a: a.ratio)
-    if len(colors) > 1 or dominant.ratio < PLAIN_SHARE:
+    """(True, 1.0) when an object shows several colours, as a printed label does: a second colour reported, or a
+    dominant one covering less than :data:`PLAIN_SHARE`; None otherwise. One colour says nothing: a label may be
+    mostly one colour (a soup can's white half, a white tin with small flowers), as a handle may be hidden."""
+    if colors and (len(colors) > 1 or max(a.ratio for a in colors) < PLAIN_SHARE):
         return True, 1.0
-    return False, ONE_COLOUR_CONFIDENCE
+    return None
 
 
 class KnowledgeClassifier(Annotator):
