@@ -14,16 +14,24 @@ Scoring. For every cue the hypothesis carries (its most confident SemanticColor,
 when read, Text) a profile gets an agreement in [0, 1]:
 
 * colour / shape: 1 when the profile lists the observed value, 0 when it lists others, 0.5 when it says nothing;
-* size class: 1 when equal, 0.25 when one class apart, 0 when two apart, 0.5 when the profile says nothing;
+* size class: from the largest extent the size expert measured, 1 inside the profile's size class bounds, falling
+  to 0 at ``SIZE_FALLOFF`` times beyond a bound (a 13 cm can is nearly small, a 30 cm box is not); without an
+  extent 1 when equal, 0.25 when one class apart, 0 when two apart; 0.5 when the profile says nothing;
 * handle: 1 when both say there is one, 0 when one is seen on a class without, ``HANDLE_HIDDEN`` when none is
   seen on a class with one (it may be behind), ``NO_HANDLE`` when neither has one, 0.5 when the profile says
   nothing;
 * open top: 1 when equal, 0 when not, 0.5 when the profile says nothing;
 * height over width: 1 inside the profile's range, falling to 0 at ``RATIO_FALLOFF`` times beyond a bound;
+* printed label (``rk:printedLabel``), when the object shows several colours (a second colour named, or the
+  dominant one short of ``PLAIN_SHARE``; one colour says nothing, a label may be mostly one colour): 1 for a
+  profile with a printed label, 0 for a plain one; counted only for profiles that say either (most classes, a
+  jar's or a mug's, may be both, and a cue every other profile is neutral about would only pull their scores
+  toward 0.5). This is what tells a labelled can from a jar or a plain plastic tub of the same size, form and
+  proportions;
 * text: the share of the profile's texts found in the read text (case and punctuation ignored), ``TEXT_NONE``
   when the profile has no texts.
 
-Colour, shape, size, handle and open-top agreements are pulled toward 0.5 by the expert's confidence
+Colour, shape, size, handle, open-top and printed-label agreements are pulled toward 0.5 by the expert's confidence
 (``0.5 + (a - 0.5) * c``), so uncertain evidence counts less. The score is the weighted mean over the observed
 cues with :data:`WEIGHTS`
 (text is strong evidence). The best match is the top score (among related profiles with that score, the most
@@ -62,7 +70,7 @@ from typing import ClassVar
 import numpy as np
 
 from annotators.classification.calibration import FITTED, Calibration
-from annotators.cloud.size import SIZE_CLASSES
+from annotators.cloud.size import SIZE_CLASS_THRESHOLDS, SIZE_CLASSES
 from robokudo.core.annotator import Annotator
 from robokudo.core.capability import Capability
 from robokudo.core.types import (
@@ -77,7 +85,7 @@ from robokudo.core.types import (
 )
 
 WEIGHTS: Mapping[str, float] = MappingProxyType(
-    {"color": 1.0, "shape": 1.0, "size": 1.0, "handle": 1.0, "open": 1.0, "ratio": 1.0, "text": 3.0}
+    {"color": 1.0, "shape": 1.0, "size": 1.0, "handle": 1.0, "open": 1.0, "ratio": 1.0, "printed": 1.0, "text": 3.0}
 )
 """How much each cue counts in the score. The open top and the size class count as much as the handle: the open top
 is what tells a cup, a mug or a bowl from a closed can, jar or tub of the same size, shape and proportions; the size
@@ -94,6 +102,15 @@ NO_HANDLE = 0.6
 
 RATIO_FALLOFF = 1.5
 """Height over width this many times beyond a profile's bound agrees not at all (log-linear in between)."""
+
+SIZE_FALLOFF = 1.5
+"""A largest extent this many times beyond a size class's bounds agrees with it not at all (log-linear in between,
+as the height over width): a 13 cm can is nearly small, a 30 cm box is not."""
+
+PLAIN_SHARE = 0.8
+"""Share of an object's named pixels its dominant colour covers from which the object looks one-coloured (plain);
+below it, or with a second colour reported, it shows several colours (a printed label). The colour expert already
+discounts shadows, highlights and edge pixels, so a plain surface is named nearly all one colour."""
 
 TEXT_NONE = 0.4
 """Text agreement of a profile without texts when the object has readable text."""
@@ -161,6 +178,7 @@ class Profile:
     handle: bool | None = None
     open_top: bool | None = None
     height_to_width: tuple[float, float] | None = None
+    printed: bool | None = None
 
     @classmethod
     def from_mapping(cls, data: Mapping[str, object]) -> Profile:
@@ -181,6 +199,7 @@ class Profile:
             handle=_flag(data, "handle"),
             open_top=_flag(data, "open_top"),
             height_to_width=_ratio_range(data.get("height_to_width")),
+            printed=_flag(data, "printed"),
         )
 
     def related(self, other: Profile) -> bool:
@@ -191,7 +210,8 @@ class Profile:
 @dataclass(frozen=True)
 class Cues:
     """The cues the experts gave about one hypothesis (None: not given): the most confident colour, shape and
-    size class with their confidences, and the text read on it."""
+    size class with their confidences, the text read on it, the form cues, the largest extent (metres) the size
+    class was named from, and whether it shows several colours (a printed label) with how sure that is."""
 
     color: tuple[str, float] | None = None
     shape: tuple[str, float] | None = None
@@ -200,6 +220,8 @@ class Cues:
     handle: tuple[bool, float] | None = None
     open_top: tuple[bool, float] | None = None
     height_to_width: float | None = None
+    extent: float | None = None
+    printed: tuple[bool, float] | None = None
 
 
 @dataclass(frozen=True)
@@ -225,6 +247,18 @@ def _size_agreement(observed: str, listed: str | None) -> float:
     if listed is None or listed not in SIZE_CLASSES or observed not in SIZE_CLASSES:
         return 0.5
     return (1.0, 0.25, 0.0)[abs(SIZE_CLASSES.index(observed) - SIZE_CLASSES.index(listed))]
+
+
+def _extent_agreement(extent: float, listed: str | None) -> float | None:
+    """Agreement of a largest extent with a size class: 1 inside its bounds (:data:`SIZE_CLASS_THRESHOLDS`),
+    falling to 0 at :data:`SIZE_FALLOFF` times beyond; None when either is unknown."""
+    if listed not in SIZE_CLASSES or not np.isfinite(extent) or extent <= 0.0:
+        return None
+    bounds = (0.0, *SIZE_CLASS_THRESHOLDS, np.inf)
+    index = SIZE_CLASSES.index(listed)  # type: ignore[arg-type]
+    low, high = bounds[index], bounds[index + 1]
+    beyond = max(np.log(low / extent) if low > 0 else 0.0, np.log(extent / high) if np.isfinite(high) else 0.0, 0.0)
+    return float(max(0.0, 1.0 - beyond / np.log(SIZE_FALLOFF)))
 
 
 def _handle_agreement(seen: bool, listed: bool | None) -> float:
@@ -256,7 +290,9 @@ def score(profile: Profile, cues: Cues) -> Match:
         total += WEIGHTS["shape"] * _toward_neutral(_value_agreement(cues.shape[0], shapes), cues.shape[1])
         weight += WEIGHTS["shape"]
     if cues.size is not None:
-        total += WEIGHTS["size"] * _toward_neutral(_size_agreement(cues.size[0], profile.size), cues.size[1])
+        graded = _extent_agreement(cues.extent, profile.size) if cues.extent is not None else None
+        agreement = _size_agreement(cues.size[0], profile.size) if graded is None else graded
+        total += WEIGHTS["size"] * _toward_neutral(agreement, cues.size[1])
         weight += WEIGHTS["size"]
     if cues.handle is not None:
         agreement = _handle_agreement(cues.handle[0], profile.handle)
@@ -270,6 +306,10 @@ def score(profile: Profile, cues: Cues) -> Match:
     if cues.height_to_width is not None:
         total += WEIGHTS["ratio"] * _ratio_agreement(cues.height_to_width, profile.height_to_width)
         weight += WEIGHTS["ratio"]
+    if cues.printed is not None and profile.printed is not None:
+        agreement = float(profile.printed == cues.printed[0])
+        total += WEIGHTS["printed"] * _toward_neutral(agreement, cues.printed[1])
+        weight += WEIGHTS["printed"]
     if cues.text:
         read = compact(cues.text)
         found = sum(1 for text in profile.texts if text in read)
@@ -464,6 +504,15 @@ def decide(
     return Decision(UNKNOWN_CLASS, 1.0 - p, best, best_lead, p, why)
 
 
+def printed_cue(colors: Sequence[SemanticColor]) -> tuple[bool, float] | None:
+    """(True, 1.0) when an object shows several colours, as a printed label does: a second colour reported, or a
+    dominant one covering less than :data:`PLAIN_SHARE`; None otherwise. One colour says nothing: a label may be
+    mostly one colour (a soup can's white half, a white tin with small flowers), as a handle may be hidden."""
+    if colors and (len(colors) > 1 or max(a.ratio for a in colors) < PLAIN_SHARE):
+        return True, 1.0
+    return None
+
+
 class KnowledgeClassifier(Annotator):
     """Names each hypothesis' class from its colour, shape, size, form and text, compared with candidate profiles."""
 
@@ -494,7 +543,8 @@ class KnowledgeClassifier(Annotator):
 
     def cues(self, hypothesis: ObjectHypothesis) -> Cues:
         """The most confident colour, shape, size and the text read on the hypothesis."""
-        color = max(self.attached(hypothesis, SemanticColor), key=lambda a: a.confidence, default=None)
+        colors = self.attached(hypothesis, SemanticColor)
+        color = max(colors, key=lambda a: a.confidence, default=None)
         shape = max(self.attached(hypothesis, Shape), key=lambda a: a.confidence, default=None)
         size = max(self.attached(hypothesis, Size), key=lambda a: a.confidence, default=None)
         texts = [t.text for t in self.attached(hypothesis, Text) if t.text.strip()]
@@ -507,6 +557,8 @@ class KnowledgeClassifier(Annotator):
             handle=(form.has_handle, form.handle_confidence) if form is not None else None,
             open_top=(form.open_top, form.open_confidence) if form is not None else None,
             height_to_width=form.height_to_width if form is not None else None,
+            extent=max(size.dimensions) if size is not None and size.dimensions else None,
+            printed=printed_cue(colors),
         )
 
     def decide(self, cues: Cues) -> Decision:

@@ -48,6 +48,7 @@ PROFILE_PROPERTIES: Mapping[str, tuple[str, Kind | None]] = {
     "brand": ("brand", None),
     "hasHandle": ("handle", None),
     "openTop": ("open_top", None),
+    "printedLabel": ("printed", None),
     "minHeightToWidth": ("min_height_to_width", None),
     "maxHeightToWidth": ("max_height_to_width", None),
 }
@@ -73,11 +74,12 @@ _SINGLE_FIELDS = (
     "transparent",
     "brand",
     "handle",
+    "printed",
     "open_top",
     "min_height_to_width",
     "max_height_to_width",
 )
-_BOOLEAN_FIELDS = ("transparent", "handle", "open_top")
+_BOOLEAN_FIELDS = ("transparent", "handle", "open_top", "printed")
 _NUMBER_FIELDS = ("min_height_to_width", "max_height_to_width")
 
 
@@ -571,6 +573,7 @@ class _Builder:
                 brand=values.get("brand"),  # type: ignore[arg-type]
                 origins=tuple(origins),
                 handle=values.get("handle"),  # type: ignore[arg-type]
+                printed=values.get("printed"),  # type: ignore[arg-type]
                 open_top=values.get("open_top"),  # type: ignore[arg-type]
                 height_to_width=_ratio_range(name, values, self.problems),
             )

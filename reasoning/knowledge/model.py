@@ -58,6 +58,8 @@ class ObjectProfile:
     open_top: bool | None = None
     height_to_width: tuple[float, float] | None = None
     """Form features: a handle on the side, open at the top, the (min, max) of height over width; None: any."""
+    printed: bool | None = None
+    """A label printed in several colours (a can's), False: a plain one-coloured surface; None: either."""
 
     def origin(self, field: str) -> str | None:
         """The class that declares ``field`` for this profile (None when the field is unset)."""

@@ -55,6 +55,7 @@ def class_profiles(kb: KnowledgeBase) -> tuple[dict[str, object], ...]:
                 "texts": profile.texts,
                 "handle": profile.handle,
                 "open_top": profile.open_top,
+                "printed": profile.printed,
                 "height_to_width": profile.height_to_width,
                 "ancestors": (name, *kb.superclasses(name)),
             }

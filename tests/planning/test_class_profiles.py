@@ -73,3 +73,31 @@ def test_a_closed_cylinder_is_no_cup_and_a_squat_open_one_is_a_bowl(profiles: di
     assert can.index("CannedFood") < min(can.index("Cup"), can.index("Mug"), can.index("Glass"))
     bowl = Cues(shape=("sphere", 0.6), size=("medium", 1.0), handle=(False, 1.0), open_top=(True, 1.0))
     assert ranked(profiles, Cues(**{**bowl.__dict__, "height_to_width": 0.4}))[0] in {"Bowl", "PlasticBowl"}
+
+
+MEDIUM_CLOSED_CYLINDER = {
+    "shape": ("cylinder", 0.75),
+    "size": ("medium", 1.0),
+    "handle": (False, 1.0),
+    "open_top": (False, 1.0),
+    "height_to_width": 0.65,
+}
+
+
+def test_a_label_tells_a_can_from_a_plain_tub_of_the_same_form(profiles: dict[str, Profile]) -> None:
+    assert profiles["CannedSoup"].printed is True and profiles["FoodContainer"].printed is False
+    assert profiles["Jar"].printed is None  # a jar may carry a label or none
+    labelled = Cues(**MEDIUM_CLOSED_CYLINDER, extent=0.137, printed=(True, 1.0), color=("brown", 0.3))
+    plain = Cues(**MEDIUM_CLOSED_CYLINDER, extent=0.157, color=("yellow", 0.7))
+    order = ranked(profiles, labelled)
+    assert order.index("CannedFood") < order.index("Jar")
+    assert decide([score(p, labelled) for p in profiles.values()], expected="CannedFood").class_name == "CannedFood"
+    assert decide([score(p, plain) for p in profiles.values()], expected="CannedFood").class_name != "CannedFood"
+
+
+def test_the_size_class_agrees_by_how_far_the_extent_is_beyond_its_bounds(profiles: dict[str, Profile]) -> None:
+    can = profiles["CannedFood"]
+    base = Cues(size=("medium", 1.0))
+    near, far = score(can, Cues(size=("medium", 1.0), extent=0.13)), score(can, Cues(size=("medium", 1.0), extent=0.2))
+    assert near.score > score(can, base).score > far.score  # 13 cm is nearly small, 20 cm is not
+    assert score(can, Cues(size=("small", 1.0), extent=0.1)).score == 1.0
