@@ -22,7 +22,10 @@ Works like :mod:`annotators.cloud.clusters` on every ``stride``-th pixel of the 
    and half over its side with the handle (:func:`annotators.geometry.support.join_jointly_held`); a piece a
    quarter of a neighbour's size or less that touches it in 3-D along most of their shared border and lies within
    its heights joins it too: a drill's chuck cut off at the concave fold where it leaves the body
-   (:func:`annotators.geometry.support.join_appendages`);
+   (:func:`annotators.geometry.support.join_appendages`); and such a piece touching a neighbour in 3-D whose wall
+   is concave toward the camera around an axis inside the two's footprint joins it: the far inner wall of a mug
+   seen over its rim, whose footprint is the back arc of the ring the outside's front arc starts
+   (:func:`annotators.geometry.inner_walls.join_inner_walls`);
 7. touching pieces that fill one slab - their lowest heights and tops agree, no depth jump along most of their
    shared border - join: a drill lying on its side, cut where its grip ends behind the battery's raised edge
    (:func:`annotators.geometry.slabs.join_slab_pieces`);
@@ -63,6 +66,7 @@ from annotators.geometry.grid_segmentation import (
     label_parts,
     merge_parts,
 )
+from annotators.geometry.inner_walls import InnerWallRules, join_inner_walls
 from annotators.geometry.occlusion import OcclusionRules, join_occluded
 from annotators.geometry.slabs import SlabRules, join_slab_pieces
 from annotators.geometry.support import AppendageRules, JointRules, SupportRules, join_pieces
@@ -80,6 +84,7 @@ class ClutterParameters(ClusterParameters):
     hue edge to split an object (``creased_share``); ``join_unsupported`` joins the pieces that could not stand by
     themselves to the object that holds them, ``join_jointly_held`` those two touching neighbours hold only
     together, and ``join_appendages`` the small pieces sticking out of a larger one;
+    ``join_inner_walls`` joins an open container's inside seen over its rim to its outside;
     ``join_slabs`` joins touching pieces of one slab (same lowest heights and tops, no depth jump between them);
     ``claim_borders`` gives the outline pixels the coarse grid
     left unlabelled and each object's foot (below ``min_height``) to the object they continue."""
@@ -106,6 +111,7 @@ class ClutterParameters(ClusterParameters):
     join_unsupported: bool = True
     join_appendages: bool = True
     join_jointly_held: bool = True
+    join_inner_walls: bool = True
     join_slabs: bool = True
     claim_borders: bool = True
 
@@ -133,6 +139,19 @@ class ClutterParameters(ClusterParameters):
         return JointRules(
             support=SupportRules(),
             min_close=self.merge_rules().min_boundary,
+            jump_absolute=self.jump_absolute,
+            jump_relative=self.jump_relative,
+        )
+
+    def inner_wall_rules(self) -> InnerWallRules:
+        """The thresholds of :func:`annotators.geometry.inner_walls.join_inner_walls`: those of
+        ``join_unsupported``, the merge rules' share of a border that must touch in 3-D and its length, and the
+        depth jumps."""
+        rules = self.merge_rules()
+        return InnerWallRules(
+            support=SupportRules(),
+            boundary_share=rules.boundary_share,
+            min_boundary=rules.min_boundary,
             jump_absolute=self.jump_absolute,
             jump_relative=self.jump_relative,
         )
@@ -213,6 +232,8 @@ def segment_clutter(
     appendages = p.appendage_rules() if p.join_appendages else None
     joint = p.joint_rules() if p.join_jointly_held else None
     labels = join_pieces(labels, grid, normals, plane_grid, support, appendages, joint)
+    if p.join_inner_walls:
+        labels = join_inner_walls(labels, grid, normals, plane_grid, to_plane[:, :3], p.inner_wall_rules())
     if p.join_slabs:
         labels = join_slab_pieces(labels, grid, normals, plane_grid, p.slab_rules())
     refine = None

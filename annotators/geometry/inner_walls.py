@@ -1,0 +1,162 @@
+"""The inside of an open container seen over its rim, on the organized grid: it joins the container's outside.
+
+Seen from above and in front, a mug shows the front of its outer wall and, over the rim, the back of its inner
+wall. On the table the two are opposite halves of one ring: the outside's footprint is the front arc, the inside's
+the back arc, so the outside's footprint holds little of the inside's and :func:`~annotators.geometry.support.
+join_unsupported` leaves the inside alone - which by itself reads as some other object.
+
+The inner wall tells itself apart by its shape: it is concave toward the camera. Its normals (oriented toward the
+camera) point at the container's axis, which lies in front of the wall; the front of a solid object curves the
+other way, its normals spreading away from an axis behind it. A piece that cannot stand by itself (the candidates
+of :func:`~annotators.geometry.support.join_unsupported`: smaller than its neighbour, not reaching the table, its
+lowest heights in the lower half of the neighbour's), whose surface touches the neighbour's in 3-D along their
+shared border (the rim; an object hidden behind another is parted from it by a depth jump), whose wall curves
+around an axis in front of it, and whose axis lies within the footprint of the two together - the container's
+floor - is that container's inside and joins it (:func:`join_inner_walls`).
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import cv2
+import numpy as np
+
+from annotators.geometry.grid_segmentation import join_labels
+from annotators.geometry.support import (
+    AppendageRules,
+    PieceSummary,
+    SupportRules,
+    close_borders,
+    joint_hull,
+    summarize_pieces,
+)
+from annotators.geometry.support_kernels import kept_labels, unsupported_candidates
+from annotators.geometry.support_kernels import pixel_footprint as footprint_angle
+
+
+@dataclass(frozen=True)
+class InnerWallRules:
+    """Thresholds of :func:`join_inner_walls`: which pieces cannot stand by themselves (``support``, as for
+    :func:`~annotators.geometry.support.join_unsupported`); the close border along which piece and holder must
+    touch in 3-D (``boundary_share`` times the square root of the piece's size, at least ``min_boundary`` pixel
+    pairs, depth jumps ``jump_absolute + jump_relative * nearer depth``); the wall points used (``wall_normal``: the
+    least horizontal component of their unit normals); how much the wall's normals must turn (``min_turn``: the
+    smaller eigenvalue of the mean of ``I - n n^T`` over its horizontal normals; a flat wall has 0 and no axis)
+    and how squarely they must face the axis (``facing``: the median distance to the axis along the normals at
+    least this share of the median distance to it)."""
+
+    support: SupportRules = SupportRules()
+    boundary_share: float = 0.6
+    min_boundary: int = 3
+    jump_absolute: float = 0.01
+    jump_relative: float = 0.01
+    wall_normal: float = 0.5
+    min_turn: float = 0.05
+    facing: float = 0.5
+
+
+_FOOTPRINT_ROWS = 8
+"""The pixel footprint (the angle between neighbouring pixels) is measured on every this many rows of the grid."""
+
+_MIN_WALL_POINTS = 10
+"""A wall with fewer sampled points has no trustworthy axis."""
+
+
+def wall_axis(plane_points: np.ndarray, plane_normals: np.ndarray, rules: InnerWallRules) -> np.ndarray | None:
+    """The ``(u, v)`` point on the plane that the horizontal normals of a wall (Nx3 ``(u, v, height)`` points and
+    normals, normals toward the camera) point at, when the wall curves around it concavely toward the camera: the
+    least-squares meeting point of the normal lines, in front of the wall (see :class:`InnerWallRules`); None for
+    a flat, convex or too small wall."""
+    horizontal = np.linalg.norm(plane_normals[:, :2], axis=1)
+    wall = (horizontal >= rules.wall_normal) & np.isfinite(plane_points).all(axis=1)
+    if np.count_nonzero(wall) < _MIN_WALL_POINTS:
+        return None
+    points = plane_points[wall, :2].astype(np.float64)
+    normals = plane_normals[wall, :2].astype(np.float64) / horizontal[wall, None]
+    across = np.eye(2)[None] - normals[:, :, None] * normals[:, None, :]  # projections across each normal line
+    matrix = across.sum(axis=0)
+    if np.linalg.eigvalsh(matrix / points.shape[0])[0] < rules.min_turn:
+        return None
+    axis = np.linalg.solve(matrix, np.einsum("nij,nj->i", across, points))
+    ahead = np.median(np.einsum("ni,ni->n", axis - points, normals))
+    distance = np.median(np.linalg.norm(axis - points, axis=1))
+    return axis if ahead > 0 and ahead >= rules.facing * distance else None
+
+
+def inner_wall_holders(
+    labels: np.ndarray,
+    points: np.ndarray,
+    normals: np.ndarray,
+    plane_points: np.ndarray,
+    to_plane: np.ndarray,
+    rules: InnerWallRules,
+    pieces: PieceSummary | None = None,
+) -> list[tuple[int, int]]:
+    """``(piece, holder)`` pairs of :func:`join_inner_walls`: each piece that is the inside of the neighbour it
+    touches along the longest close border among those that qualify (``to_plane``: the 3x3 rotation taking camera
+    directions to ``(u, v, height)``; ``pieces``: the labels' summary when already made)."""
+    support = rules.support
+    pieces = pieces or summarize_pieces(labels, plane_points, support.sample_step)
+    pairs = pieces.touching_pairs(labels)
+    if pairs.shape[0] == 0:
+        return []
+    candidates = unsupported_candidates(
+        pairs, pieces.sizes, pieces.low, pieces.high, support.tolerance, support.reach_down
+    )
+    if candidates.shape[0] == 0:
+        return []
+    involved = np.zeros(pieces.sizes.size, dtype=bool)
+    involved[candidates.reshape(-1)] = True
+    boxes = pieces.boxes[candidates[:, 0]]
+    x0, y0 = max(int(boxes[:, 0].min()) - 3, 0), max(int(boxes[:, 1].min()) - 3, 0)
+    x1, y1 = min(int(boxes[:, 2].max()) + 3, labels.shape[1]), min(int(boxes[:, 3].max()) + 3, labels.shape[0])
+    touch_rules = AppendageRules(jump_absolute=rules.jump_absolute, jump_relative=rules.jump_relative)
+    border_pairs, close_shares, lengths = close_borders(
+        kept_labels(labels[y0:y1, x0:x1], involved),
+        points[y0:y1, x0:x1],
+        normals[y0:y1, x0:x1],
+        touch_rules,
+        footprint_angle(np.ascontiguousarray(points[::_FOOTPRINT_ROWS], dtype=np.float32)),
+    )
+    along = {
+        (a, b): close * length
+        for (a, b), close, length in zip(border_pairs.tolist(), close_shares, lengths, strict=True)
+    }
+    grid_plane = plane_points.reshape(*labels.shape, 3)
+    axes: dict[int, np.ndarray | None] = {}
+    best: dict[int, tuple[float, int]] = {}
+    for piece, holder in candidates.tolist():
+        touching = along.get((min(piece, holder), max(piece, holder)), 0.0)
+        if touching < max(rules.min_boundary, rules.boundary_share * np.sqrt(pieces.sizes[piece])):
+            continue
+        if touching <= best.get(piece, (-1.0, 0))[0]:
+            continue
+        if piece not in axes:
+            bx0, by0, bx1, by1 = pieces.boxes[piece]
+            inside = labels[by0:by1, bx0:bx1] == piece
+            wall_normals = normals[by0:by1, bx0:bx1][inside] @ to_plane
+            axes[piece] = wall_axis(grid_plane[by0:by1, bx0:bx1][inside], wall_normals, rules)
+        axis = axes[piece]
+        if axis is None:
+            continue
+        floor = joint_hull(pieces, piece, holder).reshape(-1, 1, 2).astype(np.float32)
+        if floor.shape[0] >= 3 and cv2.pointPolygonTest(floor, (float(axis[0]), float(axis[1])), False) > 0:
+            best[piece] = (touching, holder)
+    return [(piece, holder) for piece, (_, holder) in best.items()]
+
+
+def join_inner_walls(
+    labels: np.ndarray,
+    points: np.ndarray,
+    normals: np.ndarray,
+    plane_points: np.ndarray,
+    to_plane: np.ndarray,
+    rules: InnerWallRules | None = None,
+) -> np.ndarray:
+    """Labels with the inside of every open container seen over its rim joined to the container's outside (see
+    the module docstring; ``points`` and ``normals`` HxWx3 in the camera frame, normals toward the camera,
+    ``plane_points`` the pixels' ``(u, v, height)``, ``to_plane`` the 3x3 rotation from camera directions to
+    ``(u, v, height)``)."""
+    joins = inner_wall_holders(labels, points, normals, plane_points, to_plane, rules or InnerWallRules())
+    return join_labels(labels, joins) if joins else labels
