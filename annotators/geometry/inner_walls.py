@@ -17,7 +17,7 @@ floor - is that container's inside and joins it (:func:`join_inner_walls`).
 
 from __future__ import annotations
 
-from dataclasses import dataclass
+from dataclasses import dataclass, field
 
 import cv2
 import numpy as np
@@ -46,7 +46,7 @@ class InnerWallRules:
     and how squarely they must face the axis (``facing``: the median distance to the axis along the normals at
     least this share of the median distance to it)."""
 
-    support: SupportRules = SupportRules()
+    support: SupportRules = field(default_factory=SupportRules)
     boundary_share: float = 0.6
     min_boundary: int = 3
     jump_absolute: float = 0.01
