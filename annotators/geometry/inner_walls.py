@@ -11,8 +11,10 @@ other way, its normals spreading away from an axis behind it. A piece that canno
 of :func:`~annotators.geometry.support.join_unsupported`: smaller than its neighbour, not reaching the table, its
 lowest heights in the lower half of the neighbour's), whose surface touches the neighbour's in 3-D along their
 shared border (the rim; an object hidden behind another is parted from it by a depth jump), whose wall curves
-around an axis in front of it, and whose axis lies within the footprint of the two together - the container's
-floor - is that container's inside and joins it (:func:`join_inner_walls`).
+around an axis in front of it, whose axis lies within the footprint of the two together - the container's floor -
+and whose neighbour's wall lies no nearer that axis - the outside surrounds the inside; a can standing in a bowl
+is nearer the bowl's axis than the bowl's inner wall - is that container's inside and joins it
+(:func:`join_inner_walls`).
 """
 
 from __future__ import annotations
@@ -63,25 +65,32 @@ _MIN_WALL_POINTS = 10
 """A wall with fewer sampled points has no trustworthy axis."""
 
 
-def wall_axis(plane_points: np.ndarray, plane_normals: np.ndarray, rules: InnerWallRules) -> np.ndarray | None:
-    """The ``(u, v)`` point on the plane that the horizontal normals of a wall (Nx3 ``(u, v, height)`` points and
-    normals, normals toward the camera) point at, when the wall curves around it concavely toward the camera: the
-    least-squares meeting point of the normal lines, in front of the wall (see :class:`InnerWallRules`); None for
-    a flat, convex or too small wall."""
+def wall_points(
+    plane_points: np.ndarray, plane_normals: np.ndarray, rules: InnerWallRules
+) -> tuple[np.ndarray, np.ndarray]:
+    """The ``(u, v)`` positions and unit horizontal normals of the wall points among Nx3 ``(u, v, height)`` points
+    and their normals: those whose normal's horizontal component is at least ``rules.wall_normal``."""
     horizontal = np.linalg.norm(plane_normals[:, :2], axis=1)
     wall = (horizontal >= rules.wall_normal) & np.isfinite(plane_points).all(axis=1)
-    if np.count_nonzero(wall) < _MIN_WALL_POINTS:
-        return None
-    points = plane_points[wall, :2].astype(np.float64)
     normals = plane_normals[wall, :2].astype(np.float64) / horizontal[wall, None]
+    return plane_points[wall, :2].astype(np.float64), normals
+
+
+def wall_axis(points: np.ndarray, normals: np.ndarray, rules: InnerWallRules) -> tuple[np.ndarray, float] | None:
+    """The ``(u, v)`` point that a wall's horizontal normals (Nx2 ``points`` and unit ``normals`` of
+    :func:`wall_points`, normals toward the camera) point at, and the wall's median distance from it, when the wall
+    curves around it concavely toward the camera: the least-squares meeting point of the normal lines, in front of
+    the wall (see :class:`InnerWallRules`); None for a flat, convex or too small wall."""
+    if points.shape[0] < _MIN_WALL_POINTS:
+        return None
     across = np.eye(2)[None] - normals[:, :, None] * normals[:, None, :]  # projections across each normal line
     matrix = across.sum(axis=0)
     if np.linalg.eigvalsh(matrix / points.shape[0])[0] < rules.min_turn:
         return None
     axis = np.linalg.solve(matrix, np.einsum("nij,nj->i", across, points))
-    ahead = np.median(np.einsum("ni,ni->n", axis - points, normals))
-    distance = np.median(np.linalg.norm(axis - points, axis=1))
-    return axis if ahead > 0 and ahead >= rules.facing * distance else None
+    ahead = float(np.median(np.einsum("ni,ni->n", axis - points, normals)))
+    distance = float(np.median(np.linalg.norm(axis - points, axis=1)))
+    return (axis, distance) if ahead > 0 and ahead >= rules.facing * distance else None
 
 
 def inner_wall_holders(
@@ -124,7 +133,13 @@ def inner_wall_holders(
         for (a, b), close, length in zip(border_pairs.tolist(), close_shares, lengths, strict=True)
     }
     grid_plane = plane_points.reshape(*labels.shape, 3)
-    axes: dict[int, np.ndarray | None] = {}
+
+    def walls(label: int) -> tuple[np.ndarray, np.ndarray]:
+        bx0, by0, bx1, by1 = pieces.boxes[label]
+        inside = labels[by0:by1, bx0:bx1] == label
+        return wall_points(grid_plane[by0:by1, bx0:bx1][inside], normals[by0:by1, bx0:bx1][inside] @ to_plane, rules)
+
+    axes: dict[int, tuple[np.ndarray, float] | None] = {}
     best: dict[int, tuple[float, int]] = {}
     for piece, holder in candidates.tolist():
         touching = along.get((min(piece, holder), max(piece, holder)), 0.0)
@@ -133,15 +148,16 @@ def inner_wall_holders(
         if touching <= best.get(piece, (-1.0, 0))[0]:
             continue
         if piece not in axes:
-            bx0, by0, bx1, by1 = pieces.boxes[piece]
-            inside = labels[by0:by1, bx0:bx1] == piece
-            wall_normals = normals[by0:by1, bx0:bx1][inside] @ to_plane
-            axes[piece] = wall_axis(grid_plane[by0:by1, bx0:bx1][inside], wall_normals, rules)
-        axis = axes[piece]
-        if axis is None:
+            axes[piece] = wall_axis(*walls(piece), rules)
+        found = axes[piece]
+        if found is None:
             continue
+        axis, radius = found
         floor = joint_hull(pieces, piece, holder).reshape(-1, 1, 2).astype(np.float32)
-        if floor.shape[0] >= 3 and cv2.pointPolygonTest(floor, (float(axis[0]), float(axis[1])), False) > 0:
+        if floor.shape[0] < 3 or cv2.pointPolygonTest(floor, (float(axis[0]), float(axis[1])), False) <= 0:
+            continue
+        outside, _ = walls(holder)  # the outer wall surrounds the inner one: no nearer the axis
+        if outside.shape[0] >= _MIN_WALL_POINTS and np.median(np.linalg.norm(outside - axis, axis=1)) >= radius:
             best[piece] = (touching, holder)
     return [(piece, holder) for piece, (_, holder) in best.items()]
 
