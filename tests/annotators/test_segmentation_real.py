@@ -12,6 +12,10 @@
   body, and the handle with the inside's right half and the body's right side down to the table - which the
   jointly-held join puts together); in frame 3 the drill's chuck stays with its body (alone, it reads as a
   cup).
+* the blue mug in frame 1 is one hypothesis with its inside: seen from above and in front, the inner wall over
+  the rim is the back arc of the ring whose front arc the outside is, so the outside's footprint holds only a
+  tenth of it; its wall curves concavely around an axis inside the mug (the inner-wall join). The small can
+  standing in the teal bowl in frame 3 stands at that bowl's axis, but inside its inner wall: it stays apart.
 """
 
 from __future__ import annotations
@@ -181,6 +185,28 @@ def test_the_white_mug_is_one_hypothesis_with_its_inside_and_handle(uoc_folder: 
     others = {hypothesis_at(hypotheses, x, y) for name, (x, y) in UOC_OBJECTS[frame].items() if name != "white mug"}
     assert len(set(mug.values())) == 1 and 0 not in mug.values(), f"the mug's parts are in hypotheses {mug}"
     assert not set(mug.values()) & others, "the mug shares its hypothesis with another object"
+
+
+BLUE_MUG = {"mug body": (220, 250), "mug inside": (230, 205)}  # frame 1: the outside, the inner wall over the rim
+
+
+def test_the_blue_mug_is_one_hypothesis_with_its_inside(uoc_folder: Path) -> None:
+    root = create_pipeline(reader_for(str(uoc_folder), 1))
+    assert Engine(root).tick() is Status.SUCCESS, [(c.name, c.feedback_message) for c in root.children]
+    hypotheses = root.cas.annotations(ObjectHypothesis)
+    mug = {name: hypothesis_at(hypotheses, x, y) for name, (x, y) in BLUE_MUG.items()}
+    others = {hypothesis_at(hypotheses, x, y) for name, (x, y) in UOC_OBJECTS[1].items() if name != "blue mug"}
+    assert len(set(mug.values())) == 1 and 0 not in mug.values(), f"the mug's parts are in hypotheses {mug}"
+    assert not set(mug.values()) & others, "the mug shares its hypothesis with another object"
+
+
+def test_the_can_standing_in_the_teal_bowl_stays_apart_from_the_bowl(uoc_folder: Path) -> None:
+    root = create_pipeline(reader_for(str(uoc_folder), 3))
+    assert Engine(root).tick() is Status.SUCCESS, [(c.name, c.feedback_message) for c in root.children]
+    hypotheses = root.cas.annotations(ObjectHypothesis)
+    can = hypothesis_at(hypotheses, 320, 200)
+    bowl = {hypothesis_at(hypotheses, x, y) for x, y in ((278, 195), UOC_OBJECTS[3]["teal bowl"])}  # left, right wall
+    assert can and can not in bowl, f"the can is in hypothesis {can}, the bowl's walls in {bowl}"
 
 
 def test_the_drill_chuck_stays_with_the_drill_body(uoc_folder: Path) -> None:

@@ -1,0 +1,47 @@
+"""The inner-wall axis: a wall concave toward the camera (the back of a container's inside) has an axis in front of
+it, a convex (a solid's front) or flat wall none, and floor points are no wall. The join itself is tested on real
+frames in test_segmentation_real.py (the blue mug; the can in the teal bowl)."""
+
+from __future__ import annotations
+
+import numpy as np
+
+from annotators.geometry.inner_walls import InnerWallRules, wall_axis, wall_points
+
+
+def arc(centre: tuple[float, float], radius: float, start: float, stop: float, inward: bool) -> np.ndarray:
+    """Nx3 points and Nx3 normals (horizontal) of a vertical wall on a circular arc from angle ``start`` to
+    ``stop``, normals toward the centre (``inward``) or away from it, at two heights."""
+    angles = np.linspace(start, stop, 40)
+    ring = np.column_stack([np.cos(angles), np.sin(angles)])
+    points = np.concatenate([np.column_stack([centre + radius * ring, np.full(40, h)]) for h in (0.02, 0.06)])
+    normals = np.concatenate([np.column_stack([-ring if inward else ring, np.zeros(40)])] * 2)
+    return points, normals
+
+
+# the camera looks along +u: the front of a container faces -u, its back wall's inside faces -u as well
+def test_a_back_inner_wall_has_its_axis_in_front_of_it() -> None:
+    points, normals = arc((0.6, 0.1), 0.035, -np.pi / 3, np.pi / 3, inward=True)  # back arc, normals to the centre
+    found = wall_axis(*wall_points(points, normals, InnerWallRules()), InnerWallRules())
+    assert found is not None
+    axis, radius = found
+    assert np.allclose(axis, (0.6, 0.1), atol=1e-6) and abs(radius - 0.035) < 1e-6
+
+
+def test_a_convex_front_wall_has_no_axis_in_front_of_it() -> None:
+    points, normals = arc((0.6, 0.1), 0.035, 2 * np.pi / 3, 4 * np.pi / 3, inward=False)  # front arc, outward
+    assert wall_axis(*wall_points(points, normals, InnerWallRules()), InnerWallRules()) is None
+
+
+def test_a_flat_wall_has_no_axis() -> None:
+    v = np.linspace(0.0, 0.08, 40)
+    points = np.column_stack([np.full(40, 0.6), v, np.full(40, 0.05)])
+    normals = np.tile([-1.0, 0.0, 0.0], (40, 1))
+    assert wall_axis(*wall_points(points, normals, InnerWallRules()), InnerWallRules()) is None
+
+
+def test_floor_points_are_no_wall() -> None:
+    points, normals = arc((0.6, 0.1), 0.035, -np.pi / 3, np.pi / 3, inward=True)
+    normals = np.tile([0.0, 0.0, 1.0], (points.shape[0], 1))  # a horizontal surface: normals straight up
+    wall, _ = wall_points(points, normals, InnerWallRules())
+    assert wall.shape[0] == 0
