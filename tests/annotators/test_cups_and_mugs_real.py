@@ -24,7 +24,13 @@ from robokudo.application.service import AnsweringService
 from robokudo.core.types import Classification, ObjectHypothesis
 
 BLUE_MUG = {1: (222, 230), 3: (490, 130)}
-"""The blue mug (handle in view) in frames 1 and 3."""
+"""The blue mug in frames 1 and 3."""
+HANDLE_IN_VIEW = (3,)
+"""The frames whose blue mug shows its handle in depth. In frame 1 (as in frame 0) the handle stands straight behind
+the body: the colour image shows a nub of it over the far rim (about (215-224, 177-181)) where the depth image reads
+the table (1.03 m; the far rim 0.86 m). A handle was seen there only while the segmenter cut the mug's inside off
+its outside: the outside alone, tapered, stuck out of the circle fitted at its foot on its right (pixels x 229-250,
+y 228-241, heights 8-9 cm). Whether a mug whose handle is hidden is a mug is the classifier's question."""
 TOUCHING_MUG = (480, 135)
 """The blue mug in frame 2: its handle touches the drill and the form expert cannot make out whether it has one."""
 WHITE_MUG = {0: (300, 255), 1: (325, 275)}
@@ -71,7 +77,7 @@ def hypothesis_at(hypotheses: list[ObjectHypothesis], pixel: tuple[int, int]) ->
 
 
 @pytest.mark.real_data
-@pytest.mark.parametrize("frame", [1, 3])
+@pytest.mark.parametrize("frame", HANDLE_IN_VIEW)
 def test_the_blue_mug_is_ranked_mug_by_its_features_and_nothing_else_is_called_a_mug(
     uoc_folder: Path, store: Path, frame: int
 ) -> None:
@@ -93,7 +99,7 @@ def test_the_blue_mug_is_ranked_mug_by_its_features_and_nothing_else_is_called_a
 
 
 @pytest.mark.real_data
-@pytest.mark.parametrize("frame", [1, 3])
+@pytest.mark.parametrize("frame", HANDLE_IN_VIEW)
 def test_find_the_mug_answers_the_blue_mug_only(
     uoc_folder: Path, store: Path, capsys: pytest.CaptureFixture, frame: int
 ) -> None:
@@ -173,7 +179,8 @@ def test_find_all_mugs_answers_the_blue_mug_and_no_bowl_can_or_box(
     # frame 1: the soup can is cut with a neighbour that sticks out like a handle, its top seen closed though not
     # surely; frame 3: the teal bowl is cut in half by the can in it, and its flaring side may be a handle
     objects = ask(capsys, store, "find all mugs", uoc_folder, frame)
-    assert covering(objects, BLUE_MUG[frame]), objects
+    if frame in HANDLE_IN_VIEW:
+        assert covering(objects, BLUE_MUG[frame]), objects
     assert all(o["class"]["label"] == "mug" for o in objects), objects
     for name, pixel in {**NOT_MUGS[frame], **CANS[frame]}.items():
         assert not covering(objects, pixel), name

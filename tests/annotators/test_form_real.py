@@ -1,7 +1,7 @@
 """The form expert's handle cue on real RealSense frames (issue 15, item 6), read off the FormFeatures of the
 hypothesis at a hand-labelled pixel (tests/data/labels/real_objects.json labels the same objects).
 
-The blue mug's handle is seen in frames 1 and 3, and on the tapered blue mug of frame 2 (its handle sticks out of
+The blue mug's handle is seen in frame 3, and on the tapered blue mug of frame 2 (its handle sticks out of
 the body profile, not of the too wide circle fitted at its foot) and the white mug of frame 0 (one hypothesis with
 its handle); none on the purple cup (frame 4), the soup and spam cans of frame 3, nor the soup can of frame 1 (the
 clump cut together with it is a streak of grazing stray points, left out of the cue).
@@ -11,7 +11,10 @@ nub of it over the far rim (about 3 by 5 pixels around (206, 146)), but the dept
 the far rim it reads the table, 1.07-1.11 m, or nothing; the rim itself 0.91 m). No handle is in view, and the cue
 must not make one up from the far rim's stray points; whether a mug whose handle is hidden is a mug or a cup is the
 classifier's question (its ``HANDLE_HIDDEN``), which the form cue answers alike for the frame-4 purple cup, seen
-from the same elevation (a handle would hide behind either body in a quarter of the directions around it).
+from the same elevation (a handle would hide behind either body in a quarter of the directions around it). So it
+is in frame 1: the nub over the far rim (about (215-224, 177-181)) reads the table in depth (1.03 m; the rim
+0.86 m). A handle was seen there only while the segmenter cut the mug's inside off: the tapered outside alone stuck
+out of the circle fitted at its foot on its right side (pixels x 229-250, y 228-241).
 """
 
 from __future__ import annotations
@@ -51,7 +54,7 @@ def handles_at(uoc_folder: Path, tmp_path_factory: pytest.TempPathFactory) -> di
     return seen
 
 
-@pytest.mark.parametrize("frame, x, y", [(1, 222, 230), (3, 490, 130)])
+@pytest.mark.parametrize("frame, x, y", [(3, 490, 130)])
 def test_the_blue_mug_handle_in_view_is_seen(handles_at: dict, frame: int, x: int, y: int) -> None:
     assert handles_at[(frame, x, y)] is True
 
@@ -73,5 +76,6 @@ def test_the_white_mug_handle_in_frame_0_is_seen(handles_at: dict) -> None:
     assert handles_at[(0, 300, 255)] is True
 
 
-def test_the_blue_mug_handle_hidden_behind_its_body_in_frame_0_is_not_made_up(handles_at: dict) -> None:
-    assert handles_at[(0, 205, 195)] is False
+@pytest.mark.parametrize("frame, x, y", [(0, 205, 195), (1, 222, 230)])
+def test_the_blue_mug_handle_hidden_behind_it_is_not_made_up(handles_at: dict, frame: int, x: int, y: int) -> None:
+    assert handles_at[(frame, x, y)] is False
