@@ -115,9 +115,38 @@ def inner_wall_holders(
     )
     if candidates.shape[0] == 0:
         return []
+    grid_plane = plane_points.reshape(*labels.shape, 3)
+
+    step = max(1, support.sample_step)
+
+    def walls(label: int) -> tuple[np.ndarray, np.ndarray]:
+        """The wall points of a label, on every ``step``-th pixel of its box."""
+        bx0, by0, bx1, by1 = pieces.boxes[label]
+        window = (slice(by0, by1, step), slice(bx0, bx1, step))
+        inside = labels[window] == label
+        return wall_points(grid_plane[window][inside], normals[window][inside] @ to_plane, rules)
+
+    # the shape first (cheap, and few pieces are concave), the borders in 3-D only for the pairs it leaves
+    axes: dict[int, tuple[np.ndarray, float] | None] = {}
+    shaped: list[tuple[int, int]] = []
+    for piece, holder in candidates.tolist():
+        if piece not in axes:
+            axes[piece] = wall_axis(*walls(piece), rules)
+        found = axes[piece]
+        if found is None:
+            continue
+        axis, radius = found
+        floor = joint_hull(pieces, piece, holder).reshape(-1, 1, 2).astype(np.float32)
+        if floor.shape[0] < 3 or cv2.pointPolygonTest(floor, (float(axis[0]), float(axis[1])), False) <= 0:
+            continue
+        outside, _ = walls(holder)  # the outer wall surrounds the inner one: no nearer the axis
+        if outside.shape[0] >= _MIN_WALL_POINTS and np.median(np.linalg.norm(outside - axis, axis=1)) >= radius:
+            shaped.append((piece, holder))
+    if not shaped:
+        return []
     involved = np.zeros(pieces.sizes.size, dtype=bool)
-    involved[candidates.reshape(-1)] = True
-    boxes = pieces.boxes[candidates[:, 0]]
+    involved[np.array(shaped).reshape(-1)] = True
+    boxes = pieces.boxes[involved]
     x0, y0 = max(int(boxes[:, 0].min()) - 3, 0), max(int(boxes[:, 1].min()) - 3, 0)
     x1, y1 = min(int(boxes[:, 2].max()) + 3, labels.shape[1]), min(int(boxes[:, 3].max()) + 3, labels.shape[0])
     touch_rules = AppendageRules(jump_absolute=rules.jump_absolute, jump_relative=rules.jump_relative)
@@ -132,32 +161,11 @@ def inner_wall_holders(
         (a, b): close * length
         for (a, b), close, length in zip(border_pairs.tolist(), close_shares, lengths, strict=True)
     }
-    grid_plane = plane_points.reshape(*labels.shape, 3)
-
-    def walls(label: int) -> tuple[np.ndarray, np.ndarray]:
-        bx0, by0, bx1, by1 = pieces.boxes[label]
-        inside = labels[by0:by1, bx0:bx1] == label
-        return wall_points(grid_plane[by0:by1, bx0:bx1][inside], normals[by0:by1, bx0:bx1][inside] @ to_plane, rules)
-
-    axes: dict[int, tuple[np.ndarray, float] | None] = {}
     best: dict[int, tuple[float, int]] = {}
-    for piece, holder in candidates.tolist():
+    for piece, holder in shaped:
         touching = along.get((min(piece, holder), max(piece, holder)), 0.0)
-        if touching < max(rules.min_boundary, rules.boundary_share * np.sqrt(pieces.sizes[piece])):
-            continue
-        if touching <= best.get(piece, (-1.0, 0))[0]:
-            continue
-        if piece not in axes:
-            axes[piece] = wall_axis(*walls(piece), rules)
-        found = axes[piece]
-        if found is None:
-            continue
-        axis, radius = found
-        floor = joint_hull(pieces, piece, holder).reshape(-1, 1, 2).astype(np.float32)
-        if floor.shape[0] < 3 or cv2.pointPolygonTest(floor, (float(axis[0]), float(axis[1])), False) <= 0:
-            continue
-        outside, _ = walls(holder)  # the outer wall surrounds the inner one: no nearer the axis
-        if outside.shape[0] >= _MIN_WALL_POINTS and np.median(np.linalg.norm(outside - axis, axis=1)) >= radius:
+        needed = max(rules.min_boundary, rules.boundary_share * np.sqrt(pieces.sizes[piece]))
+        if touching >= needed and touching > best.get(piece, (-1.0, 0))[0]:
             best[piece] = (touching, holder)
     return [(piece, holder) for piece, (_, holder) in best.items()]
 
