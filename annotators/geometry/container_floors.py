@@ -1,0 +1,111 @@
+"""The floor of an open container seen from above, on the organized grid: it joins the container.
+
+Only points at least ``min_height`` above the supporting plane are candidates of the segmentation, and the inside
+floor of a bowl, a tray or a low pot lies within that band: the floor of a thin-walled bowl is a few millimetres
+above the table, within the depth noise of the plane. Seen from above, the floor is left out, the container comes
+out as a ring of wall around a hole, and the bits of the floor that the noise lifts above ``min_height`` come out as
+small pieces of their own.
+
+Such a floor is told from the table by where it lies, in the image and on the plane at once:
+
+* in the image it is enclosed by objects (a hole of the union of the objects' pixels; the frame's border closes it
+  where the container runs out of the image) - the table beside an object runs on to the rest of the table;
+* on the plane its points lie within the footprint of one object (the convex hull of that object's points dropped
+  onto the plane holds at least ``held_share`` of them) - the table enclosed between several objects standing in a
+  ring lies outside each of their footprints, and the table seen under an overhang (a drill's chuck) is not
+  enclosed in the image, the overhanging part's silhouette leaves it open to the rest of the table.
+
+Each such hole joins the object whose footprint holds most of it (:func:`claim_container_floors`); a floor piece
+lifted by the noise then touches its container and joins it as a piece that cannot stand by itself
+(:func:`annotators.geometry.support.join_unsupported`).
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import numpy as np
+from scipy import ndimage
+
+from annotators.geometry.support import summarize_pieces
+
+
+@dataclass(frozen=True)
+class FloorRules:
+    """Thresholds of :func:`claim_container_floors`: points within ``min_height`` of the plane (either side) are
+    at table level (the segmenter's lowest candidate height); a hole joins the object whose footprint's convex
+    hull holds at least ``held_share`` of its points (as a piece held by a neighbour,
+    :class:`~annotators.geometry.support.SupportRules`); heights and feet read on every ``sample_step``-th pixel."""
+
+    min_height: float = 0.01
+    cell: float = 0.005
+    sample_step: int = 2
+
+
+def inside_convex(points: np.ndarray, hull: np.ndarray) -> np.ndarray:
+    """N bool: which of the Nx2 ``points`` lie inside (or on) the convex polygon ``hull`` (Kx2, K >= 3, in order)."""
+    edges = np.roll(hull, -1, axis=0) - hull
+    offsets = points[:, None, :] - hull[None, :, :]
+    cross = edges[None, :, 0] * offsets[..., 1] - edges[None, :, 1] * offsets[..., 0]
+    return np.all(cross >= 0, axis=1) | np.all(cross <= 0, axis=1)
+
+
+def claim_container_floors(
+    labels: np.ndarray,
+    valid: np.ndarray,
+    plane_points: np.ndarray,
+    rules: FloorRules | None = None,
+) -> tuple[np.ndarray, np.ndarray]:
+    """Labels with each container's floor joined to the container (see the module docstring), and the HxW mask
+    of the pixels claimed. ``labels`` HxW (0 unlabelled), ``valid`` the measured pixels, ``plane_points`` the
+    pixels' ``(u, v, height)`` on the plane (HxWx3 or (H*W)x3)."""
+    rules = rules or FloorRules()
+    claimed = np.zeros(labels.shape, dtype=bool)
+    if not (labels > 0).any():
+        return labels, claimed
+    plane_points = plane_points.reshape(*labels.shape, 3)
+    with np.errstate(invalid="ignore"):
+        level = valid & (labels == 0) & (np.abs(plane_points[..., 2]) < rules.min_height)
+    if not level.any():
+        return labels, claimed
+    pieces = summarize_pieces(labels, plane_points, rules.sample_step)
+    result = labels.copy()
+    for label in np.flatnonzero(pieces.sizes[1:]).tolist():
+        label += 1
+        x0, y0, x1, y1 = pieces.boxes[label].tolist()
+        rows, cols = np.nonzero(level[y0:y1, x0:x1])
+        if rows.size == 0:
+            continue
+        hull = pieces.hull(label)
+        if hull.shape[0] < 3:
+            continue
+        feet = plane_points[rows + y0, cols + x0, :2]
+        inside = inside_convex(feet, hull)
+        if not inside.any():
+            continue
+        rows, cols, feet = rows[inside], cols[inside], feet[inside]
+        own = plane_points[y0:y1, x0:x1][labels[y0:y1, x0:x1] == label]
+        free = ~overhung(feet, own, pieces.low[label] + rules.min_height, rules.cell)
+        result[rows[free] + y0, cols[free] + x0] = label
+        claimed[rows[free] + y0, cols[free] + x0] = True
+    return result, claimed
+
+
+def overhung(feet: np.ndarray, object_points: np.ndarray, clearance: float, cell: float) -> np.ndarray:
+    """N bool: which of the Nx2 ``feet`` lie in a ``cell``-metre raster cell of the plane where the object hangs
+    over the table - every point of the object (Mx3 ``(u, v, height)``) whose foot falls in the cell lies higher
+    than ``clearance`` (a drill's chuck above the table in front of its battery); the raster is closed (3x3) so
+    that the gaps between sparse feet count too. A wall that runs down to a floor has points low in its cells."""
+    object_points = object_points[np.isfinite(object_points).all(axis=1)]
+    if object_points.shape[0] == 0:
+        return np.zeros(feet.shape[0], dtype=bool)
+    low = np.minimum(object_points[:, :2].min(axis=0), feet.min(axis=0)) - 2 * cell
+    high = np.maximum(object_points[:, :2].max(axis=0), feet.max(axis=0)) + 2 * cell
+    width, height = (np.ceil((high - low) / cell).astype(np.int64) + 1).tolist()
+    lowest = np.full(height * width, np.inf)
+    cells = ((object_points[:, :2] - low) / cell).astype(np.int64)
+    np.minimum.at(lowest, cells[:, 1] * width + cells[:, 0], object_points[:, 2])
+    over = ((lowest > clearance) & np.isfinite(lowest)).reshape(height, width)
+    over = ndimage.binary_closing(over, np.ones((3, 3), dtype=bool))
+    at = ((feet - low) / cell).astype(np.int64)
+    return over[at[:, 1], at[:, 0]]
