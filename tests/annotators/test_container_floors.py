@@ -46,7 +46,7 @@ def test_the_floor_of_a_bowl_whose_near_side_is_not_seen_joins_it_within_the_far
     labels, points = flat_table()
     floor = bowl(labels, points, (30, 30), 10, 20)
     labels[31:] = 0
-    joined, claimed = claim_container_floors(labels, np.ones(labels.shape, bool), points)
+    _, claimed = claim_container_floors(labels, np.ones(labels.shape, bool), points)
     assert claimed[floor & (np.arange(60)[:, None] < 30)].mean() > 0.9
     assert not claimed[31:].any()
 
