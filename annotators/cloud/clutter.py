@@ -224,7 +224,7 @@ def segment_clutter(
         labels = join_slab_pieces(labels, grid, normals, plane_grid, p.slab_rules())
     floors = None
     if p.claim_floors:
-        rules = FloorRules(min_height=p.min_height, cell=p.hull_cell)
+        rules = FloorRules(min_height=p.min_height, margin=p.hull_margin, cell=p.hull_cell)
         labels, floors = claim_container_floors(labels, np.isfinite(depth), plane_grid, rules)
         if floors.any():  # the floor's pieces the noise lifted now touch their container
             labels = join_pieces(labels, grid, normals, plane_grid, support, appendages, joint)

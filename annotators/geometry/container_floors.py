@@ -6,18 +6,19 @@ above the table, within the depth noise of the plane. Seen from above, the floor
 out as a ring of wall around a hole, and the bits of the floor that the noise lifts above ``min_height`` come out as
 small pieces of their own.
 
-Such a floor is told from the table by where it lies, in the image and on the plane at once:
+Such a floor is told from the table by where it lies on the plane: within the container's footprint - the convex
+hull of the container's points dropped onto the plane, reached from a part of the floor at least ``margin`` inside
+it - where no part of the container hangs over it. Visible table can lie within an object's footprint only where
+it is seen over the object's rim or through it; beside a solid object the table lies outside its footprint but
+for the band where the object meets the table and the hull's noise, which no part well inside reaches, and behind
+one it is hidden. Where an object hangs over the table (a drill's chuck reaching out above the table in front of
+its battery) the table seen under it is within the footprint too, but every point of the object over it is high
+above the object's lowest heights, while a container's wall runs down to its floor (:func:`overhung`).
 
-* in the image it is enclosed by objects (a hole of the union of the objects' pixels; the frame's border closes it
-  where the container runs out of the image) - the table beside an object runs on to the rest of the table;
-* on the plane its points lie within the footprint of one object (the convex hull of that object's points dropped
-  onto the plane holds at least ``held_share`` of them) - the table enclosed between several objects standing in a
-  ring lies outside each of their footprints, and the table seen under an overhang (a drill's chuck) is not
-  enclosed in the image, the overhanging part's silhouette leaves it open to the rest of the table.
-
-Each such hole joins the object whose footprint holds most of it (:func:`claim_container_floors`); a floor piece
-lifted by the noise then touches its container and joins it as a piece that cannot stand by itself
-(:func:`annotators.geometry.support.join_unsupported`).
+Each such pixel joins the object whose footprint holds it (:func:`claim_container_floors`). A container whose
+near wall is not seen (out of the frame, or lost by the depth sensor) keeps the floor within the footprint of the
+walls that are; a floor piece lifted by the noise then touches its container and joins it as a piece that cannot
+stand by itself (:func:`annotators.geometry.support.join_unsupported`).
 """
 
 from __future__ import annotations
@@ -32,22 +33,28 @@ from annotators.geometry.support import summarize_pieces
 
 @dataclass(frozen=True)
 class FloorRules:
-    """Thresholds of :func:`claim_container_floors`: points within ``min_height`` of the plane (either side) are
-    at table level (the segmenter's lowest candidate height); a hole joins the object whose footprint's convex
-    hull holds at least ``held_share`` of its points (as a piece held by a neighbour,
-    :class:`~annotators.geometry.support.SupportRules`); heights and feet read on every ``sample_step``-th pixel."""
+    """Thresholds of :func:`claim_container_floors` (metres), the segmenter's own: points within ``min_height`` of
+    the plane (either side) are at table level (its lowest candidate height); a floor runs on (4-connected in the
+    image) from a part at least ``margin`` inside the convex hull of its container's feet (the margin of the
+    plane's extent) as far as the hull; an object hangs over the
+    ``cell``-sized cells of the plane (the plane raster's cell) whose points all lie more than ``min_height``
+    above its lowest heights; heights and feet read on every ``sample_step``-th pixel."""
 
     min_height: float = 0.01
+    margin: float = 0.015
     cell: float = 0.005
     sample_step: int = 2
 
 
-def inside_convex(points: np.ndarray, hull: np.ndarray) -> np.ndarray:
-    """N bool: which of the Nx2 ``points`` lie inside (or on) the convex polygon ``hull`` (Kx2, K >= 3, in order)."""
+def depth_inside(points: np.ndarray, hull: np.ndarray) -> np.ndarray:
+    """N float: how far each of the Nx2 ``points`` lies inside the convex polygon ``hull`` (Kx2, K >= 3, in either
+    order) - its distance to the nearest edge's line, negative outside."""
     edges = np.roll(hull, -1, axis=0) - hull
+    area = float(np.sum(hull[:, 0] * np.roll(hull[:, 1], -1) - np.roll(hull[:, 0], -1) * hull[:, 1]))
     offsets = points[:, None, :] - hull[None, :, :]
     cross = edges[None, :, 0] * offsets[..., 1] - edges[None, :, 1] * offsets[..., 0]
-    return np.all(cross >= 0, axis=1) | np.all(cross <= 0, axis=1)
+    lengths = np.maximum(np.hypot(edges[:, 0], edges[:, 1]), 1e-12)
+    return np.min(np.sign(area) * cross / lengths[None, :], axis=1)
 
 
 def claim_container_floors(
@@ -80,14 +87,21 @@ def claim_container_floors(
         if hull.shape[0] < 3:
             continue
         feet = plane_points[rows + y0, cols + x0, :2]
-        inside = inside_convex(feet, hull)
-        if not inside.any():
+        depth = depth_inside(feet, hull)
+        if not (depth >= rules.margin).any():
             continue
-        rows, cols, feet = rows[inside], cols[inside], feet[inside]
+        inside = depth >= 0
+        rows, cols, feet, depth = rows[inside], cols[inside], feet[inside], depth[inside]
         own = plane_points[y0:y1, x0:x1][labels[y0:y1, x0:x1] == label]
         free = ~overhung(feet, own, pieces.low[label] + rules.min_height, rules.cell)
-        result[rows[free] + y0, cols[free] + x0] = label
-        claimed[rows[free] + y0, cols[free] + x0] = True
+        floor = np.zeros((y1 - y0, x1 - x0), dtype=bool)
+        floor[rows[free], cols[free]] = True
+        # the floor reaches as far as the footprint where it runs on from a part well inside it
+        parts, _ = ndimage.label(floor)
+        seeded = np.unique(parts[rows[free & (depth >= rules.margin)], cols[free & (depth >= rules.margin)]])
+        floor = np.isin(parts, seeded[seeded > 0])
+        result[y0:y1, x0:x1][floor] = label
+        claimed[y0:y1, x0:x1] |= floor
     return result, claimed
 
 
