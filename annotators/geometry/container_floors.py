@@ -6,25 +6,31 @@ above the table, within the depth noise of the plane. Seen from above, the floor
 out as a ring of wall around a hole, and the bits of the floor that the noise lifts above ``min_height`` come out as
 small pieces of their own.
 
-Such a floor is told from the table by where it lies on the plane: within the container's footprint - the convex
-hull of the container's points dropped onto the plane, reached from a part of the floor at least ``margin`` inside
-it - where no part of the container hangs over it. Visible table can lie within an object's footprint only where
-it is seen over the object's rim or through it; beside a solid object the table lies outside its footprint but
-for the band where the object meets the table and the hull's noise, which no part well inside reaches, and behind
-one it is hidden. Where an object hangs over the table (a drill's chuck reaching out above the table in front of
-its battery) the table seen under it is within the footprint too, but every point of the object over it is high
-above the object's lowest heights, while a container's wall runs down to its floor (:func:`overhung`).
+Such a floor is told from the table by where it lies, on the plane and in the image:
 
-Each such pixel joins the object whose footprint holds it (:func:`claim_container_floors`). A container whose
-near wall is not seen (out of the frame, or lost by the depth sensor) keeps the floor within the footprint of the
-walls that are; a floor piece lifted by the noise then touches its container and joins it as a piece that cannot
-stand by itself (:func:`annotators.geometry.support.join_unsupported`).
+* within the container's footprint - the convex hull of the feet of the container's points (away from its
+  outline, whose mixed pixels fall anywhere) - reached from a part of the floor at least ``margin`` inside it;
+  visible table lies within an object's footprint only where it is seen over the object's rim or through it:
+  beside a solid object it lies outside but for the band where the object meets the table and the hull's noise,
+  which no part well inside reaches, and behind one it is hidden;
+* where that part lies, the container surrounds it in the image on three sides at least - its far wall and both
+  side walls; the near wall may be out of the frame or lost by the depth sensor (:func:`enclosed`);
+* no part of the container hangs over it: where an object hangs over the table (a drill's chuck reaching out
+  above the table in front of its battery) the table seen under it is within the footprint too, but every point
+  of the object over it lies high above the object's lowest heights, while a container's wall runs down to its
+  floor (:func:`overhung`).
+
+Each such pixel joins the object whose footprint holds it (:func:`claim_container_floors`); a floor piece lifted
+by the noise then touches its container and joins it as a piece that cannot stand by itself
+(:func:`annotators.geometry.support.join_unsupported`). Geometry alone cannot tell a floor from the table seen
+through an object (a drill's trigger loop, a ring lying flat): such table joins the object too.
 """
 
 from __future__ import annotations
 
 from dataclasses import dataclass
 
+import cv2
 import numpy as np
 from scipy import ndimage
 
@@ -36,9 +42,9 @@ class FloorRules:
     """Thresholds of :func:`claim_container_floors` (metres), the segmenter's own: points within ``min_height`` of
     the plane (either side) are at table level (its lowest candidate height); a floor runs on (4-connected in the
     image) from a part at least ``margin`` inside the convex hull of its container's feet (the margin of the
-    plane's extent) as far as the hull; an object hangs over the
-    ``cell``-sized cells of the plane (the plane raster's cell) whose points all lie more than ``min_height``
-    above its lowest heights; heights and feet read on every ``sample_step``-th pixel."""
+    plane's extent) as far as the hull; an object hangs over the ``cell``-sized cells of the plane (the plane
+    raster's cell) whose points all lie more than ``min_height`` above its lowest heights; the lowest heights
+    read on every ``sample_step``-th pixel."""
 
     min_height: float = 0.01
     margin: float = 0.015
@@ -83,7 +89,7 @@ def claim_container_floors(
         rows, cols = np.nonzero(level[y0:y1, x0:x1])
         if rows.size == 0:
             continue
-        hull = pieces.hull(label)
+        hull = core_hull(labels[y0:y1, x0:x1] == label, plane_points[y0:y1, x0:x1])
         if hull.shape[0] < 3:
             continue
         feet = plane_points[rows + y0, cols + x0, :2]
@@ -98,11 +104,35 @@ def claim_container_floors(
         floor[rows[free], cols[free]] = True
         # the floor reaches as far as the footprint where it runs on from a part well inside it
         parts, _ = ndimage.label(floor)
-        seeded = np.unique(parts[rows[free & (depth >= rules.margin)], cols[free & (depth >= rules.margin)]])
+        seeds = free & (depth >= rules.margin)
+        seeds[seeds] = enclosed(labels[y0:y1, x0:x1] == label)[rows[seeds], cols[seeds]]
+        seeded = np.unique(parts[rows[seeds], cols[seeds]])
         floor = np.isin(parts, seeded[seeded > 0])
         result[y0:y1, x0:x1][floor] = label
         claimed[y0:y1, x0:x1] |= floor
     return result, claimed
+
+
+def core_hull(mask: np.ndarray, plane_points: np.ndarray) -> np.ndarray:
+    """The convex hull (Kx2) of the feet of the object's pixels ``mask`` (HxW) away from its outline (eroded by
+    one pixel): the outline's mixed pixels, between the object and what lies behind it, fall anywhere."""
+    core = ndimage.binary_erosion(mask, np.ones((3, 3), dtype=bool))
+    feet = plane_points[core][:, :2]
+    feet = feet[np.isfinite(feet).all(axis=1)].astype(np.float32)
+    if feet.shape[0] < 3:
+        return feet
+    return cv2.convexHull(feet).reshape(-1, 2)
+
+
+def enclosed(mask: np.ndarray) -> np.ndarray:
+    """HxW bool: the pixels that have ``mask`` pixels on at least three of their four sides - to the left and
+    right in their row, above and below in their column: a floor seen over a container's rim has its wall on three
+    sides at least (the near wall may be out of sight), the table beside a solid object has it on one or two."""
+    sides = np.zeros(mask.shape, dtype=np.int8)
+    for axis in (0, 1):
+        sides += np.maximum.accumulate(mask, axis=axis)
+        sides += np.flip(np.maximum.accumulate(np.flip(mask, axis=axis), axis=axis), axis=axis)
+    return sides >= 3
 
 
 def overhung(feet: np.ndarray, object_points: np.ndarray, clearance: float, cell: float) -> np.ndarray:

@@ -6,7 +6,14 @@ from __future__ import annotations
 
 import numpy as np
 
-from annotators.geometry.container_floors import FloorRules, claim_container_floors, depth_inside, overhung
+from annotators.geometry.container_floors import (
+    FloorRules,
+    claim_container_floors,
+    core_hull,
+    depth_inside,
+    enclosed,
+    overhung,
+)
 
 CELL = 0.005  # metres per grid pixel in these plane coordinates
 
@@ -47,7 +54,7 @@ def test_the_floor_of_a_bowl_whose_near_side_is_not_seen_joins_it_within_the_far
     floor = bowl(labels, points, (30, 30), 10, 20)
     labels[31:] = 0
     _, claimed = claim_container_floors(labels, np.ones(labels.shape, bool), points)
-    assert claimed[floor & (np.arange(60)[:, None] <= 30)].all()
+    assert claimed[floor & (np.arange(60)[:, None] < 30)].all()
     assert not claimed[31:].any()
 
 
@@ -94,3 +101,19 @@ def test_the_table_at_the_foot_of_a_solid_object_stays_unlabelled_though_the_hul
     joined, claimed = claim_container_floors(labels, np.ones(labels.shape, bool), points)
     assert not claimed.any()
     assert np.array_equal(joined, labels)
+
+
+def test_a_pixel_is_enclosed_with_the_object_on_three_of_its_four_sides() -> None:
+    horseshoe = np.zeros((7, 7), dtype=bool)
+    horseshoe[1:6, 1] = horseshoe[1:6, 5] = horseshoe[1, 1:6] = True  # open at the bottom
+    inside = enclosed(horseshoe)
+    assert inside[3, 3] and inside[5, 3]  # wall left, right and above
+    assert not inside[3, 0] and not inside[6, 3] and not inside[0, 3]  # beside, below, above the object
+
+
+def test_the_hull_of_an_object_leaves_out_its_outlines_mixed_pixels() -> None:
+    labels, points = flat_table()
+    labels[20:40, 20:40] = 1
+    points[20:40, 39, 0] += 0.05  # the right outline's pixels mixed with what lies 5 cm behind
+    hull = core_hull(labels == 1, points)
+    assert hull[:, 0].max() <= 38 * CELL + 1e-6 and hull[:, 0].min() >= 21 * CELL - 1e-6
