@@ -16,9 +16,10 @@ Such a floor is told from the table by where it lies, on the plane and in the im
 * where that part lies, the container surrounds it in the image on three sides at least - its far wall and both
   side walls; the near wall may be out of the frame or lost by the depth sensor (:func:`enclosed`);
 * no part of the container hangs over it: where an object hangs over the table (a drill's chuck reaching out
-  above the table in front of its battery) the table seen under it is within the footprint too, but every point
-  of the object over it lies high above the object's lowest heights, while a container's wall runs down to its
-  floor (:func:`overhung`).
+  above the table in front of its battery, a box leaning on another with the table seen under its raised edge)
+  the table seen under it is within the footprint too, but every point of the object over it lies more than
+  ``min_height`` above the candidates' lowest height, while a container's wall runs down to its floor, to where
+  the candidates start (:func:`overhung`).
 
 Each such pixel joins the object whose footprint holds it (:func:`claim_container_floors`); a floor piece lifted
 by the noise then touches its container and joins it as a piece that cannot stand by itself
@@ -34,8 +35,6 @@ import cv2
 import numpy as np
 from scipy import ndimage
 
-from annotators.geometry.support import summarize_pieces
-
 
 @dataclass(frozen=True)
 class FloorRules:
@@ -43,13 +42,12 @@ class FloorRules:
     the plane (either side) are at table level (its lowest candidate height); a floor runs on (4-connected in the
     image) from a part at least ``margin`` inside the convex hull of its container's feet (the margin of the
     plane's extent) as far as the hull; an object hangs over the ``cell``-sized cells of the plane (the plane
-    raster's cell) whose points all lie more than ``min_height`` above its lowest heights; the lowest heights
-    read on every ``sample_step``-th pixel."""
+    raster's cell) whose points all lie more than ``min_height`` above the candidates' lowest height (twice
+    ``min_height`` above the plane)."""
 
     min_height: float = 0.01
     margin: float = 0.015
     cell: float = 0.005
-    sample_step: int = 2
 
 
 def depth_inside(points: np.ndarray, hull: np.ndarray) -> np.ndarray:
@@ -81,11 +79,11 @@ def claim_container_floors(
         level = valid & (labels == 0) & (np.abs(plane_points[..., 2]) < rules.min_height)
     if not level.any():
         return labels, claimed
-    pieces = summarize_pieces(labels, plane_points, rules.sample_step)
     result = labels.copy()
-    for label in np.flatnonzero(pieces.sizes[1:]).tolist():
-        label += 1
-        x0, y0, x1, y1 = pieces.boxes[label].tolist()
+    for label, window in enumerate(ndimage.find_objects(labels), start=1):
+        if window is None:
+            continue
+        (y0, y1), (x0, x1) = (window[0].start, window[0].stop), (window[1].start, window[1].stop)
         rows, cols = np.nonzero(level[y0:y1, x0:x1])
         if rows.size == 0:
             continue
@@ -99,7 +97,7 @@ def claim_container_floors(
         inside = depth >= 0
         rows, cols, feet, depth = rows[inside], cols[inside], feet[inside], depth[inside]
         own = plane_points[y0:y1, x0:x1][labels[y0:y1, x0:x1] == label]
-        free = ~overhung(feet, own, pieces.low[label] + rules.min_height, rules.cell)
+        free = ~overhung(feet, own, 2 * rules.min_height, rules.cell)
         floor = np.zeros((y1 - y0, x1 - x0), dtype=bool)
         floor[rows[free], cols[free]] = True
         # the floor reaches as far as the footprint where it runs on from a part well inside it
