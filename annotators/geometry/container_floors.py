@@ -43,22 +43,34 @@ class FloorRules:
     image) from a part at least ``margin`` inside the convex hull of its container's feet (the margin of the
     plane's extent) as far as the hull; an object hangs over the ``cell``-sized cells of the plane (the plane
     raster's cell) whose points all lie more than ``min_height`` above the candidates' lowest height (twice
-    ``min_height`` above the plane)."""
+    ``min_height`` above the plane); the hull's feet read on every ``sample_step``-th pixel."""
 
     min_height: float = 0.01
     margin: float = 0.015
     cell: float = 0.005
+    sample_step: int = 2
 
 
-def depth_inside(points: np.ndarray, hull: np.ndarray) -> np.ndarray:
-    """N float: how far each of the Nx2 ``points`` lies inside the convex polygon ``hull`` (Kx2, K >= 3, in either
-    order) - its distance to the nearest edge's line, negative outside."""
-    edges = np.roll(hull, -1, axis=0) - hull
-    area = float(np.sum(hull[:, 0] * np.roll(hull[:, 1], -1) - np.roll(hull[:, 0], -1) * hull[:, 1]))
-    offsets = points[:, None, :] - hull[None, :, :]
-    cross = edges[None, :, 0] * offsets[..., 1] - edges[None, :, 1] * offsets[..., 0]
-    lengths = np.maximum(np.hypot(edges[:, 0], edges[:, 1]), 1e-12)
-    return np.min(np.sign(area) * cross / lengths[None, :], axis=1)
+class Footprint:
+    """A convex polygon on the plane (Kx2 metres) rasterized with ``cell`` metres per pixel, with each cell's
+    distance to the polygon's outline: how deep a foot lies inside it is one lookup (to the cell)."""
+
+    def __init__(self, hull: np.ndarray, cell: float) -> None:
+        self.cell = cell
+        self.origin = hull.min(axis=0) - 2 * cell
+        width, height = (np.ceil((hull.max(axis=0) - self.origin) / cell).astype(np.int64) + 3).tolist()
+        raster = np.zeros((height, width), dtype=np.uint8)
+        cv2.fillConvexPoly(raster, np.round((hull - self.origin) / cell).astype(np.int32), 1)
+        self.distances = cv2.distanceTransform(raster, cv2.DIST_L2, 3) * cell
+
+    def depth(self, feet: np.ndarray) -> np.ndarray:
+        """N float: how far inside the polygon each of the Nx2 ``feet`` lies (metres, to the cell; 0 outside)."""
+        at = np.floor((feet - self.origin) / self.cell).astype(np.int64)
+        height, width = self.distances.shape
+        within = (at[:, 0] >= 0) & (at[:, 0] < width) & (at[:, 1] >= 0) & (at[:, 1] < height)
+        result = np.zeros(feet.shape[0], dtype=np.float32)
+        result[within] = self.distances[at[within, 1], at[within, 0]]
+        return result
 
 
 def claim_container_floors(
@@ -84,38 +96,42 @@ def claim_container_floors(
         if window is None:
             continue
         (y0, y1), (x0, x1) = (window[0].start, window[0].stop), (window[1].start, window[1].stop)
-        rows, cols = np.nonzero(level[y0:y1, x0:x1])
-        if rows.size == 0:
-            continue
-        hull = core_hull(labels[y0:y1, x0:x1] == label, plane_points[y0:y1, x0:x1])
+        mask = labels[y0:y1, x0:x1] == label
+        around = level[y0:y1, x0:x1]
+        surrounded = around & enclosed(mask)
+        if not surrounded.any():
+            continue  # no table-level pixel with the object on three sides: no floor to seed from
+        hull = core_hull(mask, plane_points[y0:y1, x0:x1], rules.sample_step)
         if hull.shape[0] < 3:
             continue
-        feet = plane_points[rows + y0, cols + x0, :2]
-        depth = depth_inside(feet, hull)
-        if not (depth >= rules.margin).any():
+        footprint = Footprint(hull, rules.cell)
+        rows, cols = np.nonzero(surrounded)
+        seeds = footprint.depth(plane_points[rows + y0, cols + x0, :2]) >= rules.margin
+        if not seeds.any():
             continue
-        inside = depth >= 0
-        rows, cols, feet, depth = rows[inside], cols[inside], feet[inside], depth[inside]
-        own = plane_points[y0:y1, x0:x1][labels[y0:y1, x0:x1] == label]
-        free = ~overhung(feet, own, 2 * rules.min_height, rules.cell)
+        seed_rows, seed_cols = rows[seeds], cols[seeds]
+        rows, cols = np.nonzero(around)
+        feet = plane_points[rows + y0, cols + x0, :2]
+        inside = footprint.depth(feet) > 0
+        rows, cols, feet = rows[inside], cols[inside], feet[inside]
+        free = ~overhung(feet, plane_points[y0:y1, x0:x1][mask], 2 * rules.min_height, rules.cell)
         floor = np.zeros((y1 - y0, x1 - x0), dtype=bool)
         floor[rows[free], cols[free]] = True
         # the floor reaches as far as the footprint where it runs on from a part well inside it
         parts, _ = ndimage.label(floor)
-        seeds = free & (depth >= rules.margin)
-        seeds[seeds] = enclosed(labels[y0:y1, x0:x1] == label)[rows[seeds], cols[seeds]]
-        seeded = np.unique(parts[rows[seeds], cols[seeds]])
+        seeded = np.unique(parts[seed_rows, seed_cols])
         floor = np.isin(parts, seeded[seeded > 0])
         result[y0:y1, x0:x1][floor] = label
         claimed[y0:y1, x0:x1] |= floor
     return result, claimed
 
 
-def core_hull(mask: np.ndarray, plane_points: np.ndarray) -> np.ndarray:
+def core_hull(mask: np.ndarray, plane_points: np.ndarray, step: int = 1) -> np.ndarray:
     """The convex hull (Kx2) of the feet of the object's pixels ``mask`` (HxW) away from its outline (eroded by
-    one pixel): the outline's mixed pixels, between the object and what lies behind it, fall anywhere."""
-    core = ndimage.binary_erosion(mask, np.ones((3, 3), dtype=bool))
-    feet = plane_points[core][:, :2]
+    one pixel), read on every ``step``-th pixel: the outline's mixed pixels, between the object and what lies
+    behind it, fall anywhere."""
+    core = ndimage.binary_erosion(mask, np.ones((3, 3), dtype=bool))[::step, ::step]
+    feet = plane_points[::step, ::step][core][:, :2]
     feet = feet[np.isfinite(feet).all(axis=1)].astype(np.float32)
     if feet.shape[0] < 3:
         return feet
@@ -144,10 +160,13 @@ def overhung(feet: np.ndarray, object_points: np.ndarray, clearance: float, cell
     low = np.minimum(object_points[:, :2].min(axis=0), feet.min(axis=0)) - 2 * cell
     high = np.maximum(object_points[:, :2].max(axis=0), feet.max(axis=0)) + 2 * cell
     width, height = (np.ceil((high - low) / cell).astype(np.int64) + 1).tolist()
-    lowest = np.full(height * width, np.inf)
     cells = ((object_points[:, :2] - low) / cell).astype(np.int64)
-    np.minimum.at(lowest, cells[:, 1] * width + cells[:, 0], object_points[:, 2])
-    over = ((lowest > clearance) & np.isfinite(lowest)).reshape(height, width)
+    occupied = np.zeros((height, width), dtype=bool)
+    occupied[cells[:, 1], cells[:, 0]] = True
+    reaching = cells[object_points[:, 2] <= clearance]
+    reached = np.zeros((height, width), dtype=bool)
+    reached[reaching[:, 1], reaching[:, 0]] = True
+    over = occupied & ~reached
     over = ndimage.binary_closing(over, np.ones((3, 3), dtype=bool))
     at = ((feet - low) / cell).astype(np.int64)
     return over[at[:, 1], at[:, 0]]

@@ -8,9 +8,9 @@ import numpy as np
 
 from annotators.geometry.container_floors import (
     FloorRules,
+    Footprint,
     claim_container_floors,
     core_hull,
-    depth_inside,
     enclosed,
     overhung,
 )
@@ -75,11 +75,12 @@ def test_the_table_under_an_overhanging_part_and_beside_solid_objects_stays_unla
     assert np.array_equal(joined, labels)
 
 
-def test_a_points_depth_inside_a_convex_polygon_is_its_distance_to_the_nearest_edge() -> None:
-    square = np.array([[0, 0], [1, 0], [1, 1], [0, 1]], dtype=np.float32)
-    points = np.array([[0.5, 0.5], [0.9, 0.5], [1.5, 0.5], [-0.1, 0.0]], dtype=np.float32)
+def test_a_foots_depth_in_a_footprint_is_its_distance_to_the_outline_to_the_cell() -> None:
+    square = np.array([[0, 0], [0.1, 0], [0.1, 0.1], [0, 0.1]], dtype=np.float32)
+    feet = np.array([[0.05, 0.05], [0.09, 0.05], [0.15, 0.05], [-0.01, 0.0]], dtype=np.float32)
     for hull in (square, square[::-1]):
-        assert np.allclose(depth_inside(points, hull), [0.5, 0.1, -0.5, -0.1])
+        depth = Footprint(hull, CELL).depth(feet)
+        assert np.allclose(depth, [0.05, 0.01, 0.0, 0.0], atol=1.5 * CELL)
 
 
 def test_a_cell_is_overhung_only_where_all_of_the_objects_points_over_it_are_high() -> None:
