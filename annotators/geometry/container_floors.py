@@ -14,7 +14,7 @@ Such a floor is told from the table by where it lies, on the plane and in the im
   beside a solid object it lies outside but for the band where the object meets the table and the hull's noise,
   which no part well inside reaches, and behind one it is hidden;
 * where that part lies, the container surrounds it in the image on three sides at least - its far wall and both
-  side walls; the near wall may be out of the frame or lost by the depth sensor (:func:`enclosed`);
+  side walls; the near wall may be out of the frame or lost by the depth sensor (:func:`enclosing_labels`);
 * no part of the container hangs over it: where an object hangs over the table (a drill's chuck reaching out
   above the table in front of its battery, a box leaning on another with the table seen under its raised edge)
   the table seen under it is within the footprint too, but every point of the object over it lies more than
@@ -91,16 +91,17 @@ def claim_container_floors(
         level = valid & (labels == 0) & (np.abs(plane_points[..., 2]) < rules.min_height)
     if not level.any():
         return labels, claimed
+    enclosing = np.where(level, enclosing_labels(labels), 0)
+    if not enclosing.any():
+        return labels, claimed  # no table-level pixel with an object on three sides: no floor to seed from
     result = labels.copy()
-    for label, window in enumerate(ndimage.find_objects(labels), start=1):
-        if window is None:
-            continue
+    windows = ndimage.find_objects(labels)
+    for label in np.unique(enclosing[enclosing > 0]).tolist():
+        window = windows[label - 1]
         (y0, y1), (x0, x1) = (window[0].start, window[0].stop), (window[1].start, window[1].stop)
         mask = labels[y0:y1, x0:x1] == label
         around = level[y0:y1, x0:x1]
-        surrounded = around & enclosed(mask)
-        if not surrounded.any():
-            continue  # no table-level pixel with the object on three sides: no floor to seed from
+        surrounded = enclosing[y0:y1, x0:x1] == label
         hull = core_hull(mask, plane_points[y0:y1, x0:x1], rules.sample_step)
         if hull.shape[0] < 3:
             continue
@@ -138,15 +139,28 @@ def core_hull(mask: np.ndarray, plane_points: np.ndarray, step: int = 1) -> np.n
     return cv2.convexHull(feet).reshape(-1, 2)
 
 
-def enclosed(mask: np.ndarray) -> np.ndarray:
-    """HxW bool: the pixels that have ``mask`` pixels on at least three of their four sides - to the left and
-    right in their row, above and below in their column: a floor seen over a container's rim has its wall on three
-    sides at least (the near wall may be out of sight), the table beside a solid object has it on one or two."""
-    sides = np.zeros(mask.shape, dtype=np.int8)
-    for axis in (0, 1):
-        sides += np.maximum.accumulate(mask, axis=axis)
-        sides += np.flip(np.maximum.accumulate(np.flip(mask, axis=axis), axis=axis), axis=axis)
-    return sides >= 3
+def nearest_labels(labels: np.ndarray, axis: int, reverse: bool) -> np.ndarray:
+    """HxW: for every pixel the label of the nearest labelled pixel (itself included) along ``axis`` - toward
+    lower indices, or higher ones with ``reverse`` - or 0 when there is none."""
+    view = np.flip(labels, axis=axis) if reverse else labels
+    size = view.shape[axis]
+    positions = np.arange(size).reshape((-1, 1) if axis == 0 else (1, -1))
+    last = np.maximum.accumulate(np.where(view > 0, positions, -1), axis=axis)
+    nearest = np.take_along_axis(view, np.maximum(last, 0), axis=axis)
+    nearest = np.where(last >= 0, nearest, 0)
+    return np.flip(nearest, axis=axis) if reverse else nearest
+
+
+def enclosing_labels(labels: np.ndarray) -> np.ndarray:
+    """HxW: for every pixel the label that is the nearest one on at least three of its four sides - to the left
+    and right in its row, above and below in its column - or 0: a floor seen over a container's rim meets its
+    wall first on three sides at least (the near wall may be out of sight), the table beside a solid object
+    meets it on one or two."""
+    left, right = nearest_labels(labels, 1, False), nearest_labels(labels, 1, True)
+    up, down = nearest_labels(labels, 0, False), nearest_labels(labels, 0, True)
+    across = (left == right) & ((left == up) | (left == down))
+    along = (up == down) & ((up == left) | (up == right))
+    return np.where(across, left, np.where(along, up, 0))
 
 
 def overhung(feet: np.ndarray, object_points: np.ndarray, clearance: float, cell: float) -> np.ndarray:

@@ -11,7 +11,7 @@ from annotators.geometry.container_floors import (
     Footprint,
     claim_container_floors,
     core_hull,
-    enclosed,
+    enclosing_labels,
     overhung,
 )
 
@@ -104,12 +104,14 @@ def test_the_table_at_the_foot_of_a_solid_object_stays_unlabelled_though_the_hul
     assert np.array_equal(joined, labels)
 
 
-def test_a_pixel_is_enclosed_with_the_object_on_three_of_its_four_sides() -> None:
-    horseshoe = np.zeros((7, 7), dtype=bool)
-    horseshoe[1:6, 1] = horseshoe[1:6, 5] = horseshoe[1, 1:6] = True  # open at the bottom
-    inside = enclosed(horseshoe)
-    assert inside[3, 3] and inside[5, 3]  # wall left, right and above
-    assert not inside[3, 0] and not inside[6, 3] and not inside[0, 3]  # beside, below, above the object
+def test_a_pixel_is_enclosed_by_the_label_it_meets_first_on_three_of_its_four_sides() -> None:
+    labels = np.zeros((7, 9), dtype=np.int32)
+    labels[1:6, 1] = labels[1:6, 5] = labels[1, 1:6] = 1  # a horseshoe open at the bottom
+    labels[3, 7] = 2
+    enclosing = enclosing_labels(labels)
+    assert enclosing[3, 3] == 1 and enclosing[5, 3] == 1  # wall left, right and above
+    assert enclosing[3, 0] == 0 and enclosing[6, 3] == 0 and enclosing[0, 3] == 0  # beside, below, above it
+    assert enclosing[3, 6] == 0  # between the horseshoe and another object
 
 
 def test_the_hull_of_an_object_leaves_out_its_outlines_mixed_pixels() -> None:
