@@ -29,11 +29,21 @@ through an object (a drill's trigger loop, a ring lying flat): such table joins 
 
 from __future__ import annotations
 
+import functools
 from dataclasses import dataclass
+from types import ModuleType
 
 import cv2
 import numpy as np
 from scipy import ndimage
+
+
+@functools.cache
+def _loops() -> ModuleType:
+    """:mod:`annotators.geometry.floor_loops`, imported (and numba with it) on first use."""
+    from annotators.geometry import floor_loops
+
+    return floor_loops
 
 
 @dataclass(frozen=True)
@@ -91,7 +101,7 @@ def claim_container_floors(
         level = valid & (labels == 0) & (np.abs(plane_points[..., 2]) < rules.min_height)
     if not level.any():
         return labels, claimed
-    enclosing = np.where(level, enclosing_labels(labels), 0)
+    enclosing = _loops().enclosing_labels(np.ascontiguousarray(labels, dtype=np.int32), level)
     if not enclosing.any():
         return labels, claimed  # no table-level pixel with an object on three sides: no floor to seed from
     result = labels.copy()
@@ -152,10 +162,10 @@ def nearest_labels(labels: np.ndarray, axis: int, reverse: bool) -> np.ndarray:
 
 
 def enclosing_labels(labels: np.ndarray) -> np.ndarray:
-    """HxW: for every pixel the label that is the nearest one on at least three of its four sides - to the left
-    and right in its row, above and below in its column - or 0: a floor seen over a container's rim meets its
-    wall first on three sides at least (the near wall may be out of sight), the table beside a solid object
-    meets it on one or two."""
+    """HxW (the reference form of the segmenter's compiled pass): for every pixel the label that is the nearest
+    one on at least three of its four sides - to the left and right in its row, above and below in its column -
+    or 0: a floor seen over a container's rim meets its wall first on three sides at least (the near wall may be
+    out of sight), the table beside a solid object meets it on one or two."""
     left, right = nearest_labels(labels, 1, False), nearest_labels(labels, 1, True)
     up, down = nearest_labels(labels, 0, False), nearest_labels(labels, 0, True)
     across = (left == right) & ((left == up) | (left == down))

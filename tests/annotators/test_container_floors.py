@@ -6,6 +6,7 @@ from __future__ import annotations
 
 import numpy as np
 
+from annotators.geometry import floor_loops
 from annotators.geometry.container_floors import (
     FloorRules,
     Footprint,
@@ -120,3 +121,11 @@ def test_the_hull_of_an_object_leaves_out_its_outlines_mixed_pixels() -> None:
     points[20:40, 39, 0] += 0.05  # the right outline's pixels mixed with what lies 5 cm behind
     hull = core_hull(labels == 1, points)
     assert hull[:, 0].max() <= 38 * CELL + 1e-6 and hull[:, 0].min() >= 21 * CELL - 1e-6
+
+
+def test_the_compiled_enclosure_pass_gives_what_the_numpy_form_gives() -> None:
+    rng = np.random.default_rng(5)
+    labels = np.where(rng.random((40, 50)) < 0.3, rng.integers(1, 5, (40, 50)), 0).astype(np.int32)
+    wanted = rng.random((40, 50)) < 0.5
+    compiled = floor_loops.enclosing_labels(labels, wanted)
+    assert np.array_equal(compiled, np.where(wanted, enclosing_labels(labels), 0))
