@@ -37,6 +37,9 @@ import cv2
 import numpy as np
 from scipy import ndimage
 
+_SQUARE = np.ones((3, 3), dtype=np.uint8)
+"""The 8-neighbourhood as a structuring element."""
+
 
 @functools.cache
 def _loops() -> ModuleType:
@@ -129,7 +132,7 @@ def claim_container_floors(
         floor = np.zeros((y1 - y0, x1 - x0), dtype=bool)
         floor[rows[free], cols[free]] = True
         # the floor reaches as far as the footprint where it runs on from a part well inside it
-        parts, _ = ndimage.label(floor)
+        _, parts = cv2.connectedComponents(floor.view(np.uint8), connectivity=4)
         seeded = np.unique(parts[seed_rows, seed_cols])
         floor = np.isin(parts, seeded[seeded > 0])
         result[y0:y1, x0:x1][floor] = label
@@ -141,7 +144,8 @@ def core_hull(mask: np.ndarray, plane_points: np.ndarray, step: int = 1) -> np.n
     """The convex hull (Kx2) of the feet of the object's pixels ``mask`` (HxW) away from its outline (eroded by
     one pixel), read on every ``step``-th pixel: the outline's mixed pixels, between the object and what lies
     behind it, fall anywhere."""
-    core = ndimage.binary_erosion(mask, np.ones((3, 3), dtype=bool))[::step, ::step]
+    eroded = cv2.erode(mask.view(np.uint8), _SQUARE, borderType=cv2.BORDER_CONSTANT, borderValue=0)
+    core = eroded[::step, ::step] > 0
     feet = plane_points[::step, ::step][core][:, :2]
     feet = feet[np.isfinite(feet).all(axis=1)].astype(np.float32)
     if feet.shape[0] < 3:
@@ -191,6 +195,6 @@ def overhung(feet: np.ndarray, object_points: np.ndarray, clearance: float, cell
     reached = np.zeros((height, width), dtype=bool)
     reached[reaching[:, 1], reaching[:, 0]] = True
     over = occupied & ~reached
-    over = ndimage.binary_closing(over, np.ones((3, 3), dtype=bool))
+    over = cv2.morphologyEx(over.view(np.uint8), cv2.MORPH_CLOSE, _SQUARE) > 0
     at = ((feet - low) / cell).astype(np.int64)
     return over[at[:, 1], at[:, 0]]
