@@ -53,7 +53,7 @@ from annotators.cloud.clusters import (
 from annotators.cloud.normals import grid_normals
 from annotators.cloud.plane import plane_basis
 from annotators.geometry.border_pixels import BorderRules, claim_border_pixels, plane_noise
-from annotators.geometry.container_floors import FloorRules, claim_container_floors
+from annotators.geometry.container_floors import FloorRules, claim_container_floors, touches_other_labels
 from annotators.geometry.convexity import ConvexityRules, convex_groups, dense_labels, grid_patches, split_by_normals
 from annotators.geometry.grid_kernels import object_pieces, strided_crop
 from annotators.geometry.grid_segmentation import (
@@ -226,7 +226,7 @@ def segment_clutter(
     if p.claim_floors:
         rules = FloorRules(min_height=p.min_height, margin=p.hull_margin, cell=p.hull_cell)
         labels, floors = claim_container_floors(labels, np.isfinite(depth), plane_grid, rules)
-        if floors.any():  # the floor's pieces the noise lifted now touch their container
+        if touches_other_labels(labels, floors):  # the floor's pieces the noise lifted now touch their container
             labels = join_pieces(labels, grid, normals, plane_grid, support, appendages, joint)
     refine = None
     if p.claim_borders:

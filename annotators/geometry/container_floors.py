@@ -140,6 +140,20 @@ def claim_container_floors(
     return result, claimed
 
 
+def touches_other_labels(labels: np.ndarray, marked: np.ndarray) -> bool:
+    """Whether a ``marked`` pixel (HxW bool) has a 4-neighbour with another non-zero label than its own."""
+    for a, b in (
+        (np.s_[:, :-1], np.s_[:, 1:]),
+        (np.s_[:, 1:], np.s_[:, :-1]),
+        (np.s_[:-1, :], np.s_[1:, :]),
+        (np.s_[1:, :], np.s_[:-1, :]),
+    ):
+        other = labels[b]
+        if np.any(marked[a] & (other > 0) & (other != labels[a])):
+            return True
+    return False
+
+
 def core_hull(mask: np.ndarray, plane_points: np.ndarray, step: int = 1) -> np.ndarray:
     """The convex hull (Kx2) of the feet of the object's pixels ``mask`` (HxW) away from its outline (eroded by
     one pixel), read on every ``step``-th pixel: the outline's mixed pixels, between the object and what lies

@@ -14,6 +14,7 @@ from annotators.geometry.container_floors import (
     core_hull,
     enclosing_labels,
     overhung,
+    touches_other_labels,
 )
 
 CELL = 0.005  # metres per grid pixel in these plane coordinates
@@ -129,3 +130,12 @@ def test_the_compiled_enclosure_pass_gives_what_the_numpy_form_gives() -> None:
     wanted = rng.random((40, 50)) < 0.5
     compiled = floor_loops.enclosing_labels(labels, wanted)
     assert np.array_equal(compiled, np.where(wanted, enclosing_labels(labels), 0))
+
+
+def test_a_marked_pixel_touches_other_labels_only_beside_a_pixel_of_another_label() -> None:
+    labels = np.array([[1, 1, 0, 2], [1, 1, 0, 2]], dtype=np.int32)
+    marked = np.zeros(labels.shape, dtype=bool)
+    marked[0, 1] = True
+    assert not touches_other_labels(labels, marked)
+    labels[0, 2] = 2
+    assert touches_other_labels(labels, marked)
