@@ -27,7 +27,8 @@ Works like :mod:`annotators.cloud.clusters` on every ``stride``-th pixel of the 
    shared border - join: a drill lying on its side, cut where its grip ends behind the battery's raised edge
    (:func:`annotators.geometry.slabs.join_slab_pieces`);
 8. the floor of an open container seen from above - within ``min_height`` of the plane, so no candidate - joins
-   the container whose footprint holds it where no part of the container hangs over it
+   the container whose footprint holds it, that surrounds it in the image on three sides at least and that does
+   not hang over it
    (:func:`annotators.geometry.container_floors.claim_container_floors`); the floor's bits that the noise lifted
    above ``min_height`` then touch their container and join it as pieces that cannot stand by themselves;
 9. at full resolution, the outline pixels the coarse grid left unlabelled and the foot below the candidates'
