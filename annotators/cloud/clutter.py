@@ -226,7 +226,8 @@ def segment_clutter(
     floors = None
     if p.claim_floors:
         rules = FloorRules(min_height=p.min_height, margin=p.hull_margin, cell=p.hull_cell)
-        labels, floors = claim_container_floors(labels, np.isfinite(depth), plane_grid, rules)
+        valid = mask[::step, ::step][y0:y1, x0:x1] & np.isfinite(depth)  # measured, within the range filter's
+        labels, floors = claim_container_floors(labels, valid, plane_grid, rules)
         if touches_other_labels(labels, floors):  # the floor's pieces the noise lifted now touch their container
             labels = join_pieces(labels, grid, normals, plane_grid, support, appendages, joint)
     refine = None
