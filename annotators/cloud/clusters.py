@@ -191,6 +191,7 @@ def full_resolution_segments(
     model: np.ndarray,
     p: ClusterParameters,
     refine: Callable[[np.ndarray, np.ndarray, np.ndarray, np.ndarray], np.ndarray] | None = None,
+    claimed: np.ndarray | None = None,
 ) -> list[Segment]:
     """Segments on the full grid from coarse labels of the region ``box`` (coarse pixels, x1/y1 exclusive).
 
@@ -201,7 +202,8 @@ def full_resolution_segments(
     it adds join the segments' masks and ROIs (their image regions) but not their point indices, so the 3-D experts
     measure the points the segmentation labelled itself, away from the mixed pixels of an outline and the band
     where an object meets the plane. Which segments are large enough (``min_points``) is judged before refining,
-    so refining never adds one.
+    so refining never adds one. ``claimed`` (coarse, the region's shape), when given, marks the cells labelled
+    though no candidates (a container's floor at table level): their measured pixels count as candidates.
     """
     rows, cols = mask.shape
     x0, y0, x1, y1 = box
@@ -210,6 +212,9 @@ def full_resolution_segments(
     fine_points = points[fy0:fy1, fx0:fx1]
     heights = np.ascontiguousarray(plane_distances(points, model)[fy0:fy1, fx0:fx1])  # no copy of the region's points
     candidates = _between_heights(heights, mask[fy0:fy1, fx0:fx1], p)
+    if claimed is not None and claimed.any():
+        spread = np.repeat(np.repeat(claimed, step, axis=0), step, axis=1)[: fy1 - fy0, : fx1 - fx0]
+        candidates |= spread & mask[fy0:fy1, fx0:fx1] & np.isfinite(heights)
     core = upsampled_labels(  # the pixels the segmentation labelled itself: the point indices
         labels, coarse_depth, fine_points[..., 2], candidates, step, p.jump_absolute, p.jump_relative
     )

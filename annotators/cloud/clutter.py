@@ -29,7 +29,12 @@ Works like :mod:`annotators.cloud.clusters` on every ``stride``-th pixel of the 
 7. touching pieces that fill one slab - their lowest heights and tops agree, no depth jump along most of their
    shared border - join: a drill lying on its side, cut where its grip ends behind the battery's raised edge
    (:func:`annotators.geometry.slabs.join_slab_pieces`);
-8. at full resolution, the outline pixels the coarse grid left unlabelled and the foot below the candidates'
+8. the floor of an open container seen from above - within ``min_height`` of the plane, so no candidate - joins
+   the container whose footprint holds it, that surrounds it in the image on three sides at least and that does
+   not hang over it
+   (:func:`annotators.geometry.container_floors.claim_container_floors`); the floor's bits that the noise lifted
+   above ``min_height`` then touch their container and join it as pieces that cannot stand by themselves;
+9. at full resolution, the outline pixels the coarse grid left unlabelled and the foot below the candidates'
    lowest height join the object whose surface they continue
    (:func:`annotators.geometry.border_pixels.claim_border_pixels`).
 """
@@ -52,6 +57,7 @@ from annotators.cloud.clusters import (
 from annotators.cloud.normals import grid_normals
 from annotators.cloud.plane import plane_basis
 from annotators.geometry.border_pixels import BorderRules, claim_border_pixels, plane_noise
+from annotators.geometry.container_floors import FloorRules, claim_container_floors, touches_other_labels
 from annotators.geometry.convexity import ConvexityRules, convex_groups, dense_labels, grid_patches, split_by_normals
 from annotators.geometry.grid_kernels import object_pieces, strided_crop
 from annotators.geometry.grid_segmentation import (
@@ -86,6 +92,7 @@ class ClutterParameters(ClusterParameters):
     together, and ``join_appendages`` the small pieces sticking out of a larger one;
     ``join_inner_walls`` joins an open container's inside seen over its rim to its outside;
     ``join_slabs`` joins touching pieces of one slab (same lowest heights and tops, no depth jump between them);
+    ``claim_floors`` gives an open container the floor seen over its rim, at table level;
     ``claim_borders`` gives the outline pixels the coarse grid
     left unlabelled and each object's foot (below ``min_height``) to the object they continue."""
 
@@ -113,6 +120,7 @@ class ClutterParameters(ClusterParameters):
     join_jointly_held: bool = True
     join_inner_walls: bool = True
     join_slabs: bool = True
+    claim_floors: bool = True
     claim_borders: bool = True
 
     def convexity_rules(self) -> ConvexityRules:
@@ -236,11 +244,18 @@ def segment_clutter(
         labels = join_inner_walls(labels, grid, normals, plane_grid, to_plane[:, :3], p.inner_wall_rules())
     if p.join_slabs:
         labels = join_slab_pieces(labels, grid, normals, plane_grid, p.slab_rules())
+    floors = None
+    if p.claim_floors:
+        rules = FloorRules(min_height=p.min_height, margin=p.hull_margin, cell=p.hull_cell)
+        valid = mask[::step, ::step][y0:y1, x0:x1] & np.isfinite(depth)  # measured, within the range filter's
+        labels, floors = claim_container_floors(labels, valid, plane_grid, rules)
+        if touches_other_labels(labels, floors):  # the floor's pieces the noise lifted now touch their container
+            labels = join_pieces(labels, grid, normals, plane_grid, support, appendages, joint)
     refine = None
     if p.claim_borders:
         floor = plane_noise(points, model, plane_indices)
         refine = partial(claim_border_pixels, plane=model, floor=floor, coarse_normals=normals, rules=p.border_rules())
-    return full_resolution_segments(labels, depth, (x0, y0, x1, y1), step, points, mask, model, p, refine)
+    return full_resolution_segments(labels, depth, (x0, y0, x1, y1), step, points, mask, model, p, refine, floors)
 
 
 def split_by_color(

@@ -1,0 +1,141 @@
+"""claim_container_floors: the floor of an open container, at table level, joins the container where its
+footprint holds it and no part of it hangs over the floor; the table beside an object, and under an overhanging
+part, stays unlabelled."""
+
+from __future__ import annotations
+
+import numpy as np
+
+from annotators.geometry import floor_loops
+from annotators.geometry.container_floors import (
+    FloorRules,
+    Footprint,
+    claim_container_floors,
+    core_hull,
+    enclosing_labels,
+    overhung,
+    touches_other_labels,
+)
+
+CELL = 0.005  # metres per grid pixel in these plane coordinates
+
+
+def flat_table(shape: tuple[int, int] = (60, 60)) -> tuple[np.ndarray, np.ndarray]:
+    """Empty labels and (u, v, height) plane coordinates of a table seen straight from above (feet under pixels)."""
+    rows, cols = np.mgrid[0 : shape[0], 0 : shape[1]]
+    points = np.zeros((*shape, 3), dtype=np.float32)
+    points[..., 0], points[..., 1] = cols * CELL, rows * CELL
+    return np.zeros(shape, dtype=np.int32), points
+
+
+def bowl(labels: np.ndarray, points: np.ndarray, centre: tuple[int, int], inner: int, outer: int) -> np.ndarray:
+    """Draw a bowl's wall (label 1): a ring of pixels between radii ``inner`` and ``outer`` rising from 1 cm at
+    the inner edge to 5 cm at the outer one; the disc inside (its floor, 4 mm high) is returned as a mask."""
+    rows, cols = np.mgrid[0 : labels.shape[0], 0 : labels.shape[1]]
+    radius = np.hypot(rows - centre[0], cols - centre[1])
+    wall = (radius >= inner) & (radius < outer)
+    labels[wall] = 1
+    points[..., 2][wall] = 0.01 + 0.04 * (radius[wall] - inner) / (outer - inner)
+    floor = radius < inner
+    points[..., 2][floor] = 0.004
+    return floor
+
+
+def test_the_floor_inside_a_bowl_joins_the_bowl_and_the_table_around_it_does_not() -> None:
+    labels, points = flat_table()
+    floor = bowl(labels, points, (30, 30), 10, 20)
+    joined, claimed = claim_container_floors(labels, np.ones(labels.shape, bool), points)
+    assert np.array_equal(claimed, floor)
+    assert np.array_equal(joined == 1, (labels == 1) | floor)
+
+
+def test_the_floor_of_a_bowl_whose_near_side_is_not_seen_joins_it_within_the_far_walls_footprint() -> None:
+    # the near half of the wall is missing (out of the frame, or its depth lost): the floor within the hull of the
+    # far half joins, up to the cut, and the table beyond it stays out
+    labels, points = flat_table()
+    floor = bowl(labels, points, (30, 30), 10, 20)
+    labels[31:] = 0
+    _, claimed = claim_container_floors(labels, np.ones(labels.shape, bool), points)
+    assert claimed[floor & (np.arange(60)[:, None] < 30)].all()
+    assert not claimed[31:].any()
+
+
+def test_the_table_under_an_overhanging_part_and_beside_solid_objects_stays_unlabelled() -> None:
+    labels, points = flat_table()
+    # a battery standing 1-8 cm high, and from its top a chuck reaching over the table 10-12 cm high
+    labels[10:30, 10:20] = 1
+    points[10:30, 10:20, 2] = 0.05
+    labels[10:14, 20:45] = 1
+    points[10:14, 20:45, 2] = 0.11
+    # a solid box of its own beside
+    labels[40:55, 40:55] = 2
+    points[40:55, 40:55, 2] = 0.06
+    # the table seen in the image below the chuck lies right under it on the plane (inside the drill's hull)
+    points[14:30, 20:45, :2] = points[12:13, 20:45, :2]
+    joined, claimed = claim_container_floors(labels, np.ones(labels.shape, bool), points)
+    assert not claimed.any()
+    assert np.array_equal(joined, labels)
+
+
+def test_a_foots_depth_in_a_footprint_is_its_distance_to_the_outline_to_the_cell() -> None:
+    square = np.array([[0, 0], [0.1, 0], [0.1, 0.1], [0, 0.1]], dtype=np.float32)
+    feet = np.array([[0.05, 0.05], [0.09, 0.05], [0.15, 0.05], [-0.01, 0.0]], dtype=np.float32)
+    for hull in (square, square[::-1]):
+        depth = Footprint(hull, CELL).depth(feet)
+        assert np.allclose(depth, [0.05, 0.01, 0.0, 0.0], atol=1.5 * CELL)
+
+
+def test_a_cell_is_overhung_only_where_all_of_the_objects_points_over_it_are_high() -> None:
+    # a wall running down to 1 cm and a ledge 10 cm high beside it
+    wall = np.array([[0.0025, 0.0025, 0.01], [0.0025, 0.0025, 0.05], [0.0125, 0.0025, 0.10]], dtype=np.float32)
+    feet = np.array([[0.0025, 0.0025], [0.0125, 0.0025]], dtype=np.float32)
+    assert overhung(feet, wall, 0.02, FloorRules().cell).tolist() == [False, True]
+
+
+def test_the_table_at_the_foot_of_a_solid_object_stays_unlabelled_though_the_hull_reaches_over_it() -> None:
+    # a box 6 cm high whose image box holds a band of table along its foot, the band's feet (noise, mixed pixels)
+    # 0.5-1 cm within the box's footprint: within the hull, but no part of the band lies well inside it
+    labels, points = flat_table()
+    labels[20:40, 20:40] = 1
+    points[20:40, 20:40, 2] = 0.06
+    labels[38:40, 22:38] = 0
+    points[38:40, 22:38, 2] = 0.0
+    points[38:40, 22:38, 1] = 37.0 * CELL
+    joined, claimed = claim_container_floors(labels, np.ones(labels.shape, bool), points)
+    assert not claimed.any()
+    assert np.array_equal(joined, labels)
+
+
+def test_a_pixel_is_enclosed_by_the_label_it_meets_first_on_three_of_its_four_sides() -> None:
+    labels = np.zeros((7, 9), dtype=np.int32)
+    labels[1:6, 1] = labels[1:6, 5] = labels[1, 1:6] = 1  # a horseshoe open at the bottom
+    labels[3, 7] = 2
+    enclosing = enclosing_labels(labels)
+    assert enclosing[3, 3] == 1 and enclosing[5, 3] == 1  # wall left, right and above
+    assert enclosing[3, 0] == 0 and enclosing[6, 3] == 0 and enclosing[0, 3] == 0  # beside, below, above it
+    assert enclosing[3, 6] == 0  # between the horseshoe and another object
+
+
+def test_the_hull_of_an_object_leaves_out_its_outlines_mixed_pixels() -> None:
+    labels, points = flat_table()
+    labels[20:40, 20:40] = 1
+    points[20:40, 39, 0] += 0.05  # the right outline's pixels mixed with what lies 5 cm behind
+    hull = core_hull(labels == 1, points)
+    assert hull[:, 0].max() <= 38 * CELL + 1e-6 and hull[:, 0].min() >= 21 * CELL - 1e-6
+
+
+def test_the_compiled_enclosure_pass_gives_what_the_numpy_form_gives() -> None:
+    rng = np.random.default_rng(5)
+    labels = np.where(rng.random((40, 50)) < 0.3, rng.integers(1, 5, (40, 50)), 0).astype(np.int32)
+    wanted = rng.random((40, 50)) < 0.5
+    compiled = floor_loops.enclosing_labels(labels, wanted)
+    assert np.array_equal(compiled, np.where(wanted, enclosing_labels(labels), 0))
+
+
+def test_a_marked_pixel_touches_other_labels_only_beside_a_pixel_of_another_label() -> None:
+    labels = np.array([[1, 1, 0, 2], [1, 1, 0, 2]], dtype=np.int32)
+    marked = np.zeros(labels.shape, dtype=bool)
+    marked[0, 1] = True
+    assert not touches_other_labels(labels, marked)
+    labels[0, 2] = 2
+    assert touches_other_labels(labels, marked)
