@@ -38,7 +38,7 @@ from typing import NamedTuple, TypeVar
 import numpy as np
 import platformdirs
 
-from reasoning.beliefs.json_text import JsonText
+from reasoning.beliefs.json_text import JsonText, parse_json
 from reasoning.fusion.association import CameraModel, in_view
 from reasoning.fusion.frame import WORLD_FRAME, FrameObject
 from reasoning.fusion.rule import CLASS_ATTRIBUTE, AttributeBelief, ClassTest, ValueSupport, fuse_values, sigmoid
@@ -926,7 +926,7 @@ def _index_entries(indexed: str) -> set[tuple[str, str]]:
 
 def _decode_attributes(text: str) -> dict[str, AttributeBelief]:
     decoded: dict[str, AttributeBelief] = {}
-    for name, values in json.loads(text).items():
+    for name, values in parse_json(text).items():
         supports = {}
         for value, s in values.items():
             supports[value] = ValueSupport(s[0], s[1], set(s[2]), s[3], s[4])
