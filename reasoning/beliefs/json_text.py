@@ -39,10 +39,8 @@ class JsonText:
         return "".join(self._fast(value, 0))
 
 
-_DECODER = json.JSONDecoder()
-_SCAN: Callable[[str, int], tuple[Any, int]] | None = getattr(
-    json.scanner, "c_make_scanner", lambda decoder: None
-)(_DECODER)
+_C_SCANNER = getattr(json.scanner, "c_make_scanner", None)
+_SCAN: Callable[[str, int], tuple[Any, int]] | None = None if _C_SCANNER is None else _C_SCANNER(json.JSONDecoder())
 
 
 def parse_json(text: str) -> Any:

@@ -46,7 +46,6 @@ def test_json_text_is_the_text_json_makes(value: object) -> None:
     assert JsonText(",", ":").encode(value) == json.JSONEncoder(separators=(",", ":")).encode(value)
 
 
-
 def _same_json(a: object, b: object) -> bool:
     """Equal JSON values, NaN equal to NaN and floats told from ints."""
     if isinstance(a, float) and isinstance(b, float):
