@@ -39,7 +39,6 @@ import numpy as np
 import platformdirs
 
 from reasoning.beliefs.json_text import JsonText, parse_json
-from reasoning.beliefs.place_index import PlaceIndex
 from reasoning.fusion.association import CameraModel, in_view
 from reasoning.fusion.frame import WORLD_FRAME, FrameObject
 from reasoning.fusion.rule import CLASS_ATTRIBUTE, AttributeBelief, ClassTest, ValueSupport, fuse_values, sigmoid
@@ -67,8 +66,6 @@ SOURCES_CACHE_LIMIT = 4096
 VIEW_CACHE_LIMIT = 4096
 """Rows :meth:`BeliefStore.query_views` remembers the views of (beyond that the memo starts afresh)."""
 WAL_AUTOCHECKPOINT_PAGES = 4000
-INDEX_REACH = 0.175
-"""Smallest search half-width (metres) the in-memory place index is built for (gate + RTREE_SLACK / 2)."""
 """Checkpoint the WAL into the file every ~16 MB (fewer fsyncs than SQLite's default of 1000 pages)."""
 
 
@@ -225,8 +222,6 @@ class BeliefStore:
         """JSON of the expert sets written (few distinct sets recur on every row)."""
         self._views: dict[tuple[object, tuple], object] = {}
         """What :meth:`query_views` made, by (view, stored row)."""
-        self._index: PlaceIndex | None = None
-        """Where the stored beliefs are (numpy arrays), for integrate's candidate search; None: build it anew."""
         self._lock = threading.RLock()
         self._conn = self._open(synchronous.upper(), busy_timeout, check)
 
@@ -327,7 +322,6 @@ class BeliefStore:
     def close(self) -> None:
         """Close the connection (idempotent)."""
         with self._lock:
-            self._index = None
             self._conn.close()
 
     def __enter__(self) -> BeliefStore:
@@ -350,12 +344,8 @@ class BeliefStore:
                 raise
 
     @contextmanager
-    def _transaction(self, follows_index: bool = False) -> Iterator[sqlite3.Connection]:
-        """One ``BEGIN IMMEDIATE`` ... ``COMMIT``; unless ``follows_index`` (the caller updates the place index
-        after the commit), the place index is dropped, as the writes may move or remove beliefs."""
+    def _transaction(self) -> Iterator[sqlite3.Connection]:
         with self._guard() as conn:
-            if not follows_index:
-                self._index = None
             conn.execute("BEGIN IMMEDIATE")
             try:
                 yield conn
@@ -382,70 +372,29 @@ class BeliefStore:
         """
         tracker = tracker or self.tracker
         writes: list[tuple[str, list[tuple]]] = []
-        noted: list[tuple] = []
-        with self._lock:
-            try:
-                with self._transaction(follows_index=True) as conn:
-                    step, next_id = self._integrate(conn, objects, time, camera, tracker, writes, noted)
-                index = self._index
-                if index is not None:  # the committed writes, followed
-                    index.next_id = next_id
-                    if not index.update(noted):
-                        self._index = None
-            except BaseException:
-                self._index = None
-                raise
+        with self._transaction() as conn:
+            beliefs, loaded = self._candidates(conn, objects, camera, tracker.config.association.gate_distance)
+            next_id = int(conn.execute("SELECT value FROM meta WHERE key = 'next_id'").fetchone()[0])
+            allocated = [next_id]
+
+            def new_id() -> int:
+                value = allocated[0]
+                allocated[0] += 1
+                return value
+
+            step = tracker.step(beliefs, objects, time, new_id, camera)
+            self._write_beliefs(conn, step.changed, tracker.class_test, loaded, writes)
+            counts = {b.id: b.observations for b in step.changed}
+            self._write_observations(conn, objects, [(i, counts.get(i, 0)) for i in step.assigned], time, writes)
+            if allocated[0] != next_id:
+                _write(conn, writes, "UPDATE meta SET value = ? WHERE key = 'next_id'", [(str(allocated[0]),)])
+            seen = set(step.assigned)
+            self._prune_history(conn, [b for b in step.changed if b.id in seen], writes)
+            # beliefs missed earlier and not seen since, wherever they are, are gone after gone_after seconds
+            _write(conn, writes, _MARK_GONE, [(time - tracker.config.gone_after,)])
         if self.write_log is not None:
             self.write_log.append(writes)
         return step
-
-    def _integrate(
-        self,
-        conn: sqlite3.Connection,
-        objects: Sequence[FrameObject],
-        time: float,
-        camera: CameraModel | None,
-        tracker: BeliefTracker,
-        writes: list[tuple[str, list[tuple]]],
-        noted: list[tuple],
-    ) -> tuple[TrackStep, int]:
-        """The body of :meth:`integrate`'s transaction; returns the tracker's step and the next free id."""
-        gate = tracker.config.association.gate_distance
-        index = self._place_index(conn, gate)
-        beliefs, loaded = self._candidates(conn, objects, camera, gate, index)
-        if index.next_id is None:
-            index.next_id = int(conn.execute("SELECT value FROM meta WHERE key = 'next_id'").fetchone()[0])
-        next_id = index.next_id
-        allocated = [next_id]
-
-        def new_id() -> int:
-            value = allocated[0]
-            allocated[0] += 1
-            return value
-
-        step = tracker.step(beliefs, objects, time, new_id, camera)
-        self._write_beliefs(conn, step.changed, tracker.class_test, loaded, writes, noted)
-        counts = {b.id: b.observations for b in step.changed}
-        self._write_observations(conn, objects, [(i, counts.get(i, 0)) for i in step.assigned], time, writes)
-        if allocated[0] != next_id:
-            _write(conn, writes, "UPDATE meta SET value = ? WHERE key = 'next_id'", [(str(allocated[0]),)])
-        seen = set(step.assigned)
-        self._prune_history(conn, [b for b in step.changed if b.id in seen], writes)
-        # beliefs missed earlier and not seen since, wherever they are, are gone after gone_after seconds (the
-        # place index learns it when its search finds them: the fetch of its hits keeps present beliefs only)
-        _write(conn, writes, _MARK_GONE, [(time - tracker.config.gone_after,)])
-        return step, allocated[0]
-
-    def _place_index(self, conn: sqlite3.Connection, gate: float) -> PlaceIndex:
-        """The place index, built anew when missing, too fine for ``gate`` or when another connection has written
-        since it was built (``PRAGMA data_version``; read inside the write transaction, so no one writes between)."""
-        index = self._index
-        if index is not None and gate + RTREE_SLACK / 2 <= index.reach:
-            version = int(conn.execute("PRAGMA data_version").fetchone()[0])
-            if version == index.version:
-                return index
-        index = self._index = PlaceIndex.build(conn, max(gate + RTREE_SLACK / 2, INDEX_REACH))
-        return index
 
     def put(self, beliefs: Sequence[ObjectBelief], class_test: ClassTest | None = None) -> None:
         """Write beliefs as they are (insert or replace, attributes included) in one transaction."""
@@ -487,13 +436,8 @@ class BeliefStore:
         objects: Sequence[FrameObject],
         camera: CameraModel | None,
         gate: float,
-        index: PlaceIndex,
     ) -> tuple[list[ObjectBelief], dict[int, _Loaded]]:
-        """Present beliefs within ``gate`` of an observation or in view of ``camera`` (an R*Tree look-up).
-
-        Near the observations, the in-memory copy of the R*Tree finds the beliefs whose entry centre lies within
-        ``gate + RTREE_SLACK / 2`` (per axis: a belief lies within ``RTREE_SLACK / 2`` of its entry's centre); their
-        rows are fetched by id and those within ``gate`` kept.
+        """Present beliefs within ``gate`` of an observation or in view of ``camera`` (R*Tree look-ups).
 
         Also returns how each one was stored, so unchanged R*Tree entries and index columns are not rewritten.
         """
@@ -501,30 +445,23 @@ class BeliefStore:
         groups: dict[tuple[str, str], list[FrameObject]] = {}
         for item in objects:
             groups.setdefault((item.frame, item.recording), []).append(item)
-        reach = gate + RTREE_SLACK / 2
-        searched = []
         for (frame, recording), members in groups.items():
+            # one statement per world: the union of the R*Tree boxes around its observations
             centres = np.array([item.position[:3] for item in members], dtype=np.float64)
-            searched.append((frame, recording, centres, index.near(centres, frame, recording, reach)))
-        wanted = np.unique(np.concatenate([hits for *_, hits in searched])) if searched else ()
-        if len(wanted):
-            fetched = {row[0]: row for row in conn.execute(_fetch_query(len(wanted)), (*wanted.tolist(), PRESENT))}
-            if len(fetched) < len(wanted):  # marked gone since the index learnt of them
-                index.forget_absent(wanted[~np.isin(wanted, list(fetched))])
-            for frame, recording, centres, hits in searched:
-                found = [
-                    row
-                    for row in map(fetched.get, set(hits.tolist()))
-                    if row is not None and row[2] == frame and (frame == WORLD_FRAME or row[23] == recording)
-                ]
-                if not found:
-                    continue
-                positions = np.array([row[3:6] for row in found], dtype=np.float64)
-                delta = positions[:, None, :] - centres[None, :, :]
-                near = (np.sqrt(np.einsum("ijk,ijk->ij", delta, delta)) <= gate).any(axis=1)
-                for row, keep in zip(found, near.tolist(), strict=True):
-                    if keep:
-                        rows[row[0]] = row
+            bounds = np.empty((len(members), 6))
+            bounds[:, 0::2] = centres + gate  # x1, y1, z1 of each box, then x0, y0, z0 in between
+            bounds[:, 1::2] = centres - gate
+            parameters = bounds.ravel().tolist()
+            found = conn.execute(_candidate_query(len(members)), (*parameters, frame, WORLD_FRAME, recording, PRESENT))
+            found = found.fetchall()
+            if not found:
+                continue
+            positions = np.array([row[3:6] for row in found], dtype=np.float64)
+            delta = positions[:, None, :] - centres[None, :, :]
+            near = (np.sqrt(np.einsum("ijk,ijk->ij", delta, delta)) <= gate).any(axis=1)
+            for row, keep in zip(found, near.tolist(), strict=True):
+                if keep:
+                    rows[row[0]] = row
         if camera is not None:
             low, high = _frustum_bounds(camera)
             world = (camera.frame, WORLD_FRAME, camera.recording)
@@ -536,16 +473,12 @@ class BeliefStore:
                 for row, seen in zip(in_frustum, in_view(positions, camera), strict=True):
                     if seen:
                         rows[row[0]] = row
-        order = sorted(rows)
         n = _COLUMN_COUNT
-        loaded = {  # an R*Tree row carries its entry; the index has the others'
-            i: _Loaded(
-                place if len(r) == n else ((r[n] + r[n + 1]) / 2, (r[n + 2] + r[n + 3]) / 2, (r[n + 4] + r[n + 5]) / 2),
-                *_labels(r),
-            )
-            for i, r, place in zip(order, map(rows.get, order), index.places(order), strict=True)
+        loaded = {
+            i: _Loaded(((r[n] + r[n + 1]) / 2, (r[n + 2] + r[n + 3]) / 2, (r[n + 4] + r[n + 5]) / 2), *_labels(r))
+            for i, r in rows.items()
         }
-        return [_belief_from_row(rows[i]) for i in order], loaded
+        return [_belief_from_row(rows[i]) for i in sorted(rows)], loaded
 
     def _write_beliefs(
         self,
@@ -554,10 +487,8 @@ class BeliefStore:
         class_test: ClassTest | None,
         loaded: Mapping[int, _Loaded] | None = None,
         writes: list[tuple[str, list[tuple]]] | None = None,
-        noted: list[tuple] | None = None,
     ) -> None:
-        """Write object rows, their R*Tree entries and attribute-index entries (noted in ``writes``; and each
-        rewritten R*Tree entry's id, frame, recording and centre in ``noted``, for the place index).
+        """Write object rows, their R*Tree entries and attribute-index entries (noted in ``writes``).
 
         Beliefs in ``loaded`` are updated in place; their indexed columns and index entries are touched only
         when they changed. The R*Tree entry of a belief is a box of half-width ``RTREE_SLACK`` around a recent
@@ -576,7 +507,6 @@ class BeliefStore:
         removed: list[tuple[str, str, int]] = []
         moved: list[tuple] = []
         classes: set[tuple[str]] = set()
-        centred = [] if noted is None else noted
         latest = {b.id: b for b in beliefs}  # a belief given twice is written as its last object is
         written = beliefs if len(latest) == len(beliefs) else [latest[b.id] for b in beliefs]
         r = RTREE_SLACK
@@ -599,11 +529,11 @@ class BeliefStore:
                 added.extend((name, value, belief_id) for name, value in new - old)
                 removed.extend((name, value, belief_id) for name, value in old - new)
             x, y, z = row[3:6]
-            if state is None or not (  # a missing entry (NaN centre) is written too
-                max(abs(x - state.place[0]), abs(y - state.place[1]), abs(z - state.place[2])) <= RTREE_SLACK / 2
+            if (
+                state is None
+                or max(abs(x - state.place[0]), abs(y - state.place[1]), abs(z - state.place[2])) > RTREE_SLACK / 2
             ):
                 moved.append((belief_id, x - r, x + r, y - r, y + r, z - r, z + r))
-                centred.append((belief_id, row[2], row[23], x, y, z))
             if b.class_name and b.class_name != (state.class_name if state is not None else None):
                 classes.add((b.class_name,))
         if fresh:
@@ -840,12 +770,6 @@ def _write(conn: sqlite3.Connection, log: list[tuple[str, list[tuple]]], stateme
     """Run one write statement over ``rows`` and note it in ``log`` (what the benchmark's reference replays)."""
     conn.executemany(statement, rows)
     log.append((statement, rows))
-
-
-@functools.lru_cache(maxsize=256)
-def _fetch_query(count: int) -> str:
-    """The present beliefs among ``count`` ids (parameters: the ids, then the status)."""
-    return f"SELECT {_OBJECT_COLUMNS} FROM objects WHERE id IN ({', '.join('?' * count)}) AND status = ?"
 
 
 @functools.lru_cache(maxsize=64)
