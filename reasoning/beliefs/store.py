@@ -20,7 +20,7 @@ experts and the support of every attribute value, packed: one binary record per 
 ``objects_place`` (R*Tree over positions),
 ``attribute_index`` (the attribute values each belief holds more likely than not, for queries),
 ``observations`` (every sighting
-with its recording and the experts' statements, bounded per object), ``classes`` and ``meta``.
+with its recording and the experts' statements, packed, bounded per object), ``classes`` and ``meta``.
 """
 
 from __future__ import annotations
@@ -43,10 +43,18 @@ import numpy as np
 import platformdirs
 
 from reasoning.beliefs.interned import InternedTexts
-from reasoning.beliefs.json_text import JsonText, parse_json
+from reasoning.beliefs.json_text import parse_json
 from reasoning.fusion.association import CameraModel, in_view
 from reasoning.fusion.frame import WORLD_FRAME, FrameObject
-from reasoning.fusion.rule import CLASS_ATTRIBUTE, AttributeBelief, ClassTest, ValueSupport, fuse_values, sigmoid
+from reasoning.fusion.rule import (
+    CLASS_ATTRIBUTE,
+    AttributeBelief,
+    ClassTest,
+    Evidence,
+    ValueSupport,
+    fuse_values,
+    sigmoid,
+)
 from reasoning.fusion.text import text_matches
 from reasoning.fusion.tracking import PRESENT, BeliefTracker, ObjectBelief, TrackStep
 from robokudo.core.regions import RegionBox
@@ -581,8 +589,11 @@ class BeliefStore:
         time: float,
         writes: list[tuple[str, list[tuple]]],
     ) -> None:
-        """Record each object's sighting under (belief id, its sighting number)."""
+        """Record each object's sighting under (belief id, its sighting number), its statements packed
+        (:data:`STATEMENT`)."""
         cache = self._sources_cache()
+        interned = self._interned
+        write = functools.partial(_write, conn, writes)
         rows = [
             (
                 object_id,
@@ -592,9 +603,7 @@ class BeliefStore:
                 *_floats(item.position, 3),
                 _roi_text(item.roi),
                 _encoded_sources(item.sources, cache),
-                _EVIDENCE_JSON.encode(
-                    [[e.attribute, e.value, _rounded(e.confidence, 6), e.source] for e in item.evidence]
-                ),
+                _pack_evidence(item.evidence, interned, conn, write),
                 item.recording,
             )
             for item, (object_id, seq) in zip(objects, assigned, strict=True)
@@ -750,19 +759,19 @@ class BeliefStore:
                 "WHERE object_id = ? ORDER BY seq DESC LIMIT ?",
                 (object_id, -1 if limit is None else limit),
             ).fetchall()
-        records = [
-            ObservationRecord(
-                object_id=row[0],
-                time=row[1],
-                frame=row[2],
-                position=(row[3], row[4], row[5]),
-                roi=_roi_from_text(row[6]),
-                sources=tuple(json.loads(row[7])),
-                evidence=tuple((e[0], e[1], float(e[2]), e[3]) for e in json.loads(row[8])),
-                recording=row[9],
-            )
-            for row in rows
-        ]
+            records = [
+                ObservationRecord(
+                    object_id=row[0],
+                    time=row[1],
+                    frame=row[2],
+                    position=(row[3], row[4], row[5]),
+                    roi=_roi_from_text(row[6]),
+                    sources=tuple(json.loads(row[7])),
+                    evidence=_unpack_evidence(row[8], self._interned, conn),
+                    recording=row[9],
+                )
+                for row in rows
+            ]
         records.reverse()
         return records
 
@@ -1008,8 +1017,52 @@ def _rounded(value: float, digits: int) -> float:
     return _rounded_cached(value, digits) if value else round(value, digits)
 
 
-_EVIDENCE_JSON = JsonText()
-"""The encoder of a sighting's statements (``json.dumps``'s format)."""
+STATEMENT = struct.Struct("<iidi")
+"""One packed statement of a sighting: attribute name code, value code, confidence (rounded to 6 digits), expert
+code (the evidence column is these records one after another; a version-2 store's sightings keep JSON text)."""
+
+
+@functools.lru_cache(maxsize=64)
+def _statements(count: int) -> struct.Struct:
+    """The packing of ``count`` statements."""
+    return struct.Struct("<" + STATEMENT.format[1:] * count)
+
+
+def _pack_evidence(
+    evidence: Sequence[Evidence],
+    interned: InternedTexts,
+    conn: sqlite3.Connection,
+    write: Callable[[str, list[tuple]], None],
+) -> bytes:
+    """A sighting's statements packed (:data:`STATEMENT`), texts new to ``interned`` interned with ``write``."""
+    codes = interned.codes
+    flat: list = []
+    for e in evidence:
+        attribute = codes.get(e.attribute)
+        if attribute is None:
+            attribute = interned.code(conn, e.attribute, write)
+        value = codes.get(e.value)
+        if value is None:
+            value = interned.code(conn, e.value, write)
+        source = codes.get(e.source)
+        if source is None:
+            source = interned.code(conn, e.source, write)
+        flat += (attribute, value, _rounded(e.confidence, 6), source)
+    return _statements(len(evidence)).pack(*flat)
+
+
+def _unpack_evidence(
+    packed: bytes | str, interned: InternedTexts, conn: sqlite3.Connection
+) -> tuple[tuple[str, str, float, str], ...]:
+    """The statements of a sighting's evidence column: packed, or JSON text (written by schema version 2)."""
+    if isinstance(packed, str):
+        return tuple((e[0], e[1], float(e[2]), e[3]) for e in json.loads(packed))
+    numbers = _statements(len(packed) // STATEMENT.size).unpack(packed)
+    text = interned.text
+    return tuple(
+        (text(conn, numbers[i]), text(conn, numbers[i + 1]), numbers[i + 2], text(conn, numbers[i + 3]))
+        for i in range(0, len(numbers), 4)
+    )
 
 
 @functools.lru_cache(maxsize=256)

@@ -1,6 +1,6 @@
-"""Attribute supports packed with interned texts (schema version 3): what is written is read back as it was (any
-texts, by this and by another connection), a rolled-back transaction's codes are not kept, and a version-2 store
-(supports as JSON text) is migrated to the same beliefs."""
+"""Attribute supports and sightings' statements packed with interned texts (schema version 3): what is written is
+read back as it was (any texts, by this and by another connection), a rolled-back transaction's codes are not kept,
+and a version-2 store (JSON text) is migrated to the same beliefs and its sightings read back."""
 
 from __future__ import annotations
 
@@ -14,7 +14,8 @@ from hypothesis import given, settings
 from hypothesis import strategies as st
 
 from reasoning.beliefs.store import SCHEMA_VERSION, BeliefStore
-from reasoning.fusion.rule import AttributeBelief, ValueSupport
+from reasoning.fusion.frame import FrameObject
+from reasoning.fusion.rule import AttributeBelief, Evidence, ValueSupport
 from reasoning.fusion.tracking import ObjectBelief
 
 TEXTS = st.text(max_size=12)
@@ -102,3 +103,34 @@ def test_a_version_2_store_is_migrated_to_the_same_beliefs(tmp_path: Path) -> No
     with sqlite3.connect(path) as conn:
         assert conn.execute("SELECT value FROM meta WHERE key = 'version'").fetchone()[0] == str(SCHEMA_VERSION)
         assert {row[0] for row in conn.execute("SELECT typeof(attributes) FROM objects")} == {"blob"}
+
+
+@settings(max_examples=40, deadline=None)
+@given(
+    statements=st.lists(
+        st.tuples(TEXTS, TEXTS, st.floats(0.01, 0.99), TEXTS).map(lambda t: Evidence(*t)), min_size=0, max_size=6
+    )
+)
+def test_a_sightings_statements_read_back_as_stated(
+    tmp_path_factory: pytest.TempPathFactory, statements: list[Evidence]
+) -> None:
+    path = tmp_path_factory.mktemp("sightings") / "b.sqlite"
+    seen = FrameObject(np.array([0.0, 0.0, 0.8]), "world", evidence=statements, sources={"Segmenter"})
+    with BeliefStore(path) as store, BeliefStore(path) as reader:
+        reader.count()
+        object_id = store.integrate([seen], 1.0).assigned[0]
+        expected = tuple((e.attribute, e.value, round(e.confidence, 6), e.source) for e in statements)
+        for each in (store, reader):
+            (record,) = each.history(object_id)
+            assert record.evidence == expected and record.sources == ("Segmenter",)
+
+
+def test_a_version_2_sighting_reads_back(tmp_path: Path) -> None:
+    path = tmp_path / "b.sqlite"
+    seen = FrameObject(np.array([0.0, 0.0, 0.8]), "world", evidence=[Evidence("color", "red", 0.8, "C")])
+    with BeliefStore(path) as store:
+        object_id = store.integrate([seen], 1.0).assigned[0]
+    with sqlite3.connect(path) as conn:  # the statements as schema version 2 wrote them
+        conn.execute("UPDATE observations SET evidence = ?", (json.dumps([["color", "red", 0.8, "C"]]),))
+    with BeliefStore(path) as store:
+        assert store.history(object_id)[0].evidence == (("color", "red", 0.8, "C"),)
