@@ -29,6 +29,7 @@ from __future__ import annotations
 
 import argparse
 import cProfile
+import functools
 import io
 import os
 import pstats
@@ -51,6 +52,7 @@ for folder in (ROOT, Path(__file__).resolve().parent):
         sys.path.insert(0, str(folder))
 
 from reasoning.beliefs.answer import answer_from_memory  # noqa: E402
+from reasoning.beliefs.interned import InternedTexts  # noqa: E402
 from reasoning.beliefs.store import (  # noqa: E402
     _OBJECT_COLUMNS,
     WAL_AUTOCHECKPOINT_PAGES,
@@ -140,6 +142,7 @@ def seed_file(path: Path, count: int, rng: np.random.Generator, named_regions: b
     color_index = rng.integers(len(COLORS), size=count)
     rooms = room_of(positions[:, 0], positions[:, 1], side)
     templates: dict[tuple[int, int, int], tuple[tuple, tuple, tuple, list[tuple[str, str]]]] = {}
+    interned = InternedTexts()
     conn = sqlite3.connect(path, isolation_level=None)
     conn.execute("PRAGMA journal_mode = MEMORY")  # seeding only: the store switches the file back to WAL
     conn.execute("PRAGMA synchronous = OFF")
@@ -158,7 +161,8 @@ def seed_file(path: Path, count: int, rng: np.random.Generator, named_regions: b
             key = keys[i]
             found = templates.get(key)
             if found is None:
-                row = _object_row(template_belief(CLASSES[key[0]], COLORS[key[1]], SHAPES[key[2]]), is_subclass, {})
+                belief = template_belief(CLASSES[key[0]], COLORS[key[1]], SHAPES[key[2]])
+                row = _object_row(belief, is_subclass, {}, interned, conn, functools.partial(replay, conn))
                 pairs = [tuple(entry.split("=", 1)) for entry in row[-1].split("\x1f")]
                 found = templates[key] = (row[1:3], row[6:21], row[22:], pairs)  # type: ignore[assignment]
             head, middle, tail, pairs = found
@@ -260,6 +264,11 @@ def bench_store(
     recorded = store.write_log or []
     store.close()
     return Rates(count / t_integrate, count / c_integrate), count / (t_fuse + t_integrate), created, recorded
+
+
+def replay(conn: sqlite3.Connection, statement: str, rows: list[tuple]) -> None:
+    """Run one recorded write statement over its rows."""
+    conn.executemany(statement, rows)
 
 
 def bench_reference(path: Path, recorded: list[Recorded], per_frame: int) -> Rates:

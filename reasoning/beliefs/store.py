@@ -11,13 +11,16 @@
 * A file that is not a valid belief store is never modified: opening it raises :class:`BeliefStoreError`
   naming the file and how to move it aside. A store of schema version 1 (before recordings were stored) is
   migrated in one transaction: its beliefs and sightings get an empty recording, so its camera-frame beliefs are
-  never confused with new observations, while its world-frame beliefs go on being updated.
+  never confused with new observations, while its world-frame beliefs go on being updated. A store of version 2
+  (attribute supports as JSON text) gets its attribute column rewritten as packed supports in that transaction.
 
 Tables: ``objects`` (one row per belief: class, pose, size, region, recording, existence, first/last seen,
-experts and the support of every attribute value as JSON), ``objects_place`` (R*Tree over positions),
+experts and the support of every attribute value, packed: one binary record per value, see :data:`SUPPORT`),
+``interned`` (the attribute names, values and expert sets those records refer to by code, append-only),
+``objects_place`` (R*Tree over positions),
 ``attribute_index`` (the attribute values each belief holds more likely than not, for queries),
 ``observations`` (every sighting
-with its recording and the experts' statements, bounded per object), ``classes`` and ``meta``.
+with its recording and the experts' statements, packed, bounded per object), ``classes`` and ``meta``.
 """
 
 from __future__ import annotations
@@ -28,6 +31,7 @@ import operator
 import os
 import shlex
 import sqlite3
+import struct
 import threading
 from collections.abc import Callable, Iterator, Mapping, Sequence
 from contextlib import contextmanager
@@ -38,22 +42,32 @@ from typing import NamedTuple, TypeVar
 import numpy as np
 import platformdirs
 
-from reasoning.beliefs.json_text import JsonText
+from reasoning.beliefs.interned import InternedTexts
+from reasoning.beliefs.json_text import parse_json
 from reasoning.fusion.association import CameraModel, in_view
 from reasoning.fusion.frame import WORLD_FRAME, FrameObject
-from reasoning.fusion.rule import CLASS_ATTRIBUTE, AttributeBelief, ClassTest, ValueSupport, fuse_values, sigmoid
+from reasoning.fusion.rule import (
+    CLASS_ATTRIBUTE,
+    AttributeBelief,
+    ClassTest,
+    Evidence,
+    ValueSupport,
+    fuse_values,
+    sigmoid,
+)
 from reasoning.fusion.text import text_matches
 from reasoning.fusion.tracking import PRESENT, BeliefTracker, ObjectBelief, TrackStep
 from robokudo.core.regions import RegionBox
 from robokudo.core.types import Text
 
 SCHEMA_NAME = "robokudo-beliefs"
-SCHEMA_VERSION = 2
+SCHEMA_VERSION = 3
 MIGRATIONS = {
     1: (
         "ALTER TABLE objects ADD COLUMN recording TEXT NOT NULL DEFAULT ''",
         "ALTER TABLE observations ADD COLUMN recording TEXT NOT NULL DEFAULT ''",
     ),
+    2: (),  # and the attribute column rewritten from JSON to packed supports (_pack_attribute_column)
 }
 """Version -> the statements that bring a store of that version to the next one."""
 SQLITE_HEADER = b"SQLite format 3\x00"
@@ -128,6 +142,8 @@ _OBJECT_COLUMNS = (
     "indexed"
 )
 
+_INTERNED_TABLE = "CREATE TABLE IF NOT EXISTS interned (code INTEGER PRIMARY KEY, text TEXT NOT NULL UNIQUE)"
+
 _SCHEMA = (
     "CREATE TABLE IF NOT EXISTS meta (key TEXT PRIMARY KEY, value TEXT NOT NULL) WITHOUT ROWID",
     """CREATE TABLE IF NOT EXISTS objects (
@@ -150,7 +166,7 @@ _SCHEMA = (
         recording TEXT NOT NULL DEFAULT '',
         roi TEXT,
         sources TEXT NOT NULL,
-        attributes TEXT NOT NULL,
+        attributes BLOB NOT NULL,
         indexed TEXT NOT NULL
     )""",
     "CREATE INDEX IF NOT EXISTS objects_class ON objects (class_name, region COLLATE NOCASE)",
@@ -177,10 +193,11 @@ _SCHEMA = (
     "CREATE UNIQUE INDEX IF NOT EXISTS observations_object ON observations (object_id, seq)",
     "CREATE INDEX IF NOT EXISTS attribute_index_object ON attribute_index (object_id)",
     "CREATE TABLE IF NOT EXISTS classes (name TEXT PRIMARY KEY) WITHOUT ROWID",
+    _INTERNED_TABLE,
 )
 
 
-_TABLES = {"meta", "objects", "objects_place", "attribute_index", "observations", "classes"}
+_TABLES = {"meta", "objects", "objects_place", "attribute_index", "observations", "classes", "interned"}
 
 
 class _Loaded(NamedTuple):
@@ -222,6 +239,8 @@ class BeliefStore:
         """JSON of the expert sets written (few distinct sets recur on every row)."""
         self._views: dict[tuple[object, tuple], object] = {}
         """What :meth:`query_views` made, by (view, stored row)."""
+        self._interned = InternedTexts()
+        """The codes of the attribute names, values and expert sets in the packed supports."""
         self._lock = threading.RLock()
         self._conn = self._open(synchronous.upper(), busy_timeout, check)
 
@@ -310,6 +329,8 @@ class BeliefStore:
                 present = {row[1] for row in conn.execute(f"PRAGMA table_info({table})")}
                 if table in tables and column not in present:
                     conn.execute(statement)
+        if version < 3 and "objects" in tables:
+            _pack_attribute_column(conn)
 
     @staticmethod
     def default_path() -> Path:
@@ -349,10 +370,12 @@ class BeliefStore:
             conn.execute("BEGIN IMMEDIATE")
             try:
                 yield conn
+                conn.execute("COMMIT")
             except BaseException:
-                conn.execute("ROLLBACK")
+                self._interned.forget()  # it may hold codes the rollback undoes
+                if conn.in_transaction:
+                    conn.execute("ROLLBACK")
                 raise
-            conn.execute("COMMIT")
 
     # ------------------------------------------------------------------ writing
 
@@ -478,7 +501,7 @@ class BeliefStore:
             i: _Loaded(((r[n] + r[n + 1]) / 2, (r[n + 2] + r[n + 3]) / 2, (r[n + 4] + r[n + 5]) / 2), *_labels(r))
             for i, r in rows.items()
         }
-        return [_belief_from_row(rows[i]) for i in sorted(rows)], loaded
+        return [_belief_from_row(rows[i], self._interned, conn) for i in sorted(rows)], loaded
 
     def _write_beliefs(
         self,
@@ -500,6 +523,8 @@ class BeliefStore:
         log = [] if writes is None else writes
         loaded = loaded or {}
         cache = self._sources_cache()
+        interned = self._interned
+        write = functools.partial(_write, conn, log)
         fresh: list[tuple] = []
         volatile: list[tuple] = []
         relabelled: list[tuple] = []
@@ -512,7 +537,7 @@ class BeliefStore:
         r = RTREE_SLACK
         for b, current in zip(beliefs, written, strict=True):  # one pass: each statement's rows in belief order
             belief_id = b.id
-            row = _object_row(current, class_test, cache)
+            row = _object_row(current, class_test, cache, interned, conn, write)
             state = loaded.get(belief_id)
             indexed = row[_INDEXED]
             if state is None:
@@ -565,8 +590,11 @@ class BeliefStore:
         time: float,
         writes: list[tuple[str, list[tuple]]],
     ) -> None:
-        """Record each object's sighting under (belief id, its sighting number)."""
+        """Record each object's sighting under (belief id, its sighting number), its statements packed
+        (:data:`STATEMENT`)."""
         cache = self._sources_cache()
+        interned = self._interned
+        write = functools.partial(_write, conn, writes)
         rows = [
             (
                 object_id,
@@ -576,9 +604,7 @@ class BeliefStore:
                 *_floats(item.position, 3),
                 _roi_text(item.roi),
                 _encoded_sources(item.sources, cache),
-                _EVIDENCE_JSON.encode(
-                    [[e.attribute, e.value, _rounded(e.confidence, 6), e.source] for e in item.evidence]
-                ),
+                _pack_evidence(item.evidence, interned, conn, write),
                 item.recording,
             )
             for item, (object_id, seq) in zip(objects, assigned, strict=True)
@@ -613,7 +639,7 @@ class BeliefStore:
         """One belief by id (gone or not), or None."""
         with self._guard() as conn:
             rows = conn.execute(f"SELECT {_OBJECT_COLUMNS} FROM objects WHERE id = ?", (object_id,)).fetchall()
-            found = [_belief_from_row(row) for row in rows]
+            found = [_belief_from_row(row, self._interned, conn) for row in rows]
         return found[0] if found else None
 
     def beliefs(self, include_gone: bool = False) -> list[ObjectBelief]:
@@ -630,7 +656,9 @@ class BeliefStore:
     def query(self, belief_filter: BeliefFilter) -> list[ObjectBelief]:
         """The beliefs matching ``belief_filter`` (class subsumption, region, attributes), by id; a ``limit`` keeps
         the first by id (answers rank before they cut: :mod:`reasoning.beliefs.ranking`)."""
-        return [_belief_from_row(row) for row in self._select(belief_filter)]
+        rows = self._select(belief_filter)
+        with self._guard() as conn:
+            return [_belief_from_row(row, self._interned, conn) for row in rows]
 
     def query_views(self, belief_filter: BeliefFilter, view: Callable[[ObjectBelief], T]) -> list[T]:
         """``view(belief)`` of each belief :meth:`query` gives, by id, remembered per stored row.
@@ -641,7 +669,7 @@ class BeliefStore:
         At most :data:`VIEW_CACHE_LIMIT` rows are remembered (beyond that the memo starts afresh).
         """
         rows = self._select(belief_filter)
-        with self._lock:
+        with self._guard() as conn:
             memo = self._views
             if len(memo) > VIEW_CACHE_LIMIT:
                 memo.clear()
@@ -650,7 +678,7 @@ class BeliefStore:
                 key = (view, row)
                 made = memo.get(key)
                 if made is None:
-                    made = memo[key] = view(_belief_from_row(row))
+                    made = memo[key] = view(_belief_from_row(row, self._interned, conn))
                 found.append(made)  # type: ignore[arg-type]
             return found
 
@@ -732,19 +760,19 @@ class BeliefStore:
                 "WHERE object_id = ? ORDER BY seq DESC LIMIT ?",
                 (object_id, -1 if limit is None else limit),
             ).fetchall()
-        records = [
-            ObservationRecord(
-                object_id=row[0],
-                time=row[1],
-                frame=row[2],
-                position=(row[3], row[4], row[5]),
-                roi=_roi_from_text(row[6]),
-                sources=tuple(json.loads(row[7])),
-                evidence=tuple((e[0], e[1], float(e[2]), e[3]) for e in json.loads(row[8])),
-                recording=row[9],
-            )
-            for row in rows
-        ]
+            records = [
+                ObservationRecord(
+                    object_id=row[0],
+                    time=row[1],
+                    frame=row[2],
+                    position=(row[3], row[4], row[5]),
+                    roi=_roi_from_text(row[6]),
+                    sources=tuple(json.loads(row[7])),
+                    evidence=_unpack_evidence(row[8], self._interned, conn),
+                    recording=row[9],
+                )
+                for row in rows
+            ]
         records.reverse()
         return records
 
@@ -799,13 +827,21 @@ def _roi_from_text(text: str | None) -> tuple[int, int, int, int] | None:
     return x0, y0, x1, y1
 
 
-def _object_row(b: ObjectBelief, class_test: ClassTest | None, sources: dict[frozenset[str], str]) -> tuple:
-    """The ``objects`` row of a belief (columns as in ``_OBJECT_COLUMNS``); ``sources`` caches encodings."""
+def _object_row(
+    b: ObjectBelief,
+    class_test: ClassTest | None,
+    sources: dict[frozenset[str], str],
+    interned: InternedTexts,
+    conn: sqlite3.Connection,
+    write: Callable[[str, list[tuple]], None],
+) -> tuple:
+    """The ``objects`` row of a belief (columns as in ``_OBJECT_COLUMNS``); ``sources`` caches encodings, texts
+    new to ``interned`` are interned with ``write`` (inside the caller's write transaction on ``conn``)."""
     x, y, z = _floats(b.position, 3)
     qx, qy, qz, qw = _floats(b.orientation, 4)
     sx, sy, sz = (None, None, None) if b.dimensions is None else _floats(b.dimensions, 3)
     appearance = None if b.appearance is None else np.asarray(b.appearance, dtype=np.float32).tobytes()
-    encoded, indexed = _encode_attributes(b.attributes, class_test)
+    encoded, indexed = _pack_attributes(b.attributes, class_test, interned, conn, write)
     return (
         b.id,
         b.class_name,
@@ -873,26 +909,102 @@ def _encoded_sources(experts: set[str], cache: dict[frozenset[str], str]) -> str
     return found
 
 
-def _encode_attributes(attributes: Mapping[str, AttributeBelief], class_test: ClassTest | None) -> tuple[str, str]:
-    """JSON of every value's support, and the attribute-index entries (values more likely than not, or fused)."""
-    encoded: dict[str, dict[str, list]] = {}
+SUPPORT = struct.Struct("<iidqidd")
+"""One packed value support: attribute name code, value code, log-odds (rounded to 9 digits), count, expert-set
+code, first seen, last seen (little-endian; the attribute column is these records one after another)."""
+_FIELDS = 7
+
+
+@functools.lru_cache(maxsize=64)
+def _supports(count: int) -> struct.Struct:
+    """The packing of ``count`` supports."""
+    return struct.Struct("<" + SUPPORT.format[1:] * count)
+
+
+def _pack_attributes(
+    attributes: Mapping[str, AttributeBelief],
+    class_test: ClassTest | None,
+    interned: InternedTexts,
+    conn: sqlite3.Connection,
+    write: Callable[[str, list[tuple]], None],
+) -> tuple[bytes, str]:
+    """The packed supports of every value (:data:`SUPPORT`, in the order of the attributes and their values) and
+    the attribute-index entries (values more likely than not, or fused)."""
+    codes = interned.codes
+    expert_codes = interned.expert_codes
+    flat: list = []
     entries: list[str] = []
     for name, attribute in attributes.items():
         values = attribute.values
-        if len(values) == 1:  # the common case: one value said, indexed
-            ((value, s),) = values.items()
-            encoded[name] = {value: [_rounded(s.log_odds, 9), s.count, sorted(s.sources), s.first_seen, s.last_seen]}
-            entries.append(f"{name}={value}")
-            continue
         if not values:
             continue
-        encoded[name] = {
-            value: [_rounded(s.log_odds, 9), s.count, sorted(s.sources), s.first_seen, s.last_seen]
-            for value, s in values.items()
-        }
+        name_code = codes.get(name)
+        if name_code is None:
+            name_code = interned.code(conn, name, write)
+        for value, s in values.items():
+            value_code = codes.get(value)
+            if value_code is None:
+                value_code = interned.code(conn, value, write)
+            experts = expert_codes.get(frozenset(s.sources))
+            if experts is None:
+                experts = interned.experts_code(conn, s.sources, write)
+            flat += (name_code, value_code, _rounded(s.log_odds, 9), s.count, experts, s.first_seen, s.last_seen)
+        if len(values) == 1:  # the common case: one value said, indexed
+            entries.append(f"{name}={next(iter(values))}")
+            continue
         fused = fuse_values(name, attribute.values, class_test if name == CLASS_ATTRIBUTE else None)
         entries.extend(f"{name}={s.value}" for s in fused.support if s.value == fused.value or s.confidence > 0.5)
-    return _COMPACT_JSON.encode(encoded), _INDEX_SEPARATOR.join(sorted(entries))
+    return _supports(len(flat) // _FIELDS).pack(*flat), _INDEX_SEPARATOR.join(sorted(entries))
+
+
+def _unpack_attributes(packed: bytes, interned: InternedTexts, conn: sqlite3.Connection) -> dict[str, AttributeBelief]:
+    """The attributes of a packed attribute column (see :func:`_pack_attributes`)."""
+    numbers = _supports(len(packed) // SUPPORT.size).unpack(packed)
+    texts = interned.texts
+    expert_sets = interned.expert_sets
+    decoded: dict[str, AttributeBelief] = {}
+    for i in range(0, len(numbers), _FIELDS):
+        name_code, value_code, log_odds, count, experts, first_seen, last_seen = numbers[i : i + _FIELDS]
+        name = texts.get(name_code)
+        if name is None:
+            name = interned.text(conn, name_code)
+        value = texts.get(value_code)
+        if value is None:
+            value = interned.text(conn, value_code)
+        sources = expert_sets.get(experts)
+        if sources is None:
+            sources = interned.experts(conn, experts)
+        attribute = decoded.get(name)
+        if attribute is None:
+            attribute = decoded[name] = AttributeBelief(name, {})
+        attribute.values[value] = ValueSupport(log_odds, count, set(sources), first_seen, last_seen)
+    return decoded
+
+
+def _pack_attribute_column(conn: sqlite3.Connection) -> None:
+    """Rewrite a version-2 store's attribute column (JSON text) as packed supports (inside the migration's
+    transaction); the attribute index is left as it is (the same values are indexed)."""
+    conn.execute(_INTERNED_TABLE)
+    interned = InternedTexts()
+
+    def write(statement: str, rows: list[tuple]) -> None:
+        conn.executemany(statement, rows)
+
+    last = -1
+    while rows := conn.execute(
+        "SELECT id, attributes FROM objects WHERE id > ? ORDER BY id LIMIT 10000", (last,)
+    ).fetchall():
+        packed = []
+        for object_id, text in rows:
+            if not isinstance(text, str):
+                continue  # packed already
+            attributes = {}
+            for name, values in parse_json(text).items():
+                supports = {value: ValueSupport(s[0], s[1], set(s[2]), s[3], s[4]) for value, s in values.items()}
+                attributes[name] = AttributeBelief(name, supports)
+            packed.append((_pack_attributes(attributes, None, interned, conn, write)[0], object_id))
+        conn.executemany("UPDATE objects SET attributes = ? WHERE id = ?", packed)
+        last = rows[-1][0]
 
 
 @functools.lru_cache(maxsize=4096, typed=True)
@@ -906,10 +1018,52 @@ def _rounded(value: float, digits: int) -> float:
     return _rounded_cached(value, digits) if value else round(value, digits)
 
 
-_COMPACT_JSON = JsonText(",", ":")
-"""The encoder of the attribute column."""
-_EVIDENCE_JSON = JsonText()
-"""The encoder of a sighting's statements (``json.dumps``'s format)."""
+STATEMENT = struct.Struct("<iidi")
+"""One packed statement of a sighting: attribute name code, value code, confidence (rounded to 6 digits), expert
+code (the evidence column is these records one after another; a version-2 store's sightings keep JSON text)."""
+
+
+@functools.lru_cache(maxsize=64)
+def _statements(count: int) -> struct.Struct:
+    """The packing of ``count`` statements."""
+    return struct.Struct("<" + STATEMENT.format[1:] * count)
+
+
+def _pack_evidence(
+    evidence: Sequence[Evidence],
+    interned: InternedTexts,
+    conn: sqlite3.Connection,
+    write: Callable[[str, list[tuple]], None],
+) -> bytes:
+    """A sighting's statements packed (:data:`STATEMENT`), texts new to ``interned`` interned with ``write``."""
+    codes = interned.codes
+    flat: list = []
+    for e in evidence:
+        attribute = codes.get(e.attribute)
+        if attribute is None:
+            attribute = interned.code(conn, e.attribute, write)
+        value = codes.get(e.value)
+        if value is None:
+            value = interned.code(conn, e.value, write)
+        source = codes.get(e.source)
+        if source is None:
+            source = interned.code(conn, e.source, write)
+        flat += (attribute, value, _rounded(e.confidence, 6), source)
+    return _statements(len(evidence)).pack(*flat)
+
+
+def _unpack_evidence(
+    packed: bytes | str, interned: InternedTexts, conn: sqlite3.Connection
+) -> tuple[tuple[str, str, float, str], ...]:
+    """The statements of a sighting's evidence column: packed, or JSON text (written by schema version 2)."""
+    if isinstance(packed, str):
+        return tuple((e[0], e[1], float(e[2]), e[3]) for e in json.loads(packed))
+    numbers = _statements(len(packed) // STATEMENT.size).unpack(packed)
+    text = interned.text
+    return tuple(
+        (text(conn, numbers[i]), text(conn, numbers[i + 1]), numbers[i + 2], text(conn, numbers[i + 3]))
+        for i in range(0, len(numbers), 4)
+    )
 
 
 @functools.lru_cache(maxsize=256)
@@ -924,18 +1078,9 @@ def _index_entries(indexed: str) -> set[tuple[str, str]]:
     return {(name, value) for name, _, value in (entry.partition("=") for entry in indexed.split(_INDEX_SEPARATOR))}
 
 
-def _decode_attributes(text: str) -> dict[str, AttributeBelief]:
-    decoded: dict[str, AttributeBelief] = {}
-    for name, values in json.loads(text).items():
-        supports = {}
-        for value, s in values.items():
-            supports[value] = ValueSupport(s[0], s[1], set(s[2]), s[3], s[4])
-        decoded[name] = AttributeBelief(name, supports)
-    return decoded
-
-
-def _belief_from_row(row: tuple) -> ObjectBelief:
-    """The belief of an ``objects`` row (extra trailing columns are ignored)."""
+def _belief_from_row(row: tuple, interned: InternedTexts, conn: sqlite3.Connection) -> ObjectBelief:
+    """The belief of an ``objects`` row (extra trailing columns are ignored; codes unknown to ``interned`` are read
+    from ``conn``)."""
     (
         object_id,
         class_name,
@@ -973,7 +1118,7 @@ def _belief_from_row(row: tuple) -> ObjectBelief:
         orientation=np.array([qx, qy, qz, qw]),
         dimensions=None if sx is None else np.array([sx, sy, sz]),
         appearance=None if appearance is None else np.frombuffer(appearance, dtype=np.float32).astype(np.float64),
-        attributes=_decode_attributes(attributes),
+        attributes=_unpack_attributes(attributes, interned, conn),
         position_variance=variance,
         existence=existence,
         status=status,
