@@ -43,7 +43,6 @@ import numpy as np
 import platformdirs
 
 from reasoning.beliefs.interned import InternedTexts
-from reasoning.beliefs.json_text import parse_json
 from reasoning.fusion.association import CameraModel, in_view
 from reasoning.fusion.frame import WORLD_FRAME, FrameObject
 from reasoning.fusion.rule import (
@@ -999,7 +998,7 @@ def _pack_attribute_column(conn: sqlite3.Connection) -> None:
             if not isinstance(text, str):
                 continue  # packed already
             attributes = {}
-            for name, values in parse_json(text).items():
+            for name, values in json.loads(text).items():
                 supports = {value: ValueSupport(s[0], s[1], set(s[2]), s[3], s[4]) for value, s in values.items()}
                 attributes[name] = AttributeBelief(name, supports)
             packed.append((_pack_attributes(attributes, None, interned, conn, write)[0], object_id))

@@ -1,5 +1,4 @@
-"""The belief write path's faster steps give exactly what the plain ones give: the reused C JSON encoder the text
-``json`` makes (and the C scanner called directly the values ``json.loads`` reads), statements accumulated in one
+"""The belief write path's faster steps give exactly what the plain ones give: statements accumulated in one
 pass the supports of :meth:`AttributeBelief.add` one by one (bit for bit), the assignment that skips the Hungarian
 when no two feasible pairs conflict the Hungarian's own, and the support update and log-odds with min, max and
 clamp written out the values of the plain forms."""
@@ -10,12 +9,10 @@ import json
 import math
 
 import numpy as np
-import pytest
 from hypothesis import given, settings
 from hypothesis import strategies as st
 from scipy.optimize import linear_sum_assignment
 
-from reasoning.beliefs.json_text import JsonText, parse_json
 from reasoning.beliefs.store import _rounded
 from reasoning.fusion.association import INFEASIBLE, assign
 from reasoning.fusion.rule import (
@@ -27,53 +24,6 @@ from reasoning.fusion.rule import (
     accumulate_into,
     logit,
 )
-
-JSON_VALUES = st.recursive(
-    st.none()
-    | st.booleans()
-    | st.integers(-(2**70), 2**70)
-    | st.floats(allow_nan=True, allow_infinity=True)
-    | st.text(max_size=8),
-    lambda inner: st.lists(inner, max_size=4) | st.dictionaries(st.text(max_size=6), inner, max_size=4),
-    max_leaves=20,
-)
-
-
-@settings(max_examples=300, deadline=None)
-@given(value=JSON_VALUES)
-def test_json_text_is_the_text_json_makes(value: object) -> None:
-    assert JsonText().encode(value) == json.dumps(value)
-    assert JsonText(",", ":").encode(value) == json.JSONEncoder(separators=(",", ":")).encode(value)
-
-
-def _same_json(a: object, b: object) -> bool:
-    """Equal JSON values, NaN equal to NaN and floats told from ints."""
-    if isinstance(a, float) and isinstance(b, float):
-        return (math.isnan(a) and math.isnan(b)) or a == b
-    if type(a) is not type(b):
-        return False
-    if isinstance(a, list):
-        return len(a) == len(b) and all(_same_json(x, y) for x, y in zip(a, b, strict=True))  # type: ignore[arg-type]
-    if isinstance(a, dict):
-        return list(a) == list(b) and all(_same_json(a[k], b[k]) for k in a)  # type: ignore[index]
-    return a == b
-
-
-@settings(max_examples=300, deadline=None)
-@given(value=JSON_VALUES, separators=st.sampled_from([(", ", ": "), (",", ":")]))
-def test_parse_json_reads_what_json_loads_reads(value: object, separators: tuple[str, str]) -> None:
-    text = json.JSONEncoder(separators=separators).encode(value)
-    assert _same_json(parse_json(text), json.loads(text))
-    assert _same_json(parse_json(f" {text}\n"), json.loads(f" {text}\n"))
-
-
-@pytest.mark.parametrize("text", ["", "{", "[1,", "{} x", '{"a":1}}', "nul"])
-def test_parse_json_rejects_what_json_loads_rejects(text: str) -> None:
-    with pytest.raises(json.JSONDecodeError):
-        json.loads(text)
-    with pytest.raises(json.JSONDecodeError):
-        parse_json(text)
-
 
 STATEMENTS = st.lists(
     st.tuples(
