@@ -75,7 +75,13 @@ from annotators.geometry.grid_segmentation import (
 from annotators.geometry.inner_walls import InnerWallRules, join_inner_walls
 from annotators.geometry.occlusion import OcclusionRules, join_occluded
 from annotators.geometry.slabs import SlabRules, join_slab_pieces
-from annotators.geometry.support import AppendageRules, JointRules, SupportRules, join_pieces
+from annotators.geometry.support import (
+    AppendageRules,
+    JointRules,
+    SupportRules,
+    join_pieces,
+    join_pieces_summarized,
+)
 from robokudo.core.annotator import Annotator
 from robokudo.core.capability import Capability
 from robokudo.core.types import CasType, ObjectHypothesis, Plane, PointCloud
@@ -239,11 +245,17 @@ def segment_clutter(
     support = SupportRules() if p.join_unsupported else None
     appendages = p.appendage_rules() if p.join_appendages else None
     joint = p.joint_rules() if p.join_jointly_held else None
-    labels = join_pieces(labels, grid, normals, plane_grid, support, appendages, joint)
+    # each step hands the summary of the labels it leaves to the next while they stay as they are
+    labels, pieces, summary_step = join_pieces_summarized(labels, grid, normals, plane_grid, support, appendages, joint)
     if p.join_inner_walls:
-        labels = join_inner_walls(labels, grid, normals, plane_grid, to_plane[:, :3], p.inner_wall_rules())
+        wall_rules = p.inner_wall_rules()
+        known = pieces if summary_step == wall_rules.support.sample_step else None
+        joined = join_inner_walls(labels, grid, normals, plane_grid, to_plane[:, :3], wall_rules, known)
+        pieces, summary_step, labels = (known, summary_step, labels) if joined is labels else (None, 0, joined)
     if p.join_slabs:
-        labels = join_slab_pieces(labels, grid, normals, plane_grid, p.slab_rules())
+        slab_rules = p.slab_rules()
+        known = pieces if summary_step == slab_rules.sample_step else None
+        labels = join_slab_pieces(labels, grid, normals, plane_grid, slab_rules, known)
     floors = None
     if p.claim_floors:
         rules = FloorRules(min_height=p.min_height, margin=p.hull_margin, cell=p.hull_cell)

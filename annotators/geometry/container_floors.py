@@ -35,7 +35,6 @@ from types import ModuleType
 
 import cv2
 import numpy as np
-from scipy import ndimage
 
 _SQUARE = np.ones((3, 3), dtype=np.uint8)
 """The 8-neighbourhood as a structuring element."""
@@ -97,30 +96,31 @@ def claim_container_floors(
     pixels' ``(u, v, height)`` on the plane (HxWx3 or (H*W)x3)."""
     rules = rules or FloorRules()
     claimed = np.zeros(labels.shape, dtype=bool)
-    if not (labels > 0).any():
-        return labels, claimed
     plane_points = plane_points.reshape(*labels.shape, 3)
-    with np.errstate(invalid="ignore"):
-        level = valid & (labels == 0) & (np.abs(plane_points[..., 2]) < rules.min_height)
-    if not level.any():
-        return labels, claimed
-    enclosing = _loops().enclosing_labels(np.ascontiguousarray(labels, dtype=np.int32), level)
-    if not enclosing.any():
+    # one compiled pass: the table-level pixels, the label enclosing each, the labels' boxes
+    level, enclosing, boxes, enclosed = _loops().floor_seeds(
+        np.ascontiguousarray(labels, dtype=np.int32), valid, plane_points[..., 2], np.float32(rules.min_height)
+    )
+    if not enclosed.any():
         return labels, claimed  # no table-level pixel with an object on three sides: no floor to seed from
     result = labels.copy()
-    windows = ndimage.find_objects(labels)
-    for label in np.unique(enclosing[enclosing > 0]).tolist():
-        window = windows[label - 1]
-        (y0, y1), (x0, x1) = (window[0].start, window[0].stop), (window[1].start, window[1].stop)
+    for label in np.flatnonzero(enclosed).tolist():
+        y0, y1, x0, x1 = boxes[label].tolist()
         mask = labels[y0:y1, x0:x1] == label
         around = level[y0:y1, x0:x1]
         surrounded = enclosing[y0:y1, x0:x1] == label
-        hull = core_hull(mask, plane_points[y0:y1, x0:x1], rules.sample_step)
+        core = core_feet(mask, plane_points[y0:y1, x0:x1], rules.sample_step)
+        if core.shape[0] < 3:
+            continue
+        rows, cols = np.nonzero(surrounded)
+        seed_feet = plane_points[rows + y0, cols + x0, :2]
+        if not may_lie_within(seed_feet, core, rules.margin, rules.cell):
+            continue  # no part of the floor can lie margin inside the footprint: no hull needed to tell
+        hull = cv2.convexHull(core).reshape(-1, 2)
         if hull.shape[0] < 3:
             continue
         footprint = Footprint(hull, rules.cell)
-        rows, cols = np.nonzero(surrounded)
-        seeds = footprint.depth(plane_points[rows + y0, cols + x0, :2]) >= rules.margin
+        seeds = footprint.depth(seed_feet) >= rules.margin
         if not seeds.any():
             continue
         seed_rows, seed_cols = rows[seeds], cols[seeds]
@@ -141,7 +141,13 @@ def claim_container_floors(
 
 
 def touches_other_labels(labels: np.ndarray, marked: np.ndarray) -> bool:
-    """Whether a ``marked`` pixel (HxW bool) has a 4-neighbour with another non-zero label than its own."""
+    """Whether a ``marked`` pixel (HxW bool) has a 4-neighbour with another non-zero label than its own, in one
+    compiled pass that stops at the first (:func:`touches_other_labels_numpy` is its reference form)."""
+    return bool(_loops().touches_other_labels(np.ascontiguousarray(labels), np.ascontiguousarray(marked)))
+
+
+def touches_other_labels_numpy(labels: np.ndarray, marked: np.ndarray) -> bool:
+    """:func:`touches_other_labels` in whole-array numpy: the reference form its compiled pass is tested against."""
     for a, b in (
         (np.s_[:, :-1], np.s_[:, 1:]),
         (np.s_[:, 1:], np.s_[:, :-1]),
@@ -154,17 +160,36 @@ def touches_other_labels(labels: np.ndarray, marked: np.ndarray) -> bool:
     return False
 
 
-def core_hull(mask: np.ndarray, plane_points: np.ndarray, step: int = 1) -> np.ndarray:
-    """The convex hull (Kx2) of the feet of the object's pixels ``mask`` (HxW) away from its outline (eroded by
-    one pixel), read on every ``step``-th pixel: the outline's mixed pixels, between the object and what lies
-    behind it, fall anywhere."""
+def core_feet(mask: np.ndarray, plane_points: np.ndarray, step: int = 1) -> np.ndarray:
+    """The feet (Nx2 float32) of the object's pixels ``mask`` (HxW) away from its outline (eroded by one pixel),
+    read on every ``step``-th pixel: the outline's mixed pixels, between the object and what lies behind it, fall
+    anywhere."""
     eroded = cv2.erode(mask.view(np.uint8), _SQUARE, borderType=cv2.BORDER_CONSTANT, borderValue=0)
     core = eroded[::step, ::step] > 0
     feet = plane_points[::step, ::step][core][:, :2]
-    feet = feet[np.isfinite(feet).all(axis=1)].astype(np.float32)
+    return feet[np.isfinite(feet).all(axis=1)].astype(np.float32)
+
+
+def core_hull(mask: np.ndarray, plane_points: np.ndarray, step: int = 1) -> np.ndarray:
+    """The convex hull (Kx2) of :func:`core_feet` (the feet themselves when fewer than three)."""
+    feet = core_feet(mask, plane_points, step)
     if feet.shape[0] < 3:
         return feet
     return cv2.convexHull(feet).reshape(-1, 2)
+
+
+def may_lie_within(feet: np.ndarray, corners: np.ndarray, margin: float, cell: float) -> bool:
+    """Whether any of the Nx2 ``feet`` can lie at least ``margin`` inside the :class:`Footprint` (``cell``) of the
+    convex hull of the Kx2 ``corners``, told from the corners' bounding box alone: False only where no foot can.
+
+    A cell of the footprint's raster lies ``margin`` (at least two cells' worth: the distance transform's diagonal
+    step is under 1.37 cells) inside only where every cell within two steps is filled, so at least two cells
+    inside the box of the rounded corners: its foot lies at least 1.5 cells above the corners' least ``u`` and
+    ``v`` and 0.5 cells below their greatest; the test leaves half a cell of slack on either side."""
+    if margin <= 2 * 1.3694 * cell:
+        return bool(feet.shape[0])  # too thin a margin for the box to rule anything out
+    low, high = corners.min(axis=0) + cell, corners.max(axis=0)
+    return bool(((feet >= low) & (feet <= high)).all(axis=1).any())
 
 
 def nearest_labels(labels: np.ndarray, axis: int, reverse: bool) -> np.ndarray:

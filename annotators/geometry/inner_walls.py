@@ -177,10 +177,12 @@ def join_inner_walls(
     plane_points: np.ndarray,
     to_plane: np.ndarray,
     rules: InnerWallRules | None = None,
+    pieces: PieceSummary | None = None,
 ) -> np.ndarray:
     """Labels with the inside of every open container seen over its rim joined to the container's outside (see
     the module docstring; ``points`` and ``normals`` HxWx3 in the camera frame, normals toward the camera,
     ``plane_points`` the pixels' ``(u, v, height)``, ``to_plane`` the 3x3 rotation from camera directions to
-    ``(u, v, height)``)."""
-    joins = inner_wall_holders(labels, points, normals, plane_points, to_plane, rules or InnerWallRules())
+    ``(u, v, height)``; ``pieces`` the labels' summary when already made, with the rules' sample step); the same
+    array when nothing joined."""
+    joins = inner_wall_holders(labels, points, normals, plane_points, to_plane, rules or InnerWallRules(), pieces)
     return join_labels(labels, joins) if joins else labels

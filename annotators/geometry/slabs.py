@@ -126,9 +126,10 @@ def join_slab_pieces(
     normals: np.ndarray,
     plane_points: np.ndarray,
     rules: SlabRules | None = None,
+    pieces: PieceSummary | None = None,
 ) -> np.ndarray:
     """Labels with the pieces of one slab joined: touching pieces whose lowest heights and tops agree within the
     height noise and whose shared border has no depth jump along most of it (see :class:`SlabRules`); renumbered
-    1..n when anything joined."""
-    joins = slab_partners(labels, points, normals, plane_points, rules or SlabRules())
+    1..n when anything joined (``pieces``: the labels' summary when already made, with the rules' sample step)."""
+    joins = slab_partners(labels, points, normals, plane_points, rules or SlabRules(), pieces)
     return join_labels(labels, joins) if joins else labels

@@ -487,20 +487,34 @@ def join_pieces(
     """:func:`join_unsupported` (unless ``support`` is None), :func:`join_jointly_held` (unless ``joint`` is None;
     then :func:`join_unsupported` again where it joined), then :func:`join_appendages` (unless ``appendages`` is
     None), summarizing the pieces once where a step joined nothing."""
+    return join_pieces_summarized(labels, points, normals, plane_points, support, appendages, joint)[0]
+
+
+def join_pieces_summarized(
+    labels: np.ndarray,
+    points: np.ndarray,
+    normals: np.ndarray,
+    plane_points: np.ndarray,
+    support: SupportRules | None,
+    appendages: AppendageRules | None,
+    joint: JointRules | None = None,
+) -> tuple[np.ndarray, PieceSummary | None, int]:
+    """:func:`join_pieces`, with the summary of the labels it returns and the sample step it was made with, for the
+    next step to read (None and 0 when the last join left none)."""
     pieces, step = None, 0
     if support is not None:
         labels, pieces = _join_unsupported(labels, plane_points, support)
         step = support.sample_step
     if joint is not None:
         if joint.support.sample_step != step:
-            pieces = None
+            pieces, step = None, 0
         labels, joined = _join_jointly_held(labels, points, normals, plane_points, joint, pieces)
         if joined:
             labels, pieces = _join_unsupported(labels, plane_points, support or joint.support)
             step = (support or joint.support).sample_step
     if appendages is None:
-        return labels
-    if appendages.sample_step != step:
-        pieces = None
+        return labels, pieces, step
+    if appendages.sample_step != step or pieces is None:
+        pieces, step = summarize_pieces(labels, plane_points, appendages.sample_step), appendages.sample_step
     joins = appendage_owners(labels, points, normals, plane_points, appendages, pieces)
-    return join_labels(labels, joins) if joins else labels
+    return (join_labels(labels, joins), None, 0) if joins else (labels, pieces, step)

@@ -4,7 +4,9 @@ part, stays unlabelled."""
 
 from __future__ import annotations
 
+import cv2
 import numpy as np
+from scipy import ndimage
 
 from annotators.geometry import floor_loops
 from annotators.geometry.container_floors import (
@@ -13,8 +15,10 @@ from annotators.geometry.container_floors import (
     claim_container_floors,
     core_hull,
     enclosing_labels,
+    may_lie_within,
     overhung,
     touches_other_labels,
+    touches_other_labels_numpy,
 )
 
 CELL = 0.005  # metres per grid pixel in these plane coordinates
@@ -124,12 +128,54 @@ def test_the_hull_of_an_object_leaves_out_its_outlines_mixed_pixels() -> None:
     assert hull[:, 0].max() <= 38 * CELL + 1e-6 and hull[:, 0].min() >= 21 * CELL - 1e-6
 
 
-def test_the_compiled_enclosure_pass_gives_what_the_numpy_form_gives() -> None:
+def test_the_compiled_seed_pass_gives_what_the_numpy_forms_give() -> None:
     rng = np.random.default_rng(5)
-    labels = np.where(rng.random((40, 50)) < 0.3, rng.integers(1, 5, (40, 50)), 0).astype(np.int32)
-    wanted = rng.random((40, 50)) < 0.5
-    compiled = floor_loops.enclosing_labels(labels, wanted)
-    assert np.array_equal(compiled, np.where(wanted, enclosing_labels(labels), 0))
+    for _ in range(20):
+        labels = np.where(rng.random((40, 50)) < 0.3, rng.integers(1, 7, (40, 50)), 0).astype(np.int32)
+        valid = rng.random((40, 50)) < 0.9
+        heights = rng.uniform(-0.02, 0.02, (40, 50)).astype(np.float32)
+        heights[rng.random((40, 50)) < 0.05] = np.nan
+        heights[rng.random((40, 50)) < 0.05] = np.float32(0.01)  # on the bound: not within it
+        level, enclosing, boxes, enclosed = floor_loops.floor_seeds(labels, valid, heights, np.float32(0.01))
+        with np.errstate(invalid="ignore"):
+            expected_level = valid & (labels == 0) & (np.abs(heights) < 0.01)
+        assert np.array_equal(level, expected_level)
+        expected = np.where(expected_level, enclosing_labels(labels), 0)
+        assert np.array_equal(enclosing, expected)
+        assert np.flatnonzero(enclosed).tolist() == np.unique(expected[expected > 0]).tolist()
+        for label, window in enumerate(ndimage.find_objects(labels), start=1):
+            if window is not None:
+                rows, cols = window
+                assert boxes[label].tolist() == [rows.start, rows.stop, cols.start, cols.stop]
+
+
+def test_the_compiled_touch_test_gives_what_the_numpy_form_gives() -> None:
+    rng = np.random.default_rng(6)
+    outcomes = set()
+    for _ in range(200):
+        labels = np.where(rng.random((8, 9)) < 0.3, rng.integers(1, 4, (8, 9)), 0).astype(np.int32)
+        marked = rng.random((8, 9)) < 0.03
+        expected = touches_other_labels_numpy(labels, marked)
+        assert touches_other_labels(labels, marked) == expected
+        outcomes.add(expected)
+    assert outcomes == {False, True}
+
+
+def test_the_footprint_box_rules_out_no_foot_that_lies_margin_inside_the_footprint() -> None:
+    rng = np.random.default_rng(7)
+    rules = FloorRules()
+    ruled_out = 0
+    for _ in range(300):
+        corners = rng.uniform(0.0, 0.08, (int(rng.integers(3, 9)), 2)).astype(np.float32)
+        hull = cv2.convexHull(corners).reshape(-1, 2)
+        if hull.shape[0] < 3:
+            continue
+        feet = rng.uniform(-0.01, 0.09, (int(rng.integers(1, 6)), 2)).astype(np.float32)
+        inside = (Footprint(hull, rules.cell).depth(feet) >= rules.margin).any()
+        possible = may_lie_within(feet, corners, rules.margin, rules.cell)
+        assert possible or not inside
+        ruled_out += not possible
+    assert ruled_out > 0
 
 
 def test_a_marked_pixel_touches_other_labels_only_beside_a_pixel_of_another_label() -> None:
