@@ -96,25 +96,24 @@ def claim_container_floors(
     pixels' ``(u, v, height)`` on the plane (HxWx3 or (H*W)x3)."""
     rules = rules or FloorRules()
     claimed = np.zeros(labels.shape, dtype=bool)
-    plane_points = plane_points.reshape(*labels.shape, 3)
+    plane_points = np.ascontiguousarray(plane_points.reshape(*labels.shape, 3), dtype=np.float32)
+    loops = _loops()
+    grid_labels = np.ascontiguousarray(labels, dtype=np.int32)
     # one compiled pass: the table-level pixels, the label enclosing each, the labels' boxes
-    level, enclosing, boxes, enclosed = _loops().floor_seeds(
-        np.ascontiguousarray(labels, dtype=np.int32), valid, plane_points[..., 2], np.float32(rules.min_height)
+    level, enclosing, boxes, enclosed = loops.floor_seeds(
+        grid_labels, valid, plane_points[..., 2], np.float32(rules.min_height)
     )
     if not enclosed.any():
         return labels, claimed  # no table-level pixel with an object on three sides: no floor to seed from
     result = labels.copy()
+    box_decides = box_rules_out(rules.margin, rules.cell)
+    cell = np.float32(rules.cell)
     for label in np.flatnonzero(enclosed).tolist():
         y0, y1, x0, x1 = boxes[label].tolist()
-        mask = labels[y0:y1, x0:x1] == label
-        around = level[y0:y1, x0:x1]
-        surrounded = enclosing[y0:y1, x0:x1] == label
-        core = core_feet(mask, plane_points[y0:y1, x0:x1], rules.sample_step)
-        if core.shape[0] < 3:
-            continue
-        rows, cols = np.nonzero(surrounded)
-        seed_feet = plane_points[rows + y0, cols + x0, :2]
-        if not may_lie_within(seed_feet, core, rules.margin, rules.cell):
+        core, rows, cols, seed_feet, possible = loops.floor_candidate(
+            grid_labels, enclosing, plane_points, label, boxes[label], rules.sample_step, cell
+        )
+        if core.shape[0] < 3 or (box_decides and not possible):
             continue  # no part of the floor can lie margin inside the footprint: no hull needed to tell
         hull = cv2.convexHull(core).reshape(-1, 2)
         if hull.shape[0] < 3:
@@ -124,11 +123,12 @@ def claim_container_floors(
         if not seeds.any():
             continue
         seed_rows, seed_cols = rows[seeds], cols[seeds]
-        rows, cols = np.nonzero(around)
+        rows, cols = np.nonzero(level[y0:y1, x0:x1])
         feet = plane_points[rows + y0, cols + x0, :2]
         inside = footprint.depth(feet) > 0
         rows, cols, feet = rows[inside], cols[inside], feet[inside]
-        free = ~overhung(feet, plane_points[y0:y1, x0:x1][mask], 2 * rules.min_height, rules.cell)
+        clearance = np.float32(2 * rules.min_height)
+        free = ~loops.overhung(feet, grid_labels, plane_points, label, boxes[label], clearance, cell)
         floor = np.zeros((y1 - y0, x1 - x0), dtype=bool)
         floor[rows[free], cols[free]] = True
         # the floor reaches as far as the footprint where it runs on from a part well inside it
@@ -178,15 +178,26 @@ def core_hull(mask: np.ndarray, plane_points: np.ndarray, step: int = 1) -> np.n
     return cv2.convexHull(feet).reshape(-1, 2)
 
 
+_DIAGONAL_STEP = 1.3694
+"""The distance transform's (L2, 3x3 mask) diagonal step in cells, rounded up: no step is longer."""
+
+
+def box_rules_out(margin: float, cell: float) -> bool:
+    """Whether a ``margin`` is deep enough in a :class:`Footprint` of ``cell`` metres for :func:`may_lie_within` to
+    rule feet out: more than two of the distance transform's longest steps."""
+    return margin > 2 * _DIAGONAL_STEP * cell
+
+
 def may_lie_within(feet: np.ndarray, corners: np.ndarray, margin: float, cell: float) -> bool:
     """Whether any of the Nx2 ``feet`` can lie at least ``margin`` inside the :class:`Footprint` (``cell``) of the
     convex hull of the Kx2 ``corners``, told from the corners' bounding box alone: False only where no foot can.
 
-    A cell of the footprint's raster lies ``margin`` (at least two cells' worth: the distance transform's diagonal
-    step is under 1.37 cells) inside only where every cell within two steps is filled, so at least two cells
-    inside the box of the rounded corners: its foot lies at least 1.5 cells above the corners' least ``u`` and
-    ``v`` and 0.5 cells below their greatest; the test leaves half a cell of slack on either side."""
-    if margin <= 2 * 1.3694 * cell:
+    A cell of the footprint's raster lies ``margin`` (more than two of the distance transform's longest steps, see
+    :func:`box_rules_out`) inside only where every cell within two steps is filled, so at least two cells inside the
+    box of the rounded corners: its foot lies at least 1.5 cells above the corners' least ``u`` and ``v`` and 0.5
+    cells below their greatest; the test leaves half a cell of slack on either side. The segmenter runs it compiled
+    (:mod:`annotators.geometry.floor_loops`)."""
+    if not box_rules_out(margin, cell):
         return bool(feet.shape[0])  # too thin a margin for the box to rule anything out
     low, high = corners.min(axis=0) + cell, corners.max(axis=0)
     return bool(((feet >= low) & (feet <= high)).all(axis=1).any())
@@ -220,7 +231,8 @@ def overhung(feet: np.ndarray, object_points: np.ndarray, clearance: float, cell
     """N bool: which of the Nx2 ``feet`` lie in a ``cell``-metre raster cell of the plane where the object hangs
     over the table - every point of the object (Mx3 ``(u, v, height)``) whose foot falls in the cell lies higher
     than ``clearance`` (a drill's chuck above the table in front of its battery); the raster is closed (3x3) so
-    that the gaps between sparse feet count too. A wall that runs down to a floor has points low in its cells."""
+    that the gaps between sparse feet count too. A wall that runs down to a floor has points low in its cells. The
+    reference form of the segmenter's compiled pass (:func:`annotators.geometry.floor_loops.overhung`)."""
     object_points = object_points[np.isfinite(object_points).all(axis=1)]
     if object_points.shape[0] == 0:
         return np.zeros(feet.shape[0], dtype=bool)

@@ -84,3 +84,143 @@ def touches_other_labels(labels: np.ndarray, marked: np.ndarray) -> bool:
                     if other > 0 and other != own:
                         return True
     return False
+
+
+@njit(cache=True, nogil=True)
+def floor_candidate(
+    labels: np.ndarray,
+    enclosing: np.ndarray,
+    plane: np.ndarray,
+    label: int,
+    box: np.ndarray,
+    step: int,
+    cell: np.float32,
+) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray, bool]:
+    """``(core, rows, cols, feet, possible)`` of one label in its pixel ``box`` ``(y0, y1, x0, x1)``: the feet of its
+    pixels away from its outline (all eight neighbours the label) on every ``step``-th pixel of the box, with finite
+    ``(u, v)`` (Kx2 float32, row-major: :func:`~annotators.geometry.container_floors.core_feet`); the pixels it
+    encloses (``rows``, ``cols`` within the box, row-major) and their feet (Nx2); whether any of those feet lies
+    within the core feet's box shrunk by ``cell`` at its low sides
+    (:func:`~annotators.geometry.container_floors.may_lie_within`'s test, float32)."""
+    y0, y1, x0, x1 = box[0], box[1], box[2], box[3]
+    count = 0
+    for r in range(y0, y1, step):
+        for c in range(x0, x1, step):
+            if _core_foot(labels, plane, r, c, label):
+                count += 1
+    core = np.empty((count, 2), dtype=np.float32)
+    count = 0
+    for r in range(y0, y1, step):
+        for c in range(x0, x1, step):
+            if _core_foot(labels, plane, r, c, label):
+                core[count, 0], core[count, 1] = plane[r, c, 0], plane[r, c, 1]
+                count += 1
+    enclosed = 0
+    for r in range(y0, y1):
+        for c in range(x0, x1):
+            enclosed += enclosing[r, c] == label
+    seed_rows = np.empty(enclosed, dtype=np.int64)
+    seed_cols = np.empty(enclosed, dtype=np.int64)
+    feet = np.empty((enclosed, 2), dtype=np.float32)
+    enclosed = 0
+    for r in range(y0, y1):
+        for c in range(x0, x1):
+            if enclosing[r, c] == label:
+                seed_rows[enclosed], seed_cols[enclosed] = r - y0, c - x0
+                feet[enclosed, 0], feet[enclosed, 1] = plane[r, c, 0], plane[r, c, 1]
+                enclosed += 1
+    possible = False
+    if count > 0:
+        low_u, low_v, high_u, high_v = core[0, 0], core[0, 1], core[0, 0], core[0, 1]
+        for k in range(1, count):
+            low_u, high_u = min(low_u, core[k, 0]), max(high_u, core[k, 0])
+            low_v, high_v = min(low_v, core[k, 1]), max(high_v, core[k, 1])
+        low_u, low_v = np.float32(low_u + cell), np.float32(low_v + cell)
+        for k in range(enclosed):
+            u, v = feet[k, 0], feet[k, 1]
+            if u >= low_u and u <= high_u and v >= low_v and v <= high_v:
+                possible = True
+                break
+    return core, seed_rows, seed_cols, feet, possible
+
+
+@njit(cache=True, nogil=True)
+def _core_foot(labels: np.ndarray, plane: np.ndarray, r: int, c: int, label: int) -> bool:
+    """Whether pixel ``(r, c)`` and all eight neighbours lie in the grid and carry ``label``, and its ``(u, v)`` is
+    finite."""
+    rows, cols = labels.shape
+    if r == 0 or c == 0 or r == rows - 1 or c == cols - 1:
+        return False
+    for dr in range(-1, 2):
+        for dc in range(-1, 2):
+            if labels[r + dr, c + dc] != label:
+                return False
+    return np.isfinite(plane[r, c, 0]) and np.isfinite(plane[r, c, 1])
+
+
+@njit(cache=True, nogil=True)
+def overhung(
+    feet: np.ndarray,
+    labels: np.ndarray,
+    plane: np.ndarray,
+    label: int,
+    box: np.ndarray,
+    clearance: np.float32,
+    cell: np.float32,
+) -> np.ndarray:
+    """N bool: :func:`annotators.geometry.container_floors.overhung` of the Nx2 float32 ``feet`` (N >= 1) and the
+    points of ``label`` in its pixel ``box`` ``(y0, y1, x0, x1)`` of ``plane`` (HxWx3 float32), in float32 as numpy
+    computes it; the raster's 3x3 closing ignores what lies outside it, as OpenCV's does."""
+    y0, y1, x0, x1 = box[0], box[1], box[2], box[3]
+    count = 0
+    low_u, low_v = feet[0, 0], feet[0, 1]
+    high_u, high_v = feet[0, 0], feet[0, 1]
+    for k in range(1, feet.shape[0]):
+        low_u, high_u = min(low_u, feet[k, 0]), max(high_u, feet[k, 0])
+        low_v, high_v = min(low_v, feet[k, 1]), max(high_v, feet[k, 1])
+    for r in range(y0, y1):
+        for c in range(x0, x1):
+            if labels[r, c] == label and _finite(plane, r, c):
+                count += 1
+                low_u, high_u = min(low_u, plane[r, c, 0]), max(high_u, plane[r, c, 0])
+                low_v, high_v = min(low_v, plane[r, c, 1]), max(high_v, plane[r, c, 1])
+    result = np.zeros(feet.shape[0], dtype=np.bool_)
+    if count == 0:
+        return result
+    two = np.float32(2.0 * cell)
+    low_u, low_v = np.float32(low_u - two), np.float32(low_v - two)
+    high_u, high_v = np.float32(high_u + two), np.float32(high_v + two)
+    width = int(np.ceil(np.float32(np.float32(high_u - low_u) / cell))) + 1
+    height = int(np.ceil(np.float32(np.float32(high_v - low_v) / cell))) + 1
+    occupied = np.zeros((height, width), dtype=np.bool_)
+    reached = np.zeros((height, width), dtype=np.bool_)
+    for r in range(y0, y1):
+        for c in range(x0, x1):
+            if labels[r, c] == label and _finite(plane, r, c):
+                i = int(np.float32(np.float32(plane[r, c, 0] - low_u) / cell))
+                j = int(np.float32(np.float32(plane[r, c, 1] - low_v) / cell))
+                occupied[j, i] = True
+                if plane[r, c, 2] <= clearance:
+                    reached[j, i] = True
+    dilated = np.zeros((height, width), dtype=np.bool_)
+    for j in range(height):
+        for i in range(width):
+            if occupied[j, i] and not reached[j, i]:
+                for dj in range(max(j - 1, 0), min(j + 2, height)):
+                    for di in range(max(i - 1, 0), min(i + 2, width)):
+                        dilated[dj, di] = True
+    for k in range(feet.shape[0]):
+        i = int(np.float32(np.float32(feet[k, 0] - low_u) / cell))
+        j = int(np.float32(np.float32(feet[k, 1] - low_v) / cell))
+        closed = True
+        for dj in range(max(j - 1, 0), min(j + 2, height)):
+            for di in range(max(i - 1, 0), min(i + 2, width)):
+                closed = closed and dilated[dj, di]
+        result[k] = closed
+    return result
+
+
+@njit(cache=True, nogil=True)
+def _finite(plane: np.ndarray, r: int, c: int) -> bool:
+    """Whether all three coordinates of pixel ``(r, c)`` are finite."""
+    return np.isfinite(plane[r, c, 0]) and np.isfinite(plane[r, c, 1]) and np.isfinite(plane[r, c, 2])

@@ -13,6 +13,7 @@ from annotators.geometry.container_floors import (
     FloorRules,
     Footprint,
     claim_container_floors,
+    core_feet,
     core_hull,
     enclosing_labels,
     may_lie_within,
@@ -185,3 +186,62 @@ def test_a_marked_pixel_touches_other_labels_only_beside_a_pixel_of_another_labe
     assert not touches_other_labels(labels, marked)
     labels[0, 2] = 2
     assert touches_other_labels(labels, marked)
+
+
+def random_scene(rng: np.random.Generator) -> tuple[np.ndarray, np.ndarray]:
+    """Blobby labels on a tilted, noisy table with some unmeasured pixels: labels and float32 plane coordinates."""
+    labels, points = flat_table((30, 40))
+    for label in range(1, 4):
+        y, x = rng.integers(0, 25), rng.integers(0, 35)
+        labels[y : y + rng.integers(3, 12), x : x + rng.integers(3, 14)] = label
+    labels[rng.random(labels.shape) < 0.05] = 0
+    points[..., :2] += rng.normal(0.0, 0.002, (*labels.shape, 2)).astype(np.float32)
+    points[..., 2] = np.where(labels > 0, rng.uniform(0.0, 0.05, labels.shape), 0.0).astype(np.float32)
+    points[rng.random(labels.shape) < 0.03] = np.nan
+    return labels, points
+
+
+def test_the_compiled_candidate_pass_gives_the_core_feet_enclosed_pixels_and_box_test_of_the_numpy_forms() -> None:
+    rng = np.random.default_rng(8)
+    rules = FloorRules()
+    for _ in range(60):
+        labels, points = random_scene(rng)
+        level = rng.random(labels.shape) < 0.5
+        enclosing = np.where(level & (labels == 0), enclosing_labels(labels), 0).astype(np.int32)
+        for label, window in enumerate(ndimage.find_objects(labels), start=1):
+            if window is None:
+                continue
+            rows, cols = window
+            box = np.array([rows.start, rows.stop, cols.start, cols.stop], dtype=np.int64)
+            core, seed_rows, seed_cols, feet, possible = floor_loops.floor_candidate(
+                labels, enclosing, points, label, box, rules.sample_step, np.float32(rules.cell)
+            )
+            expected = core_feet(labels[window] == label, points[window], rules.sample_step)
+            assert np.array_equal(core, expected)
+            expected_rows, expected_cols = np.nonzero(enclosing[window] == label)
+            assert np.array_equal(seed_rows, expected_rows) and np.array_equal(seed_cols, expected_cols)
+            assert np.array_equal(feet, points[window][expected_rows, expected_cols, :2], equal_nan=True)
+            if core.shape[0]:
+                assert possible == may_lie_within(feet, core, rules.margin, rules.cell)
+
+
+def test_the_compiled_overhang_pass_gives_what_the_numpy_form_gives() -> None:
+    rng = np.random.default_rng(9)
+    both = set()
+    for _ in range(60):
+        labels, points = random_scene(rng)
+        label = int(rng.integers(1, 4))
+        window = ndimage.find_objects(labels)[label - 1] if label <= labels.max() else None
+        if window is None:
+            continue
+        rows, cols = window
+        box = np.array([rows.start, rows.stop, cols.start, cols.stop], dtype=np.int64)
+        feet = points[rows, cols][labels[window] == 0][:, :2]
+        feet = feet[np.isfinite(feet).all(axis=1)]
+        if feet.shape[0] == 0:
+            continue
+        compiled = floor_loops.overhung(feet, labels, points, label, box, np.float32(0.02), np.float32(CELL))
+        expected = overhung(feet, points[window][labels[window] == label], 0.02, CELL)
+        assert np.array_equal(compiled, expected)
+        both.update(expected.tolist())
+    assert both == {False, True}
