@@ -93,6 +93,21 @@ def wall_axis(points: np.ndarray, normals: np.ndarray, rules: InnerWallRules) ->
     return (axis, distance) if ahead > 0 and ahead >= rules.facing * distance else None
 
 
+def bordering_long_enough(
+    candidates: np.ndarray, pairs: np.ndarray, pieces: PieceSummary, rules: InnerWallRules
+) -> np.ndarray:
+    """M bool: which ``(piece, holder)`` candidates (Mx2) share a border of at least as many 4-neighbour pixel pairs
+    (``pieces.border`` of the touching ``pairs``, Kx2 in increasing order) as the close border
+    :func:`inner_wall_holders` asks of the piece: a close border is part of the shared one, so the others cannot
+    qualify and are left out before their walls are measured."""
+    base = pieces.sizes.size
+    keys = pairs[:, 0] * base + pairs[:, 1]
+    low, high = np.minimum(candidates[:, 0], candidates[:, 1]), np.maximum(candidates[:, 0], candidates[:, 1])
+    border = pieces.border[np.searchsorted(keys, low * base + high)]
+    needed = np.maximum(rules.min_boundary, rules.boundary_share * np.sqrt(pieces.sizes[candidates[:, 0]]))
+    return border >= needed
+
+
 def inner_wall_holders(
     labels: np.ndarray,
     points: np.ndarray,
@@ -113,6 +128,8 @@ def inner_wall_holders(
     candidates = unsupported_candidates(
         pairs, pieces.sizes, pieces.low, pieces.high, support.tolerance, support.reach_down
     )
+    if pieces.border is not None:
+        candidates = candidates[bordering_long_enough(candidates, pairs, pieces, rules)]
     if candidates.shape[0] == 0:
         return []
     grid_plane = plane_points.reshape(*labels.shape, 3)
