@@ -108,7 +108,12 @@ def claim_container_floors(
     result = labels.copy()
     box_decides = box_rules_out(rules.margin, rules.cell)
     cell = np.float32(rules.cell)
-    for label in np.flatnonzero(enclosed).tolist():
+    # the labels with too few core feet, or whose box rules out every enclosed foot, screened out all at once
+    counts, possible = loops.candidate_screen(
+        grid_labels, enclosing, plane_points, boxes, enclosed, rules.sample_step, cell
+    )
+    promising = enclosed & (counts >= 3) & (possible | (not box_decides))
+    for label in np.flatnonzero(promising).tolist():
         y0, y1, x0, x1 = boxes[label].tolist()
         core, rows, cols, seed_feet, possible = loops.floor_candidate(
             grid_labels, enclosing, plane_points, label, boxes[label], rules.sample_step, cell

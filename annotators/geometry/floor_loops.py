@@ -224,3 +224,50 @@ def overhung(
 def _finite(plane: np.ndarray, r: int, c: int) -> bool:
     """Whether all three coordinates of pixel ``(r, c)`` are finite."""
     return np.isfinite(plane[r, c, 0]) and np.isfinite(plane[r, c, 1]) and np.isfinite(plane[r, c, 2])
+
+
+@njit(cache=True, nogil=True)
+def candidate_screen(
+    labels: np.ndarray,
+    enclosing: np.ndarray,
+    plane: np.ndarray,
+    boxes: np.ndarray,
+    enclosed: np.ndarray,
+    step: int,
+    cell: np.float32,
+) -> tuple[np.ndarray, np.ndarray]:
+    """``(counts, possible)`` per label: for every ``enclosed`` label the number of core feet and the box test of
+    :func:`floor_candidate` (its pixel box ``boxes[label]`` as ``(y0, y1, x0, x1)``), in two passes over the grid
+    for all labels at once; zeros and False for the others."""
+    rows, cols = labels.shape
+    count = enclosed.size
+    counts = np.zeros(count, dtype=np.int64)
+    low = np.zeros((count, 2), dtype=np.float32)
+    high = np.zeros((count, 2), dtype=np.float32)
+    for r in range(rows):
+        for c in range(cols):
+            label = labels[r, c]
+            if label <= 0 or not enclosed[label]:
+                continue
+            if (r - boxes[label, 0]) % step != 0 or (c - boxes[label, 2]) % step != 0:
+                continue
+            if not _core_foot(labels, plane, r, c, label):
+                continue
+            u, v = plane[r, c, 0], plane[r, c, 1]
+            if counts[label] == 0:
+                low[label, 0], low[label, 1], high[label, 0], high[label, 1] = u, v, u, v
+            else:
+                low[label, 0], high[label, 0] = min(low[label, 0], u), max(high[label, 0], u)
+                low[label, 1], high[label, 1] = min(low[label, 1], v), max(high[label, 1], v)
+            counts[label] += 1
+    possible = np.zeros(count, dtype=np.bool_)
+    for r in range(rows):
+        for c in range(cols):
+            label = enclosing[r, c]
+            if label <= 0 or counts[label] == 0 or possible[label]:
+                continue
+            u, v = plane[r, c, 0], plane[r, c, 1]
+            low_u, low_v = np.float32(low[label, 0] + cell), np.float32(low[label, 1] + cell)
+            if u >= low_u and u <= high[label, 0] and v >= low_v and v <= high[label, 1]:
+                possible[label] = True
+    return counts, possible

@@ -208,11 +208,20 @@ def test_the_compiled_candidate_pass_gives_the_core_feet_enclosed_pixels_and_box
         labels, points = random_scene(rng)
         level = rng.random(labels.shape) < 0.5
         enclosing = np.where(level & (labels == 0), enclosing_labels(labels), 0).astype(np.int32)
-        for label, window in enumerate(ndimage.find_objects(labels), start=1):
+        windows = ndimage.find_objects(labels)
+        boxes = np.zeros((len(windows) + 1, 4), dtype=np.int64)
+        for label, window in enumerate(windows, start=1):
+            if window is not None:
+                boxes[label] = window[0].start, window[0].stop, window[1].start, window[1].stop
+        enclosed = np.zeros(len(windows) + 1, dtype=bool)
+        enclosed[np.unique(enclosing[enclosing > 0])] = True
+        counts, screened = floor_loops.candidate_screen(
+            labels, enclosing, points, boxes, enclosed, rules.sample_step, np.float32(rules.cell)
+        )
+        for label, window in enumerate(windows, start=1):
             if window is None:
                 continue
-            rows, cols = window
-            box = np.array([rows.start, rows.stop, cols.start, cols.stop], dtype=np.int64)
+            box = boxes[label]
             core, seed_rows, seed_cols, feet, possible = floor_loops.floor_candidate(
                 labels, enclosing, points, label, box, rules.sample_step, np.float32(rules.cell)
             )
@@ -223,6 +232,8 @@ def test_the_compiled_candidate_pass_gives_the_core_feet_enclosed_pixels_and_box
             assert np.array_equal(feet, points[window][expected_rows, expected_cols, :2], equal_nan=True)
             if core.shape[0]:
                 assert possible == may_lie_within(feet, core, rules.margin, rules.cell)
+            if enclosed[label]:
+                assert counts[label] == core.shape[0] and screened[label] == possible
 
 
 def test_the_compiled_overhang_pass_gives_what_the_numpy_form_gives() -> None:
