@@ -81,6 +81,7 @@ from annotators.geometry.support import (
     SupportRules,
     join_pieces,
     join_pieces_summarized,
+    summarize_pieces,
 )
 from robokudo.core.annotator import Annotator
 from robokudo.core.capability import Capability
@@ -249,9 +250,12 @@ def segment_clutter(
     labels, pieces, summary_step = join_pieces_summarized(labels, grid, normals, plane_grid, support, appendages, joint)
     if p.join_inner_walls:
         wall_rules = p.inner_wall_rules()
-        known = pieces if summary_step == wall_rules.support.sample_step else None
-        joined = join_inner_walls(labels, grid, normals, plane_grid, to_plane[:, :3], wall_rules, known)
-        pieces, summary_step, labels = (known, summary_step, labels) if joined is labels else (None, 0, joined)
+        if pieces is None or summary_step != wall_rules.support.sample_step:  # made here, it serves the slabs too
+            summary_step = wall_rules.support.sample_step
+            pieces = summarize_pieces(labels, plane_grid, summary_step)
+        joined = join_inner_walls(labels, grid, normals, plane_grid, to_plane[:, :3], wall_rules, pieces)
+        if joined is not labels:
+            pieces, summary_step, labels = None, 0, joined
     if p.join_slabs:
         slab_rules = p.slab_rules()
         known = pieces if summary_step == slab_rules.sample_step else None
