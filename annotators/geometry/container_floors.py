@@ -137,9 +137,11 @@ def claim_container_floors(
         floor = np.zeros((y1 - y0, x1 - x0), dtype=bool)
         floor[rows[free], cols[free]] = True
         # the floor reaches as far as the footprint where it runs on from a part well inside it
-        _, parts = cv2.connectedComponents(floor.view(np.uint8), connectivity=4)
-        seeded = np.unique(parts[seed_rows, seed_cols])
-        floor = np.isin(parts, seeded[seeded > 0])
+        count, parts = cv2.connectedComponents(floor.view(np.uint8), connectivity=4)
+        seeded = np.zeros(count, dtype=bool)  # the parts holding a seed, looked up per pixel
+        seeded[parts[seed_rows, seed_cols]] = True
+        seeded[0] = False
+        floor = seeded[parts]
         result[y0:y1, x0:x1][floor] = label
         claimed[y0:y1, x0:x1] |= floor
     return result, claimed
