@@ -59,7 +59,7 @@ from annotators.cloud.plane import plane_basis
 from annotators.geometry.border_pixels import BorderRules, claim_border_pixels, plane_noise
 from annotators.geometry.container_floors import FloorRules, claim_container_floors, touches_other_labels
 from annotators.geometry.convexity import ConvexityRules, convex_groups, dense_labels, grid_patches, split_by_normals
-from annotators.geometry.grid_kernels import object_pieces, strided_crop
+from annotators.geometry.grid_kernels import object_pieces, plane_coordinates, strided_crop
 from annotators.geometry.grid_segmentation import (
     MergeRules,
     boundaries,
@@ -234,7 +234,8 @@ def segment_clutter(
     basis = plane_basis(np.asarray(model[:3], dtype=np.float64)).T.astype(np.float32)
     to_plane = np.column_stack([basis, np.asarray(model[:3], dtype=np.float32)])
     offset = np.array([0.0, 0.0, model[3]], dtype=np.float32)
-    plane_grid = grid.reshape(-1, 3) @ to_plane + offset  # (u, v, height) of every grid point on the plane
+    # (u, v, height) of every grid point on the plane
+    plane_grid = plane_coordinates(grid.reshape(-1, 3), to_plane, offset)
     labels = merge_parts(labels, depth, plane_grid.__getitem__, p.merge_rules())
     if colors is not None and p.use_color:
         colors_crop = strided_crop(colors, step, (x0, y0, x1, y1))

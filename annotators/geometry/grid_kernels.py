@@ -291,3 +291,15 @@ def joined_labels(labels: np.ndarray, pairs: np.ndarray) -> np.ndarray:
     """HxW int32: ``labels`` (HxW, non-negative integers) with every connected group of the label ``pairs`` (Kx2)
     joined, renumbered 1..n in order of each group's smallest present label (0 stays 0)."""
     return _loops().joined_labels(labels, np.ascontiguousarray(pairs, dtype=np.int64).reshape(-1, 2))
+
+
+def plane_coordinates(points: np.ndarray, to_plane: np.ndarray, offset: np.ndarray) -> np.ndarray:
+    """Nx3 float32: ``points @ to_plane + offset`` of Nx3 float32 ``points``, a 3x3 float32 ``to_plane`` and a
+    float32 ``offset`` (3), each product sum rounded as OpenBLAS's float32 matrix product rounds it on machines
+    with fused multiply-add (the first product, then the other two fused in row order), in one single-threaded
+    pass: numpy's product starts BLAS threads for a few ten thousand rows, which cost far more than the sums."""
+    return _loops().plane_coordinates(
+        np.ascontiguousarray(points, dtype=np.float32),
+        np.ascontiguousarray(to_plane, dtype=np.float32),
+        np.ascontiguousarray(offset, dtype=np.float32),
+    )

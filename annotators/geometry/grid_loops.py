@@ -5,7 +5,9 @@ this file). Importing this module imports numba; the segmentation modules reach 
 from __future__ import annotations
 
 import numpy as np
-from numba import njit
+from llvmlite import ir
+from numba import njit, types
+from numba.extending import intrinsic
 
 
 @njit(cache=True, nogil=True)
@@ -865,3 +867,31 @@ def joined_labels(labels: np.ndarray, pairs: np.ndarray) -> np.ndarray:
                 number[root] = numbered
             renumber[label] = number[root]
     return _looked_up(renumber, labels)
+
+
+@intrinsic
+def _fused_multiply_add(typing_context, a, b, c):
+    """``a * b + c`` of three float32 rounded once (LLVM's ``fma``), as BLAS kernels accumulate products."""
+    signature = types.float32(types.float32, types.float32, types.float32)
+
+    def codegen(context, builder, signature, arguments):
+        single = ir.FloatType()
+        function = builder.module.declare_intrinsic("llvm.fma", [single], ir.FunctionType(single, [single] * 3))
+        return builder.call(function, arguments)
+
+    return signature, codegen
+
+
+@njit(cache=True, nogil=True)
+def plane_coordinates(points: np.ndarray, to_plane: np.ndarray, offset: np.ndarray) -> np.ndarray:
+    """See :func:`annotators.geometry.grid_kernels.plane_coordinates`."""
+    count = points.shape[0]
+    result = np.empty((count, 3), dtype=np.float32)
+    for i in range(count):
+        x, y, z = points[i, 0], points[i, 1], points[i, 2]
+        for k in range(3):
+            total = x * to_plane[0, k]
+            total = _fused_multiply_add(y, to_plane[1, k], total)
+            total = _fused_multiply_add(z, to_plane[2, k], total)
+            result[i, k] = total + offset[k]
+    return result

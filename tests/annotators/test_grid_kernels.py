@@ -2,6 +2,8 @@
 
 from __future__ import annotations
 
+from fractions import Fraction
+
 import cv2
 import numpy as np
 import pytest
@@ -19,6 +21,7 @@ from annotators.geometry.grid_kernels import (
     jump_between,
     label_pixels,
     nearest_seed_labels,
+    plane_coordinates,
     shadowed_near,
     strided_crop,
     symmetric_eigen,
@@ -353,3 +356,36 @@ def test_label_groups_are_the_stable_sort_of_the_labelled_pixels(seed: int) -> N
     grouped, grouped_starts = label_groups(labels)
     np.testing.assert_array_equal(grouped, pixels)
     np.testing.assert_array_equal(grouped_starts, starts)
+
+
+def _fused(a: np.float32, b: np.float32, c: np.float32) -> np.float32:
+    """``a * b + c`` computed exactly, rounded once to float32."""
+    return np.float32(float(Fraction(float(a)) * Fraction(float(b)) + Fraction(float(c))))
+
+
+@pytest.mark.parametrize("seed", range(3))
+def test_plane_coordinates_round_each_sum_once_per_fused_product(seed: int) -> None:
+    rng = np.random.default_rng(seed)
+    points = rng.normal(0.0, 0.5, (200, 3)).astype(np.float32)
+    to_plane = rng.normal(0.0, 1.0, (3, 3)).astype(np.float32)
+    offset = rng.normal(0.0, 1.0, 3).astype(np.float32)
+    result = plane_coordinates(points, to_plane, offset)
+    for i in range(points.shape[0]):
+        for k in range(3):
+            total = np.float32(points[i, 0] * to_plane[0, k])
+            total = _fused(points[i, 1], to_plane[1, k], total)
+            total = _fused(points[i, 2], to_plane[2, k], total)
+            assert result[i, k] == np.float32(total + offset[k])
+
+
+def test_plane_coordinates_give_what_the_matrix_product_gives_on_a_grid_with_gaps() -> None:
+    rng = np.random.default_rng(7)
+    points = rng.normal(0.0, 0.5, (60_000, 3)).astype(np.float32)
+    points[rng.random(points.shape[0]) < 0.1] = np.nan
+    rotation, _ = np.linalg.qr(rng.normal(size=(3, 3)))
+    to_plane = rotation.astype(np.float32)
+    offset = np.array([0.0, 0.0, 0.7], dtype=np.float32)
+    result = plane_coordinates(points, to_plane, offset)
+    expected = points @ to_plane + offset
+    assert np.array_equal(result, expected, equal_nan=True)
+    assert not np.array_equal(result, points.astype(np.float64) @ to_plane + offset, equal_nan=True)
