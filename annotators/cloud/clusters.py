@@ -160,15 +160,23 @@ def extract_clusters(
 
 
 def standing_region(
-    points: np.ndarray, mask: np.ndarray, model: np.ndarray, plane_indices: np.ndarray, p: ClusterParameters
+    points: np.ndarray,
+    mask: np.ndarray,
+    model: np.ndarray,
+    plane_indices: np.ndarray,
+    p: ClusterParameters,
+    distances: np.ndarray | None = None,
 ) -> np.ndarray:
     """The candidates on every ``p.stride``-th pixel: points between ``min_height`` and ``max_height`` above the
-    plane ``model`` whose foot lies inside the extent of its inliers ``plane_indices`` (shrunk by ``hull_margin``)."""
+    plane ``model`` whose foot lies inside the extent of its inliers ``plane_indices`` (shrunk by ``hull_margin``).
+    ``distances``, when given, are :func:`plane_distances` of all ``points`` to ``model``, made by the caller."""
     step = max(1, p.stride)
     basis = plane_basis(np.asarray(model[:3], dtype=np.float64)).T.astype(np.float32)
     coarse_points = points[::step, ::step]
+    if distances is None:
+        distances = plane_distances(points, model)
     # on the whole grid, which needs no copy of strided points (each point's distance is the same either way)
-    heights = np.ascontiguousarray(plane_distances(points, model)[::step, ::step])
+    heights = np.ascontiguousarray(distances[::step, ::step])
     flat = points.reshape(-1, 3)
     plane_points = flat[plane_indices[:: max(1, plane_indices.size // 2000)]]
     plane_points = plane_points[np.isfinite(plane_points).all(axis=1)]
@@ -192,6 +200,7 @@ def full_resolution_segments(
     p: ClusterParameters,
     refine: Callable[[np.ndarray, np.ndarray, np.ndarray, np.ndarray], np.ndarray] | None = None,
     claimed: np.ndarray | None = None,
+    distances: np.ndarray | None = None,
 ) -> list[Segment]:
     """Segments on the full grid from coarse labels of the region ``box`` (coarse pixels, x1/y1 exclusive).
 
@@ -204,13 +213,16 @@ def full_resolution_segments(
     where an object meets the plane. Which segments are large enough (``min_points``) is judged before refining,
     so refining never adds one. ``claimed`` (coarse, the region's shape), when given, marks the cells labelled
     though no candidates (a container's floor at table level): their measured pixels count as candidates.
+    ``distances``, when given, are :func:`plane_distances` of all ``points`` to ``model``, made by the caller.
     """
     rows, cols = mask.shape
     x0, y0, x1, y1 = box
     fy0, fx0 = y0 * step, x0 * step
     fy1, fx1 = min(y1 * step, rows), min(x1 * step, cols)
     fine_points = points[fy0:fy1, fx0:fx1]
-    heights = np.ascontiguousarray(plane_distances(points, model)[fy0:fy1, fx0:fx1])  # no copy of the region's points
+    if distances is None:
+        distances = plane_distances(points, model)  # of the whole grid: no copy of the region's points
+    heights = np.ascontiguousarray(distances[fy0:fy1, fx0:fx1])
     candidates = _between_heights(heights, mask[fy0:fy1, fx0:fx1], p)
     if claimed is not None and claimed.any():
         spread = np.repeat(np.repeat(claimed, step, axis=0), step, axis=1)[: fy1 - fy0, : fx1 - fx0]

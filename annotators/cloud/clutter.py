@@ -55,7 +55,7 @@ from annotators.cloud.clusters import (
     supporting_plane,
 )
 from annotators.cloud.normals import grid_normals
-from annotators.cloud.plane import plane_basis
+from annotators.cloud.plane import plane_basis, plane_distances
 from annotators.geometry.border_pixels import BorderRules, claim_border_pixels, plane_noise
 from annotators.geometry.container_floors import FloorRules, claim_container_floors, touches_other_labels
 from annotators.geometry.convexity import ConvexityRules, convex_groups, dense_labels, grid_patches, split_by_normals
@@ -216,7 +216,8 @@ def segment_clutter(
     first; ``plane_indices`` are the plane's inliers (flat indices) and define its extent."""
     p = parameters or ClutterParameters()
     step = max(1, p.stride)
-    coarse = standing_region(points, mask, model, plane_indices, p)
+    distances = plane_distances(points, model)  # the heights of all points, for the candidates and the segments
+    coarse = standing_region(points, mask, model, plane_indices, p, distances)
     if not coarse.any():
         return []
     x0, y0, x1, y1 = bounding_box(coarse, margin=2)
@@ -272,7 +273,9 @@ def segment_clutter(
     if p.claim_borders:
         floor = plane_noise(points, model, plane_indices)
         refine = partial(claim_border_pixels, plane=model, floor=floor, coarse_normals=normals, rules=p.border_rules())
-    return full_resolution_segments(labels, depth, (x0, y0, x1, y1), step, points, mask, model, p, refine, floors)
+    return full_resolution_segments(
+        labels, depth, (x0, y0, x1, y1), step, points, mask, model, p, refine, floors, distances
+    )
 
 
 def split_by_color(
