@@ -26,6 +26,7 @@ import numpy as np
 
 from annotators.geometry.grid_segmentation import join_labels
 from annotators.geometry.support import (
+    FOOTPRINT_ROWS,
     AppendageRules,
     PieceSummary,
     SupportRules,
@@ -57,9 +58,6 @@ class InnerWallRules:
     min_turn: float = 0.05
     facing: float = 0.5
 
-
-_FOOTPRINT_ROWS = 8
-"""The pixel footprint (the angle between neighbouring pixels) is measured on every this many rows of the grid."""
 
 _MIN_WALL_POINTS = 10
 """A wall with fewer sampled points has no trustworthy axis."""
@@ -172,7 +170,7 @@ def inner_wall_holders(
         points[y0:y1, x0:x1],
         normals[y0:y1, x0:x1],
         touch_rules,
-        footprint_angle(np.ascontiguousarray(points[::_FOOTPRINT_ROWS], dtype=np.float32)),
+        footprint_angle(np.ascontiguousarray(points[::FOOTPRINT_ROWS], dtype=np.float32)),
     )
     along = {
         (a, b): close * length

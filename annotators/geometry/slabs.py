@@ -20,7 +20,7 @@ import numpy as np
 
 from annotators.geometry.grid_kernels import boundary_pairs
 from annotators.geometry.grid_segmentation import distinct_keys, join_labels
-from annotators.geometry.support import PieceSummary, summarize_pieces
+from annotators.geometry.support import BORDER_REACH, PieceSummary, summarize_pieces
 
 
 @dataclass(frozen=True)
@@ -39,10 +39,6 @@ class SlabRules:
     jump_absolute: float = 0.01
     jump_relative: float = 0.01
     sample_step: int = 2
-
-
-_BORDER_REACH = 2
-"""Pixels beside a border read on either side (only the depth jumps are used here)."""
 
 
 def slab_candidates(pieces: PieceSummary, labels: np.ndarray, rules: SlabRules) -> np.ndarray:
@@ -71,7 +67,7 @@ def continuous_borders(
         np.ascontiguousarray(labels),
         np.asarray(points, dtype=np.float32),
         np.asarray(normals, dtype=np.float32),
-        _BORDER_REACH,
+        BORDER_REACH,
         rules.jump_absolute,
         rules.jump_relative,
         0.0,
@@ -101,7 +97,7 @@ def slab_partners(
     if candidates.shape[0] == 0:
         return []
     boxes = pieces.boxes[candidates.reshape(-1)]
-    margin = _BORDER_REACH + 1
+    margin = BORDER_REACH + 1
     x0, y0 = max(int(boxes[:, 0].min()) - margin, 0), max(int(boxes[:, 1].min()) - margin, 0)
     x1 = min(int(boxes[:, 2].max()) + margin, labels.shape[1])
     y1 = min(int(boxes[:, 3].max()) + margin, labels.shape[0])

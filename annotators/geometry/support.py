@@ -228,14 +228,14 @@ class AppendageRules:
     sample_step: int = 2
 
 
-_BORDER_REACH = 2
+BORDER_REACH = 2
 """Pixels beside a border that :func:`~annotators.geometry.grid_segmentation.boundaries` reads on either side."""
 
 _CLOSE_FACTOR = 2.5
 """Points at most this many pixel footprints apart are close (the default of
 :func:`~annotators.geometry.grid_segmentation.boundaries`)."""
 
-_FOOTPRINT_ROWS = 8
+FOOTPRINT_ROWS = 8
 """The pixel footprint (the angle between neighbouring pixels) is measured on every this many rows of the grid."""
 
 
@@ -243,12 +243,12 @@ def close_borders(
     labels: np.ndarray, points: np.ndarray, normals: np.ndarray, rules: AppendageRules, footprint: float
 ) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
     """``pairs``, ``close`` and ``length`` of :func:`~annotators.geometry.grid_segmentation.boundaries` (its
-    default close factor, :data:`_BORDER_REACH`, the depth jumps of ``rules``), without its other measures."""
+    default close factor, :data:`BORDER_REACH`, the depth jumps of ``rules``), without its other measures."""
     key, _, near, _, _ = boundary_pairs(
         np.ascontiguousarray(labels),
         np.asarray(points, dtype=np.float32),
         np.asarray(normals, dtype=np.float32),
-        _BORDER_REACH,
+        BORDER_REACH,
         rules.jump_absolute,
         rules.jump_relative,
         _CLOSE_FACTOR * footprint,
@@ -301,7 +301,7 @@ def appendage_owners(
     involved = np.zeros(pieces.sizes.size, dtype=bool)
     involved[fitting_pairs.reshape(-1)] = True
     boxes = pieces.boxes[fitting_pairs[:, 0]]  # those of the small pieces, grown by the border reach
-    margin = _BORDER_REACH + 1
+    margin = BORDER_REACH + 1
     x0, y0 = max(int(boxes[:, 0].min()) - margin, 0), max(int(boxes[:, 1].min()) - margin, 0)
     x1, y1 = (
         min(int(boxes[:, 2].max()) + margin, labels.shape[1]),
@@ -313,7 +313,7 @@ def appendage_owners(
         points[y0:y1, x0:x1],
         normals[y0:y1, x0:x1],
         rules,
-        _footprint(points[::_FOOTPRINT_ROWS]),
+        _footprint(points[::FOOTPRINT_ROWS]),
     )
     fitting = set(map(tuple, fitting_pairs.tolist()))
     best: dict[int, tuple[float, int]] = {}
@@ -397,7 +397,7 @@ def jointly_held(
     involved = np.zeros(pieces.sizes.size, dtype=bool)
     involved[np.array(triples).reshape(-1)] = True
     boxes = pieces.boxes[involved]
-    margin = _BORDER_REACH + 1
+    margin = BORDER_REACH + 1
     x0, y0 = max(int(boxes[:, 0].min()) - margin, 0), max(int(boxes[:, 1].min()) - margin, 0)
     x1 = min(int(boxes[:, 2].max()) + margin, labels.shape[1])
     y1 = min(int(boxes[:, 3].max()) + margin, labels.shape[0])
@@ -407,7 +407,7 @@ def jointly_held(
         points[y0:y1, x0:x1],
         normals[y0:y1, x0:x1],
         touch_rules,
-        _footprint(points[::_FOOTPRINT_ROWS]),
+        _footprint(points[::FOOTPRINT_ROWS]),
     )
     attached = {
         tuple(pair)
