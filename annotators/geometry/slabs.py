@@ -18,9 +18,8 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from annotators.geometry.grid_kernels import boundary_pairs
-from annotators.geometry.grid_segmentation import distinct_keys, join_labels
-from annotators.geometry.support import BORDER_REACH, PieceSummary, summarize_pieces
+from annotators.geometry.grid_segmentation import join_labels
+from annotators.geometry.support import BORDER_REACH, PieceSummary, border_tallies, summarize_pieces
 
 
 @dataclass(frozen=True)
@@ -63,22 +62,10 @@ def continuous_borders(
 ) -> tuple[np.ndarray, np.ndarray]:
     """Per touching label pair (Kx2, a < b) of ``labels``: the number of its 4-neighbour pixel pairs without a
     depth jump, and their share of the border."""
-    key, jump, _, _, _ = boundary_pairs(
-        np.ascontiguousarray(labels),
-        np.asarray(points, dtype=np.float32),
-        np.asarray(normals, dtype=np.float32),
-        BORDER_REACH,
-        rules.jump_absolute,
-        rules.jump_relative,
-        0.0,
-    )
-    if key.size == 0:
-        return np.zeros((0, 2), np.int64), np.zeros(0)
-    unique, inverse = distinct_keys(key)
-    length = np.bincount(inverse, minlength=unique.size).astype(np.float64)
-    smooth = np.bincount(inverse, weights=~jump, minlength=unique.size)
-    base = int(labels.max(initial=0)) + 1
-    return np.column_stack([unique // base, unique % base]), np.column_stack([smooth, smooth / length])
+    pairs, length, smooth, _ = border_tallies(labels, points, normals, rules.jump_absolute, rules.jump_relative, 0.0)
+    if length.size == 0:
+        return pairs, np.zeros(0)
+    return pairs, np.column_stack([smooth, smooth / length])
 
 
 def slab_partners(

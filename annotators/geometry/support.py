@@ -239,27 +239,45 @@ FOOTPRINT_ROWS = 8
 """The pixel footprint (the angle between neighbouring pixels) is measured on every this many rows of the grid."""
 
 
+def border_tallies(
+    labels: np.ndarray,
+    points: np.ndarray,
+    normals: np.ndarray,
+    jump_absolute: float,
+    jump_relative: float,
+    close_distance: float,
+) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
+    """Per touching label pair (Kx2, a < b) of ``labels``: the number of its 4-neighbour pixel pairs (read
+    :data:`BORDER_REACH` pixels to either side), of those without a depth jump (``jump_absolute + jump_relative *
+    nearer depth``) and of those whose points lie within ``close_distance`` in 3-D."""
+    key, jump, near, _, _ = boundary_pairs(
+        np.ascontiguousarray(labels),
+        np.asarray(points, dtype=np.float32),
+        np.asarray(normals, dtype=np.float32),
+        BORDER_REACH,
+        jump_absolute,
+        jump_relative,
+        close_distance,
+    )
+    if key.size == 0:
+        return np.zeros((0, 2), np.int64), np.zeros(0), np.zeros(0), np.zeros(0)
+    unique, inverse = distinct_keys(key)
+    length = np.bincount(inverse, minlength=unique.size).astype(np.float64)
+    smooth = np.bincount(inverse, weights=~jump, minlength=unique.size)
+    close = np.bincount(inverse, weights=near, minlength=unique.size)
+    base = int(labels.max(initial=0)) + 1
+    return np.column_stack([unique // base, unique % base]), length, smooth, close
+
+
 def close_borders(
     labels: np.ndarray, points: np.ndarray, normals: np.ndarray, rules: AppendageRules, footprint: float
 ) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
     """``pairs``, ``close`` and ``length`` of :func:`~annotators.geometry.grid_segmentation.boundaries` (its
     default close factor, :data:`BORDER_REACH`, the depth jumps of ``rules``), without its other measures."""
-    key, _, near, _, _ = boundary_pairs(
-        np.ascontiguousarray(labels),
-        np.asarray(points, dtype=np.float32),
-        np.asarray(normals, dtype=np.float32),
-        BORDER_REACH,
-        rules.jump_absolute,
-        rules.jump_relative,
-        _CLOSE_FACTOR * footprint,
+    pairs, length, _, close = border_tallies(
+        labels, points, normals, rules.jump_absolute, rules.jump_relative, _CLOSE_FACTOR * footprint
     )
-    if key.size == 0:
-        return np.zeros((0, 2), np.int64), np.zeros(0), np.zeros(0)
-    unique, inverse = distinct_keys(key)
-    length = np.bincount(inverse, minlength=unique.size).astype(np.float64)
-    close = np.bincount(inverse, weights=near, minlength=unique.size) / length
-    base = int(labels.max(initial=0)) + 1
-    return np.column_stack([unique // base, unique % base]), close, length
+    return pairs, close / length, length
 
 
 def _footprint(points: np.ndarray) -> float:
