@@ -473,9 +473,7 @@ class BeliefStore:
             bounds = np.empty((len(members), 6))
             bounds[:, 0::2] = centres + gate  # x1, y1, z1 of each box, then x0, y0, z0 in between
             bounds[:, 1::2] = centres - gate
-            parameters = bounds.ravel().tolist()
-            found = conn.execute(_candidate_query(len(members)), (*parameters, frame, WORLD_FRAME, recording, PRESENT))
-            found = found.fetchall()
+            found = _near_entries_rows(conn, centres, bounds, gate, (frame, WORLD_FRAME, recording, PRESENT))
             if not found:
                 continue
             positions = np.array([row[3:6] for row in found], dtype=np.float64)
@@ -799,6 +797,63 @@ def _write(conn: sqlite3.Connection, log: list[tuple[str, list[tuple]]], stateme
     log.append((statement, rows))
 
 
+MERGED_ENTRIES_PER_BOX = 4
+"""A frame's observations of one world are looked up with one R*Tree query of the bounding box of their gate boxes
+when that box holds at most this many entries per observation; else with one query per gate box, united."""
+
+_ENTRIES_IN_BOX = (
+    "SELECT id, x0, x1, y0, y1, z0, z1 FROM objects_place "
+    "WHERE x0 <= ? AND x1 >= ? AND y0 <= ? AND y1 >= ? AND z0 <= ? AND z1 >= ? LIMIT ?"
+)
+
+
+def _near_entries_rows(
+    conn: sqlite3.Connection, centres: np.ndarray, bounds: np.ndarray, gate: float, world: tuple[str, str, str, str]
+) -> list[tuple]:
+    """The ``objects`` rows (with their R*Tree entry's x0, x1, y0, y1, z0, z1 appended) of the beliefs of ``world``
+    (frame, world frame, recording, status) whose entries meet any of the gate boxes ``bounds`` (x1, x0, y1, y0,
+    z1, z0 per box, around ``centres``).
+
+    Several boxes near each other (the common frame) take one R*Tree query of their bounding box, the entries that
+    meet a box picked in numpy by the very comparisons the R*Tree makes, then one fetch by id; when the bounding box
+    holds more than :data:`MERGED_ENTRIES_PER_BOX` entries per box (boxes far apart, or a crowded place), one query
+    per box, united, instead.
+    """
+    count = len(bounds)
+    if count > 1:
+        high, low = centres.max(axis=0) + gate, centres.min(axis=0) - gate
+        cap = MERGED_ENTRIES_PER_BOX * count
+        entries = conn.execute(_ENTRIES_IN_BOX, (high[0], low[0], high[1], low[1], high[2], low[2], cap + 1)).fetchall()
+        if len(entries) <= cap:
+            if not entries:
+                return []
+            boxes = np.array(entries, dtype=np.float64)
+            meets = (
+                (boxes[:, 1, None] <= bounds[None, :, 0])
+                & (boxes[:, 2, None] >= bounds[None, :, 1])
+                & (boxes[:, 3, None] <= bounds[None, :, 2])
+                & (boxes[:, 4, None] >= bounds[None, :, 3])
+                & (boxes[:, 5, None] <= bounds[None, :, 4])
+                & (boxes[:, 6, None] >= bounds[None, :, 5])
+            ).any(axis=1)
+            hits = {entry[0]: entry[1:] for entry, hit in zip(entries, meets.tolist(), strict=True) if hit}
+            if not hits:
+                return []
+            rows = conn.execute(_rows_by_id_query(len(hits)), (*hits, *world)).fetchall()
+            return [row + hits[row[0]] for row in rows]
+    return conn.execute(_candidate_query(count), (*bounds.ravel().tolist(), *world)).fetchall()
+
+
+@functools.lru_cache(maxsize=128)
+def _rows_by_id_query(count: int) -> str:
+    """The ``objects`` rows of ``count`` ids of one world (parameters: the ids, then the frame, the world frame,
+    the recording, the status)."""
+    return (
+        f"SELECT {_OBJECT_COLUMNS} FROM objects WHERE id IN ({', '.join('?' * count)}) "
+        "AND frame = ? AND (frame = ? OR recording = ?) AND status = ?"
+    )
+
+
 @functools.lru_cache(maxsize=64)
 def _candidate_query(boxes: int) -> str:
     """The present beliefs of one world whose R*Tree entries meet any of ``boxes`` boxes (one statement; its
@@ -822,7 +877,7 @@ def _roi_text(roi: tuple[int, int, int, int] | None) -> str | None:
 def _roi_from_text(text: str | None) -> tuple[int, int, int, int] | None:
     if not text:
         return None
-    x0, y0, x1, y1 = (int(v) for v in text.split(","))
+    x0, y0, x1, y1 = map(int, text.split(","))
     return x0, y0, x1, y1
 
 
@@ -947,7 +1002,9 @@ def _pack_attributes(
             experts = expert_codes.get(frozenset(s.sources))
             if experts is None:
                 experts = interned.experts_code(conn, s.sources, write)
-            flat += (name_code, value_code, _rounded(s.log_odds, 9), s.count, experts, s.first_seen, s.last_seen)
+            log_odds = s.log_odds  # _rounded(log_odds, 9), inlined (four values per belief, every frame)
+            rounded = _rounded_cached(log_odds, 9) if log_odds else round(log_odds, 9)
+            flat += (name_code, value_code, rounded, s.count, experts, s.first_seen, s.last_seen)
         if len(values) == 1:  # the common case: one value said, indexed
             entries.append(f"{name}={next(iter(values))}")
             continue
@@ -958,12 +1015,10 @@ def _pack_attributes(
 
 def _unpack_attributes(packed: bytes, interned: InternedTexts, conn: sqlite3.Connection) -> dict[str, AttributeBelief]:
     """The attributes of a packed attribute column (see :func:`_pack_attributes`)."""
-    numbers = _supports(len(packed) // SUPPORT.size).unpack(packed)
     texts = interned.texts
     expert_sets = interned.expert_sets
     decoded: dict[str, AttributeBelief] = {}
-    for i in range(0, len(numbers), _FIELDS):
-        name_code, value_code, log_odds, count, experts, first_seen, last_seen = numbers[i : i + _FIELDS]
+    for name_code, value_code, log_odds, count, experts, first_seen, last_seen in SUPPORT.iter_unpack(packed):
         name = texts.get(name_code)
         if name is None:
             name = interned.text(conn, name_code)

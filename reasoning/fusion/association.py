@@ -152,13 +152,16 @@ def typical_size(dimensions: np.ndarray) -> float:
 def typical_sizes(items: Sequence[Trackable]) -> np.ndarray:
     """:func:`typical_size` of every item's dimensions (0 when it has none), computed for all at once."""
     dimensions = [item.dimensions for item in items]
+    extents = _stacked(dimensions)
+    if extents is not None and (extents > 0).all():  # the common case: three positive extents each
+        return np.exp(np.log(extents).sum(axis=1) / 3.0)
     sizes = np.zeros(len(dimensions))
     full = [k for k, d in enumerate(dimensions) if d is not None and len(d) == 3]
     if full:
         chosen = dimensions if len(full) == len(dimensions) else [dimensions[k] for k in full]
         extents = np.array(chosen, dtype=np.float64)
         positive = (extents > 0).all(axis=1)
-        if positive.all():  # the common case: no zero extent, no masking
+        if positive.all():  # no zero extent, no masking
             sizes[full] = np.exp(np.log(extents).sum(axis=1) / 3.0)
         else:
             logs = np.log(np.where(positive[:, None], extents, 1.0))
@@ -170,6 +173,25 @@ def typical_sizes(items: Sequence[Trackable]) -> np.ndarray:
             if d is not None and len(d) != 3 and len(d):
                 sizes[k] = typical_size(d)
     return sizes
+
+
+def _stacked(vectors: Sequence[np.ndarray | None]) -> np.ndarray | None:
+    """The vectors as one Nx3 float array when every one is a 3-vector (N >= 1), else None."""
+    if not vectors:
+        return None
+    try:
+        stacked = np.array(vectors, dtype=np.float64)
+    except (TypeError, ValueError):  # None among them, or vectors of several lengths
+        return None
+    return stacked if stacked.ndim == 2 and stacked.shape[1] == 3 else None
+
+
+def _positions(items: Sequence[Trackable]) -> np.ndarray:
+    """The first three coordinates of every item's position, as one Nx3 float array."""
+    stacked = _stacked([item.position for item in items])
+    if stacked is not None:
+        return stacked
+    return np.array([item.position[:3] for item in items], dtype=np.float64)
 
 
 def geometric_costs(
@@ -214,8 +236,7 @@ def _near_pairs(
     if not observations or not beliefs:
         empty = np.empty(0, dtype=np.int64)
         return empty, empty, np.empty(0)
-    a = np.array([o.position[:3] for o in observations], dtype=np.float64)
-    b = np.array([x.position[:3] for x in beliefs], dtype=np.float64)
+    a, b = _positions(observations), _positions(beliefs)
     delta = a[:, None, :] - b[None, :, :]
     distance = np.sqrt(np.einsum("ijk,ijk->ij", delta, delta))
     near = distance <= gate
@@ -240,22 +261,26 @@ def assign(cost: np.ndarray) -> Association:
     if rows == 0 or cols == 0:
         return Association((), tuple(range(rows)), tuple(range(cols)))
     feasible = cost < INFEASIBLE
-    if not feasible.any():
+    feasible_rows, feasible_cols = np.nonzero(feasible)
+    pair_rows, pair_cols = feasible_rows.tolist(), feasible_cols.tolist()
+    if not pair_rows:
         return Association((), tuple(range(rows)), tuple(range(cols)))
-    if rows == 1 or cols == 1:
-        i, j = np.unravel_index(int(np.argmin(cost)), cost.shape)
-        chosen_rows, chosen_cols = np.array([i]), np.array([j])
-    elif _disjoint(feasible):
+    if len(set(pair_rows)) == len(pair_rows) and len(set(pair_cols)) == len(pair_cols):
         # no two feasible pairs share an observation or a belief: the optimal assignment takes them all (leaving
         # one out would put a prohibitive cost in its place), so there is nothing to choose
-        chosen_rows, chosen_cols = np.nonzero(feasible)
+        matched_rows, matched_cols = pair_rows, pair_cols
+        costs = cost[feasible_rows, feasible_cols].tolist()
     else:
-        from scipy.optimize import linear_sum_assignment
+        if rows == 1 or cols == 1:
+            i, j = np.unravel_index(int(np.argmin(cost)), cost.shape)
+            chosen_rows, chosen_cols = np.array([i]), np.array([j])
+        else:
+            from scipy.optimize import linear_sum_assignment
 
-        chosen_rows, chosen_cols = linear_sum_assignment(np.where(feasible, cost, INFEASIBLE))
-    kept = feasible[chosen_rows, chosen_cols]
-    matched_rows, matched_cols = chosen_rows[kept].tolist(), chosen_cols[kept].tolist()
-    costs = cost[chosen_rows[kept], chosen_cols[kept]].tolist()
+            chosen_rows, chosen_cols = linear_sum_assignment(np.where(feasible, cost, INFEASIBLE))
+        kept = feasible[chosen_rows, chosen_cols]
+        matched_rows, matched_cols = chosen_rows[kept].tolist(), chosen_cols[kept].tolist()
+        costs = cost[chosen_rows[kept], chosen_cols[kept]].tolist()
     matches = tuple(zip(matched_rows, matched_cols, costs, strict=True))
     taken_rows, taken_cols = set(matched_rows), set(matched_cols)
     return Association(
@@ -263,11 +288,6 @@ def assign(cost: np.ndarray) -> Association:
         tuple(i for i in range(rows) if i not in taken_rows),
         tuple(j for j in range(cols) if j not in taken_cols),
     )
-
-
-def _disjoint(feasible: np.ndarray) -> bool:
-    """True when every row and every column of the boolean matrix holds at most one True."""
-    return bool((feasible.sum(axis=0) <= 1).all() and (feasible.sum(axis=1) <= 1).all())
 
 
 def associate(
