@@ -473,7 +473,9 @@ class BeliefStore:
             bounds = np.empty((len(members), 6))
             bounds[:, 0::2] = centres + gate  # x1, y1, z1 of each box, then x0, y0, z0 in between
             bounds[:, 1::2] = centres - gate
-            found = _near_entries_rows(conn, centres, bounds, gate, (frame, WORLD_FRAME, recording, PRESENT))
+            parameters = bounds.ravel().tolist()
+            found = conn.execute(_candidate_query(len(members)), (*parameters, frame, WORLD_FRAME, recording, PRESENT))
+            found = found.fetchall()
             if not found:
                 continue
             positions = np.array([row[3:6] for row in found], dtype=np.float64)
@@ -797,63 +799,6 @@ def _write(conn: sqlite3.Connection, log: list[tuple[str, list[tuple]]], stateme
     log.append((statement, rows))
 
 
-MERGED_ENTRIES_PER_BOX = 4
-"""A frame's observations of one world are looked up with one R*Tree query of the bounding box of their gate boxes
-when that box holds at most this many entries per observation; else with one query per gate box, united."""
-
-_ENTRIES_IN_BOX = (
-    "SELECT id, x0, x1, y0, y1, z0, z1 FROM objects_place "
-    "WHERE x0 <= ? AND x1 >= ? AND y0 <= ? AND y1 >= ? AND z0 <= ? AND z1 >= ? LIMIT ?"
-)
-
-
-def _near_entries_rows(
-    conn: sqlite3.Connection, centres: np.ndarray, bounds: np.ndarray, gate: float, world: tuple[str, str, str, str]
-) -> list[tuple]:
-    """The ``objects`` rows (with their R*Tree entry's x0, x1, y0, y1, z0, z1 appended) of the beliefs of ``world``
-    (frame, world frame, recording, status) whose entries meet any of the gate boxes ``bounds`` (x1, x0, y1, y0,
-    z1, z0 per box, around ``centres``).
-
-    Several boxes near each other (the common frame) take one R*Tree query of their bounding box, the entries that
-    meet a box picked in numpy by the very comparisons the R*Tree makes, then one fetch by id; when the bounding box
-    holds more than :data:`MERGED_ENTRIES_PER_BOX` entries per box (boxes far apart, or a crowded place), one query
-    per box, united, instead.
-    """
-    count = len(bounds)
-    if count > 1:
-        high, low = centres.max(axis=0) + gate, centres.min(axis=0) - gate
-        cap = MERGED_ENTRIES_PER_BOX * count
-        entries = conn.execute(_ENTRIES_IN_BOX, (high[0], low[0], high[1], low[1], high[2], low[2], cap + 1)).fetchall()
-        if len(entries) <= cap:
-            if not entries:
-                return []
-            boxes = np.array(entries, dtype=np.float64)
-            meets = (
-                (boxes[:, 1, None] <= bounds[None, :, 0])
-                & (boxes[:, 2, None] >= bounds[None, :, 1])
-                & (boxes[:, 3, None] <= bounds[None, :, 2])
-                & (boxes[:, 4, None] >= bounds[None, :, 3])
-                & (boxes[:, 5, None] <= bounds[None, :, 4])
-                & (boxes[:, 6, None] >= bounds[None, :, 5])
-            ).any(axis=1)
-            hits = {entry[0]: entry[1:] for entry, hit in zip(entries, meets.tolist(), strict=True) if hit}
-            if not hits:
-                return []
-            rows = conn.execute(_rows_by_id_query(len(hits)), (*hits, *world)).fetchall()
-            return [row + hits[row[0]] for row in rows]
-    return conn.execute(_candidate_query(count), (*bounds.ravel().tolist(), *world)).fetchall()
-
-
-@functools.lru_cache(maxsize=128)
-def _rows_by_id_query(count: int) -> str:
-    """The ``objects`` rows of ``count`` ids of one world (parameters: the ids, then the frame, the world frame,
-    the recording, the status)."""
-    return (
-        f"SELECT {_OBJECT_COLUMNS} FROM objects WHERE id IN ({', '.join('?' * count)}) "
-        "AND frame = ? AND (frame = ? OR recording = ?) AND status = ?"
-    )
-
-
 @functools.lru_cache(maxsize=64)
 def _candidate_query(boxes: int) -> str:
     """The present beliefs of one world whose R*Tree entries meet any of ``boxes`` boxes (one statement; its
@@ -871,7 +816,7 @@ def _roi_text(roi: tuple[int, int, int, int] | None) -> str | None:
     if roi is None:
         return None
     x0, y0, x1, y1 = roi
-    return f"{int(x0)},{int(y0)},{int(x1)},{int(y1)}"
+    return "%d,%d,%d,%d" % (x0, y0, x1, y1)  # noqa: UP031 - int() of each, faster than an f-string of four int()
 
 
 def _roi_from_text(text: str | None) -> tuple[int, int, int, int] | None:
@@ -1102,7 +1047,8 @@ def _pack_evidence(
         source = codes.get(e.source)
         if source is None:
             source = interned.code(conn, e.source, write)
-        flat += (attribute, value, _rounded(e.confidence, 6), source)
+        confidence = e.confidence  # _rounded(confidence, 6), inlined
+        flat += (attribute, value, _rounded_cached(confidence, 6) if confidence else round(confidence, 6), source)
     return _statements(len(evidence)).pack(*flat)
 
 

@@ -248,8 +248,12 @@ def accumulate_into(
 ) -> None:
     """Accumulate statements into ``beliefs`` (by attribute, created when missing), stamped with ``time`` when given
     (e.g. one frame's statements straight into a stored belief's attributes)."""
-    for item in evidence:
+    for item in evidence:  # AttributeBelief.add of each statement, written out (the hot path of every update)
         belief = beliefs.get(item.attribute)
         if belief is None:
             belief = beliefs[item.attribute] = AttributeBelief(item.attribute)
-        belief.add(item, time)
+        values = belief.values
+        support = values.get(item.value)
+        if support is None:
+            support = values[item.value] = ValueSupport()
+        support.add(logit(item.confidence), (item.source,), item.time if time is None else time)
