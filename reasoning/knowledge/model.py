@@ -58,6 +58,9 @@ class ObjectProfile:
     open_top: bool | None = None
     height_to_width: tuple[float, float] | None = None
     """Form features: a handle on the side, open at the top, the (min, max) of height over width; None: any."""
+    elongation: tuple[float, float] | None = None
+    """The (min, max) of the longest extent over the second longest (a banana's footprint is long and narrow, a
+    tin's round); None: any."""
     printed: bool | None = None
     """A label printed in several colours (a can's), False: a plain one-coloured surface; None: either."""
 
