@@ -4,12 +4,13 @@ The planner passes one profile per candidate class as plain data::
 
     {"class": "Milk", "colors": ("white",), "shape": "box", "size": "medium", "texts": ("milk",),
      "handle": False, "open_top": False, "height_to_width": (1.2, 4.0), "elongation": None,
-     "ancestors": ("Milk", "Drink", "FoodOrDrink", "PhysicalObject")}
+     "ancestors": ("Milk", "Drink", "FoodOrDrink", "PhysicalObject"), "packaged_in": ()}
 
 (colour, shape and size are the ontology's lower-case labels; the form cues - a handle, an open top, the ranges of
 height over width and of elongation - are the ontology's ``rk:hasHandle``, ``rk:openTop``,
-``rk:min/maxHeightToWidth``, ``rk:min/maxElongation``; any key but ``class`` may be missing or None: the class may
-have any value).
+``rk:min/maxHeightToWidth``, ``rk:min/maxElongation``; ``packaged_in`` names the container class the objects are
+typically packaged in and its ancestors, ``rk:packagedIn``: a query for a bottle also asks for a mustard; any key
+but ``class`` may be missing or None: the class may have any value).
 
 Scoring. For every cue the hypothesis carries (its most confident SemanticColor, Shape, Size, FormFeatures and,
 when read, Text) a profile gets an agreement in [0, 1]:
@@ -50,7 +51,9 @@ asserted only when it fits (score >= ``min_score``) and that probability reaches
 Classification confidence is that probability. Otherwise the query's class (``expected``) may break a tie: a match
 of that class that fits and scores as high as the best fitting one (within ``margin``: equal but for rounding, so
 the cues cannot tell the two classes apart) is asserted with its own (low) calibrated probability - the query never
-lifts a poor fit (a class named by printed text fits only when its text was read; the root class breaks no tie),
+lifts a poor fit (a class named by printed text whose text went unread is named only as a guess: it must tie with
+every fitting class, and the calibration's unread term keeps its probability low; the root class breaks no tie;
+a class packaged in the query's class counts as one of it: a mustard for "find all bottles"),
 and it decides only what the form cues leave open: no settled form cue (said with confidence 1) may speak against
 it - a mug seen surely closed is no mug, whatever else ties with it - and it must stay the best fitting class
 (within ``margin``) however the unsettled ones turn out (:func:`cue_outcomes`): the open top as the form expert said
@@ -193,6 +196,13 @@ class Profile:
     height_to_width: tuple[float, float] | None = None
     printed: bool | None = None
     elongation: tuple[float, float] | None = None
+    packaged_in: frozenset[str] = frozenset()
+    """The container class the objects are typically packaged in and its ancestors (lower case), or empty."""
+
+    def answers(self, wanted: str) -> bool:
+        """True when an object of this class answers a query for ``wanted`` (lower case): it is one, or it is
+        typically packaged in one (a mustard is seen as its bottle)."""
+        return wanted in self.ancestors or wanted in self.packaged_in
 
     @classmethod
     def from_mapping(cls, data: Mapping[str, object]) -> Profile:
@@ -216,6 +226,7 @@ class Profile:
             height_to_width=_ratio_range(data.get("height_to_width")),
             printed=_flag(data, "printed"),
             elongation=_ratio_range(data.get("elongation")),
+            packaged_in=frozenset(_names(data.get("packaged_in"))),
         )
 
     def related(self, other: Profile) -> bool:
@@ -401,17 +412,25 @@ def more_general_fit(
 
 
 def choose_expected(matches: Sequence[Match], expected: str, min_score: float, margin: float) -> Match | None:
-    """The query's class breaking a tie: among the fitting matches within ``margin`` of the best fitting
-    score, the best one of the expected class (or a subclass); None otherwise, and always for the root class
-    (a query for any object prefers none). A match fits when it scores at least ``min_score`` and, for a class
-    named by printed text, its text was read."""
-    fitting = [m for m in matches if m.score >= min_score and not m.unread]
+    """The query's class breaking a tie: the best match of the expected class (a subclass, or a class packaged in
+    it: :meth:`Profile.answers`) among the fitting matches within ``margin`` of the best fitting score; None
+    otherwise, and always for the root class (a query for any object prefers none). A match fits when it scores at
+    least ``min_score``. A class named by printed text that went unread (a mustard whose label was not read) is
+    only a guess: it must tie with every fitting match, those of other unread classes included, while a match
+    whose texts were read (or that names none) need only tie with those (an unread class scores without the
+    cue that would tell it apart, so it does not raise their bar); its calibrated probability stays low."""
     wanted = expected.lower()
+    fitting = [m for m in matches if m.score >= min_score]
     if not fitting or wanted == UNKNOWN_CLASS.lower():
         return None
     top = max(m.score for m in fitting)
-    candidates = [m for m in fitting if top - m.score <= margin and wanted in m.profile.ancestors]
-    return max(candidates, key=lambda m: (m.score, -len(m.profile.ancestors)), default=None)
+    top_read = max((m.score for m in fitting if not m.unread), default=top)
+    candidates = [
+        m
+        for m in fitting
+        if (top if m.unread else top_read) - m.score <= margin and m.profile.answers(wanted)
+    ]
+    return max(candidates, key=lambda m: (not m.unread, m.score, -len(m.profile.ancestors)), default=None)
 
 
 def cue_outcomes(cues: Cues) -> list[Cues]:

@@ -43,6 +43,7 @@ PROFILE_PROPERTIES: Mapping[str, tuple[str, Kind | None]] = {
     "sizeClass": ("size_class", "size"),
     "madeOf": ("material", "material"),
     "storedIn": ("stored_in", "region_class"),
+    "packagedIn": ("packaged_in", "class"),
     "transparent": ("transparent", None),
     "printedText": ("texts", None),
     "brand": ("brand", None),
@@ -73,6 +74,7 @@ _SINGLE_FIELDS = (
     "size_class",
     "material",
     "stored_in",
+    "packaged_in",
     "transparent",
     "brand",
     "handle",
@@ -576,6 +578,7 @@ class _Builder:
                 material=values.get("material"),  # type: ignore[arg-type]
                 transparent=values.get("transparent"),  # type: ignore[arg-type]
                 stored_in=values.get("stored_in"),  # type: ignore[arg-type]
+                packaged_in=values.get("packaged_in"),  # type: ignore[arg-type]
                 texts=tuple(texts),
                 brand=values.get("brand"),  # type: ignore[arg-type]
                 origins=tuple(origins),

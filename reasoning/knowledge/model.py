@@ -63,6 +63,8 @@ class ObjectProfile:
     tin's round); None: any."""
     printed: bool | None = None
     """A label printed in several colours (a can's), False: a plain one-coloured surface; None: either."""
+    packaged_in: str | None = None
+    """The container class objects of the class are typically sold and kept in (a mustard's bottle), or None."""
 
     def origin(self, field: str) -> str | None:
         """The class that declares ``field`` for this profile (None when the field is unset)."""

@@ -65,9 +65,34 @@ def test_the_query_breaks_a_near_tie_between_fitting_classes_with_a_low_confiden
 
 def test_a_class_named_by_its_text_needs_the_text() -> None:
     white_box = Cues(color=("white", 0.9), shape=("box", 0.8), size=("medium", 1.0))
-    assert decide(matches(white_box), expected="Milk").class_name == UNKNOWN_CLASS  # milk or flour: text unread
+    assert decide(matches(white_box)).class_name == UNKNOWN_CLASS  # milk or flour: text unread
+    # the query names it only as a guess, hedged by the calibration's unread term (what "find the milk" answers
+    # with "milk?"), and only when it ties with every fitting class
+    guess = decide(matches(white_box), expected="Milk")
+    assert guess.class_name == "Milk" and guess.confidence < 0.1, guess
     read = decide(matches(Cues(**{**white_box.__dict__, "text": "fresh MILK"})))
     assert read.class_name == "Milk" and read.confidence > 0.5
+    # an unread class the cues score below another fitting one is no guess: the query does not lift it
+    milk_lower = [replace(m, score=m.score - 0.05) if m.profile.class_name == "Milk" else m for m in matches(white_box)]
+    assert decide(milk_lower, expected="Milk").class_name != "Milk"
+
+
+def test_a_query_for_a_container_asks_for_what_is_packaged_in_it() -> None:
+    bottle = ("PlasticBottle", "Bottle", "Container", "PhysicalObject")
+    mustard = {"class": "Mustard", "colors": ("yellow",), "shape": "cylinder", "size": "medium",
+               "texts": ("mustard",), "ancestors": ("Mustard", "Condiment", "Food", "PhysicalObject"),
+               "packaged_in": bottle}  # fmt: skip
+    soda = {**mustard, "class": "LemonSoda", "texts": ("lemon",), "packaged_in": (),
+            "ancestors": ("LemonSoda", "SoftDrink", "Drink", "PhysicalObject")}  # fmt: skip
+    profiles = [Profile.from_mapping(p) for p in (mustard, soda, MUG, CUP)]
+    assert profiles[0].answers("bottle") and profiles[0].answers("container") and not profiles[1].answers("bottle")
+    yellow_cylinder = Cues(color=("yellow", 0.6), shape=("cylinder", 0.5), size=("medium", 1.0))
+    found = [score(p, yellow_cylinder) for p in profiles]
+    assert decide(found).class_name == UNKNOWN_CLASS  # mustard or lemon soda: cannot tell
+    for_bottles = decide(found, expected="Bottle")
+    assert for_bottles.class_name == "Mustard" and for_bottles.confidence < 0.5  # hedged: it may be a soda can
+    assert decide(found, expected="LemonSoda").class_name == "LemonSoda"
+    assert decide(found, expected="Mug").class_name == UNKNOWN_CLASS  # a poor fit is never lifted
 
 
 def test_leaves_the_cues_cannot_tell_apart_are_named_by_the_class_above_them() -> None:
