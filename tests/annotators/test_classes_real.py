@@ -21,6 +21,7 @@ from pathlib import Path
 import pytest
 
 from robokudo.application import cli
+from robokudo.core.types import Classification
 
 pytestmark = pytest.mark.real_data
 
@@ -94,3 +95,42 @@ def test_a_round_cookie_tin_is_no_carrot_nor_banana(
     if not source.is_file():
         pytest.skip(f"needs {source}")
     assert classes_at(capsys, store, source, 0, {"cookie tin": tin})["cookie tin"] == UNKNOWN
+
+
+def answered_at(capsys: pytest.CaptureFixture, store: Path, source: Path, frame: int, query: str, pixel: tuple) -> dict:
+    """The answer object of ``robokudo query QUERY --json`` whose image box holds ``pixel`` (the smallest one)."""
+    code = cli.main(["query", query, "--input", str(source), "--frame", str(frame), "--store", str(store), "--json"])
+    out = capsys.readouterr().out
+    objects = json.loads(out)["objects"] if code == 0 else []
+    x, y = pixel
+    holding = [o for o in objects if o["roi"] and o["roi"][0] <= x < o["roi"][2] and o["roi"][1] <= y < o["roi"][3]]
+    assert holding, f"{query!r} on frame {frame} answered nothing at {pixel}: {out}"
+    return min(holding, key=lambda o: (o["roi"][2] - o["roi"][0]) * (o["roi"][3] - o["roi"][1]))
+
+
+def class_confidence(answered: dict) -> float:
+    """The probability the answer gives that the object's class is right."""
+    return answered["attributes"][Classification.attribute]["confidence"]
+
+
+# the mustard bottle: frames 0 and 2 are in the fit split, 1 and 3 held out (labels/real_objects.json)
+MUSTARD = [(0, (285, 100)), (1, (280, 180)), (2, (190, 150)), (3, (190, 160))]
+
+
+@pytest.mark.parametrize("frame, pixel", [MUSTARD[0], MUSTARD[3]], ids=["frame0-fit", "frame3-held-out"])
+def test_find_all_bottles_answers_the_mustard_bottle(
+    capsys: pytest.CaptureFixture, store: Path, frame: int, pixel: tuple
+) -> None:
+    """A mustard is packaged in a bottle (rk:packagedIn), so "find all bottles" asks for it. Its label went unread
+    and it ties with a lemon soda (a can), so the answer is hedged: a low class probability, marked "?"."""
+    found = answered_at(capsys, store, Path("../shared/data/uoc_tabletop_realsense"), frame, "find all bottles", pixel)
+    assert found["class"]["label"] in {"bottle", "plastic bottle", "mustard"}, found
+    assert class_confidence(found) < 0.5, found
+
+
+@pytest.mark.parametrize("frame, pixel", [MUSTARD[2], MUSTARD[1]], ids=["frame2-fit", "frame1-held-out"])
+def test_find_the_mustard_answers_the_yellow_bottle_hedged(
+    capsys: pytest.CaptureFixture, store: Path, frame: int, pixel: tuple
+) -> None:
+    found = answered_at(capsys, store, Path("../shared/data/uoc_tabletop_realsense"), frame, "find the mustard", pixel)
+    assert found["class"]["label"] == "mustard" and class_confidence(found) < 0.5, found
