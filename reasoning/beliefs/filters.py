@@ -9,6 +9,9 @@ A list of words under an attribute key (``color: [red, blue]``, from ``red or bl
 selects objects with any of those values: an object has one dominant colour, shape and size, so "all of them"
 would match nothing, and RoboKudo's designator lists mean alternatives too.
 
+The class test of the filter is :func:`kb_query_class_test`: an object answers a query for a class it is, or for the
+container it is typically packaged in (``rk:packagedIn``: a mustard for "find all bottles").
+
 Which key filters which attribute comes from the ontology (the annotation type answering the key, its value
 kind) and the annotation type's ``attribute`` (:mod:`robokudo.core.types`); without a knowledge base a key
 filters the attribute of the same name.
