@@ -169,6 +169,13 @@ def table(kb: KnowledgeBase, samples: list[Sample], title: str) -> None:
         print(f"  {low:.1f}-{min(high, 1.0):.1f}          {len(inside):7d}   {share}")
     unknown = [s for s in seen if s.truth == UNKNOWN]
     reported = [s for s in seen if s.said == UNKNOWN_CLASS]
+    known = [s for s in samples if s.truth != UNKNOWN]
+    named_known = [s for s in known if s.said is not None and s.said != UNKNOWN_CLASS]
+    named_right = sum(right(kb, s.said, s.truth) for s in named_known)
+    print(
+        f"  coverage: known objects named {len(named_known)}/{len(known)}"
+        f" ({len(named_known) / max(len(known), 1):.2f}), of them right {named_right}"
+    )
     print(
         f"  unknown objects reported unknown: {sum(s.said == UNKNOWN_CLASS for s in unknown)}/{len(unknown)}; "
         f"known objects reported unknown: {sum(s.truth != UNKNOWN for s in reported)}/"

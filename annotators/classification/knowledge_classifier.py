@@ -3,12 +3,14 @@
 The planner passes one profile per candidate class as plain data::
 
     {"class": "Milk", "colors": ("white",), "shape": "box", "size": "medium", "texts": ("milk",),
-     "handle": False, "open_top": False, "height_to_width": (1.2, 4.0),
-     "ancestors": ("Milk", "Drink", "FoodOrDrink", "PhysicalObject")}
+     "handle": False, "open_top": False, "height_to_width": (1.2, 4.0), "elongation": None,
+     "ancestors": ("Milk", "Drink", "FoodOrDrink", "PhysicalObject"), "packaged_in": ()}
 
-(colour, shape and size are the ontology's lower-case labels; the form cues - a handle, an open top, the range of
-height over width - are the ontology's ``rk:hasHandle``, ``rk:openTop``, ``rk:min/maxHeightToWidth``; any key but
-``class`` may be missing or None: the class may have any value).
+(colour, shape and size are the ontology's lower-case labels; the form cues - a handle, an open top, the ranges of
+height over width and of elongation - are the ontology's ``rk:hasHandle``, ``rk:openTop``,
+``rk:min/maxHeightToWidth``, ``rk:min/maxElongation``; ``packaged_in`` names the container class the objects are
+typically packaged in and its ancestors, ``rk:packagedIn``: a query for a bottle also asks for a mustard; any key
+but ``class`` may be missing or None: the class may have any value).
 
 Scoring. For every cue the hypothesis carries (its most confident SemanticColor, Shape, Size, FormFeatures and,
 when read, Text) a profile gets an agreement in [0, 1]:
@@ -22,6 +24,10 @@ when read, Text) a profile gets an agreement in [0, 1]:
   nothing;
 * open top: 1 when equal, 0 when not, 0.5 when the profile says nothing;
 * height over width: 1 inside the profile's range, falling to 0 at ``RATIO_FALLOFF`` times beyond a bound;
+* elongation (the longest extent the size expert measured over the second longest): as the height over width,
+  counted only for profiles that declare a range (long, narrow classes: a banana, a carrot); the others may be
+  any, and a cue every other profile is neutral about would only pull their scores toward 0.5. It tells a banana
+  lying on the table from a round tub or tin of the same colour, size and height over width;
 * printed label (``rk:printedLabel``), when the object shows several colours (a second colour named, or the
   dominant one short of ``PLAIN_SHARE``; one colour says nothing, a label may be mostly one colour): 1 for a
   profile with a printed label, 0 for a plain one; counted only for profiles that say either (most classes, a
@@ -42,21 +48,24 @@ Deciding. The score is not a probability: many classes share colour, shape and s
 are all small cylinders). The calibration (``calibration.FITTED``, fitted on labelled objects) turns the best
 match's score, lead and whether its printed text went unread into the probability that it is right. A class is
 asserted only when it fits (score >= ``min_score``) and that probability reaches :data:`ASSERT_PROBABILITY`; its
-Classification confidence is that probability. Otherwise the most specific class above the best one that fits
-and reaches that probability by its own score and lead is asserted (cues that cannot tell a white ceramic bowl
-from a plastic one still say bowl). Otherwise the query's class (``expected``) may break a tie:
-a match of that class that fits and scores as high as the best fitting one (within ``margin``: equal but for
-rounding, so the cues cannot tell the two classes apart) is asserted with its own
-(low) calibrated probability - the query never lifts a poor fit (a class named by printed text fits only when its
-text was read; the root class breaks no tie), and it decides only what the form cues leave open: no settled form
-cue (said with confidence 1) may speak against it - a mug seen surely closed is no mug, whatever else ties with it -
-and it must stay the best fitting class (within ``margin``) however the unsettled ones turn out
-(:func:`cue_outcomes`): the open top as the form expert said it, and the handle either way, as a view hides or shows
-it by chance. A mug whose handle the form expert could not make out ties with a cup, but its handle seen would make
-it a mug, so "find a cup" does not answer it; nor is half a bowl, flaring like a handle, a mug for "find all mugs"
-(surely without a handle it would be a cup). Everything
-else is classified :data:`UNKNOWN_CLASS` ("unknown object") with confidence 1 - probability (how sure the
-classifier is that naming the best candidate would be wrong).
+Classification confidence is that probability. Otherwise the query's class (``expected``) may break a tie: a match
+of that class that fits and scores as high as the best fitting one (within ``margin``: equal but for rounding, so
+the cues cannot tell the two classes apart) is asserted with its own (low) calibrated probability - the query never
+lifts a poor fit (a class named by printed text whose text went unread is named only as a guess: it must tie with
+every fitting class, and the calibration's unread term keeps its probability low; the root class breaks no tie;
+a class packaged in the query's class counts as one of it: a mustard for "find all bottles"),
+and it decides only what the form cues leave open: no settled form cue (said with confidence 1) may speak against
+it - a mug seen surely closed is no mug, whatever else ties with it - and it must stay the best fitting class
+(within ``margin``) however the unsettled ones turn out (:func:`cue_outcomes`): the open top as the form expert said
+it, and the handle either way, as a view hides or shows it by chance. A mug whose handle the form expert could not
+make out ties with a cup, but its handle seen would make it a mug, so "find a cup" does not answer it; nor is half
+a bowl, flaring like a handle, a mug for "find all mugs" (surely without a handle it would be a cup).
+Otherwise the most specific class above the best one (with or without a profile of its own) that, taken as a
+whole, fits and reaches :data:`ASSERT_PROBABILITY` is asserted: its score is the best of its own and its
+subclasses' profiles, its lead that over the best profile outside it (cues that cannot tell a white ceramic bowl
+from a plastic one still say bowl; a cup from a glass, still a container; a carton whose printed text went unread,
+still food or drink; :func:`class_evidence`). Everything else is classified :data:`UNKNOWN_CLASS` ("unknown
+object") with confidence 1 - probability (how sure the classifier is that naming the best candidate would be wrong).
 """
 
 from __future__ import annotations
@@ -159,10 +168,15 @@ def _ratio_range(value: object) -> tuple[float, float] | None:
     try:
         low, high = (float(v) for v in value)  # type: ignore[attr-defined]
     except (TypeError, ValueError) as error:
-        raise ValueError(f"a profile's height_to_width must be (min, max), got {value!r}") from error
+        raise ValueError(f"a profile's ratio range must be (min, max), got {value!r}") from error
     if not 0.0 <= low < high:
-        raise ValueError(f"a profile's height_to_width range must have 0 <= min < max, got {value!r}")
+        raise ValueError(f"a profile's ratio range must have 0 <= min < max, got {value!r}")
     return low, high
+
+
+def _lineage(name: str, ancestors: object) -> tuple[str, ...]:
+    given = [str(a) for a in ancestors] if isinstance(ancestors, Sequence) and not isinstance(ancestors, str) else []  # type: ignore[union-attr]
+    return (name, *(a for a in dict.fromkeys(given) if a and a.lower() != name.lower()))
 
 
 @dataclass(frozen=True)
@@ -175,10 +189,20 @@ class Profile:
     size: str | None = None
     texts: tuple[str, ...] = ()
     ancestors: frozenset[str] = frozenset()
+    lineage: tuple[str, ...] = ()
+    """The class and its ancestors as named, the most specific first (as the planner orders them)."""
     handle: bool | None = None
     open_top: bool | None = None
     height_to_width: tuple[float, float] | None = None
     printed: bool | None = None
+    elongation: tuple[float, float] | None = None
+    packaged_in: frozenset[str] = frozenset()
+    """The container class the objects are typically packaged in and its ancestors (lower case), or empty."""
+
+    def answers(self, wanted: str) -> bool:
+        """True when an object of this class answers a query for ``wanted`` (lower case): it is one, or it is
+        typically packaged in one (a mustard is seen as its bottle)."""
+        return wanted in self.ancestors or wanted in self.packaged_in
 
     @classmethod
     def from_mapping(cls, data: Mapping[str, object]) -> Profile:
@@ -196,10 +220,13 @@ class Profile:
             size=sizes[0] if sizes else None,
             texts=tuple(t for t in (compact(t) for t in _names(data.get("texts"))) if t),
             ancestors=frozenset(_names(data.get("ancestors"))) | {name.lower()},
+            lineage=_lineage(name, data.get("ancestors")),
             handle=_flag(data, "handle"),
             open_top=_flag(data, "open_top"),
             height_to_width=_ratio_range(data.get("height_to_width")),
             printed=_flag(data, "printed"),
+            elongation=_ratio_range(data.get("elongation")),
+            packaged_in=frozenset(_names(data.get("packaged_in"))),
         )
 
     def related(self, other: Profile) -> bool:
@@ -211,7 +238,8 @@ class Profile:
 class Cues:
     """The cues the experts gave about one hypothesis (None: not given): the most confident colour, shape and
     size class with their confidences, the text read on it, the form cues, the largest extent (metres) the size
-    class was named from, and whether it shows several colours (a printed label) with how sure that is."""
+    class was named from, the longest extent over the second longest (elongation), and whether it shows several
+    colours (a printed label) with how sure that is."""
 
     color: tuple[str, float] | None = None
     shape: tuple[str, float] | None = None
@@ -222,6 +250,7 @@ class Cues:
     height_to_width: float | None = None
     extent: float | None = None
     printed: tuple[bool, float] | None = None
+    elongation: float | None = None
 
 
 @dataclass(frozen=True)
@@ -306,6 +335,9 @@ def score(profile: Profile, cues: Cues) -> Match:
     if cues.height_to_width is not None:
         total += WEIGHTS["ratio"] * _ratio_agreement(cues.height_to_width, profile.height_to_width)
         weight += WEIGHTS["ratio"]
+    if cues.elongation is not None and profile.elongation is not None:
+        total += WEIGHTS["ratio"] * _ratio_agreement(cues.elongation, profile.elongation)
+        weight += WEIGHTS["ratio"]
     if cues.printed is not None and profile.printed is not None:
         agreement = float(profile.printed == cues.printed[0])
         total += WEIGHTS["printed"] * _toward_neutral(agreement, cues.printed[1])
@@ -336,40 +368,69 @@ def lead(match: Match, matches: Sequence[Match]) -> float:
     return match.score - max(rivals, default=0.0)
 
 
+def members(name: str, matches: Sequence[Match]) -> list[Match]:
+    """The matches of ``name`` (lower case) and of its subclasses."""
+    return [m for m in matches if name in m.profile.ancestors]
+
+
+def above(match: Match, name: str, inside: Sequence[Match]) -> bool:
+    """True when ``match``'s class is a proper superclass of ``name`` (lower case), whose matches (of it and its
+    subclasses) are ``inside``: every one of them has it as an ancestor, and it is not below ``name``."""
+    own = match.profile.class_name.lower()
+    return own != name and name not in match.profile.ancestors and all(own in m.profile.ancestors for m in inside)
+
+
+def class_evidence(name: str, matches: Sequence[Match]) -> tuple[float, float, bool]:
+    """The evidence for class ``name`` (lower case, with or without a profile of its own) as a whole: the best score
+    of its own and its subclasses' profiles, how far that lies above the best profile outside it (neither below
+    nor above it), and whether its own profile names it by printed text that was not read."""
+    inside = members(name, matches)
+    top = max((m.score for m in inside), default=0.0)
+    rivals = [m.score for m in matches if name not in m.profile.ancestors and not above(m, name, inside)]
+    unread = any(m.unread for m in inside if m.profile.class_name.lower() == name)
+    return top, top - max(rivals, default=0.0), unread
+
+
 def more_general_fit(
     best: Match, matches: Sequence[Match], min_score: float, calibration: Calibration, assert_probability: float
-) -> tuple[Match, float] | None:
-    """The most specific class above ``best`` (one of its ancestors, not the root class) that fits and is right with
-    at least ``assert_probability`` by its own score and lead, with that probability; None when there is none. When
-    the cues cannot tell a white ceramic bowl from a plastic one, it is still surely a bowl."""
-    above = [
-        m
-        for m in matches
-        if m is not best
-        and m.profile.class_name.lower() in best.profile.ancestors
-        and m.profile.class_name.lower() != UNKNOWN_CLASS.lower()
-    ]
-    for match in sorted(above, key=lambda m: -len(m.profile.ancestors)):
-        if match.score < min_score or match.unread:
+) -> tuple[str, float, float, float] | None:
+    """The most specific class above ``best`` (one of its ancestors, not the root class, with or without a profile of
+    its own) that, taken as a whole (:func:`class_evidence`), fits and is right with at least
+    ``assert_probability``: (its name, score, lead, probability); None when there is none. When the cues cannot tell
+    a white ceramic bowl from a plastic one it is still surely a bowl; when they cannot tell a cup from a glass it is
+    still a container; when a carton's printed text was not read it is still food or drink."""
+    names = [a for a in best.profile.lineage[1:] if a.lower() != UNKNOWN_CLASS.lower()]
+    names.sort(key=lambda a: len(members(a.lower(), matches)))  # stable: the lineage order breaks ties
+    for name in names:
+        top, name_lead, unread = class_evidence(name.lower(), matches)
+        if top < min_score or unread:
             continue
-        p = calibration.probability(match.score, lead(match, matches), match.unread)
+        p = calibration.probability(top, name_lead, unread)
         if p >= assert_probability:
-            return match, p
+            return name, top, name_lead, p
     return None
 
 
 def choose_expected(matches: Sequence[Match], expected: str, min_score: float, margin: float) -> Match | None:
-    """The query's class breaking a tie: among the fitting matches within ``margin`` of the best fitting
-    score, the best one of the expected class (or a subclass); None otherwise, and always for the root class
-    (a query for any object prefers none). A match fits when it scores at least ``min_score`` and, for a class
-    named by printed text, its text was read."""
-    fitting = [m for m in matches if m.score >= min_score and not m.unread]
+    """The query's class breaking a tie: the best match of the expected class (a subclass, or a class packaged in
+    it: :meth:`Profile.answers`) among the fitting matches within ``margin`` of the best fitting score; None
+    otherwise, and always for the root class (a query for any object prefers none). A match fits when it scores at
+    least ``min_score``. A class named by printed text that went unread (a mustard whose label was not read) is
+    only a guess: it must tie with every fitting match, those of other unread classes included, while a match
+    whose texts were read (or that names none) need only tie with those (an unread class scores without the
+    cue that would tell it apart, so it does not raise their bar); its calibrated probability stays low."""
     wanted = expected.lower()
+    fitting = [m for m in matches if m.score >= min_score]
     if not fitting or wanted == UNKNOWN_CLASS.lower():
         return None
     top = max(m.score for m in fitting)
-    candidates = [m for m in fitting if top - m.score <= margin and wanted in m.profile.ancestors]
-    return max(candidates, key=lambda m: (m.score, -len(m.profile.ancestors)), default=None)
+    top_read = max((m.score for m in fitting if not m.unread), default=top)
+    candidates = [
+        m
+        for m in fitting
+        if (top if m.unread else top_read) - m.score <= margin and m.profile.answers(wanted)
+    ]
+    return max(candidates, key=lambda m: (not m.unread, m.score, -len(m.profile.ancestors)), default=None)
 
 
 def cue_outcomes(cues: Cues) -> list[Cues]:
@@ -459,10 +520,21 @@ def decide(
     name = best.profile.class_name
     if best.score >= min_score and p >= assert_probability:
         return Decision(name, p, best, best_lead, p, f"fits {name} (score {best.score:.2f}, lead {best_lead:.2f})")
+    pick = choose_expected(matches, expected, min_score, margin) if expected else None
+    if pick is not None and holds_up(pick, matches, cues, min_score, margin):
+        pick_lead = lead(pick, matches)
+        return Decision(
+            pick.profile.class_name,
+            calibration.probability(pick.score, pick_lead, pick.unread),
+            best,
+            best_lead,
+            p,
+            f"{pick.profile.class_name} fits (score {pick.score:.2f}) as well as any other class; "
+            f"the query's class decides",
+        )
     general = more_general_fit(best, matches, min_score, calibration, assert_probability)
     if general is not None:
-        match, general_p = general
-        general_name = match.profile.class_name
+        general_name, general_score, general_lead, general_p = general
         return Decision(
             general_name,
             general_p,
@@ -470,32 +542,19 @@ def decide(
             best_lead,
             p,
             f"fits {name} but leads only by {best_lead:.2f}; fits {general_name}, a class above it "
-            f"(score {match.score:.2f}, lead {lead(match, matches):.2f})",
+            f"(score {general_score:.2f}, lead {general_lead:.2f})",
         )
-    if expected:
-        pick = choose_expected(matches, expected, min_score, margin)
-        if pick is not None and not holds_up(pick, matches, cues, min_score, margin):
-            return Decision(
-                UNKNOWN_CLASS,
-                1.0 - p,
-                best,
-                best_lead,
-                p,
-                f"{pick.profile.class_name} fits (score {pick.score:.2f}) as well as any other class, but a form cue "
-                f"speaks against it or, unsettled, could make another class fit better: the query's class does not "
-                f"decide",
-            )
-        if pick is not None:
-            pick_lead = lead(pick, matches)
-            return Decision(
-                pick.profile.class_name,
-                calibration.probability(pick.score, pick_lead, pick.unread),
-                best,
-                best_lead,
-                p,
-                f"{pick.profile.class_name} fits (score {pick.score:.2f}) as well as any other class; "
-                f"the query's class decides",
-            )
+    if pick is not None:
+        return Decision(
+            UNKNOWN_CLASS,
+            1.0 - p,
+            best,
+            best_lead,
+            p,
+            f"{pick.profile.class_name} fits (score {pick.score:.2f}) as well as any other class, but a form cue "
+            f"speaks against it or, unsettled, could make another class fit better: the query's class does not "
+            f"decide",
+        )
     why = (
         f"no class fits: the closest, {name}, scores {best.score:.2f}"
         if best.score < min_score
@@ -511,6 +570,14 @@ def printed_cue(colors: Sequence[SemanticColor]) -> tuple[bool, float] | None:
     if colors and (len(colors) > 1 or max(a.ratio for a in colors) < PLAIN_SHARE):
         return True, 1.0
     return None
+
+
+def elongation(dimensions: Sequence[float]) -> float | None:
+    """The longest extent over the second longest (dimensions sorted largest first, as the size expert gives them);
+    None when there are not two positive extents."""
+    if len(dimensions) < 2 or not dimensions[1] > 0.0 or not np.isfinite(dimensions[0]):
+        return None
+    return float(dimensions[0] / dimensions[1])
 
 
 class KnowledgeClassifier(Annotator):
@@ -559,6 +626,7 @@ class KnowledgeClassifier(Annotator):
             height_to_width=form.height_to_width if form is not None else None,
             extent=max(size.dimensions) if size is not None and size.dimensions else None,
             printed=printed_cue(colors),
+            elongation=elongation(size.dimensions) if size is not None else None,
         )
 
     def decide(self, cues: Cues) -> Decision:

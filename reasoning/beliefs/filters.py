@@ -9,6 +9,9 @@ A list of words under an attribute key (``color: [red, blue]``, from ``red or bl
 selects objects with any of those values: an object has one dominant colour, shape and size, so "all of them"
 would match nothing, and RoboKudo's designator lists mean alternatives too.
 
+The class test of the filter is :func:`kb_query_class_test`: an object answers a query for a class it is, or for the
+container it is typically packaged in (``rk:packagedIn``: a mustard for "find all bottles").
+
 Which key filters which attribute comes from the ontology (the annotation type answering the key, its value
 kind) and the annotation type's ``attribute`` (:mod:`robokudo.core.types`); without a knowledge base a key
 filters the attribute of the same name.
@@ -41,6 +44,8 @@ class Vocabulary(Protocol):
 
     def is_subclass(self, name: str, ancestor: str) -> bool: ...
 
+    def answers_to(self, name: str, asked: str) -> bool: ...
+
     def annotation_type_for_key(self, key: str) -> str: ...
 
     def value_kind(self, annotation_type: str) -> str | None: ...
@@ -64,7 +69,7 @@ def belief_filter(
     if region_word is not None and region_word.strip().lower() == ANYWHERE:  # ``location: anywhere``: no region
         region_word = None
     attributes = _attributes(blocks, kb, strict)
-    class_test = kb_class_test(kb)
+    class_test = kb_query_class_test(kb)
     if object_class is not None:
         object_class = _resolve(kb, object_class, "class", strict)
     region, boxes = (None, ()) if region_word is None else _resolve_region(kb, region_word, strict)
@@ -210,6 +215,22 @@ def _resolve_region(kb: Vocabulary | None, word: str, strict: bool) -> tuple[str
         if boxes:
             return name, boxes
     return candidates[-1], ()
+
+
+def kb_query_class_test(kb: Vocabulary | None) -> Callable[[str, str], bool] | None:
+    """``kb.answers_to`` as the class test of a query: an object of class ``a`` answers a query for class ``b`` when
+    it is one or is typically packaged in one (a mustard for "bottle"); names the KB does not know are equal or
+    unrelated. Fusion and association keep :func:`kb_class_test` (what an object is, not what it is seen as)."""
+    if kb is None:
+        return None
+
+    def class_test(a: str, b: str) -> bool:
+        try:
+            return kb.answers_to(a, b)
+        except LookupError:
+            return a == b
+
+    return class_test
 
 
 def kb_class_test(kb: Vocabulary | None) -> Callable[[str, str], bool] | None:

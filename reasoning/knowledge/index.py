@@ -43,6 +43,7 @@ PROFILE_PROPERTIES: Mapping[str, tuple[str, Kind | None]] = {
     "sizeClass": ("size_class", "size"),
     "madeOf": ("material", "material"),
     "storedIn": ("stored_in", "region_class"),
+    "packagedIn": ("packaged_in", "class"),
     "transparent": ("transparent", None),
     "printedText": ("texts", None),
     "brand": ("brand", None),
@@ -51,6 +52,8 @@ PROFILE_PROPERTIES: Mapping[str, tuple[str, Kind | None]] = {
     "printedLabel": ("printed", None),
     "minHeightToWidth": ("min_height_to_width", None),
     "maxHeightToWidth": ("max_height_to_width", None),
+    "minElongation": ("min_elongation", None),
+    "maxElongation": ("max_elongation", None),
 }
 """Restriction property -> (profile field, kind of its filler class, None for literal values)."""
 
@@ -71,6 +74,7 @@ _SINGLE_FIELDS = (
     "size_class",
     "material",
     "stored_in",
+    "packaged_in",
     "transparent",
     "brand",
     "handle",
@@ -78,19 +82,24 @@ _SINGLE_FIELDS = (
     "open_top",
     "min_height_to_width",
     "max_height_to_width",
+    "min_elongation",
+    "max_elongation",
 )
 _BOOLEAN_FIELDS = ("transparent", "handle", "open_top", "printed")
-_NUMBER_FIELDS = ("min_height_to_width", "max_height_to_width")
+_NUMBER_FIELDS = ("min_height_to_width", "max_height_to_width", "min_elongation", "max_elongation")
 
 
-def _ratio_range(name: str, values: Mapping[str, object], problems: list[str]) -> tuple[float, float] | None:
-    """The class's height-to-width range from its (inherited) minimum and maximum; a missing bound is open."""
-    low, high = values.get("min_height_to_width"), values.get("max_height_to_width")
+def _ratio_range(
+    name: str, values: Mapping[str, object], problems: list[str], ratio: str = "height_to_width"
+) -> tuple[float, float] | None:
+    """The class's range of a ratio (``height_to_width`` or ``elongation``) from its (inherited) minimum and
+    maximum; a missing bound is open."""
+    low, high = values.get(f"min_{ratio}"), values.get(f"max_{ratio}")
     if low is None and high is None:
         return None
     bounds = (float(low) if low is not None else 0.0, float(high) if high is not None else float("inf"))  # type: ignore[arg-type]
     if not 0.0 <= bounds[0] < bounds[1]:
-        problems.append(f"{name}: height-to-width range {bounds} is empty or negative")
+        problems.append(f"{name}: {ratio.replace('_', '-')} range {bounds} is empty or negative")
         return None
     return bounds
 
@@ -569,6 +578,7 @@ class _Builder:
                 material=values.get("material"),  # type: ignore[arg-type]
                 transparent=values.get("transparent"),  # type: ignore[arg-type]
                 stored_in=values.get("stored_in"),  # type: ignore[arg-type]
+                packaged_in=values.get("packaged_in"),  # type: ignore[arg-type]
                 texts=tuple(texts),
                 brand=values.get("brand"),  # type: ignore[arg-type]
                 origins=tuple(origins),
@@ -576,6 +586,7 @@ class _Builder:
                 printed=values.get("printed"),  # type: ignore[arg-type]
                 open_top=values.get("open_top"),  # type: ignore[arg-type]
                 height_to_width=_ratio_range(name, values, self.problems),
+                elongation=_ratio_range(name, values, self.problems, "elongation"),
             )
         return profiles
 

@@ -301,6 +301,16 @@ class KnowledgeBase:
         """True when ``name`` is ``ancestor`` or one of its (transitive) subclasses."""
         return self._class(ancestor) in self._index.up[self._class(name)]
 
+    def answers_to(self, name: str, asked: str) -> bool:
+        """True when an object of class ``name`` answers a query for class ``asked``: it is one (``is_subclass``),
+        or it is typically packaged in one (``rk:packagedIn``, inherited): what is seen of a mustard is its
+        bottle, so a mustard answers "find all bottles"."""
+        if self.is_subclass(name, asked):
+            return True
+        cls = self._class(name)
+        package = self._index.profiles[cls].packaged_in if self.kind(cls) == "class" else None
+        return package is not None and self.is_subclass(package, asked)
+
     def subclasses(self, name: str, direct: bool = False) -> list[str]:
         """The (direct or all) proper subclasses of a class, sorted."""
         cls = self._class(name)

@@ -58,8 +58,13 @@ class ObjectProfile:
     open_top: bool | None = None
     height_to_width: tuple[float, float] | None = None
     """Form features: a handle on the side, open at the top, the (min, max) of height over width; None: any."""
+    elongation: tuple[float, float] | None = None
+    """The (min, max) of the longest extent over the second longest (a banana's footprint is long and narrow, a
+    tin's round); None: any."""
     printed: bool | None = None
     """A label printed in several colours (a can's), False: a plain one-coloured surface; None: either."""
+    packaged_in: str | None = None
+    """The container class objects of the class are typically sold and kept in (a mustard's bottle), or None."""
 
     def origin(self, field: str) -> str | None:
         """The class that declares ``field`` for this profile (None when the field is unset)."""

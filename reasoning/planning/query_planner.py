@@ -40,6 +40,9 @@ def class_profiles(kb: KnowledgeBase) -> tuple[dict[str, object], ...]:
     """What every object class typically looks like, as plain data for a knowledge-based classifier.
 
     Colours, shape and size are the ontology's lower-case labels; classes that say nothing visible are left out.
+    The ancestors come the most specific first (a classifier names the nearest one the cues leave no doubt about);
+    ``packaged_in`` is the container class the objects are typically packaged in with its ancestors (what a query
+    for that container also asks for), or ().
     """
     profiles = []
     for name in kb.names_of_kind("class"):
@@ -57,7 +60,11 @@ def class_profiles(kb: KnowledgeBase) -> tuple[dict[str, object], ...]:
                 "open_top": profile.open_top,
                 "printed": profile.printed,
                 "height_to_width": profile.height_to_width,
-                "ancestors": (name, *kb.superclasses(name)),
+                "elongation": profile.elongation,
+                "ancestors": (name, *sorted(kb.superclasses(name), key=lambda a: -len(kb.superclasses(a)))),
+                "packaged_in": (profile.packaged_in, *sorted(kb.superclasses(profile.packaged_in)))
+                if profile.packaged_in
+                else (),
             }
         )
     return tuple(profiles)

@@ -223,6 +223,9 @@ class FakeKnowledgeBase:
     def is_subclass(self, name: str, ancestor: str) -> bool:
         return is_subclass(name, ancestor)
 
+    def answers_to(self, name: str, asked: str) -> bool:
+        return is_subclass(name, asked)
+
     def annotation_type_for_key(self, key: str) -> str:
         types = {"color": "SemanticColor", "shape": "Shape", "size": "Size", "text": "Text"}
         if key not in types:

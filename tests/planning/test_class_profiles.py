@@ -3,9 +3,13 @@ form experts measure, and with the shipped ontology the form cues tell container
 
 from __future__ import annotations
 
+from pathlib import Path
+
 import pytest
 
 from annotators.classification.knowledge_classifier import Cues, Profile, best_match, decide, score
+from queries import parse_query
+from reasoning.beliefs.filters import belief_filter
 from reasoning.knowledge.knowledge_base import KnowledgeBase
 from reasoning.planning.query_planner import class_profiles
 
@@ -101,3 +105,20 @@ def test_the_size_class_agrees_by_how_far_the_extent_is_beyond_its_bounds(profil
     near, far = score(can, Cues(size=("medium", 1.0), extent=0.13)), score(can, Cues(size=("medium", 1.0), extent=0.2))
     assert near.score > score(can, base).score > far.score  # 13 cm is nearly small, 20 cm is not
     assert score(can, Cues(size=("small", 1.0), extent=0.1)).score == 1.0
+
+
+def test_packaged_products_answer_a_query_for_their_container(tmp_path: Path) -> None:
+    """rk:packagedIn: a mustard is not a bottle (food is disjoint with tableware) but is seen as one, so a query
+    for bottles (or containers) asks for it; a lemon soda (a can) and a bowl are not asked for."""
+    kb = KnowledgeBase.load(tmp_path / "user.ttl")
+    assert kb.object_profile("Mustard").packaged_in == "PlasticBottle"
+    assert kb.object_profile("Salt").packaged_in is None  # declared on the products, not on all condiments
+    assert not kb.is_subclass("Mustard", "Bottle") and kb.answers_to("Mustard", "Bottle")
+    assert kb.answers_to("DishSoap", "bottle") and kb.answers_to("Mustard", "Container")
+    assert not kb.answers_to("LemonSoda", "Bottle") and not kb.answers_to("Mustard", "Bowl")
+    assert kb.answers_to("PlasticBottle", "Bottle") and kb.answers_to("Mustard", "Condiment")
+    test = belief_filter(parse_query("find all bottles"), kb).class_test
+    assert test is not None and test("Mustard", "Bottle") and test("GlassBottle", "Bottle")
+    assert not test("LemonSoda", "Bottle")
+    mustard = Profile.from_mapping(next(p for p in class_profiles(kb) if p["class"] == "Mustard"))
+    assert mustard.answers("bottle") and mustard.answers("plasticbottle") and not mustard.answers("bowl")

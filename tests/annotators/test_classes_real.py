@@ -1,0 +1,136 @@
+"""Known objects on real frames are named by their class, or by the class above it when the cues cannot tell the
+leaves apart, and objects no profile describes stay unknown (issue 15, item 6).
+
+What a user sees from ``robokudo query "find all objects"``: the Cheez-It box, whose printed text no expert reads in
+that tree, ties with milk, juice and coffee cartons and with a bag of chips (all red or white medium boxes, all named
+by their printed text), and so is "food or drink"; the dark blue mug, whose handle faces away, ties with a cup and a
+glass and is "a container"; the spam can, whose text is not read, is at least "food". The cookie tin (a wide, round,
+orange patterned tin) used to look most like a carrot or a banana; those are long and narrow (``rk:minElongation``)
+and it is round, so it stays an unknown object; so do the drill, the laptop and the cardboard box.
+
+Pixels and splits are those of tests/data/labels/real_objects.json: uoc frames 0 and 2 and mOSD learn scene 35 are
+in the fit split (what the rule was checked on while it was made); uoc frames 1 and 3, the milk carton scene and
+mOSD learn scene 40 are in the check split and are held out here.
+"""
+
+from __future__ import annotations
+
+import json
+from pathlib import Path
+
+import pytest
+
+from robokudo.application import cli
+from robokudo.core.types import Classification
+
+pytestmark = pytest.mark.real_data
+
+
+@pytest.fixture
+def store(tmp_path: Path, monkeypatch: pytest.MonkeyPatch) -> Path:
+    monkeypatch.setenv("ROBOKUDO_USER_ONTOLOGY", str(tmp_path / "user.ttl"))
+    monkeypatch.setenv("ROBOKUDO_BELIEF_STORE", str(tmp_path / "beliefs.sqlite"))
+    return tmp_path / "answers.sqlite"
+
+
+def classes_at(capsys: pytest.CaptureFixture, store: Path, source: Path, frame: int, pixels: dict) -> dict[str, set]:
+    """The class labels ``robokudo query "find all objects"`` gives the objects whose image box holds each pixel."""
+    code = cli.main(
+        ["query", "find all objects", "--input", str(source), "--frame", str(frame), "--store", str(store), "--json"]
+    )
+    out = capsys.readouterr().out
+    assert code == 0, out
+    objects = json.loads(out)["objects"]
+    found = {}
+    for name, (x, y) in pixels.items():
+        holding = [o for o in objects if o["roi"] and o["roi"][0] <= x < o["roi"][2] and o["roi"][1] <= y < o["roi"][3]]
+        # the smallest box holding the pixel is the object's own (a bigger one may reach over it)
+        own = min(holding, key=lambda o: (o["roi"][2] - o["roi"][0]) * (o["roi"][3] - o["roi"][1]), default=None)
+        assert own is not None, f"the {name} was not seen"
+        found[name] = own["class"]["label"]
+    return found
+
+
+UNKNOWN = "unknown object"
+BOX_OF_FOOD_OR_DRINK = {"food or drink", "food", "snack", "crackers"}
+CONTAINER = {"container", "mug", "cup"}
+FOOD = {"food", "canned food", "food or drink"}
+
+
+@pytest.mark.parametrize(
+    "frame, pixels",
+    [
+        (0, {"cheez-it box": (500, 250), "blue mug": (205, 195), "spam can": (75, 310), "drill": (345, 140)}),  # fit
+        (3, {"cheez-it box": (260, 70), "teal bowl": (340, 185), "drill": (395, 180)}),  # held out
+    ],
+)
+def test_find_all_objects_names_the_class_above_leaves_it_cannot_tell_apart(
+    uoc_folder: Path, store: Path, capsys: pytest.CaptureFixture, frame: int, pixels: dict
+) -> None:
+    found = classes_at(capsys, store, uoc_folder, frame, pixels)
+    assert found["cheez-it box"] in BOX_OF_FOOD_OR_DRINK, found
+    assert found["drill"] == UNKNOWN, found
+    if frame == 0:
+        assert found["blue mug"] in CONTAINER, found
+        assert found["spam can"] in FOOD, found
+    else:
+        assert found["teal bowl"] in {"container", "bowl"}, found
+
+
+def test_the_milk_carton_is_food_or_drink_held_out(
+    shared_data: Path, store: Path, capsys: pytest.CaptureFixture
+) -> None:
+    scene = shared_data / "pcl_tabletop_pcd" / "milk_cartoon_all_small_clorox.pcd"
+    if not scene.is_file():
+        pytest.skip(f"needs {scene}")
+    found = classes_at(capsys, store, scene, 0, {"milk carton": (280, 150)})
+    assert found["milk carton"] in {"food or drink", "drink", "milk"}, found
+
+
+@pytest.mark.parametrize("scene, tin", [("learn35.pcd", (300, 389)), ("learn40.pcd", (165, 353))])  # fit, held out
+def test_a_round_cookie_tin_is_no_carrot_nor_banana(
+    shared_data: Path, store: Path, capsys: pytest.CaptureFixture, scene: str, tin: tuple[int, int]
+) -> None:
+    source = shared_data / "pcl_mosd_tabletop" / "learn" / scene
+    if not source.is_file():
+        pytest.skip(f"needs {source}")
+    assert classes_at(capsys, store, source, 0, {"cookie tin": tin})["cookie tin"] == UNKNOWN
+
+
+def answered_at(capsys: pytest.CaptureFixture, store: Path, source: Path, frame: int, query: str, pixel: tuple) -> dict:
+    """The answer object of ``robokudo query QUERY --json`` whose image box holds ``pixel`` (the smallest one)."""
+    code = cli.main(["query", query, "--input", str(source), "--frame", str(frame), "--store", str(store), "--json"])
+    out = capsys.readouterr().out
+    objects = json.loads(out)["objects"] if code == 0 else []
+    x, y = pixel
+    holding = [o for o in objects if o["roi"] and o["roi"][0] <= x < o["roi"][2] and o["roi"][1] <= y < o["roi"][3]]
+    assert holding, f"{query!r} on frame {frame} answered nothing at {pixel}: {out}"
+    return min(holding, key=lambda o: (o["roi"][2] - o["roi"][0]) * (o["roi"][3] - o["roi"][1]))
+
+
+def class_confidence(answered: dict) -> float:
+    """The probability the answer gives that the object's class is right."""
+    return answered["attributes"][Classification.attribute]["confidence"]
+
+
+# the mustard bottle: frames 0 and 2 are in the fit split, 1 and 3 held out (labels/real_objects.json)
+MUSTARD = [(0, (285, 100)), (1, (280, 180)), (2, (190, 150)), (3, (190, 160))]
+
+
+@pytest.mark.parametrize("frame, pixel", [MUSTARD[0], MUSTARD[3]], ids=["frame0-fit", "frame3-held-out"])
+def test_find_all_bottles_answers_the_mustard_bottle(
+    capsys: pytest.CaptureFixture, store: Path, frame: int, pixel: tuple
+) -> None:
+    """A mustard is packaged in a bottle (rk:packagedIn), so "find all bottles" asks for it. Its label went unread
+    and it ties with a lemon soda (a can), so the answer is hedged: a low class probability, marked "?"."""
+    found = answered_at(capsys, store, Path("../shared/data/uoc_tabletop_realsense"), frame, "find all bottles", pixel)
+    assert found["class"]["label"] in {"bottle", "plastic bottle", "mustard"}, found
+    assert class_confidence(found) < 0.5, found
+
+
+@pytest.mark.parametrize("frame, pixel", [MUSTARD[2], MUSTARD[1]], ids=["frame2-fit", "frame1-held-out"])
+def test_find_the_mustard_answers_the_yellow_bottle_hedged(
+    capsys: pytest.CaptureFixture, store: Path, frame: int, pixel: tuple
+) -> None:
+    found = answered_at(capsys, store, Path("../shared/data/uoc_tabletop_realsense"), frame, "find the mustard", pixel)
+    assert found["class"]["label"] == "mustard" and class_confidence(found) < 0.5, found
