@@ -74,6 +74,7 @@ from annotators.geometry.grid_segmentation import (
 )
 from annotators.geometry.inner_walls import InnerWallRules, join_inner_walls
 from annotators.geometry.occlusion import OcclusionRules, join_occluded
+from annotators.geometry.rims import RimRules, join_rim_pieces, one_stands_inside
 from annotators.geometry.slabs import SlabRules, join_slab_pieces
 from annotators.geometry.support import (
     AppendageRules,
@@ -98,6 +99,8 @@ class ClutterParameters(ClusterParameters):
     themselves to the object that holds them, ``join_jointly_held`` those two touching neighbours hold only
     together, and ``join_appendages`` the small pieces sticking out of a larger one;
     ``join_inner_walls`` joins an open container's inside seen over its rim to its outside;
+    ``join_rims`` joins the pieces of one open container's rim that an object standing in it cuts apart, and its
+    outer wall below the rim;
     ``join_slabs`` joins touching pieces of one slab (same lowest heights and tops, no depth jump between them);
     ``claim_floors`` gives an open container the floor seen over its rim, at table level;
     ``claim_borders`` gives the outline pixels the coarse grid
@@ -126,6 +129,7 @@ class ClutterParameters(ClusterParameters):
     join_appendages: bool = True
     join_jointly_held: bool = True
     join_inner_walls: bool = True
+    join_rims: bool = True
     join_slabs: bool = True
     claim_floors: bool = True
     claim_borders: bool = True
@@ -237,7 +241,9 @@ def segment_clutter(
     offset = np.array([0.0, 0.0, model[3]], dtype=np.float32)
     # (u, v, height) of every grid point on the plane
     plane_grid = plane_coordinates(grid.reshape(-1, 3), to_plane, offset)
-    labels = merge_parts(labels, depth, plane_grid.__getitem__, p.merge_rules())
+    labels = merge_parts(
+        labels, depth, plane_grid.__getitem__, p.merge_rules(), stand_apart=one_stands_inside if p.join_rims else None
+    )
     if colors is not None and p.use_color:
         colors_crop = strided_crop(colors, step, (x0, y0, x1, y1))
         labels = split_by_color(labels, grid, normals, colors_crop, p)
@@ -256,6 +262,10 @@ def segment_clutter(
             summary_step = wall_rules.support.sample_step
             pieces = summarize_pieces(labels, plane_grid, summary_step)
         joined = join_inner_walls(labels, grid, normals, plane_grid, to_plane[:, :3], wall_rules, pieces)
+        if joined is not labels:
+            pieces, summary_step, labels = None, 0, joined
+    if p.join_rims:
+        joined = join_rim_pieces(labels, plane_grid, RimRules())
         if joined is not labels:
             pieces, summary_step, labels = None, 0, joined
     if p.join_slabs:

@@ -1,0 +1,192 @@
+"""The rim of an open container, on the organized grid: the pieces of one container whose rim an object cuts.
+
+Seen from above, the inside of a bowl shows the back of its inner wall over the rim, and the top edge of that
+wall is an arc of the rim: a circle on the table plane at one height, curving around a centre nearer the camera
+than the arc (the front of a solid object curves the other way). An object standing in the bowl hides the middle
+of the inner wall and cuts it into pieces left and right of it that touch little or not at all, and the grouping
+keeps the concave wall apart from the front of the outer wall anyway. The rim still tells them together:
+
+* two pieces whose top edges are concave arcs at one height (their 95 % heights within ``tolerance``) that fit
+  one circle (:func:`rim_circle`) and that are cut apart by one neighbour (both touch it) are the inner wall of
+  one container, on both sides of what stands in it;
+* a piece touching that container (directly or through its outer wall's other pieces, never through the
+  neighbour that cuts the rim) within its rim circle (its 95 % distance from the centre at most ``hold`` of the
+  radius) that stays below the rim and reaches out to the circle (at least ``reach``) or lies in front of the
+  centre is its outer wall seen below the front rim.
+
+An object standing in the container and rising above the rim is never joined (:func:`join_rim_pieces`); one
+lying in it below the rim, in front of its centre, would be (the convexity grouping keeps most of them apart
+before). :func:`stands_inside` tells an object standing in a container from the inner wall around it.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import numpy as np
+
+from annotators.geometry.grid_segmentation import join_labels, touching_pairs
+
+
+@dataclass(frozen=True)
+class RimRules:
+    """Thresholds of :func:`join_rim_pieces` (metres and shares of the rim's radius): the height band below a
+    piece's 95 % height holding its top edge (``band``), the median distance of the top edge from the fitted
+    circle (``fit``, share of the radius), the agreement of rim heights (``tolerance``), the reach of an outer
+    wall toward the circle (``reach``, ``hold``), the nearness to the centre of an object standing inside
+    (``inside``), and the fewest top-edge points a circle is fitted to (``min_points``)."""
+
+    band: float = 0.01
+    fit: float = 0.1
+    tolerance: float = 0.01
+    reach: float = 0.9
+    hold: float = 1.1
+    inside: float = 0.5
+    min_points: int = 20
+
+
+@dataclass(frozen=True)
+class Rim:
+    """A rim circle on the table plane: ``centre`` (u, v), ``radius`` and ``height`` (metres)."""
+
+    centre: np.ndarray
+    radius: float
+    height: float
+
+
+def fit_circle(points: np.ndarray) -> tuple[np.ndarray, float]:
+    """The least-squares circle ``(centre, radius)`` through Nx2 points (algebraic fit)."""
+    design = np.column_stack([2.0 * points, np.ones(points.shape[0])])
+    solution = np.linalg.lstsq(design, (points**2).sum(axis=1), rcond=None)[0]
+    centre = solution[:2]
+    return centre, float(np.sqrt(max(solution[2] + centre @ centre, 0.0)))
+
+
+def top_edge(points: np.ndarray, rules: RimRules) -> tuple[np.ndarray, float]:
+    """The (u, v) of a piece's top-edge points (Nx3 ``(u, v, height)``, finite) within ``rules.band`` of its 95 %
+    height, and that height."""
+    top = float(np.quantile(points[:, 2], 0.95))
+    return points[points[:, 2] >= top - rules.band, :2].astype(np.float64), top
+
+
+def curves_like_a_rim(centre: np.ndarray, edge: np.ndarray) -> bool:
+    """Could an arc (Nx2 points on the plane, the camera's foot at the origin) around ``centre`` be part of an
+    open container's rim? Either it curves around a centre nearer the camera than itself (the back of the rim,
+    over which the inner wall is seen), not bulging toward the camera as the front of a solid object does; or it
+    runs around the centre over more than half the circle (the rim of a whole container)."""
+    if np.linalg.norm(centre) < np.median(np.linalg.norm(edge, axis=1)):
+        return True
+    angles = np.sort(np.arctan2(edge[:, 1] - centre[1], edge[:, 0] - centre[0]))
+    gaps = np.diff(np.concatenate([angles, angles[:1] + 2.0 * np.pi]))
+    return bool(2.0 * np.pi - gaps.max() > np.pi)
+
+
+def rim_circle(edges: list[np.ndarray], heights: list[float], rules: RimRules) -> Rim | None:
+    """The rim that the top edges of one or more pieces (Nx2 each, on the plane with the camera's foot at the
+    origin) lie on: one circle they each fit within ``rules.fit`` of its radius, each shaped like part of a rim
+    (:func:`curves_like_a_rim`), at heights within ``rules.tolerance``; None otherwise."""
+    if any(edge.shape[0] < rules.min_points for edge in edges) or np.ptp(heights) > rules.tolerance:
+        return None
+    centre, radius = fit_circle(np.concatenate(edges))
+    if radius <= 0.0:
+        return None
+    for edge in edges:
+        distances = np.linalg.norm(edge - centre, axis=1)
+        if np.median(np.abs(distances - radius)) > rules.fit * radius:
+            return None
+        if not curves_like_a_rim(centre, edge):
+            return None
+    return Rim(centre, radius, float(np.mean(heights)))
+
+
+def stands_inside(wall: np.ndarray, other: np.ndarray, rules: RimRules) -> bool:
+    """Does part ``other`` stand inside the container whose inner wall is part ``wall`` (both Nx3 ``(u, v,
+    height)``)? The wall's top edge is (part of) a rim (:func:`rim_circle`), the other part lies near the rim's
+    centre (median distance at most ``rules.inside`` of the radius) and rises above the rim: a can standing in a
+    bowl."""
+    wall, other = (part[np.isfinite(part).all(axis=1)] for part in (wall, other))
+    if wall.shape[0] < rules.min_points or other.shape[0] < rules.min_points:
+        return False
+    edge, height = top_edge(wall, rules)
+    rim = rim_circle([edge], [height], rules)
+    if rim is None:
+        return False
+    near = np.median(np.linalg.norm(other[:, :2] - rim.centre, axis=1)) <= rules.inside * rim.radius
+    return bool(near and np.quantile(other[:, 2], 0.95) > rim.height + rules.tolerance)
+
+
+def one_stands_inside(first: np.ndarray, second: np.ndarray, rules: RimRules | None = None) -> bool:
+    """Does either of two parts (Nx3 ``(u, v, height)``) stand inside the container whose inner wall the other is
+    (:func:`stands_inside`)?"""
+    rules = rules or RimRules()
+    return stands_inside(first, second, rules) or stands_inside(second, first, rules)
+
+
+def rim_joins(labels: np.ndarray, plane_points: np.ndarray, rules: RimRules) -> list[tuple[int, int]]:
+    """Label pairs of :func:`join_rim_pieces` (``plane_points``: the ``(u, v, height)`` of every pixel, HxWx3)."""
+    pairs = touching_pairs(labels)
+    if pairs.shape[0] < 2:
+        return []
+    neighbours: dict[int, set[int]] = {}
+    for a, b in pairs.tolist():
+        neighbours.setdefault(a, set()).add(b)
+        neighbours.setdefault(b, set()).add(a)
+    coordinates: dict[int, np.ndarray] = {}
+
+    def points_of(label: int) -> np.ndarray:
+        if label not in coordinates:
+            own = plane_points[labels == label]
+            coordinates[label] = own[np.isfinite(own).all(axis=1)]
+        return coordinates[label]
+
+    edges: dict[int, tuple[np.ndarray, float] | None] = {}
+
+    def edge_of(label: int) -> tuple[np.ndarray, float] | None:
+        if label not in edges:
+            own = points_of(label)
+            found = top_edge(own, rules) if own.shape[0] >= rules.min_points else None
+            # a short arc fixes its circle loosely: only its curvature is asked here, the fit of the joint circle
+            concave = found is not None and found[0].shape[0] >= rules.min_points
+            edges[label] = found if concave and curves_like_a_rim(fit_circle(found[0])[0], found[0]) else None
+        return edges[label]
+
+    joins: list[tuple[int, int]] = []
+    for cut, around in neighbours.items():  # the pieces one neighbour cuts apart
+        walls = sorted(label for label in around if edge_of(label) is not None)
+        for k, first in enumerate(walls):
+            for second in walls[k + 1 :]:
+                found = [edge_of(first), edge_of(second)]
+                rim = rim_circle([edge for edge, _ in found], [height for _, height in found], rules)  # type: ignore[misc]
+                if rim is None:
+                    continue
+                joins.append((first, second))
+                # the outer wall, piece by piece from the inner wall on, never through what stands inside
+                container, frontier = {first, second}, [first, second]
+                while frontier:
+                    for piece in sorted(neighbours[frontier.pop()] - container - {cut}):
+                        if is_outer_wall(points_of(piece), rim, rules):
+                            container.add(piece)
+                            frontier.append(piece)
+                            joins.append((first, piece))
+    return joins
+
+
+def is_outer_wall(points: np.ndarray, rim: Rim, rules: RimRules) -> bool:
+    """Is a piece (Nx3 ``(u, v, height)``, the camera's foot at the origin) the container's outer wall below its
+    rim: within the rim circle (95 % distance from the centre at most ``rules.hold`` of the radius), no higher than
+    the rim (95 % height), and reaching out to the circle (at least ``rules.reach`` of the radius) or lying in
+    front of the centre, nearer the camera (the front of a tapering wall, toward the foot)?"""
+    if points.shape[0] < rules.min_points:
+        return False
+    reach = float(np.quantile(np.linalg.norm(points[:, :2] - rim.centre, axis=1), 0.95))
+    if reach > rules.hold * rim.radius or float(np.quantile(points[:, 2], 0.95)) > rim.height + rules.tolerance:
+        return False
+    in_front = float(np.median(np.linalg.norm(points[:, :2], axis=1))) < float(np.linalg.norm(rim.centre))
+    return reach >= rules.reach * rim.radius or in_front
+
+
+def join_rim_pieces(labels: np.ndarray, plane_points: np.ndarray, rules: RimRules | None = None) -> np.ndarray:
+    """Labels with the pieces of one open container's rim joined (see the module docstring; ``plane_points`` the
+    ``(u, v, height)`` of every pixel, HxWx3 or (H*W)x3); the same array when nothing joined."""
+    joins = rim_joins(labels, plane_points.reshape(*labels.shape, 3), rules or RimRules())
+    return join_labels(labels, joins) if joins else labels
