@@ -7,8 +7,9 @@ of the inner wall and cuts it into pieces left and right of it that touch little
 keeps the concave wall apart from the front of the outer wall anyway. The rim still tells them together:
 
 * two pieces whose top edges are concave arcs at one height (their 95 % heights within ``tolerance``) that fit
-  one circle (:func:`rim_circle`) and that are cut apart by one neighbour (both touch it) are the inner wall of
-  one container, on both sides of what stands in it;
+  one circle (:func:`rim_circle`) bending about as each arc does (``curvature``: not the arcs of two rims facing
+  one another) and that are cut apart by one neighbour (both touch it) are the inner wall of one container, on
+  both sides of what stands in it;
 * a piece touching that container (directly or through its outer wall's other pieces, never through the
   neighbour that cuts the rim) within its rim circle (its 95 % distance from the centre at most ``hold`` of the
   radius) that stays below the rim and reaches out to the circle (at least ``reach``) or lies in front of the
@@ -25,7 +26,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from annotators.geometry.grid_segmentation import join_labels, touching_pairs
+from annotators.geometry.grid_segmentation import join_labels, label_groups, touching_pairs
 
 
 @dataclass(frozen=True)
@@ -33,15 +34,18 @@ class RimRules:
     """Thresholds of :func:`join_rim_pieces` (metres and shares of the rim's radius): the height band below a
     piece's 95 % height holding its top edge (``band``), the median distance of the top edge from the fitted
     circle (``fit``, share of the radius), the agreement of rim heights (``tolerance``), the reach of an outer
-    wall toward the circle (``reach``, ``hold``), the nearness to the centre of an object standing inside
-    (``inside``), and the fewest top-edge points a circle is fitted to (``min_points``)."""
+    wall toward the circle (``reach``, ``hold``), the reach from the centre of an object standing inside
+    (``inside``: its median distance, well within the rim), how much more tightly than their joint rim two pieces' top
+    edges may each curve (``curvature``: the joint radius at most this many times each edge's own; a short arc
+    fixes its own circle loosely) and the fewest top-edge points a circle is fitted to (``min_points``)."""
 
     band: float = 0.01
     fit: float = 0.1
     tolerance: float = 0.01
     reach: float = 0.9
     hold: float = 1.1
-    inside: float = 0.5
+    inside: float = 0.75
+    curvature: float = 2.0
     min_points: int = 20
 
 
@@ -81,6 +85,29 @@ def curves_like_a_rim(centre: np.ndarray, edge: np.ndarray) -> bool:
     return bool(2.0 * np.pi - gaps.max() > np.pi)
 
 
+@dataclass(frozen=True)
+class Arc:
+    """A piece's top edge that could be part of a rim: its ``edge`` points (Nx2), their ``height`` (the piece's
+    95 % height) and the ``radius`` of the circle fitted to them alone."""
+
+    edge: np.ndarray
+    height: float
+    radius: float
+
+
+def rim_arc(points: np.ndarray, rules: RimRules) -> Arc | None:
+    """The top edge of a piece (Nx3 ``(u, v, height)``, finite) when it curves like part of a rim
+    (:func:`curves_like_a_rim` around the circle fitted to it alone; a short arc fixes that circle loosely, so only
+    its curvature is asked here and the fit of a joint circle later); None for fewer than ``rules.min_points``."""
+    if points.shape[0] < rules.min_points:
+        return None
+    edge, height = top_edge(points, rules)
+    if edge.shape[0] < rules.min_points:
+        return None
+    centre, radius = fit_circle(edge)
+    return Arc(edge, height, radius) if curves_like_a_rim(centre, edge) else None
+
+
 def rim_circle(edges: list[np.ndarray], heights: list[float], rules: RimRules) -> Rim | None:
     """The rim that the top edges of one or more pieces (Nx2 each, on the plane with the camera's foot at the
     origin) lie on: one circle they each fit within ``rules.fit`` of its radius, each shaped like part of a rim
@@ -101,9 +128,9 @@ def rim_circle(edges: list[np.ndarray], heights: list[float], rules: RimRules) -
 
 def stands_inside(wall: np.ndarray, other: np.ndarray, rules: RimRules) -> bool:
     """Does part ``other`` stand inside the container whose inner wall is part ``wall`` (both Nx3 ``(u, v,
-    height)``)? The wall's top edge is (part of) a rim (:func:`rim_circle`), the other part lies near the rim's
-    centre (median distance at most ``rules.inside`` of the radius) and rises above the rim: a can standing in a
-    bowl."""
+    height)``)? The wall's top edge is (part of) a rim (:func:`rim_circle`), the other part lies well within the rim
+    (its median distance from the centre at most ``rules.inside`` of the radius) and rises above it: a can standing
+    in a bowl."""
     wall, other = (part[np.isfinite(part).all(axis=1)] for part in (wall, other))
     if wall.shape[0] < rules.min_points or other.shape[0] < rules.min_points:
         return False
@@ -131,34 +158,29 @@ def rim_joins(labels: np.ndarray, plane_points: np.ndarray, rules: RimRules) -> 
     for a, b in pairs.tolist():
         neighbours.setdefault(a, set()).add(b)
         neighbours.setdefault(b, set()).add(a)
-    coordinates: dict[int, np.ndarray] = {}
+    pixels, starts = label_groups(labels)
+    flat = plane_points.reshape(-1, 3)
 
     def points_of(label: int) -> np.ndarray:
-        if label not in coordinates:
-            own = plane_points[labels == label]
-            coordinates[label] = own[np.isfinite(own).all(axis=1)]
-        return coordinates[label]
+        own = flat[pixels[starts[label] : starts[label + 1]]]
+        return own[np.isfinite(own).all(axis=1)]
 
-    edges: dict[int, tuple[np.ndarray, float] | None] = {}
+    arcs: dict[int, Arc | None] = {}
 
-    def edge_of(label: int) -> tuple[np.ndarray, float] | None:
-        if label not in edges:
-            own = points_of(label)
-            found = top_edge(own, rules) if own.shape[0] >= rules.min_points else None
-            # a short arc fixes its circle loosely: only its curvature is asked here, the fit of the joint circle
-            concave = found is not None and found[0].shape[0] >= rules.min_points
-            edges[label] = found if concave and curves_like_a_rim(fit_circle(found[0])[0], found[0]) else None
-        return edges[label]
+    def arc_of(label: int) -> Arc | None:
+        if label not in arcs:
+            arcs[label] = rim_arc(points_of(label), rules)
+        return arcs[label]
 
     joins: list[tuple[int, int]] = []
     for cut, around in neighbours.items():  # the pieces one neighbour cuts apart
-        walls = sorted(label for label in around if edge_of(label) is not None)
+        walls = {label: arc for label in sorted(around) if (arc := arc_of(label)) is not None}
         for k, first in enumerate(walls):
-            for second in walls[k + 1 :]:
-                found = [edge_of(first), edge_of(second)]
-                rim = rim_circle([edge for edge, _ in found], [height for _, height in found], rules)  # type: ignore[misc]
-                if rim is None:
-                    continue
+            for second in list(walls)[k + 1 :]:
+                pair = (walls[first], walls[second])
+                rim = rim_circle([arc.edge for arc in pair], [arc.height for arc in pair], rules)
+                if rim is None or rim.radius > rules.curvature * min(arc.radius for arc in pair):
+                    continue  # arcs of two smaller rims facing one another
                 joins.append((first, second))
                 # the outer wall, piece by piece from the inner wall on, never through what stands inside
                 container, frontier = {first, second}, [first, second]
