@@ -265,7 +265,9 @@ def segment_clutter(
         if joined is not labels:
             pieces, summary_step, labels = None, 0, joined
     if p.join_rims:
-        joined = join_rim_pieces(labels, plane_grid, RimRules())
+        # the heights and touching pairs of the labels as they are, when summarized
+        tops, touching = (pieces.high, pieces.touching) if pieces is not None else (None, None)
+        joined = join_rim_pieces(labels, plane_grid, RimRules(), tops, touching)
         if joined is not labels:
             pieces, summary_step, labels = None, 0, joined
     if p.join_slabs:

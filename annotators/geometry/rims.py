@@ -8,8 +8,8 @@ keeps the concave wall apart from the front of the outer wall anyway. The rim st
 
 * two pieces whose top edges are concave arcs at one height (their 95 % heights within ``tolerance``) that fit
   one circle (:func:`rim_circle`) bending about as each arc does (``curvature``: not the arcs of two rims facing
-  one another) and that are cut apart by one neighbour (both touch it) are the inner wall of one container, on
-  both sides of what stands in it;
+  one another) and that are cut apart by one neighbour (both touch it; it reaches up to their rim, which it hides
+  between them) are the inner wall of one container, on both sides of what stands in it;
 * a piece touching that container (directly or through its outer wall's other pieces, never through the
   neighbour that cuts the rim) within its rim circle (its 95 % distance from the centre at most ``hold`` of the
   radius) that stays below the rim and reaches out to the circle (at least ``reach``) or lies in front of the
@@ -58,10 +58,20 @@ class Rim:
     height: float
 
 
+def share_value(values: np.ndarray, share: float) -> float:
+    """The value ``share`` (0..1) of the way up a 1-D array's sorted values (nearest rank; a partial sort, cheap for
+    the few hundred values of a piece)."""
+    rank = round(share * (values.size - 1))
+    return float(np.partition(values, rank)[rank])
+
+
 def fit_circle(points: np.ndarray) -> tuple[np.ndarray, float]:
     """The least-squares circle ``(centre, radius)`` through Nx2 points (algebraic fit)."""
     design = np.column_stack([2.0 * points, np.ones(points.shape[0])])
-    solution = np.linalg.lstsq(design, (points**2).sum(axis=1), rcond=None)[0]
+    normal = design.T @ design  # the normal equations: 3x3, cheaper than a least-squares solver's SVD
+    if abs(np.linalg.det(normal)) < 1e-18:
+        return points.mean(axis=0), 0.0  # the points on a line or one point: no circle
+    solution = np.linalg.solve(normal, design.T @ (points**2).sum(axis=1))
     centre = solution[:2]
     return centre, float(np.sqrt(max(solution[2] + centre @ centre, 0.0)))
 
@@ -69,7 +79,7 @@ def fit_circle(points: np.ndarray) -> tuple[np.ndarray, float]:
 def top_edge(points: np.ndarray, rules: RimRules) -> tuple[np.ndarray, float]:
     """The (u, v) of a piece's top-edge points (Nx3 ``(u, v, height)``, finite) within ``rules.band`` of its 95 %
     height, and that height."""
-    top = float(np.quantile(points[:, 2], 0.95))
+    top = share_value(points[:, 2], 0.95)
     return points[points[:, 2] >= top - rules.band, :2].astype(np.float64), top
 
 
@@ -78,7 +88,7 @@ def curves_like_a_rim(centre: np.ndarray, edge: np.ndarray) -> bool:
     open container's rim? Either it curves around a centre nearer the camera than itself (the back of the rim,
     over which the inner wall is seen), not bulging toward the camera as the front of a solid object does; or it
     runs around the centre over more than half the circle (the rim of a whole container)."""
-    if np.linalg.norm(centre) < np.median(np.linalg.norm(edge, axis=1)):
+    if np.hypot(*centre) < share_value(np.hypot(edge[:, 0], edge[:, 1]), 0.5):
         return True
     angles = np.sort(np.arctan2(edge[:, 1] - centre[1], edge[:, 0] - centre[0]))
     gaps = np.diff(np.concatenate([angles, angles[:1] + 2.0 * np.pi]))
@@ -118,8 +128,8 @@ def rim_circle(edges: list[np.ndarray], heights: list[float], rules: RimRules) -
     if radius <= 0.0:
         return None
     for edge in edges:
-        distances = np.linalg.norm(edge - centre, axis=1)
-        if np.median(np.abs(distances - radius)) > rules.fit * radius:
+        distances = np.hypot(edge[:, 0] - centre[0], edge[:, 1] - centre[1])
+        if share_value(np.abs(distances - radius), 0.5) > rules.fit * radius:
             return None
         if not curves_like_a_rim(centre, edge):
             return None
@@ -131,6 +141,15 @@ def stands_inside(wall: np.ndarray, other: np.ndarray, rules: RimRules) -> bool:
     height)``)? The wall's top edge is (part of) a rim (:func:`rim_circle`), the other part lies well within the rim
     (its median distance from the centre at most ``rules.inside`` of the radius) and rises above it: a can standing
     in a bowl."""
+    if wall.shape[0] < rules.min_points or other.shape[0] < rules.min_points:
+        return False
+    if not share_value(other[:, 2], 0.95) > share_value(wall[:, 2], 0.95) + rules.tolerance:
+        return False  # the heights first (cheap): most parts rise no higher than the wall beside them
+    return _within_rim(wall, other, rules)
+
+
+def _within_rim(wall: np.ndarray, other: np.ndarray, rules: RimRules) -> bool:
+    """The rim test of :func:`stands_inside`, its heights checked already."""
     wall, other = (part[np.isfinite(part).all(axis=1)] for part in (wall, other))
     if wall.shape[0] < rules.min_points or other.shape[0] < rules.min_points:
         return False
@@ -138,20 +157,34 @@ def stands_inside(wall: np.ndarray, other: np.ndarray, rules: RimRules) -> bool:
     rim = rim_circle([edge], [height], rules)
     if rim is None:
         return False
-    near = np.median(np.linalg.norm(other[:, :2] - rim.centre, axis=1)) <= rules.inside * rim.radius
-    return bool(near and np.quantile(other[:, 2], 0.95) > rim.height + rules.tolerance)
+    distances = np.hypot(other[:, 0] - rim.centre[0], other[:, 1] - rim.centre[1])
+    return share_value(distances, 0.5) <= rules.inside * rim.radius
 
 
 def one_stands_inside(first: np.ndarray, second: np.ndarray, rules: RimRules | None = None) -> bool:
     """Does either of two parts (Nx3 ``(u, v, height)``) stand inside the container whose inner wall the other is
-    (:func:`stands_inside`)?"""
+    (:func:`stands_inside`)? Only the one rising above the other's heights can."""
     rules = rules or RimRules()
-    return stands_inside(first, second, rules) or stands_inside(second, first, rules)
+    if first.shape[0] < rules.min_points or second.shape[0] < rules.min_points:
+        return False
+    first_top, second_top = share_value(first[:, 2], 0.95), share_value(second[:, 2], 0.95)
+    if second_top > first_top + rules.tolerance:
+        return _within_rim(first, second, rules)
+    if first_top > second_top + rules.tolerance:
+        return _within_rim(second, first, rules)
+    return False
 
 
-def rim_joins(labels: np.ndarray, plane_points: np.ndarray, rules: RimRules) -> list[tuple[int, int]]:
-    """Label pairs of :func:`join_rim_pieces` (``plane_points``: the ``(u, v, height)`` of every pixel, HxWx3)."""
-    pairs = touching_pairs(labels)
+def rim_joins(
+    labels: np.ndarray,
+    plane_points: np.ndarray,
+    rules: RimRules,
+    tops: np.ndarray | None = None,
+    touching: np.ndarray | None = None,
+) -> list[tuple[int, int]]:
+    """Label pairs of :func:`join_rim_pieces` (``plane_points``: the ``(u, v, height)`` of every pixel, HxWx3;
+    ``tops`` each label's 95 % height and ``touching`` the touching label pairs when known)."""
+    pairs = touching_pairs(labels) if touching is None else touching
     if pairs.shape[0] < 2:
         return []
     neighbours: dict[int, set[int]] = {}
@@ -161,9 +194,24 @@ def rim_joins(labels: np.ndarray, plane_points: np.ndarray, rules: RimRules) -> 
     pixels, starts = label_groups(labels)
     flat = plane_points.reshape(-1, 3)
 
+    coordinates: dict[int, np.ndarray] = {}
+
     def points_of(label: int) -> np.ndarray:
-        own = flat[pixels[starts[label] : starts[label + 1]]]
-        return own[np.isfinite(own).all(axis=1)]
+        if label not in coordinates:
+            own = flat[pixels[starts[label] : starts[label + 1]]]
+            coordinates[label] = own[np.isfinite(own).all(axis=1)]
+        return coordinates[label]
+
+    heights: dict[int, float] = {}  # each piece's 95 % height, NaN when too small to have an edge
+
+    def height_of(label: int) -> float:
+        if tops is not None:
+            return float(tops[label])
+        if label not in heights:
+            own = flat[pixels[starts[label] : starts[label + 1]], 2]
+            own = own[np.isfinite(own)]
+            heights[label] = share_value(own, 0.95) if own.size >= rules.min_points else np.nan
+        return heights[label]
 
     arcs: dict[int, Arc | None] = {}
 
@@ -173,11 +221,18 @@ def rim_joins(labels: np.ndarray, plane_points: np.ndarray, rules: RimRules) -> 
         return arcs[label]
 
     joins: list[tuple[int, int]] = []
+    tried: set[tuple[int, int]] = set()
     for cut, around in neighbours.items():  # the pieces one neighbour cuts apart
-        walls = {label: arc for label in sorted(around) if (arc := arc_of(label)) is not None}
-        for k, first in enumerate(walls):
-            for second in list(walls)[k + 1 :]:
-                pair = (walls[first], walls[second])
+        # to cut the rim, the neighbour reaches up to it in front of it; the pieces' rims are at one height
+        candidates = sorted(label for label in around if height_of(cut) >= height_of(label) - rules.tolerance)
+        for k, first in enumerate(candidates):
+            for second in candidates[k + 1 :]:
+                if (first, second) in tried or abs(height_of(first) - height_of(second)) > rules.tolerance:
+                    continue
+                tried.add((first, second))
+                pair = (arc_of(first), arc_of(second))
+                if pair[0] is None or pair[1] is None:
+                    continue
                 rim = rim_circle([arc.edge for arc in pair], [arc.height for arc in pair], rules)
                 if rim is None or rim.radius > rules.curvature * min(arc.radius for arc in pair):
                     continue  # arcs of two smaller rims facing one another
@@ -200,15 +255,24 @@ def is_outer_wall(points: np.ndarray, rim: Rim, rules: RimRules) -> bool:
     front of the centre, nearer the camera (the front of a tapering wall, toward the foot)?"""
     if points.shape[0] < rules.min_points:
         return False
-    reach = float(np.quantile(np.linalg.norm(points[:, :2] - rim.centre, axis=1), 0.95))
-    if reach > rules.hold * rim.radius or float(np.quantile(points[:, 2], 0.95)) > rim.height + rules.tolerance:
+    if share_value(points[:, 2], 0.95) > rim.height + rules.tolerance:
         return False
-    in_front = float(np.median(np.linalg.norm(points[:, :2], axis=1))) < float(np.linalg.norm(rim.centre))
+    reach = share_value(np.linalg.norm(points[:, :2] - rim.centre, axis=1), 0.95)
+    if reach > rules.hold * rim.radius:
+        return False
+    in_front = share_value(np.linalg.norm(points[:, :2], axis=1), 0.5) < float(np.linalg.norm(rim.centre))
     return reach >= rules.reach * rim.radius or in_front
 
 
-def join_rim_pieces(labels: np.ndarray, plane_points: np.ndarray, rules: RimRules | None = None) -> np.ndarray:
+def join_rim_pieces(
+    labels: np.ndarray,
+    plane_points: np.ndarray,
+    rules: RimRules | None = None,
+    tops: np.ndarray | None = None,
+    touching: np.ndarray | None = None,
+) -> np.ndarray:
     """Labels with the pieces of one open container's rim joined (see the module docstring; ``plane_points`` the
-    ``(u, v, height)`` of every pixel, HxWx3 or (H*W)x3); the same array when nothing joined."""
-    joins = rim_joins(labels, plane_points.reshape(*labels.shape, 3), rules or RimRules())
+    ``(u, v, height)`` of every pixel, HxWx3 or (H*W)x3; ``tops`` each label's 95 % height and ``touching`` the
+    touching label pairs, when a summary of the labels has them); the same array when nothing joined."""
+    joins = rim_joins(labels, plane_points.reshape(*labels.shape, 3), rules or RimRules(), tops, touching)
     return join_labels(labels, joins) if joins else labels
