@@ -22,7 +22,9 @@ before). :func:`stands_inside` tells an object standing in a container from the 
 
 from __future__ import annotations
 
+import functools
 from dataclasses import dataclass
+from types import ModuleType
 
 import numpy as np
 
@@ -58,29 +60,32 @@ class Rim:
     height: float
 
 
+@functools.cache
+def _loops() -> ModuleType:
+    """:mod:`annotators.geometry.rim_loops`, imported (and numba with it) on first use."""
+    from annotators.geometry import rim_loops
+
+    return rim_loops
+
+
 def share_value(values: np.ndarray, share: float) -> float:
-    """The value ``share`` (0..1) of the way up a 1-D array's sorted values (nearest rank; a partial sort, cheap for
-    the few hundred values of a piece)."""
-    rank = round(share * (values.size - 1))
-    return float(np.partition(values, rank)[rank])
+    """The value ``share`` (0..1) of the way up a 1-D array's sorted values (nearest rank, by a partial sort; NaN for
+    none)."""
+    return float(_loops().share_value(np.ascontiguousarray(values), float(share)))
 
 
 def fit_circle(points: np.ndarray) -> tuple[np.ndarray, float]:
-    """The least-squares circle ``(centre, radius)`` through Nx2 points (algebraic fit)."""
-    design = np.column_stack([2.0 * points, np.ones(points.shape[0])])
-    normal = design.T @ design  # the normal equations: 3x3, cheaper than a least-squares solver's SVD
-    if abs(np.linalg.det(normal)) < 1e-18:
-        return points.mean(axis=0), 0.0  # the points on a line or one point: no circle
-    solution = np.linalg.solve(normal, design.T @ (points**2).sum(axis=1))
-    centre = solution[:2]
-    return centre, float(np.sqrt(max(solution[2] + centre @ centre, 0.0)))
+    """The least-squares circle ``(centre, radius)`` through Nx2 points (algebraic fit; radius 0 when the points fix
+    no circle)."""
+    u, v, radius = _loops().fit_circle(np.ascontiguousarray(points, dtype=np.float64))
+    return np.array([u, v]), float(radius)
 
 
 def top_edge(points: np.ndarray, rules: RimRules) -> tuple[np.ndarray, float]:
-    """The (u, v) of a piece's top-edge points (Nx3 ``(u, v, height)``, finite) within ``rules.band`` of its 95 %
-    height, and that height."""
-    top = share_value(points[:, 2], 0.95)
-    return points[points[:, 2] >= top - rules.band, :2].astype(np.float64), top
+    """The (u, v) of a piece's top-edge points (Nx3 ``(u, v, height)``; those not finite left out) within
+    ``rules.band`` of its 95 % height, and that height."""
+    edge, top = _loops().top_edge(np.ascontiguousarray(points), float(rules.band))
+    return edge, float(top)
 
 
 def curves_like_a_rim(centre: np.ndarray, edge: np.ndarray) -> bool:
@@ -88,11 +93,13 @@ def curves_like_a_rim(centre: np.ndarray, edge: np.ndarray) -> bool:
     open container's rim? Either it curves around a centre nearer the camera than itself (the back of the rim,
     over which the inner wall is seen), not bulging toward the camera as the front of a solid object does; or it
     runs around the centre over more than half the circle (the rim of a whole container)."""
-    if np.hypot(*centre) < share_value(np.hypot(edge[:, 0], edge[:, 1]), 0.5):
-        return True
-    angles = np.sort(np.arctan2(edge[:, 1] - centre[1], edge[:, 0] - centre[0]))
-    gaps = np.diff(np.concatenate([angles, angles[:1] + 2.0 * np.pi]))
-    return bool(2.0 * np.pi - gaps.max() > np.pi)
+    edge = np.ascontiguousarray(edge, dtype=np.float64)
+    return _rim_shaped(edge, centre, _loops().arc_measures(edge, centre[0], centre[1], 0.0)[1])
+
+
+def _rim_shaped(edge: np.ndarray, centre: np.ndarray, away: float) -> bool:
+    """:func:`curves_like_a_rim` of an edge whose median distance from the camera's foot is ``away``."""
+    return bool(np.hypot(*centre) < away or _loops().arc_turn(edge, centre[0], centre[1]) > np.pi)
 
 
 @dataclass(frozen=True)
@@ -106,7 +113,7 @@ class Arc:
 
 
 def rim_arc(points: np.ndarray, rules: RimRules) -> Arc | None:
-    """The top edge of a piece (Nx3 ``(u, v, height)``, finite) when it curves like part of a rim
+    """The top edge of a piece (Nx3 ``(u, v, height)``; those not finite left out) when it curves like part of a rim
     (:func:`curves_like_a_rim` around the circle fitted to it alone; a short arc fixes that circle loosely, so only
     its curvature is asked here and the fit of a joint circle later); None for fewer than ``rules.min_points``."""
     if points.shape[0] < rules.min_points:
@@ -128,10 +135,8 @@ def rim_circle(edges: list[np.ndarray], heights: list[float], rules: RimRules) -
     if radius <= 0.0:
         return None
     for edge in edges:
-        distances = np.hypot(edge[:, 0] - centre[0], edge[:, 1] - centre[1])
-        if share_value(np.abs(distances - radius), 0.5) > rules.fit * radius:
-            return None
-        if not curves_like_a_rim(centre, edge):
+        off, away = _loops().arc_measures(edge, centre[0], centre[1], radius)
+        if off > rules.fit * radius or not _rim_shaped(edge, centre, away):
             return None
     return Rim(centre, radius, float(np.mean(heights)))
 
@@ -150,15 +155,17 @@ def stands_inside(wall: np.ndarray, other: np.ndarray, rules: RimRules) -> bool:
 
 def _within_rim(wall: np.ndarray, other: np.ndarray, rules: RimRules) -> bool:
     """The rim test of :func:`stands_inside`, its heights checked already."""
-    wall, other = (part[np.isfinite(part).all(axis=1)] for part in (wall, other))
-    if wall.shape[0] < rules.min_points or other.shape[0] < rules.min_points:
-        return False
+    other = other[np.isfinite(other).all(axis=1)]
     edge, height = top_edge(wall, rules)
     rim = rim_circle([edge], [height], rules)
-    if rim is None:
+    if rim is None or other.shape[0] < rules.min_points:
         return False
-    distances = np.hypot(other[:, 0] - rim.centre[0], other[:, 1] - rim.centre[1])
-    return share_value(distances, 0.5) <= rules.inside * rim.radius
+    return _distance_share(other, rim.centre, 0.5) <= rules.inside * rim.radius
+
+
+def _distance_share(points: np.ndarray, centre: np.ndarray, share: float) -> float:
+    """The value ``share`` of the way up the sorted (u, v) distances of Nx3 points from ``centre``."""
+    return float(_loops().distance_share(np.ascontiguousarray(points), float(centre[0]), float(centre[1]), share))
 
 
 def one_stands_inside(first: np.ndarray, second: np.ndarray, rules: RimRules | None = None) -> bool:
@@ -167,7 +174,8 @@ def one_stands_inside(first: np.ndarray, second: np.ndarray, rules: RimRules | N
     rules = rules or RimRules()
     if first.shape[0] < rules.min_points or second.shape[0] < rules.min_points:
         return False
-    first_top, second_top = share_value(first[:, 2], 0.95), share_value(second[:, 2], 0.95)
+    first_top = _loops().top_height(np.ascontiguousarray(first))
+    second_top = _loops().top_height(np.ascontiguousarray(second))
     if second_top > first_top + rules.tolerance:
         return _within_rim(first, second, rules)
     if first_top > second_top + rules.tolerance:
@@ -198,8 +206,7 @@ def rim_joins(
 
     def points_of(label: int) -> np.ndarray:
         if label not in coordinates:
-            own = flat[pixels[starts[label] : starts[label + 1]]]
-            coordinates[label] = own[np.isfinite(own).all(axis=1)]
+            coordinates[label] = flat[pixels[starts[label] : starts[label + 1]]]
         return coordinates[label]
 
     heights: dict[int, float] = {}  # each piece's 95 % height, NaN when too small to have an edge
@@ -253,14 +260,15 @@ def is_outer_wall(points: np.ndarray, rim: Rim, rules: RimRules) -> bool:
     rim: within the rim circle (95 % distance from the centre at most ``rules.hold`` of the radius), no higher than
     the rim (95 % height), and reaching out to the circle (at least ``rules.reach`` of the radius) or lying in
     front of the centre, nearer the camera (the front of a tapering wall, toward the foot)?"""
+    points = points[np.isfinite(points).all(axis=1)]
     if points.shape[0] < rules.min_points:
         return False
     if share_value(points[:, 2], 0.95) > rim.height + rules.tolerance:
         return False
-    reach = share_value(np.linalg.norm(points[:, :2] - rim.centre, axis=1), 0.95)
+    reach = _distance_share(points, rim.centre, 0.95)
     if reach > rules.hold * rim.radius:
         return False
-    in_front = share_value(np.linalg.norm(points[:, :2], axis=1), 0.5) < float(np.linalg.norm(rim.centre))
+    in_front = _distance_share(points, np.zeros(2), 0.5) < float(np.hypot(*rim.centre))
     return reach >= rules.reach * rim.radius or in_front
 
 
