@@ -265,9 +265,9 @@ def segment_clutter(
         if joined is not labels:
             pieces, summary_step, labels = None, 0, joined
     if p.join_rims:
-        # the heights and touching pairs of the labels as they are, when summarized
-        tops, touching = (pieces.high, pieces.touching) if pieces is not None else (None, None)
-        joined = join_rim_pieces(labels, plane_grid, RimRules(), tops, touching)
+        # the heights, touching pairs and boxes of the labels as they are, when summarized
+        known = (pieces.high, pieces.touching, pieces.boxes) if pieces is not None else (None, None, None)
+        joined = join_rim_pieces(labels, plane_grid.reshape(*labels.shape, 3), RimRules(), *known)
         if joined is not labels:
             pieces, summary_step, labels = None, 0, joined
     if p.join_slabs:

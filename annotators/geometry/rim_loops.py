@@ -105,9 +105,14 @@ def arc_turn(edge: np.ndarray, u: float, v: float) -> float:
 
 @njit(cache=True, nogil=True)
 def distance_share(points: np.ndarray, u: float, v: float, share: float) -> float:
-    """The value ``share`` of the way up the sorted (u, v) distances of Nx2+ points from ``(u, v)``."""
+    """The value ``share`` of the way up the sorted (u, v) distances of the Nx2+ points with finite (u, v) from
+    ``(u, v)`` (NaN for none)."""
     distances = np.empty(points.shape[0])
+    count = 0
     for i in range(points.shape[0]):
         du, dv = points[i, 0] - u, points[i, 1] - v
-        distances[i] = math.sqrt(du * du + dv * dv)
-    return share_value(distances, share)
+        distance = math.sqrt(du * du + dv * dv)
+        if np.isfinite(distance):
+            distances[count] = distance
+            count += 1
+    return share_value(distances[:count], share)

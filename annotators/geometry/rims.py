@@ -129,9 +129,9 @@ def rim_circle(edges: list[np.ndarray], heights: list[float], rules: RimRules) -
     """The rim that the top edges of one or more pieces (Nx2 each, on the plane with the camera's foot at the
     origin) lie on: one circle they each fit within ``rules.fit`` of its radius, each shaped like part of a rim
     (:func:`curves_like_a_rim`), at heights within ``rules.tolerance``; None otherwise."""
-    if any(edge.shape[0] < rules.min_points for edge in edges) or np.ptp(heights) > rules.tolerance:
+    if any(edge.shape[0] < rules.min_points for edge in edges) or max(heights) - min(heights) > rules.tolerance:
         return None
-    centre, radius = fit_circle(np.concatenate(edges))
+    centre, radius = fit_circle(edges[0] if len(edges) == 1 else np.concatenate(edges))
     if radius <= 0.0:
         return None
     for edge in edges:
@@ -155,16 +155,14 @@ def stands_inside(wall: np.ndarray, other: np.ndarray, rules: RimRules) -> bool:
 
 def _within_rim(wall: np.ndarray, other: np.ndarray, rules: RimRules) -> bool:
     """The rim test of :func:`stands_inside`, its heights checked already."""
-    other = other[np.isfinite(other).all(axis=1)]
     edge, height = top_edge(wall, rules)
     rim = rim_circle([edge], [height], rules)
-    if rim is None or other.shape[0] < rules.min_points:
-        return False
-    return _distance_share(other, rim.centre, 0.5) <= rules.inside * rim.radius
+    return rim is not None and _distance_share(other, rim.centre, 0.5) <= rules.inside * rim.radius
 
 
 def _distance_share(points: np.ndarray, centre: np.ndarray, share: float) -> float:
-    """The value ``share`` of the way up the sorted (u, v) distances of Nx3 points from ``centre``."""
+    """The value ``share`` of the way up the sorted (u, v) distances of Nx3 points (those not finite left out) from
+    ``centre``."""
     return float(_loops().distance_share(np.ascontiguousarray(points), float(centre[0]), float(centre[1]), share))
 
 
@@ -189,9 +187,11 @@ def rim_joins(
     rules: RimRules,
     tops: np.ndarray | None = None,
     touching: np.ndarray | None = None,
+    boxes: np.ndarray | None = None,
 ) -> list[tuple[int, int]]:
     """Label pairs of :func:`join_rim_pieces` (``plane_points``: the ``(u, v, height)`` of every pixel, HxWx3;
-    ``tops`` each label's 95 % height and ``touching`` the touching label pairs when known)."""
+    ``tops`` each label's 95 % height, ``touching`` the touching label pairs and ``boxes`` each label's pixel box
+    ``(x0, y0, x1, y1)`` when known)."""
     pairs = touching_pairs(labels) if touching is None else touching
     if pairs.shape[0] < 2:
         return []
@@ -199,14 +199,18 @@ def rim_joins(
     for a, b in pairs.tolist():
         neighbours.setdefault(a, set()).add(b)
         neighbours.setdefault(b, set()).add(a)
-    pixels, starts = label_groups(labels)
-    flat = plane_points.reshape(-1, 3)
-
     coordinates: dict[int, np.ndarray] = {}
+    if boxes is None:
+        pixels, starts = label_groups(labels)
+        flat = plane_points.reshape(-1, 3)
 
     def points_of(label: int) -> np.ndarray:
         if label not in coordinates:
-            coordinates[label] = flat[pixels[starts[label] : starts[label + 1]]]
+            if boxes is None:
+                coordinates[label] = flat[pixels[starts[label] : starts[label + 1]]]
+            else:
+                x0, y0, x1, y1 = boxes[label]
+                coordinates[label] = plane_points[y0:y1, x0:x1][labels[y0:y1, x0:x1] == label]
         return coordinates[label]
 
     heights: dict[int, float] = {}  # each piece's 95 % height, NaN when too small to have an edge
@@ -215,9 +219,8 @@ def rim_joins(
         if tops is not None:
             return float(tops[label])
         if label not in heights:
-            own = flat[pixels[starts[label] : starts[label + 1]], 2]
-            own = own[np.isfinite(own)]
-            heights[label] = share_value(own, 0.95) if own.size >= rules.min_points else np.nan
+            own = points_of(label)
+            heights[label] = _loops().top_height(own) if own.shape[0] >= rules.min_points else np.nan
         return heights[label]
 
     arcs: dict[int, Arc | None] = {}
@@ -278,9 +281,11 @@ def join_rim_pieces(
     rules: RimRules | None = None,
     tops: np.ndarray | None = None,
     touching: np.ndarray | None = None,
+    boxes: np.ndarray | None = None,
 ) -> np.ndarray:
     """Labels with the pieces of one open container's rim joined (see the module docstring; ``plane_points`` the
-    ``(u, v, height)`` of every pixel, HxWx3 or (H*W)x3; ``tops`` each label's 95 % height and ``touching`` the
-    touching label pairs, when a summary of the labels has them); the same array when nothing joined."""
-    joins = rim_joins(labels, plane_points.reshape(*labels.shape, 3), rules or RimRules(), tops, touching)
+    ``(u, v, height)`` of every pixel, HxWx3 or (H*W)x3; ``tops`` each label's 95 % height, ``touching`` the
+    touching label pairs and ``boxes`` the labels' pixel boxes, when a summary of the labels has them); the same
+    array when nothing joined."""
+    joins = rim_joins(labels, plane_points.reshape(*labels.shape, 3), rules or RimRules(), tops, touching, boxes)
     return join_labels(labels, joins) if joins else labels
