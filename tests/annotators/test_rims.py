@@ -2,7 +2,8 @@
 
 The camera's foot is at the origin of the table plane and it looks along +u; a bowl of radius 7 cm with its rim
 8 cm high stands at u = 0.5. Its inner wall seen over the rim is the back of the ring (u beyond the centre), its
-outer wall below the rim the front; a can standing in it rises to 10 cm at the centre.
+outer wall below the rim the front; a can standing in it rises to 10 cm at the centre (it is no piece of the bowl
+for join_unsupported either).
 """
 
 from __future__ import annotations
@@ -16,6 +17,7 @@ from annotators.geometry.rims import (
     join_rim_pieces,
     stands_inside,
 )
+from annotators.geometry.support import SupportRules, join_unsupported
 
 CENTRE = np.array([0.5, 0.0])
 RADIUS = 0.07
@@ -119,3 +121,25 @@ def test_walls_of_two_bowls_or_at_two_heights_stay_apart() -> None:
             (20, 60),
         )
         assert join_rim_pieces(labels, plane) is labels
+
+
+def whole_bowl(count: int = 400) -> np.ndarray:
+    """Points of a whole bowl seen from above: its inner wall all around (the rim on top) and its outer wall in
+    front, down to the table."""
+    rng = np.random.default_rng(11)
+    inside = inner_wall(-90.0, 90.0, count // 2)
+    outside = ring(rng.uniform(90.0, 270.0, count // 2), RADIUS * rng.uniform(0.7, 1.0, count // 2), 0.0)
+    outside[:, 2] = rng.uniform(0.0, RIM, count // 2)
+    return np.concatenate([inside, outside])
+
+
+def test_a_can_standing_in_a_whole_bowl_is_no_piece_of_it() -> None:
+    """join_unsupported: the can does not reach the table, its footprint lies within the bowl's and its foot in the
+    lower half of the bowl's heights - the marks of a piece that cannot stand by itself - but it stands inside."""
+    labels, plane = grid_of(
+        {1: (slice(0, 20), slice(0, 40), whole_bowl()), 2: (slice(20, 30), slice(10, 30), can(0.10))}, (30, 40)
+    )
+    apart = join_unsupported(labels, plane)
+    assert apart[5, 5] != apart[25, 20]
+    joined = join_unsupported(labels, plane, SupportRules(standing_inside=False))
+    assert joined[5, 5] == joined[25, 20]  # without the rim test it would be taken for a piece of the bowl
