@@ -9,7 +9,8 @@ Works like :mod:`annotators.cloud.clusters` on every ``stride``-th pixel of the 
    (:func:`annotators.geometry.convexity.convex_groups`); colour plays no part, so a printed box is one object;
 3. the cut pixels are given back, and a container's inside joins its outside (a handle its body): the footprints on
    the plane overlap and the heights nest, which an object standing on another never does
-   (:func:`annotators.geometry.grid_segmentation.merge_parts`);
+   (:func:`annotators.geometry.grid_segmentation.merge_parts`) - nor one standing in a container and rising above
+   its rim, whose inner wall's heights lie within its own (:func:`annotators.geometry.rims.one_stands_inside`);
 4. an object is split along a hue edge only where a concave crease runs along it (:func:`split_by_color`: a can
    standing flush on a can is one convex surface but two colours with a crease between);
 5. pieces that an occluder in front splits apart join when they continue one plane behind it
@@ -26,15 +27,19 @@ Works like :mod:`annotators.cloud.clusters` on every ``stride``-th pixel of the 
    is concave toward the camera around an axis inside the two's footprint joins it: the far inner wall of a mug
    seen over its rim, whose footprint is the back arc of the ring the outside's front arc starts
    (:func:`annotators.geometry.inner_walls.join_inner_walls`);
-7. touching pieces that fill one slab - their lowest heights and tops agree, no depth jump along most of their
+7. the inner wall of an open container that an object standing in it cuts into pieces on both sides joins again
+   where the pieces' top edges lie on one rim circle at one height, with the outer wall below the front rim
+   within that circle; the object rising above the rim stays apart, and no piece standing inside a container is
+   joined to it as unable to stand by itself (:func:`annotators.geometry.rims.join_rim_pieces`);
+8. touching pieces that fill one slab - their lowest heights and tops agree, no depth jump along most of their
    shared border - join: a drill lying on its side, cut where its grip ends behind the battery's raised edge
    (:func:`annotators.geometry.slabs.join_slab_pieces`);
-8. the floor of an open container seen from above - within ``min_height`` of the plane, so no candidate - joins
+9. the floor of an open container seen from above - within ``min_height`` of the plane, so no candidate - joins
    the container whose footprint holds it, that surrounds it in the image on three sides at least and that does
    not hang over it
    (:func:`annotators.geometry.container_floors.claim_container_floors`); the floor's bits that the noise lifted
    above ``min_height`` then touch their container and join it as pieces that cannot stand by themselves;
-9. at full resolution, the outline pixels the coarse grid left unlabelled and the foot below the candidates'
+10. at full resolution, the outline pixels the coarse grid left unlabelled and the foot below the candidates'
    lowest height join the object whose surface they continue
    (:func:`annotators.geometry.border_pixels.claim_border_pixels`).
 """
@@ -74,6 +79,7 @@ from annotators.geometry.grid_segmentation import (
 )
 from annotators.geometry.inner_walls import InnerWallRules, join_inner_walls
 from annotators.geometry.occlusion import OcclusionRules, join_occluded
+from annotators.geometry.rims import RimRules, join_rim_pieces, one_stands_inside
 from annotators.geometry.slabs import SlabRules, join_slab_pieces
 from annotators.geometry.support import (
     AppendageRules,
@@ -98,6 +104,8 @@ class ClutterParameters(ClusterParameters):
     themselves to the object that holds them, ``join_jointly_held`` those two touching neighbours hold only
     together, and ``join_appendages`` the small pieces sticking out of a larger one;
     ``join_inner_walls`` joins an open container's inside seen over its rim to its outside;
+    ``join_rims`` joins the pieces of one open container's rim that an object standing in it cuts apart, and its
+    outer wall below the rim;
     ``join_slabs`` joins touching pieces of one slab (same lowest heights and tops, no depth jump between them);
     ``claim_floors`` gives an open container the floor seen over its rim, at table level;
     ``claim_borders`` gives the outline pixels the coarse grid
@@ -126,6 +134,7 @@ class ClutterParameters(ClusterParameters):
     join_appendages: bool = True
     join_jointly_held: bool = True
     join_inner_walls: bool = True
+    join_rims: bool = True
     join_slabs: bool = True
     claim_floors: bool = True
     claim_borders: bool = True
@@ -237,7 +246,9 @@ def segment_clutter(
     offset = np.array([0.0, 0.0, model[3]], dtype=np.float32)
     # (u, v, height) of every grid point on the plane
     plane_grid = plane_coordinates(grid.reshape(-1, 3), to_plane, offset)
-    labels = merge_parts(labels, depth, plane_grid.__getitem__, p.merge_rules())
+    labels = merge_parts(
+        labels, depth, plane_grid.__getitem__, p.merge_rules(), stand_apart=one_stands_inside if p.join_rims else None
+    )
     if colors is not None and p.use_color:
         colors_crop = strided_crop(colors, step, (x0, y0, x1, y1))
         labels = split_by_color(labels, grid, normals, colors_crop, p)
@@ -256,6 +267,12 @@ def segment_clutter(
             summary_step = wall_rules.support.sample_step
             pieces = summarize_pieces(labels, plane_grid, summary_step)
         joined = join_inner_walls(labels, grid, normals, plane_grid, to_plane[:, :3], wall_rules, pieces)
+        if joined is not labels:
+            pieces, summary_step, labels = None, 0, joined
+    if p.join_rims:
+        # the heights, touching pairs and boxes of the labels as they are, when summarized
+        known = (pieces.high, pieces.touching, pieces.boxes) if pieces is not None else (None, None, None)
+        joined = join_rim_pieces(labels, plane_grid.reshape(*labels.shape, 3), RimRules(), *known)
         if joined is not labels:
             pieces, summary_step, labels = None, 0, joined
     if p.join_slabs:

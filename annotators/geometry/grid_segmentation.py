@@ -590,6 +590,7 @@ def merge_parts(
     plane_coordinates: Callable[[np.ndarray], np.ndarray],
     rules: MergeRules,
     surface: Boundaries | None = None,
+    stand_apart: Callable[[np.ndarray, np.ndarray], bool] | None = None,
 ) -> np.ndarray:
     """Join touching parts that are pieces of one object; labels renumbered 1..n (0 = none).
 
@@ -606,6 +607,10 @@ def merge_parts(
       goes on across it smoothly (normals within ~35°) or over a convex edge (a box's top and front face), never
       into a concave crease (a can standing on a box); below ~18° between the normals the surfaces count as one
       plane, whatever the (then noisy) convexity says.
+
+    ``stand_apart(first, second)`` (Nx3 plane coordinates of two parts), when given, vetoes the footprint rule: a
+    can standing in a bowl shares the footprint of the bowl's inner wall around it, and the wall's heights lie
+    within the can's when the can rises above the rim.
 
     A pair whose shared boundary is mostly a depth jump (continuous on less than ``rules.occlusion`` of it) is an
     occluder and what it hides, or a container's rim and its inside: only the inside rule may join it. Parts
@@ -668,7 +673,7 @@ def merge_parts(
                 not rules.nested
                 or _sorted_heights_nest(ordered[0][:, 2], ordered[1][:, 2], rules.nest_tolerance)
                 or _sorted_floor_within(*ordered, parts.hull(first), parts.hull(second), rules)
-            ):
+            ) and (stand_apart is None or not stand_apart(parts.coordinates(first), parts.coordinates(second))):
                 allowed.append((first, second))
                 continue
             stacked = True

@@ -8,7 +8,8 @@ down into the lower part of the neighbour's heights, so it cannot rest on the ne
 of a mug or bowl seen over its rim together with the rim and the handle's top is such a piece: the convexity
 grouping cuts it from the outside along the concave fold of the inner wall. Two solid objects standing side by
 side have footprints apart, an object standing on another starts at the other's top, and a can standing in a bowl
-is larger than the piece of the bowl's outside it touches; none of them is joined (:func:`join_unsupported`).
+is larger than the piece of the bowl's outside it touches, and rises above the rim of the whole bowl near its
+centre - it rests on the bowl's floor; none of them is joined (:func:`join_unsupported`).
 
 The grouping can also cut a container in three: the inside seen over the rim, the outside's front, and its side
 with the handle, the side reaching the table too. The inside then lies half over each outside piece: neither holds
@@ -38,6 +39,7 @@ from annotators.geometry.grid_segmentation import (
     pixel_footprint,
     touching_pairs,
 )
+from annotators.geometry.rims import RimRules, stands_inside
 from annotators.geometry.support_kernels import (
     appendage_candidates,
     hull_candidates,
@@ -56,13 +58,16 @@ class SupportRules:
     which its lowest heights must exceed the holder's (``tolerance``), the share of the holder's heights (from its
     5 % to its 95 % height) its lowest heights must lie below (``reach_down``), the raster cell of the footprints
     (metres) and
-    the spacing of the grid pixels sampled for heights and footprints (``sample_step``)."""
+    the spacing of the grid pixels sampled for heights and footprints (``sample_step``); with ``standing_inside``
+    a piece that stands inside a holder that is an open container (:func:`~annotators.geometry.rims.stands_inside`)
+    is never held: it rests on the container's floor."""
 
     held_share: float = 0.5
     tolerance: float = 0.003
     reach_down: float = 0.5
     cell: float = 0.005
     sample_step: int = 2
+    standing_inside: bool = True
 
 
 _FEW_FEET = 16
@@ -184,8 +189,21 @@ def unsupported_holders(
         else:
             share = held_share(hulls[piece], hulls[holder], rules.cell)
             if share >= rules.held_share and share > best.get(piece, (-1.0, 0))[0]:
+                if rules.standing_inside and _stands_inside(labels, plane_points, pieces, piece, holder):
+                    continue
                 best[piece] = (share, holder)
     return [(piece, holder) for piece, (_, holder) in best.items()]
+
+
+def _stands_inside(labels: np.ndarray, plane_points: np.ndarray, pieces: PieceSummary, piece: int, holder: int) -> bool:
+    """:func:`~annotators.geometry.rims.stands_inside` of two labels, read in their boxes."""
+    grid = plane_points.reshape(*labels.shape, 3)
+
+    def points_of(label: int) -> np.ndarray:
+        x0, y0, x1, y1 = pieces.boxes[label]
+        return grid[y0:y1, x0:x1][labels[y0:y1, x0:x1] == label]
+
+    return stands_inside(points_of(holder), points_of(piece), RimRules())
 
 
 def join_unsupported(labels: np.ndarray, plane_points: np.ndarray, rules: SupportRules | None = None) -> np.ndarray:

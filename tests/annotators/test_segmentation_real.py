@@ -16,6 +16,9 @@
   the rim is the back arc of the ring whose front arc the outside is, so the outside's footprint holds only a
   tenth of it; its wall curves concavely around an axis inside the mug (the inner-wall join). The small can
   standing in the teal bowl in frame 3 stands at that bowl's axis, but inside its inner wall: it stays apart.
+* the teal bowl with that can standing in it (frames 2 and 3) is one hypothesis and the can another: the can cuts
+  the bowl's inner wall into a left and a right piece whose top edges lie on one rim circle, and the outer wall
+  below the front rim lies within that circle, below the rim; the can rises above the rim.
 """
 
 from __future__ import annotations
@@ -207,6 +210,28 @@ def test_the_can_standing_in_the_teal_bowl_stays_apart_from_the_bowl(uoc_folder:
     can = hypothesis_at(hypotheses, 320, 200)
     bowl = {hypothesis_at(hypotheses, x, y) for x, y in ((278, 195), UOC_OBJECTS[3]["teal bowl"])}  # left, right wall
     assert can and can not in bowl, f"the can is in hypothesis {can}, the bowl's walls in {bowl}"
+
+
+TEAL_BOWL = {  # the inner wall left and right of the can standing in the teal bowl, its outer wall below the rim
+    2: {"left wall": (270, 210), "right wall": (340, 235), "outer wall": (298, 254), "outer wall right": (330, 262)},
+    3: {"left wall": (278, 195), "right wall": (340, 185), "outer wall": (300, 250), "outer wall right": (330, 255)},
+}
+CAN_IN_BOWL = {2: (305, 200), 3: (320, 200)}
+
+
+@pytest.mark.parametrize("frame", [2, 3])
+def test_the_teal_bowl_with_a_can_standing_in_it_is_one_hypothesis_and_the_can_another(
+    uoc_folder: Path, frame: int
+) -> None:
+    root = create_pipeline(reader_for(str(uoc_folder), frame))
+    assert Engine(root).tick() is Status.SUCCESS, [(c.name, c.feedback_message) for c in root.children]
+    hypotheses = root.cas.annotations(ObjectHypothesis)
+    bowl = {name: hypothesis_at(hypotheses, x, y) for name, (x, y) in TEAL_BOWL[frame].items()}
+    can = hypothesis_at(hypotheses, *CAN_IN_BOWL[frame])
+    others = {hypothesis_at(hypotheses, x, y) for name, (x, y) in UOC_OBJECTS[frame].items() if name != "teal bowl"}
+    assert len(set(bowl.values())) == 1 and 0 not in bowl.values(), f"the bowl's parts are in hypotheses {bowl}"
+    assert can and can not in bowl.values(), f"the can is in hypothesis {can}, the bowl in {bowl}"
+    assert not set(bowl.values()) & others, "the bowl shares its hypothesis with another object"
 
 
 def test_the_drill_chuck_stays_with_the_drill_body(uoc_folder: Path) -> None:
