@@ -17,9 +17,10 @@ Rule (log-odds accumulation over a categorical domain with an implicit "somethin
 The probability that an object answers a query for class ``C`` (:func:`answer_probability`) is the same rule applied
 to ``C`` as a value stated by every value the query's class test accepts (``C``, its subclasses, classes packaged in
 it): the most general of them (pairwise unrelated) state ``C`` as alternatives, their odds adding up
-(``L(C) = log Σ e^L(m)``; ``L(C)`` itself when ``C`` was stated), the ones below them support ``C`` as a subclass
-does (``+ max(L(u), 0)``), each value counted once whatever its paths to ``C``; the rivals are the values that
-answer neither ``C`` nor are above ``C`` or one of its answering values.
+(``e^S(C) = Σ_m e^S(m)``; ``S(C)`` itself when ``C`` was stated), the ones below them support ``C`` as a subclass
+does (``S(m) = L(m) + Σ_u max(L(u), 0)`` over all of them, bounded by ``±MAX_LOG_ODDS``), each value counted once
+whatever its paths to ``C``; the rivals are the values that neither answer ``C`` nor are above ``C`` or one of its
+answering values.
 """
 
 from __future__ import annotations
@@ -246,9 +247,8 @@ def answer_probability(values: Mapping[str, ValueSupport], asked: str, class_tes
         return class_test is not None and a != b and class_test(a, b)
 
     general = [m for m in members if not any(below(m, n) for n in members)]
-    top_own = max(values[m].log_odds for m in general)
-    own = top_own + math.log(sum(math.exp(values[m].log_odds - top_own) for m in general))
-    score = _clamp(own + sum(max(values[u].log_odds, 0.0) for u in members if u not in general))
+    support = sum(max(values[u].log_odds, 0.0) for u in members if u not in general)
+    terms = [_clamp(values[m].log_odds + support) for m in general]  # bounded as a value's score is
 
     def related(w: str) -> bool:  # w answers, is above the asked class or above one of its answering values
         return w in members or below(asked, w) or any(below(m, w) for m in members)
@@ -258,8 +258,8 @@ def answer_probability(values: Mapping[str, ValueSupport], asked: str, class_tes
     rival_scores = [
         _clamp(values[w].log_odds + sum(max(values[u].log_odds, 0.0) for u in values if below(u, w))) for w in rivals
     ]
-    top = max([score, 0.0, *rival_scores])
-    mass = math.exp(score - top)
+    top = max([*terms, 0.0, *rival_scores])
+    mass = sum(math.exp(t - top) for t in terms)
     return mass / (mass + math.exp(-top) + sum(math.exp(s - top) for s in rival_scores))
 
 
