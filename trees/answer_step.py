@@ -182,6 +182,7 @@ class AnswerStep(Annotator):
                     roi=seen[b.id].roi,
                     label_of=self.label_of,
                     guessed_class=belief_filter.object_class if b.id in guesses else None,
+                    asked_class=belief_filter.object_class,
                 )
                 for b in matching
             ),

@@ -66,6 +66,11 @@ subclasses' profiles, its lead that over the best profile outside it (cues that 
 from a plastic one still say bowl; a cup from a glass, still a container; a carton whose printed text went unread,
 still food or drink; :func:`class_evidence`). Everything else is classified :data:`UNKNOWN_CLASS` ("unknown
 object") with confidence 1 - probability (how sure the classifier is that naming the best candidate would be wrong).
+When the query's class decided for another class (a subclass, or a class packaged in it), the classifier also states
+the query's class with the calibrated probability that the object answers to it as a whole (its answering profiles'
+best score and lead, :func:`answering_evidence`) when that is higher: the answer shows the class distribution's mass
+on the classes that answer to the query (:func:`reasoning.fusion.rule.answer_probability`), and a mustard whose
+label went unread is unlikely a mustard but, tying with a lemon soda, as likely a bottle as the tie allows.
 """
 
 from __future__ import annotations
@@ -391,6 +396,17 @@ def class_evidence(name: str, matches: Sequence[Match]) -> tuple[float, float, b
     return top, top - max(rivals, default=0.0), unread
 
 
+def answering_evidence(wanted: str, matches: Sequence[Match]) -> tuple[float, float, bool]:
+    """The evidence that the object answers a query for class ``wanted`` (lower case), taken as a whole: as
+    :func:`class_evidence`, over the profiles that answer to it (:meth:`Profile.answers`: it, its subclasses, classes
+    packaged in it), against those that do not and are not above all of them."""
+    inside = [m for m in matches if m.profile.answers(wanted)]
+    top = max((m.score for m in inside), default=0.0)
+    rivals = [m.score for m in matches if not m.profile.answers(wanted) and not above(m, wanted, inside)]
+    unread = any(m.unread for m in inside if m.profile.class_name.lower() == wanted)
+    return top, top - max(rivals, default=0.0), unread
+
+
 def more_general_fit(
     best: Match, matches: Sequence[Match], min_score: float, calibration: Calibration, assert_probability: float
 ) -> tuple[str, float, float, float] | None:
@@ -488,7 +504,11 @@ class Decision:
     ``class_name`` is the asserted class, or :data:`UNKNOWN_CLASS` when no profile fits clearly; ``confidence``
     is the calibrated probability that the statement is right (for the unknown class: that the best candidate
     would have been wrong). ``best`` and ``margin`` are the evidence, ``probability`` the calibrated probability
-    that ``best`` is right, ``reason`` says in words why the class was or was not asserted.
+    that ``best`` is right, ``reason`` says in words why the class was or was not asserted. ``answering`` is set
+    when the query's class decided for a class other than itself (a subclass, or a class packaged in it): the
+    calibrated probability that the object answers to the query's class, taken as a whole
+    (:func:`answering_evidence`), when it exceeds ``confidence`` (a mustard whose label went unread and that ties
+    with a lemon soda is surely no mustard, but as likely a bottle as the tie allows).
     """
 
     class_name: str
@@ -497,6 +517,7 @@ class Decision:
     margin: float
     probability: float
     reason: str
+    answering: float | None = None
 
 
 def decide(
@@ -523,14 +544,19 @@ def decide(
     pick = choose_expected(matches, expected, min_score, margin) if expected else None
     if pick is not None and holds_up(pick, matches, cues, min_score, margin):
         pick_lead = lead(pick, matches)
+        pick_p = calibration.probability(pick.score, pick_lead, pick.unread)
+        answering = None
+        if expected and pick.profile.class_name.lower() != expected.lower():
+            answering = calibration.probability(*answering_evidence(expected.lower(), matches))
         return Decision(
             pick.profile.class_name,
-            calibration.probability(pick.score, pick_lead, pick.unread),
+            pick_p,
             best,
             best_lead,
             p,
             f"{pick.profile.class_name} fits (score {pick.score:.2f}) as well as any other class; "
             f"the query's class decides",
+            answering if answering is not None and answering > pick_p else None,
         )
     general = more_general_fit(best, matches, min_score, calibration, assert_probability)
     if general is not None:
@@ -636,7 +662,9 @@ class KnowledgeClassifier(Annotator):
 
     def analyse(self) -> None:
         """Attach a Classification to every hypothesis that carries cues: its class when one fits clearly, else
-        :data:`UNKNOWN_CLASS` (so the answer can say "unknown object")."""
+        :data:`UNKNOWN_CLASS` (so the answer can say "unknown object"); when the query's class decided for a class
+        below or packaged in it, also the query's class with the probability that the object answers to it
+        (:attr:`Decision.answering`: the fused answer then shows that figure for "find all bottles")."""
         if not self.profiles:
             self.fail("no candidate class profiles to compare the hypotheses with")
         hypotheses = self.annotations(ObjectHypothesis)
@@ -649,6 +677,8 @@ class KnowledgeClassifier(Annotator):
                 continue
             decision = self.decide(cues)
             self.attach(hypothesis, Classification(class_name=decision.class_name, confidence=decision.confidence))
+            if decision.answering is not None and self.expected:  # what the query asked for, as a whole
+                self.attach(hypothesis, Classification(class_name=self.expected, confidence=decision.answering))
             classified += 1
         if classified == 0:
             self.fail("no object hypothesis carries a colour, shape, size or text to classify by")

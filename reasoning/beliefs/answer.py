@@ -2,9 +2,12 @@
 
 An :class:`ObjectDesignator` is what the robot acts on: id, class (IRI and label), pose (position, quaternion
 x-y-z-w, frame), size, region, attributes with confidence (and the alternatives experts also proposed), the
-image ROI when the object was seen in this frame's image, and the experts that contributed. :class:`Answer` is
-a list of them; both turn into JSON-ready dicts. The tree leaf that answers from a frame is
-:class:`trees.answer_step.AnswerStep`.
+image ROI when the object was seen in this frame's image, and the experts that contributed; when the query asked
+for a class, also the probability that the object answers to it (``class.answers`` in the JSON, only then): the
+fused class distribution's mass on the classes the query's class test accepts
+(:func:`~reasoning.fusion.rule.answer_probability`; a mustard answers "find all bottles", as it is packaged in
+one). :class:`Answer` is a list of them; both turn into JSON-ready dicts. The tree leaf that answers from a frame
+is :class:`trees.answer_step.AnswerStep`.
 """
 
 from __future__ import annotations
@@ -18,7 +21,7 @@ from typing import Any
 
 from reasoning.beliefs.ranking import answer_order
 from reasoning.beliefs.store import BeliefFilter, BeliefStore
-from reasoning.fusion.rule import CLASS_ATTRIBUTE, ClassTest, FusedAttribute, fuse_values
+from reasoning.fusion.rule import CLASS_ATTRIBUTE, ClassTest, FusedAttribute, answer_probability, fuse_values
 from reasoning.fusion.tracking import ObjectBelief
 from reasoning.knowledge.index import ROOTS
 from robokudo.core.types import ONTOLOGY_NAMESPACE, SemanticColor, Size
@@ -72,7 +75,9 @@ class AttributeDesignator:
 
 @dataclass(frozen=True, slots=True)
 class ObjectDesignator:
-    """One object in an answer (see the module docstring); ``roi`` is ``(x0, y0, x1, y1)`` pixels or None."""
+    """One object in an answer (see the module docstring); ``roi`` is ``(x0, y0, x1, y1)`` pixels or None;
+    ``answers`` is the probability that the object answers to the class the query asked for (None: it asked for
+    none)."""
 
     id: int
     class_iri: str | None
@@ -88,18 +93,32 @@ class ObjectDesignator:
     first_seen: float = 0.0
     last_seen: float = 0.0
     status: str = "present"
+    answers: float | None = None
+
+    def class_probability(self) -> float | None:
+        """The class probability shown to people: that the object answers to the asked class when the query asked
+        for one, else that its fused class is right (None when no class was stated)."""
+        if self.answers is not None:
+            return self.answers
+        stated = self.attributes.get(CLASS_ATTRIBUTE)
+        return stated.confidence if stated is not None else None
 
     def shown_label(self) -> str:
-        """The class label for people: ``?`` marks a class more likely wrong than right."""
-        stated = self.attributes.get(CLASS_ATTRIBUTE)
-        doubtful = self.class_label is not None and stated is not None and stated.confidence < 0.5
+        """The class label for people: ``?`` marks a class more likely wrong than right (for a query asking for a
+        class: an object more likely not of that class)."""
+        probability = self.class_probability()
+        doubtful = self.class_label is not None and probability is not None and probability < 0.5
         return f"{self.class_label or UNKNOWN_LABEL}{'?' if doubtful else ''}"
 
     def to_dict(self) -> dict[str, Any]:
-        """A JSON-ready dict (numbers rounded to 6 decimals)."""
+        """A JSON-ready dict (numbers rounded to 6 decimals); ``class.answers`` is :attr:`answers`, only when the
+        query asked for a class."""
+        shown_class: dict[str, Any] = {"iri": self.class_iri, "label": self.class_label}
+        if self.answers is not None:
+            shown_class["answers"] = round(self.answers, 6)
         return {
             "id": self.id,
-            "class": {"iri": self.class_iri, "label": self.class_label},
+            "class": shown_class,
             "pose": {
                 "position": _rounded(self.pose.position),
                 "orientation": _rounded(self.pose.orientation),
@@ -286,7 +305,8 @@ class Answer:
 
     def summary(self) -> str:
         """One line per object, for people: a class more likely wrong than right is marked ``?``; ``class`` is the
-        probability that the class is right, ``exists`` the confidence that the object is there; then the free places
+        probability that the object answers to the class the query asked for (without one: that its class is
+        right), ``exists`` the confidence that the object is there; then the free places
         when the query asked for free space."""
         lines = self._object_lines()
         if self.placements is not None:
@@ -306,13 +326,13 @@ class Answer:
         for o in self.objects:
             p = o.pose.position
             colour = o.attributes.get(SemanticColor.attribute)
-            stated = o.attributes.get(CLASS_ATTRIBUTE)
+            probability = o.class_probability()
             lines.append(
                 f"#{o.id} {o.shown_label()}"
                 + (f" ({colour.value})" if colour else "")
                 + f" at ({p[0]:.3f}, {p[1]:.3f}, {p[2]:.3f}) [{o.pose.frame}]"
                 + (f" in {o.region}" if o.region else "")
-                + (f", class {stated.confidence:.2f}" if stated is not None and o.class_label else "")
+                + (f", class {probability:.2f}" if probability is not None and o.class_label else "")
                 + f", exists {o.confidence:.2f}, by {', '.join(o.experts) or 'nobody'}"
             )
         return lines
@@ -382,15 +402,18 @@ def designator(
     iri_of: Callable[[str], str] = class_iri,
     label_of: Callable[[str], str] = class_label,
     guessed_class: str | None = None,
+    asked_class: str | None = None,
 ) -> ObjectDesignator:
     """The designator of a belief; ``roi`` is given when the object was seen in the current image.
 
     ``guessed_class`` names the object when this answer offers it as a candidate of that class without evidence
-    the belief keeps (its class attribute still shows what the evidence says).
+    the belief keeps (its class attribute still shows what the evidence says). ``asked_class`` is the class the
+    query asked for: the designator then carries the probability that the object answers to it (``class_test``
+    is the query's: a class packaged in the asked one answers to it).
     """
     return _designate(
         _belief_view(belief), class_test=class_test, roi=roi, iri_of=iri_of, label_of=label_of,
-        guessed_class=guessed_class,
+        guessed_class=guessed_class, asked_class=asked_class,
     )  # fmt: skip
 
 
@@ -402,6 +425,7 @@ def _designate(
     iri_of: Callable[[str], str] = class_iri,
     label_of: Callable[[str], str] = class_label,
     guessed_class: str | None = None,
+    asked_class: str | None = None,
 ) -> ObjectDesignator:
     """The designator of a belief's view (see :func:`designator`)."""
     belief = view.belief
@@ -421,6 +445,10 @@ def _designate(
     if class_name is None:
         class_name = supported_class
     size_attribute = attributes.get(Size.attribute)
+    answers = None
+    if asked_class:
+        classes = belief.attributes.get(CLASS_ATTRIBUTE)
+        answers = answer_probability(classes.values, asked_class, class_test) if classes is not None else 0.0
     return ObjectDesignator(
         id=belief.id,
         class_iri=iri_of(class_name) if class_name else None,
@@ -436,6 +464,7 @@ def _designate(
         first_seen=belief.first_seen,
         last_seen=belief.last_seen,
         status=belief.status,
+        answers=answers,
     )
 
 
@@ -449,5 +478,8 @@ def answer_from_memory(store: BeliefStore, belief_filter: BeliefFilter, query: s
     else:
         views = store.query_views(belief_filter, _belief_view)
         views.sort(key=lambda v: (-v.confidence, v.belief.id))
-    designators = tuple(_designate(v, class_test=belief_filter.class_test, **options) for v in views)
+    designators = tuple(
+        _designate(v, class_test=belief_filter.class_test, asked_class=belief_filter.object_class, **options)
+        for v in views
+    )
     return Answer(query=query, objects=designators, from_memory=True)

@@ -1,8 +1,10 @@
 """Which of the beliefs matching a query answer it best: the order a query with ``max_results`` is cut in.
 
 "find a cup" asks for one object. Of the beliefs the filter lets through, the one most likely to be what was asked
-comes first: the probability that the object exists times the fused probability of the asked class (with
-subsumption: a paper cup's support counts for "cup") and of every asked attribute value (``color: red``). A belief
+comes first: the probability that the object exists times the probability that it answers to the asked class (the
+fused class distribution's mass on the classes the query's class test accepts, each counted once: a paper cup's
+support counts for "cup", a mustard's for "bottle"; :func:`~reasoning.fusion.rule.answer_probability`) and the fused
+probability of every asked attribute value (``color: red``). A belief
 the query's class was only guessed for (no stored evidence of that class) ranks after every belief with evidence.
 """
 
@@ -11,13 +13,9 @@ from __future__ import annotations
 from collections.abc import Callable, Iterable, Mapping
 
 from reasoning.beliefs.store import BeliefFilter
-from reasoning.fusion.rule import CLASS_ATTRIBUTE, ClassTest, ValueSupport, fuse_values
+from reasoning.fusion.rule import CLASS_ATTRIBUTE, ClassTest, ValueSupport, answer_probability, fuse_values
 from reasoning.fusion.tracking import ObjectBelief
 from robokudo.core.types import Text
-
-
-def _same_name(a: str, b: str) -> bool:
-    return a.lower() == b.lower()
 
 
 def _best_probability(
@@ -36,15 +34,13 @@ def _alternatives(wanted: str | tuple[str, ...]) -> tuple[str, ...]:
 
 def match_probability(belief: ObjectBelief, belief_filter: BeliefFilter) -> float:
     """How likely ``belief`` is what ``belief_filter`` asks for: its existence confidence times the probability of
-    the asked class and of each asked attribute value (read text is matched, not scored, and counts 1)."""
+    the object answering to the asked class and of each asked attribute value (read text is matched, not scored,
+    and counts 1)."""
     probability = belief.confidence
     asked = belief_filter.object_class
     if asked:
-        test = belief_filter.class_test or _same_name
         classes = belief.attributes.get(CLASS_ATTRIBUTE)
-        probability *= _best_probability(
-            CLASS_ATTRIBUTE, classes.values if classes else {}, lambda value: test(value, asked), test
-        )
+        probability *= answer_probability(classes.values, asked, belief_filter.class_test) if classes else 0.0
     for name, wanted in belief_filter.attributes.items():
         if name == Text.attribute:
             continue

@@ -13,6 +13,14 @@ Rule (log-odds accumulation over a categorical domain with an implicit "somethin
 * the fused value is the most probable one, refined to its most specific subclass that is itself more likely
   than not; every value is kept with its support (log-odds, count, experts), so conflicts are never dropped;
   it is ``supported`` when its score is positive (a value stated with confidence 0.5 only is no evidence).
+
+The probability that an object answers a query for class ``C`` (:func:`answer_probability`) is the same rule applied
+to ``C`` as a value stated by every value the query's class test accepts (``C``, its subclasses, classes packaged in
+it): the most general of them (pairwise unrelated) state ``C`` as alternatives, their odds adding up
+(``e^S(C) = Σ_m e^S(m)``; ``S(C)`` itself when ``C`` was stated), the ones below them support ``C`` as a subclass
+does (``S(m) = L(m) + Σ_u max(L(u), 0)`` over all of them, bounded by ``±MAX_LOG_ODDS``), each value counted once
+whatever its paths to ``C``; the rivals are the values that neither answer ``C`` nor are above ``C`` or one of its
+answering values.
 """
 
 from __future__ import annotations
@@ -223,6 +231,36 @@ def fuse_values(name: str, values: Mapping[str, ValueSupport], class_test: Class
         )
     )
     return FusedAttribute(name, best, probability[best], tuple(sorted(supporters)), summary, conflict, score[best] > 0)
+
+
+def answer_probability(values: Mapping[str, ValueSupport], asked: str, class_test: ClassTest | None = None) -> float:
+    """The fused probability that an object whose class attribute holds ``values`` answers a query for ``asked``:
+    the mass of the class distribution on the values ``class_test(value, asked)`` accepts, each counted once (see
+    the module docstring); without a test, values named ``asked`` (case ignored). 0 when none of them was stated;
+    equal to ``fuse_values(...).confidence_of(asked)`` when ``asked`` was stated and the test is a taxonomy's."""
+    accepts = class_test or (lambda a, b: a.lower() == b.lower())
+    members = [v for v in values if v == asked or accepts(v, asked)]
+    if not members:
+        return 0.0
+
+    def below(a: str, b: str) -> bool:  # a is a strict subclass of b
+        return class_test is not None and a != b and class_test(a, b)
+
+    general = [m for m in members if not any(below(m, n) for n in members)]
+    support = sum(max(values[u].log_odds, 0.0) for u in members if u not in general)
+    terms = [_clamp(values[m].log_odds + support) for m in general]  # bounded as a value's score is
+
+    def related(w: str) -> bool:  # w answers, is above the asked class or above one of its answering values
+        return w in members or below(asked, w) or any(below(m, w) for m in members)
+
+    rivals = [w for w in values if not related(w)]
+    rivals = [w for w in rivals if not any(below(w, x) for x in rivals)]
+    rival_scores = [
+        _clamp(values[w].log_odds + sum(max(values[u].log_odds, 0.0) for u in values if below(u, w))) for w in rivals
+    ]
+    top = max([*terms, 0.0, *rival_scores])
+    mass = sum(math.exp(t - top) for t in terms)
+    return mass / (mass + math.exp(-top) + sum(math.exp(s - top) for s in rival_scores))
 
 
 def fuse_evidence(evidence: Iterable[Evidence], class_test: ClassTest | None = None) -> dict[str, FusedAttribute]:

@@ -57,7 +57,10 @@ FILTERS = [
 def afresh(store: BeliefStore, belief_filter: BeliefFilter) -> list[dict]:
     """The reference: every designator made from the beliefs :meth:`BeliefStore.query` gives."""
     beliefs = sorted(store.query(belief_filter), key=lambda b: (-b.confidence, b.id))
-    return [designator(b, class_test=belief_filter.class_test).to_dict() for b in beliefs]
+    return [
+        designator(b, class_test=belief_filter.class_test, asked_class=belief_filter.object_class).to_dict()
+        for b in beliefs
+    ]
 
 
 def remembered(store: BeliefStore, belief_filter: BeliefFilter) -> list[dict]:
