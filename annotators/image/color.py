@@ -178,9 +178,12 @@ def _shade_links(labs_per_object: list[list[np.ndarray]], max_difference: float)
     links = [np.zeros((len(labs), len(labs)), dtype=bool) for labs in labs_per_object]
     pairs = [(k, i, j) for k, labs in enumerate(labs_per_object) for i in range(len(labs)) for j in range(i)]
     if pairs:
+        from annotators.image.delta_e_loops import delta_e_2000_pairs  # numba is loaded with the first objects
+
         first = np.array([labs_per_object[k][i] for k, i, _ in pairs])
         second = np.array([labs_per_object[k][j] for k, _, j in pairs])
-        for (k, i, j), close in zip(pairs, (delta_e_2000(first, second) < max_difference).tolist(), strict=True):
+        differences = delta_e_2000_pairs(first, second)  # delta_e_2000's, compiled: a few pairs, few calls
+        for (k, i, j), close in zip(pairs, (differences < max_difference).tolist(), strict=True):
             links[k][i, j] = close
     return links
 
