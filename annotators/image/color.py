@@ -37,7 +37,7 @@ from typing import ClassVar
 import numpy as np
 
 from annotators.image.color_prototypes import prototypes
-from annotators.image.color_space import delta_e_2000, linear_to_lab
+from annotators.image.color_space import linear_to_lab
 from annotators.image.color_surfaces import (
     DEFAULT_PARAMETERS,
     NamingParameters,
@@ -102,8 +102,10 @@ def _term_votes(labs: np.ndarray, parameters: NamingParameters) -> np.ndarray:
     """The chromatic terms' shares of the prototype votes for CIELAB colours (Sx3 in, S x terms out; each row
     sums to 1, all on the nearest prototype's term when the colour is far from every prototype). The distances
     are computed in single precision, the votes from them in double."""
+    from annotators.image.delta_e_loops import delta_e_2000_outer  # numba is loaded with the first objects
+
     labs = np.asarray(labs, dtype=np.float32).reshape(-1, 3)
-    distances = delta_e_2000(labs[:, None, :], _PROTOTYPE_LAB32[None, :, :]).astype(np.float64)
+    distances = delta_e_2000_outer(labs, _PROTOTYPE_LAB32).astype(np.float64)  # delta_e_2000's, compiled
     density = np.exp(-0.5 * (distances / parameters.kernel_width) ** 2) @ _TERM_AVERAGE
     total = density.sum(axis=1)
     far = total <= 1e-300
