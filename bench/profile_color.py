@@ -37,8 +37,9 @@ def main() -> None:
     parser = argparse.ArgumentParser(description=__doc__.split("\n")[0])
     parser.add_argument("--frame", type=int, default=3)
     parser.add_argument("--rounds", type=int, default=30)
+    parser.add_argument("--data", type=Path, default=DATA, help="the uoc recording (default: the shared one)")
     args = parser.parse_args()
-    root = create_tree(str(DATA), args.frame)
+    root = create_tree(str(args.data), args.frame)
     engine = Engine(root, hz=1000.0)
     for _ in range(3):
         engine.tick()
