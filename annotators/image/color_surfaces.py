@@ -391,8 +391,10 @@ def objects_surfaces(
             Surface(labs[row], linears[row], sizes_of_groups[row], kinds[row])
             for row in range(firsts[index], firsts[index + 1])
         ]
-        surfaces = _merge_mixtures([s for s in found if s.kind == "regular"], parameters.mixture_tolerance)
-        surfaces = _merge_shaded(_merge_white_blends(surfaces, parameters), parameters)
+        surfaces = [s for s in found if s.kind == "regular"]
+        if len(surfaces) > 1:  # a single surface merges with nothing
+            surfaces = _merge_mixtures(surfaces, parameters.mixture_tolerance)
+            surfaces = _merge_shaded(_merge_white_blends(surfaces, parameters), parameters)
         surfaces += [s for s in found if s.kind == "dark"]
         if not surfaces:  # only highlights, too few of them to count as a white surface otherwise
             part = slice(int(ends[index]) - count, int(ends[index]))
