@@ -22,7 +22,9 @@ reported when its share and its confidence (share x certainty) are large enough.
 
 The annotator names all the hypotheses of a frame together (:func:`name_objects_colors`): their pixels are
 picked and grouped in one pass over the frame, and every surface's prototype votes and every pair of shades come
-from one CIEDE2000 computation each, with the same results as naming each object alone (:func:`name_colors`).
+from one CIEDE2000 computation each (compiled, :mod:`annotators.image.delta_e_loops`, equal to the NumPy form of
+:func:`~annotators.image.color_space.delta_e_2000` to the last bit), with the same results as naming each object
+alone (:func:`name_colors`).
 
 :data:`COLOR_TERMS` is the one list of names this namer reports: the lower-case labels of the ontology's colour
 classes (``rk:Color`` in ontology/perception.ttl); the annotator's capability is derived from it.
