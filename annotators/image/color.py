@@ -22,7 +22,9 @@ reported when its share and its confidence (share x certainty) are large enough.
 
 The annotator names all the hypotheses of a frame together (:func:`name_objects_colors`): their pixels are
 picked and grouped in one pass over the frame, and every surface's prototype votes and every pair of shades come
-from one CIEDE2000 computation each, with the same results as naming each object alone (:func:`name_colors`).
+from one CIEDE2000 computation each (compiled, :mod:`annotators.image.delta_e_loops`, equal to the NumPy form of
+:func:`~annotators.image.color_space.delta_e_2000` to the last bit), with the same results as naming each object
+alone (:func:`name_colors`).
 
 :data:`COLOR_TERMS` is the one list of names this namer reports: the lower-case labels of the ontology's colour
 classes (``rk:Color`` in ontology/perception.ttl); the annotator's capability is derived from it.
@@ -37,7 +39,7 @@ from typing import ClassVar
 import numpy as np
 
 from annotators.image.color_prototypes import prototypes
-from annotators.image.color_space import delta_e_2000, linear_to_lab
+from annotators.image.color_space import linear_to_lab
 from annotators.image.color_surfaces import (
     DEFAULT_PARAMETERS,
     NamingParameters,
@@ -102,8 +104,10 @@ def _term_votes(labs: np.ndarray, parameters: NamingParameters) -> np.ndarray:
     """The chromatic terms' shares of the prototype votes for CIELAB colours (Sx3 in, S x terms out; each row
     sums to 1, all on the nearest prototype's term when the colour is far from every prototype). The distances
     are computed in single precision, the votes from them in double."""
+    from annotators.image.delta_e_loops import delta_e_2000_outer  # numba is loaded with the first objects
+
     labs = np.asarray(labs, dtype=np.float32).reshape(-1, 3)
-    distances = delta_e_2000(labs[:, None, :], _PROTOTYPE_LAB32[None, :, :]).astype(np.float64)
+    distances = delta_e_2000_outer(labs, _PROTOTYPE_LAB32).astype(np.float64)  # delta_e_2000's, compiled
     density = np.exp(-0.5 * (distances / parameters.kernel_width) ** 2) @ _TERM_AVERAGE
     total = density.sum(axis=1)
     far = total <= 1e-300
@@ -178,9 +182,12 @@ def _shade_links(labs_per_object: list[list[np.ndarray]], max_difference: float)
     links = [np.zeros((len(labs), len(labs)), dtype=bool) for labs in labs_per_object]
     pairs = [(k, i, j) for k, labs in enumerate(labs_per_object) for i in range(len(labs)) for j in range(i)]
     if pairs:
+        from annotators.image.delta_e_loops import delta_e_2000_pairs  # numba is loaded with the first objects
+
         first = np.array([labs_per_object[k][i] for k, i, _ in pairs])
         second = np.array([labs_per_object[k][j] for k, _, j in pairs])
-        for (k, i, j), close in zip(pairs, (delta_e_2000(first, second) < max_difference).tolist(), strict=True):
+        differences = delta_e_2000_pairs(first, second)  # delta_e_2000's, compiled: a few pairs, few calls
+        for (k, i, j), close in zip(pairs, (differences < max_difference).tolist(), strict=True):
             links[k][i, j] = close
     return links
 

@@ -153,9 +153,10 @@ def _mixture_target(surface: Surface, larger: list[Surface], tolerance: float) -
     covered by a dark purple print and half by white paper lies near the white end. The share of the blend
     that is each part's area undoes that weighting."""
     point = _rg(surface.linear)
+    chromaticities = [_rg(larger_surface.linear) for larger_surface in larger]
     for i, first in enumerate(larger):
         for j in range(i + 1, len(larger)):
-            a, b = _rg(first.linear), _rg(larger[j].linear)
+            a, b = chromaticities[i], chromaticities[j]
             segment = b - a
             length = float(segment @ segment)
             if length < 1e-8:
@@ -223,6 +224,7 @@ def _merge_white_blends(surfaces: list[Surface], parameters: NamingParameters) -
     whitened: set[int] = set()
     lit_saturated = [s.kind != "dark" and not is_unsaturated(s.lab, parameters) for s in surfaces]
     saturation = [_saturation(s.lab) for s in surfaces]
+    lightness = [float(s.lab[0]) for s in surfaces]
     for index, surface in enumerate(surfaces):
         if not lit_saturated[index]:
             continue
@@ -233,7 +235,7 @@ def _merge_white_blends(surfaces: list[Surface], parameters: NamingParameters) -
                 or host_index in whitened
                 or not lit_saturated[host_index]
                 or saturation[host_index] <= saturation[index]
-                or host.lab[0] >= surface.lab[0]
+                or lightness[host_index] >= lightness[index]
             ):
                 continue
             blend = _white_blend(host, surface, parameters)
@@ -265,26 +267,34 @@ def _merge_shaded(surfaces: list[Surface], parameters: NamingParameters) -> list
     side turns orange in a camera image, but the brick is yellow."""
     ordered = sorted(surfaces, key=lambda s: -s.pixels)
     kept: list[Surface] = []
+    kept_looks: list[tuple[bool, float, float, float]] = []  # each kept surface's colour, which merging keeps
     for surface in ordered:
         host_index = None
-        if not is_unsaturated(surface.lab, parameters):
-            for index, host in enumerate(kept):
-                offset = abs((_hue(surface.lab) - _hue(host.lab) + 180.0) % 360.0 - 180.0)
-                darker = host.lab[0] - surface.lab[0] >= parameters.shade_lightness
-                ratio = _saturation(surface.lab) / max(_saturation(host.lab), 1e-9)
+        unsaturated, hue, saturation, lightness = _look(surface.lab, parameters)
+        if not unsaturated:
+            for index, (host_unsaturated, host_hue, host_saturation, host_lightness) in enumerate(kept_looks):
+                offset = abs((hue - host_hue + 180.0) % 360.0 - 180.0)
+                darker = host_lightness - lightness >= parameters.shade_lightness
+                ratio = saturation / max(host_saturation, 1e-9)
                 alike = (
                     offset <= parameters.shade_hue
                     and 1.0 / parameters.shade_saturation <= ratio <= parameters.shade_saturation
                 )
-                if not is_unsaturated(host.lab, parameters) and alike and darker:
+                if not host_unsaturated and alike and darker:
                     host_index = index
                     break
         if host_index is None:
             kept.append(surface)
+            kept_looks.append((unsaturated, hue, saturation, lightness))
         else:
             host = kept[host_index]
             kept[host_index] = Surface(host.lab, host.linear, host.pixels + surface.pixels, host.kind)
     return kept
+
+
+def _look(lab: np.ndarray, parameters: NamingParameters) -> tuple[bool, float, float, float]:
+    """What :func:`_merge_shaded` compares of a colour: whether it is unsaturated, its hue, saturation and L*."""
+    return is_unsaturated(lab, parameters), _hue(lab), _saturation(lab), float(lab[0])
 
 
 DARK_GROUP = 1
@@ -371,15 +381,20 @@ def objects_surfaces(
     )
     ends = np.cumsum(counts)
     groups = all_groups(rows, px, py, cells, regular, dark, ends, group_settings(parameters), parameters.max_groups)
-    firsts = np.searchsorted(groups[:, 0], np.arange(len(objects) + 1))
+    firsts = np.searchsorted(groups[:, 0], np.arange(len(objects) + 1)).tolist()
+    labs, linears = groups[:, 2:5].copy(), groups[:, 5:8].copy()  # each surface's colours: rows of these
+    kinds = ["dark" if kind == DARK_GROUP else "regular" for kind in groups[:, 1].tolist()]
+    sizes_of_groups = groups[:, 8].astype(np.int64).tolist()
     result = []
     for index, count in enumerate(counts.tolist()):
         found = [
-            Surface(row[2:5].copy(), row[5:8].copy(), int(row[8]), "dark" if row[1] == DARK_GROUP else "regular")
-            for row in groups[firsts[index] : firsts[index + 1]]
+            Surface(labs[row], linears[row], sizes_of_groups[row], kinds[row])
+            for row in range(firsts[index], firsts[index + 1])
         ]
-        surfaces = _merge_mixtures([s for s in found if s.kind == "regular"], parameters.mixture_tolerance)
-        surfaces = _merge_shaded(_merge_white_blends(surfaces, parameters), parameters)
+        surfaces = [s for s in found if s.kind == "regular"]
+        if len(surfaces) > 1:  # a single surface merges with nothing
+            surfaces = _merge_mixtures(surfaces, parameters.mixture_tolerance)
+            surfaces = _merge_shaded(_merge_white_blends(surfaces, parameters), parameters)
         surfaces += [s for s in found if s.kind == "dark"]
         if not surfaces:  # only highlights, too few of them to count as a white surface otherwise
             part = slice(int(ends[index]) - count, int(ends[index]))

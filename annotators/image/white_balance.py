@@ -39,11 +39,14 @@ _UINT8_TO_LINEAR = srgb_to_linear(np.arange(256, dtype=np.uint8)).astype(np.floa
 def grey_edge_illuminant(linear: np.ndarray, clipped: np.ndarray | None = None, sigma: float = 1.0) -> np.ndarray:
     """The illuminant colour (3 values with mean 1) of a linear RGB image (HxWx3) by first-order grey-edge
     (p = 1); ``clipped`` (HxW bool) pixels are left out of the average when enough others remain."""
+    return _grey_edge(linear, None if clipped is None else (~clipped).view(np.uint8), sigma)
+
+
+def _grey_edge(linear: np.ndarray, unclipped: np.ndarray | None, sigma: float) -> np.ndarray:
+    """:func:`grey_edge_illuminant` with the pixels to average given as an HxW uint8 mask (non-zero: kept)."""
     smooth = cv2.GaussianBlur(np.asarray(linear, dtype=np.float32), (0, 0), sigma)
     magnitude = cv2.magnitude(cv2.Sobel(smooth, cv2.CV_32F, 1, 0), cv2.Sobel(smooth, cv2.CV_32F, 0, 1))
-    mask = None
-    if clipped is not None and np.count_nonzero(~clipped) >= 100:
-        mask = (~clipped).view(np.uint8)
+    mask = unclipped if unclipped is not None and cv2.countNonZero(unclipped) >= 100 else None
     illuminant = np.array(cv2.mean(magnitude, mask=mask)[:3])
     if not np.all(illuminant > 0):
         return np.ones(3)
@@ -58,8 +61,9 @@ def estimate_frame_light(image: np.ndarray, max_gain: float = 2.0, scale: int = 
         height, width = rgb.shape[:2]
         rgb = cv2.resize(rgb, (max(1, width // scale), max(1, height // scale)), interpolation=cv2.INTER_AREA)
     linear = cv2.LUT(rgb, _UINT8_TO_LINEAR.reshape(1, 256))
-    clipped = np.maximum(np.maximum(rgb[..., 0], rgb[..., 1]), rgb[..., 2]) >= 248
-    gains = np.clip(1.0 / grey_edge_illuminant(linear, clipped, sigma=1.0 / scale), 1.0 / max_gain, max_gain)
+    unclipped = cv2.inRange(rgb, (0, 0, 0), (247, 247, 247)) & 1  # 1 where no channel reaches 248 (cv2.mean
+    # sums in another order for a mask of 255s)
+    gains = np.clip(1.0 / _grey_edge(linear, unclipped, sigma=1.0 / scale), 1.0 / max_gain, max_gain)
     from annotators.image.radix_select import kth_smallest  # numba is loaded with the first frame
 
     luminance = cv2.transform(linear, (gains * LUMINANCE).astype(np.float32).reshape(1, 3)).reshape(-1)
