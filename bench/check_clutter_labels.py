@@ -11,14 +11,12 @@ Prints one line per differing input and ``identical on N/N inputs``.
 from __future__ import annotations
 
 import argparse
-import io
-import subprocess
 import sys
-import tarfile
 import tempfile
 from pathlib import Path
 
 import numpy as np
+from revision_workers import export_revision, run_both
 
 ROOT = Path(__file__).resolve().parents[1]
 DATA = (ROOT.parent / "shared" / "data").resolve()
@@ -95,17 +93,11 @@ def main() -> None:
         return
     with tempfile.TemporaryDirectory() as temporary:
         folder = Path(temporary)
-        archive = subprocess.run(["git", "-C", str(ROOT), "archive", args.reference], check=True, capture_output=True)
-        reference = folder / "reference"
-        reference.mkdir()
-        with tarfile.open(fileobj=io.BytesIO(archive.stdout)) as tar:
-            tar.extractall(reference, filter="data")
+        reference = export_revision(args.reference, folder)
         inputs = folder / "inputs"
         inputs.mkdir()
         names = prepare(inputs)
-        for tag, checkout in (("ours", str(ROOT)), ("theirs", str(reference))):
-            command = [sys.executable, __file__, args.reference, "--worker", checkout, str(inputs), tag]
-            subprocess.run(command, check=True)
+        run_both(__file__, args.reference, inputs, reference)
         same = 0
         for name in names:
             ours, theirs = np.load(inputs / f"ours-{name}.npz"), np.load(inputs / f"theirs-{name}.npz")

@@ -221,26 +221,20 @@ def kb_query_class_test(kb: Vocabulary | None) -> Callable[[str, str], bool] | N
     """``kb.answers_to`` as the class test of a query: an object of class ``a`` answers a query for class ``b`` when
     it is one or is typically packaged in one (a mustard for "bottle"); names the KB does not know are equal or
     unrelated. Fusion and association keep :func:`kb_class_test` (what an object is, not what it is seen as)."""
-    if kb is None:
-        return None
-
-    def class_test(a: str, b: str) -> bool:
-        try:
-            return kb.answers_to(a, b)
-        except LookupError:
-            return a == b
-
-    return class_test
+    return None if kb is None else _known_or_equal(kb.answers_to)
 
 
 def kb_class_test(kb: Vocabulary | None) -> Callable[[str, str], bool] | None:
     """``kb.is_subclass`` as a class test that treats names the KB does not know as equal-or-unrelated."""
-    if kb is None:
-        return None
+    return None if kb is None else _known_or_equal(kb.is_subclass)
+
+
+def _known_or_equal(relation: Callable[[str, str], bool]) -> Callable[[str, str], bool]:
+    """``relation`` where the KB knows both names; otherwise a name stands only for itself."""
 
     def class_test(a: str, b: str) -> bool:
         try:
-            return kb.is_subclass(a, b)
+            return relation(a, b)
         except LookupError:
             return a == b
 
