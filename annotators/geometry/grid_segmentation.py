@@ -383,25 +383,30 @@ class ContainerOutside:
     front: float
     middle: float
 
-    def could_hold(self, far: np.ndarray, depth_ratio: float) -> bool:
-        """Could part ``far`` (Nx3 plane coordinates) be the inside of this container?"""
+    def could_hold(self, far: np.ndarray, depth_ratio: float, far_heights: np.ndarray | None = None) -> bool:
+        """Could part ``far`` (Nx3 plane coordinates) be the inside of this container? ``far_heights``, when
+        given, are ``far``'s heights sorted (then not sorted again). The heights are tested before the
+        projections: each test only rules out, so their order does not change the answer."""
         if far.shape[0] < 3:
+            return False
+        far_median, far_top = _sorted_range(np.sort(far[:, 2]) if far_heights is None else far_heights, 0.5, 0.95)
+        if far_top > self.rim + self.margin:
+            return False
+        if not (far_top - far_median >= INNER_SPREAD * self.rim or far_median <= 0.5 * self.rim):
             return False
         far_low, far_high = _range(far[:, :2] @ self.across, 0.05, 0.95)
         if far_low < self.low - self.margin or far_high > self.high + self.margin:
             return False
-        far_median, far_top = _range(far[:, 2], 0.5, 0.95)
-        if far_top > self.rim + self.margin:
-            return False
         far_middle, far_back = _range(far[:, :2] @ self.along, 0.5, 0.95)
-        if far_middle <= self.middle or far_back > self.front + depth_ratio * (self.high - self.low):
-            return False
-        return far_top - far_median >= INNER_SPREAD * self.rim or far_median <= 0.5 * self.rim
+        return not (far_middle <= self.middle or far_back > self.front + depth_ratio * (self.high - self.low))
 
 
-def container_outside(near: np.ndarray, tolerance: float) -> ContainerOutside | None:
+def container_outside(
+    near: np.ndarray, tolerance: float, near_heights: np.ndarray | None = None
+) -> ContainerOutside | None:
     """Part ``near`` (Nx3 plane coordinates) as the outside of a possible container (``tolerance`` metres of
-    margin at least); None when it has too few points or lies right below the camera."""
+    margin at least); None when it has too few points or lies right below the camera. ``near_heights``, when
+    given, are ``near``'s heights sorted (then not sorted again)."""
     if near.shape[0] < 3:
         return None
     centre = near[:, :2].mean(axis=0)
@@ -412,7 +417,7 @@ def container_outside(near: np.ndarray, tolerance: float) -> ContainerOutside | 
     across = np.array([-along[1], along[0]], dtype=near.dtype)
     near_low, near_high = _range(near[:, :2] @ across, 0.05, 0.95)
     margin = max(tolerance, 0.1 * (near_high - near_low))
-    rim = _range(near[:, 2], 0.5, 0.95)[1]
+    rim = _sorted_range(np.sort(near[:, 2]) if near_heights is None else near_heights, 0.5, 0.95)[1]
     near_front, near_middle = _range(near[:, :2] @ along, 0.05, 0.5)
     return ContainerOutside(along, across, near_low, near_high, margin, rim, near_front, near_middle)
 
@@ -464,7 +469,8 @@ class _Parts:
     def outside(self, label: int, tolerance: float) -> ContainerOutside | None:
         """The part as the outside of a possible container (:func:`container_outside`)."""
         if (label, tolerance) not in self._outsides:
-            self._outsides[label, tolerance] = container_outside(self.coordinates(label), tolerance)
+            heights = self.sorted_coordinates(label)[:, 2]
+            self._outsides[label, tolerance] = container_outside(self.coordinates(label), tolerance, heights)
         return self._outsides[label, tolerance]
 
     def depth_of(self, label: int) -> float:
@@ -679,7 +685,9 @@ def merge_parts(
             stacked = True
         near, far = sorted((first, second), key=parts.depth_of)
         outside = parts.outside(near, rules.inside_tolerance) if rules.inside else None
-        if outside is not None and outside.could_hold(parts.coordinates(far), rules.inside_depth_ratio):
+        if outside is not None and outside.could_hold(
+            parts.coordinates(far), rules.inside_depth_ratio, parts.sorted_coordinates(far)[:, 2]
+        ):
             allowed.append((first, second))
         elif stacked:
             creases.append((first, second))  # one stands on the other: never joined, not even through a third

@@ -29,6 +29,7 @@ from types import ModuleType
 import numpy as np
 
 from annotators.geometry.grid_segmentation import join_labels, label_groups, touching_pairs
+from annotators.geometry.support_kernels import box_label_points
 
 
 @dataclass(frozen=True)
@@ -209,8 +210,7 @@ def rim_joins(
             if boxes is None:
                 coordinates[label] = flat[pixels[starts[label] : starts[label + 1]]]
             else:
-                x0, y0, x1, y1 = boxes[label]
-                coordinates[label] = plane_points[y0:y1, x0:x1][labels[y0:y1, x0:x1] == label]
+                coordinates[label] = box_label_points(labels, plane_points, label, boxes[label])
         return coordinates[label]
 
     heights: dict[int, float] = {}  # each piece's 95 % height, NaN when too small to have an edge

@@ -42,6 +42,7 @@ from annotators.geometry.grid_segmentation import (
 from annotators.geometry.rims import RimRules, stands_inside
 from annotators.geometry.support_kernels import (
     appendage_candidates,
+    box_label_points,
     hull_candidates,
     kept_labels,
     piece_summary,
@@ -198,12 +199,8 @@ def unsupported_holders(
 def _stands_inside(labels: np.ndarray, plane_points: np.ndarray, pieces: PieceSummary, piece: int, holder: int) -> bool:
     """:func:`~annotators.geometry.rims.stands_inside` of two labels, read in their boxes."""
     grid = plane_points.reshape(*labels.shape, 3)
-
-    def points_of(label: int) -> np.ndarray:
-        x0, y0, x1, y1 = pieces.boxes[label]
-        return grid[y0:y1, x0:x1][labels[y0:y1, x0:x1] == label]
-
-    return stands_inside(points_of(holder), points_of(piece), RimRules())
+    holder_points = box_label_points(labels, grid, holder, pieces.boxes[holder])
+    return stands_inside(holder_points, box_label_points(labels, grid, piece, pieces.boxes[piece]), RimRules())
 
 
 def join_unsupported(labels: np.ndarray, plane_points: np.ndarray, rules: SupportRules | None = None) -> np.ndarray:

@@ -130,3 +130,10 @@ def hull_candidates(points: np.ndarray) -> np.ndarray:
     inside the quadrilateral of the leftmost, lowest, rightmost and highest points are dropped (by a margin, so
     that a point rounding could put on an edge stays), and the convex hull of the rest is theirs."""
     return _loops().hull_candidates(np.ascontiguousarray(points, dtype=np.float32))
+
+
+def box_label_points(labels: np.ndarray, points: np.ndarray, label: int, box: np.ndarray) -> np.ndarray:
+    """The rows of ``points`` (HxWxC) at the pixels of ``label`` in ``labels`` (HxW) within ``box`` ``(x0, y0, x1,
+    y1)`` (exclusive), row-major: what ``points[y0:y1, x0:x1][labels[y0:y1, x0:x1] == label]`` gives, read in one
+    compiled pass without the mask and the copy of the box."""
+    return _loops().box_label_points(labels, points, int(label), np.asarray(box, dtype=np.int64))

@@ -274,3 +274,23 @@ def hull_candidates(points: np.ndarray) -> np.ndarray:
             candidates[index, 0], candidates[index, 1] = points[k, 0], points[k, 1]
             index += 1
     return candidates
+
+
+@njit(cache=True, nogil=True)
+def box_label_points(labels: np.ndarray, points: np.ndarray, label: int, box: np.ndarray) -> np.ndarray:
+    """See :func:`annotators.geometry.support_kernels.box_label_points`."""
+    x0, y0, x1, y1 = box[0], box[1], box[2], box[3]
+    count = 0
+    for r in range(y0, y1):
+        for c in range(x0, x1):
+            if labels[r, c] == label:
+                count += 1
+    found = np.empty((count, points.shape[2]), dtype=points.dtype)
+    index = 0
+    for r in range(y0, y1):
+        for c in range(x0, x1):
+            if labels[r, c] == label:
+                for k in range(points.shape[2]):
+                    found[index, k] = points[r, c, k]
+                index += 1
+    return found

@@ -16,6 +16,7 @@ from annotators.geometry.support import (
 )
 from annotators.geometry.support_kernels import (
     appendage_candidates,
+    box_label_points,
     hull_candidates,
     kept_labels,
     unsupported_candidates,
@@ -157,3 +158,22 @@ def test_the_height_quantiles_of_many_small_tied_pieces_are_the_numpy_ones(seed:
     compiled, reference = summarize_pieces(labels, plane, 1), summarize_pieces_numpy(labels, plane, 1)
     for name in ("low", "high", "top"):
         assert np.array_equal(getattr(compiled, name), getattr(reference, name), equal_nan=True), name
+
+
+@pytest.mark.parametrize("seed", range(6))
+def test_box_label_points_match_the_masked_box(seed: int) -> None:
+    labels, _, plane = blocky_scene(seed)
+    pieces = summarize_pieces(labels, plane, 1)
+    window = (slice(2, -3), slice(1, -4))  # a strided view of the grid is read in place, as a whole one
+    for grid, labelling in ((plane, labels), (plane[window], labels[window])):
+        for label in range(0, int(labelling.max()) + 2):
+            for box in ((0, 0, labelling.shape[1], labelling.shape[0]), (3, 2, 17, 11), (5, 5, 5, 9)):
+                x0, y0, x1, y1 = box
+                expected = grid[y0:y1, x0:x1][labelling[y0:y1, x0:x1] == label]
+                found = box_label_points(labelling, grid, label, np.array(box))
+                assert found.dtype == expected.dtype
+                assert np.array_equal(found, expected, equal_nan=True)
+    for label in range(1, int(labels.max()) + 1):  # the labels' own boxes, as the support joins read them
+        x0, y0, x1, y1 = pieces.boxes[label]
+        expected = plane[y0:y1, x0:x1][labels[y0:y1, x0:x1] == label]
+        assert np.array_equal(box_label_points(labels, plane, label, pieces.boxes[label]), expected, equal_nan=True)
