@@ -10,13 +10,11 @@ Prints one line per differing input and ``identical on N/N inputs``.
 
 from __future__ import annotations
 
-import argparse
 import sys
-import tempfile
 from pathlib import Path
 
 import numpy as np
-from revision_workers import export_revision, run_both
+from revision_workers import compare_with_revision
 
 ROOT = Path(__file__).resolve().parents[1]
 DATA = (ROOT.parent / "shared" / "data").resolve()
@@ -81,31 +79,20 @@ def worker(checkout: str, folder: Path, names: list[str], tag: str) -> None:
         )
 
 
+def report(inputs: Path, names: list[str]) -> None:
+    """Compare the two sides' results input by input and print the differences and the count."""
+    same = 0
+    for name in names:
+        ours, theirs = np.load(inputs / f"ours-{name}.npz"), np.load(inputs / f"theirs-{name}.npz")
+        equal = all(np.array_equal(ours[key], theirs[key]) for key in ("sizes", "indices", "masks", "rois"))
+        same += equal
+        if not equal:
+            print(f"DIFFERENT: {name} ({ours['sizes'].size} vs {theirs['sizes'].size} segments)")
+    print(f"identical on {same}/{len(names)} inputs")
+
+
 def main() -> None:
-    parser = argparse.ArgumentParser(description=__doc__.split("\n")[0])
-    parser.add_argument("reference", help="git revision to compare with")
-    parser.add_argument("--worker", nargs=3, metavar=("CHECKOUT", "FOLDER", "TAG"), help=argparse.SUPPRESS)
-    args = parser.parse_args()
-    if args.worker:
-        checkout, folder, tag = args.worker
-        names = sorted(path.stem for path in Path(folder).glob("*.npz") if "-" not in path.stem)
-        worker(checkout, Path(folder), names, tag)
-        return
-    with tempfile.TemporaryDirectory() as temporary:
-        folder = Path(temporary)
-        reference = export_revision(args.reference, folder)
-        inputs = folder / "inputs"
-        inputs.mkdir()
-        names = prepare(inputs)
-        run_both(__file__, args.reference, inputs, reference)
-        same = 0
-        for name in names:
-            ours, theirs = np.load(inputs / f"ours-{name}.npz"), np.load(inputs / f"theirs-{name}.npz")
-            equal = all(np.array_equal(ours[key], theirs[key]) for key in ("sizes", "indices", "masks", "rois"))
-            same += equal
-            if not equal:
-                print(f"DIFFERENT: {name} ({ours['sizes'].size} vs {theirs['sizes'].size} segments)")
-        print(f"identical on {same}/{len(names)} inputs")
+    compare_with_revision(__file__, __doc__.split("\n")[0], prepare, worker, report, lambda stem: "-" not in stem)
 
 
 if __name__ == "__main__":

@@ -11,14 +11,12 @@ last bits of the numbers differ or also the names) and ``identical on N/N inputs
 
 from __future__ import annotations
 
-import argparse
 import json
 import sys
-import tempfile
 from pathlib import Path
 
 import numpy as np
-from revision_workers import export_revision, run_both
+from revision_workers import compare_with_revision
 
 ROOT = Path(__file__).resolve().parents[1]
 DATA = (ROOT.parent / "shared" / "data").resolve()
@@ -111,43 +109,32 @@ def worker(checkout: str, folder: Path, names: list[str], tag: str) -> None:
     (folder / f"{tag}.json").write_text(json.dumps(results))
 
 
+def report(inputs: Path, names: list[str]) -> None:
+    """Compare the two sides' results input by input and print the differences and the count."""
+    ours = json.loads((inputs / "ours.json").read_text())
+    theirs = json.loads((inputs / "theirs.json").read_text())
+    same = hypotheses = annotations = 0
+    for name in names:
+        mine, other = ours[name], theirs[name]
+        hypotheses += len(other["hypotheses"])
+        annotations += sum(len(h) for h in other["hypotheses"])
+        if mine == other:
+            same += 1
+            continue
+        if mine["status"] != other["status"] or len(mine["hypotheses"]) != len(other["hypotheses"]):
+            print(f"DIFFERENT: {name}: {mine['status']} vs {other['status']}")
+            continue
+        for index, (a, b) in enumerate(zip(mine["hypotheses"], other["hypotheses"], strict=True)):
+            if a != b:
+                names_same = [c[0] for c in a] == [c[0] for c in b]
+                kind = "numbers only (names and order the same)" if names_same else "NAMES"
+                print(f"DIFFERENT: {name} hypothesis {index}, {kind}: {a} vs {b}")
+    print(f"{hypotheses} hypotheses, {annotations} colour annotations in {len(names)} inputs")
+    print(f"identical on {same}/{len(names)} inputs")
+
+
 def main() -> None:
-    parser = argparse.ArgumentParser(description=__doc__.split("\n")[0])
-    parser.add_argument("reference", help="git revision to compare with")
-    parser.add_argument("--worker", nargs=3, metavar=("CHECKOUT", "FOLDER", "TAG"), help=argparse.SUPPRESS)
-    args = parser.parse_args()
-    if args.worker:
-        checkout, folder, tag = args.worker
-        names = sorted(path.stem for path in Path(folder).glob("*.npz"))
-        worker(checkout, Path(folder), names, tag)
-        return
-    with tempfile.TemporaryDirectory() as temporary:
-        folder = Path(temporary)
-        reference = export_revision(args.reference, folder)
-        inputs = folder / "inputs"
-        inputs.mkdir()
-        names = prepare(inputs)
-        run_both(__file__, args.reference, inputs, reference)
-        ours = json.loads((inputs / "ours.json").read_text())
-        theirs = json.loads((inputs / "theirs.json").read_text())
-        same = hypotheses = annotations = 0
-        for name in names:
-            mine, other = ours[name], theirs[name]
-            hypotheses += len(other["hypotheses"])
-            annotations += sum(len(h) for h in other["hypotheses"])
-            if mine == other:
-                same += 1
-                continue
-            if mine["status"] != other["status"] or len(mine["hypotheses"]) != len(other["hypotheses"]):
-                print(f"DIFFERENT: {name}: {mine['status']} vs {other['status']}")
-                continue
-            for index, (a, b) in enumerate(zip(mine["hypotheses"], other["hypotheses"], strict=True)):
-                if a != b:
-                    names_same = [c[0] for c in a] == [c[0] for c in b]
-                    kind = "numbers only (names and order the same)" if names_same else "NAMES"
-                    print(f"DIFFERENT: {name} hypothesis {index}, {kind}: {a} vs {b}")
-        print(f"{hypotheses} hypotheses, {annotations} colour annotations in {len(names)} inputs")
-        print(f"identical on {same}/{len(names)} inputs")
+    compare_with_revision(__file__, __doc__.split("\n")[0], prepare, worker, report)
 
 
 if __name__ == "__main__":

@@ -8,10 +8,13 @@ process of its own (so each imports its own code), writing its results into ``FO
 
 from __future__ import annotations
 
+import argparse
 import io
 import subprocess
 import sys
 import tarfile
+import tempfile
+from collections.abc import Callable
 from pathlib import Path
 
 ROOT = Path(__file__).resolve().parents[1]
@@ -31,3 +34,33 @@ def run_both(script: str, revision: str, inputs: Path, reference: Path) -> None:
     """Run ``script``'s worker on ``inputs`` with this checkout (tag "ours") and with ``reference`` ("theirs")."""
     for tag, checkout in (("ours", str(ROOT)), ("theirs", str(reference))):
         subprocess.run([sys.executable, script, revision, "--worker", checkout, str(inputs), tag], check=True)
+
+
+def compare_with_revision(
+    script: str,
+    description: str,
+    prepare: Callable[[Path], list[str]],
+    worker: Callable[[str, Path, list[str], str], None],
+    report: Callable[[Path, list[str]], None],
+    is_input: Callable[[str], bool] = lambda stem: True,
+) -> None:
+    """The command line of a ``check_*`` script: ``SCRIPT REV`` prepares the inputs (``prepare(folder)`` returns their
+    names), runs ``worker(checkout, folder, names, tag)`` on both sides and calls ``report(folder, names)``; the
+    hidden ``--worker CHECKOUT FOLDER TAG`` runs one side (its inputs: the ``.npz`` files whose stem ``is_input``)."""
+    parser = argparse.ArgumentParser(description=description)
+    parser.add_argument("reference", help="git revision to compare with")
+    parser.add_argument("--worker", nargs=3, metavar=("CHECKOUT", "FOLDER", "TAG"), help=argparse.SUPPRESS)
+    args = parser.parse_args()
+    if args.worker:
+        checkout, folder, tag = args.worker
+        names = sorted(path.stem for path in Path(folder).glob("*.npz") if is_input(path.stem))
+        worker(checkout, Path(folder), names, tag)
+        return
+    with tempfile.TemporaryDirectory() as temporary:
+        folder = Path(temporary)
+        reference = export_revision(args.reference, folder)
+        inputs = folder / "inputs"
+        inputs.mkdir()
+        names = prepare(inputs)
+        run_both(script, args.reference, inputs, reference)
+        report(inputs, names)
