@@ -442,9 +442,7 @@ def choose_expected(matches: Sequence[Match], expected: str, min_score: float, m
     top = max(m.score for m in fitting)
     top_read = max((m.score for m in fitting if not m.unread), default=top)
     candidates = [
-        m
-        for m in fitting
-        if (top if m.unread else top_read) - m.score <= margin and m.profile.answers(wanted)
+        m for m in fitting if (top if m.unread else top_read) - m.score <= margin and m.profile.answers(wanted)
     ]
     return max(candidates, key=lambda m: (not m.unread, m.score, -len(m.profile.ancestors)), default=None)
 
