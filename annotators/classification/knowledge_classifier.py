@@ -76,7 +76,7 @@ label went unread is unlikely a mustard but, tying with a lemon soda, as likely 
 from __future__ import annotations
 
 import re
-from collections.abc import Mapping, Sequence
+from collections.abc import Callable, Mapping, Sequence
 from dataclasses import dataclass, replace
 from types import MappingProxyType
 from typing import ClassVar
@@ -389,21 +389,23 @@ def class_evidence(name: str, matches: Sequence[Match]) -> tuple[float, float, b
     """The evidence for class ``name`` (lower case, with or without a profile of its own) as a whole: the best score
     of its own and its subclasses' profiles, how far that lies above the best profile outside it (neither below
     nor above it), and whether its own profile names it by printed text that was not read."""
-    inside = members(name, matches)
-    top = max((m.score for m in inside), default=0.0)
-    rivals = [m.score for m in matches if name not in m.profile.ancestors and not above(m, name, inside)]
-    unread = any(m.unread for m in inside if m.profile.class_name.lower() == name)
-    return top, top - max(rivals, default=0.0), unread
+    return _evidence_of(name, matches, lambda profile: name in profile.ancestors)
 
 
 def answering_evidence(wanted: str, matches: Sequence[Match]) -> tuple[float, float, bool]:
     """The evidence that the object answers a query for class ``wanted`` (lower case), taken as a whole: as
     :func:`class_evidence`, over the profiles that answer to it (:meth:`Profile.answers`: it, its subclasses, classes
     packaged in it), against those that do not and are not above all of them."""
-    inside = [m for m in matches if m.profile.answers(wanted)]
+    return _evidence_of(wanted, matches, lambda profile: profile.answers(wanted))
+
+
+def _evidence_of(name: str, matches: Sequence[Match], belongs: Callable[[Profile], bool]) -> tuple[float, float, bool]:
+    """(best score, lead, unread) of the matches whose profile ``belongs`` to ``name``, against the others that are
+    not above all of them."""
+    inside = [m for m in matches if belongs(m.profile)]
     top = max((m.score for m in inside), default=0.0)
-    rivals = [m.score for m in matches if not m.profile.answers(wanted) and not above(m, wanted, inside)]
-    unread = any(m.unread for m in inside if m.profile.class_name.lower() == wanted)
+    rivals = [m.score for m in matches if not belongs(m.profile) and not above(m, name, inside)]
+    unread = any(m.unread for m in inside if m.profile.class_name.lower() == name)
     return top, top - max(rivals, default=0.0), unread
 
 
