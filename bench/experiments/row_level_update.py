@@ -37,6 +37,7 @@ sys.path.insert(0, str(BENCH))
 
 import bench_beliefs as bench  # noqa: E402
 
+from reasoning.beliefs import packed  # noqa: E402
 from reasoning.beliefs import store as store_module  # noqa: E402
 from reasoning.beliefs.interned import InternedTexts  # noqa: E402
 from reasoning.beliefs.store import BeliefStore  # noqa: E402
@@ -89,7 +90,7 @@ class RowLevel:
         """True when the update is the common case this sketch handles."""
         if row[14] is not None or observation.appearance is not None or observation.dimensions is None:
             return False
-        names = [r[0] for r in store_module.SUPPORT.iter_unpack(row[26])]
+        names = [r[0] for r in packed.SUPPORT.iter_unpack(row[26])]
         if len(set(names)) != len(names):
             return False
         stated: dict[str, str] = {}
@@ -97,7 +98,7 @@ class RowLevel:
             if stated.setdefault(e.attribute, e.value) != e.value:
                 return False
         texts = self.interned.texts
-        values = {texts[r[0]]: texts[r[1]] for r in store_module.SUPPORT.iter_unpack(row[26])}
+        values = {texts[r[0]]: texts[r[1]] for r in packed.SUPPORT.iter_unpack(row[26])}
         return all(values.get(name, value) == value for name, value in stated.items())
 
     def row(self, row: tuple, observation: FrameObject, at: float) -> tuple:
@@ -106,7 +107,7 @@ class RowLevel:
          last_seen, _, observations, _, _, recording, _, sources, packed, _) = row[:28]  # fmt: skip
         interned, conn, write = self.interned, self.conn, self.write
         codes = interned.codes
-        records = [list(r) for r in store_module.SUPPORT.iter_unpack(packed)]
+        records = [list(r) for r in packed.SUPPORT.iter_unpack(packed)]
         by_name = {r[0]: r for r in records}
         for e in observation.evidence:
             name = codes.get(e.attribute)
@@ -147,7 +148,7 @@ class RowLevel:
         for r in records:
             flat += r
             log_odds = r[2]
-            flat[-5] = store_module._rounded_cached(log_odds, 9) if log_odds else round(log_odds, 9)
+            flat[-5] = packed.rounded_cached(log_odds, 9) if log_odds else round(log_odds, 9)
             name, value = texts[r[0]], texts[r[1]]
             named[name] = (value, log_odds)
             entries.append(f"{name}={value}")
@@ -179,10 +180,10 @@ class RowLevel:
             named.get(Location.attribute, ("",))[0],
             "",
             recording,
-            store_module._roi_text(observation.roi),
+            packed.roi_text(observation.roi),
             text,
-            store_module._supports(len(records)).pack(*flat),
-            store_module._INDEX_SEPARATOR.join(sorted(entries)),
+            packed.supports_packing(len(records)).pack(*flat),
+            packed.INDEX_SEPARATOR.join(sorted(entries)),
         )
 
 

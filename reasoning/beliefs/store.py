@@ -43,6 +43,17 @@ import numpy as np
 import platformdirs
 
 from reasoning.beliefs.interned import InternedTexts
+from reasoning.beliefs.packed import (
+    FIELDS,
+    INDEX_SEPARATOR,
+    SUPPORT,
+    decoded_sources,
+    floats,
+    roi_from_text,
+    roi_text,
+    rounded_cached,
+    supports_packing,
+)
 from reasoning.fusion.association import CameraModel, in_view
 from reasoning.fusion.frame import WORLD_FRAME, FrameObject
 from reasoning.fusion.rule import (
@@ -600,8 +611,8 @@ class BeliefStore:
                 seq,
                 time,
                 item.frame,
-                *_floats(item.position, 3),
-                _roi_text(item.roi),
+                *floats(item.position, 3),
+                roi_text(item.roi),
                 _encoded_sources(item.sources, cache),
                 _pack_evidence(item.evidence, interned, conn, write),
                 item.recording,
@@ -765,7 +776,7 @@ class BeliefStore:
                     time=row[1],
                     frame=row[2],
                     position=(row[3], row[4], row[5]),
-                    roi=_roi_from_text(row[6]),
+                    roi=roi_from_text(row[6]),
                     sources=tuple(json.loads(row[7])),
                     evidence=_unpack_evidence(row[8], self._interned, conn),
                     recording=row[9],
@@ -812,20 +823,6 @@ def _candidate_query(boxes: int) -> str:
     )
 
 
-def _roi_text(roi: tuple[int, int, int, int] | None) -> str | None:
-    if roi is None:
-        return None
-    x0, y0, x1, y1 = roi
-    return "%d,%d,%d,%d" % (x0, y0, x1, y1)  # noqa: UP031 - int() of each, faster than an f-string of four int()
-
-
-def _roi_from_text(text: str | None) -> tuple[int, int, int, int] | None:
-    if not text:
-        return None
-    x0, y0, x1, y1 = map(int, text.split(","))
-    return x0, y0, x1, y1
-
-
 def _object_row(
     b: ObjectBelief,
     class_test: ClassTest | None,
@@ -836,9 +833,9 @@ def _object_row(
 ) -> tuple:
     """The ``objects`` row of a belief (columns as in ``_OBJECT_COLUMNS``); ``sources`` caches encodings, texts
     new to ``interned`` are interned with ``write`` (inside the caller's write transaction on ``conn``)."""
-    x, y, z = _floats(b.position, 3)
-    qx, qy, qz, qw = _floats(b.orientation, 4)
-    sx, sy, sz = (None, None, None) if b.dimensions is None else _floats(b.dimensions, 3)
+    x, y, z = floats(b.position, 3)
+    qx, qy, qz, qw = floats(b.orientation, 4)
+    sx, sy, sz = (None, None, None) if b.dimensions is None else floats(b.dimensions, 3)
     appearance = None if b.appearance is None else np.asarray(b.appearance, dtype=np.float32).tobytes()
     encoded, indexed = _pack_attributes(b.attributes, class_test, interned, conn, write)
     return (
@@ -866,18 +863,11 @@ def _object_row(
         b.region,
         b.region_class,
         b.recording,
-        _roi_text(b.roi),
+        roi_text(b.roi),
         _encoded_sources(b.sources, sources),
         encoded,
         indexed,
     )
-
-
-def _floats(values: np.ndarray | Sequence[float], count: int) -> list[float]:
-    """The first ``count`` values as Python floats (one conversion of the array, not one per element)."""
-    if type(values) is np.ndarray and values.dtype == np.float64 and values.shape == (count,):
-        return values.tolist()  # the common case: already that array
-    return np.asarray(values, dtype=np.float64)[:count].tolist()
 
 
 _COLUMN_COUNT = len(_OBJECT_COLUMNS.split(","))
@@ -887,7 +877,6 @@ _VOLATILE_INDEXES = (*(i for i in range(1, _COLUMN_COUNT) if i not in _LABEL_COL
 _VOLATILE_COLUMNS = tuple(_OBJECT_COLUMNS.split(",")[i].strip() for i in _VOLATILE_INDEXES[:-1])
 _UPDATE_VOLATILE = f"UPDATE objects SET {', '.join(c + ' = ?' for c in _VOLATILE_COLUMNS)} WHERE id = ?"
 _PLACEHOLDERS = ", ".join("?" * _COLUMN_COUNT)
-_INDEX_SEPARATOR = "\x1f"
 
 _volatile = operator.itemgetter(*_VOLATILE_INDEXES)
 """The values of ``_VOLATILE_COLUMNS`` of an object row, then its id."""
@@ -906,18 +895,6 @@ def _encoded_sources(experts: set[str], cache: dict[frozenset[str], str]) -> str
     if found is None:
         found = cache[key] = json.dumps(sorted(key))
     return found
-
-
-SUPPORT = struct.Struct("<iidqidd")
-"""One packed value support: attribute name code, value code, log-odds (rounded to 9 digits), count, expert-set
-code, first seen, last seen (little-endian; the attribute column is these records one after another)."""
-_FIELDS = 7
-
-
-@functools.lru_cache(maxsize=64)
-def _supports(count: int) -> struct.Struct:
-    """The packing of ``count`` supports."""
-    return struct.Struct("<" + SUPPORT.format[1:] * count)
 
 
 def _pack_attributes(
@@ -948,14 +925,14 @@ def _pack_attributes(
             if experts is None:
                 experts = interned.experts_code(conn, s.sources, write)
             log_odds = s.log_odds  # _rounded(log_odds, 9), inlined (four values per belief, every frame)
-            rounded = _rounded_cached(log_odds, 9) if log_odds else round(log_odds, 9)
+            rounded = rounded_cached(log_odds, 9) if log_odds else round(log_odds, 9)
             flat += (name_code, value_code, rounded, s.count, experts, s.first_seen, s.last_seen)
         if len(values) == 1:  # the common case: one value said, indexed
             entries.append(f"{name}={next(iter(values))}")
             continue
         fused = fuse_values(name, attribute.values, class_test if name == CLASS_ATTRIBUTE else None)
         entries.extend(f"{name}={s.value}" for s in fused.support if s.value == fused.value or s.confidence > 0.5)
-    return _supports(len(flat) // _FIELDS).pack(*flat), _INDEX_SEPARATOR.join(sorted(entries))
+    return supports_packing(len(flat) // FIELDS).pack(*flat), INDEX_SEPARATOR.join(sorted(entries))
 
 
 def _unpack_attributes(packed: bytes, interned: InternedTexts, conn: sqlite3.Connection) -> dict[str, AttributeBelief]:
@@ -1006,17 +983,6 @@ def _pack_attribute_column(conn: sqlite3.Connection) -> None:
         last = rows[-1][0]
 
 
-@functools.lru_cache(maxsize=4096, typed=True)
-def _rounded_cached(value: float, digits: int) -> float:
-    return round(value, digits)
-
-
-def _rounded(value: float, digits: int) -> float:
-    """``round(value, digits)``, remembered for the values that recur on every row (accumulated log-odds, the
-    experts' confidences); zero is rounded afresh, as the cache would not tell -0.0 from 0.0."""
-    return _rounded_cached(value, digits) if value else round(value, digits)
-
-
 STATEMENT = struct.Struct("<iidi")
 """One packed statement of a sighting: attribute name code, value code, confidence (rounded to 6 digits), expert
 code (the evidence column is these records one after another; a version-2 store's sightings keep JSON text)."""
@@ -1048,7 +1014,7 @@ def _pack_evidence(
         if source is None:
             source = interned.code(conn, e.source, write)
         confidence = e.confidence  # _rounded(confidence, 6), inlined
-        flat += (attribute, value, _rounded_cached(confidence, 6) if confidence else round(confidence, 6), source)
+        flat += (attribute, value, rounded_cached(confidence, 6) if confidence else round(confidence, 6), source)
     return _statements(len(evidence)).pack(*flat)
 
 
@@ -1066,16 +1032,10 @@ def _unpack_evidence(
     )
 
 
-@functools.lru_cache(maxsize=256)
-def _decoded_sources(text: str) -> tuple[str, ...]:
-    """The experts of a ``sources`` column (few distinct texts recur on every row)."""
-    return tuple(json.loads(text))
-
-
 def _index_entries(indexed: str) -> set[tuple[str, str]]:
     if not indexed:
         return set()
-    return {(name, value) for name, _, value in (entry.partition("=") for entry in indexed.split(_INDEX_SEPARATOR))}
+    return {(name, value) for name, _, value in (entry.partition("=") for entry in indexed.split(INDEX_SEPARATOR))}
 
 
 def _belief_from_row(row: tuple, interned: InternedTexts, conn: sqlite3.Connection) -> ObjectBelief:
@@ -1127,8 +1087,8 @@ def _belief_from_row(row: tuple, interned: InternedTexts, conn: sqlite3.Connecti
         misses=misses,
         region=region,
         region_class=region_class,
-        roi=_roi_from_text(roi),
-        sources=set(_decoded_sources(sources)),
+        roi=roi_from_text(roi),
+        sources=set(decoded_sources(sources)),
         observations=observations,
         class_name=class_name,
         recording=recording,

@@ -13,7 +13,7 @@ from hypothesis import given, settings
 from hypothesis import strategies as st
 from scipy.optimize import linear_sum_assignment
 
-from reasoning.beliefs.store import _rounded
+from reasoning.beliefs.packed import rounded as _rounded
 from reasoning.fusion.association import INFEASIBLE, assign
 from reasoning.fusion.rule import (
     CONFIDENCE_CLIP,
