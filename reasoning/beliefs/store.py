@@ -54,6 +54,7 @@ from reasoning.beliefs.packed import (
     rounded_cached,
     supports_packing,
 )
+from reasoning.beliefs.row_update import RowUpdate, Support, belief_of
 from reasoning.fusion.association import CameraModel, in_view
 from reasoning.fusion.frame import WORLD_FRAME, FrameObject
 from reasoning.fusion.rule import (
@@ -221,6 +222,52 @@ class _Loaded(NamedTuple):
     indexed: str
 
 
+class _Candidate:
+    """A stored candidate row as the association sees it (position, size, histogram, class, world, colour), the
+    ``ObjectBelief`` decoded only when the general update path needs it."""
+
+    __slots__ = (
+        "appearance",
+        "class_name",
+        "conn",
+        "dimensions",
+        "frame",
+        "id",
+        "interned",
+        "position",
+        "recording",
+        "records",
+        "row",
+        "status",
+    )
+
+    def __init__(self, row: tuple, records: list[Support], interned: InternedTexts, conn: sqlite3.Connection) -> None:
+        self.row = row
+        self.records = records
+        self.interned = interned
+        self.conn = conn
+        self.id: int = row[0]
+        self.class_name: str | None = row[1]
+        self.frame: str = row[2]
+        self.position = row[3:6]
+        self.dimensions = None if row[10] is None else row[10:13]
+        appearance = row[14]
+        self.appearance = None if appearance is None else np.frombuffer(appearance, dtype=np.float32).astype(np.float64)
+        self.status: str = row[16]
+        self.recording: str = row[23]
+
+    def value(self, attribute: str) -> str | None:
+        """``ObjectBelief.value(attribute)`` of the stored belief."""
+        found = [r for r in self.records if r[7] == attribute]
+        if len(found) == 1:
+            return found[0][8]
+        return self.belief().value(attribute) if found else None
+
+    def belief(self) -> ObjectBelief:
+        """The stored belief, decoded."""
+        return _belief_from_row(self.row, self.interned, self.conn)
+
+
 class BeliefStore:
     """Object beliefs persisted in one SQLite file (see the module docstring).
 
@@ -251,6 +298,8 @@ class BeliefStore:
         """What :meth:`query_views` made, by (view, stored row)."""
         self._interned = InternedTexts()
         """The codes of the attribute names, values and expert sets in the packed supports."""
+        self._row_updates: RowUpdate | None = None
+        """The row-level update of :meth:`integrate`, for the last tracker configuration."""
         self._lock = threading.RLock()
         self._conn = self._open(synchronous.upper(), busy_timeout, check)
 
@@ -406,7 +455,7 @@ class BeliefStore:
         tracker = tracker or self.tracker
         writes: list[tuple[str, list[tuple]]] = []
         with self._transaction() as conn:
-            beliefs, loaded = self._candidates(conn, objects, camera, tracker.config.association.gate_distance)
+            rows, loaded = self._candidates(conn, objects, camera, tracker.config.association.gate_distance)
             next_id = int(conn.execute("SELECT value FROM meta WHERE key = 'next_id'").fetchone()[0])
             allocated = [next_id]
 
@@ -415,19 +464,101 @@ class BeliefStore:
                 allocated[0] += 1
                 return value
 
-            step = tracker.step(beliefs, objects, time, new_id, camera)
-            self._write_beliefs(conn, step.changed, tracker.class_test, loaded, writes)
-            counts = {b.id: b.observations for b in step.changed}
+            write = functools.partial(_write, conn, writes)
+            if RowUpdate.applies(tracker):
+                step, updated = self._step_on_rows(conn, tracker, rows, objects, time, new_id, camera)
+                cache = self._sources_cache()
+                update = self._row_update(tracker)
+                written = [
+                    _object_row(b, tracker.class_test, cache, self._interned, conn, write)
+                    if made is None
+                    else update.pack(made[0], made[1], write)
+                    for b, made in zip(step.changed, updated, strict=True)
+                ]
+                self._write_rows(conn, written, loaded, writes)
+            else:
+                beliefs = [_belief_from_row(row, self._interned, conn) for row in rows]
+                step = tracker.step(beliefs, objects, time, new_id, camera)
+                written = self._write_beliefs(conn, step.changed, tracker.class_test, loaded, writes)
+            counts = {row[0]: row[20] for row in written}
             self._write_observations(conn, objects, [(i, counts.get(i, 0)) for i in step.assigned], time, writes)
             if allocated[0] != next_id:
                 _write(conn, writes, "UPDATE meta SET value = ? WHERE key = 'next_id'", [(str(allocated[0]),)])
             seen = set(step.assigned)
-            self._prune_history(conn, [b for b in step.changed if b.id in seen], writes)
+            self._prune_history(conn, [(row[0], row[20]) for row in written if row[0] in seen], writes)
             # beliefs missed earlier and not seen since, wherever they are, are gone after gone_after seconds
             _write(conn, writes, _MARK_GONE, [(time - tracker.config.gone_after,)])
         if self.write_log is not None:
             self.write_log.append(writes)
         return step
+
+    def _row_update(self, tracker: BeliefTracker) -> RowUpdate:
+        """The row-level update for ``tracker`` (one per tracker configuration, kept while it is the same)."""
+        current = self._row_updates
+        if current is None or current.config is not tracker.config:
+            current = self._row_updates = RowUpdate(tracker, self._interned, self._conn)
+        return current
+
+    def _step_on_rows(
+        self,
+        conn: sqlite3.Connection,
+        tracker: BeliefTracker,
+        rows: Sequence[tuple],
+        objects: Sequence[FrameObject],
+        time: float,
+        new_id: Callable[[], int],
+        camera: CameraModel | None,
+    ) -> tuple[TrackStep, list[tuple[tuple, list] | None]]:
+        """``tracker.step`` on the stored candidate rows: the same association (on light views of the rows), the
+        same updates, creations, misses and departures, with matched beliefs in the common case updated on their
+        rows (:mod:`reasoning.beliefs.row_update`). Returns the step and, for each changed belief, its new row and
+        supports when it was updated on its row (else None: the belief is encoded as usual)."""
+        interned = self._interned
+        update = self._row_update(tracker)
+        candidates = [_Candidate(row, update.supports(row), interned, conn) for row in rows]
+        association = tracker._associate(objects, candidates)
+        changed: dict[int, tuple[ObjectBelief, tuple[tuple, list] | None]] = {}
+        assigned = [0] * len(objects)
+        for i, j, _ in association.matches:
+            candidate, observation = candidates[j], objects[i]
+            if update.covers(candidate.row, candidate.records, observation):
+                row = update.update(candidate.row, candidate.records, observation, time)
+                changed[candidate.id] = (belief_of(row, candidate.records, observation.roi), (row, candidate.records))
+            else:
+                belief = candidate.belief()
+                tracker._update(belief, observation, time)
+                changed[candidate.id] = (belief, None)
+            assigned[i] = candidate.id
+        created = []
+        for i in association.new:
+            if objects[i].doubt:
+                continue
+            belief = tracker._create(objects[i], time, new_id())
+            changed[belief.id] = (belief, None)
+            assigned[i] = belief.id
+            created.append(belief.id)
+        missed, gone = [], []
+        for j in association.unmatched:
+            candidate = candidates[j]
+            if camera is None and not candidate.row[19]:
+                continue  # neither in view nor missed before: unchanged
+            belief = candidate.belief()
+            was_missed, is_gone = tracker.unseen(belief, time, camera)
+            if was_missed:
+                missed.append(belief.id)
+                changed[belief.id] = (belief, None)
+            if is_gone:
+                gone.append(belief.id)
+                changed[belief.id] = (belief, None)
+        step = TrackStep(
+            tuple(b for b, _ in changed.values()),
+            tuple(assigned),
+            tuple(created),
+            tuple(missed),
+            tuple(gone),
+            association,
+        )
+        return step, [made for _, made in changed.values()]
 
     def put(self, beliefs: Sequence[ObjectBelief], class_test: ClassTest | None = None) -> None:
         """Write beliefs as they are (insert or replace, attributes included) in one transaction."""
@@ -469,8 +600,9 @@ class BeliefStore:
         objects: Sequence[FrameObject],
         camera: CameraModel | None,
         gate: float,
-    ) -> tuple[list[ObjectBelief], dict[int, _Loaded]]:
-        """Present beliefs within ``gate`` of an observation or in view of ``camera`` (R*Tree look-ups).
+    ) -> tuple[list[tuple], dict[int, _Loaded]]:
+        """The rows of the present beliefs within ``gate`` of an observation or in view of ``camera`` (R*Tree
+        look-ups), by id.
 
         Also returns how each one was stored, so unchanged R*Tree entries and index columns are not rewritten.
         """
@@ -511,7 +643,7 @@ class BeliefStore:
             i: _Loaded(((r[n] + r[n + 1]) / 2, (r[n + 2] + r[n + 3]) / 2, (r[n + 4] + r[n + 5]) / 2), *_labels(r))
             for i, r in rows.items()
         }
-        return [_belief_from_row(rows[i], self._interned, conn) for i in sorted(rows)], loaded
+        return [rows[i] for i in sorted(rows)], loaded
 
     def _write_beliefs(
         self,
@@ -520,21 +652,36 @@ class BeliefStore:
         class_test: ClassTest | None,
         loaded: Mapping[int, _Loaded] | None = None,
         writes: list[tuple[str, list[tuple]]] | None = None,
-    ) -> None:
-        """Write object rows, their R*Tree entries and attribute-index entries (noted in ``writes``).
+    ) -> list[tuple]:
+        """Write the object rows of ``beliefs`` (:meth:`_write_rows`); returns the rows written."""
+        if not beliefs:
+            return []
+        log = [] if writes is None else writes
+        cache = self._sources_cache()
+        write = functools.partial(_write, conn, log)
+        latest = {b.id: b for b in beliefs}  # a belief given twice is written as its last object is
+        written = beliefs if len(latest) == len(beliefs) else [latest[b.id] for b in beliefs]
+        rows = [_object_row(b, class_test, cache, self._interned, conn, write) for b in written]
+        self._write_rows(conn, rows, loaded, log)
+        return rows
 
-        Beliefs in ``loaded`` are updated in place; their indexed columns and index entries are touched only
+    def _write_rows(
+        self,
+        conn: sqlite3.Connection,
+        rows: Sequence[tuple],
+        loaded: Mapping[int, _Loaded] | None,
+        log: list[tuple[str, list[tuple]]],
+    ) -> None:
+        """Write object rows, their R*Tree entries and attribute-index entries (noted in ``log``).
+
+        Rows of beliefs in ``loaded`` are updated in place; their indexed columns and index entries are touched only
         when they changed. The R*Tree entry of a belief is a box of half-width ``RTREE_SLACK`` around a recent
         position; it is rewritten only when the belief has moved more than half of that from the entry's centre,
         so the true position always lies inside the entry and look-ups by position miss nothing.
         """
-        if not beliefs:
+        if not rows:
             return
-        log = [] if writes is None else writes
         loaded = loaded or {}
-        cache = self._sources_cache()
-        interned = self._interned
-        write = functools.partial(_write, conn, log)
         fresh: list[tuple] = []
         volatile: list[tuple] = []
         relabelled: list[tuple] = []
@@ -542,12 +689,9 @@ class BeliefStore:
         removed: list[tuple[str, str, int]] = []
         moved: list[tuple] = []
         classes: set[tuple[str]] = set()
-        latest = {b.id: b for b in beliefs}  # a belief given twice is written as its last object is
-        written = beliefs if len(latest) == len(beliefs) else [latest[b.id] for b in beliefs]
         r = RTREE_SLACK
-        for b, current in zip(beliefs, written, strict=True):  # one pass: each statement's rows in belief order
-            belief_id = b.id
-            row = _object_row(current, class_test, cache, interned, conn, write)
+        for row in rows:  # one pass: each statement's rows in belief order
+            belief_id = row[0]
             state = loaded.get(belief_id)
             indexed = row[_INDEXED]
             if state is None:
@@ -569,8 +713,9 @@ class BeliefStore:
                 or max(abs(x - state.place[0]), abs(y - state.place[1]), abs(z - state.place[2])) > RTREE_SLACK / 2
             ):
                 moved.append((belief_id, x - r, x + r, y - r, y + r, z - r, z + r))
-            if b.class_name and b.class_name != (state.class_name if state is not None else None):
-                classes.add((b.class_name,))
+            class_name = row[1]
+            if class_name and class_name != (state.class_name if state is not None else None):
+                classes.add((class_name,))
         if fresh:
             _write(conn, log, "DELETE FROM attribute_index WHERE object_id = ?", [(row[0],) for row in fresh])
             _write(conn, log, f"INSERT OR REPLACE INTO objects ({_OBJECT_COLUMNS}) VALUES ({_PLACEHOLDERS})", fresh)
@@ -636,10 +781,11 @@ class BeliefStore:
         return self._sources_text
 
     def _prune_history(
-        self, conn: sqlite3.Connection, beliefs: Sequence[ObjectBelief], writes: list[tuple[str, list[tuple]]]
+        self, conn: sqlite3.Connection, seen: Sequence[tuple[int, int]], writes: list[tuple[str, list[tuple]]]
     ) -> None:
+        """Drop the oldest sightings of the ``seen`` (belief id, sightings) beyond ``history_limit`` (every 16th)."""
         limit = self.history_limit
-        due = [(b.id, b.observations - limit) for b in beliefs if b.observations > limit and b.observations % 16 == 0]
+        due = [(i, count - limit) for i, count in seen if count > limit and count % 16 == 0]
         if due:
             _write(conn, writes, "DELETE FROM observations WHERE object_id = ? AND seq <= ?", due)
 

@@ -185,18 +185,28 @@ class BeliefTracker:
         missed, gone = [], []
         for j in association.unmatched:
             belief = beliefs[j]
-            if camera is not None and same_world(belief, camera) and visible_from(belief.position, camera):
-                belief.existence = max(belief.existence - self.config.miss_log_odds, -MAX_LOG_ODDS)
-                belief.misses += 1
+            was_missed, is_gone = self.unseen(belief, time, camera)
+            if was_missed:
                 missed.append(belief.id)
                 changed[belief.id] = belief
-            if belief.misses > 0 and time - belief.last_seen >= self.config.gone_after:
-                belief.status = GONE
+            if is_gone:
                 gone.append(belief.id)
                 changed[belief.id] = belief
         return TrackStep(
             tuple(changed.values()), tuple(assigned), tuple(created), tuple(missed), tuple(gone), association
         )
+
+    def unseen(self, belief: ObjectBelief, time: float, camera: CameraModel | None) -> tuple[bool, bool]:
+        """Apply a frame that did not match ``belief`` (changed in place): whether it was missed (in view of
+        ``camera``: existence lowered) and whether it is now gone (missed and not seen for ``gone_after``)."""
+        missed = camera is not None and same_world(belief, camera) and visible_from(belief.position, camera)
+        if missed:
+            belief.existence = max(belief.existence - self.config.miss_log_odds, -MAX_LOG_ODDS)
+            belief.misses += 1
+        gone = belief.misses > 0 and time - belief.last_seen >= self.config.gone_after
+        if gone:
+            belief.status = GONE
+        return missed, gone
 
     # ------------------------------------------------------------------ internals
 

@@ -1,0 +1,235 @@
+"""Matched beliefs updated on their stored rows: the common case of :meth:`BeliefTracker._update` followed by the
+store's encoding of the belief, without decoding the row into an ``ObjectBelief`` first.
+
+A stored ``objects`` row and the observation matched to it give the new row directly: the position filtered and
+the size blended with Python floats (the same operations, in the same order, as the tracker's numpy ones), the
+frame's statements accumulated into the packed supports with the rule of ``ValueSupport.add``, and the supports
+packed again. The common case is: no colour histogram on either side, a 3-vector position, size and 4-vector
+orientation in float64, every attribute single-valued before and after the update, and no named regions on the
+tracker. Anything else goes the general way (decode, ``BeliefTracker._update``, encode); both ways give the same
+row (``tests/fusion/test_row_update.py``).
+
+The supports are kept as :class:`Support` records in text space (attribute name, value, expert set) until they are
+packed, so new texts are interned in the order the general encoder interns them (the same codes, the same file).
+"""
+
+from __future__ import annotations
+
+import json
+import sqlite3
+from collections.abc import Callable, Sequence
+
+import numpy as np
+
+from reasoning.beliefs.interned import InternedTexts
+from reasoning.beliefs.packed import (
+    INDEX_SEPARATOR,
+    SUPPORT,
+    decoded_sources,
+    floats,
+    roi_text,
+    rounded_cached,
+    supports_packing,
+)
+from reasoning.fusion.frame import FrameObject
+from reasoning.fusion.rule import CLASS_ATTRIBUTE, MAX_LOG_ODDS, AttributeBelief, ValueSupport, logit
+from reasoning.fusion.tracking import PRESENT, BeliefTracker, ObjectBelief
+from robokudo.core.types import Location
+
+Support = list
+"""One support of a stored belief while it is updated: [name code or None, value code or None, log-odds (not
+rounded), count, expert-set code or None, first seen, last seen, name, value, expert names]; a code is None when it
+is still to be interned (a new text or a new expert set)."""
+
+_SUPPORT_NAME, _SUPPORT_VALUE, _SUPPORT_EXPERTS = 7, 8, 9
+
+
+def _is_vector(values: object, length: int) -> bool:
+    return type(values) is np.ndarray and values.dtype == np.float64 and values.shape == (length,)
+
+
+class RowUpdate:
+    """The row-level update of one store connection (see the module docstring).
+
+    ``sources`` caches the JSON of expert sets by (stored text, stated experts); it holds texts only, so it stays
+    right after a rollback (codes are never cached here beyond :class:`InternedTexts`, which forgets them).
+    """
+
+    def __init__(self, tracker: BeliefTracker, interned: InternedTexts, conn: sqlite3.Connection) -> None:
+        self.config = tracker.config
+        self.interned = interned
+        self.conn = conn
+        self.sources: dict[tuple[str, frozenset[str]], str] = {}
+
+    @staticmethod
+    def applies(tracker: BeliefTracker) -> bool:
+        """True when ``tracker`` updates beliefs as this module does (the plain tracker, no named regions)."""
+        return type(tracker) is BeliefTracker and not tracker.regions
+
+    def supports(self, row: tuple) -> list[Support]:
+        """The supports of a stored row, in stored order (texts read from ``interned``)."""
+        interned, conn = self.interned, self.conn
+        texts, expert_sets = interned.texts, interned.expert_sets
+        records = []
+        for name_code, value_code, log_odds, count, experts, first_seen, last_seen in SUPPORT.iter_unpack(row[26]):
+            name = texts.get(name_code)
+            if name is None:
+                name = interned.text(conn, name_code)
+            value = texts.get(value_code)
+            if value is None:
+                value = interned.text(conn, value_code)
+            names = expert_sets.get(experts)
+            if names is None:
+                names = interned.experts(conn, experts)
+            records.append([name_code, value_code, log_odds, count, experts, first_seen, last_seen, name, value, names])
+        return records
+
+    def covers(self, row: tuple, records: Sequence[Support], observation: FrameObject) -> bool:
+        """True when updating ``row`` (its ``records``) by ``observation`` is the common case."""
+        if row[14] is not None or observation.appearance is not None:
+            return False
+        if not (
+            _is_vector(observation.position, 3)
+            and _is_vector(observation.orientation, 4)
+            and _is_vector(observation.dimensions, 3)
+        ):
+            return False
+        values: dict[str, str] = {}
+        for r in records:
+            if r[_SUPPORT_NAME] in values:
+                return False  # a multi-valued attribute
+            values[r[_SUPPORT_NAME]] = r[_SUPPORT_VALUE]
+        # no second value stated for any attribute
+        return all(values.setdefault(e.attribute, e.value) == e.value for e in observation.evidence)
+
+    def update(self, row: tuple, records: list[Support], observation: FrameObject, time: float) -> tuple:
+        """The new ``objects`` row of ``row`` updated by ``observation`` at ``time`` (a covered case); ``records``
+        are updated in place. Its attribute column is left None: :meth:`pack` fills it, in write order."""
+        (object_id, _, frame, px, py, pz, _, _, _, _, sx, sy, sz, variance, appearance, existence, _, first_seen,
+         last_seen, _, observations, _, _, recording, _, sources, _, _) = row[:28]  # fmt: skip
+        by_name = {r[_SUPPORT_NAME]: r for r in records}
+        for e in observation.evidence:  # ValueSupport.add of each statement, at ``time``
+            r = by_name.get(e.attribute)
+            if r is None:
+                r = by_name[e.attribute] = [None, None, 0.0, 0, None, 0.0, 0.0, e.attribute, e.value, ()]
+                records.append(r)
+            if r[3] == 0 or time < r[5]:
+                r[5] = time
+            total = r[2] + logit(e.confidence)
+            total = -MAX_LOG_ODDS if total < -MAX_LOG_ODDS else total
+            r[2] = MAX_LOG_ODDS if total > MAX_LOG_ODDS else total
+            r[3] += 1
+            if e.source not in r[_SUPPORT_EXPERTS]:
+                r[_SUPPORT_EXPERTS] = (*r[_SUPPORT_EXPERTS], e.source)
+                r[4] = None
+            if r[6] < time:
+                r[6] = time
+        config = self.config
+        predicted = variance + config.motion_sigma**2 * max(time - last_seen, 0.0)
+        gain = predicted / (predicted + config.measurement_sigma**2 / max(observation.confidence, 0.1))
+        x, y, z = observation.position.tolist()
+        a, b, c = observation.dimensions.tolist()  # type: ignore[union-attr]
+        if sx is not None:
+            rate = config.blend_rate
+            a, b, c = (1.0 - rate) * sx + rate * a, (1.0 - rate) * sy + rate * b, (1.0 - rate) * sz + rate * c
+        class_name = region = None
+        entries = []
+        for r in records:
+            name, value = r[_SUPPORT_NAME], r[_SUPPORT_VALUE]
+            if name == CLASS_ATTRIBUTE:
+                class_name = value if r[2] > 0 else None
+            elif name == Location.attribute:
+                region = value
+            entries.append(f"{name}={value}")
+        stated = frozenset(observation.sources)
+        text = self.sources.get((sources, stated))
+        if text is None:
+            text = self.sources[(sources, stated)] = json.dumps(sorted({*decoded_sources(sources), *stated}))
+        qx, qy, qz, qw = floats(observation.orientation, 4)
+        return (
+            object_id,
+            class_name,
+            frame,
+            px + gain * (x - px),
+            py + gain * (y - py),
+            pz + gain * (z - pz),
+            qx,
+            qy,
+            qz,
+            qw,
+            a,
+            b,
+            c,
+            (1.0 - gain) * predicted,
+            appearance,
+            min(existence + config.hit_log_odds, MAX_LOG_ODDS),
+            PRESENT,
+            first_seen,
+            float(max(last_seen, time)),
+            0,
+            observations + 1,
+            region or "",
+            "",
+            recording,
+            roi_text(observation.roi),
+            text,
+            None,
+            INDEX_SEPARATOR.join(sorted(entries)),
+        )
+
+    def pack(self, row: tuple, records: Sequence[Support], write: Callable[[str, list[tuple]], None]) -> tuple:
+        """``row`` with its attribute column packed from ``records`` (texts new to the store interned with
+        ``write``, in the order of the records: name, value, experts)."""
+        interned, conn = self.interned, self.conn
+        codes, expert_codes = interned.codes, interned.expert_codes
+        flat: list = []
+        for r in records:
+            name_code, value_code, log_odds, count, experts, first_seen, last_seen, name, value, names = r
+            if name_code is None:
+                name_code = codes.get(name)
+                if name_code is None:
+                    name_code = interned.code(conn, name, write)
+            if value_code is None:
+                value_code = codes.get(value)
+                if value_code is None:
+                    value_code = interned.code(conn, value, write)
+            if experts is None:
+                experts = expert_codes.get(frozenset(names))
+                if experts is None:
+                    experts = interned.experts_code(conn, set(names), write)
+            rounded = rounded_cached(log_odds, 9) if log_odds else round(log_odds, 9)
+            flat += (name_code, value_code, rounded, count, experts, first_seen, last_seen)
+        return (*row[:26], supports_packing(len(records)).pack(*flat), row[27])
+
+
+def belief_of(row: tuple, records: Sequence[Support], roi: tuple[int, int, int, int] | None) -> ObjectBelief:
+    """The ``ObjectBelief`` a row-level update stands for: the new row, the supports with their log-odds not rounded,
+    and the observation's image box as given (what ``BeliefTracker._update`` leaves in the belief)."""
+    attributes: dict[str, AttributeBelief] = {}
+    for r in records:
+        name = r[_SUPPORT_NAME]
+        attributes[name] = AttributeBelief(
+            name, {r[_SUPPORT_VALUE]: ValueSupport(r[2], r[3], set(r[_SUPPORT_EXPERTS]), r[5], r[6])}
+        )
+    return ObjectBelief(
+        id=row[0],
+        frame=row[2],
+        position=np.array(row[3:6]),
+        orientation=np.array(row[6:10]),
+        dimensions=np.array(row[10:13]),
+        appearance=None,
+        attributes=attributes,
+        position_variance=row[13],
+        existence=row[15],
+        status=row[16],
+        first_seen=row[17],
+        last_seen=row[18],
+        misses=row[19],
+        region=row[21],
+        region_class=row[22],
+        roi=roi,
+        sources=set(decoded_sources(row[25])),
+        observations=row[20],
+        class_name=row[1],
+        recording=row[23],
+    )
