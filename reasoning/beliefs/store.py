@@ -67,7 +67,7 @@ from reasoning.fusion.rule import (
     sigmoid,
 )
 from reasoning.fusion.text import text_matches
-from reasoning.fusion.tracking import PRESENT, BeliefTracker, ObjectBelief, TrackStep
+from reasoning.fusion.tracking import PRESENT, BeliefTracker, ChangedBeliefs, ObjectBelief, TrackStep
 from robokudo.core.regions import RegionBox
 from robokudo.core.types import Text
 
@@ -470,10 +470,10 @@ class BeliefStore:
                 cache = self._sources_cache()
                 update = self._row_update(tracker)
                 written = [
-                    _object_row(b, tracker.class_test, cache, self._interned, conn, write)
-                    if made is None
+                    _object_row(made, tracker.class_test, cache, self._interned, conn, write)
+                    if isinstance(made, ObjectBelief)
                     else update.pack(made[0], made[1], write)
-                    for b, made in zip(step.changed, updated, strict=True)
+                    for made in updated
                 ]
                 self._write_rows(conn, written, loaded, writes)
             else:
@@ -508,33 +508,36 @@ class BeliefStore:
         time: float,
         new_id: Callable[[], int],
         camera: CameraModel | None,
-    ) -> tuple[TrackStep, list[tuple[tuple, list] | None]]:
+    ) -> tuple[TrackStep, list[ObjectBelief | tuple[tuple, list[Support]]]]:
         """``tracker.step`` on the stored candidate rows: the same association (on light views of the rows), the
         same updates, creations, misses and departures, with matched beliefs in the common case updated on their
-        rows (:mod:`reasoning.beliefs.row_update`). Returns the step and, for each changed belief, its new row and
-        supports when it was updated on its row (else None: the belief is encoded as usual)."""
+        rows (:mod:`reasoning.beliefs.row_update`; their ``ObjectBelief`` made only when the step's ``changed`` is
+        read). Returns the step and each changed belief: the belief, or its new row and supports when it was
+        updated on its row."""
         interned = self._interned
         update = self._row_update(tracker)
         candidates = [_Candidate(row, update.supports(row), interned, conn) for row in rows]
         association = tracker._associate(objects, candidates)
-        changed: dict[int, tuple[ObjectBelief, tuple[tuple, list] | None]] = {}
+        changed: dict[int, ObjectBelief | tuple[tuple, list[Support]]] = {}
+        makers: dict[int, ObjectBelief | Callable[[], ObjectBelief]] = {}
         assigned = [0] * len(objects)
         for i, j, _ in association.matches:
             candidate, observation = candidates[j], objects[i]
             if update.covers(candidate.row, candidate.records, observation):
                 row = update.update(candidate.row, candidate.records, observation, time)
-                changed[candidate.id] = (belief_of(row, candidate.records, observation.roi), (row, candidate.records))
+                changed[candidate.id] = (row, candidate.records)
+                makers[candidate.id] = functools.partial(belief_of, row, candidate.records, observation.roi)
             else:
                 belief = candidate.belief()
                 tracker._update(belief, observation, time)
-                changed[candidate.id] = (belief, None)
+                changed[candidate.id] = makers[candidate.id] = belief
             assigned[i] = candidate.id
         created = []
         for i in association.new:
             if objects[i].doubt:
                 continue
             belief = tracker._create(objects[i], time, new_id())
-            changed[belief.id] = (belief, None)
+            changed[belief.id] = makers[belief.id] = belief
             assigned[i] = belief.id
             created.append(belief.id)
         missed, gone = [], []
@@ -546,19 +549,14 @@ class BeliefStore:
             was_missed, is_gone = tracker.unseen(belief, time, camera)
             if was_missed:
                 missed.append(belief.id)
-                changed[belief.id] = (belief, None)
             if is_gone:
                 gone.append(belief.id)
-                changed[belief.id] = (belief, None)
+            if was_missed or is_gone:
+                changed[belief.id] = makers[belief.id] = belief
         step = TrackStep(
-            tuple(b for b, _ in changed.values()),
-            tuple(assigned),
-            tuple(created),
-            tuple(missed),
-            tuple(gone),
-            association,
+            ChangedBeliefs(makers.values()), tuple(assigned), tuple(created), tuple(missed), tuple(gone), association
         )
-        return step, [made for _, made in changed.values()]
+        return step, list(changed.values())
 
     def put(self, beliefs: Sequence[ObjectBelief], class_test: ClassTest | None = None) -> None:
         """Write beliefs as they are (insert or replace, attributes included) in one transaction."""

@@ -17,8 +17,9 @@ stated without evidence (e.g. only the query's guess) is kept among the alternat
 
 from __future__ import annotations
 
-from collections.abc import Callable, Sequence
+from collections.abc import Callable, Iterable, Iterator, Sequence
 from dataclasses import dataclass, field
+from typing import overload
 
 import numpy as np
 
@@ -113,12 +114,54 @@ class TrackerConfig:
     blend_rate: float = 0.3
 
 
+class ChangedBeliefs(Sequence[ObjectBelief]):
+    """The beliefs a frame changed, in order, each one made when first read: an item is a belief or a function
+    making it (a store that updates beliefs on their stored rows makes the objects only for a caller that looks).
+    Compares equal to any sequence of the same beliefs (a tuple included)."""
+
+    __slots__ = ("_items",)
+
+    def __init__(self, items: Iterable[ObjectBelief | Callable[[], ObjectBelief]]) -> None:
+        self._items = list(items)
+
+    def __len__(self) -> int:
+        return len(self._items)
+
+    @overload
+    def __getitem__(self, index: int) -> ObjectBelief: ...
+
+    @overload
+    def __getitem__(self, index: slice) -> tuple[ObjectBelief, ...]: ...
+
+    def __getitem__(self, index: int | slice) -> ObjectBelief | tuple[ObjectBelief, ...]:
+        if isinstance(index, slice):
+            return tuple(self[i] for i in range(*index.indices(len(self._items))))
+        item = self._items[index]
+        if not isinstance(item, ObjectBelief):
+            item = self._items[index] = item()
+        return item
+
+    def __iter__(self) -> Iterator[ObjectBelief]:
+        return (self[i] for i in range(len(self._items)))
+
+    def __eq__(self, other: object) -> bool:
+        if not isinstance(other, Sequence) or isinstance(other, str) or len(other) != len(self):
+            return False
+        return all(a == b for a, b in zip(self, other, strict=True))
+
+    __hash__ = None  # type: ignore[assignment]  # beliefs are mutable, as in a tuple of them
+
+    def __repr__(self) -> str:
+        return f"ChangedBeliefs({list(self)!r})"
+
+
 @dataclass(frozen=True, slots=True)
 class TrackStep:
     """The outcome of one frame: ``assigned[i]`` is the belief id of observation ``i`` (0 when a doubted
-    observation matched no belief and was dropped)."""
+    observation matched no belief and was dropped). ``changed`` is a tuple, or :class:`ChangedBeliefs` (made on
+    first read) when a store updated beliefs on their rows."""
 
-    changed: tuple[ObjectBelief, ...]
+    changed: Sequence[ObjectBelief]
     assigned: tuple[int, ...]
     created: tuple[int, ...]
     missed: tuple[int, ...]

@@ -16,7 +16,7 @@ from reasoning.beliefs.store import BeliefStore
 from reasoning.fusion.association import CameraModel
 from reasoning.fusion.frame import FrameObject
 from reasoning.fusion.rule import Evidence
-from reasoning.fusion.tracking import BeliefTracker, ObjectBelief, TrackerConfig, TrackStep
+from reasoning.fusion.tracking import BeliefTracker, ChangedBeliefs, ObjectBelief, TrackerConfig, TrackStep
 from robokudo.core.types import CameraIntrinsics
 
 SUBCLASSES = {("LactoseFreeMilk", "Milk"), ("Milk", "Drink"), ("LactoseFreeMilk", "Drink")}
@@ -167,3 +167,19 @@ def test_row_level_update_gives_the_steps_and_the_store_of_the_general_way(
     assert tables(tmp_path / "rows.sqlite") == tables(tmp_path / "general.sqlite")
     assert len(on_rows) >= 10  # the row-level update did the common case
     assert len(decoded) >= (5 if quirks else 0)  # and the general way the others
+
+
+def test_changed_beliefs_are_made_once_on_first_read_and_compare_as_a_tuple() -> None:
+    made: list[int] = []
+    stored = ObjectBelief(id=1, frame="world", position=np.zeros(3))
+
+    def make() -> ObjectBelief:
+        made.append(2)
+        return ObjectBelief(id=2, frame="world", position=np.ones(3))
+
+    changed = ChangedBeliefs([stored, make])
+    assert len(changed) == 2 and made == []
+    assert changed[0] is stored and made == []
+    second = changed[1]
+    assert [b.id for b in changed] == [1, 2] and changed[1] is second and made == [2]
+    assert changed[:1] == (stored,) and changed == (stored, second) and changed != (stored,)
