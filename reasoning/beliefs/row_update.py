@@ -42,6 +42,8 @@ rounded), count, expert-set code or None, first seen, last seen, name, value, ex
 is still to be interned (a new text or a new expert set)."""
 
 _SUPPORT_NAME, _SUPPORT_VALUE, _SUPPORT_EXPERTS = 7, 8, 9
+LOGIT_CACHE_LIMIT = 4096
+"""Distinct confidences whose log-odds a :class:`RowUpdate` remembers (beyond that it starts afresh)."""
 
 
 def _is_vector(values: object, length: int) -> bool:
@@ -60,6 +62,8 @@ class RowUpdate:
         self.interned = interned
         self.conn = conn
         self.sources: dict[tuple[str, frozenset[str]], str] = {}
+        self.logits: dict[float, float] = {}
+        """``logit`` of the confidences met (few distinct values recur on every frame)."""
 
     @staticmethod
     def applies(tracker: BeliefTracker) -> bool:
@@ -84,30 +88,33 @@ class RowUpdate:
             records.append([name_code, value_code, log_odds, count, experts, first_seen, last_seen, name, value, names])
         return records
 
-    def covers(self, row: tuple, records: Sequence[Support], observation: FrameObject) -> bool:
-        """True when updating ``row`` (its ``records``) by ``observation`` is the common case."""
+    def update(self, row: tuple, records: list[Support], observation: FrameObject, time: float) -> tuple | None:
+        """The new ``objects`` row of ``row`` (its supports ``records``) updated by ``observation`` at ``time``, or
+        None when that is not the common case (then nothing was changed). ``records`` are updated in place; the
+        row's attribute column is left None: :meth:`pack` fills it, in write order."""
         if row[14] is not None or observation.appearance is not None:
-            return False
+            return None
         if not (
             _is_vector(observation.position, 3)
             and _is_vector(observation.orientation, 4)
             and _is_vector(observation.dimensions, 3)
         ):
-            return False
-        values: dict[str, str] = {}
+            return None
+        by_name: dict[str, Support] = {}
         for r in records:
-            if r[_SUPPORT_NAME] in values:
-                return False  # a multi-valued attribute
-            values[r[_SUPPORT_NAME]] = r[_SUPPORT_VALUE]
-        # no second value stated for any attribute
-        return all(values.setdefault(e.attribute, e.value) == e.value for e in observation.evidence)
-
-    def update(self, row: tuple, records: list[Support], observation: FrameObject, time: float) -> tuple:
-        """The new ``objects`` row of ``row`` updated by ``observation`` at ``time`` (a covered case); ``records``
-        are updated in place. Its attribute column is left None: :meth:`pack` fills it, in write order."""
+            if r[_SUPPORT_NAME] in by_name:
+                return None  # a multi-valued attribute
+            by_name[r[_SUPPORT_NAME]] = r
+        stated: dict[str, str] = {}
+        for e in observation.evidence:
+            r = by_name.get(e.attribute)
+            if (r[_SUPPORT_VALUE] if r is not None else stated.setdefault(e.attribute, e.value)) != e.value:
+                return None  # a second value stated
         (object_id, _, frame, px, py, pz, _, _, _, _, sx, sy, sz, variance, appearance, existence, _, first_seen,
          last_seen, _, observations, _, _, recording, _, sources, _, _) = row[:28]  # fmt: skip
-        by_name = {r[_SUPPORT_NAME]: r for r in records}
+        logits = self.logits
+        if len(logits) > LOGIT_CACHE_LIMIT:
+            logits.clear()
         for e in observation.evidence:  # ValueSupport.add of each statement, at ``time``
             r = by_name.get(e.attribute)
             if r is None:
@@ -115,7 +122,11 @@ class RowUpdate:
                 records.append(r)
             if r[3] == 0 or time < r[5]:
                 r[5] = time
-            total = r[2] + logit(e.confidence)
+            confidence = e.confidence
+            log_odds = logits.get(confidence)
+            if log_odds is None:
+                log_odds = logits[confidence] = logit(confidence)
+            total = r[2] + log_odds
             total = -MAX_LOG_ODDS if total < -MAX_LOG_ODDS else total
             r[2] = MAX_LOG_ODDS if total > MAX_LOG_ODDS else total
             r[3] += 1

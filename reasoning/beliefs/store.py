@@ -523,8 +523,8 @@ class BeliefStore:
         assigned = [0] * len(objects)
         for i, j, _ in association.matches:
             candidate, observation = candidates[j], objects[i]
-            if update.covers(candidate.row, candidate.records, observation):
-                row = update.update(candidate.row, candidate.records, observation, time)
+            row = update.update(candidate.row, candidate.records, observation, time)
+            if row is not None:
                 changed[candidate.id] = (row, candidate.records)
                 makers[candidate.id] = functools.partial(belief_of, row, candidate.records, observation.roi)
             else:

@@ -142,9 +142,11 @@ def test_row_level_update_gives_the_steps_and_the_store_of_the_general_way(
     on_rows, decoded = [], []
     row_update, update = RowUpdate.update, BeliefTracker._update
 
-    def counted_row_update(self: RowUpdate, *args: object) -> tuple:
-        on_rows.append(1)
-        return row_update(self, *args)  # type: ignore[arg-type]
+    def counted_row_update(self: RowUpdate, *args: object) -> tuple | None:
+        row = row_update(self, *args)  # type: ignore[arg-type]
+        if row is not None:
+            on_rows.append(1)
+        return row
 
     def counted_update(*args: object) -> None:
         decoded.append(1)
