@@ -32,17 +32,28 @@ from reasoning.beliefs.store import BeliefStore  # noqa: E402
 from reasoning.fusion.frame import frame_objects  # noqa: E402
 from reasoning.fusion.tracking import BeliefTracker  # noqa: E402
 
+try:  # the row-level update (store8 and later); the phases of a tree without it are skipped
+    from reasoning.beliefs.row_update import RowUpdate
+except ImportError:  # pragma: no cover - an older tree
+    RowUpdate = None  # type: ignore[assignment,misc]
+
 PHASES: tuple[tuple[object, str, str], ...] = (
     (BeliefStore, "integrate", "integrate (all)"),
     (BeliefStore, "_candidates", "candidate search"),
     (store_module, "_belief_from_row", "  of it: decoding rows"),
     (BeliefTracker, "step", "tracker.step"),
+    (BeliefStore, "_step_on_rows", "tracker step on rows"),
+    (RowUpdate, "supports", "  of it: supports unpacked"),
     (BeliefTracker, "_associate", "  of it: association"),
-    (BeliefTracker, "_update", "  of it: updates"),
-    (BeliefStore, "_write_beliefs", "object rows written"),
+    (BeliefTracker, "_update", "  of it: updates (general)"),
+    (RowUpdate, "update", "  of it: updates (on rows)"),
+    (BeliefStore, "_write_beliefs", "object rows written (general)"),
     (store_module, "_object_row", "  of it: building rows"),
+    (RowUpdate, "pack", "supports packed (on rows)"),
+    (BeliefStore, "_write_rows", "object rows written"),
     (BeliefStore, "_write_observations", "sightings written"),
 )
+"""(owner, method, label) of each timed phase; a phase whose owner or method a tree lacks is left out."""
 
 
 class _Fetched:
@@ -93,7 +104,9 @@ def timed_phases(totals: dict[str, int]) -> Iterator[None]:
     """Wrap the methods of :data:`PHASES` so each adds its CPU ns to ``totals`` (restored on exit)."""
     originals = []
     for owner, name, label in PHASES:
-        original = getattr(owner, name)
+        original = getattr(owner, name, None)
+        if original is None:
+            continue
         originals.append((owner, name, original))
         setattr(owner, name, _timed(original, label, totals))
     try:
