@@ -26,7 +26,6 @@ from reasoning.beliefs.packed import (
     INDEX_SEPARATOR,
     SUPPORT,
     decoded_sources,
-    floats,
     roi_text,
     rounded_cached,
     supports_packing,
@@ -46,8 +45,13 @@ LOGIT_CACHE_LIMIT = 4096
 """Distinct confidences whose log-odds a :class:`RowUpdate` remembers (beyond that it starts afresh)."""
 
 
+_FLOAT64 = np.dtype(np.float64)
+
+
 def _is_vector(values: object, length: int) -> bool:
-    return type(values) is np.ndarray and values.dtype == np.float64 and values.shape == (length,)
+    """True when ``values`` is a float64 array of shape ``(length,)`` (another float64 descriptor object than numpy's
+    own only sends the update the general way)."""
+    return type(values) is np.ndarray and values.dtype is _FLOAT64 and values.shape == (length,)
 
 
 class RowUpdate:
@@ -156,7 +160,7 @@ class RowUpdate:
         text = self.sources.get((sources, stated))
         if text is None:
             text = self.sources[(sources, stated)] = json.dumps(sorted({*decoded_sources(sources), *stated}))
-        qx, qy, qz, qw = floats(observation.orientation, 4)
+        qx, qy, qz, qw = observation.orientation.tolist()  # floats(orientation, 4) of a float64 4-vector
         return (
             object_id,
             class_name,
