@@ -37,7 +37,7 @@ sys.path.insert(0, str(BENCH))
 
 import bench_beliefs as bench  # noqa: E402
 
-from reasoning.beliefs import packed  # noqa: E402
+from reasoning.beliefs import packed as packed_forms  # noqa: E402
 from reasoning.beliefs import store as store_module  # noqa: E402
 from reasoning.beliefs.interned import InternedTexts  # noqa: E402
 from reasoning.beliefs.store import BeliefStore  # noqa: E402
@@ -45,6 +45,12 @@ from reasoning.fusion.frame import FrameObject, frame_objects  # noqa: E402
 from reasoning.fusion.rule import CLASS_ATTRIBUTE, MAX_LOG_ODDS, logit  # noqa: E402
 from reasoning.fusion.tracking import BeliefTracker  # noqa: E402
 from robokudo.core.types import Location  # noqa: E402
+
+
+class GeneralTracker(BeliefTracker):
+    """The plain tracker, which ``integrate`` runs the general way (decode, ``_update``, encode): since store8 the
+    plain ``BeliefTracker`` has its common-case updates done on the rows (``reasoning/beliefs/row_update.py``)."""
+
 
 Update = tuple[tuple, FrameObject, float]
 """A stored row, the observation matched to it and the frame's time."""
@@ -90,7 +96,7 @@ class RowLevel:
         """True when the update is the common case this sketch handles."""
         if row[14] is not None or observation.appearance is not None or observation.dimensions is None:
             return False
-        names = [r[0] for r in packed.SUPPORT.iter_unpack(row[26])]
+        names = [r[0] for r in packed_forms.SUPPORT.iter_unpack(row[26])]
         if len(set(names)) != len(names):
             return False
         stated: dict[str, str] = {}
@@ -98,7 +104,7 @@ class RowLevel:
             if stated.setdefault(e.attribute, e.value) != e.value:
                 return False
         texts = self.interned.texts
-        values = {texts[r[0]]: texts[r[1]] for r in packed.SUPPORT.iter_unpack(row[26])}
+        values = {texts[r[0]]: texts[r[1]] for r in packed_forms.SUPPORT.iter_unpack(row[26])}
         return all(values.get(name, value) == value for name, value in stated.items())
 
     def row(self, row: tuple, observation: FrameObject, at: float) -> tuple:
@@ -107,7 +113,7 @@ class RowLevel:
          last_seen, _, observations, _, _, recording, _, sources, packed, _) = row[:28]  # fmt: skip
         interned, conn, write = self.interned, self.conn, self.write
         codes = interned.codes
-        records = [list(r) for r in packed.SUPPORT.iter_unpack(packed)]
+        records = [list(r) for r in packed_forms.SUPPORT.iter_unpack(packed)]
         by_name = {r[0]: r for r in records}
         for e in observation.evidence:
             name = codes.get(e.attribute)
@@ -148,7 +154,7 @@ class RowLevel:
         for r in records:
             flat += r
             log_odds = r[2]
-            flat[-5] = packed.rounded_cached(log_odds, 9) if log_odds else round(log_odds, 9)
+            flat[-5] = packed_forms.rounded_cached(log_odds, 9) if log_odds else round(log_odds, 9)
             name, value = texts[r[0]], texts[r[1]]
             named[name] = (value, log_odds)
             entries.append(f"{name}={value}")
@@ -180,10 +186,10 @@ class RowLevel:
             named.get(Location.attribute, ("",))[0],
             "",
             recording,
-            packed.roi_text(observation.roi),
+            packed_forms.roi_text(observation.roi),
             text,
-            packed.supports_packing(len(records)).pack(*flat),
-            packed.INDEX_SEPARATOR.join(sorted(entries)),
+            packed_forms.supports_packing(len(records)).pack(*flat),
+            packed_forms.INDEX_SEPARATOR.join(sorted(entries)),
         )
 
 
@@ -200,7 +206,7 @@ def main() -> int:
         frames = [frame_objects(bench.hypotheses_near(seeded, rng, 20)) for _ in range(args.frames)]
         path = folder / "run.sqlite"
         shutil.copy(template, path)
-        tracker = BeliefTracker(class_test=bench.is_subclass)
+        tracker = GeneralTracker(class_test=bench.is_subclass)  # the general way: every update is captured
         store = BeliefStore(path, tracker=tracker)
         updates = captured_updates(store, frames)
         conn, interned = store._conn, store._interned
