@@ -37,7 +37,7 @@ from collections.abc import Callable, Iterator, Mapping, Sequence
 from contextlib import contextmanager
 from dataclasses import dataclass, field
 from pathlib import Path
-from typing import NamedTuple, TypeVar
+from typing import TypeVar
 
 import numpy as np
 import platformdirs
@@ -209,17 +209,6 @@ _SCHEMA = (
 
 
 _TABLES = {"meta", "objects", "objects_place", "attribute_index", "observations", "classes", "interned"}
-
-
-class _Loaded(NamedTuple):
-    """What a belief looked like in the store when loaded: its R*Tree entry centre and its indexed columns (a named
-    tuple: made for every candidate of every frame)."""
-
-    place: tuple[float, float, float]
-    class_name: str | None
-    region: str
-    region_class: str
-    indexed: str
 
 
 class _Candidate:
@@ -598,11 +587,12 @@ class BeliefStore:
         objects: Sequence[FrameObject],
         camera: CameraModel | None,
         gate: float,
-    ) -> tuple[list[tuple], dict[int, _Loaded]]:
+    ) -> tuple[list[tuple], dict[int, tuple]]:
         """The rows of the present beliefs within ``gate`` of an observation or in view of ``camera`` (R*Tree
         look-ups), by id.
 
-        Also returns how each one was stored, so unchanged R*Tree entries and index columns are not rewritten.
+        Also returns each row by id with its R*Tree entry after its columns, so unchanged R*Tree entries and index
+        columns are not rewritten.
         """
         rows: dict[int, tuple] = {}
         groups: dict[tuple[str, str], list[FrameObject]] = {}
@@ -636,19 +626,14 @@ class BeliefStore:
                 for row, seen in zip(in_frustum, in_view(positions, camera), strict=True):
                     if seen:
                         rows[row[0]] = row
-        n = _COLUMN_COUNT
-        loaded = {
-            i: _Loaded(((r[n] + r[n + 1]) / 2, (r[n + 2] + r[n + 3]) / 2, (r[n + 4] + r[n + 5]) / 2), *_labels(r))
-            for i, r in rows.items()
-        }
-        return [rows[i] for i in sorted(rows)], loaded
+        return [rows[i] for i in sorted(rows)], rows
 
     def _write_beliefs(
         self,
         conn: sqlite3.Connection,
         beliefs: Sequence[ObjectBelief],
         class_test: ClassTest | None,
-        loaded: Mapping[int, _Loaded] | None = None,
+        loaded: Mapping[int, tuple] | None = None,
         writes: list[tuple[str, list[tuple]]] | None = None,
     ) -> list[tuple]:
         """Write the object rows of ``beliefs`` (:meth:`_write_rows`); returns the rows written."""
@@ -667,15 +652,17 @@ class BeliefStore:
         self,
         conn: sqlite3.Connection,
         rows: Sequence[tuple],
-        loaded: Mapping[int, _Loaded] | None,
+        loaded: Mapping[int, tuple] | None,
         log: list[tuple[str, list[tuple]]],
     ) -> None:
         """Write object rows, their R*Tree entries and attribute-index entries (noted in ``log``).
 
-        Rows of beliefs in ``loaded`` are updated in place; their indexed columns and index entries are touched only
-        when they changed. The R*Tree entry of a belief is a box of half-width ``RTREE_SLACK`` around a recent
-        position; it is rewritten only when the belief has moved more than half of that from the entry's centre,
-        so the true position always lies inside the entry and look-ups by position miss nothing.
+        ``loaded`` holds the stored rows of beliefs as the candidate search read them (their columns, then their
+        R*Tree entry: x0, x1, y0, y1, z0, z1); those beliefs are updated in place, their indexed columns and index
+        entries touched only when they changed. The R*Tree entry of a belief is a box of half-width
+        ``RTREE_SLACK`` around a recent position; it is rewritten only when the belief has moved more than half of
+        that from the entry's centre, so the true position always lies inside the entry and look-ups by position
+        miss nothing.
         """
         if not rows:
             return
@@ -688,6 +675,7 @@ class BeliefStore:
         moved: list[tuple] = []
         classes: set[tuple[str]] = set()
         r = RTREE_SLACK
+        n = _COLUMN_COUNT  # a loaded row's R*Tree entry: x0, x1, y0, y1, z0, z1 after its columns
         for row in rows:  # one pass: each statement's rows in belief order
             belief_id = row[0]
             state = loaded.get(belief_id)
@@ -698,21 +686,26 @@ class BeliefStore:
             else:
                 volatile.append(_volatile(row))
                 labels = _labels(row)
-                if labels != _state(state):
+                if labels != _labels(state):
                     relabelled.append((*labels, belief_id))
-                old = _index_entries(state.indexed) if state.indexed != indexed else set()
-            if state is None or state.indexed != indexed:
+                old = _index_entries(state[_INDEXED]) if state[_INDEXED] != indexed else set()
+            if state is None or state[_INDEXED] != indexed:
                 new = _index_entries(indexed)
                 added.extend((name, value, belief_id) for name, value in new - old)
                 removed.extend((name, value, belief_id) for name, value in old - new)
             x, y, z = row[3:6]
             if (
                 state is None
-                or max(abs(x - state.place[0]), abs(y - state.place[1]), abs(z - state.place[2])) > RTREE_SLACK / 2
+                or max(
+                    abs(x - (state[n] + state[n + 1]) / 2),
+                    abs(y - (state[n + 2] + state[n + 3]) / 2),
+                    abs(z - (state[n + 4] + state[n + 5]) / 2),
+                )
+                > RTREE_SLACK / 2
             ):
                 moved.append((belief_id, x - r, x + r, y - r, y + r, z - r, z + r))
             class_name = row[1]
-            if class_name and class_name != (state.class_name if state is not None else None):
+            if class_name and class_name != (state[1] if state is not None else None):
                 classes.add((class_name,))
         if fresh:
             _write(conn, log, "DELETE FROM attribute_index WHERE object_id = ?", [(row[0],) for row in fresh])
@@ -1027,10 +1020,6 @@ _volatile = operator.itemgetter(*_VOLATILE_INDEXES)
 
 _labels = operator.itemgetter(*_LABEL_COLUMNS)
 """The indexed columns of an object row: class, region, region class, attribute-index entries."""
-
-
-def _state(loaded: _Loaded) -> tuple:
-    return loaded.class_name, loaded.region, loaded.region_class, loaded.indexed
 
 
 def _encoded_sources(experts: set[str], cache: dict[frozenset[str], str]) -> str:
