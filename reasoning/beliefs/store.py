@@ -440,6 +440,10 @@ class BeliefStore:
         Beliefs near the observations (and, with ``camera``, in front of it) are loaded, associated and
         updated by the tracker; new objects get new ids; the changes and the sightings are written. Beliefs
         missed earlier and not seen for the tracker's ``gone_after`` seconds are marked gone, wherever they are.
+
+        With the plain :class:`BeliefTracker` (no named regions) the step runs on the stored rows: matched beliefs in
+        the common case are updated on their rows (:mod:`reasoning.beliefs.row_update`) and the step's ``changed``
+        makes their ``ObjectBelief`` only when read; results are those of ``tracker.step`` on decoded beliefs.
         """
         tracker = tracker or self.tracker
         writes: list[tuple[str, list[tuple]]] = []
