@@ -30,7 +30,7 @@ import numpy as np
 from annotators.cloud.normals import grid_normals
 from annotators.cloud.plane import plane_basis, plane_distances
 from annotators.cloud.point_cloud import cloud_problem
-from annotators.geometry.grid_kernels import label_pixels, standing_candidates, upsampled_labels
+from annotators.geometry.grid_kernels import label_masks, label_pixels, standing_candidates, upsampled_labels
 from annotators.geometry.grid_segmentation import (
     MergeRules,
     boundaries,
@@ -231,18 +231,14 @@ def full_resolution_segments(
         labels, coarse_depth, fine_points[..., 2], candidates, step, p.jump_absolute, p.jump_relative
     )
     # flat indices of the whole grid, sorted by label
-    core_indices, core_starts, boxes = label_pixels(core, (fy0, fx0), cols)
+    core_indices, core_starts, _ = label_pixels(core, (fy0, fx0), cols)
     sizes = np.diff(core_starts)
     kept = [label for label in range(1, sizes.size) if sizes[label] >= p.min_points]  # judged before refining
-    mask_indices, starts = core_indices, core_starts
-    if refine is not None:
-        mask_indices, starts, boxes = label_pixels(refine(core, fine_points, heights, candidates), (fy0, fx0), cols)
-    masks = np.zeros((len(kept), rows, cols), dtype=bool)  # one allocation for all masks
+    refined = core if refine is None else refine(core, fine_points, heights, candidates)
+    masks, boxes = label_masks(refined, kept, (fy0, fx0), (rows, cols))
     segments = []
-    for object_mask, label in zip(masks, kept, strict=True):
-        object_mask.reshape(-1)[mask_indices[starts[label] : starts[label + 1]]] = True
+    for object_mask, label, (left, top, right, bottom) in zip(masks, kept, boxes.tolist(), strict=True):
         indices = core_indices[core_starts[label] : core_starts[label + 1]]
-        left, top, right, bottom = boxes[label].tolist()
         roi = (left + fx0, top + fy0, right + fx0, bottom + fy0)
         segments.append(Segment(indices=indices, mask=object_mask, roi=roi))
     segments.sort(key=lambda s: -s.indices.size)

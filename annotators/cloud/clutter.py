@@ -239,7 +239,7 @@ def segment_clutter(
     patches = split_by_normals(grid_patches(surfaces, p.cell), normals, p.normal_spread)
     # patches without a trustworthy plane (a face seen edge-on, a few points) go with the object beside them
     reach = max(2.0 * p.cell, p.grow_distance / step)
-    labels, _ = convex_groups(patches, grid, p.convexity_rules(), region & ~seams, grow=reach)
+    labels = convex_groups(patches, grid, p.convexity_rules(), region & ~seams, grow=reach)
     labels = grow_on_surface(labels, region, depth, p.jump_absolute, p.jump_relative)
     basis = plane_basis(np.asarray(model[:3], dtype=np.float64)).T.astype(np.float32)
     to_plane = np.column_stack([basis, np.asarray(model[:3], dtype=np.float32)])

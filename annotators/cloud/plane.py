@@ -175,7 +175,7 @@ def largest_region_mask(mask: np.ndarray, step: int = 2) -> np.ndarray:
     keep = cv2.dilate((labels == biggest).view(np.uint8), np.ones((3, 3), np.uint8))
     rows, cols = mask.shape
     keep = cv2.resize(keep, (keep.shape[1] * step, keep.shape[0] * step), interpolation=cv2.INTER_NEAREST)
-    return mask & (keep[:rows, :cols] > 0)
+    return mask & keep[:rows, :cols].view(bool)  # keep holds 0 and 1 only (dilated 0/1, scaled up)
 
 
 def largest_region(indices: np.ndarray, shape: tuple[int, int], step: int = 2) -> np.ndarray:

@@ -171,8 +171,8 @@ def convex_groups(
     rules: ConvexityRules,
     between: np.ndarray | None = None,
     grow: float = 0.0,
-) -> tuple[np.ndarray, np.ndarray]:
-    """Object labels and face labels (int32, 0 = none, 1..n) from surface patches in two steps.
+) -> np.ndarray:
+    """Object labels (int32, 0 = none, 1..n) from surface patches in two steps.
 
     1. *Faces*: patches joined along smooth connections - normals within ``rules.smooth_degrees``, the line between
        the centroids within that angle of both tangent planes (one surface going on, flat or gently curved, not a
@@ -208,7 +208,7 @@ def convex_groups(
     labels = _dense(objects[faces], usable)[kept]
     if grow > 0:
         labels = grow_from_seeds(labels, seeds, grow)
-    return labels, _dense(faces, usable)[kept]
+    return labels
 
 
 def _alignment(planes: PatchPlanes, pairs: np.ndarray, degrees: float) -> tuple[np.ndarray, np.ndarray]:

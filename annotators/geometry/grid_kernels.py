@@ -74,6 +74,20 @@ def label_pixels(
     return _loops().label_pixels(labels, top, left, labels.shape[1] if width is None else width)
 
 
+def label_masks(
+    labels: np.ndarray, kept: list[int], origin: tuple[int, int], shape: tuple[int, int]
+) -> tuple[np.ndarray, np.ndarray]:
+    """One bool mask of the grid ``shape`` (HxW) per label of ``kept``, in that order, holding the pixels HxW
+    ``labels`` - a window of that grid at ``origin`` ``(row, column)`` - give the label, and each one's box
+    ``(x0, y0, x1, y1)`` (exclusive, in the window's coordinates; zeros for a label without pixels): the masks
+    :func:`label_pixels`' indices would fill and its boxes, in one pass over the window."""
+    slots = np.full(max(kept, default=0) + 1, -1, dtype=np.int64)
+    slots[kept] = np.arange(len(kept))
+    masks = np.zeros((len(kept), *shape), dtype=bool)  # one allocation for all masks
+    boxes = _loops().fill_label_masks(np.ascontiguousarray(labels), slots, masks, origin[0], origin[1])
+    return masks, boxes
+
+
 def label_moments(
     labels: np.ndarray, values: np.ndarray, means: np.ndarray, count: int
 ) -> tuple[np.ndarray, np.ndarray, np.ndarray]:

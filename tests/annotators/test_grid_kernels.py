@@ -19,6 +19,7 @@ from annotators.geometry.grid_kernels import (
     groups_unless_apart,
     joined_labels,
     jump_between,
+    label_masks,
     label_pixels,
     nearest_seed_labels,
     plane_coordinates,
@@ -84,6 +85,21 @@ def test_pixels_grouped_by_label_in_raster_order(seed: int) -> None:
     expected, _, _ = label_pixels(grid)
     assert np.array_equal(in_grid, expected) and np.array_equal(grid_starts, all_starts)
     assert np.array_equal(window_boxes, boxes)
+
+
+@pytest.mark.parametrize("seed", range(3))
+def test_label_masks_hold_the_pixels_and_boxes_label_pixels_gives(seed: int) -> None:
+    labels = _blobs(seed)
+    labels[labels == 2] = 0  # a kept label without pixels gets an empty mask and a zero box
+    origin, shape = (5, 3), (labels.shape[0] + 7, labels.shape[1] + 9)
+    pixels, starts, boxes = label_pixels(labels, origin, shape[1])
+    kept = [4, 2, 1, 6]  # any order, not every label
+    masks, kept_boxes = label_masks(labels, kept, origin, shape)
+    assert masks.shape == (len(kept), *shape) and masks.dtype == bool
+    for mask, box, label in zip(masks, kept_boxes.tolist(), kept, strict=True):
+        assert np.array_equal(np.flatnonzero(mask), pixels[starts[label] : starts[label + 1]])
+        assert box == boxes[label].tolist()
+    assert label_masks(labels, [], origin, shape)[0].shape == (0, *shape)
 
 
 def test_facing_values_are_the_dilated_band_on_the_target() -> None:

@@ -1,0 +1,52 @@
+"""Whether this checkout's RANSAC support plane is exactly another git revision's, on the clutter checks' inputs.
+
+``python bench/check_support_planes.py REV`` prepares the inputs of :mod:`bench.check_clutter_labels` once (the
+uoc, mOSD, pcl_tabletop_pcd and grabber frames and the rendered 15-object scene, each with its range mask); then this
+checkout and REV (exported with ``git archive``) each fit :func:`~annotators.cloud.plane.ransac_support_plane` on
+them in a worker process of their own, and the models (to the last bit) and inlier indices are compared input by
+input. Prints one line per differing input and ``identical on N/N inputs``.
+"""
+
+from __future__ import annotations
+
+import sys
+from pathlib import Path
+
+import numpy as np
+from check_clutter_labels import prepare
+from revision_workers import compare_with_revision
+
+
+def worker(checkout: str, folder: Path, names: list[str], tag: str) -> None:
+    """Fit the checkout's support plane on every prepared input; write ``{tag}-{name}.npz`` with model and inliers."""
+    sys.path.insert(0, checkout)
+    from annotators.cloud.plane import ransac_support_plane
+
+    for name in names:
+        data = np.load(folder / f"{name}.npz")
+        fit = ransac_support_plane(data["points"], data["mask"])
+        model = np.full(4, np.nan) if fit is None else fit.model
+        inliers = np.zeros(0, np.int64) if fit is None else np.asarray(fit.inlier_indices, dtype=np.int64)
+        np.savez(folder / f"{tag}-{name}.npz", model=model, inliers=inliers)
+
+
+def report(inputs: Path, names: list[str]) -> None:
+    """Compare the two sides' planes input by input and print the differences and the count."""
+    same = 0
+    for name in names:
+        ours, theirs = np.load(inputs / f"ours-{name}.npz"), np.load(inputs / f"theirs-{name}.npz")
+        equal = np.array_equal(ours["model"], theirs["model"], equal_nan=True) and np.array_equal(
+            ours["inliers"], theirs["inliers"]
+        )
+        same += equal
+        if not equal:
+            print(f"DIFFERENT: {name} ({ours['inliers'].size} vs {theirs['inliers'].size} inliers)")
+    print(f"identical on {same}/{len(names)} inputs")
+
+
+def main() -> None:
+    compare_with_revision(__file__, __doc__.split("\n")[0], prepare, worker, report, lambda stem: "-" not in stem)
+
+
+if __name__ == "__main__":
+    main()
