@@ -36,7 +36,8 @@ ABOVE_PLANE_M = 0.012
 RING_PX = 14
 """Width of the ring around a box whose depth gives the support plane."""
 
-SPLITS = ("tune", "held_out")
+SPLITS = ("tune", "held_out", "fresh")
+"""The labelled splits: the namer is tuned on "tune" only; "held_out" and "fresh" (labelled later) check it."""
 
 
 @dataclass(frozen=True)
