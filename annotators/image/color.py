@@ -15,12 +15,6 @@ Each surface is named (:func:`name_surface`):
   counts only when it is a sizeable part of the object or has the name of one of its lit surfaces (shadows are
   dropped).
 
-An object with a white surface shows how light a white is in the light it is in: its saturated surfaces are
-named relative to that white (the white's luminance is the reference white of their CIELAB,
-:func:`relative_to_white`), as a person anchors lightness to the white in view. A yellow tube with a white band
-in a dim part of the frame is yellow, not the brown its absolute lightness would be on a display; an object
-without a white keeps the display's white (a brown tin stays brown).
-
 Lit saturated surfaces that are shades of one colour (CIEDE2000 neighbours) are named together by their pooled
 votes (:func:`_pool_shades`). A name's share is the share of the named pixels its surfaces hold (grey merges into
 white: an unsaturated object's shaded side). The dominant colour is the largest share; a second colour is
@@ -151,31 +145,6 @@ def _vote_lab(surface: Surface, parameters: NamingParameters) -> np.ndarray | No
     return None if is_unsaturated(surface.lab, parameters) else surface.lab
 
 
-def object_white(surfaces: list[Surface], surround: float, parameters: NamingParameters = DEFAULT_PARAMETERS) -> float:
-    """The luminance (relative, 0..1) of an object's lightest white surface: how light a white is in the light
-    the object is in; 1 (the display's white) when it has no white surface. The white of a blend does not count
-    (its lightness is the blend's)."""
-    whites = [
-        ((float(surface.lab[0]) + 16.0) / 116.0) ** 3
-        for surface in surfaces
-        if surface.kind != "dark"
-        and not surface.blended_white
-        and is_unsaturated(surface.lab, parameters)
-        and _lightness_name(surface, surround, parameters).name == "white"
-    ]
-    return min(max(whites), 1.0) if whites else 1.0
-
-
-def relative_to_white(lab: np.ndarray | None, white: float) -> np.ndarray | None:
-    """A colour's CIELAB with a white of luminance ``white`` (0..1] as the reference white instead of the
-    display's: L* + 16, a* and b* all scale by the cube root of 1 / ``white`` (CIELAB's cube-root part); None
-    (a surface named by lightness) stays None."""
-    if lab is None or white >= 1.0:
-        return lab
-    scale = (1.0 / white) ** (1.0 / 3.0)
-    return np.array([(float(lab[0]) + 16.0) * scale - 16.0, float(lab[1]) * scale, float(lab[2]) * scale])
-
-
 def _lightness_name(surface: Surface, surround: float, parameters: NamingParameters) -> SurfaceName:
     """The name of a surface without a hue: a dark pool is black; an unsaturated surface is white, grey or black
     by its lit lightness against the surround (see the module docstring)."""
@@ -291,10 +260,7 @@ def name_objects_colors(
     """:func:`name_colors` for the objects of one frame at once (each its RGB pixels and their edge strengths or
     None): the pixels are grouped together and every surface's prototype votes come from one computation."""
     found = objects_surfaces(objects, light, parameters)
-    vote_labs = []
-    for surfaces, _ in found:
-        white = object_white(surfaces, light.surround, parameters)
-        vote_labs.append([relative_to_white(_vote_lab(surface, parameters), white) for surface in surfaces])
+    vote_labs = [[_vote_lab(surface, parameters) for surface in surfaces] for surfaces, _ in found]
     voted = [lab for labs in vote_labs for lab in labs if lab is not None]
     vote_rows = _term_votes(np.array(voted), parameters) if voted else np.zeros((0, len(CHROMATIC_TERMS)))
     winners = vote_rows.argmax(axis=1)  # each voted surface's name, as _name_of_votes picks it

@@ -119,14 +119,12 @@ DEFAULT_PARAMETERS = NamingParameters()
 @dataclass(frozen=True)
 class Surface:
     """One surface of an object: its colour (CIELAB at its lit lightness), its mean linear RGB, its pixel
-    count, its kind: ``"regular"`` or ``"dark"`` (the near-black pool), and whether it is the white of a blend
-    (:func:`_merge_white_blends`: a white seen only mixed with a colour, so its lightness is the blend's)."""
+    count and its kind: ``"regular"`` or ``"dark"`` (the near-black pool)."""
 
     lab: np.ndarray
     linear: np.ndarray
     pixels: int
     kind: str
-    blended_white: bool = False
 
 
 def edge_strength(image: np.ndarray, where: np.ndarray | None = None) -> np.ndarray:
@@ -188,7 +186,7 @@ def _merge_mixtures(surfaces: list[Surface], tolerance: float) -> list[Surface]:
             kept.append(surface)
         else:
             host = kept[target]
-            kept[target] = Surface(host.lab, host.linear, host.pixels + surface.pixels, host.kind, host.blended_white)
+            kept[target] = Surface(host.lab, host.linear, host.pixels + surface.pixels, host.kind)
     return kept
 
 
@@ -252,13 +250,11 @@ def _merge_white_blends(surfaces: list[Surface], parameters: NamingParameters) -
                 continue
             share, white_lab = blend
             if share >= 0.5:
-                result[index] = Surface(white_lab, surface.linear, surface.pixels, surface.kind, blended_white=True)
+                result[index] = Surface(white_lab, surface.linear, surface.pixels, surface.kind)
                 whitened.add(index)
             else:
                 target = result[host_index]
-                result[host_index] = Surface(
-                    target.lab, target.linear, target.pixels + surface.pixels, target.kind, target.blended_white
-                )
+                result[host_index] = Surface(target.lab, target.linear, target.pixels + surface.pixels, target.kind)
                 merged.add(index)
             break
     return [surface for index, surface in enumerate(result) if index not in merged]
@@ -301,9 +297,7 @@ def _merge_shaded(surfaces: list[Surface], parameters: NamingParameters) -> list
             kept_looks.append((unsaturated, hue, saturation, lightness))
         else:
             host = kept[host_index]
-            kept[host_index] = Surface(
-                host.lab, host.linear, host.pixels + surface.pixels, host.kind, host.blended_white
-            )
+            kept[host_index] = Surface(host.lab, host.linear, host.pixels + surface.pixels, host.kind)
     return kept
 
 
