@@ -9,6 +9,15 @@ the pick, after it (``--check``), so the choice cannot look at them.
 
     python bench/experiments/tune_color_namer.py            # the search, tune scores only
     python bench/experiments/tune_color_namer.py --check    # ... then held_out and fresh, defaults vs the pick
+
+Results on branch colour4 (tune 63 objects after the round-2 split; held_out 49; fresh 21), neither kept:
+
+* this search picks second_share 0.3 -> 0.18, white_surround_ratio 0.85 -> 0.765, black_lightness 38 -> 41.8 and
+  shade_delta_e 15 -> 22.5: tune 55 -> 58, held_out 42 -> 39, fresh 15 -> 14;
+* a salience weight for hues (a saturated surface's pixels counted k times against white, grey or black when an
+  object's colours are weighed, for the red-and-white boxes whose red share is under 0.3): tune 56 for k in
+  1.1..1.5 (55 at 1, 53 from 1.7), k = 1.3 (the plateau's middle): tune 55 -> 56 (a red-and-white box gains its
+  red), held_out 42 -> 41 (a white bowl gains a blue), fresh 15 -> 15.
 """
 
 from __future__ import annotations
