@@ -11,7 +11,8 @@ black and the rest; a group whose colour is a blend of two larger ones (pixels m
 joins the nearer of the two; a lighter, paler group that is a blend of a saturated one with white (a specular
 highlight on it, or a white part its colour bleeds into on a small or blurred object) is the saturated surface's
 highlight when it is mostly that colour, else the white it is mixed with (:func:`_merge_white_blends`); and a
-darker group of nearly the same hue and saturation as a larger one is its shaded side.
+darker group of nearly the same hue as a larger one, as saturated or paler, is its shaded side, and so is a
+darker group with a slight cast next to a larger white or grey one.
 
 The per-pixel steps (:mod:`annotators.image.color_pixels`), the grouping and the groups' order statistics
 (:mod:`annotators.image.color_groups`) run compiled, for all the objects of a frame at once; the pixels are held in
@@ -77,7 +78,13 @@ class NamingParameters:
     shade_lightness: float = 8.0
     """... at least this much darker (L*) ..."""
     shade_saturation: float = 1.6
-    """... and whose saturation C*/(L* + 16) is within this factor of the larger one's is its shaded side."""
+    """... and whose saturation C*/(L* + 16) is at most this factor of the larger one's (any paler: the ambient
+    light of a shaded side is paler than the direct light) is its shaded side."""
+    shaded_white_tint: float = 2.0
+    """A darker surface whose tint (:func:`tint`) is at most this (a colour cast of up to twice the achromatic
+    ellipse) is the shaded side of a larger white or grey surface: the light a shaded side gets is the room's,
+    bounced off the table and walls and tinted by them, and people see a white box's shaded side as a white in
+    shadow, not as a brown or a blue."""
     lit_percentile: float = 80.0
     """The lit lightness of a surface: this percentile of its L*."""
     achromatic_chroma: float = 12.0
@@ -263,8 +270,11 @@ def _saturation(lab: np.ndarray) -> float:
 
 def _merge_shaded(surfaces: list[Surface], parameters: NamingParameters) -> list[Surface]:
     """Surfaces with every saturated surface that is a shaded side of a larger one (a hue within ``shade_hue``
-    degrees, a similar saturation, at least ``shade_lightness`` darker) merged into it: a yellow brick's shaded
-    side turns orange in a camera image, but the brick is yellow."""
+    degrees, at most ``shade_saturation`` times as saturated, at least ``shade_lightness`` darker) merged into it:
+    a yellow brick's shaded side turns orange in a camera image, but the brick is yellow; and a side turned away
+    from the light is lit by the room's paler ambient light, so it is paler as well as darker (a yellow box's
+    shaded side looks brown), but it is the same yellow. A larger white or grey surface's shaded side is a darker
+    surface with at most ``shaded_white_tint`` of a cast."""
     ordered = sorted(surfaces, key=lambda s: -s.pixels)
     kept: list[Surface] = []
     kept_looks: list[tuple[bool, float, float, float]] = []  # each kept surface's colour, which merging keeps
@@ -276,11 +286,10 @@ def _merge_shaded(surfaces: list[Surface], parameters: NamingParameters) -> list
                 offset = abs((hue - host_hue + 180.0) % 360.0 - 180.0)
                 darker = host_lightness - lightness >= parameters.shade_lightness
                 ratio = saturation / max(host_saturation, 1e-9)
-                alike = (
-                    offset <= parameters.shade_hue
-                    and 1.0 / parameters.shade_saturation <= ratio <= parameters.shade_saturation
-                )
-                if not host_unsaturated and alike and darker:
+                alike = offset <= parameters.shade_hue and ratio <= parameters.shade_saturation
+                if host_unsaturated:
+                    alike = tint(surface.lab, parameters) <= parameters.shaded_white_tint
+                if alike and darker:
                     host_index = index
                     break
         if host_index is None:

@@ -36,7 +36,11 @@ ABOVE_PLANE_M = 0.012
 RING_PX = 14
 """Width of the ring around a box whose depth gives the support plane."""
 
-SPLITS = ("tune", "held_out")
+SPLITS = ("tune", "held_out", "fresh")
+"""The labelled splits: the namer is tuned on "tune" only; "held_out" and "fresh" check it."""
+
+FIRST_ROUND = 1
+"""The labelling round the issue's goals were measured on (its "tune" and "held_out" objects, 84)."""
 
 
 @dataclass(frozen=True)
@@ -50,6 +54,7 @@ class ColorSample:
     colors: tuple[str, ...]
     alternatives: tuple[str, ...]
     also: tuple[str, ...]
+    labelling_round: int = FIRST_ROUND
     label: int | None = None
     box: tuple[int, int, int, int] | None = None
     above_plane: bool = True
@@ -76,6 +81,7 @@ def load_samples(path: Path = LABELS) -> list[ColorSample]:
                     colors=tuple(obj["colors"]),
                     alternatives=tuple(obj.get("or", ())),
                     also=tuple(obj.get("also", ())),
+                    labelling_round=int(frame.get("round", FIRST_ROUND)),
                     label=mask.get("label"),
                     box=tuple(mask["box"]) if "box" in mask else None,
                     above_plane=bool(mask.get("above_plane", True)),
