@@ -79,6 +79,8 @@ def test_the_shipped_ontology_gives_branded_ycb_products_their_brand_and_kind() 
     assert "Crackers" in profiles["CheezIt"]["ancestors"]
     assert profiles["FrenchsMustard"]["kind_texts"] == ("mustard",)
     assert profiles["CampbellsTomatoSoup"]["kind_texts"] == ("soup",)
+    assert profiles["DominoSugar"]["kind_texts"] == ("sugar",) and profiles["Pringles"]["kind_texts"] == ("chips",)
+    assert profiles["Pringles"]["shape"] == "cylinder"  # a tube, not a bag of chips
     assert profiles["Crackers"]["brand"] is None  # crackers in general have no brand
 
 
