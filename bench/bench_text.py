@@ -26,9 +26,9 @@ from py_trees.common import Status  # noqa: E402
 from annotators.readers.choice import reader_for  # noqa: E402
 from annotators.text.lines import TextLine, assign_lines, text_of  # noqa: E402
 from annotators.text.reader import ocr_engine, read_lines  # noqa: E402
-from reasoning.fusion.text import text_matches  # noqa: E402
 from robokudo.core.engine import Engine  # noqa: E402
 from robokudo.core.resources import Guarded, SharedResources  # noqa: E402
+from robokudo.core.text_match import text_matches  # noqa: E402
 from robokudo.core.types import ColorImage, ObjectHypothesis  # noqa: E402
 from trees.tabletop import create_pipeline  # noqa: E402
 

@@ -3,14 +3,16 @@
 The planner passes one profile per candidate class as plain data::
 
     {"class": "Milk", "colors": ("white",), "shape": "box", "size": "medium", "texts": ("milk",),
-     "handle": False, "open_top": False, "height_to_width": (1.2, 4.0), "elongation": None,
-     "ancestors": ("Milk", "Drink", "FoodOrDrink", "PhysicalObject"), "packaged_in": ()}
+     "brand": None, "kind_texts": (), "handle": False, "open_top": False, "height_to_width": (1.2, 4.0),
+     "elongation": None, "ancestors": ("Milk", "Drink", "FoodOrDrink", "PhysicalObject"), "packaged_in": ()}
 
 (colour, shape and size are the ontology's lower-case labels; the form cues - a handle, an open top, the ranges of
 height over width and of elongation - are the ontology's ``rk:hasHandle``, ``rk:openTop``,
 ``rk:min/maxHeightToWidth``, ``rk:min/maxElongation``; ``packaged_in`` names the container class the objects are
-typically packaged in and its ancestors, ``rk:packagedIn``: a query for a bottle also asks for a mustard; any key
-but ``class`` may be missing or None: the class may have any value).
+typically packaged in and its ancestors, ``rk:packagedIn``: a query for a bottle also asks for a mustard; ``brand``
+is the ``rk:brand`` of a branded product, ``kind_texts`` the printed texts it inherits from its ancestors (what kind
+of product it is: "crackers" for a Cheez-It box); any key but ``class`` may be missing or None: the class may have
+any value).
 
 Scoring. For every cue the hypothesis carries (its most confident SemanticColor, Shape, Size, FormFeatures and,
 when read, Text) a profile gets an agreement in [0, 1]:
@@ -34,8 +36,11 @@ when read, Text) a profile gets an agreement in [0, 1]:
   jar's or a mug's, may be both, and a cue every other profile is neutral about would only pull their scores
   toward 0.5). This is what tells a labelled can from a jar or a plain plastic tub of the same size, form and
   proportions;
-* text: the share of the profile's texts found in the read text (case and punctuation ignored), ``TEXT_NONE``
-  when the profile has no texts.
+* text: the share of the profile's texts and brand found in the read text (case, spaces and punctuation ignored, one
+  OCR error tolerated per 5 letters: :func:`robokudo.core.text_match.phrase_found`), ``TEXT_NONE`` when the profile
+  has neither. A brand read also counts the texts the class inherits (``kind_texts``) as read: the brand names the
+  product, and with it its kind - a box reading "CHEEZ-IT" is a box of crackers whether or not the small "crackers"
+  on it was read - while a variant's own text still tells variants of one brand apart (Fizzy cola, Fizzy lemon).
 
 Colour, shape, size, handle, open-top and printed-label agreements are pulled toward 0.5 by the expert's confidence
 (``0.5 + (a - 0.5) * c``), so uncertain evidence counts less. The score is the weighted mean over the observed
@@ -75,7 +80,6 @@ label went unread is unlikely a mustard but, tying with a lemon soda, as likely 
 
 from __future__ import annotations
 
-import re
 from collections.abc import Callable, Mapping, Sequence
 from dataclasses import dataclass, replace
 from types import MappingProxyType
@@ -87,6 +91,7 @@ from annotators.classification.calibration import FITTED, Calibration
 from annotators.cloud.size import SIZE_CLASS_THRESHOLDS, SIZE_CLASSES
 from robokudo.core.annotator import Annotator
 from robokudo.core.capability import Capability
+from robokudo.core.text_match import phrase_found
 from robokudo.core.types import (
     CasType,
     Classification,
@@ -144,13 +149,6 @@ open (a cup and a glass look alike to a depth camera), so it cannot do the work 
 ASSERT_PROBABILITY = 0.5
 """Calibrated probability of being right from which a class is asserted (more likely right than wrong)."""
 
-_NOT_ALPHANUMERIC = re.compile(r"[^0-9a-z]+")
-
-
-def compact(text: str) -> str:
-    """Lower-case letters and digits only: how texts are compared (OCR splits and joins words freely)."""
-    return _NOT_ALPHANUMERIC.sub("", text.lower())
-
 
 def _names(value: object) -> tuple[str, ...]:
     if value is None:
@@ -203,6 +201,14 @@ class Profile:
     elongation: tuple[float, float] | None = None
     packaged_in: frozenset[str] = frozenset()
     """The container class the objects are typically packaged in and its ancestors (lower case), or empty."""
+    brand: str | None = None
+    kind_texts: frozenset[str] = frozenset()
+    """The texts (of :attr:`texts`) the class inherits from its ancestors: read when its brand is read."""
+
+    @property
+    def named_by_text(self) -> bool:
+        """True when printed text or a brand names the class (reading it is what tells the class apart)."""
+        return bool(self.texts or self.brand)
 
     def answers(self, wanted: str) -> bool:
         """True when an object of this class answers a query for ``wanted`` (lower case): it is one, or it is
@@ -218,12 +224,14 @@ class Profile:
         if not isinstance(name, str) or not name:
             raise ValueError(f"a profile needs a non-empty 'class', got {data!r}")
         shapes, sizes = _names(data.get("shape")), _names(data.get("size"))
+        texts = _names(data.get("texts"))
+        brands = _names(data.get("brand"))
         return cls(
             class_name=name,
             colors=_names(data.get("colors")),
             shape=shapes[0] if shapes else None,
             size=sizes[0] if sizes else None,
-            texts=tuple(t for t in (compact(t) for t in _names(data.get("texts"))) if t),
+            texts=texts,
             ancestors=frozenset(_names(data.get("ancestors"))) | {name.lower()},
             lineage=_lineage(name, data.get("ancestors")),
             handle=_flag(data, "handle"),
@@ -232,6 +240,8 @@ class Profile:
             printed=_flag(data, "printed"),
             elongation=_ratio_range(data.get("elongation")),
             packaged_in=frozenset(_names(data.get("packaged_in"))),
+            brand=brands[0] if brands else None,
+            kind_texts=frozenset(_names(data.get("kind_texts"))) & frozenset(texts),
         )
 
     def related(self, other: Profile) -> bool:
@@ -348,12 +358,20 @@ def score(profile: Profile, cues: Cues) -> Match:
         total += WEIGHTS["printed"] * _toward_neutral(agreement, cues.printed[1])
         weight += WEIGHTS["printed"]
     if cues.text:
-        read = compact(cues.text)
-        found = sum(1 for text in profile.texts if text in read)
-        agreement = found / len(profile.texts) if profile.texts else TEXT_NONE
+        found = text_found(profile, cues.text)
+        names = len(profile.texts) + (profile.brand is not None)
+        agreement = found / names if names else TEXT_NONE
         total += WEIGHTS["text"] * agreement
         weight += WEIGHTS["text"]
-    return Match(profile, total / weight if weight else 0.0, found, unread=bool(profile.texts) and not cues.text)
+    return Match(profile, total / weight if weight else 0.0, found, unread=profile.named_by_text and not cues.text)
+
+
+def text_found(profile: Profile, read: str) -> int:
+    """How many of the profile's texts and brand are found in the ``read`` text; a brand found also finds the texts
+    the class inherits (:attr:`Profile.kind_texts`: the brand names the product's kind too)."""
+    brand = profile.brand is not None and phrase_found(profile.brand, read)
+    found = [text for text in profile.texts if (brand and text in profile.kind_texts) or phrase_found(text, read)]
+    return len(found) + brand
 
 
 def best_match(matches: Sequence[Match]) -> Match:

@@ -66,9 +66,9 @@ from reasoning.fusion.rule import (
     fuse_values,
     sigmoid,
 )
-from reasoning.fusion.text import text_matches
 from reasoning.fusion.tracking import PRESENT, BeliefTracker, ChangedBeliefs, ObjectBelief, TrackStep
 from robokudo.core.regions import RegionBox
+from robokudo.core.text_match import text_matches
 from robokudo.core.types import Text
 
 SCHEMA_NAME = "robokudo-beliefs"
@@ -109,7 +109,7 @@ class BeliefFilter:
     ignored). A belief is in ``region`` when its stored region has that name (case ignored) or when its world
     position lies in one of ``region_boxes``. ``attributes`` (e.g. ``{"color": "red"}``, case ignored) match the
     fused value or any value more likely than not; ``text`` matches when each of its words is read in such a
-    value, tolerating OCR errors (:func:`~reasoning.fusion.text.text_matches`). An attribute given several values
+    value, tolerating OCR errors (:func:`~robokudo.core.text_match.text_matches`). An attribute given several values
     (``{"color": ("red", "blue")}``) matches when any of them does. ``ids`` restricts the answer to those beliefs.
     """
 

@@ -42,13 +42,22 @@ def class_profiles(kb: KnowledgeBase) -> tuple[dict[str, object], ...]:
     Colours, shape and size are the ontology's lower-case labels; classes that say nothing visible are left out.
     The ancestors come the most specific first (a classifier names the nearest one the cues leave no doubt about);
     ``packaged_in`` is the container class the objects are typically packaged in with its ancestors (what a query
-    for that container also asks for), or ().
+    for that container also asks for), or (); ``brand`` the product's brand, ``kind_texts`` the printed texts it
+    inherits from its ancestors (what kind of product it is: reading the brand says that too).
     """
     profiles = []
     for name in kb.names_of_kind("class"):
         profile = kb.object_profile(name)
-        if not (profile.colors or profile.shape or profile.size_class or profile.texts or profile.height_to_width):
+        if not (
+            profile.colors
+            or profile.shape
+            or profile.size_class
+            or profile.texts
+            or profile.brand
+            or profile.height_to_width
+        ):
             continue
+        inherited = {text for parent in kb.superclasses(name) for text in kb.object_profile(parent).texts}
         profiles.append(
             {
                 "class": name,
@@ -56,6 +65,8 @@ def class_profiles(kb: KnowledgeBase) -> tuple[dict[str, object], ...]:
                 "shape": kb.label(profile.shape) if profile.shape else None,
                 "size": kb.label(profile.size_class) if profile.size_class else None,
                 "texts": profile.texts,
+                "brand": profile.brand,
+                "kind_texts": tuple(t for t in profile.texts if t in inherited),
                 "handle": profile.handle,
                 "open_top": profile.open_top,
                 "printed": profile.printed,

@@ -21,10 +21,10 @@ from py_trees.common import Status
 from annotators.readers.choice import reader_for
 from annotators.text.lines import TextLine, assign_lines, overlap, text_of
 from annotators.text.reader import TextReader
-from reasoning.fusion.text import text_matches
 from robokudo.core.annotator import Annotator
 from robokudo.core.engine import Engine
 from robokudo.core.pipeline import Pipeline
+from robokudo.core.text_match import text_matches
 from robokudo.core.types import ColorImage, ObjectHypothesis, SemanticColor, Text
 from trees.tabletop import create_pipeline
 

@@ -21,9 +21,9 @@ from annotators.simulation.kitchen_scene import kitchen_objects
 from reasoning.beliefs.store import SCHEMA_VERSION, BeliefFilter, BeliefStore, BeliefStoreError
 from reasoning.fusion.frame import FrameContext, FrameObject, frame_objects, geometry_doubt
 from reasoning.fusion.rule import Evidence
-from reasoning.fusion.text import text_matches
 from reasoning.fusion.tracking import BeliefTracker
 from robokudo.application import cli
+from robokudo.core.text_match import text_matches
 from robokudo.core.types import ObjectHypothesis, Pose, Size
 
 UOC = Path("../shared/data/uoc_tabletop_realsense")

@@ -1,4 +1,5 @@
-"""Matching words asked for against text an OCR expert read: containment, case ignored, OCR errors tolerated.
+"""Matching words asked for, or printed on a class of objects, against text an OCR expert read: containment, case
+ignored, OCR errors tolerated (one rule for the query's text and the classifier's printed texts and brands).
 
 ``text_matches("lactose free", "MILK lactose free")`` holds: every asked word must be found among the read words
 within an edit distance of ``len(word) // OCR_LETTERS_PER_ERROR`` ("CHEEL" is read "CHEEZ"), anywhere in the read
@@ -47,3 +48,12 @@ def text_matches(wanted: str, read: str) -> bool:
     matches anything."""
     found = words(read)
     return all(word_found(word, found) for word in words(wanted))
+
+
+def phrase_found(phrase: str, read: str) -> bool:
+    """True when a phrase printed on an object (a brand, "lactose free") is found in ``read``: its letters and
+    digits with the spaces and punctuation removed, taken as one word (:func:`word_found`: "Cheez-It" in "CHEEZIT",
+    "CHEEL IT" or "cheez it"; a phrase shorter than ``MIN_JOINED_LETTERS`` must be a read word of its own). False for
+    a phrase without letters or digits."""
+    joined = "".join(words(phrase))
+    return bool(joined) and word_found(joined, words(read))
