@@ -11,8 +11,7 @@ black and the rest; a group whose colour is a blend of two larger ones (pixels m
 joins the nearer of the two; a lighter, paler group that is a blend of a saturated one with white (a specular
 highlight on it, or a white part its colour bleeds into on a small or blurred object) is the saturated surface's
 highlight when it is mostly that colour, else the white it is mixed with (:func:`_merge_white_blends`); and a
-darker group of nearly the same hue as a larger one, as saturated or paler, is its shaded side, and so is a
-darker group with a slight cast next to a larger white or grey one.
+darker group of nearly the same hue as a larger one, as saturated or paler, is its shaded side.
 
 The per-pixel steps (:mod:`annotators.image.color_pixels`), the grouping and the groups' order statistics
 (:mod:`annotators.image.color_groups`) run compiled, for all the objects of a frame at once; the pixels are held in
@@ -80,11 +79,6 @@ class NamingParameters:
     shade_saturation: float = 1.6
     """... and whose saturation C*/(L* + 16) is at most this factor of the larger one's (any paler: the ambient
     light of a shaded side is paler than the direct light) is its shaded side."""
-    shaded_white_tint: float = 2.0
-    """A darker surface whose tint (:func:`tint`) is at most this (a colour cast of up to twice the achromatic
-    ellipse) is the shaded side of a larger white or grey surface: the light a shaded side gets is the room's,
-    bounced off the table and walls and tinted by them, and people see a white box's shaded side as a white in
-    shadow, not as a brown or a blue."""
     lit_percentile: float = 80.0
     """The lit lightness of a surface: this percentile of its L*."""
     achromatic_chroma: float = 12.0
@@ -273,8 +267,7 @@ def _merge_shaded(surfaces: list[Surface], parameters: NamingParameters) -> list
     degrees, at most ``shade_saturation`` times as saturated, at least ``shade_lightness`` darker) merged into it:
     a yellow brick's shaded side turns orange in a camera image, but the brick is yellow; and a side turned away
     from the light is lit by the room's paler ambient light, so it is paler as well as darker (a yellow box's
-    shaded side looks brown), but it is the same yellow. A larger white or grey surface's shaded side is a darker
-    surface with at most ``shaded_white_tint`` of a cast."""
+    shaded side looks brown), but it is the same yellow."""
     ordered = sorted(surfaces, key=lambda s: -s.pixels)
     kept: list[Surface] = []
     kept_looks: list[tuple[bool, float, float, float]] = []  # each kept surface's colour, which merging keeps
@@ -287,9 +280,7 @@ def _merge_shaded(surfaces: list[Surface], parameters: NamingParameters) -> list
                 darker = host_lightness - lightness >= parameters.shade_lightness
                 ratio = saturation / max(host_saturation, 1e-9)
                 alike = offset <= parameters.shade_hue and ratio <= parameters.shade_saturation
-                if host_unsaturated:
-                    alike = tint(surface.lab, parameters) <= parameters.shaded_white_tint
-                if alike and darker:
+                if not host_unsaturated and alike and darker:
                     host_index = index
                     break
         if host_index is None:

@@ -230,11 +230,3 @@ def test_a_shaded_side_lit_by_the_paler_room_light_keeps_the_lit_sides_name() ->
     shaded = patch((185, 155, 115), count=270, seed=1)
     assert names(shaded) == ["brown"]
     assert names(np.vstack([patch((230, 210, 90), count=540), shaded])) == ["yellow"]
-
-
-def test_a_white_objects_shaded_side_with_a_warm_cast_stays_white() -> None:
-    # light bounced off a wooden table tints a white box's shaded side (a brown on its own)
-    shaded = patch((160, 130, 100), count=300, seed=1)
-    assert names(shaded) == ["brown"]
-    for white in ((165, 155, 155), (200, 200, 200)):
-        assert names(np.vstack([patch(white, count=400), shaded])) == ["white"]
