@@ -24,12 +24,11 @@ from typing import overload
 import numpy as np
 
 from reasoning.fusion.association import (
-    INFEASIBLE,
     Association,
     AssociationConfig,
     CameraModel,
-    assign,
-    geometric_costs,
+    assign_pairs,
+    gated_costs,
     same_world,
     visible_from,
 )
@@ -254,42 +253,45 @@ class BeliefTracker:
     # ------------------------------------------------------------------ internals
 
     def _associate(self, observations: Sequence[FrameObject], beliefs: Sequence[ObjectBelief]) -> Association:
-        """One cost matrix for the frame (:func:`geometric_costs`), the colour and class penalties of
-        :func:`pair_cost` added on the feasible pairs, then one optimal assignment."""
+        """The feasible pairs of the frame with their geometric costs (:func:`gated_costs`, found once), the colour
+        and class penalties of :func:`pair_cost` added on them, then one optimal assignment (:func:`assign_pairs`)."""
         config = self.config.association
-        cost, compared = geometric_costs(observations, beliefs, config)
-        rows, cols = np.nonzero(cost < INFEASIBLE)
-        if not rows.size:
-            return assign(cost)
+        pairs = gated_costs(observations, beliefs, config)
+        if not pairs.rows.size:
+            return assign_pairs(pairs)
         colors: dict[int, str | None] = {}
         stated: dict[int, tuple[set[str], set[str]]] = {}
         test = self.class_test or _same_class
-        color_added = [0.0] * rows.size
-        class_added = [0.0] * rows.size
-        pairs = zip(rows.tolist(), cols.tolist(), compared[rows, cols].tolist(), strict=True)
-        for k, (i, j, histograms_compared) in enumerate(pairs):
+        color_penalty, class_penalty = config.color_penalty, config.class_penalty
+        color_added = [0.0] * pairs.rows.size
+        class_added = [0.0] * pairs.rows.size
+        rows, cols = pairs.rows.tolist(), pairs.cols.tolist()
+        for k, (i, j, histograms_compared) in enumerate(zip(rows, cols, pairs.compared.tolist(), strict=True)):
             found = stated.get(i)
             if found is None:
                 found = stated[i] = _stated_colors_and_classes(observations[i])
             observation_colors, observation_classes = found
             if observation_colors and not histograms_compared:
-                if j not in colors:
-                    colors[j] = beliefs[j].value(SemanticColor.attribute)
-                if colors[j] and colors[j] not in observation_colors:
-                    color_added[k] = config.color_penalty
+                if j in colors:
+                    color = colors[j]
+                else:
+                    color = colors[j] = beliefs[j].value(SemanticColor.attribute)
+                if color and color not in observation_colors:
+                    color_added[k] = color_penalty
             belief_class = beliefs[j].class_name
             if observation_classes and belief_class:
                 for c in observation_classes:
                     if test(c, belief_class) or test(belief_class, c):
                         break
                 else:
-                    class_added[k] = config.class_penalty
+                    class_added[k] = class_penalty
         # the colour penalty first, then the class penalty, as pair_cost adds them (adding 0.0 changes nothing)
+        costs = pairs.costs
         if any(color_added):
-            cost[rows, cols] += np.array(color_added)
+            costs = costs + np.array(color_added)
         if any(class_added):
-            cost[rows, cols] += np.array(class_added)
-        return assign(cost)
+            costs = costs + np.array(class_added)
+        return assign_pairs(pairs if costs is pairs.costs else pairs.with_costs(costs))
 
     def _create(self, observation: FrameObject, time: float, belief_id: int) -> ObjectBelief:
         belief = ObjectBelief(
