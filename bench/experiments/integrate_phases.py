@@ -44,8 +44,10 @@ PHASES: tuple[tuple[object, str, str], ...] = (
     (BeliefTracker, "step", "tracker.step"),
     (BeliefStore, "_step_on_rows", "tracker step on rows"),
     (RowUpdate, "supports", "  of it: supports unpacked"),
-    (BeliefTracker, "_associate", "  of it: association"),
-    (BeliefTracker, "_update", "  of it: updates (general)"),
+    (BeliefTracker, "associate", "  of it: association"),
+    (BeliefTracker, "_associate", "  of it: association"),  # its name before store9
+    (BeliefTracker, "update", "  of it: updates (general)"),
+    (BeliefTracker, "_update", "  of it: updates (general)"),  # its name before store9
     (RowUpdate, "update", "  of it: updates (on rows)"),
     (BeliefStore, "_write_beliefs", "object rows written (general)"),
     (store_module, "_object_row", "  of it: building rows"),

@@ -1,4 +1,4 @@
-"""Matched beliefs updated on their stored rows: the common case of :meth:`BeliefTracker._update` followed by the
+"""Matched beliefs updated on their stored rows: the common case of :meth:`BeliefTracker.update` followed by the
 store's encoding of the belief, without decoding the row into an ``ObjectBelief`` first.
 
 A stored ``objects`` row and the observation matched to it give the new row directly: the position filtered and
@@ -6,7 +6,7 @@ the size blended with Python floats (the same operations, in the same order, as 
 frame's statements accumulated into the packed supports with the rule of ``ValueSupport.add``, and the supports
 packed again. The common case is: no colour histogram on either side, a 3-vector position, size and 4-vector
 orientation in float64, every attribute single-valued before and after the update, and no named regions on the
-tracker. Anything else goes the general way (decode, ``BeliefTracker._update``, encode); both ways give the same
+tracker. Anything else goes the general way (decode, ``BeliefTracker.update``, encode); both ways give the same
 row (``tests/fusion/test_row_update.py``).
 
 The supports are kept as :class:`Support` records in text space (attribute name, value, expert set) until they are
@@ -219,7 +219,7 @@ class RowUpdate:
 
 def belief_of(row: tuple, records: Sequence[Support], roi: tuple[int, int, int, int] | None) -> ObjectBelief:
     """The ``ObjectBelief`` a row-level update stands for: the new row, the supports with their log-odds not rounded,
-    and the observation's image box as given (what ``BeliefTracker._update`` leaves in the belief)."""
+    and the observation's image box as given (what ``BeliefTracker.update`` leaves in the belief)."""
     attributes: dict[str, AttributeBelief] = {}
     for r in records:
         name = r[_SUPPORT_NAME]

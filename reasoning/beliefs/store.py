@@ -510,7 +510,7 @@ class BeliefStore:
         interned = self._interned
         update = self._row_update(tracker)
         candidates = [_Candidate(row, update.supports(row), interned, conn) for row in rows]
-        association = tracker._associate(objects, candidates)
+        association = tracker.associate(objects, candidates)
         changed: dict[int, ObjectBelief | tuple[tuple, list[Support]]] = {}
         makers: dict[int, ObjectBelief | Callable[[], ObjectBelief]] = {}
         assigned = [0] * len(objects)
@@ -522,14 +522,14 @@ class BeliefStore:
                 makers[candidate.id] = functools.partial(belief_of, row, candidate.records, observation.roi)
             else:
                 belief = candidate.belief()
-                tracker._update(belief, observation, time)
+                tracker.update(belief, observation, time)
                 changed[candidate.id] = makers[candidate.id] = belief
             assigned[i] = candidate.id
         created = []
         for i in association.new:
             if objects[i].doubt:
                 continue
-            belief = tracker._create(objects[i], time, new_id())
+            belief = tracker.create(objects[i], time, new_id())
             changed[belief.id] = makers[belief.id] = belief
             assigned[i] = belief.id
             created.append(belief.id)

@@ -185,7 +185,11 @@ def _stated_colors_and_classes(observation: FrameObject) -> tuple[set[str], set[
 
 
 class BeliefTracker:
-    """Associates frames of objects with beliefs and updates them (see the module docstring)."""
+    """Associates frames of objects with beliefs and updates them (see the module docstring).
+
+    :meth:`step` is one frame. Its parts are public for stores that run the step on their own rows (the belief
+    store does): :meth:`associate` pairs observations with beliefs, :meth:`update` applies a matched observation,
+    :meth:`create` makes the belief of a new one and :meth:`unseen` applies a frame that did not see a belief."""
 
     def __init__(
         self,
@@ -208,19 +212,19 @@ class BeliefTracker:
     ) -> TrackStep:
         """Integrate one frame; ``beliefs`` are the present beliefs that could be involved (changed in place)."""
         beliefs = [b for b in beliefs if b.status == PRESENT]
-        association = self._associate(observations, beliefs)
+        association = self.associate(observations, beliefs)
         changed: dict[int, ObjectBelief] = {}
         assigned = [0] * len(observations)
         for i, j, _ in association.matches:
             belief = beliefs[j]
-            self._update(belief, observations[i], time)
+            self.update(belief, observations[i], time)
             changed[belief.id] = belief
             assigned[i] = belief.id
         created = []
         for i in association.new:
             if observations[i].doubt:
                 continue
-            belief = self._create(observations[i], time, new_id())
+            belief = self.create(observations[i], time, new_id())
             changed[belief.id] = belief
             assigned[i] = belief.id
             created.append(belief.id)
@@ -250,9 +254,7 @@ class BeliefTracker:
             belief.status = GONE
         return missed, gone
 
-    # ------------------------------------------------------------------ internals
-
-    def _associate(self, observations: Sequence[FrameObject], beliefs: Sequence[ObjectBelief]) -> Association:
+    def associate(self, observations: Sequence[FrameObject], beliefs: Sequence[ObjectBelief]) -> Association:
         """The feasible pairs of the frame with their geometric costs (:func:`gated_costs`, found once), the colour
         and class penalties of :func:`pair_cost` added on them, then one optimal assignment (:func:`assign_pairs`)."""
         config = self.config.association
@@ -293,7 +295,8 @@ class BeliefTracker:
             costs = costs + np.array(class_added)
         return assign_pairs(pairs if costs is pairs.costs else pairs.with_costs(costs))
 
-    def _create(self, observation: FrameObject, time: float, belief_id: int) -> ObjectBelief:
+    def create(self, observation: FrameObject, time: float, belief_id: int) -> ObjectBelief:
+        """The new belief ``belief_id`` of an observation no belief matched, first seen at ``time``."""
         belief = ObjectBelief(
             id=belief_id,
             frame=observation.frame,
@@ -314,10 +317,9 @@ class BeliefTracker:
         self._refresh(belief)
         return belief
 
-    def _measurement_variance(self, observation: FrameObject) -> float:
-        return self.config.measurement_sigma**2 / max(observation.confidence, 0.1)
-
-    def _update(self, belief: ObjectBelief, observation: FrameObject, time: float) -> None:
+    def update(self, belief: ObjectBelief, observation: FrameObject, time: float) -> None:
+        """Apply the observation matched with ``belief`` at ``time`` (changed in place): Kalman step of the position,
+        blended size and histogram, accumulated evidence, existence raised."""
         config = self.config
         elapsed = max(time - belief.last_seen, 0.0)
         predicted = belief.position_variance + config.motion_sigma**2 * elapsed
@@ -347,6 +349,11 @@ class BeliefTracker:
         belief.sources.update(observation.sources)
         belief.observations += 1
         self._refresh(belief)
+
+    # ------------------------------------------------------------------ internals
+
+    def _measurement_variance(self, observation: FrameObject) -> float:
+        return self.config.measurement_sigma**2 / max(observation.confidence, 0.1)
 
     def _refresh(self, belief: ObjectBelief) -> None:
         """Recompute the cached class and the region after a change."""
