@@ -159,7 +159,7 @@ def main() -> int:
             store.close()
             where = f"from {cameras} fixed cameras in turn" if cameras else "each at a random place"
             print(f"{args.size} stored, {args.frames} frames x 20 hypotheses {where}: CPU ms per frame")
-            for _, _, label in PHASES:
+            for label in dict.fromkeys(label for _, _, label in PHASES):  # a label twice: a method renamed
                 print(f"  {label:32s} {phases.get(label, 0) / args.frames / 1e6:7.3f}")
             sql = sum(statements.values())
             print(f"  {'SQL (all statements)':32s} {sql / args.frames / 1e6:7.3f}")
