@@ -509,9 +509,9 @@ class BeliefStore:
     ) -> tuple[TrackStep, list[ObjectBelief | tuple[tuple, list[Support]]]]:
         """``tracker.step`` on the stored candidate rows: the same association (on light views of the rows), the
         same updates, creations, misses and departures, with matched beliefs in the common case updated on their
-        rows (:mod:`reasoning.beliefs.row_update`; their ``ObjectBelief`` made only when the step's ``changed`` is
-        read). Returns the step and each changed belief: the belief, or its new row and supports when it was
-        updated on its row."""
+        rows and new ones in the common case made as rows (:mod:`reasoning.beliefs.row_update`; their
+        ``ObjectBelief`` made only when the step's ``changed`` is read). Returns the step and each changed belief:
+        the belief, or its new row and supports when it was updated or made as a row."""
         update = self._row_update(tracker)
         candidates = [_Candidate(row, update) for row in rows]
         association = tracker.associate(objects, candidates)
@@ -532,12 +532,18 @@ class BeliefStore:
             assigned[i] = candidate.id
         created = []
         for i in association.new:
-            if objects[i].doubt:
+            observation = objects[i]
+            if observation.doubt:
                 continue
-            belief = tracker.create(objects[i], time, new_id())
-            changed[belief.id] = makers[belief.id] = belief
-            assigned[i] = belief.id
-            created.append(belief.id)
+            belief_id = new_id()
+            made = update.create(observation, time, belief_id)
+            if made is not None:
+                changed[belief_id] = made
+                makers[belief_id] = functools.partial(belief_of, made[0], made[1], observation.roi)
+            else:
+                changed[belief_id] = makers[belief_id] = tracker.create(observation, time, belief_id)
+            assigned[i] = belief_id
+            created.append(belief_id)
         missed, gone = [], []
         for j in association.unmatched:
             candidate = candidates[j]
