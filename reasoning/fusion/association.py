@@ -231,8 +231,7 @@ def gated_costs(
     if rows.size == 0:
         return GatedPairs(shape, rows, cols, distance, np.zeros(0, dtype=bool))
     total = (distance / config.position_sigma) ** 2
-    sizes = typical_sizes([*observations, *beliefs])  # one pass for both sides (each size computed on its own)
-    size_a, size_b = sizes[rows], sizes[len(observations) + cols]
+    size_a, size_b = typical_sizes(observations)[rows], typical_sizes(beliefs)[cols]
     sized = (size_a > 0) & (size_b > 0)
     ratio = np.maximum(size_a, size_b) / np.where(sized, np.minimum(size_a, size_b), 1.0)
     feasible = ~sized | (ratio <= config.size_ratio_gate)
