@@ -1,10 +1,10 @@
 """What a row-level hot path would save per matched belief (issue 19, goal 1): an experiment, not a benchmark.
 
 ``BeliefStore.integrate`` decodes each candidate row into an ``ObjectBelief`` (``_belief_from_row``), the tracker
-updates it (``BeliefTracker._update``) and the store encodes it again (``_object_row``). This script captures the
+updates it (``BeliefTracker.update``) and the store encodes it again (``_object_row``). This script captures the
 (stored row, observation, time) of every update of bench frames and computes the new row two ways:
 
-* reference: decode + ``_update`` + ``_object_row``, as ``integrate`` does;
+* reference: decode + ``update`` + ``_object_row``, as ``integrate`` does;
 * row level: the packed supports unpacked to records, the frame's statements accumulated into them with the rule of
   ``ValueSupport.add``, the position filtered and the size blended with Python floats, the records packed again,
   with no ``ObjectBelief``, ``AttributeBelief``, ``ValueSupport``, set or numpy array made. It covers the common
@@ -48,7 +48,7 @@ from robokudo.core.types import Location  # noqa: E402
 
 
 class GeneralTracker(BeliefTracker):
-    """The plain tracker, which ``integrate`` runs the general way (decode, ``_update``, encode): since store8 the
+    """The plain tracker, which ``integrate`` runs the general way (decode, ``update``, encode): since store8 the
     plain ``BeliefTracker`` has its common-case updates done on the rows (``reasoning/beliefs/row_update.py``)."""
 
 
@@ -60,7 +60,7 @@ def captured_updates(store: BeliefStore, frames: list[list[FrameObject]]) -> lis
     """Integrate ``frames`` and return every (row as loaded, observation, time) the tracker updated."""
     rows: dict[int, tuple] = {}
     updates: list[Update] = []
-    decode, update = store_module._belief_from_row, BeliefTracker._update
+    decode, update = store_module._belief_from_row, BeliefTracker.update
 
     def remember_row(row: tuple, *args: object) -> object:
         rows[row[0]] = row
@@ -71,18 +71,18 @@ def captured_updates(store: BeliefStore, frames: list[list[FrameObject]]) -> lis
         update(tracker, belief, observation, at)  # type: ignore[arg-type]
 
     store_module._belief_from_row = remember_row  # type: ignore[assignment]
-    BeliefTracker._update = remember_update  # type: ignore[assignment,method-assign]
+    BeliefTracker.update = remember_update  # type: ignore[assignment,method-assign]
     try:
         for index, frame in enumerate(frames):
             store.integrate(frame, 1000.0 + index)
     finally:
         store_module._belief_from_row = decode
-        BeliefTracker._update = update  # type: ignore[method-assign]
+        BeliefTracker.update = update  # type: ignore[method-assign]
     return updates
 
 
 class RowLevel:
-    """The common case of ``_update`` + ``_object_row`` computed on the stored row (see the module docstring)."""
+    """The common case of ``update`` + ``_object_row`` computed on the stored row (see the module docstring)."""
 
     def __init__(self, tracker: BeliefTracker, interned: InternedTexts, conn: sqlite3.Connection) -> None:
         self.config = tracker.config
@@ -217,7 +217,7 @@ def main() -> int:
 
         def reference(row: tuple, observation: FrameObject, at: float) -> tuple:
             belief = store_module._belief_from_row(row, interned, conn)
-            tracker._update(belief, observation, at)
+            tracker.update(belief, observation, at)
             return store_module._object_row(belief, tracker.class_test, cache, interned, conn, write)
 
         conn.execute("BEGIN IMMEDIATE")  # codes interned by the sketch are rolled back

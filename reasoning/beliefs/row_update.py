@@ -1,4 +1,4 @@
-"""Matched beliefs updated on their stored rows: the common case of :meth:`BeliefTracker._update` followed by the
+"""Matched beliefs updated on their stored rows: the common case of :meth:`BeliefTracker.update` followed by the
 store's encoding of the belief, without decoding the row into an ``ObjectBelief`` first.
 
 A stored ``objects`` row and the observation matched to it give the new row directly: the position filtered and
@@ -6,8 +6,10 @@ the size blended with Python floats (the same operations, in the same order, as 
 frame's statements accumulated into the packed supports with the rule of ``ValueSupport.add``, and the supports
 packed again. The common case is: no colour histogram on either side, a 3-vector position, size and 4-vector
 orientation in float64, every attribute single-valued before and after the update, and no named regions on the
-tracker. Anything else goes the general way (decode, ``BeliefTracker._update``, encode); both ways give the same
-row (``tests/fusion/test_row_update.py``).
+tracker. Anything else goes the general way (decode, ``BeliefTracker.update``, encode); both ways give the same
+row (``tests/fusion/test_row_update.py``). A new belief in the common case is made as a row the same way
+(:meth:`RowUpdate.create`: the supports accumulated from none, the row ``BeliefTracker.create`` and the store's
+encoding would give).
 
 The supports are kept as :class:`Support` records in text space (attribute name, value, expert set) until they are
 packed, so new texts are interned in the order the general encoder interns them (the same codes, the same file).
@@ -116,29 +118,7 @@ class RowUpdate:
                 return None  # a second value stated
         (object_id, _, frame, px, py, pz, _, _, _, _, sx, sy, sz, variance, appearance, existence, _, first_seen,
          last_seen, _, observations, _, _, recording, _, sources, _, _) = row[:28]  # fmt: skip
-        logits = self.logits
-        if len(logits) > LOGIT_CACHE_LIMIT:
-            logits.clear()
-        for e in observation.evidence:  # ValueSupport.add of each statement, at ``time``
-            r = by_name.get(e.attribute)
-            if r is None:
-                r = by_name[e.attribute] = [None, None, 0.0, 0, None, 0.0, 0.0, e.attribute, e.value, ()]
-                records.append(r)
-            if r[3] == 0 or time < r[5]:
-                r[5] = time
-            confidence = e.confidence
-            log_odds = logits.get(confidence)
-            if log_odds is None:
-                log_odds = logits[confidence] = logit(confidence)
-            total = r[2] + log_odds
-            total = -MAX_LOG_ODDS if total < -MAX_LOG_ODDS else total
-            r[2] = MAX_LOG_ODDS if total > MAX_LOG_ODDS else total
-            r[3] += 1
-            if e.source not in r[_SUPPORT_EXPERTS]:
-                r[_SUPPORT_EXPERTS] = (*r[_SUPPORT_EXPERTS], e.source)
-                r[4] = None
-            if r[6] < time:
-                r[6] = time
+        self._accumulate(by_name, records, observation, time)
         config = self.config
         predicted = variance + config.motion_sigma**2 * max(time - last_seen, 0.0)
         gain = predicted / (predicted + config.measurement_sigma**2 / max(observation.confidence, 0.1))
@@ -192,6 +172,91 @@ class RowUpdate:
             INDEX_SEPARATOR.join(sorted(entries)),
         )
 
+    def _accumulate(
+        self, by_name: dict[str, Support], records: list[Support], observation: FrameObject, time: float
+    ) -> None:
+        """``ValueSupport.add`` of each of the observation's statements at ``time`` into the single-valued supports
+        ``by_name`` (a new attribute's support appended to ``records``)."""
+        logits = self.logits
+        if len(logits) > LOGIT_CACHE_LIMIT:
+            logits.clear()
+        for e in observation.evidence:
+            r = by_name.get(e.attribute)
+            if r is None:
+                r = by_name[e.attribute] = [None, None, 0.0, 0, None, 0.0, 0.0, e.attribute, e.value, ()]
+                records.append(r)
+            if r[3] == 0 or time < r[5]:
+                r[5] = time
+            confidence = e.confidence
+            log_odds = logits.get(confidence)
+            if log_odds is None:
+                log_odds = logits[confidence] = logit(confidence)
+            total = r[2] + log_odds
+            total = -MAX_LOG_ODDS if total < -MAX_LOG_ODDS else total
+            r[2] = MAX_LOG_ODDS if total > MAX_LOG_ODDS else total
+            r[3] += 1
+            if e.source not in r[_SUPPORT_EXPERTS]:
+                r[_SUPPORT_EXPERTS] = (*r[_SUPPORT_EXPERTS], e.source)
+                r[4] = None
+            if r[6] < time:
+                r[6] = time
+
+    def create(self, observation: FrameObject, time: float, belief_id: int) -> tuple[tuple, list[Support]] | None:
+        """The ``objects`` row and supports of the belief ``BeliefTracker.create`` makes of ``observation`` (id
+        ``belief_id``, first seen at ``time``), or None when that is not the common case (no histogram, float64
+        3-vector position and size, 4-vector orientation, one value stated per attribute). The attribute column is
+        left None: :meth:`pack` fills it, in write order."""
+        if observation.appearance is not None or not (
+            _is_vector(observation.position, 3)
+            and _is_vector(observation.orientation, 4)
+            and _is_vector(observation.dimensions, 3)
+        ):
+            return None
+        stated: dict[str, str] = {}
+        for e in observation.evidence:
+            if stated.setdefault(e.attribute, e.value) != e.value:
+                return None  # a second value stated
+        records: list[Support] = []
+        self._accumulate({}, records, observation, time)
+        class_name = region = None
+        entries = []
+        for r in records:
+            name, value = r[_SUPPORT_NAME], r[_SUPPORT_VALUE]
+            if name == CLASS_ATTRIBUTE:
+                class_name = value if r[2] > 0 else None
+            elif name == Location.attribute:
+                region = value
+            entries.append(f"{name}={value}")
+        experts = frozenset(observation.sources)
+        text = self.sources.get(("[]", experts))  # an empty stored set joined with the stated experts
+        if text is None:
+            text = self.sources[("[]", experts)] = json.dumps(sorted(experts))
+        config = self.config
+        seen = float(time)
+        return (
+            belief_id,
+            class_name,
+            observation.frame,
+            *observation.position.tolist(),
+            *observation.orientation.tolist(),
+            *observation.dimensions.tolist(),  # type: ignore[union-attr]
+            float(config.measurement_sigma**2 / max(observation.confidence, 0.1)),
+            None,
+            float(min(logit(observation.confidence), config.hit_log_odds)),
+            PRESENT,
+            seen,
+            seen,
+            0,
+            1,
+            region or "",
+            "",
+            observation.recording,
+            roi_text(observation.roi),
+            text,
+            None,
+            INDEX_SEPARATOR.join(sorted(entries)),
+        ), records
+
     def pack(self, row: tuple, records: Sequence[Support], write: Callable[[str, list[tuple]], None]) -> tuple:
         """``row`` with its attribute column packed from ``records`` (texts new to the store interned with
         ``write``, in the order of the records: name, value, experts)."""
@@ -219,7 +284,7 @@ class RowUpdate:
 
 def belief_of(row: tuple, records: Sequence[Support], roi: tuple[int, int, int, int] | None) -> ObjectBelief:
     """The ``ObjectBelief`` a row-level update stands for: the new row, the supports with their log-odds not rounded,
-    and the observation's image box as given (what ``BeliefTracker._update`` leaves in the belief)."""
+    and the observation's image box as given (what ``BeliefTracker.update`` leaves in the belief)."""
     attributes: dict[str, AttributeBelief] = {}
     for r in records:
         name = r[_SUPPORT_NAME]

@@ -212,29 +212,27 @@ _TABLES = {"meta", "objects", "objects_place", "attribute_index", "observations"
 
 
 class _Candidate:
-    """A stored candidate row as the association sees it (position, size, histogram, class, world, colour), the
-    ``ObjectBelief`` decoded only when the general update path needs it."""
+    """A stored candidate row as the association sees it (position, size, histogram, class, world, colour): its
+    supports unpacked only when read (a colour asked for, or the row updated), the ``ObjectBelief`` decoded only when
+    the general update path needs it."""
 
     __slots__ = (
+        "_records",
         "appearance",
         "class_name",
-        "conn",
         "dimensions",
         "frame",
         "id",
-        "interned",
         "position",
         "recording",
-        "records",
         "row",
-        "status",
+        "update",
     )
 
-    def __init__(self, row: tuple, records: list[Support], interned: InternedTexts, conn: sqlite3.Connection) -> None:
+    def __init__(self, row: tuple, update: RowUpdate) -> None:
         self.row = row
-        self.records = records
-        self.interned = interned
-        self.conn = conn
+        self.update = update
+        self._records: list[Support] | None = None
         self.id: int = row[0]
         self.class_name: str | None = row[1]
         self.frame: str = row[2]
@@ -242,8 +240,15 @@ class _Candidate:
         self.dimensions = None if row[10] is None else row[10:13]
         appearance = row[14]
         self.appearance = None if appearance is None else np.frombuffer(appearance, dtype=np.float32).astype(np.float64)
-        self.status: str = row[16]
         self.recording: str = row[23]
+
+    @property
+    def records(self) -> list[Support]:
+        """The row's supports (:meth:`RowUpdate.supports`), unpacked on first read."""
+        records = self._records
+        if records is None:
+            records = self._records = self.update.supports(self.row)
+        return records
 
     def value(self, attribute: str) -> str | None:
         """``ObjectBelief.value(attribute)`` of the stored belief."""
@@ -254,7 +259,7 @@ class _Candidate:
 
     def belief(self) -> ObjectBelief:
         """The stored belief, decoded."""
-        return _belief_from_row(self.row, self.interned, self.conn)
+        return _belief_from_row(self.row, self.update.interned, self.update.conn)
 
 
 class BeliefStore:
@@ -504,35 +509,41 @@ class BeliefStore:
     ) -> tuple[TrackStep, list[ObjectBelief | tuple[tuple, list[Support]]]]:
         """``tracker.step`` on the stored candidate rows: the same association (on light views of the rows), the
         same updates, creations, misses and departures, with matched beliefs in the common case updated on their
-        rows (:mod:`reasoning.beliefs.row_update`; their ``ObjectBelief`` made only when the step's ``changed`` is
-        read). Returns the step and each changed belief: the belief, or its new row and supports when it was
-        updated on its row."""
-        interned = self._interned
+        rows and new ones in the common case made as rows (:mod:`reasoning.beliefs.row_update`; their
+        ``ObjectBelief`` made only when the step's ``changed`` is read). Returns the step and each changed belief:
+        the belief, or its new row and supports when it was updated or made as a row."""
         update = self._row_update(tracker)
-        candidates = [_Candidate(row, update.supports(row), interned, conn) for row in rows]
-        association = tracker._associate(objects, candidates)
+        candidates = [_Candidate(row, update) for row in rows]
+        association = tracker.associate(objects, candidates)
         changed: dict[int, ObjectBelief | tuple[tuple, list[Support]]] = {}
         makers: dict[int, ObjectBelief | Callable[[], ObjectBelief]] = {}
         assigned = [0] * len(objects)
         for i, j, _ in association.matches:
             candidate, observation = candidates[j], objects[i]
-            row = update.update(candidate.row, candidate.records, observation, time)
+            records = candidate.records
+            row = update.update(candidate.row, records, observation, time)
             if row is not None:
-                changed[candidate.id] = (row, candidate.records)
-                makers[candidate.id] = functools.partial(belief_of, row, candidate.records, observation.roi)
+                changed[candidate.id] = (row, records)
+                makers[candidate.id] = functools.partial(belief_of, row, records, observation.roi)
             else:
                 belief = candidate.belief()
-                tracker._update(belief, observation, time)
+                tracker.update(belief, observation, time)
                 changed[candidate.id] = makers[candidate.id] = belief
             assigned[i] = candidate.id
         created = []
         for i in association.new:
-            if objects[i].doubt:
+            observation = objects[i]
+            if observation.doubt:
                 continue
-            belief = tracker._create(objects[i], time, new_id())
-            changed[belief.id] = makers[belief.id] = belief
-            assigned[i] = belief.id
-            created.append(belief.id)
+            belief_id = new_id()
+            made = update.create(observation, time, belief_id)
+            if made is not None:
+                changed[belief_id] = made
+                makers[belief_id] = functools.partial(belief_of, made[0], made[1], observation.roi)
+            else:
+                changed[belief_id] = makers[belief_id] = tracker.create(observation, time, belief_id)
+            assigned[i] = belief_id
+            created.append(belief_id)
         missed, gone = [], []
         for j in association.unmatched:
             candidate = candidates[j]

@@ -15,9 +15,10 @@ The cost of pairing an observation with a belief is a sum of squared normalised 
 Only positions of one world are compared (:func:`same_world`): the same fixed frame (``world``, known when the
 camera pose is), or the same camera frame of the same recording.
 
-:func:`pair_cost` states the rule for one pair; :func:`geometric_costs` computes its position, size and appearance
-terms for a whole frame at once (numpy distance matrix as the pre-gate, then the gated pairs only), which is what
-the tracker uses. The assignment minimising the total cost is found with one
+:func:`pair_cost` states the rule for one pair; :func:`gated_costs` computes its position, size and appearance
+terms for a whole frame at once (numpy distance matrix as the pre-gate, then the near pairs only) and returns the
+feasible pairs once (:class:`GatedPairs`), which is what the tracker adds its penalties to and assigns on
+(:func:`assign_pairs`). The assignment minimising the total cost is found with one
 ``scipy.optimize.linear_sum_assignment`` per frame on the gated matrix (infeasible pairs get a prohibitive cost and
 are rejected afterwards); when no two feasible pairs share an observation or a belief (a sparse frame, the common
 case) that assignment is all of them, and the solver is not called. Observations left over become new objects.
@@ -194,25 +195,48 @@ def _positions(items: Sequence[Trackable]) -> np.ndarray:
     return np.array([item.position[:3] for item in items], dtype=np.float64)
 
 
-def geometric_costs(
-    observations: Sequence[Trackable], beliefs: Sequence[Trackable], config: AssociationConfig
-) -> tuple[np.ndarray, np.ndarray]:
-    """The position, size and appearance terms of :func:`pair_cost` for every (observation, belief) pair at once.
+@dataclass(frozen=True, slots=True)
+class GatedPairs:
+    """The feasible (observation, belief) pairs of a frame in row-major order, found once: ``rows[k]``, ``cols[k]``
+    and the cost ``costs[k]`` of pair ``k``, and whether both histograms were compared there (then the colour
+    penalty does not apply). ``shape`` is (observations, beliefs)."""
 
-    Returns the cost matrix (:data:`INFEASIBLE` where a gate fails) and where both histograms were compared (there
-    the colour penalty does not apply). Only the pairs within the distance gate are costed further.
-    """
-    cost = np.full((len(observations), len(beliefs)), INFEASIBLE)
-    compared = np.zeros(cost.shape, dtype=bool)
+    shape: tuple[int, int]
+    rows: np.ndarray
+    cols: np.ndarray
+    costs: np.ndarray
+    compared: np.ndarray
+
+    def with_costs(self, costs: np.ndarray) -> GatedPairs:
+        """The same pairs with other costs (those not below :data:`INFEASIBLE` dropped, as :func:`assign` does)."""
+        keep = costs < INFEASIBLE
+        if keep.all():
+            return GatedPairs(self.shape, self.rows, self.cols, costs, self.compared)
+        return GatedPairs(self.shape, self.rows[keep], self.cols[keep], costs[keep], self.compared[keep])
+
+    def matrix(self) -> np.ndarray:
+        """The full cost matrix (:data:`INFEASIBLE` outside the pairs)."""
+        cost = np.full(self.shape, INFEASIBLE)
+        cost[self.rows, self.cols] = self.costs
+        return cost
+
+
+def gated_costs(
+    observations: Sequence[Trackable], beliefs: Sequence[Trackable], config: AssociationConfig
+) -> GatedPairs:
+    """The position, size and appearance terms of :func:`pair_cost` on the pairs that pass every gate, in one
+    vectorised pass: the distance pre-gate on all pairs, then sizes and histograms on the near pairs only."""
+    shape = (len(observations), len(beliefs))
     rows, cols, distance = _near_pairs(observations, beliefs, config.gate_distance)
     if rows.size == 0:
-        return cost, compared
+        return GatedPairs(shape, rows, cols, distance, np.zeros(0, dtype=bool))
     total = (distance / config.position_sigma) ** 2
     size_a, size_b = typical_sizes(observations)[rows], typical_sizes(beliefs)[cols]
     sized = (size_a > 0) & (size_b > 0)
     ratio = np.maximum(size_a, size_b) / np.where(sized, np.minimum(size_a, size_b), 1.0)
     feasible = ~sized | (ratio <= config.size_ratio_gate)
     total += np.where(sized, (np.log(np.where(sized, ratio, 1.0)) / config.size_sigma) ** 2, 0.0)
+    compared = np.zeros(rows.size, dtype=bool)
     histograms = any(o.appearance is not None for o in observations) and any(b.appearance is not None for b in beliefs)
     pairs = list(zip(rows.tolist(), cols.tolist(), strict=True)) if histograms else []  # else nothing to compare
     for k, (i, j) in enumerate(pairs):
@@ -220,13 +244,26 @@ def geometric_costs(
         if ha is None or hb is None or ha.shape != hb.shape or not feasible[k]:
             continue
         appearance = bhattacharyya_distance(ha, hb)
-        compared[i, j] = True
+        compared[k] = True
         if appearance > config.appearance_gate:
             feasible[k] = False
         else:
             total[k] += (appearance / config.appearance_sigma) ** 2
-    cost[rows[feasible], cols[feasible]] = total[feasible]
-    return cost, compared
+    feasible &= total < INFEASIBLE  # what the cost matrix would not count as feasible
+    if not feasible.all():
+        rows, cols, total, compared = rows[feasible], cols[feasible], total[feasible], compared[feasible]
+    return GatedPairs(shape, rows, cols, total, compared)
+
+
+def geometric_costs(
+    observations: Sequence[Trackable], beliefs: Sequence[Trackable], config: AssociationConfig
+) -> tuple[np.ndarray, np.ndarray]:
+    """:func:`gated_costs` as matrices: the cost matrix (:data:`INFEASIBLE` where a gate fails) and where both
+    histograms were compared on a feasible pair."""
+    pairs = gated_costs(observations, beliefs, config)
+    compared = np.zeros(pairs.shape, dtype=bool)
+    compared[pairs.rows, pairs.cols] = pairs.compared
+    return pairs.matrix(), compared
 
 
 def _near_pairs(
@@ -257,32 +294,34 @@ def _triple(position: np.ndarray) -> tuple[float, float, float]:
 
 def assign(cost: np.ndarray) -> Association:
     """Optimal assignment on a cost matrix (rows: observations, columns: beliefs) honouring the gates."""
-    rows, cols = cost.shape
-    if rows == 0 or cols == 0:
-        return Association((), tuple(range(rows)), tuple(range(cols)))
-    feasible = cost < INFEASIBLE
-    feasible_rows, feasible_cols = np.nonzero(feasible)
-    pair_rows, pair_cols = feasible_rows.tolist(), feasible_cols.tolist()
-    if not pair_rows:
+    rows, cols = np.nonzero(cost < INFEASIBLE)
+    return assign_pairs(GatedPairs(cost.shape, rows, cols, cost[rows, cols], np.zeros(rows.size, dtype=bool)))
+
+
+def assign_pairs(pairs: GatedPairs) -> Association:
+    """:func:`assign` on the feasible pairs (the same assignment; the matrix is only made when the solver runs)."""
+    rows, cols = pairs.shape
+    pair_rows, pair_cols = pairs.rows.tolist(), pairs.cols.tolist()
+    if rows == 0 or cols == 0 or not pair_rows:
         return Association((), tuple(range(rows)), tuple(range(cols)))
     if len(set(pair_rows)) == len(pair_rows) and len(set(pair_cols)) == len(pair_cols):
         # no two feasible pairs share an observation or a belief: the optimal assignment takes them all (leaving
         # one out would put a prohibitive cost in its place), so there is nothing to choose
-        matched_rows, matched_cols = pair_rows, pair_cols
-        costs = cost[feasible_rows, feasible_cols].tolist()
+        matches = tuple(zip(pair_rows, pair_cols, pairs.costs.tolist(), strict=True))
+    elif rows == 1 or cols == 1:
+        k = int(np.argmin(pairs.costs))  # the first least cost in row-major order, as argmin over the matrix
+        matches = ((pair_rows[k], pair_cols[k], float(pairs.costs[k])),)
     else:
-        if rows == 1 or cols == 1:
-            i, j = np.unravel_index(int(np.argmin(cost)), cost.shape)
-            chosen_rows, chosen_cols = np.array([i]), np.array([j])
-        else:
-            from scipy.optimize import linear_sum_assignment
+        from scipy.optimize import linear_sum_assignment
 
-            chosen_rows, chosen_cols = linear_sum_assignment(np.where(feasible, cost, INFEASIBLE))
-        kept = feasible[chosen_rows, chosen_cols]
-        matched_rows, matched_cols = chosen_rows[kept].tolist(), chosen_cols[kept].tolist()
-        costs = cost[chosen_rows[kept], chosen_cols[kept]].tolist()
-    matches = tuple(zip(matched_rows, matched_cols, costs, strict=True))
-    taken_rows, taken_cols = set(matched_rows), set(matched_cols)
+        cost = pairs.matrix()
+        chosen_rows, chosen_cols = linear_sum_assignment(cost)
+        kept = cost[chosen_rows, chosen_cols] < INFEASIBLE
+        matched_rows, matched_cols = chosen_rows[kept], chosen_cols[kept]
+        matches = tuple(
+            zip(matched_rows.tolist(), matched_cols.tolist(), cost[matched_rows, matched_cols].tolist(), strict=True)
+        )
+    taken_rows, taken_cols = {m[0] for m in matches}, {m[1] for m in matches}
     return Association(
         matches,
         tuple(i for i in range(rows) if i not in taken_rows),

@@ -24,12 +24,11 @@ from typing import overload
 import numpy as np
 
 from reasoning.fusion.association import (
-    INFEASIBLE,
     Association,
     AssociationConfig,
     CameraModel,
-    assign,
-    geometric_costs,
+    assign_pairs,
+    gated_costs,
     same_world,
     visible_from,
 )
@@ -186,7 +185,11 @@ def _stated_colors_and_classes(observation: FrameObject) -> tuple[set[str], set[
 
 
 class BeliefTracker:
-    """Associates frames of objects with beliefs and updates them (see the module docstring)."""
+    """Associates frames of objects with beliefs and updates them (see the module docstring).
+
+    :meth:`step` is one frame. Its parts are public for stores that run the step on their own rows (the belief
+    store does): :meth:`associate` pairs observations with beliefs, :meth:`update` applies a matched observation,
+    :meth:`create` makes the belief of a new one and :meth:`unseen` applies a frame that did not see a belief."""
 
     def __init__(
         self,
@@ -209,19 +212,19 @@ class BeliefTracker:
     ) -> TrackStep:
         """Integrate one frame; ``beliefs`` are the present beliefs that could be involved (changed in place)."""
         beliefs = [b for b in beliefs if b.status == PRESENT]
-        association = self._associate(observations, beliefs)
+        association = self.associate(observations, beliefs)
         changed: dict[int, ObjectBelief] = {}
         assigned = [0] * len(observations)
         for i, j, _ in association.matches:
             belief = beliefs[j]
-            self._update(belief, observations[i], time)
+            self.update(belief, observations[i], time)
             changed[belief.id] = belief
             assigned[i] = belief.id
         created = []
         for i in association.new:
             if observations[i].doubt:
                 continue
-            belief = self._create(observations[i], time, new_id())
+            belief = self.create(observations[i], time, new_id())
             changed[belief.id] = belief
             assigned[i] = belief.id
             created.append(belief.id)
@@ -251,47 +254,49 @@ class BeliefTracker:
             belief.status = GONE
         return missed, gone
 
-    # ------------------------------------------------------------------ internals
-
-    def _associate(self, observations: Sequence[FrameObject], beliefs: Sequence[ObjectBelief]) -> Association:
-        """One cost matrix for the frame (:func:`geometric_costs`), the colour and class penalties of
-        :func:`pair_cost` added on the feasible pairs, then one optimal assignment."""
+    def associate(self, observations: Sequence[FrameObject], beliefs: Sequence[ObjectBelief]) -> Association:
+        """The feasible pairs of the frame with their geometric costs (:func:`gated_costs`, found once), the colour
+        and class penalties of :func:`pair_cost` added on them, then one optimal assignment (:func:`assign_pairs`)."""
         config = self.config.association
-        cost, compared = geometric_costs(observations, beliefs, config)
-        rows, cols = np.nonzero(cost < INFEASIBLE)
-        if not rows.size:
-            return assign(cost)
+        pairs = gated_costs(observations, beliefs, config)
+        if not pairs.rows.size:
+            return assign_pairs(pairs)
         colors: dict[int, str | None] = {}
         stated: dict[int, tuple[set[str], set[str]]] = {}
         test = self.class_test or _same_class
-        color_added = [0.0] * rows.size
-        class_added = [0.0] * rows.size
-        pairs = zip(rows.tolist(), cols.tolist(), compared[rows, cols].tolist(), strict=True)
-        for k, (i, j, histograms_compared) in enumerate(pairs):
+        color_penalty, class_penalty = config.color_penalty, config.class_penalty
+        color_added = [0.0] * pairs.rows.size
+        class_added = [0.0] * pairs.rows.size
+        rows, cols = pairs.rows.tolist(), pairs.cols.tolist()
+        for k, (i, j, histograms_compared) in enumerate(zip(rows, cols, pairs.compared.tolist(), strict=True)):
             found = stated.get(i)
             if found is None:
                 found = stated[i] = _stated_colors_and_classes(observations[i])
             observation_colors, observation_classes = found
             if observation_colors and not histograms_compared:
-                if j not in colors:
-                    colors[j] = beliefs[j].value(SemanticColor.attribute)
-                if colors[j] and colors[j] not in observation_colors:
-                    color_added[k] = config.color_penalty
+                if j in colors:
+                    color = colors[j]
+                else:
+                    color = colors[j] = beliefs[j].value(SemanticColor.attribute)
+                if color and color not in observation_colors:
+                    color_added[k] = color_penalty
             belief_class = beliefs[j].class_name
             if observation_classes and belief_class:
                 for c in observation_classes:
                     if test(c, belief_class) or test(belief_class, c):
                         break
                 else:
-                    class_added[k] = config.class_penalty
+                    class_added[k] = class_penalty
         # the colour penalty first, then the class penalty, as pair_cost adds them (adding 0.0 changes nothing)
+        costs = pairs.costs
         if any(color_added):
-            cost[rows, cols] += np.array(color_added)
+            costs = costs + np.array(color_added)
         if any(class_added):
-            cost[rows, cols] += np.array(class_added)
-        return assign(cost)
+            costs = costs + np.array(class_added)
+        return assign_pairs(pairs if costs is pairs.costs else pairs.with_costs(costs))
 
-    def _create(self, observation: FrameObject, time: float, belief_id: int) -> ObjectBelief:
+    def create(self, observation: FrameObject, time: float, belief_id: int) -> ObjectBelief:
+        """The new belief ``belief_id`` of an observation no belief matched, first seen at ``time``."""
         belief = ObjectBelief(
             id=belief_id,
             frame=observation.frame,
@@ -312,10 +317,9 @@ class BeliefTracker:
         self._refresh(belief)
         return belief
 
-    def _measurement_variance(self, observation: FrameObject) -> float:
-        return self.config.measurement_sigma**2 / max(observation.confidence, 0.1)
-
-    def _update(self, belief: ObjectBelief, observation: FrameObject, time: float) -> None:
+    def update(self, belief: ObjectBelief, observation: FrameObject, time: float) -> None:
+        """Apply the observation matched with ``belief`` at ``time`` (changed in place): Kalman step of the position,
+        blended size and histogram, accumulated evidence, existence raised."""
         config = self.config
         elapsed = max(time - belief.last_seen, 0.0)
         predicted = belief.position_variance + config.motion_sigma**2 * elapsed
@@ -345,6 +349,11 @@ class BeliefTracker:
         belief.sources.update(observation.sources)
         belief.observations += 1
         self._refresh(belief)
+
+    # ------------------------------------------------------------------ internals
+
+    def _measurement_variance(self, observation: FrameObject) -> float:
+        return self.config.measurement_sigma**2 / max(observation.confidence, 0.1)
 
     def _refresh(self, belief: ObjectBelief) -> None:
         """Recompute the cached class and the region after a change."""

@@ -140,7 +140,7 @@ def test_row_level_update_gives_the_steps_and_the_store_of_the_general_way(
     row_level = BeliefStore(tmp_path / "rows.sqlite", tracker=tracker)
     general = BeliefStore(tmp_path / "general.sqlite", tracker=GeneralTracker(config, class_test=is_subclass))
     on_rows, decoded = [], []
-    row_update, update = RowUpdate.update, BeliefTracker._update
+    row_update, update = RowUpdate.update, BeliefTracker.update
 
     def counted_row_update(self: RowUpdate, *args: object) -> tuple | None:
         row = row_update(self, *args)  # type: ignore[arg-type]
@@ -153,7 +153,7 @@ def test_row_level_update_gives_the_steps_and_the_store_of_the_general_way(
         update(tracker, *args)  # type: ignore[arg-type]
 
     monkeypatch.setattr(RowUpdate, "update", counted_row_update)
-    monkeypatch.setattr(tracker, "_update", counted_update)
+    monkeypatch.setattr(tracker, "update", counted_update)
     at = 0.0
     frames = 40
     for index in range(frames):

@@ -119,7 +119,7 @@ def test_vectorised_association_gives_the_reference_assignment(seed: int, gate: 
     config = AssociationConfig(gate_distance=gate)
     reference = reference_cost(observations, beliefs, config)
     tracker = BeliefTracker(TrackerConfig(association=config), class_test=is_subclass)
-    vectorised = tracker._associate(observations, beliefs)
+    vectorised = tracker.associate(observations, beliefs)
     expected = assign(reference)
     assert sorted((i, j) for i, j, _ in vectorised.matches) == sorted((i, j) for i, j, _ in expected.matches)
     assert vectorised.new == expected.new and vectorised.unmatched == expected.unmatched
