@@ -317,3 +317,29 @@ def plane_coordinates(points: np.ndarray, to_plane: np.ndarray, offset: np.ndarr
         np.ascontiguousarray(to_plane, dtype=np.float32),
         np.ascontiguousarray(offset, dtype=np.float32),
     )
+
+
+@functools.cache
+def _footprint_loops() -> ModuleType:
+    """:mod:`annotators.geometry.footprint_loops`, imported (and numba with it) on first use."""
+    from annotators.geometry import footprint_loops
+
+    return footprint_loops
+
+
+def convex_hull(points: np.ndarray) -> np.ndarray:
+    """Kx2: the convex hull of Nx2 float ``points`` (counter-clockwise, no collinear vertices; fewer than three
+    points are returned as they are), in their dtype. A strided view (two columns of a wider array) is read in
+    place."""
+    return _footprint_loops().convex_hull(np.asarray(points))
+
+
+def outside_extents(near: np.ndarray, heights: np.ndarray) -> np.ndarray:
+    """The extents of a part seen as a container's outside, from its Nx3 plane coordinates ``(u, v, height)``
+    (N >= 1) and its heights sorted: 8 float64, the unit direction ``along`` the line of sight (the centroid's
+    horizontal direction from the camera's foot, 2), the 5 % and 95 % positions across it, the 95 % height (the
+    rim), the 5 % and 50 % positions along it, and the centroid's distance; NaN everywhere when the centroid lies
+    within a micrometre of the camera's foot. Positions are sorted-order quantiles at index ``round(q (n - 1))``."""
+    return _footprint_loops().outside_extents(
+        np.ascontiguousarray(near, dtype=np.float32), np.ascontiguousarray(heights, dtype=np.float32)
+    )

@@ -16,10 +16,12 @@ import numpy as np
 from annotators.geometry.grid_kernels import (
     boundary_pairs,
     connected_parts,
+    convex_hull,
     groups_unless_apart,
     joined_labels,
     label_pixels,
     nearest_seed_labels,
+    outside_extents,
     seam_pixels,
     surface_growth,
     touching_keys,
@@ -409,16 +411,13 @@ def container_outside(
     given, are ``near``'s heights sorted (then not sorted again)."""
     if near.shape[0] < 3:
         return None
-    centre = near[:, :2].mean(axis=0)
-    distance = float(np.linalg.norm(centre))
-    if distance < 1e-6:
+    extents = outside_extents(near, np.sort(near[:, 2]) if near_heights is None else near_heights)
+    if not np.isfinite(extents[7]):
         return None
-    along = centre / distance
-    across = np.array([-along[1], along[0]], dtype=near.dtype)
-    near_low, near_high = _range(near[:, :2] @ across, 0.05, 0.95)
+    along = extents[:2]
+    across = np.array([-along[1], along[0]])
+    near_low, near_high, rim, near_front, near_middle = extents[2:7].tolist()
     margin = max(tolerance, 0.1 * (near_high - near_low))
-    rim = _sorted_range(np.sort(near[:, 2]) if near_heights is None else near_heights, 0.5, 0.95)[1]
-    near_front, near_middle = _range(near[:, :2] @ along, 0.05, 0.5)
     return ContainerOutside(along, across, near_low, near_high, margin, rim, near_front, near_middle)
 
 
@@ -463,7 +462,7 @@ class _Parts:
     def hull(self, label: int) -> np.ndarray:
         """The convex hull of the part's footprint (Kx2)."""
         if label not in self._hulls:
-            self._hulls[label] = cv2.convexHull(np.ascontiguousarray(self.coordinates(label)[:, :2])).reshape(-1, 2)
+            self._hulls[label] = convex_hull(self.coordinates(label)[:, :2])
         return self._hulls[label]
 
     def outside(self, label: int, tolerance: float) -> ContainerOutside | None:
