@@ -56,18 +56,26 @@ def convex_hull(points: np.ndarray) -> np.ndarray:
     chain = np.empty(2 * size + 1, dtype=np.int64)
     length = 0
     for i in kept:  # lower hull, left to right
-        while length >= 2 and _turn(
-            x[chain[length - 2]], y[chain[length - 2]], x[chain[length - 1]], y[chain[length - 1]], x[i], y[i]
-        ) <= 0.0:
+        while (
+            length >= 2
+            and _turn(
+                x[chain[length - 2]], y[chain[length - 2]], x[chain[length - 1]], y[chain[length - 1]], x[i], y[i]
+            )
+            <= 0.0
+        ):
             length -= 1
         chain[length] = i
         length += 1
     lower = length + 1
     for j in range(size - 2, -1, -1):  # upper hull, right to left
         i = kept[j]
-        while length >= lower and _turn(
-            x[chain[length - 2]], y[chain[length - 2]], x[chain[length - 1]], y[chain[length - 1]], x[i], y[i]
-        ) <= 0.0:
+        while (
+            length >= lower
+            and _turn(
+                x[chain[length - 2]], y[chain[length - 2]], x[chain[length - 1]], y[chain[length - 1]], x[i], y[i]
+            )
+            <= 0.0
+        ):
             length -= 1
         chain[length] = i
         length += 1
@@ -116,3 +124,63 @@ def outside_extents(near: np.ndarray, heights: np.ndarray) -> np.ndarray:
     result[5], result[6] = along[low], along[middle]
     result[7] = distance
     return result
+
+
+@njit(cache=True, nogil=True)
+def _row_spans(vertices: np.ndarray, start: int, end: int, height: int) -> tuple[np.ndarray, np.ndarray]:
+    """Per row of a convex polygon's raster (integer ``vertices[start:end]``, cell centres at integer coordinates,
+    ``height`` rows from 0), the first and last column of the cells the polygon touches within the row (the
+    polygon clipped to the row's band ``r - 0.5 .. r + 0.5``); ``first > last`` where it touches none."""
+    first = np.full(height, np.iinfo(np.int64).max, dtype=np.int64)
+    last = np.full(height, np.iinfo(np.int64).min, dtype=np.int64)
+    low = np.full(height, np.inf)
+    high = np.full(height, -np.inf)
+    size = end - start
+    for k in range(size):
+        px, py = float(vertices[start + k, 0]), float(vertices[start + k, 1])
+        following = start + (k + 1) % size
+        qx, qy = float(vertices[following, 0]), float(vertices[following, 1])
+        bottom, top = min(py, qy), max(py, qy)
+        for row in range(max(0, int(np.floor(bottom + 0.75))), min(height - 1, int(np.ceil(top - 0.75))) + 1):
+            y0, y1 = max(bottom, row - 0.25), min(top, row + 0.25)
+            if py == qy:
+                x0, x1 = px, qx
+            else:
+                x0 = px + (qx - px) * (y0 - py) / (qy - py)
+                x1 = px + (qx - px) * (y1 - py) / (qy - py)
+            low[row] = min(low[row], x0, x1)
+            high[row] = max(high[row], x0, x1)
+    for row in range(height):
+        if low[row] <= high[row]:
+            first[row] = int(np.floor(low[row] + 0.5))
+            last[row] = int(np.ceil(high[row] - 0.5))
+    return first, last
+
+
+@njit(cache=True, nogil=True)
+def footprint_shares(
+    vertices: np.ndarray, starts: np.ndarray, boxes: np.ndarray, pairs: np.ndarray, count: int
+) -> np.ndarray:
+    """See :func:`annotators.geometry.grid_kernels.footprint_shares`."""
+    shares = np.zeros(count)
+    for pair in pairs:
+        second = pair + count
+        a_first, a_last = _row_spans(vertices, starts[pair], starts[pair + 1], boxes[pair, 3])
+        b_first, b_last = _row_spans(vertices, starts[second], starts[second + 1], boxes[second, 3])
+        areas = np.zeros(2, dtype=np.int64)
+        for side, (first, last) in enumerate(((a_first, a_last), (b_first, b_last))):
+            for row in range(first.size):
+                if first[row] <= last[row]:
+                    areas[side] += last[row] - first[row] + 1
+        ax, ay, bx, by = boxes[pair, 0], boxes[pair, 1], boxes[second, 0], boxes[second, 1]
+        shared = 0
+        for y in range(max(ay, by), min(ay + a_first.size, by + b_first.size)):
+            a, b = y - ay, y - by
+            if a_first[a] > a_last[a] or b_first[b] > b_last[b]:
+                continue
+            low = max(a_first[a] + ax, b_first[b] + bx)
+            high = min(a_last[a] + ax, b_last[b] + bx)
+            if low <= high:
+                shared += high - low + 1
+        shares[pair] = shared / max(1, min(areas[0], areas[1]))
+    return shares

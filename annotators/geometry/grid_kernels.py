@@ -343,3 +343,20 @@ def outside_extents(near: np.ndarray, heights: np.ndarray) -> np.ndarray:
     return _footprint_loops().outside_extents(
         np.ascontiguousarray(near, dtype=np.float32), np.ascontiguousarray(heights, dtype=np.float32)
     )
+
+
+def footprint_shares(
+    vertices: np.ndarray, starts: np.ndarray, boxes: np.ndarray, pairs: np.ndarray, count: int
+) -> np.ndarray:
+    """float64 (``count``): for each of the ``pairs`` (indices k < ``count``) the cells shared by convex polygons
+    k and ``count + k`` over the smaller one's cells, 0 for the others. Polygon j has the integer (Nx2) ``vertices
+    [starts[j]:starts[j + 1]]`` on the raster of its bounding cells ``boxes[j]`` = ``(x, y, width, height)`` (integer
+    cells of one grid, its vertices relative to ``(x, y)``); it covers, in each row, the cells it touches within
+    the row's band (a polygon edge-on, a line, still covers one cell per row)."""
+    return _footprint_loops().footprint_shares(
+        np.ascontiguousarray(vertices, dtype=np.int64),
+        np.ascontiguousarray(starts, dtype=np.int64),
+        np.ascontiguousarray(boxes, dtype=np.int64),
+        np.ascontiguousarray(pairs, dtype=np.int64),
+        count,
+    )

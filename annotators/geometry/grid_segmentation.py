@@ -17,6 +17,7 @@ from annotators.geometry.grid_kernels import (
     boundary_pairs,
     connected_parts,
     convex_hull,
+    footprint_shares,
     groups_unless_apart,
     joined_labels,
     label_pixels,
@@ -206,13 +207,12 @@ def footprint_overlap(first: np.ndarray, second: np.ndarray, cell: float) -> flo
 def footprint_overlaps(firsts: Sequence[np.ndarray], seconds: Sequence[np.ndarray], cell: float) -> np.ndarray:
     """:func:`footprint_overlap` of every pair ``(firsts[k], seconds[k])`` of convex polygons (Nx2, metres).
 
-    The bounds, the test for footprints apart and the raster vertices of all polygons are computed at once; only
-    the filling and counting of the rasters goes pair by pair.
+    The bounds, the test for footprints apart and the raster vertices of all polygons are computed at once, the
+    shared cells of the pairs near each other in one compiled pass (:func:`footprint_shares`).
     """
     count = len(firsts)
-    shares = np.zeros(count)
     if count == 0:
-        return shares
+        return np.zeros(0)
     hulls = [*firsts, *seconds]
     sizes = np.array([hull.shape[0] for hull in hulls])
     starts = np.cumsum(sizes) - sizes
@@ -226,33 +226,9 @@ def footprint_overlaps(firsts: Sequence[np.ndarray], seconds: Sequence[np.ndarra
     vertices = np.round((stacked - np.repeat(np.concatenate([low, low]), sizes, axis=0)) / cell).astype(np.int32)
     corner = np.minimum.reduceat(vertices, starts, axis=0)
     far_corner = np.maximum.reduceat(vertices, starts, axis=0) + 1
-    boxes = np.column_stack([corner, far_corner - corner]).tolist()  # x, y, width, height of the cells spanned
+    boxes = np.column_stack([corner, far_corner - corner])  # x, y, width, height of the cells spanned
     vertices -= np.repeat(corner, sizes, axis=0)  # each polygon's vertices on its own raster
-    ends = (starts + sizes).tolist()
-    starts = starts.tolist()
-    for pair in np.flatnonzero(near).tolist():
-        rasters = []
-        for hull in (pair, pair + count):
-            rasters.append(_filled(vertices[starts[hull] : ends[hull]], boxes[hull]))
-        (ax, ay, aw, ah), (bx, by, bw, bh) = boxes[pair], boxes[pair + count]
-        x0, y0, x1, y1 = max(ax, bx), max(ay, by), min(ax + aw, bx + bw), min(ay + ah, by + bh)
-        shared = 0
-        if x1 > x0 and y1 > y0:
-            shared = cv2.countNonZero(
-                cv2.bitwise_and(
-                    rasters[0][y0 - ay : y1 - ay, x0 - ax : x1 - ax], rasters[1][y0 - by : y1 - by, x0 - bx : x1 - bx]
-                )
-            )
-        shares[pair] = shared / max(1, min(cv2.countNonZero(rasters[0]), cv2.countNonZero(rasters[1])))
-    return shares
-
-
-def _filled(vertices: np.ndarray, box: Sequence[int]) -> np.ndarray:
-    """The cells (uint8, 1 = covered) a convex polygon covers on the raster of its bounding ``box`` ``(x, y, width,
-    height)``, its integer ``vertices`` given relative to the box's corner."""
-    raster = np.zeros((box[3], box[2]), dtype=np.uint8)
-    cv2.fillConvexPoly(raster, vertices, 1)
-    return raster
+    return footprint_shares(vertices, np.append(starts, stacked.shape[0]), boxes, np.flatnonzero(near), count)
 
 
 def join_labels(labels: np.ndarray, pairs: list[tuple[int, int]]) -> np.ndarray:
