@@ -360,3 +360,9 @@ def footprint_shares(
         np.ascontiguousarray(pairs, dtype=np.int64),
         count,
     )
+
+
+def sampled_median(values: np.ndarray, indices: np.ndarray, step: int) -> float:
+    """The median of ``values[indices[::step]]`` (1-D float ``values``, int ``indices``), in float64; NaN when
+    one of them is NaN or there are none."""
+    return _loops().sampled_median(values, indices, step)

@@ -23,6 +23,7 @@ from annotators.geometry.grid_kernels import (
     label_pixels,
     nearest_seed_labels,
     outside_extents,
+    sampled_median,
     seam_pixels,
     surface_growth,
     touching_keys,
@@ -452,7 +453,7 @@ class _Parts:
         """The median depth of the part."""
         if label not in self._depths:
             own = self.own(label)
-            self._depths[label] = float(_median(self.depth[own[:: max(1, own.size // 500)]]))
+            self._depths[label] = sampled_median(self.depth, own, max(1, own.size // 500))
         return self._depths[label]
 
 
