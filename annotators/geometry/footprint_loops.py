@@ -184,3 +184,18 @@ def footprint_shares(
                 shared += high - low + 1
         shares[pair] = shared / max(1, min(areas[0], areas[1]))
     return shares
+
+
+@njit(cache=True, nogil=True)
+def sight_extents(points: np.ndarray, ax: float, ay: float) -> np.ndarray:
+    """See :func:`annotators.geometry.grid_kernels.sight_extents`."""
+    count = points.shape[0]
+    across = np.empty(count)
+    along = np.empty(count)
+    for i in range(count):
+        across[i] = -ay * points[i, 0] + ax * points[i, 1]
+        along[i] = ax * points[i, 0] + ay * points[i, 1]
+    low, middle, high = _rank(count, 0.05), _rank(count, 0.5), _rank(count, 0.95)
+    across = np.partition(across, np.array([low, high]))
+    along = np.partition(along, np.array([middle, high]))
+    return np.array([across[low], across[high], along[middle], along[high]])

@@ -366,3 +366,12 @@ def sampled_median(values: np.ndarray, indices: np.ndarray, step: int) -> float:
     """The median of ``values[indices[::step]]`` (1-D float ``values``, int ``indices``), in float64; NaN when
     one of them is NaN or there are none."""
     return _loops().sampled_median(values, indices, step)
+
+
+def sight_extents(points: np.ndarray, along: np.ndarray) -> np.ndarray:
+    """4 float64 of Nx3 plane coordinates ``points`` (N >= 1) seen along the unit horizontal direction ``along``:
+    the 5 % and 95 % positions across it (``(-along[1], along[0])``) and the 50 % and 95 % positions along it
+    (sorted-order quantiles at index ``round(q (n - 1))``)."""
+    return _footprint_loops().sight_extents(
+        np.ascontiguousarray(points, dtype=np.float32), float(along[0]), float(along[1])
+    )

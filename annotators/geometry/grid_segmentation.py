@@ -25,6 +25,7 @@ from annotators.geometry.grid_kernels import (
     outside_extents,
     sampled_median,
     seam_pixels,
+    sight_extents,
     surface_growth,
     touching_keys,
     unlabelled_box,
@@ -237,13 +238,8 @@ def join_labels(labels: np.ndarray, pairs: list[tuple[int, int]]) -> np.ndarray:
     return joined_labels(np.asarray(labels), np.asarray(pairs, dtype=np.int64))
 
 
-def _range(values: np.ndarray, low: float, high: float) -> tuple[float, float]:
-    """The ``low`` and ``high`` quantiles (0..1) of a 1-D array, by sorting (cheap for a few hundred values)."""
-    return _sorted_range(np.sort(values), low, high)
-
-
 def _sorted_range(ordered: np.ndarray, low: float, high: float) -> tuple[float, float]:
-    """:func:`_range` of values already sorted."""
+    """The ``low`` and ``high`` quantiles (0..1) of a sorted 1-D array (the values at ``round(q (n - 1))``)."""
     last = ordered.size - 1
     return float(ordered[round(low * last)]), float(ordered[round(high * last)])
 
@@ -364,8 +360,8 @@ class ContainerOutside:
 
     def could_hold(self, far: np.ndarray, depth_ratio: float, far_heights: np.ndarray | None = None) -> bool:
         """Could part ``far`` (Nx3 plane coordinates) be the inside of this container? ``far_heights``, when
-        given, are ``far``'s heights sorted (then not sorted again). The heights are tested before the
-        projections: each test only rules out, so their order does not change the answer."""
+        given, are ``far``'s heights sorted (then not sorted again). Each test only rules out, so their order does
+        not change the answer."""
         if far.shape[0] < 3:
             return False
         far_median, far_top = _sorted_range(np.sort(far[:, 2]) if far_heights is None else far_heights, 0.5, 0.95)
@@ -373,10 +369,9 @@ class ContainerOutside:
             return False
         if not (far_top - far_median >= INNER_SPREAD * self.rim or far_median <= 0.5 * self.rim):
             return False
-        far_low, far_high = _range(far[:, :2] @ self.across, 0.05, 0.95)
+        far_low, far_high, far_middle, far_back = sight_extents(far, self.along).tolist()
         if far_low < self.low - self.margin or far_high > self.high + self.margin:
             return False
-        far_middle, far_back = _range(far[:, :2] @ self.along, 0.5, 0.95)
         return not (far_middle <= self.middle or far_back > self.front + depth_ratio * (self.high - self.low))
 
 

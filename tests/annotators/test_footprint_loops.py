@@ -7,7 +7,7 @@ import cv2
 import numpy as np
 import pytest
 
-from annotators.geometry.grid_kernels import convex_hull, footprint_shares, outside_extents
+from annotators.geometry.grid_kernels import convex_hull, footprint_shares, outside_extents, sight_extents
 
 
 def _polygon(points: np.ndarray) -> tuple[float, list[float], list[float]]:
@@ -95,3 +95,14 @@ def test_footprint_shares_agree_with_opencvs_fill() -> None:
         np.tile(vertices[: starts[1]], (2, 1)), np.array([0, starts[1], 2 * starts[1]]), boxes[[0, 0]], np.array([0]), 1
     )
     assert same[0] == 1.0
+
+
+def test_sight_extents_are_the_quantiles_of_the_projections() -> None:
+    rng = np.random.default_rng(4)
+    points = (rng.normal(size=(300, 3)) * [0.02, 0.05, 0.03] + [-0.2, 0.5, 0.05]).astype(np.float32)
+    along = np.array([0.6, 0.8])
+    across = np.array([-0.8, 0.6])
+    on_along, on_across = np.sort(points[:, :2] @ along), np.sort(points[:, :2] @ across)
+    # index round(q * 299): 14.95 -> 15, 284.05 -> 284, 149.5 -> 150 (half to even)
+    expected = [on_across[15], on_across[284], on_along[150], on_along[284]]
+    assert sight_extents(points, along) == pytest.approx(expected, rel=1e-9, abs=1e-12)
