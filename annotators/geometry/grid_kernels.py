@@ -317,3 +317,61 @@ def plane_coordinates(points: np.ndarray, to_plane: np.ndarray, offset: np.ndarr
         np.ascontiguousarray(to_plane, dtype=np.float32),
         np.ascontiguousarray(offset, dtype=np.float32),
     )
+
+
+@functools.cache
+def _footprint_loops() -> ModuleType:
+    """:mod:`annotators.geometry.footprint_loops`, imported (and numba with it) on first use."""
+    from annotators.geometry import footprint_loops
+
+    return footprint_loops
+
+
+def convex_hull(points: np.ndarray) -> np.ndarray:
+    """Kx2: the convex hull of Nx2 float ``points`` (counter-clockwise, no collinear vertices; fewer than three
+    points are returned as they are), in their dtype. A strided view (two columns of a wider array) is read in
+    place."""
+    return _footprint_loops().convex_hull(np.asarray(points))
+
+
+def outside_extents(near: np.ndarray, heights: np.ndarray) -> np.ndarray:
+    """The extents of a part seen as a container's outside, from its Nx3 plane coordinates ``(u, v, height)``
+    (N >= 1) and its heights sorted: 8 float64, the unit direction ``along`` the line of sight (the centroid's
+    horizontal direction from the camera's foot, 2), the 5 % and 95 % positions across it, the 95 % height (the
+    rim), the 5 % and 50 % positions along it, and the centroid's distance; NaN everywhere when the centroid lies
+    within a micrometre of the camera's foot. Positions are sorted-order quantiles at index ``round(q (n - 1))``."""
+    return _footprint_loops().outside_extents(
+        np.ascontiguousarray(near, dtype=np.float32), np.ascontiguousarray(heights, dtype=np.float32)
+    )
+
+
+def footprint_shares(
+    vertices: np.ndarray, starts: np.ndarray, boxes: np.ndarray, pairs: np.ndarray, count: int
+) -> np.ndarray:
+    """float64 (``count``): for each of the ``pairs`` (indices k < ``count``) the cells shared by convex polygons
+    k and ``count + k`` over the smaller one's cells, 0 for the others. Polygon j has the integer (Nx2) ``vertices
+    [starts[j]:starts[j + 1]]`` on the raster of its bounding cells ``boxes[j]`` = ``(x, y, width, height)`` (integer
+    cells of one grid, its vertices relative to ``(x, y)``); it covers, in each row, the cells it touches within
+    the row's band (a polygon edge-on, a line, still covers one cell per row)."""
+    return _footprint_loops().footprint_shares(
+        np.ascontiguousarray(vertices, dtype=np.int64),
+        np.ascontiguousarray(starts, dtype=np.int64),
+        np.ascontiguousarray(boxes, dtype=np.int64),
+        np.ascontiguousarray(pairs, dtype=np.int64),
+        count,
+    )
+
+
+def sampled_median(values: np.ndarray, indices: np.ndarray, step: int) -> float:
+    """The median of ``values[indices[::step]]`` (1-D float ``values``, int ``indices``), in float64; NaN when
+    one of them is NaN or there are none."""
+    return _loops().sampled_median(values, indices, step)
+
+
+def sight_extents(points: np.ndarray, along: np.ndarray) -> np.ndarray:
+    """4 float64 of Nx3 plane coordinates ``points`` (N >= 1) seen along the unit horizontal direction ``along``:
+    the 5 % and 95 % positions across it (``(-along[1], along[0])``) and the 50 % and 95 % positions along it
+    (sorted-order quantiles at index ``round(q (n - 1))``)."""
+    return _footprint_loops().sight_extents(
+        np.ascontiguousarray(points, dtype=np.float32), float(along[0]), float(along[1])
+    )

@@ -918,3 +918,20 @@ def plane_coordinates(points: np.ndarray, to_plane: np.ndarray, offset: np.ndarr
             total = _fused_multiply_add(z, to_plane[2, k], total)
             result[i, k] = total + offset[k]
     return result
+
+
+@njit(cache=True, nogil=True)
+def sampled_median(values: np.ndarray, indices: np.ndarray, step: int) -> float:
+    """See :func:`annotators.geometry.grid_kernels.sampled_median`."""
+    count = (indices.size + step - 1) // step
+    if count == 0:
+        return np.nan
+    picked = np.empty(count, dtype=np.float64)
+    for k in range(count):
+        value = values[indices[k * step]]
+        if np.isnan(value):
+            return np.nan
+        picked[k] = value
+    low, high = (count - 1) // 2, count // 2
+    ordered = np.partition(picked, np.array([low, high]))
+    return (ordered[low] + ordered[high]) / 2.0

@@ -16,11 +16,16 @@ import numpy as np
 from annotators.geometry.grid_kernels import (
     boundary_pairs,
     connected_parts,
+    convex_hull,
+    footprint_shares,
     groups_unless_apart,
     joined_labels,
     label_pixels,
     nearest_seed_labels,
+    outside_extents,
+    sampled_median,
     seam_pixels,
+    sight_extents,
     surface_growth,
     touching_keys,
     unlabelled_box,
@@ -204,13 +209,12 @@ def footprint_overlap(first: np.ndarray, second: np.ndarray, cell: float) -> flo
 def footprint_overlaps(firsts: Sequence[np.ndarray], seconds: Sequence[np.ndarray], cell: float) -> np.ndarray:
     """:func:`footprint_overlap` of every pair ``(firsts[k], seconds[k])`` of convex polygons (Nx2, metres).
 
-    The bounds, the test for footprints apart and the raster vertices of all polygons are computed at once; only
-    the filling and counting of the rasters goes pair by pair.
+    The bounds, the test for footprints apart and the raster vertices of all polygons are computed at once, the
+    shared cells of the pairs near each other in one compiled pass (:func:`footprint_shares`).
     """
     count = len(firsts)
-    shares = np.zeros(count)
     if count == 0:
-        return shares
+        return np.zeros(0)
     hulls = [*firsts, *seconds]
     sizes = np.array([hull.shape[0] for hull in hulls])
     starts = np.cumsum(sizes) - sizes
@@ -224,33 +228,9 @@ def footprint_overlaps(firsts: Sequence[np.ndarray], seconds: Sequence[np.ndarra
     vertices = np.round((stacked - np.repeat(np.concatenate([low, low]), sizes, axis=0)) / cell).astype(np.int32)
     corner = np.minimum.reduceat(vertices, starts, axis=0)
     far_corner = np.maximum.reduceat(vertices, starts, axis=0) + 1
-    boxes = np.column_stack([corner, far_corner - corner]).tolist()  # x, y, width, height of the cells spanned
+    boxes = np.column_stack([corner, far_corner - corner])  # x, y, width, height of the cells spanned
     vertices -= np.repeat(corner, sizes, axis=0)  # each polygon's vertices on its own raster
-    ends = (starts + sizes).tolist()
-    starts = starts.tolist()
-    for pair in np.flatnonzero(near).tolist():
-        rasters = []
-        for hull in (pair, pair + count):
-            rasters.append(_filled(vertices[starts[hull] : ends[hull]], boxes[hull]))
-        (ax, ay, aw, ah), (bx, by, bw, bh) = boxes[pair], boxes[pair + count]
-        x0, y0, x1, y1 = max(ax, bx), max(ay, by), min(ax + aw, bx + bw), min(ay + ah, by + bh)
-        shared = 0
-        if x1 > x0 and y1 > y0:
-            shared = cv2.countNonZero(
-                cv2.bitwise_and(
-                    rasters[0][y0 - ay : y1 - ay, x0 - ax : x1 - ax], rasters[1][y0 - by : y1 - by, x0 - bx : x1 - bx]
-                )
-            )
-        shares[pair] = shared / max(1, min(cv2.countNonZero(rasters[0]), cv2.countNonZero(rasters[1])))
-    return shares
-
-
-def _filled(vertices: np.ndarray, box: Sequence[int]) -> np.ndarray:
-    """The cells (uint8, 1 = covered) a convex polygon covers on the raster of its bounding ``box`` ``(x, y, width,
-    height)``, its integer ``vertices`` given relative to the box's corner."""
-    raster = np.zeros((box[3], box[2]), dtype=np.uint8)
-    cv2.fillConvexPoly(raster, vertices, 1)
-    return raster
+    return footprint_shares(vertices, np.append(starts, stacked.shape[0]), boxes, np.flatnonzero(near), count)
 
 
 def join_labels(labels: np.ndarray, pairs: list[tuple[int, int]]) -> np.ndarray:
@@ -258,13 +238,8 @@ def join_labels(labels: np.ndarray, pairs: list[tuple[int, int]]) -> np.ndarray:
     return joined_labels(np.asarray(labels), np.asarray(pairs, dtype=np.int64))
 
 
-def _range(values: np.ndarray, low: float, high: float) -> tuple[float, float]:
-    """The ``low`` and ``high`` quantiles (0..1) of a 1-D array, by sorting (cheap for a few hundred values)."""
-    return _sorted_range(np.sort(values), low, high)
-
-
 def _sorted_range(ordered: np.ndarray, low: float, high: float) -> tuple[float, float]:
-    """:func:`_range` of values already sorted."""
+    """The ``low`` and ``high`` quantiles (0..1) of a sorted 1-D array (the values at ``round(q (n - 1))``)."""
     last = ordered.size - 1
     return float(ordered[round(low * last)]), float(ordered[round(high * last)])
 
@@ -385,8 +360,8 @@ class ContainerOutside:
 
     def could_hold(self, far: np.ndarray, depth_ratio: float, far_heights: np.ndarray | None = None) -> bool:
         """Could part ``far`` (Nx3 plane coordinates) be the inside of this container? ``far_heights``, when
-        given, are ``far``'s heights sorted (then not sorted again). The heights are tested before the
-        projections: each test only rules out, so their order does not change the answer."""
+        given, are ``far``'s heights sorted (then not sorted again). Each test only rules out, so their order does
+        not change the answer."""
         if far.shape[0] < 3:
             return False
         far_median, far_top = _sorted_range(np.sort(far[:, 2]) if far_heights is None else far_heights, 0.5, 0.95)
@@ -394,10 +369,9 @@ class ContainerOutside:
             return False
         if not (far_top - far_median >= INNER_SPREAD * self.rim or far_median <= 0.5 * self.rim):
             return False
-        far_low, far_high = _range(far[:, :2] @ self.across, 0.05, 0.95)
+        far_low, far_high, far_middle, far_back = sight_extents(far, self.along).tolist()
         if far_low < self.low - self.margin or far_high > self.high + self.margin:
             return False
-        far_middle, far_back = _range(far[:, :2] @ self.along, 0.5, 0.95)
         return not (far_middle <= self.middle or far_back > self.front + depth_ratio * (self.high - self.low))
 
 
@@ -409,16 +383,13 @@ def container_outside(
     given, are ``near``'s heights sorted (then not sorted again)."""
     if near.shape[0] < 3:
         return None
-    centre = near[:, :2].mean(axis=0)
-    distance = float(np.linalg.norm(centre))
-    if distance < 1e-6:
+    extents = outside_extents(near, np.sort(near[:, 2]) if near_heights is None else near_heights)
+    if not np.isfinite(extents[7]):
         return None
-    along = centre / distance
-    across = np.array([-along[1], along[0]], dtype=near.dtype)
-    near_low, near_high = _range(near[:, :2] @ across, 0.05, 0.95)
+    along = extents[:2]
+    across = np.array([-along[1], along[0]])
+    near_low, near_high, rim, near_front, near_middle = extents[2:7].tolist()
     margin = max(tolerance, 0.1 * (near_high - near_low))
-    rim = _sorted_range(np.sort(near[:, 2]) if near_heights is None else near_heights, 0.5, 0.95)[1]
-    near_front, near_middle = _range(near[:, :2] @ along, 0.05, 0.5)
     return ContainerOutside(along, across, near_low, near_high, margin, rim, near_front, near_middle)
 
 
@@ -463,7 +434,7 @@ class _Parts:
     def hull(self, label: int) -> np.ndarray:
         """The convex hull of the part's footprint (Kx2)."""
         if label not in self._hulls:
-            self._hulls[label] = cv2.convexHull(np.ascontiguousarray(self.coordinates(label)[:, :2])).reshape(-1, 2)
+            self._hulls[label] = convex_hull(self.coordinates(label)[:, :2])
         return self._hulls[label]
 
     def outside(self, label: int, tolerance: float) -> ContainerOutside | None:
@@ -477,7 +448,7 @@ class _Parts:
         """The median depth of the part."""
         if label not in self._depths:
             own = self.own(label)
-            self._depths[label] = float(_median(self.depth[own[:: max(1, own.size // 500)]]))
+            self._depths[label] = sampled_median(self.depth, own, max(1, own.size // 500))
         return self._depths[label]
 
 

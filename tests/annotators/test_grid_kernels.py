@@ -23,6 +23,7 @@ from annotators.geometry.grid_kernels import (
     label_pixels,
     nearest_seed_labels,
     plane_coordinates,
+    sampled_median,
     shadowed_near,
     strided_crop,
     symmetric_eigen,
@@ -405,3 +406,16 @@ def test_plane_coordinates_give_what_the_matrix_product_gives_on_a_grid_with_gap
     expected = points @ to_plane + offset
     assert np.array_equal(result, expected, equal_nan=True)
     assert not np.array_equal(result, points.astype(np.float64) @ to_plane + offset, equal_nan=True)
+
+
+@pytest.mark.parametrize("step", [1, 2, 7])
+def test_sampled_median_is_numpys_median_of_the_sample(step: int) -> None:
+    rng = np.random.default_rng(step)
+    values = rng.uniform(0.4, 2.0, 5000).astype(np.float32)
+    indices = np.sort(rng.choice(5000, size=1001, replace=False))
+    for end in (1001, 1000, 3):  # odd and even sample sizes
+        expected = float(np.median(values[indices[:end:step]].astype(np.float64)))
+        assert sampled_median(values, indices[:end], step) == expected
+    values[indices[2 * step]] = np.nan
+    assert np.isnan(sampled_median(values, indices, step))
+    assert np.isnan(sampled_median(values, indices[:0], step))

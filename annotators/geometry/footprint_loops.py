@@ -1,0 +1,201 @@
+"""The compiled loops behind the footprint gateways of :mod:`annotators.geometry.grid_kernels`: the convex hull of a
+part's footprint on the support plane and the extents of a part seen as a container's outside (numba, machine code
+cached on disk next to this file). Importing this module imports numba; the segmentation modules reach it through
+:mod:`~annotators.geometry.grid_kernels` only, on first use."""
+
+from __future__ import annotations
+
+import numpy as np
+from numba import njit
+
+
+@njit(cache=True, nogil=True)
+def _turn(ox: float, oy: float, ax: float, ay: float, bx: float, by: float) -> float:
+    """The cross product ``(a - o) x (b - o)``: positive when ``o, a, b`` turn counter-clockwise."""
+    return (ax - ox) * (by - oy) - (ay - oy) * (bx - ox)
+
+
+@njit(cache=True, nogil=True)
+def convex_hull(points: np.ndarray) -> np.ndarray:
+    """Kx2 (``points``' dtype): the convex hull of Nx2 ``points``, counter-clockwise, without collinear vertices.
+
+    The points strictly inside the quadrilateral of the four extreme points (least and largest x and y) cannot be
+    vertices and are dropped first (Akl-Toussaint); the rest are sorted by x, then y, and the monotone chain
+    builds the lower and upper hulls."""
+    count = points.shape[0]
+    if count < 3:
+        return points.copy()
+    x = points[:, 0].astype(np.float64)
+    y = points[:, 1].astype(np.float64)
+    west = east = south = north = 0
+    for i in range(1, count):
+        if x[i] < x[west]:
+            west = i
+        if x[i] > x[east]:
+            east = i
+        if y[i] < y[south]:
+            south = i
+        if y[i] > y[north]:
+            north = i
+    corners = (west, south, east, north)  # counter-clockwise around the points
+    kept = np.empty(count, dtype=np.int64)
+    size = 0
+    for i in range(count):
+        inside = True
+        for k in range(4):
+            a, b = corners[k], corners[(k + 1) % 4]
+            if _turn(x[a], y[a], x[b], y[b], x[i], y[i]) <= 0.0:
+                inside = False
+                break
+        if not inside:
+            kept[size] = i
+            size += 1
+    kept = kept[:size]
+    kept = kept[np.argsort(y[kept], kind="mergesort")]
+    kept = kept[np.argsort(x[kept], kind="mergesort")]
+    chain = np.empty(2 * size + 1, dtype=np.int64)
+    length = 0
+    for i in kept:  # lower hull, left to right
+        while (
+            length >= 2
+            and _turn(
+                x[chain[length - 2]], y[chain[length - 2]], x[chain[length - 1]], y[chain[length - 1]], x[i], y[i]
+            )
+            <= 0.0
+        ):
+            length -= 1
+        chain[length] = i
+        length += 1
+    lower = length + 1
+    for j in range(size - 2, -1, -1):  # upper hull, right to left
+        i = kept[j]
+        while (
+            length >= lower
+            and _turn(
+                x[chain[length - 2]], y[chain[length - 2]], x[chain[length - 1]], y[chain[length - 1]], x[i], y[i]
+            )
+            <= 0.0
+        ):
+            length -= 1
+        chain[length] = i
+        length += 1
+    length = max(length - 1, 1)  # the last vertex repeats the first
+    hull = np.empty((length, 2), dtype=points.dtype)
+    for k in range(length):
+        hull[k, 0] = points[chain[k], 0]
+        hull[k, 1] = points[chain[k], 1]
+    return hull
+
+
+@njit(cache=True, nogil=True)
+def _rank(count: int, share: float) -> int:
+    """The index ``round(share * (count - 1))`` (half to even) of the ``share`` quantile of ``count`` sorted
+    values."""
+    return int(np.rint(share * (count - 1)))
+
+
+@njit(cache=True, nogil=True)
+def outside_extents(near: np.ndarray, heights: np.ndarray) -> np.ndarray:
+    """See :func:`annotators.geometry.grid_kernels.outside_extents`."""
+    count = near.shape[0]
+    result = np.full(8, np.nan)
+    cx = 0.0
+    cy = 0.0
+    for i in range(count):
+        cx += near[i, 0]
+        cy += near[i, 1]
+    cx /= count
+    cy /= count
+    distance = np.sqrt(cx * cx + cy * cy)
+    if distance < 1e-6:
+        return result
+    ax, ay = cx / distance, cy / distance
+    across = np.empty(count)
+    along = np.empty(count)
+    for i in range(count):
+        across[i] = -ay * near[i, 0] + ax * near[i, 1]
+        along[i] = ax * near[i, 0] + ay * near[i, 1]
+    low, middle, high = _rank(count, 0.05), _rank(count, 0.5), _rank(count, 0.95)
+    across = np.partition(across, np.array([low, high]))
+    along = np.partition(along, np.array([low, middle]))
+    result[0], result[1] = ax, ay
+    result[2], result[3] = across[low], across[high]
+    result[4] = heights[_rank(heights.size, 0.95)]
+    result[5], result[6] = along[low], along[middle]
+    result[7] = distance
+    return result
+
+
+@njit(cache=True, nogil=True)
+def _row_spans(vertices: np.ndarray, start: int, end: int, height: int) -> tuple[np.ndarray, np.ndarray]:
+    """Per row of a convex polygon's raster (integer ``vertices[start:end]``, cell centres at integer coordinates,
+    ``height`` rows from 0), the first and last column of the cells the polygon touches within the row (the
+    polygon clipped to the row's band ``r - 0.5 .. r + 0.5``); ``first > last`` where it touches none."""
+    first = np.full(height, np.iinfo(np.int64).max, dtype=np.int64)
+    last = np.full(height, np.iinfo(np.int64).min, dtype=np.int64)
+    low = np.full(height, np.inf)
+    high = np.full(height, -np.inf)
+    size = end - start
+    for k in range(size):
+        px, py = float(vertices[start + k, 0]), float(vertices[start + k, 1])
+        following = start + (k + 1) % size
+        qx, qy = float(vertices[following, 0]), float(vertices[following, 1])
+        bottom, top = min(py, qy), max(py, qy)
+        for row in range(max(0, int(np.floor(bottom + 0.75))), min(height - 1, int(np.ceil(top - 0.75))) + 1):
+            y0, y1 = max(bottom, row - 0.25), min(top, row + 0.25)
+            if py == qy:
+                x0, x1 = px, qx
+            else:
+                x0 = px + (qx - px) * (y0 - py) / (qy - py)
+                x1 = px + (qx - px) * (y1 - py) / (qy - py)
+            low[row] = min(low[row], x0, x1)
+            high[row] = max(high[row], x0, x1)
+    for row in range(height):
+        if low[row] <= high[row]:
+            first[row] = int(np.floor(low[row] + 0.5))
+            last[row] = int(np.ceil(high[row] - 0.5))
+    return first, last
+
+
+@njit(cache=True, nogil=True)
+def footprint_shares(
+    vertices: np.ndarray, starts: np.ndarray, boxes: np.ndarray, pairs: np.ndarray, count: int
+) -> np.ndarray:
+    """See :func:`annotators.geometry.grid_kernels.footprint_shares`."""
+    shares = np.zeros(count)
+    for pair in pairs:
+        second = pair + count
+        a_first, a_last = _row_spans(vertices, starts[pair], starts[pair + 1], boxes[pair, 3])
+        b_first, b_last = _row_spans(vertices, starts[second], starts[second + 1], boxes[second, 3])
+        areas = np.zeros(2, dtype=np.int64)
+        for side, (first, last) in enumerate(((a_first, a_last), (b_first, b_last))):
+            for row in range(first.size):
+                if first[row] <= last[row]:
+                    areas[side] += last[row] - first[row] + 1
+        ax, ay, bx, by = boxes[pair, 0], boxes[pair, 1], boxes[second, 0], boxes[second, 1]
+        shared = 0
+        for y in range(max(ay, by), min(ay + a_first.size, by + b_first.size)):
+            a, b = y - ay, y - by
+            if a_first[a] > a_last[a] or b_first[b] > b_last[b]:
+                continue
+            low = max(a_first[a] + ax, b_first[b] + bx)
+            high = min(a_last[a] + ax, b_last[b] + bx)
+            if low <= high:
+                shared += high - low + 1
+        shares[pair] = shared / max(1, min(areas[0], areas[1]))
+    return shares
+
+
+@njit(cache=True, nogil=True)
+def sight_extents(points: np.ndarray, ax: float, ay: float) -> np.ndarray:
+    """See :func:`annotators.geometry.grid_kernels.sight_extents`."""
+    count = points.shape[0]
+    across = np.empty(count)
+    along = np.empty(count)
+    for i in range(count):
+        across[i] = -ay * points[i, 0] + ax * points[i, 1]
+        along[i] = ax * points[i, 0] + ay * points[i, 1]
+    low, middle, high = _rank(count, 0.05), _rank(count, 0.5), _rank(count, 0.95)
+    across = np.partition(across, np.array([low, high]))
+    along = np.partition(along, np.array([middle, high]))
+    return np.array([across[low], across[high], along[middle], along[high]])
