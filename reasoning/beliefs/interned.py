@@ -10,7 +10,8 @@ from __future__ import annotations
 
 import json
 import sqlite3
-from collections.abc import Callable, Set
+import struct
+from collections.abc import Callable, Iterator, Set
 
 INTERN = "INSERT OR IGNORE INTO interned (text) VALUES (?)"
 """The statement that interns a text (its code: the next rowid)."""
@@ -75,3 +76,26 @@ class InternedTexts:
         for code, text in conn.execute("SELECT code, text FROM interned"):
             self.codes[text] = code
             self.texts[code] = text
+
+
+DecodedSupport = tuple[int, int, float, int, int, float, float, str, str, tuple[str, ...]]
+"""A packed support's fields (name code, value code, log-odds, count, expert-set code, first seen, last seen) followed
+by its attribute name, value and expert names as texts."""
+
+
+def decoded_supports(
+    packed: bytes, record: struct.Struct, interned: InternedTexts, conn: sqlite3.Connection
+) -> Iterator[DecodedSupport]:
+    """Each support of a packed attribute column (``record``: one support's layout) with its codes read as texts."""
+    texts, expert_sets = interned.texts, interned.expert_sets
+    for name_code, value_code, log_odds, count, experts, first_seen, last_seen in record.iter_unpack(packed):
+        name = texts.get(name_code)
+        if name is None:
+            name = interned.text(conn, name_code)
+        value = texts.get(value_code)
+        if value is None:
+            value = interned.text(conn, value_code)
+        names = expert_sets.get(experts)
+        if names is None:
+            names = interned.experts(conn, experts)
+        yield name_code, value_code, log_odds, count, experts, first_seen, last_seen, name, value, names

@@ -23,7 +23,7 @@ from collections.abc import Callable, Sequence
 
 import numpy as np
 
-from reasoning.beliefs.interned import InternedTexts
+from reasoning.beliefs.interned import InternedTexts, decoded_supports
 from reasoning.beliefs.packed import (
     INDEX_SEPARATOR,
     SUPPORT,
@@ -78,21 +78,7 @@ class RowUpdate:
 
     def supports(self, row: tuple) -> list[Support]:
         """The supports of a stored row, in stored order (texts read from ``interned``)."""
-        interned, conn = self.interned, self.conn
-        texts, expert_sets = interned.texts, interned.expert_sets
-        records = []
-        for name_code, value_code, log_odds, count, experts, first_seen, last_seen in SUPPORT.iter_unpack(row[26]):
-            name = texts.get(name_code)
-            if name is None:
-                name = interned.text(conn, name_code)
-            value = texts.get(value_code)
-            if value is None:
-                value = interned.text(conn, value_code)
-            names = expert_sets.get(experts)
-            if names is None:
-                names = interned.experts(conn, experts)
-            records.append([name_code, value_code, log_odds, count, experts, first_seen, last_seen, name, value, names])
-        return records
+        return [list(decoded) for decoded in decoded_supports(row[26], SUPPORT, self.interned, self.conn)]
 
     def update(self, row: tuple, records: list[Support], observation: FrameObject, time: float) -> tuple | None:
         """The new ``objects`` row of ``row`` (its supports ``records``) updated by ``observation`` at ``time``, or
@@ -127,15 +113,7 @@ class RowUpdate:
         if sx is not None:
             rate = config.blend_rate
             a, b, c = (1.0 - rate) * sx + rate * a, (1.0 - rate) * sy + rate * b, (1.0 - rate) * sz + rate * c
-        class_name = region = None
-        entries = []
-        for r in records:
-            name, value = r[_SUPPORT_NAME], r[_SUPPORT_VALUE]
-            if name == CLASS_ATTRIBUTE:
-                class_name = value if r[2] > 0 else None
-            elif name == Location.attribute:
-                region = value
-            entries.append(f"{name}={value}")
+        class_name, region, entries = _class_region_entries(records)
         stated = frozenset(observation.sources)
         text = self.sources.get((sources, stated))
         if text is None:
@@ -218,15 +196,7 @@ class RowUpdate:
                 return None  # a second value stated
         records: list[Support] = []
         self._accumulate({}, records, observation, time)
-        class_name = region = None
-        entries = []
-        for r in records:
-            name, value = r[_SUPPORT_NAME], r[_SUPPORT_VALUE]
-            if name == CLASS_ATTRIBUTE:
-                class_name = value if r[2] > 0 else None
-            elif name == Location.attribute:
-                region = value
-            entries.append(f"{name}={value}")
+        class_name, region, entries = _class_region_entries(records)
         experts = frozenset(observation.sources)
         text = self.sources.get(("[]", experts))  # an empty stored set joined with the stated experts
         if text is None:
@@ -280,6 +250,21 @@ class RowUpdate:
             rounded = rounded_cached(log_odds, 9) if log_odds else round(log_odds, 9)
             flat += (name_code, value_code, rounded, count, experts, first_seen, last_seen)
         return (*row[:26], supports_packing(len(records)).pack(*flat), row[27])
+
+
+def _class_region_entries(records: Sequence[Support]) -> tuple[str | None, str | None, list[str]]:
+    """The class (when its support is positive), the region and the index entries (``name=value``) of single-valued
+    supports."""
+    class_name = region = None
+    entries = []
+    for r in records:
+        name, value = r[_SUPPORT_NAME], r[_SUPPORT_VALUE]
+        if name == CLASS_ATTRIBUTE:
+            class_name = value if r[2] > 0 else None
+        elif name == Location.attribute:
+            region = value
+        entries.append(f"{name}={value}")
+    return class_name, region, entries
 
 
 def belief_of(row: tuple, records: Sequence[Support], roi: tuple[int, int, int, int] | None) -> ObjectBelief:

@@ -42,7 +42,7 @@ from typing import TypeVar
 import numpy as np
 import platformdirs
 
-from reasoning.beliefs.interned import InternedTexts
+from reasoning.beliefs.interned import InternedTexts, decoded_supports
 from reasoning.beliefs.packed import (
     FIELDS,
     INDEX_SEPARATOR,
@@ -1085,19 +1085,10 @@ def _pack_attributes(
 
 def _unpack_attributes(packed: bytes, interned: InternedTexts, conn: sqlite3.Connection) -> dict[str, AttributeBelief]:
     """The attributes of a packed attribute column (see :func:`_pack_attributes`)."""
-    texts = interned.texts
-    expert_sets = interned.expert_sets
     decoded: dict[str, AttributeBelief] = {}
-    for name_code, value_code, log_odds, count, experts, first_seen, last_seen in SUPPORT.iter_unpack(packed):
-        name = texts.get(name_code)
-        if name is None:
-            name = interned.text(conn, name_code)
-        value = texts.get(value_code)
-        if value is None:
-            value = interned.text(conn, value_code)
-        sources = expert_sets.get(experts)
-        if sources is None:
-            sources = interned.experts(conn, experts)
+    for _, _, log_odds, count, _, first_seen, last_seen, name, value, sources in decoded_supports(
+        packed, SUPPORT, interned, conn
+    ):
         attribute = decoded.get(name)
         if attribute is None:
             attribute = decoded[name] = AttributeBelief(name, {})
