@@ -14,7 +14,7 @@ import sys
 from pathlib import Path
 
 import numpy as np
-from revision_workers import compare_with_revision
+from revision_workers import compare_with_revision, report_npz_pairs
 
 ROOT = Path(__file__).resolve().parents[1]
 DATA = (ROOT.parent / "shared" / "data").resolve()
@@ -81,14 +81,12 @@ def worker(checkout: str, folder: Path, names: list[str], tag: str) -> None:
 
 def report(inputs: Path, names: list[str]) -> None:
     """Compare the two sides' results input by input and print the differences and the count."""
-    same = 0
-    for name in names:
-        ours, theirs = np.load(inputs / f"ours-{name}.npz"), np.load(inputs / f"theirs-{name}.npz")
-        equal = all(np.array_equal(ours[key], theirs[key]) for key in ("sizes", "indices", "masks", "rois"))
-        same += equal
-        if not equal:
-            print(f"DIFFERENT: {name} ({ours['sizes'].size} vs {theirs['sizes'].size} segments)")
-    print(f"identical on {same}/{len(names)} inputs")
+    report_npz_pairs(
+        inputs,
+        names,
+        lambda ours, theirs: all(np.array_equal(ours[k], theirs[k]) for k in ("sizes", "indices", "masks", "rois")),
+        lambda ours, theirs: f"{ours['sizes'].size} vs {theirs['sizes'].size} segments",
+    )
 
 
 def main() -> None:

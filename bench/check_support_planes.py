@@ -14,7 +14,7 @@ from pathlib import Path
 
 import numpy as np
 from check_clutter_labels import prepare
-from revision_workers import compare_with_revision
+from revision_workers import compare_with_revision, report_npz_pairs
 
 
 def worker(checkout: str, folder: Path, names: list[str], tag: str) -> None:
@@ -32,16 +32,15 @@ def worker(checkout: str, folder: Path, names: list[str], tag: str) -> None:
 
 def report(inputs: Path, names: list[str]) -> None:
     """Compare the two sides' planes input by input and print the differences and the count."""
-    same = 0
-    for name in names:
-        ours, theirs = np.load(inputs / f"ours-{name}.npz"), np.load(inputs / f"theirs-{name}.npz")
-        equal = np.array_equal(ours["model"], theirs["model"], equal_nan=True) and np.array_equal(
-            ours["inliers"], theirs["inliers"]
-        )
-        same += equal
-        if not equal:
-            print(f"DIFFERENT: {name} ({ours['inliers'].size} vs {theirs['inliers'].size} inliers)")
-    print(f"identical on {same}/{len(names)} inputs")
+    report_npz_pairs(
+        inputs,
+        names,
+        lambda ours, theirs: (
+            np.array_equal(ours["model"], theirs["model"], equal_nan=True)
+            and np.array_equal(ours["inliers"], theirs["inliers"])
+        ),
+        lambda ours, theirs: f"{ours['inliers'].size} vs {theirs['inliers'].size} inliers",
+    )
 
 
 def main() -> None:

@@ -17,6 +17,8 @@ import tempfile
 from collections.abc import Callable
 from pathlib import Path
 
+import numpy as np
+
 ROOT = Path(__file__).resolve().parents[1]
 
 
@@ -64,3 +66,18 @@ def compare_with_revision(
         names = prepare(inputs)
         run_both(script, args.reference, inputs, reference)
         report(inputs, names)
+
+
+def report_npz_pairs(
+    inputs: Path, names: list[str], equal: Callable[[dict, dict], bool], describe: Callable[[dict, dict], str]
+) -> None:
+    """Compare each input's ``ours-NAME.npz`` with ``theirs-NAME.npz`` by ``equal``, print each difference (what
+    ``describe`` says of it) and the count of identical inputs."""
+    same = 0
+    for name in names:
+        ours, theirs = np.load(inputs / f"ours-{name}.npz"), np.load(inputs / f"theirs-{name}.npz")
+        if equal(ours, theirs):
+            same += 1
+        else:
+            print(f"DIFFERENT: {name} ({describe(ours, theirs)})")
+    print(f"identical on {same}/{len(names)} inputs")
