@@ -114,6 +114,23 @@ def _term_votes(labs: np.ndarray, parameters: NamingParameters) -> np.ndarray:
     votes = density / np.where(far, 1.0, total)[:, None]
     if np.any(far):
         votes[far] = np.eye(len(CHROMATIC_TERMS))[_PROTOTYPE_CODES[np.argmin(distances[far], axis=1)]]
+    return _without_colourful_brown(votes, labs, parameters)
+
+
+_BROWN = CHROMATIC_TERMS.index("brown")
+
+
+def _without_colourful_brown(votes: np.ndarray, labs: np.ndarray, parameters: NamingParameters) -> np.ndarray:
+    """The votes with brown's taken away (the others' shares renormalised) for colours whose chroma C* is at
+    least ``brown_max_chroma``: too colourful for a brown surface, they are a yellow or orange seen in less light;
+    a colour whose every vote is brown keeps them."""
+    colourful = np.hypot(labs[:, 1], labs[:, 2]) >= parameters.brown_max_chroma
+    rest = 1.0 - votes[:, _BROWN]
+    change = colourful & (rest > 1e-12)
+    if np.any(change):
+        votes = votes.copy()
+        votes[change, _BROWN] = 0.0
+        votes[change] /= rest[change, None]
     return votes
 
 
