@@ -230,3 +230,10 @@ def test_a_shaded_side_lit_by_the_paler_room_light_keeps_the_lit_sides_name() ->
     shaded = patch((185, 155, 115), count=270, seed=1)
     assert names(shaded) == ["brown"]
     assert names(np.vstack([patch((230, 210, 90), count=540), shaded])) == ["yellow"]
+
+
+def test_a_dim_yellow_print_too_colourful_for_brown_is_not_brown() -> None:
+    # a crisps tube's yellow print in a dim mOSD frame (L* 54, C* 53): the survey's display browns match it by
+    # lightness, but a brown surface is not that colourful; a brown of moderate chroma stays brown
+    assert names(patch((160, 125, 30))) in (["orange"], ["yellow"])
+    assert names(patch((110, 70, 40))) == ["brown"]
