@@ -16,8 +16,9 @@ Each surface is named (:func:`name_surface`):
   dropped).
 
 Lit saturated surfaces that are shades of one colour (CIEDE2000 neighbours) are named together by their pooled
-votes (:func:`_pool_shades`). A name's share is the share of the named pixels its surfaces hold (grey merges into
-white: an unsaturated object's shaded side). The dominant colour is the largest share; a second colour is
+votes (:func:`_pool_shades`). A name's share is the share of the named pixels its surfaces hold; grey beside white
+is the white's shaded side and is left out (it names no colour of its own, and counted with the white it would hide
+a print as large as the white it is printed on). The dominant colour is the largest share; a second colour is
 reported when its share and its confidence (share x certainty) are large enough.
 
 The annotator names all the hypotheses of a frame together (:func:`name_objects_colors`): their pixels are
@@ -254,9 +255,8 @@ def _object_colors(
             continue  # shadows of the object's surfaces
         weights[named.name] = weights.get(named.name, 0.0) + surface.pixels
         certainties[named.name] = certainties.get(named.name, 0.0) + surface.pixels * named.certainty
-    if "white" in weights and "grey" in weights:  # an unsaturated object's shaded sides
-        weights["white"] += weights.pop("grey")
-        certainties["white"] += certainties.pop("grey")
+    if "white" in weights and "grey" in weights:  # the white's shaded sides: they name nothing new
+        del weights["grey"], certainties["grey"]
     total = sum(weights.values())
     ranked = sorted(weights, key=lambda name: (-weights[name], COLOR_TERMS.index(name)))
     result: list[NamedColor] = []
