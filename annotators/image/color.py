@@ -10,7 +10,8 @@ Each surface is named (:func:`name_surface`):
 * a saturated surface is named in CIELAB by CIEDE2000 distances to the colour-name prototypes of
   :mod:`annotators.image.color_prototypes` (the xkcd colour survey), as a kernel density classifier: each
   term's prototypes vote with a Gaussian of their distance (``kernel_width``) averaged per term, and the winning
-  term's share of the votes is the name's certainty;
+  term's share of the votes is the name's certainty; brown gets no vote from a colour of chroma C* at least
+  ``brown_max_chroma`` (brown surfaces are of moderate chroma; a dim yellow or orange print is not brown);
 * the near-black pool is a dark colour (a navy mug) when its mean colour is clearly saturated, else black; it
   counts only when it is a sizeable part of the object or has the name of one of its lit surfaces (shadows are
   dropped).
