@@ -10,14 +10,16 @@ Each surface is named (:func:`name_surface`):
 * a saturated surface is named in CIELAB by CIEDE2000 distances to the colour-name prototypes of
   :mod:`annotators.image.color_prototypes` (the xkcd colour survey), as a kernel density classifier: each
   term's prototypes vote with a Gaussian of their distance (``kernel_width``) averaged per term, and the winning
-  term's share of the votes is the name's certainty;
+  term's share of the votes is the name's certainty; brown gets no vote from a colour of chroma C* at least
+  ``brown_max_chroma`` (brown surfaces are of moderate chroma; a dim yellow or orange print is not brown);
 * the near-black pool is a dark colour (a navy mug) when its mean colour is clearly saturated, else black; it
   counts only when it is a sizeable part of the object or has the name of one of its lit surfaces (shadows are
   dropped).
 
 Lit saturated surfaces that are shades of one colour (CIEDE2000 neighbours) are named together by their pooled
-votes (:func:`_pool_shades`). A name's share is the share of the named pixels its surfaces hold (grey merges into
-white: an unsaturated object's shaded side). The dominant colour is the largest share; a second colour is
+votes (:func:`_pool_shades`). A name's share is the share of the named pixels its surfaces hold; grey beside white
+is the white's shaded side and is left out (it names no colour of its own, and counted with the white it would hide
+a print as large as the white it is printed on). The dominant colour is the largest share; a second colour is
 reported when its share and its confidence (share x certainty) are large enough.
 
 The annotator names all the hypotheses of a frame together (:func:`name_objects_colors`): their pixels are
@@ -114,6 +116,23 @@ def _term_votes(labs: np.ndarray, parameters: NamingParameters) -> np.ndarray:
     votes = density / np.where(far, 1.0, total)[:, None]
     if np.any(far):
         votes[far] = np.eye(len(CHROMATIC_TERMS))[_PROTOTYPE_CODES[np.argmin(distances[far], axis=1)]]
+    return _without_colourful_brown(votes, labs, parameters)
+
+
+_BROWN = CHROMATIC_TERMS.index("brown")
+
+
+def _without_colourful_brown(votes: np.ndarray, labs: np.ndarray, parameters: NamingParameters) -> np.ndarray:
+    """The votes with brown's taken away (the others' shares renormalised) for colours whose chroma C* is at
+    least ``brown_max_chroma``: too colourful for a brown surface, they are a yellow or orange seen in less light;
+    a colour whose every vote is brown keeps them."""
+    colourful = np.hypot(labs[:, 1], labs[:, 2]) >= parameters.brown_max_chroma
+    rest = 1.0 - votes[:, _BROWN]
+    change = colourful & (rest > 1e-12)
+    if np.any(change):
+        votes = votes.copy()
+        votes[change, _BROWN] = 0.0
+        votes[change] /= rest[change, None]
     return votes
 
 
@@ -237,9 +256,8 @@ def _object_colors(
             continue  # shadows of the object's surfaces
         weights[named.name] = weights.get(named.name, 0.0) + surface.pixels
         certainties[named.name] = certainties.get(named.name, 0.0) + surface.pixels * named.certainty
-    if "white" in weights and "grey" in weights:  # an unsaturated object's shaded sides
-        weights["white"] += weights.pop("grey")
-        certainties["white"] += certainties.pop("grey")
+    if "white" in weights and "grey" in weights:  # the white's shaded sides: they name nothing new
+        del weights["grey"], certainties["grey"]
     total = sum(weights.values())
     ranked = sorted(weights, key=lambda name: (-weights[name], COLOR_TERMS.index(name)))
     result: list[NamedColor] = []

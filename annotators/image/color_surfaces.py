@@ -101,6 +101,10 @@ class NamingParameters:
     are named together."""
     kernel_width: float = 8.0
     """Width (CIEDE2000 units) of each prototype's vote."""
+    brown_max_chroma: float = 48.0
+    """A surface at least this colourful (C*) is not brown: brown surfaces (wood, cardboard, tins) are of moderate
+    chroma, while the survey's browns are display colours that a dim yellow or orange print matches by lightness
+    alone (tuned on the "tune" split: its browns reach C* 33, its yellows named brown 57)."""
     second_share: float = 0.3
     """A second colour is reported when its share of the named pixels is at least this ..."""
     second_confidence: float = 0.1

@@ -230,3 +230,19 @@ def test_a_shaded_side_lit_by_the_paler_room_light_keeps_the_lit_sides_name() ->
     shaded = patch((185, 155, 115), count=270, seed=1)
     assert names(shaded) == ["brown"]
     assert names(np.vstack([patch((230, 210, 90), count=540), shaded])) == ["yellow"]
+
+
+def test_a_dim_yellow_print_too_colourful_for_brown_is_not_brown() -> None:
+    # a crisps tube's yellow print in a dim mOSD frame (L* 54, C* 53): the survey's display browns match it by
+    # lightness, but a brown surface is not that colourful; a brown of moderate chroma stays brown
+    assert names(patch((160, 125, 30))) in (["orange"], ["yellow"])
+    assert names(patch((110, 70, 40))) == ["brown"]
+
+
+def test_a_print_is_measured_against_the_white_not_the_whites_shaded_side() -> None:
+    # a white box with a red print on 28 % of it, a quarter of it the white's shaded side (grey, a slight cast):
+    # the shaded side names no colour of its own; counted with the white it hid the print (white only)
+    white = patch((235, 235, 232), count=450)
+    shaded_white = patch((225, 235, 195), 0.2, count=270, seed=1)
+    assert names(shaded_white) == ["grey"]
+    assert names(np.vstack([white, shaded_white, patch((200, 30, 35), count=280, seed=2)])) == ["white", "red"]
