@@ -98,6 +98,7 @@ from robokudo.core.annotator import Annotator
 from robokudo.core.capability import Capability
 from robokudo.core.text_match import phrase_found
 from robokudo.core.types import (
+    AnswersTo,
     CasType,
     Classification,
     FormFeatures,
@@ -695,7 +696,7 @@ class KnowledgeClassifier(Annotator):
 
     inputs: ClassVar[tuple[type[CasType], ...]] = (ObjectHypothesis, SemanticColor, Shape, Size, FormFeatures)
     optional_inputs: ClassVar[tuple[type[CasType], ...]] = (Text,)
-    outputs: ClassVar[tuple[type[CasType], ...]] = (Classification,)
+    outputs: ClassVar[tuple[type[CasType], ...]] = (Classification, AnswersTo)
     capability: ClassVar[Capability] = Capability(
         label="knowledge classifier",
         classes=(UNKNOWN_CLASS,),
@@ -747,8 +748,9 @@ class KnowledgeClassifier(Annotator):
     def analyse(self) -> None:
         """Attach a Classification to every hypothesis that carries cues: its class when one fits clearly, else
         :data:`UNKNOWN_CLASS` (so the answer can say "unknown object"); when the query's class decided for a class
-        below or packaged in it, also the query's class with the probability that the object answers to it
-        (:attr:`Decision.answering`: the fused answer then shows that figure for "find all bottles")."""
+        below or packaged in it, also an AnswersTo of the query's class with the probability that the object
+        answers to it (:attr:`Decision.answering`: the answer then shows that figure for "find all bottles", while
+        the object's belief keeps only what the object was classified as)."""
         if not self.profiles:
             self.fail("no candidate class profiles to compare the hypotheses with")
         hypotheses = self.annotations(ObjectHypothesis)
@@ -762,7 +764,7 @@ class KnowledgeClassifier(Annotator):
             decision = self.decide(cues)
             self.attach(hypothesis, Classification(class_name=decision.class_name, confidence=decision.confidence))
             if decision.answering is not None and self.expected:  # what the query asked for, as a whole
-                self.attach(hypothesis, Classification(class_name=self.expected, confidence=decision.answering))
+                self.attach(hypothesis, AnswersTo(class_name=self.expected, confidence=decision.answering))
             classified += 1
         if classified == 0:
             self.fail("no object hypothesis carries a colour, shape, size or text to classify by")
