@@ -85,6 +85,7 @@ label went unread is unlikely a mustard but, tying with a lemon soda, as likely 
 
 from __future__ import annotations
 
+import math
 from collections.abc import Callable, Mapping, Sequence
 from dataclasses import dataclass, replace
 from types import MappingProxyType
@@ -413,8 +414,13 @@ def ruled_out(profile: Profile, cues: Cues | None) -> bool:
 
 
 def _beyond(ratio: float | None, listed: tuple[float, float] | None) -> bool:
-    """True when a measured ratio agrees not at all with a declared range (both known)."""
-    return ratio is not None and listed is not None and _ratio_agreement(ratio, listed) <= 0.0
+    """True when a measured ratio agrees not at all with a declared range (both known): it lies
+    :data:`RATIO_FALLOFF` times or more beyond a bound, where :func:`_ratio_agreement` reaches 0 (compared
+    directly, without its logarithms: this runs for every profile in every lead)."""
+    if ratio is None or listed is None or not 0.0 < ratio < math.inf:
+        return False
+    low, high = listed
+    return ratio * RATIO_FALLOFF <= low or ratio >= high * RATIO_FALLOFF
 
 
 def standing(profile: Profile, cues: Cues | None) -> bool:

@@ -15,6 +15,7 @@ import pytest
 
 from annotators.classification.calibration import FITTED, fit
 from annotators.classification.knowledge_classifier import (
+    RATIO_FALLOFF,
     UNKNOWN_CLASS,
     Cues,
     KnowledgeClassifier,
@@ -300,3 +301,17 @@ def test_a_rival_stays_a_rival_while_the_form_cues_could_still_rule_out_the_clas
     # a handle seen rules nothing out for the lead: a drill's grip looks like one, and the class left would lead
     # by its whole score; the can counts again once the open top is not settled
     assert not ruled_out(can, replace(BLUE_MUG_SEEN, open_top=None))
+
+
+def test_a_ratio_rules_a_class_out_exactly_where_it_agrees_not_at_all() -> None:
+    """ruled_out compares the ratio with the range directly; the score's agreement reaches 0 at the same place."""
+    rng = np.random.default_rng(5)
+    for _ in range(2000):
+        low = float(rng.uniform(0.0, 2.0))
+        high = low + float(rng.uniform(0.01, 3.0))
+        ratio = float(np.exp(rng.uniform(-3.0, 2.5)))
+        if min(abs(ratio * RATIO_FALLOFF - low), abs(ratio - high * RATIO_FALLOFF)) < 1e-9:
+            continue  # on the boundary itself rounding may differ
+        profile = Profile.from_mapping({"class": "Thing", "height_to_width": (low, high)})
+        agreement = score(profile, Cues(height_to_width=ratio)).score
+        assert ruled_out(profile, Cues(height_to_width=ratio)) == (agreement <= 0.0), (low, high, ratio)
