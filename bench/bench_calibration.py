@@ -145,7 +145,7 @@ def run_frame(frame: LabelledFrame, store: Path) -> Iterator[Sample]:
                     said.confidence,
                     best.profile.class_name,
                     best.score,
-                    lead(best, matches),
+                    lead(best, matches, cues),
                     best.unread,
                 )
 

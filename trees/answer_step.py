@@ -183,6 +183,7 @@ class AnswerStep(Annotator):
                     label_of=self.label_of,
                     guessed_class=belief_filter.object_class if b.id in guesses else None,
                     asked_class=belief_filter.object_class,
+                    answering=seen[b.id].answering,
                 )
                 for b in matching
             ),
@@ -248,9 +249,9 @@ class AnswerStep(Annotator):
         store: BeliefStore, belief_filter: BeliefFilter, seen: dict[int, FrameObject], found: set[int]
     ) -> dict[int, ObjectBelief]:
         """Objects seen in this frame that an expert named the asked class (or a subclass of it) without evidence
-        to store (confidence 0.5 at most: a guess, e.g. the classifier deciding a tie by the query) and that match
-        the rest of the filter, by id: answered as candidates of the asked class, though their belief keeps no
-        such class."""
+        to store (confidence 0.5 at most: a guess, e.g. the classifier deciding a tie by the query), or said
+        answers to it with no more (AnswersTo), and that match the rest of the filter, by id: answered as
+        candidates of the asked class, though their belief keeps no such class."""
         wanted = belief_filter.object_class
         if not wanted:
             return {}
@@ -260,7 +261,8 @@ class AnswerStep(Annotator):
             for i, item in seen.items()
             if i not in found
             and any(
-                e.attribute == CLASS_ATTRIBUTE and e.confidence <= 0.5 and test(e.value, wanted) for e in item.evidence
+                e.attribute == CLASS_ATTRIBUTE and e.confidence <= 0.5 and test(e.value, wanted)
+                for e in (*item.evidence, *item.answering)
             )
         )
         if not guessed:

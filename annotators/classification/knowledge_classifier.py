@@ -47,7 +47,12 @@ Colour, shape, size, handle, open-top and printed-label agreements are pulled to
 cues with :data:`WEIGHTS`
 (text is strong evidence). The best match is the top score (among related profiles with that score, the most
 specific one with the most matched texts when text matched, lactose-free milk over milk; else the most general
-one: no evidence for a variant); its lead is how far it scores above the best profile not related to it.
+one: no evidence for a variant); its lead is how far it scores above the best rival: a profile not related to it
+that no form cue rules out (:func:`ruled_out`: a settled open top the class rules out, a height over width or
+elongation where the class agrees not at all) - when none can rule out the best class itself, however the
+unsettled cues turn out (:func:`standing`; else every unrelated profile is a rival). A closed can, whatever its
+colour, is no rival of a mug surely seen open: knowing a blue can does not make a blue mug less surely a mug. The
+same holds for a class taken as a whole.
 
 Deciding. The score is not a probability: many classes share colour, shape and size (a cup, a mug and a glass
 are all small cylinders). The calibration (``calibration.FITTED``, fitted on labelled objects) turns the best
@@ -80,6 +85,7 @@ label went unread is unlikely a mustard but, tying with a lemon soda, as likely 
 
 from __future__ import annotations
 
+import math
 from collections.abc import Callable, Mapping, Sequence
 from dataclasses import dataclass, replace
 from types import MappingProxyType
@@ -93,6 +99,7 @@ from robokudo.core.annotator import Annotator
 from robokudo.core.capability import Capability
 from robokudo.core.text_match import phrase_found
 from robokudo.core.types import (
+    AnswersTo,
     CasType,
     Classification,
     FormFeatures,
@@ -384,10 +391,63 @@ def best_match(matches: Sequence[Match]) -> Match:
     return min(tied, key=lambda m: len(m.profile.ancestors))
 
 
-def lead(match: Match, matches: Sequence[Match]) -> float:
-    """How far ``match`` scores above the best profile not related to it by subsumption (its own score when
-    there is none); negative when an unrelated profile scores higher."""
-    rivals = [m.score for m in matches if not m.profile.related(match.profile)]
+def ruled_out(profile: Profile, cues: Cues | None) -> bool:
+    """True when a form cue rules the profile's class out: an open top said with confidence 1 (settled) on a
+    closed class or the other way, or a height over width (or, for a class that declares one, an elongation)
+    :data:`RATIO_FALLOFF` times or more beyond the class's range, where it agrees not at all. A handle seen rules
+    nothing out here: the form expert also sees one in a drill's grip or a toy brick's knobs, objects of no known
+    class, and with every class without a handle ruled out, the one class with a handle left would lead by its
+    whole score (it still keeps the query from deciding for a class without one: :func:`contradicted`). Colour,
+    shape and size never rule a class out (the view or the light can make any of them look wrong). False without
+    ``cues``."""
+    if cues is None:
+        return False
+    seen = cues.open_top
+    open_top_against = (
+        seen is not None and seen[1] >= 1.0 and profile.open_top is not None and profile.open_top != seen[0]
+    )
+    return (
+        open_top_against
+        or _beyond(cues.height_to_width, profile.height_to_width)
+        or _beyond(cues.elongation, profile.elongation)
+    )
+
+
+def _beyond(ratio: float | None, listed: tuple[float, float] | None) -> bool:
+    """True when a measured ratio agrees not at all with a declared range (both known): it lies
+    :data:`RATIO_FALLOFF` times or more beyond a bound, where :func:`_ratio_agreement` reaches 0 (compared
+    directly, without its logarithms: this runs for every profile in every lead)."""
+    if ratio is None or listed is None or not 0.0 < ratio < math.inf:
+        return False
+    low, high = listed
+    return ratio * RATIO_FALLOFF <= low or ratio >= high * RATIO_FALLOFF
+
+
+def standing(profile: Profile, cues: Cues | None) -> bool:
+    """True when no form cue rules the class out or speaks against it (:func:`ruled_out`, :func:`contradicted`: a
+    handle surely seen on a class without one) as the cues were said nor however the unsettled ones turn out
+    (:func:`cue_outcomes`); True without ``cues``."""
+    return cues is None or not any(
+        ruled_out(profile, c) or contradicted(profile, c) for c in (cues, *cue_outcomes(cues))
+    )
+
+
+def counts_as_rival(other: Profile, standing_match: bool, cues: Cues | None) -> bool:
+    """True when a profile outside the class being weighed still competes with it: always, unless the class is
+    ``standing_match`` (:func:`standing`: no form cue can rule it out) and a form cue rules ``other`` out (a closed
+    can, whatever its colour, is no rival of a mug surely seen open; of a mug seen closed though not surely, it is,
+    as the mug itself might be ruled out)."""
+    return not (standing_match and ruled_out(other, cues))
+
+
+def lead(match: Match, matches: Sequence[Match], cues: Cues | None = None) -> float:
+    """How far ``match`` scores above the best rival: a profile not related to it by subsumption that still
+    competes with it under the form ``cues`` the matches were scored on (:func:`counts_as_rival`); its own score
+    when there is none; negative when a rival scores higher."""
+    keep = standing(match.profile, cues)
+    rivals = [
+        m.score for m in matches if not m.profile.related(match.profile) and counts_as_rival(m.profile, keep, cues)
+    ]
     return match.score - max(rivals, default=0.0)
 
 
@@ -403,32 +463,45 @@ def above(match: Match, name: str, inside: Sequence[Match]) -> bool:
     return own != name and name not in match.profile.ancestors and all(own in m.profile.ancestors for m in inside)
 
 
-def class_evidence(name: str, matches: Sequence[Match]) -> tuple[float, float, bool]:
+def class_evidence(name: str, matches: Sequence[Match], cues: Cues | None = None) -> tuple[float, float, bool]:
     """The evidence for class ``name`` (lower case, with or without a profile of its own) as a whole: the best score
     of its own and its subclasses' profiles, how far that lies above the best profile outside it (neither below
-    nor above it), and whether its own profile names it by printed text that was not read."""
-    return _evidence_of(name, matches, lambda profile: name in profile.ancestors)
+    nor above it, and competing under the form ``cues``: :func:`counts_as_rival`), and whether its own profile
+    names it by printed text that was not read."""
+    return _evidence_of(name, matches, lambda profile: name in profile.ancestors, cues)
 
 
-def answering_evidence(wanted: str, matches: Sequence[Match]) -> tuple[float, float, bool]:
+def answering_evidence(wanted: str, matches: Sequence[Match], cues: Cues | None = None) -> tuple[float, float, bool]:
     """The evidence that the object answers a query for class ``wanted`` (lower case), taken as a whole: as
     :func:`class_evidence`, over the profiles that answer to it (:meth:`Profile.answers`: it, its subclasses, classes
-    packaged in it), against those that do not and are not above all of them."""
-    return _evidence_of(wanted, matches, lambda profile: profile.answers(wanted))
+    packaged in it), against those that do not, are not above all of them and still compete."""
+    return _evidence_of(wanted, matches, lambda profile: profile.answers(wanted), cues)
 
 
-def _evidence_of(name: str, matches: Sequence[Match], belongs: Callable[[Profile], bool]) -> tuple[float, float, bool]:
+def _evidence_of(
+    name: str, matches: Sequence[Match], belongs: Callable[[Profile], bool], cues: Cues | None
+) -> tuple[float, float, bool]:
     """(best score, lead, unread) of the matches whose profile ``belongs`` to ``name``, against the others that are
-    not above all of them."""
+    not above all of them and still compete under the form ``cues`` (:func:`counts_as_rival`)."""
     inside = [m for m in matches if belongs(m.profile)]
     top = max((m.score for m in inside), default=0.0)
-    rivals = [m.score for m in matches if not belongs(m.profile) and not above(m, name, inside)]
+    keep = any(standing(m.profile, cues) for m in inside if m.score >= top)
+    rivals = [
+        m.score
+        for m in matches
+        if not belongs(m.profile) and not above(m, name, inside) and counts_as_rival(m.profile, keep, cues)
+    ]
     unread = any(m.unread for m in inside if m.profile.class_name.lower() == name)
     return top, top - max(rivals, default=0.0), unread
 
 
 def more_general_fit(
-    best: Match, matches: Sequence[Match], min_score: float, calibration: Calibration, assert_probability: float
+    best: Match,
+    matches: Sequence[Match],
+    min_score: float,
+    calibration: Calibration,
+    assert_probability: float,
+    cues: Cues | None = None,
 ) -> tuple[str, float, float, float] | None:
     """The most specific class above ``best`` (one of its ancestors, not the root class, with or without a profile of
     its own) that, taken as a whole (:func:`class_evidence`), fits and is right with at least
@@ -438,7 +511,7 @@ def more_general_fit(
     names = [a for a in best.profile.lineage[1:] if a.lower() != UNKNOWN_CLASS.lower()]
     names.sort(key=lambda a: len(members(a.lower(), matches)))  # stable: the lineage order breaks ties
     for name in names:
-        top, name_lead, unread = class_evidence(name.lower(), matches)
+        top, name_lead, unread = class_evidence(name.lower(), matches, cues)
         if top < min_score or unread:
             continue
         p = calibration.probability(top, name_lead, unread)
@@ -549,23 +622,23 @@ def decide(
     cues: Cues | None = None,
 ) -> Decision:
     """The class of one hypothesis from its matches (see the module docstring); ValueError without matches.
-    With the ``cues`` the matches were scored on, the query's class decides only when it holds up against them
-    (:func:`holds_up`)."""
+    With the ``cues`` the matches were scored on, classes the form cues rule out are no rivals in the leads
+    (:func:`ruled_out`), and the query's class decides only when it holds up against them (:func:`holds_up`)."""
     if not matches:
         raise ValueError("no profile matches to decide from")
     best = best_match(matches)
-    best_lead = lead(best, matches)
+    best_lead = lead(best, matches, cues)
     p = calibration.probability(best.score, best_lead, best.unread)
     name = best.profile.class_name
     if best.score >= min_score and p >= assert_probability:
         return Decision(name, p, best, best_lead, p, f"fits {name} (score {best.score:.2f}, lead {best_lead:.2f})")
     pick = choose_expected(matches, expected, min_score, margin) if expected else None
     if pick is not None and holds_up(pick, matches, cues, min_score, margin):
-        pick_lead = lead(pick, matches)
+        pick_lead = lead(pick, matches, cues)
         pick_p = calibration.probability(pick.score, pick_lead, pick.unread)
         answering = None
         if expected and pick.profile.class_name.lower() != expected.lower():
-            answering = calibration.probability(*answering_evidence(expected.lower(), matches))
+            answering = calibration.probability(*answering_evidence(expected.lower(), matches, cues))
         return Decision(
             pick.profile.class_name,
             pick_p,
@@ -576,7 +649,7 @@ def decide(
             f"the query's class decides",
             answering if answering is not None and answering > pick_p else None,
         )
-    general = more_general_fit(best, matches, min_score, calibration, assert_probability)
+    general = more_general_fit(best, matches, min_score, calibration, assert_probability, cues)
     if general is not None:
         general_name, general_score, general_lead, general_p = general
         return Decision(
@@ -629,7 +702,7 @@ class KnowledgeClassifier(Annotator):
 
     inputs: ClassVar[tuple[type[CasType], ...]] = (ObjectHypothesis, SemanticColor, Shape, Size, FormFeatures)
     optional_inputs: ClassVar[tuple[type[CasType], ...]] = (Text,)
-    outputs: ClassVar[tuple[type[CasType], ...]] = (Classification,)
+    outputs: ClassVar[tuple[type[CasType], ...]] = (Classification, AnswersTo)
     capability: ClassVar[Capability] = Capability(
         label="knowledge classifier",
         classes=(UNKNOWN_CLASS,),
@@ -681,8 +754,9 @@ class KnowledgeClassifier(Annotator):
     def analyse(self) -> None:
         """Attach a Classification to every hypothesis that carries cues: its class when one fits clearly, else
         :data:`UNKNOWN_CLASS` (so the answer can say "unknown object"); when the query's class decided for a class
-        below or packaged in it, also the query's class with the probability that the object answers to it
-        (:attr:`Decision.answering`: the fused answer then shows that figure for "find all bottles")."""
+        below or packaged in it, also an AnswersTo of the query's class with the probability that the object
+        answers to it (:attr:`Decision.answering`: the answer then shows that figure for "find all bottles", while
+        the object's belief keeps only what the object was classified as)."""
         if not self.profiles:
             self.fail("no candidate class profiles to compare the hypotheses with")
         hypotheses = self.annotations(ObjectHypothesis)
@@ -696,7 +770,7 @@ class KnowledgeClassifier(Annotator):
             decision = self.decide(cues)
             self.attach(hypothesis, Classification(class_name=decision.class_name, confidence=decision.confidence))
             if decision.answering is not None and self.expected:  # what the query asked for, as a whole
-                self.attach(hypothesis, Classification(class_name=self.expected, confidence=decision.answering))
+                self.attach(hypothesis, AnswersTo(class_name=self.expected, confidence=decision.answering))
             classified += 1
         if classified == 0:
             self.fail("no object hypothesis carries a colour, shape, size or text to classify by")

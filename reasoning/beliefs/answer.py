@@ -15,13 +15,22 @@ from __future__ import annotations
 import functools
 import json
 import re
-from collections.abc import Callable
+from collections.abc import Callable, Mapping, Sequence
 from dataclasses import dataclass, replace
 from typing import Any
 
 from reasoning.beliefs.ranking import answer_order
 from reasoning.beliefs.store import BeliefFilter, BeliefStore
-from reasoning.fusion.rule import CLASS_ATTRIBUTE, ClassTest, FusedAttribute, answer_probability, fuse_values
+from reasoning.fusion.rule import (
+    CLASS_ATTRIBUTE,
+    AttributeBelief,
+    ClassTest,
+    Evidence,
+    FusedAttribute,
+    ValueSupport,
+    answer_probability,
+    fuse_values,
+)
 from reasoning.fusion.tracking import ObjectBelief
 from reasoning.knowledge.index import ROOTS
 from robokudo.core.types import ONTOLOGY_NAMESPACE, SemanticColor, Size
@@ -403,17 +412,20 @@ def designator(
     label_of: Callable[[str], str] = class_label,
     guessed_class: str | None = None,
     asked_class: str | None = None,
+    answering: Sequence[Evidence] = (),
 ) -> ObjectDesignator:
     """The designator of a belief; ``roi`` is given when the object was seen in the current image.
 
     ``guessed_class`` names the object when this answer offers it as a candidate of that class without evidence
     the belief keeps (its class attribute still shows what the evidence says). ``asked_class`` is the class the
     query asked for: the designator then carries the probability that the object answers to it (``class_test``
-    is the query's: a class packaged in the asked one answers to it).
+    is the query's: a class packaged in the asked one answers to it), counting with the belief's class evidence
+    this frame's ``answering`` statements (that the object answers to the asked class as a whole), which the
+    belief does not keep.
     """
     return _designate(
         _belief_view(belief), class_test=class_test, roi=roi, iri_of=iri_of, label_of=label_of,
-        guessed_class=guessed_class, asked_class=asked_class,
+        guessed_class=guessed_class, asked_class=asked_class, answering=answering,
     )  # fmt: skip
 
 
@@ -426,6 +438,7 @@ def _designate(
     label_of: Callable[[str], str] = class_label,
     guessed_class: str | None = None,
     asked_class: str | None = None,
+    answering: Sequence[Evidence] = (),
 ) -> ObjectDesignator:
     """The designator of a belief's view (see :func:`designator`)."""
     belief = view.belief
@@ -447,8 +460,8 @@ def _designate(
     size_attribute = attributes.get(Size.attribute)
     answers = None
     if asked_class:
-        classes = belief.attributes.get(CLASS_ATTRIBUTE)
-        answers = answer_probability(classes.values, asked_class, class_test) if classes is not None else 0.0
+        values = _with_answering(belief.attributes.get(CLASS_ATTRIBUTE), answering)
+        answers = answer_probability(values, asked_class, class_test) if values else 0.0
     return ObjectDesignator(
         id=belief.id,
         class_iri=iri_of(class_name) if class_name else None,
@@ -466,6 +479,19 @@ def _designate(
         status=belief.status,
         answers=answers,
     )
+
+
+def _with_answering(classes: AttributeBelief | None, answering: Sequence[Evidence]) -> Mapping[str, ValueSupport]:
+    """The class values of a belief with this frame's answering statements added to a copy (the belief is left
+    as it is)."""
+    if not answering:
+        return classes.values if classes is not None else {}
+    merged = AttributeBelief(CLASS_ATTRIBUTE)
+    if classes is not None:
+        merged.merge(classes)
+    for statement in answering:
+        merged.add(statement)
+    return merged.values
 
 
 def answer_from_memory(store: BeliefStore, belief_filter: BeliefFilter, query: str = "", **options: Any) -> Answer:

@@ -20,9 +20,17 @@ from typing import TypeVar
 
 import numpy as np
 
-from reasoning.fusion.rule import Evidence
+from reasoning.fusion.rule import CLASS_ATTRIBUTE, Evidence
 from robokudo.core.geometry import IDENTITY_QUATERNION, quaternion_from_matrix
-from robokudo.core.types import ATTRIBUTE_TYPES, Annotation, ColorHistogram, ObjectHypothesis, Pose, Size
+from robokudo.core.types import (
+    ATTRIBUTE_TYPES,
+    Annotation,
+    AnswersTo,
+    ColorHistogram,
+    ObjectHypothesis,
+    Pose,
+    Size,
+)
 
 A = TypeVar("A", bound=Annotation)
 AttachedReader = Callable[[ObjectHypothesis, type[A]], list[A]]
@@ -60,8 +68,11 @@ percentiles."""
 DEFAULT_MIN_OVERLAP = 0.6
 """Two hypotheses whose point sets overlap at least this much (of the smaller one) are one object."""
 
-FUSED_TYPES: tuple[type[Annotation], ...] = tuple(dict.fromkeys((Pose, Size, ColorHistogram, *ATTRIBUTE_TYPES)))
-"""The annotation types fusion reads from a hypothesis: pose, extents, appearance and every stated attribute."""
+FUSED_TYPES: tuple[type[Annotation], ...] = tuple(
+    dict.fromkeys((Pose, Size, ColorHistogram, *ATTRIBUTE_TYPES, AnswersTo))
+)
+"""The annotation types fusion reads from a hypothesis: pose, extents, appearance, every stated attribute, and
+whether the object answers to the query's class (for this frame's answer only)."""
 
 
 @dataclass(slots=True)
@@ -86,6 +97,9 @@ class FrameObject:
     """The recording the frame belongs to (``CameraInfo.recording``)."""
     doubt: str = ""
     """Why the object's geometry is not trusted ("" when it is); a doubted object never creates a belief."""
+    answering: list[Evidence] = field(default_factory=list)
+    """Class statements that the object answers to the query's class (from AnswersTo): they count in this frame's
+    answer to the query, not in the object's belief (they say how well it answers, not what it is)."""
 
     def values(self, attribute: str) -> set[str]:
         """The values stated for ``attribute`` in this frame."""
@@ -295,6 +309,12 @@ def _merge_group(
     position = placed_on_points(np.asarray(position, dtype=np.float64), points)
     doubt = geometry_doubt(dimensions, points)
     evidence = [e for h in members for e in hypothesis_evidence(h, context.time, reader)]
+    answering = [
+        Evidence(CLASS_ATTRIBUTE, a.class_name.strip(), a.confidence, a.source or "unknown", context.time)
+        for h in members
+        for a in reader(h, AnswersTo)
+        if a.class_name.strip()
+    ]
     sources = {h.source for h in members if h.source}
     sources.update(e.source for e in evidence)
     sources.update(p.source for p in poses if p.source)
@@ -312,6 +332,7 @@ def _merge_group(
         hypotheses=len(members),
         recording=context.recording,
         doubt=doubt,
+        answering=answering,
     )
 
 

@@ -1272,8 +1272,11 @@ class _Layout:
         refined = self.refines_output_of.get(name)  # what a refiner's step reads of the type it refines
         feeds = []
         for needed in spec.inputs:
-            if inside_types and needed in inside_types:
-                maker = self.units[self.assignment.guaranteed_by()[needed]].providers[0].name
+            # a type a unit inside the branch also makes as a by-product may be guaranteed by none (the reader
+            # makes it): then it is fed as outside the branch
+            guarantor = self.assignment.guaranteed_by().get(needed) if inside_types and needed in inside_types else None
+            if guarantor is not None:
+                maker = self.units[guarantor].providers[0].name
                 feeds.append(f"{needed} from {maker}")
             elif refined is not None and needed in spec.outputs:
                 feeds.append(f"{needed} from {self._label(refined)}")

@@ -349,6 +349,16 @@ class Classification(Annotation):
 
 
 @dataclass(eq=False, kw_only=True)
+class AnswersTo(Annotation):
+    """That the object answers to the query's class as a whole (``class_name``, the class the query asked for),
+    with the probability ``confidence``, when an expert named a class below it or packaged in it (a mustard for
+    "find all bottles"). It says how well the object answers this query, not what the object is: the answer to
+    the query shows it, the object's belief does not keep it (it states no attribute)."""
+
+    class_name: str
+
+
+@dataclass(eq=False, kw_only=True)
 class Text(Annotation):
     """Text read on the object, with its image box ``(x0, y0, x1, y1)``."""
 

@@ -20,6 +20,7 @@ from pathlib import Path
 
 import pytest
 
+from reasoning.beliefs.store import BeliefStore
 from robokudo.application import cli
 from robokudo.core.types import Classification
 
@@ -132,6 +133,27 @@ def test_find_all_bottles_answers_the_mustard_bottle(
     assert class_confidence(found) < 0.5, found
     stated = {a["value"]: a["confidence"] for a in found["attributes"][Classification.attribute]["alternatives"]}
     assert stated.get("Mustard", 0.0) < found["class"]["answers"] < 0.5, found
+
+
+def test_that_the_mustard_answers_to_bottle_is_shown_but_not_kept_in_its_belief(
+    capsys: pytest.CaptureFixture, store: Path
+) -> None:
+    """How likely the mustard answers "find all bottles" is a figure of that answer (AnswersTo), not something the
+    object is: the belief store keeps only what the mustard was classified as, so a later query on the same store
+    does not count "bottle" as a class of it; the answer still shows the figure."""
+    frame, pixel = MUSTARD[0]
+    source = Path("../shared/data/uoc_tabletop_realsense")
+    found = answered_at(capsys, store, source, frame, "find all bottles", pixel)
+    stated = {a["value"]: a["confidence"] for a in found["attributes"][Classification.attribute]["alternatives"]}
+    assert stated.get("Mustard", 0.0) < found["class"]["answers"] < 0.5, found
+    assert "Bottle" not in stated, stated
+    with BeliefStore(store) as beliefs:
+        kept = beliefs.get(found["id"])
+        assert kept is not None and "Bottle" not in kept.attributes[Classification.attribute].values, kept
+    again = answered_at(capsys, store, source, frame, "find all bottles", pixel)  # a second look, the same store
+    assert again["id"] == found["id"] and again["class"]["answers"] > stated.get("Mustard", 0.0), again
+    with BeliefStore(store) as beliefs:
+        assert "Bottle" not in beliefs.get(found["id"]).attributes[Classification.attribute].values
 
 
 @pytest.mark.parametrize("frame, pixel", [MUSTARD[2], MUSTARD[1]], ids=["frame2-fit", "frame1-held-out"])

@@ -15,6 +15,7 @@ import pytest
 
 from annotators.classification.calibration import FITTED, fit
 from annotators.classification.knowledge_classifier import (
+    RATIO_FALLOFF,
     UNKNOWN_CLASS,
     Cues,
     KnowledgeClassifier,
@@ -22,6 +23,8 @@ from annotators.classification.knowledge_classifier import (
     contradicted,
     cue_outcomes,
     decide,
+    lead,
+    ruled_out,
     score,
 )
 from robokudo.application import cli
@@ -257,3 +260,58 @@ def test_the_query_does_not_decide_for_a_class_a_settled_form_cue_rules_out() ->
     can = replace(odd, handle=(False, 1.0))
     assert form_decision(can, "CannedFood") == "CannedFood"
     assert contradicted(FORM_PROFILES[0], replace(odd, open_top=(True, 1.0), handle=(False, 1.0))) is False
+
+
+BLUE_MUG = {**FORM_MUG, "colors": ("blue",), "height_to_width": (0.8, 1.4)}
+BLUE_CAN = {**FORM_CAN, "class": "CoffeeCan", "colors": ("blue",), "height_to_width": (1.0, 1.8),
+            "ancestors": ("CoffeeCan", "Drink", "PhysicalObject")}  # fmt: skip
+TALL_BOTTLE = {"class": "Bottle", "colors": ("blue",), "shape": "cylinder", "size": "small", "open_top": False,
+               "height_to_width": (2.5, 4.0), "ancestors": ("Bottle", "Container", "PhysicalObject")}  # fmt: skip
+BLUE_MUG_SEEN = Cues(color=("blue", 0.8), shape=("cylinder", 0.8), size=("small", 1.0), handle=(True, 1.0),
+                     open_top=(True, 1.0), height_to_width=1.2)  # fmt: skip
+
+
+def test_a_rival_a_form_cue_rules_out_does_not_lower_the_lead() -> None:
+    """A blue can scores high on a blue mug (colour, shape, size, proportions), but its closed top is ruled out by
+    the open top seen for sure: knowing blue cans does not make the blue mug less surely a mug."""
+    mug, can, cup = (Profile.from_mapping(p) for p in (BLUE_MUG, BLUE_CAN, {**FORM_CUP, "colors": ("white",)}))
+    with_can = [score(p, BLUE_MUG_SEEN) for p in (mug, can, cup)]
+    without_can = [score(p, BLUE_MUG_SEEN) for p in (mug, cup)]
+    assert with_can[1].score > with_can[2].score  # the can is the best-scoring class unrelated to the mug
+    assert ruled_out(can, BLUE_MUG_SEEN) and not ruled_out(mug, BLUE_MUG_SEEN)
+    assert lead(with_can[0], with_can, BLUE_MUG_SEEN) == pytest.approx(lead(without_can[0], without_can, BLUE_MUG_SEEN))
+    assert lead(with_can[0], with_can) < lead(with_can[0], with_can, BLUE_MUG_SEEN)  # counted without the cues
+    known, unknown = (decide(m, cues=BLUE_MUG_SEEN) for m in (with_can, without_can))
+    assert known.class_name == unknown.class_name == "Mug"
+    assert known.confidence == pytest.approx(unknown.confidence)
+
+
+def test_a_rival_stays_a_rival_while_the_form_cues_could_still_rule_out_the_class_itself() -> None:
+    """Seen open but not surely, the object might be closed: then the mug would be out and the can in, so the can
+    still counts; a height over width far outside a class's range rules it out as an open top does."""
+    unsure = replace(BLUE_MUG_SEEN, open_top=(True, 0.7))
+    mug, can, bottle = (Profile.from_mapping(p) for p in (BLUE_MUG, BLUE_CAN, TALL_BOTTLE))
+    found = [score(p, unsure) for p in (mug, can)]
+    assert not ruled_out(can, unsure)
+    assert lead(found[0], found, unsure) == pytest.approx(found[0].score - found[1].score)
+    # the mug's proportions (1.2) lie 2x below a tall bottle's range: the bottle is no rival, open top or not
+    assert ruled_out(bottle, unsure) and not ruled_out(bottle, replace(unsure, height_to_width=2.0))
+    with_bottle = [score(p, BLUE_MUG_SEEN) for p in (mug, bottle)]
+    assert lead(with_bottle[0], with_bottle, BLUE_MUG_SEEN) == pytest.approx(with_bottle[0].score)
+    # a handle seen rules nothing out for the lead: a drill's grip looks like one, and the class left would lead
+    # by its whole score; the can counts again once the open top is not settled
+    assert not ruled_out(can, replace(BLUE_MUG_SEEN, open_top=None))
+
+
+def test_a_ratio_rules_a_class_out_exactly_where_it_agrees_not_at_all() -> None:
+    """ruled_out compares the ratio with the range directly; the score's agreement reaches 0 at the same place."""
+    rng = np.random.default_rng(5)
+    for _ in range(2000):
+        low = float(rng.uniform(0.0, 2.0))
+        high = low + float(rng.uniform(0.01, 3.0))
+        ratio = float(np.exp(rng.uniform(-3.0, 2.5)))
+        if min(abs(ratio * RATIO_FALLOFF - low), abs(ratio - high * RATIO_FALLOFF)) < 1e-9:
+            continue  # on the boundary itself rounding may differ
+        profile = Profile.from_mapping({"class": "Thing", "height_to_width": (low, high)})
+        agreement = score(profile, Cues(height_to_width=ratio)).score
+        assert ruled_out(profile, Cues(height_to_width=ratio)) == (agreement <= 0.0), (low, high, ratio)

@@ -21,8 +21,9 @@ def profiles(tmp_path_factory: pytest.TempPathFactory) -> dict[str, Profile]:
 
 
 def stands_or_lies(profile: Profile) -> bool:
-    """Boxes of dry food stand or lie: their height over width may be anything (like a cup's colour)."""
-    return "dryfood" in profile.ancestors
+    """Boxes of dry food and of sweets stand or lie: their height over width may be anything (like a cup's
+    colour)."""
+    return "dryfood" in profile.ancestors or "sweets" in profile.ancestors
 
 
 def test_every_class_declares_its_form(profiles: dict[str, Profile]) -> None:
