@@ -5,8 +5,10 @@
   matched by a hypothesis with point IoU >= 0.5.
 * uoc_tabletop_realsense frames 0-4: every listed object has its own hypothesis - also the soup can standing on
   the spam can in frames 2 and 3 - and the red Cheez-It box is named red and OCR reads "CHEEZ" inside its image box.
-  The power drill (orange body, black grip, battery below) is one hypothesis in frames 2 and 3 (in frame 3 it lies
-  on its side and its grip ends behind the battery's raised edge: the pieces of one slab join).
+  The power drill (orange body, black grip, battery below) is one hypothesis in frames 1, 2 and 3 (in frame 3 it
+  lies on its side and its grip ends behind the battery's raised edge: the pieces of one slab join); in frame 0 it
+  is not yet (cut where the grip enters the battery's top), nor is the clear water bottle in frame 3 (it reads the
+  table through the water): both are strict expected failures, their causes in bench/profiles/pieces3-analysis.txt.
 * the white mug in frames 0 and 1 is one hypothesis with its inside (seen over the rim) and its handle: a body
   without its handle reads as a paper cup (in frame 1 the grouping cuts it in three - the inside's left half, the
   body, and the handle with the inside's right half and the body's right side down to the table - which the
@@ -156,13 +158,24 @@ def test_uoc_objects_get_their_own_hypotheses_and_the_cheez_it_box_is_red_and_re
     assert rx0 - 8 <= x0 < x1 <= rx1 + 8 and ry0 - 8 <= y0 < y1 <= ry1 + 8
 
 
-DRILL = {  # body top, grip, battery of the power drill
+DRILL = {  # body top, grip, battery of the power drill (upright in frames 0-2, with its chuck in 0 and 1)
+    0: {"drill body": (345, 140), "drill chuck": (405, 140), "drill grip": (340, 180), "drill battery": (360, 200)},
+    1: {"drill body": (380, 150), "drill chuck": (440, 155), "drill grip": (360, 200), "drill battery": (390, 220)},
     2: {"drill body": (380, 110), "drill grip": (370, 150), "drill battery": (400, 180)},
     3: {"drill body": (370, 115), "drill grip": (365, 150), "drill battery": (395, 180)},
 }
 
 
-@pytest.mark.parametrize("frame", [2, 3])
+# In frame 0 the convexity grouping cuts the upright drill at the grip's foot, where it enters the battery's top:
+# the body with the grip then starts at the battery's top, its footprint over the battery's, as the soup can stands
+# on the spam can in frames 2 and 3, which must stay apart (bench/profiles/pieces3-analysis.txt). Strict: the mark
+# must go when a rule with a physical reason joins the two.
+CUT_AT_THE_BATTERY = pytest.mark.xfail(
+    reason="the drill's body and grip rest on the battery like a can standing on a can", strict=True
+)
+
+
+@pytest.mark.parametrize("frame", [pytest.param(0, marks=CUT_AT_THE_BATTERY), 1, 2, 3])
 def test_the_drill_is_one_hypothesis_of_its_own(uoc_folder: Path, frame: int) -> None:
     root = create_pipeline(reader_for(str(uoc_folder), frame))
     assert Engine(root).tick() is Status.SUCCESS, [(c.name, c.feedback_message) for c in root.children]
@@ -232,6 +245,26 @@ def test_the_teal_bowl_with_a_can_standing_in_it_is_one_hypothesis_and_the_can_a
     assert len(set(bowl.values())) == 1 and 0 not in bowl.values(), f"the bowl's parts are in hypotheses {bowl}"
     assert can and can not in bowl.values(), f"the can is in hypothesis {can}, the bowl in {bowl}"
     assert not set(bowl.values()) & others, "the bowl shares its hypothesis with another object"
+
+
+WATER_BOTTLE = {"cap": (565, 35), "upper body": (550, 80), "middle": (560, 150), "lower body": (575, 185)}  # frame 3
+
+
+@pytest.mark.xfail(
+    reason="the clear bottle's lower half reads the table through the water: pieces at other depths", strict=True
+)
+def test_the_clear_water_bottle_is_one_hypothesis(uoc_folder: Path) -> None:
+    """Below its cap and label band, up to 58 % of an image row of the bottle reads 3-7 cm behind its front
+    surface (the water passes the projector's pattern), 8 % of the bottle reads the table and 14 % nothing: it
+    falls apart at the depth jumps into pieces that look like objects standing behind one another
+    (bench/profiles/pieces3-analysis.txt). Strict: the mark must go when the bottle comes out whole."""
+    root = create_pipeline(reader_for(str(uoc_folder), 3))
+    assert Engine(root).tick() is Status.SUCCESS, [(c.name, c.feedback_message) for c in root.children]
+    hypotheses = root.cas.annotations(ObjectHypothesis)
+    bottle = {hypothesis_at(hypotheses, x, y) for x, y in WATER_BOTTLE.values()}
+    others = {hypothesis_at(hypotheses, x, y) for name, (x, y) in UOC_OBJECTS[3].items() if name != "water bottle"}
+    assert len(bottle) == 1 and 0 not in bottle, f"the bottle's parts are in hypotheses {bottle}"
+    assert not bottle & others, "the bottle shares its hypothesis with another object"
 
 
 def test_the_drill_chuck_stays_with_the_drill_body(uoc_folder: Path) -> None:
