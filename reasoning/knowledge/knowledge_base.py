@@ -238,7 +238,9 @@ class KnowledgeBase:
     def _lookup(self, word: str, kinds: Collection[Kind] | None) -> tuple[Resolved, ...]:
         words = self._index.words
         key = word_key(word)
-        for candidate in (key, *singular_keys(key)):
+        # A label said only in the plural ("sweets", "oats") is still found from its singular, which a phrase's
+        # plural rule may have made of it; after the key and its singulars, so it never shadows a label.
+        for candidate in (key, *singular_keys(key), key + "s", key + "es"):
             found = words.get(candidate)
             if found and kinds is not None:
                 found = tuple(r for r in found if r.kind in kinds)

@@ -276,12 +276,18 @@ def _confidence(value: Value | None, inferences: list[str]) -> float:
 def _why_text_matters(object_class: str, kb: KnowledgeBase) -> str:
     """Why text must be read to recognise ``object_class`` ("" when it need not be).
 
-    Text matters when the class's variants differ only by printed text, or when another, unrelated class
-    looks the same (same colours, shape and size) and the class carries printed text that tells them apart.
+    Text matters when the class's variants differ only by printed text, when the class is a branded product (the
+    brand printed on it is what tells it from other products of its kind), or when another, unrelated class looks
+    the same (same colours, shape and size) and the class carries printed text that tells them apart.
     """
     if kb.variants_differ_by_text(object_class):
         return f"{object_class} differs from its sibling classes only by printed text, so text must be read"
     profile = kb.object_profile(object_class)
+    if profile.brand:
+        return (
+            f"{object_class} is sold under the brand {profile.brand!r}; only the brand printed on it tells it from "
+            "other products of its kind, so text must be read"
+        )
     if not profile.texts:
         return ""
     for other in kb.look_alikes(object_class):

@@ -118,6 +118,9 @@ CASES = [
         "KnowledgeClassifier SemanticColorAnnotator",
     ),
     case('{"detect": {"obj": {"type": "milk", "location": "fridge"}}}', "RegionFilter KnowledgeClassifier TextReader"),
+    case("find the toffifee", "TextReader KnowledgeClassifier", inference="brand 'Toffifee'"),
+    case("find the cheez-it box", "TextReader KnowledgeClassifier", inference="brand 'Cheez-It'"),
+    case("find the sweets", "KnowledgeClassifier", "TextReader"),
 ]
 
 FAILURES = [

@@ -34,6 +34,9 @@ from reasoning.knowledge.model import Resolved
         ("tomatoes", "class", "Tomato"),
         ("yoghurt", "class", "Yogurt"),
         ("beverages", "class", "Drink"),
+        ("sweets", "class", "Sweets"),
+        ("sweet", "class", "Sweets"),  # a label said only in the plural, from a phrase's singular
+        ("potato chip", "class", "PotatoChips"),
         ("refrigerator", "region_class", "Fridge"),
         ("Fridge", "region_class", "Fridge"),
         ("fridge", "region", "fridge"),
