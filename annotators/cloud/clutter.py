@@ -71,7 +71,7 @@ from annotators.geometry.grid_segmentation import (
     bounding_box,
     color_edges,
     depth_seams,
-    grow_labels,
+    grow_labels_nearby,
     grow_on_surface,
     join_unless_apart,
     label_parts,
@@ -331,7 +331,7 @@ def split_by_color(
     pieces_of = np.bincount(owner[1:], weights=large[1:], minlength=int(labels.max()) + 1)
     if pieces_of.max(initial=0) < 2:
         return labels
-    pieces = grow_labels(pieces, objects, p.grow_distance / step)
+    pieces = grow_labels_nearby(pieces, objects, p.grow_distance / step)
     pieces[owner[pieces] != labels] = 0
     several = pieces_of[labels] >= 2  # only objects of several pieces can split: their boundaries are measured
     x0, y0, x1, y1 = bounding_box(several, margin=3)
@@ -361,7 +361,7 @@ def split_by_color(
     chained = np.column_stack([first_piece[owner[rest]], rest])
     groups = join_unless_apart(owner.size, np.concatenate([touching, chained]), surface.pairs[creased])
     result = dense_labels(np.where(pieces > 0, groups[pieces] + 1, 0))
-    return grow_labels(result, objects, p.grow_distance / step)
+    return grow_labels_nearby(result, objects, p.grow_distance / step)
 
 
 class ClutterSegmenter(Annotator):

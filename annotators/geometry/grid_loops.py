@@ -745,6 +745,23 @@ def graph_components(pairs: np.ndarray, count: int) -> np.ndarray:
 
 
 @njit(cache=True, nogil=True)
+def nearest_labels_within(labels: np.ndarray, region: np.ndarray, offsets: np.ndarray) -> np.ndarray:
+    """See :func:`annotators.geometry.grid_kernels.nearest_labels_within`."""
+    rows, cols = labels.shape
+    grown = labels.copy()
+    for r in range(rows):
+        for c in range(cols):
+            if labels[r, c] != 0 or not region[r, c]:
+                continue
+            for k in range(offsets.shape[0]):
+                nr, nc = r + offsets[k, 0], c + offsets[k, 1]
+                if 0 <= nr < rows and 0 <= nc < cols and labels[nr, nc] > 0:
+                    grown[r, c] = labels[nr, nc]
+                    break
+    return grown
+
+
+@njit(cache=True, nogil=True)
 def nearest_seed_labels(
     window: np.ndarray,
     unlabelled: np.ndarray,
