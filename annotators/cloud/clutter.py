@@ -71,7 +71,7 @@ from annotators.geometry.grid_segmentation import (
     bounding_box,
     color_edges,
     depth_seams,
-    grow_labels,
+    grow_labels_nearby,
     grow_on_surface,
     join_unless_apart,
     label_parts,
@@ -82,6 +82,7 @@ from annotators.geometry.occlusion import OcclusionRules, join_occluded
 from annotators.geometry.rims import RimRules, join_rim_pieces, one_stands_inside
 from annotators.geometry.slabs import SlabRules, join_slab_pieces
 from annotators.geometry.support import (
+    FOOTPRINT_ROWS,
     AppendageRules,
     JointRules,
     SupportRules,
@@ -89,6 +90,7 @@ from annotators.geometry.support import (
     join_pieces_summarized,
     summarize_pieces,
 )
+from annotators.geometry.support_kernels import pixel_footprint
 from robokudo.core.annotator import Annotator
 from robokudo.core.capability import Capability
 from robokudo.core.types import CasType, ObjectHypothesis, Plane, PointCloud
@@ -239,7 +241,9 @@ def segment_clutter(
     patches = split_by_normals(grid_patches(surfaces, p.cell), normals, p.normal_spread)
     # patches without a trustworthy plane (a face seen edge-on, a few points) go with the object beside them
     reach = max(2.0 * p.cell, p.grow_distance / step)
-    labels = convex_groups(patches, grid, p.convexity_rules(), region & ~seams, grow=reach)
+    # the angle between neighbouring pixels, a property of the camera: measured once, on every few rows
+    footprint = pixel_footprint(np.ascontiguousarray(grid[::FOOTPRINT_ROWS]))
+    labels = convex_groups(patches, grid, p.convexity_rules(), region & ~seams, grow=reach, footprint=footprint)
     labels = grow_on_surface(labels, region, depth, p.jump_absolute, p.jump_relative)
     basis = plane_basis(np.asarray(model[:3], dtype=np.float64)).T.astype(np.float32)
     to_plane = np.column_stack([basis, np.asarray(model[:3], dtype=np.float32)])
@@ -251,7 +255,7 @@ def segment_clutter(
     )
     if colors is not None and p.use_color:
         colors_crop = strided_crop(colors, step, (x0, y0, x1, y1))
-        labels = split_by_color(labels, grid, normals, colors_crop, p)
+        labels = split_by_color(labels, grid, normals, colors_crop, p, footprint)
     if p.complete_occluded:
         labels = join_occluded(
             labels, grid, normals, plane_grid.reshape(grid.shape), p.jump_absolute, p.jump_relative, OcclusionRules()
@@ -296,7 +300,12 @@ def segment_clutter(
 
 
 def split_by_color(
-    labels: np.ndarray, grid: np.ndarray, normals: np.ndarray, colors: np.ndarray, p: ClutterParameters
+    labels: np.ndarray,
+    grid: np.ndarray,
+    normals: np.ndarray,
+    colors: np.ndarray,
+    p: ClutterParameters,
+    footprint: float | None = None,
 ) -> np.ndarray:
     """Objects split where a hue edge and a concave crease coincide: two objects whose surfaces continue one
     another (a can standing on a can with its side flush with the lower one's front, boxes stacked flush) are one
@@ -309,6 +318,8 @@ def split_by_color(
     creased pixel pairs between a large piece and a crumb are noise, not two objects meeting. Everything else of
     the object joins again - longest shared boundaries first, so a piece goes with the side it shares most with. A
     print on a box (no crease) or the pieces of one object seen on both sides of an occluder never split.
+    ``footprint`` is the :func:`~annotators.geometry.grid_segmentation.pixel_footprint` of ``grid`` when the caller
+    has measured it.
     """
     step = max(1, p.stride)
     objects = labels > 0
@@ -320,12 +331,14 @@ def split_by_color(
     pieces_of = np.bincount(owner[1:], weights=large[1:], minlength=int(labels.max()) + 1)
     if pieces_of.max(initial=0) < 2:
         return labels
-    pieces = grow_labels(pieces, objects, p.grow_distance / step)
+    pieces = grow_labels_nearby(pieces, objects, p.grow_distance / step)
     pieces[owner[pieces] != labels] = 0
     several = pieces_of[labels] >= 2  # only objects of several pieces can split: their boundaries are measured
     x0, y0, x1, y1 = bounding_box(several, margin=3)
     window = np.where(several[y0:y1, x0:x1], pieces[y0:y1, x0:x1], 0)
-    surface = boundaries(window, grid[y0:y1, x0:x1], normals[y0:y1, x0:x1], p.jump_absolute, p.jump_relative)
+    surface = boundaries(
+        window, grid[y0:y1, x0:x1], normals[y0:y1, x0:x1], p.jump_absolute, p.jump_relative, footprint=footprint
+    )
     rules = p.merge_rules()
     sizes = np.bincount(window.reshape(-1), minlength=owner.size)
     smaller = np.minimum(sizes[surface.pairs[:, 0]], sizes[surface.pairs[:, 1]])
@@ -348,7 +361,7 @@ def split_by_color(
     chained = np.column_stack([first_piece[owner[rest]], rest])
     groups = join_unless_apart(owner.size, np.concatenate([touching, chained]), surface.pairs[creased])
     result = dense_labels(np.where(pieces > 0, groups[pieces] + 1, 0))
-    return grow_labels(result, objects, p.grow_distance / step)
+    return grow_labels_nearby(result, objects, p.grow_distance / step)
 
 
 class ClutterSegmenter(Annotator):

@@ -171,6 +171,7 @@ def convex_groups(
     rules: ConvexityRules,
     between: np.ndarray | None = None,
     grow: float = 0.0,
+    footprint: float | None = None,
 ) -> np.ndarray:
     """Object labels (int32, 0 = none, 1..n) from surface patches in two steps.
 
@@ -189,7 +190,8 @@ def convex_groups(
     points, thicker than ``rules.max_thickness`` or narrower than ``rules.min_width``) are left out (0).
     With ``grow`` > 0 the object labels are grown by up to ``grow`` pixels into the unlabelled pixels of ``between``
     (what :func:`~annotators.geometry.grid_segmentation.grow_labels` gives), from the distance transform of the
-    gap growth (the objects cover the kept patches' pixels).
+    gap growth (the objects cover the kept patches' pixels). ``footprint`` is the
+    :func:`~annotators.geometry.grid_segmentation.pixel_footprint` of ``points`` when the caller has measured it.
     """
     planes = patch_planes(patches, points)
     count = planes.counts.size + 1
@@ -199,7 +201,9 @@ def convex_groups(
     between = np.isfinite(points[..., 2]) if between is None else between
     seeds = seed_distances(kept, between | (kept > 0), max(rules.gap_width, grow))
     pairs = touching_pairs(grow_from_seeds(kept, seeds, rules.gap_width))
-    pairs = pairs[close_in_space(patches, planes, pairs, pixel_footprint(points), rules.close_factor)]
+    if footprint is None:
+        footprint = pixel_footprint(points)
+    pairs = pairs[close_in_space(patches, planes, pairs, footprint, rules.close_factor)]
     parallel, in_planes = _alignment(planes, pairs, rules.smooth_degrees)
     concave = connection_bending(planes, pairs) < -rules.concave_bending
     continuous = parallel & in_planes & ~concave

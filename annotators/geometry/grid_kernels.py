@@ -362,6 +362,17 @@ def footprint_shares(
     )
 
 
+def nearest_labels_within(labels: np.ndarray, region: np.ndarray, offsets: np.ndarray) -> np.ndarray:
+    """HxW ``labels`` with each unlabelled pixel of ``region`` (HxW bool) given the label (> 0) of the first
+    labelled pixel found at the ``offsets`` (Kx2 int64 row, column offsets, nearest first) from it; unlabelled
+    when none is. Only the unlabelled pixels of the region are visited."""
+    return _loops().nearest_labels_within(
+        np.ascontiguousarray(labels),
+        np.ascontiguousarray(region, dtype=bool),
+        np.ascontiguousarray(offsets, dtype=np.int64),
+    )
+
+
 def sampled_median(values: np.ndarray, indices: np.ndarray, step: int) -> float:
     """The median of ``values[indices[::step]]`` (1-D float ``values``, int ``indices``), in float64; NaN when
     one of them is NaN or there are none."""

@@ -745,6 +745,23 @@ def graph_components(pairs: np.ndarray, count: int) -> np.ndarray:
 
 
 @njit(cache=True, nogil=True)
+def nearest_labels_within(labels: np.ndarray, region: np.ndarray, offsets: np.ndarray) -> np.ndarray:
+    """See :func:`annotators.geometry.grid_kernels.nearest_labels_within`."""
+    rows, cols = labels.shape
+    grown = labels.copy()
+    for r in range(rows):
+        for c in range(cols):
+            if labels[r, c] != 0 or not region[r, c]:
+                continue
+            for k in range(offsets.shape[0]):
+                nr, nc = r + offsets[k, 0], c + offsets[k, 1]
+                if 0 <= nr < rows and 0 <= nc < cols and labels[nr, nc] > 0:
+                    grown[r, c] = labels[nr, nc]
+                    break
+    return grown
+
+
+@njit(cache=True, nogil=True)
 def nearest_seed_labels(
     window: np.ndarray,
     unlabelled: np.ndarray,
@@ -775,7 +792,7 @@ def unlabelled_box(labels: np.ndarray, region: np.ndarray, margin: int) -> tuple
     """See :func:`annotators.geometry.grid_kernels.unlabelled_box`."""
     rows, cols = labels.shape
     unlabelled = np.zeros((rows, cols), dtype=np.bool_)
-    box = np.array([cols, rows, -1, -1], dtype=np.int64)
+    left, top, right, bottom = cols, rows, -1, -1  # the box's bounds as scalars: no array write per pixel
     labelled = False
     for r in range(rows):
         for c in range(cols):
@@ -783,10 +800,11 @@ def unlabelled_box(labels: np.ndarray, region: np.ndarray, margin: int) -> tuple
                 labelled = True
             elif region[r, c]:
                 unlabelled[r, c] = True
-                box[0], box[1] = min(box[0], c), min(box[1], r)
-                box[2], box[3] = max(box[2], c + 1), max(box[3], r + 1)
-    if box[2] < 0 or not labelled:
+                left, right = min(left, c), max(right, c + 1)
+                top, bottom = min(top, r), max(bottom, r + 1)
+    if right < 0 or not labelled:
         return unlabelled, np.zeros(4, dtype=np.int64), False
+    box = np.array([left, top, right, bottom], dtype=np.int64)
     box[0], box[1] = max(box[0] - margin, 0), max(box[1] - margin, 0)
     box[2], box[3] = min(box[2] + margin, cols), min(box[3] + margin, rows)
     return unlabelled, box, True

@@ -24,18 +24,11 @@ from __future__ import annotations
 
 import functools
 from dataclasses import dataclass
+from types import ModuleType
 
 import numpy as np
 
-from annotators.geometry.grid_kernels import (
-    finite_rows,
-    grouped_pixels,
-    jump_between,
-    label_pixels,
-    piece_near,
-    shadowed_near,
-    window_counts,
-)
+from annotators.geometry.grid_kernels import label_pixels
 from annotators.geometry.grid_segmentation import join_labels, touching_pairs
 
 
@@ -96,58 +89,13 @@ def join_occluded(
         return labels
     depth = points[..., 2]
     flat_labels = labels.reshape(-1)
-    flat_normals, flat_plane = normals.reshape(-1, 3), on_plane.reshape(-1, 3)
-    _, starts, boxes = label_pixels(np.ascontiguousarray(labels))  # boxes (x0, y0, x1, y1) of labels 0..count
-    sizes = np.diff(starts)
-    unmeasured = ~np.isfinite(depth)
-    measured = ~unmeasured.reshape(-1) & (flat_labels > 0)
-    sums = np.bincount(flat_labels[measured], depth.reshape(-1)[measured], minlength=count + 1)
-    mean_depth = sums / np.maximum(np.bincount(flat_labels[measured], minlength=count + 1), 1)
-    touching: set[tuple[int, int]] | None = None
+    touching = _touching(labels, count)
     joined: list[tuple[int, int]] = []
-    for occluder in range(1, count + 1):
-        # what an occluder hides lies farther than it as a whole: at least two such objects or nothing to join
-        farther = np.flatnonzero(mean_depth > mean_depth[occluder])
-        if sizes[occluder] < rules.min_points or farther.size < 2:
-            continue
-        x0, y0, x1, y1 = _grown(boxes[occluder].tolist(), labels.shape, 3 * rules.band + 1)
-        window = labels[y0:y1, x0:x1]
-        # a piece's band near the occluder lies in the window: only pieces with enough pixels there can join
-        possible = farther[window_counts(window, count)[farther] >= rules.min_points]
-        if possible.size < 2:
-            continue  # fewer than two farther objects near this one
-        if touching is None:
-            touching = _touching(labels)
-        if len(_apart_from_another(possible.tolist(), touching)) < 2:
-            continue  # the farther objects near it all touch one another: nothing to join
-        occluding = window == occluder
-        window_depth = depth[y0:y1, x0:x1]
-        near = shadowed_near(occluding, unmeasured[y0:y1, x0:x1], 3 * rules.band, rules.band)
-        # the farther objects with enough pixels near the occluder; two of them must be apart to join anything
-        near_pixels, near_starts = grouped_pixels(window, near, count)
-        band_sizes = near_starts[1:] - near_starts[:-1]
-        candidates = _apart_from_another(farther[band_sizes[farther] >= rules.min_points].tolist(), touching)
-        if len(candidates) < 2:
-            continue
-        reach = 3 * rules.band
-        behind = []
-        for piece in candidates:
-            own = near_pixels[near_starts[piece] : near_starts[piece + 1]]
-            facing, piece_depth, occluder_depth, flat, xyz, centre, pixel = piece_near(
-                own, (window.shape[1], y0, x0), occluding, window_depth, reach, points
-            )
-            if facing < rules.min_points:
-                continue  # too few of the occluder's pixels within reach of the band
-            if not jump_between(piece_depth, occluder_depth, absolute, relative):
-                continue
-            if piece_depth <= occluder_depth or xyz.shape[0] < rules.min_points:
-                continue
-            band_normals, section = finite_rows(flat_normals, flat), finite_rows(flat_plane, flat)
-            behind.append(_Piece(piece, flat, xyz, centre, pixel, band_normals, section))
+    for occluder, behind in _pieces_behind(labels, points, normals, on_plane, touching, absolute, relative, rules):
         for index, first in enumerate(behind):
             for second in behind[index + 1 :]:
                 key = (min(first.label, second.label), max(first.label, second.label))
-                if key in touching:
+                if touching[key]:
                     continue
                 if (
                     _continues(first, second, rules)
@@ -158,18 +106,74 @@ def join_occluded(
     return join_labels(labels, joined) if joined else labels
 
 
+def _loops() -> ModuleType:
+    """:mod:`annotators.geometry.occlusion_loops`, imported (and numba with it) on first use."""
+    from annotators.geometry import occlusion_loops
+
+    return occlusion_loops
+
+
+def _pieces_behind(
+    labels: np.ndarray,
+    points: np.ndarray,
+    normals: np.ndarray,
+    on_plane: np.ndarray,
+    touching: np.ndarray,
+    absolute: float,
+    relative: float,
+    rules: OcclusionRules,
+) -> list[tuple[int, list[_Piece]]]:
+    """Each occluder (increasing) with the pieces behind it that may join (increasing): objects farther than it
+    as a whole, with at least ``rules.min_points`` pixels in its band (within ``rules.band`` pixels of it or of the
+    sensor's shadow beside it) that face as many of its pixels, farther than it there by a depth jump, and apart
+    from another such piece (``touching``: the bool matrix of labels that touch). Found in one compiled pass
+    (:func:`annotators.geometry.occlusion_loops.pieces_behind`); occluders with fewer than two are left out."""
+    count = touching.shape[0] - 1
+    _, starts, boxes = label_pixels(np.ascontiguousarray(labels))  # boxes (x0, y0, x1, y1) of labels 0..count
+    sizes = np.diff(starts)
+    depth = points[..., 2]
+    flat_labels = labels.reshape(-1)
+    measured = np.isfinite(depth).reshape(-1) & (flat_labels > 0)
+    sums = np.bincount(flat_labels[measured], depth.reshape(-1)[measured], minlength=count + 1)
+    mean_depth = sums / np.maximum(np.bincount(flat_labels[measured], minlength=count + 1), 1)
+    ids, ends, bands, xyz, band_normals, sections, centres, pixels = _loops().pieces_behind(
+        np.ascontiguousarray(labels),
+        np.ascontiguousarray(points),
+        normals.reshape(-1, 3),
+        on_plane.reshape(-1, 3),
+        mean_depth,
+        sizes,
+        boxes,
+        touching,
+        rules.band,
+        rules.min_points,
+        absolute,
+        relative,
+    )
+    found: list[tuple[int, list[_Piece]]] = []
+    for k, (occluder, label) in enumerate(ids.tolist()):
+        piece = _Piece(
+            label,
+            bands[ends[0, k] : ends[0, k + 1]],
+            xyz[ends[1, k] : ends[1, k + 1]],
+            centres[k],
+            pixels[k],
+            band_normals[ends[2, k] : ends[2, k + 1]],
+            sections[ends[3, k] : ends[3, k + 1]],
+        )
+        if found and found[-1][0] == occluder:
+            found[-1][1].append(piece)
+        else:
+            found.append((occluder, [piece]))
+    return found
+
+
 def _coplanar(first: _Piece, second: _Piece, flat: float) -> bool:
     """Do the two pieces' points near the occluder lie on one plane (RMS distance at most ``flat`` metres)?"""
     xyz = np.concatenate([first.points, second.points]).astype(np.float64)
     centred = xyz - xyz.mean(axis=0)
     smallest = np.linalg.eigvalsh(centred.T @ centred / xyz.shape[0])[0]
     return bool(np.sqrt(max(smallest, 0.0)) <= flat)
-
-
-def _grown(box: list[int], shape: tuple[int, int], margin: int) -> tuple[int, int, int, int]:
-    """The box ``(x0, y0, x1, y1)`` (exclusive), grown by ``margin`` and clipped to ``shape``."""
-    x0, y0, x1, y1 = box
-    return max(x0 - margin, 0), max(y0 - margin, 0), min(x1 + margin, shape[1]), min(y1 + margin, shape[0])
 
 
 def _continues(first: _Piece, second: _Piece, rules: OcclusionRules) -> bool:
@@ -215,20 +219,13 @@ def _same_section(first: _Piece, second: _Piece, rules: OcclusionRules) -> bool:
     return low_a >= low_b - width and high_a <= high_b + width
 
 
-def _apart_from_another(labels: list[int], touching: set[tuple[int, int]]) -> list[int]:
-    """The (increasing) ``labels`` that do not touch at least one of the others: only those can be joined."""
-    apart = []
-    for a in labels:
-        for b in labels:
-            if b != a and ((a, b) if a < b else (b, a)) not in touching:
-                apart.append(a)
-                break
-    return apart
-
-
-def _touching(labels: np.ndarray) -> set[tuple[int, int]]:
-    """The pairs ``(a, b)``, ``a < b``, of labels that touch as 4-neighbours."""
-    return {(a, b) for a, b in touching_pairs(labels).tolist()}
+def _touching(labels: np.ndarray, count: int) -> np.ndarray:
+    """The symmetric (count+1)x(count+1) bool matrix of the labels that touch as 4-neighbours."""
+    pairs = touching_pairs(labels)
+    touching = np.zeros((count + 1, count + 1), dtype=bool)
+    touching[pairs[:, 0], pairs[:, 1]] = True
+    touching[pairs[:, 1], pairs[:, 0]] = True
+    return touching
 
 
 def _across(

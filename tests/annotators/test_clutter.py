@@ -10,7 +10,13 @@ from annotators.cloud.clutter import segment_clutter
 from annotators.cloud.filters import range_mask
 from annotators.cloud.plane import ransac_support_plane
 from annotators.geometry.convexity import dense_labels
-from annotators.geometry.grid_segmentation import grow_from_seeds, grow_labels, seed_distances
+from annotators.geometry.grid_segmentation import (
+    disc_offsets,
+    grow_from_seeds,
+    grow_labels,
+    grow_labels_nearby,
+    seed_distances,
+)
 
 Box = tuple[tuple[float, float, float], tuple[float, float, float]]  # (size, corner)
 
@@ -95,3 +101,46 @@ def test_labels_grow_alike_from_a_transform_made_for_a_farther_reach(seed: int) 
         expected = grow_labels(renamed, region, near)
         assert np.array_equal(grow_from_seeds(renamed, seed_distances(labels, region, far), near), expected)
         assert np.count_nonzero(expected) > np.count_nonzero(renamed)  # something grew
+
+
+def test_disc_offsets_are_the_pixels_within_the_radius_nearest_first() -> None:
+    offsets = disc_offsets(3.0)
+    squared = (offsets**2).sum(axis=1)
+    assert offsets.shape == (28, 2)  # 29 pixels within 3 px of the origin, the origin left out
+    assert squared.min() == 1 and squared.max() == 9 and np.all(np.diff(squared) >= 0)
+    assert offsets[:4].tolist() == [[-1, 0], [0, -1], [0, 1], [1, 0]]  # row-major among equals
+
+
+@pytest.mark.parametrize("seed", range(4))
+def test_nearby_growth_gives_each_unlabelled_pixel_the_nearest_label_within_reach(seed: int) -> None:
+    rng = np.random.default_rng(seed)
+    labels = np.zeros((60, 80), dtype=np.int32)
+    labels[rng.random(labels.shape) < 0.03] = 1
+    labels[rng.random(labels.shape) < 0.03] = 2
+    region = rng.random(labels.shape) < 0.7
+    grown = grow_labels_nearby(labels, region, 3.0)
+    rows, cols = np.nonzero(labels)
+    for r, c in zip(*np.nonzero(region & (labels == 0)), strict=True):
+        distances = np.hypot(rows - r, cols - c)
+        if distances.min() > 3.0:
+            assert grown[r, c] == 0
+        else:  # the label of a nearest labelled pixel (one of them where several lie at that distance)
+            assert grown[r, c] in set(labels[rows, cols][distances == distances.min()].tolist())
+    assert np.array_equal(grown[~region | (labels > 0)], labels[~region | (labels > 0)])
+
+
+@pytest.mark.parametrize("seed", range(4))
+def test_nearby_growth_reaches_the_pixels_the_distance_transform_reaches(seed: int) -> None:
+    # the chamfer transform of grow_labels and the Euclidean disc reach the same pixels within 3 px; they may
+    # pick another of two labels only where both lie about as near, and never on blocky parts with one label
+    rng = np.random.default_rng(seed)
+    labels = np.zeros((120, 160), dtype=np.int32)
+    labels[30:78, 40:104] = np.kron(rng.integers(0, 6, (12, 16)), np.ones((4, 4), dtype=np.int64)).astype(np.int32)
+    labels[rng.random(labels.shape) < 0.15] = 0
+    region = np.zeros(labels.shape, dtype=bool)
+    region[20:88, 30:114] = rng.random((68, 84)) < 0.8
+    nearby, transformed = grow_labels_nearby(labels, region, 3.0), grow_labels(labels, region, 3.0)
+    assert np.array_equal(nearby > 0, transformed > 0)
+    assert np.count_nonzero(nearby != transformed) < 0.05 * np.count_nonzero(nearby > labels)
+    single = (labels > 0).astype(np.int32)
+    assert np.array_equal(grow_labels_nearby(single, region, 3.0), grow_labels(single, region, 3.0))
