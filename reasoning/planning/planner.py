@@ -1124,7 +1124,7 @@ class _Layout:
         found = self._branch_members.get(key)
         if found is None:
             owned = self.branches.get(type_name, {}).get(spec.name, [])
-            ordered = _topological(owned, self.units) if owned else []
+            ordered = _topological(owned, self.units, self.assignment.guaranteed_by()) if owned else []
             found = self._branch_members[key] = [self.units[t].providers[0] for t in ordered] + [spec]
         return found
 
@@ -1349,14 +1349,18 @@ def _by_rank_among_crops(spec: AnnotatorSpec) -> tuple[float, float, str]:
     return spec.cost_ms, -spec.reliability, spec.name
 
 
-def _topological(keys: list[str], units: Mapping[str, _UnitChoice]) -> list[str]:
-    """Order units so that each comes after the units of the same list whose types it needs."""
+def _topological(keys: list[str], units: Mapping[str, _UnitChoice], guaranteed: Mapping[str, str]) -> list[str]:
+    """Order units so that each comes after the units of the same list that make the types it needs.
+
+    A type's maker is the unit that guarantees it in the plan (``guaranteed``), not any unit that also writes it:
+    a unit writing a type another unit already makes must not be waited for by that type's readers (that could
+    make a cycle, and the cycle's order would be arbitrary)."""
     ordered: list[str] = []
     remaining = list(keys)
     while remaining:
         for key in sorted(remaining):
-            needs = set(units[key].providers[0].inputs)
-            if not any(units[other].guaranteed() & needs for other in remaining if other != key):
+            makers = {guaranteed.get(t) for t in units[key].providers[0].inputs}
+            if not any(other in makers for other in remaining if other != key):
                 ordered.append(key)
                 remaining.remove(key)
                 break

@@ -7,7 +7,7 @@ import tempfile
 from pathlib import Path
 
 import pytest
-from hypothesis import HealthCheck, given, settings
+from hypothesis import HealthCheck, example, given, settings
 from hypothesis import strategies as st
 
 from reasoning.planning.plan import Alternatives, Plan, Step, Task
@@ -53,6 +53,7 @@ def plan_for(ontology: CapabilityOntology, kb, wanted: list[str]) -> Plan:
 
 @settings(max_examples=25, deadline=None, suppress_health_check=[HealthCheck.too_slow])
 @given(seed=st.integers(0, 10_000), annotators=st.integers(3, 14), types=st.integers(3, 9))
+@example(seed=1818, annotators=12, types=7)  # a branch's absorbed unit also wrote a type another unit makes
 def test_random_capability_ontologies(seed: int, annotators: int, types: int) -> None:
     rng = random.Random(seed)
     ontology = random_ontology(rng, sensors=2, types=types, annotators=annotators)
