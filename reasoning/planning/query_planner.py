@@ -15,6 +15,8 @@ from robokudo.core.regions import RegionBox
 from robokudo.core.types import type_by_name
 
 DEPTH_TYPES = frozenset({"DepthImage", "PointCloud"})
+COLOUR_TYPE = "ColorImage"
+"""The sensor type text is read on."""
 REGION_PRECONDITION = "NeedsRegion"
 ROOT_CLASS = "PhysicalObject"
 
@@ -208,7 +210,9 @@ class QueryPlanner:
         the box around the object an ``inspect`` query names by id (:func:`reasoning.planning.focus.object_focus`),
         which then takes the place of a region."""
         depth = bool(source.types & DEPTH_TYPES)
-        interpretation = interpret(query, self.kb, depth=depth, camera_pose=source.camera_pose)
+        interpretation = interpret(
+            query, self.kb, depth=depth, camera_pose=source.camera_pose, colour=COLOUR_TYPE in source.types
+        )
         if focus is not None and query.kind == "inspect":
             interpretation = focused(interpretation, focus, depth and source.camera_pose)
         box = interpretation.region_box
