@@ -21,6 +21,7 @@ from queries.model import (
     FREE_SPACE_KEY,
     HUMAN_KEY,
     POINTING_KEY,
+    TEXT_KEY,
     Asked,
     Block,
     Field,
@@ -30,6 +31,7 @@ from queries.model import (
     String,
     Symbol,
     Value,
+    text_switch,
 )
 from reasoning.errors import TermError
 from reasoning.knowledge.knowledge_base import KnowledgeBase
@@ -41,8 +43,6 @@ _RELATIONS = ("in", "inside", "on", "at", "near")
 _STRUCTURAL_KEYS = frozenset({"type", "location", "id", "transparent", "confidence"})
 _TRUTH = {"true": True, "yes": True, "false": False, "no": False}
 _KINDS_WITH_OBJECTS = ("detect", "inspect", "track")
-TEXT_KEY = "text"
-"""The query key of the text printed on an object (``text: "lactose free"``, ``text: ?``, ``text: false``)."""
 TRACK_TYPE = "TargetTrack"
 """What a continuous query needs in every frame: the estimate of its one target (a tracker's output)."""
 
@@ -93,9 +93,9 @@ def interpret(
     if object_class is not None:
         constraints.append(Constraint("type", "Classification", object_class))
         requirements.append(Requirement("Classification", object_class, f"query asks type = {object_class}"))
-    text_switch = _text_switch(obj.get(TEXT_KEY))
+    switch = text_switch(obj.get(TEXT_KEY))
     for field in obj.fields:
-        if field.key in _STRUCTURAL_KEYS or (field.key == TEXT_KEY and text_switch is not None):
+        if field.key in _STRUCTURAL_KEYS or (field.key == TEXT_KEY and switch is not None):
             continue
         annotation_type = _annotation_type(field.key, kb)
         for value in _values(field.value):
@@ -109,8 +109,8 @@ def interpret(
         requirements += _inspection(object_id, {r.annotation_type for r in requirements}, kb)
     transparent = _transparency(obj.get("transparent"), object_class, kb, inferences)
     min_confidence = _confidence(obj.get("confidence"), inferences)
-    if text_switch is not None:
-        requirements += _switched_text(text_switch, kb, inferences)
+    if switch is not None:
+        requirements += _switched_text(switch, kb, inferences)
     elif object_class is not None and not obj.get(TEXT_KEY) and not _names_no_class(object_class, kb):
         why = _why_text_matters(object_class, kb)
         if why:
@@ -325,14 +325,6 @@ def _names_objects(requirements: list[Requirement]) -> bool:
     return any(r.annotation_type == "Classification" for r in requirements)
 
 
-def _text_switch(value: Value | None) -> bool | None:
-    """``text: true`` / ``text: false`` (unquoted) switches text reading on or off; None for anything else (a
-    quoted ``"false"`` is text to look for)."""
-    if isinstance(value, Symbol):
-        return _TRUTH.get(value.name.strip().lower())
-    return None
-
-
 def _switched_text(wanted: bool, kb: KnowledgeBase, inferences: list[str]) -> list[Requirement]:
     """The text requirement ``text: true`` asks for (none for ``text: false``), with the inference saying so."""
     if not wanted:
@@ -385,7 +377,7 @@ def _interpret_scan(query: Query, kb: KnowledgeBase, camera_pose: bool, colour: 
     ]
     if not free_space:
         inferences: list[str] = []
-        switch = _text_switch(query.get(TEXT_KEY))
+        switch = text_switch(query.get(TEXT_KEY))
         if switch is not None:
             requirements += _switched_text(switch, kb, inferences)
         else:
