@@ -62,19 +62,25 @@ class Interpretation:
 
 
 def interpret(
-    query: Query, kb: KnowledgeBase, depth: bool = True, camera_pose: bool = True, colour: bool = True
+    query: Query,
+    kb: KnowledgeBase,
+    depth: bool = True,
+    camera_pose: bool = True,
+    colour: bool = True,
+    text_told: tuple[str, ...] | None = None,
 ) -> Interpretation:
     """Resolve the query's words and list the annotation types its answer needs.
 
     ``depth`` says whether the sensor measures depth; without it objects are reported by their image region
     and no pose is required. ``camera_pose`` says whether the input's frames carry the camera pose, without
     which no region of the semantic map can be applied. ``colour`` says whether the input has a colour image,
-    without which a query that names no class reads no text.
+    without which a query that names no class reads no text. ``text_told`` are the ontology's
+    :func:`text_told_classes` when the caller keeps them per ontology (None: derived here, linear in the classes).
     """
     if query.kind == "stop":
         raise PlanningError("a stop query cancels a running task; there is no perception tree to plan for it")
     if query.kind == "scan":
-        return _interpret_scan(query, kb, camera_pose, colour)
+        return _interpret_scan(query, kb, camera_pose, colour, text_told)
     pointing = query.get(POINTING_KEY)
     if isinstance(pointing, Block):
         return _interpret_pointing(query, pointing, depth, camera_pose, kb)
@@ -117,7 +123,7 @@ def interpret(
             inferences.append(why)
             requirements.append(Requirement("Text", None, why))
     elif query.kind not in CONTINUOUS_KINDS and not obj.get(TEXT_KEY) and _names_objects(requirements):
-        requirements += _text_for_any_class(query.kind, kb, colour, inferences)
+        requirements += _text_for_any_class(query.kind, kb, colour, text_told, inferences)
     location = obj.get("location")
     region_box = _region(location, kb, camera_pose)
     if _is_anywhere(location):
@@ -341,11 +347,15 @@ def text_told_classes(kb: KnowledgeBase) -> tuple[str, ...]:
     return tuple(c for c in kb.names_of_kind("class") if _why_text_matters(c, kb))
 
 
-def _text_for_any_class(kind: str, kb: KnowledgeBase, colour: bool, inferences: list[str]) -> list[Requirement]:
+def _text_for_any_class(
+    kind: str, kb: KnowledgeBase, colour: bool, text_told: tuple[str, ...] | None, inferences: list[str]
+) -> list[Requirement]:
     """The text requirement of a one-shot query that names no class: any object may be one of the classes only
     printed text tells apart, so the whole frame is read once (when there is a colour image to read)."""
-    told = text_told_classes(kb)
-    if not told or not colour:
+    if not colour:
+        return []
+    told = text_told_classes(kb) if text_told is None else text_told
+    if not told:
         return []
     shown = ", ".join(told[:3]) + (f" and {len(told) - 3} more" if len(told) > 3 else "")
     why = (
@@ -361,7 +371,9 @@ def _article(word: str) -> str:
     return "an" if word[:1].lower() in "aeiou" else "a"
 
 
-def _interpret_scan(query: Query, kb: KnowledgeBase, camera_pose: bool, colour: bool) -> Interpretation:
+def _interpret_scan(
+    query: Query, kb: KnowledgeBase, camera_pose: bool, colour: bool, text_told: tuple[str, ...] | None
+) -> Interpretation:
     """A scan lists the objects on a region's supporting surface; asked for free space (``free_space: {...}``, or
     ``for: free_space``) it also finds where a footprint fits."""
     block = query.get(FREE_SPACE_KEY)
@@ -381,7 +393,7 @@ def _interpret_scan(query: Query, kb: KnowledgeBase, camera_pose: bool, colour: 
         if switch is not None:
             requirements += _switched_text(switch, kb, inferences)
         else:
-            requirements += _text_for_any_class("scan", kb, colour, inferences)
+            requirements += _text_for_any_class("scan", kb, colour, text_told, inferences)
         task = Task(kind="scan", region=region_box.name if region_box else None, inferences=tuple(inferences))
         return Interpretation(task, tuple(requirements), region_box)
     footprint, why = _footprint(inner, kb)
