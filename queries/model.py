@@ -160,6 +160,21 @@ FREE_SPACE_KEYS: tuple[str, ...] = ("region", "for", "footprint")
 """The keys a free-space block may hold: where, what is to be put there (a class), and its footprint
 (``footprint: [10cm, 8cm]``, width and depth; one length for a square)."""
 
+TEXT_KEY = "text"
+"""The key of the text printed on an object: ``text: "lactose free"`` looks for it, ``text: ?`` asks for it, and
+an unquoted truth value switches text reading on or off (``text: true``, ``text: false``; see :func:`text_switch`)."""
+
+_SWITCHES = {"true": True, "yes": True, "false": False, "no": False}
+
+
+def text_switch(value: Value | None) -> bool | None:
+    """Whether an unquoted ``true``/``false`` (``yes``/``no``) asks for text reading or skips it; None for any other
+    value (a quoted ``"false"`` is text to look for)."""
+    if isinstance(value, Symbol):
+        return _SWITCHES.get(value.name.strip().lower())
+    return None
+
+
 KINDS: tuple[str, ...] = ("detect", "inspect", "track", "scan", "stop")
 """The known query kinds, in canonical order."""
 

@@ -23,6 +23,7 @@ from collections.abc import Callable, Collection, Sequence
 from typing import Protocol
 
 from queries import ANYWHERE, Block, ListValue, Number, Query, String, Symbol, Value
+from queries.model import text_switch
 from reasoning.beliefs.store import BeliefFilter
 from reasoning.knowledge.model import Resolved
 from robokudo.core.regions import RegionBox
@@ -134,6 +135,12 @@ def _attributes(blocks: list[Block], kb: Vocabulary | None, strict: bool) -> dic
     for block in blocks:
         for field in block.fields:
             annotation_type = _answering_type(kb, field.key)
+            if (
+                annotation_type is not None
+                and annotation_type.attribute == "text"
+                and text_switch(field.value) is not None
+            ):
+                continue  # ``text: false`` / ``text: true`` says whether to read text, not a text to look for
             asked = _words(field.value)
             if annotation_type is not None and asked:
                 words.setdefault(annotation_type, asked)

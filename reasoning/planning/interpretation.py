@@ -4,8 +4,11 @@
 from the ontology (Milk is stored in the Fridge) as a hint: it is used only when it can be applied (the input
 carries the camera pose and the semantic map has such a region), otherwise the whole view is searched and the
 inferences say so. ``location: anywhere`` searches the whole view. A region the query names on an input without
-a camera pose is a planning error. A class whose variants differ only by printed text needs text reading. Each
-requirement carries the sentence that explains it.
+a camera pose is a planning error. A class whose variants differ only by printed text needs text reading, and so
+does a one-shot query that names no class but asks what the objects are (``find all objects``, ``scan { region:
+table }``; not ``find the red thing``) when there is a colour image and the ontology knows classes that only their
+printed text or brand tells apart; ``text: false`` skips the reading, ``text: true`` (or ``text: ?``) asks for it.
+Each requirement carries the sentence that explains it.
 """
 
 from __future__ import annotations
@@ -18,6 +21,7 @@ from queries.model import (
     FREE_SPACE_KEY,
     HUMAN_KEY,
     POINTING_KEY,
+    TEXT_KEY,
     Asked,
     Block,
     Field,
@@ -27,6 +31,7 @@ from queries.model import (
     String,
     Symbol,
     Value,
+    text_switch,
 )
 from reasoning.errors import TermError
 from reasoning.knowledge.knowledge_base import KnowledgeBase
@@ -56,17 +61,26 @@ class Interpretation:
     transparent: bool = False
 
 
-def interpret(query: Query, kb: KnowledgeBase, depth: bool = True, camera_pose: bool = True) -> Interpretation:
+def interpret(
+    query: Query,
+    kb: KnowledgeBase,
+    depth: bool = True,
+    camera_pose: bool = True,
+    colour: bool = True,
+    text_told: tuple[str, ...] | None = None,
+) -> Interpretation:
     """Resolve the query's words and list the annotation types its answer needs.
 
     ``depth`` says whether the sensor measures depth; without it objects are reported by their image region
     and no pose is required. ``camera_pose`` says whether the input's frames carry the camera pose, without
-    which no region of the semantic map can be applied.
+    which no region of the semantic map can be applied. ``colour`` says whether the input has a colour image,
+    without which a query that names no class reads no text. ``text_told`` are the ontology's
+    :func:`text_told_classes` when the caller keeps them per ontology (None: derived here, linear in the classes).
     """
     if query.kind == "stop":
         raise PlanningError("a stop query cancels a running task; there is no perception tree to plan for it")
     if query.kind == "scan":
-        return _interpret_scan(query, kb, camera_pose)
+        return _interpret_scan(query, kb, camera_pose, colour, text_told)
     pointing = query.get(POINTING_KEY)
     if isinstance(pointing, Block):
         return _interpret_pointing(query, pointing, depth, camera_pose, kb)
@@ -85,8 +99,9 @@ def interpret(query: Query, kb: KnowledgeBase, depth: bool = True, camera_pose: 
     if object_class is not None:
         constraints.append(Constraint("type", "Classification", object_class))
         requirements.append(Requirement("Classification", object_class, f"query asks type = {object_class}"))
+    switch = text_switch(obj.get(TEXT_KEY))
     for field in obj.fields:
-        if field.key in _STRUCTURAL_KEYS:
+        if field.key in _STRUCTURAL_KEYS or (field.key == TEXT_KEY and switch is not None):
             continue
         annotation_type = _annotation_type(field.key, kb)
         for value in _values(field.value):
@@ -100,11 +115,15 @@ def interpret(query: Query, kb: KnowledgeBase, depth: bool = True, camera_pose: 
         requirements += _inspection(object_id, {r.annotation_type for r in requirements}, kb)
     transparent = _transparency(obj.get("transparent"), object_class, kb, inferences)
     min_confidence = _confidence(obj.get("confidence"), inferences)
-    if object_class is not None and not obj.get("text"):
+    if switch is not None:
+        requirements += _switched_text(switch, kb, inferences)
+    elif object_class is not None and not obj.get(TEXT_KEY) and not _names_no_class(object_class, kb):
         why = _why_text_matters(object_class, kb)
         if why:
             inferences.append(why)
             requirements.append(Requirement("Text", None, why))
+    elif query.kind not in CONTINUOUS_KINDS and not obj.get(TEXT_KEY) and _names_objects(requirements):
+        requirements += _text_for_any_class(query.kind, kb, colour, text_told, inferences)
     location = obj.get("location")
     region_box = _region(location, kb, camera_pose)
     if _is_anywhere(location):
@@ -300,7 +319,61 @@ def _why_text_matters(object_class: str, kb: KnowledgeBase) -> str:
     return ""
 
 
-def _interpret_scan(query: Query, kb: KnowledgeBase, camera_pose: bool) -> Interpretation:
+def _names_no_class(object_class: str, kb: KnowledgeBase) -> bool:
+    """Whether ``object_class`` asks for no class in particular: it is the most general one (``find all objects``
+    asks for PhysicalObject, which has no superclass)."""
+    return not kb.superclasses(object_class)
+
+
+def _names_objects(requirements: list[Requirement]) -> bool:
+    """Whether the answer says what the objects are (a classification is required): only then can text read on
+    them name them (``find all objects`` does; ``find the red thing`` asks only for a colour)."""
+    return any(r.annotation_type == "Classification" for r in requirements)
+
+
+def _switched_text(wanted: bool, kb: KnowledgeBase, inferences: list[str]) -> list[Requirement]:
+    """The text requirement ``text: true`` asks for (none for ``text: false``), with the inference saying so."""
+    if not wanted:
+        inferences.append("the query says text: false, so no text is read (faster; brands stay unread)")
+        return []
+    why = "the query says text: true, so the text printed on the objects is read"
+    inferences.append(why)
+    return [Requirement(kb.annotation_type_for_key(TEXT_KEY), None, why)]
+
+
+def text_told_classes(kb: KnowledgeBase) -> tuple[str, ...]:
+    """The object classes that only the text or brand printed on them tells from others (see
+    :func:`_why_text_matters`), sorted."""
+    return tuple(c for c in kb.names_of_kind("class") if _why_text_matters(c, kb))
+
+
+def _text_for_any_class(
+    kind: str, kb: KnowledgeBase, colour: bool, text_told: tuple[str, ...] | None, inferences: list[str]
+) -> list[Requirement]:
+    """The text requirement of a one-shot query that names no class: any object may be one of the classes only
+    printed text tells apart, so the whole frame is read once (when there is a colour image to read)."""
+    if not colour:
+        return []
+    told = text_told_classes(kb) if text_told is None else text_told
+    if not told:
+        return []
+    shown = ", ".join(told[:3]) + (f" and {len(told) - 3} more" if len(told) > 3 else "")
+    why = (
+        f"{_article(kind)} {kind} query that names no class may meet any class, and {len(told)} classes ({shown}) "
+        "only the text or brand printed on them tells apart, so the text is read once on the whole frame "
+        "(text: false skips it)"
+    )
+    inferences.append(why)
+    return [Requirement(kb.annotation_type_for_key(TEXT_KEY), None, why)]
+
+
+def _article(word: str) -> str:
+    return "an" if word[:1].lower() in "aeiou" else "a"
+
+
+def _interpret_scan(
+    query: Query, kb: KnowledgeBase, camera_pose: bool, colour: bool, text_told: tuple[str, ...] | None
+) -> Interpretation:
     """A scan lists the objects on a region's supporting surface; asked for free space (``free_space: {...}``, or
     ``for: free_space``) it also finds where a footprint fits."""
     block = query.get(FREE_SPACE_KEY)
@@ -315,7 +388,13 @@ def _interpret_scan(query: Query, kb: KnowledgeBase, camera_pose: bool) -> Inter
         Requirement("ObjectHypothesis", None, "a scan needs the objects occupying the surface"),
     ]
     if not free_space:
-        task = Task(kind="scan", region=region_box.name if region_box else None)
+        inferences: list[str] = []
+        switch = text_switch(query.get(TEXT_KEY))
+        if switch is not None:
+            requirements += _switched_text(switch, kb, inferences)
+        else:
+            requirements += _text_for_any_class("scan", kb, colour, text_told, inferences)
+        task = Task(kind="scan", region=region_box.name if region_box else None, inferences=tuple(inferences))
         return Interpretation(task, tuple(requirements), region_box)
     footprint, why = _footprint(inner, kb)
     requirements.append(Requirement(kb.annotation_type_for_key(FREE_SPACE_KEY), None, why))

@@ -8,13 +8,15 @@ from dataclasses import dataclass, replace
 from queries.model import CONTINUOUS_KINDS, FREE_SPACE_KEY, Query
 from reasoning.knowledge.knowledge_base import KnowledgeBase
 from reasoning.knowledge.model import AnnotatorSpec, Conditions
-from reasoning.planning.interpretation import TRACK_TYPE, Interpretation, interpret
+from reasoning.planning.interpretation import TRACK_TYPE, Interpretation, interpret, text_told_classes
 from reasoning.planning.plan import Plan, Task
 from reasoning.planning.planner import SensorSource, plan_requirements
 from robokudo.core.regions import RegionBox
 from robokudo.core.types import type_by_name
 
 DEPTH_TYPES = frozenset({"DepthImage", "PointCloud"})
+COLOUR_TYPE = "ColorImage"
+"""The sensor type text is read on."""
 REGION_PRECONDITION = "NeedsRegion"
 ROOT_CLASS = "PhysicalObject"
 
@@ -184,6 +186,7 @@ class QueryPlanner:
         self._profiles: tuple[dict[str, object], ...] = ()
         self._parameterised: tuple[AnnotatorSpec, ...] = ()
         self._trackers: tuple[AnnotatorSpec, ...] = ()
+        self._text_told: tuple[str, ...] = ()
         self._catalogs: dict[tuple[object, ...], object] = {}
         self._regions: dict[str, tuple[RegionBox, dict[str, object]]] = {}
 
@@ -194,6 +197,7 @@ class QueryPlanner:
             self._profiles = class_profiles(self.kb)
             self._parameterised = parameterised_annotators(self.kb)
             self._trackers = tuple(spec for spec in self.kb.annotators() if TRACK_TYPE in spec.outputs)
+            self._text_told = text_told_classes(self.kb)
             # the semantic map's region boxes as annotator arguments (a focus box is converted when planned)
             self._regions = {box.name: (box, region_parameters(box)) for box in self.kb.regions()}
             self._catalogs = {}
@@ -208,13 +212,14 @@ class QueryPlanner:
         the box around the object an ``inspect`` query names by id (:func:`reasoning.planning.focus.object_focus`),
         which then takes the place of a region."""
         depth = bool(source.types & DEPTH_TYPES)
-        interpretation = interpret(query, self.kb, depth=depth, camera_pose=source.camera_pose)
+        self._refresh()
+        colour = COLOUR_TYPE in source.types
+        interpretation = interpret(query, self.kb, depth, source.camera_pose, colour, self._text_told)
         if focus is not None and query.kind == "inspect":
             interpretation = focused(interpretation, focus, depth and source.camera_pose)
         box = interpretation.region_box
         conditions = Conditions(depth=depth, region=box is not None, transparent=interpretation.transparent)
         task = interpretation.task
-        self._refresh()
         region = None
         if box is not None:
             known = self._regions.get(box.name)

@@ -2,7 +2,7 @@
 
 from __future__ import annotations
 
-from dataclasses import dataclass, field
+from dataclasses import dataclass, field, replace
 from pathlib import Path
 
 import py_trees
@@ -12,6 +12,7 @@ from queries import parse_query
 from reasoning.beliefs.store import BeliefStore
 from reasoning.knowledge.editing import OntologyEditor
 from reasoning.knowledge.knowledge_base import KnowledgeBase
+from reasoning.planning.interpretation import interpret, text_told_classes
 from reasoning.planning.plan import Alternatives, Plan, Step
 from reasoning.planning.planner import PlanningError, SensorSource
 from reasoning.planning.query_planner import plan_query
@@ -121,6 +122,15 @@ CASES = [
     case("find the toffifee", "TextReader KnowledgeClassifier", inference="brand 'Toffifee'"),
     case("find the cheez-it box", "TextReader KnowledgeClassifier", inference="brand 'Cheez-It'"),
     case("find the sweets", "KnowledgeClassifier", "TextReader"),
+    # a one-shot query that asks what the objects are, naming no class, reads the text that alone names some
+    case("find all objects", "TextReader KnowledgeClassifier", inference="only the text or brand printed on them"),
+    case("inspect object 3", "TextReader KnowledgeClassifier", inference="only the text or brand printed on them"),
+    case("scan { region: table }", "TextReader", "KnowledgeClassifier", inference="names no class", region="table"),
+    case("track { obj: { type: object } }", "KnowledgeClassifier", "TextReader"),
+    case("detect { obj: { type: object, text: false } }", "KnowledgeClassifier", "TextReader", inference="text: false"),
+    case("scan { region: table, text: false }", "", "TextReader", inference="text: false", region="table"),
+    case("detect { obj: { type: CheezIt, text: false } }", "KnowledgeClassifier", "TextReader"),
+    case("detect { obj: { color: red, text: true } }", "TextReader SemanticColorAnnotator", "KnowledgeClassifier"),
 ]
 
 FAILURES = [
@@ -220,3 +230,30 @@ def test_a_new_object_class_plans_and_runs_at_once(tmp_path: Path) -> None:
         answer = service.answer("find the picnic cup").answer
     assert answer.objects, "the new class was not found in the kitchen"
     assert answer.objects[0].class_iri.endswith("PicnicCup")
+
+
+def test_a_query_naming_no_class_reads_text_only_with_a_colour_image_and_text_told_classes(kb: KnowledgeBase) -> None:
+    """The text is read for ``find all objects`` because the ontology holds classes only their printed text or
+    brand tells apart, and there is a colour image to read it on; without either, no text is read."""
+    query = parse_query("find all objects")
+    assert text_told_classes(kb) and {"CheezIt", "CampbellsTomatoSoup"} <= set(text_told_classes(kb))
+    texts = [r for r in interpret(query, kb).requirements if r.annotation_type == "Text"]
+    assert len(texts) == 1 and "only the text or brand printed on them" in texts[0].reason
+    assert not [r for r in interpret(query, kb, colour=False).requirements if r.annotation_type == "Text"]
+    assert not [r for r in interpret(query, _no_text_told(kb)).requirements if r.annotation_type == "Text"]
+
+
+def _no_text_told(kb: KnowledgeBase) -> KnowledgeBase:
+    """A stand-in knowledge base in which no class is told apart by text (every other answer is ``kb``'s)."""
+
+    class Plain:
+        def __getattr__(self, name: str) -> object:
+            return getattr(kb, name)
+
+        def variants_differ_by_text(self, name: str) -> bool:
+            return False
+
+        def object_profile(self, name: str) -> object:
+            return replace(kb.object_profile(name), brand=None, texts=())
+
+    return Plain()  # type: ignore[return-value]
