@@ -89,11 +89,15 @@ def interpret(
     hypothesis = kb.hypothesis_type(object_class) if object_class is not None else "ObjectHypothesis"
     if hypothesis != "ObjectHypothesis":
         return _interpret_specialised(query, obj, object_class, hypothesis)
-    requirements = [Requirement("ObjectHypothesis", None, f"a {query.kind} query needs object hypotheses")]
+    requirements = [
+        Requirement("ObjectHypothesis", None, f"{_article(query.kind)} {query.kind} query needs object hypotheses")
+    ]
     constraints: list[Constraint] = []
     inferences: list[str] = []
     if depth or isinstance(obj.get("pose"), Asked):
-        requirements.append(Requirement("Pose", None, f"a {query.kind} query reports each object's pose"))
+        requirements.append(
+            Requirement("Pose", None, f"{_article(query.kind)} {query.kind} query reports each object's pose")
+        )
     else:
         inferences.append("the sensor measures no depth, so objects are reported by image region without a pose")
     if object_class is not None:
@@ -168,7 +172,10 @@ def _interpret_specialised(query: Query, obj: Block, object_class: str, hypothes
             f"{', '.join(asked)} cannot be asked of a {object_class} yet (its detectors say only "
             f"where it is and its body keypoints)"
         )
-    why = f"{object_class} is perceived as {hypothesis}, so a {query.kind} query needs a provider of it"
+    why = (
+        f"{object_class} is perceived as {hypothesis}, so {_article(query.kind)} {query.kind} query needs a "
+        "provider of it"
+    )
     task = Task(
         kind=query.kind,
         object_class=object_class,
@@ -185,7 +192,7 @@ def _tracking(query: Query) -> tuple[Requirement, ...]:
     """The tracker a continuous query needs (none for a one-shot query)."""
     if query.kind not in CONTINUOUS_KINDS:
         return ()
-    why = f"a {query.kind} query follows its target from frame to frame"
+    why = f"{_article(query.kind)} {query.kind} query follows its target from frame to frame"
     return (Requirement(TRACK_TYPE, None, why),)
 
 
@@ -255,13 +262,15 @@ def _target(query: Query) -> Block:
     """The block describing what to find: ``obj``, or ``human`` (an object of the class the word human names)."""
     obj, human = query.get("obj"), query.get("human")
     if obj is not None and human is not None:
-        raise PlanningError(f"a {query.kind} query names either an obj or a human, not both")
+        raise PlanningError(f"{_article(query.kind)} {query.kind} query names either an obj or a human, not both")
     if isinstance(human, Block):
         if human.get("type") is not None:
             return human
         return Block((Field("type", Symbol(HUMAN_KEY)), *human.fields))
     if not isinstance(obj, Block):
-        raise PlanningError(f"a {query.kind} query needs an obj block describing the object (or a human block)")
+        raise PlanningError(
+            f"{_article(query.kind)} {query.kind} query needs an obj block describing the object (or a human block)"
+        )
     return obj
 
 
@@ -368,6 +377,7 @@ def _text_for_any_class(
 
 
 def _article(word: str) -> str:
+    """The indefinite article for ``word`` ("an inspect query", "a detect query")."""
     return "an" if word[:1].lower() in "aeiou" else "a"
 
 
