@@ -189,22 +189,34 @@ def label_pixels(labels: np.ndarray, top: int, left: int, width: int) -> tuple[n
 
 
 @njit(cache=True, nogil=True)
+def _run_end(labels: np.ndarray, r: int, c: int) -> int:
+    """The column after the run of equal labels that starts at ``labels[r, c]`` (exclusive)."""
+    label, cols = labels[r, c], labels.shape[1]
+    c += 1
+    while c < cols and labels[r, c] == label:
+        c += 1
+    return c
+
+
+@njit(cache=True, nogil=True)
 def fill_label_masks(labels: np.ndarray, slots: np.ndarray, masks: np.ndarray, top: int, left: int) -> np.ndarray:
-    """See :func:`annotators.geometry.grid_kernels.label_masks`."""
+    """See :func:`annotators.geometry.grid_kernels.label_masks` (row by row, one run of equal labels at a time)."""
     rows, cols = labels.shape
     boxes = np.zeros((masks.shape[0], 4), dtype=np.int64)
     boxes[:, 0], boxes[:, 1] = cols, rows
     seen = np.zeros(masks.shape[0], dtype=np.bool_)
     for r in range(rows):
-        for c in range(cols):
+        c = 0
+        while c < cols:
             label = labels[r, c]
-            if label <= 0 or label >= slots.size or slots[label] < 0:
-                continue
-            slot = slots[label]
-            masks[slot, r + top, c + left] = True
-            seen[slot] = True
-            boxes[slot, 0], boxes[slot, 1] = min(boxes[slot, 0], c), min(boxes[slot, 1], r)
-            boxes[slot, 2], boxes[slot, 3] = max(boxes[slot, 2], c + 1), max(boxes[slot, 3], r + 1)
+            end = _run_end(labels, r, c)
+            if 0 < label < slots.size and slots[label] >= 0:
+                slot = slots[label]
+                masks[slot, r + top, c + left : end + left] = True
+                seen[slot] = True
+                boxes[slot, 0], boxes[slot, 1] = min(boxes[slot, 0], c), min(boxes[slot, 1], r)
+                boxes[slot, 2], boxes[slot, 3] = max(boxes[slot, 2], end), max(boxes[slot, 3], r + 1)
+            c = end
     for slot in range(masks.shape[0]):
         if not seen[slot]:
             boxes[slot] = 0
