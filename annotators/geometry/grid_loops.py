@@ -155,8 +155,18 @@ def upsampled_labels(
 
 
 @njit(cache=True, nogil=True)
+def _run_end(labels: np.ndarray, r: int, c: int) -> int:
+    """The column after the run of equal labels that starts at ``labels[r, c]`` (exclusive)."""
+    label, cols = labels[r, c], labels.shape[1]
+    c += 1
+    while c < cols and labels[r, c] == label:
+        c += 1
+    return c
+
+
+@njit(cache=True, nogil=True)
 def label_pixels(labels: np.ndarray, top: int, left: int, width: int) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
-    """See :func:`annotators.geometry.grid_kernels.label_pixels`."""
+    """See :func:`annotators.geometry.grid_kernels.label_pixels` (row by row, one run of equal labels at a time)."""
     rows, cols = labels.shape
     count = 0
     for r in range(rows):
@@ -166,36 +176,34 @@ def label_pixels(labels: np.ndarray, top: int, left: int, width: int) -> tuple[n
     boxes = np.zeros((count + 1, 4), dtype=np.int64)
     boxes[:, 0], boxes[:, 1] = cols, rows
     for r in range(rows):
-        for c in range(cols):
+        c = 0
+        while c < cols:
             label = labels[r, c]
+            end = _run_end(labels, r, c)
             if label > 0:
-                starts[label + 1] += 1
+                starts[label + 1] += end - c
                 boxes[label, 0], boxes[label, 1] = min(boxes[label, 0], c), min(boxes[label, 1], r)
-                boxes[label, 2], boxes[label, 3] = max(boxes[label, 2], c + 1), max(boxes[label, 3], r + 1)
+                boxes[label, 2], boxes[label, 3] = max(boxes[label, 2], end), max(boxes[label, 3], r + 1)
+            c = end
     for label in range(1, count + 2):
         starts[label] += starts[label - 1]
     pixels = np.empty(starts[count + 1], dtype=np.int64)
     filled = starts[:-1].copy()
     for r in range(rows):
-        for c in range(cols):
+        c = 0
+        while c < cols:
             label = labels[r, c]
+            end = _run_end(labels, r, c)
             if label > 0:
-                pixels[filled[label]] = (r + top) * width + c + left
-                filled[label] += 1
+                first, offset = filled[label], (r + top) * width + left
+                for k in range(c, end):
+                    pixels[first + k - c] = offset + k
+                filled[label] = first + end - c
+            c = end
     for label in range(count + 1):
         if starts[label + 1] == starts[label]:
             boxes[label] = 0
     return pixels, starts, boxes
-
-
-@njit(cache=True, nogil=True)
-def _run_end(labels: np.ndarray, r: int, c: int) -> int:
-    """The column after the run of equal labels that starts at ``labels[r, c]`` (exclusive)."""
-    label, cols = labels[r, c], labels.shape[1]
-    c += 1
-    while c < cols and labels[r, c] == label:
-        c += 1
-    return c
 
 
 @njit(cache=True, nogil=True)
