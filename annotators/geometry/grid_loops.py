@@ -867,6 +867,13 @@ def strided_crop(values: np.ndarray, step: int, x0: int, y0: int, x1: int, y1: i
     """See :func:`annotators.geometry.grid_kernels.strided_crop`."""
     channels = values.shape[2]
     crop = np.empty((y1 - y0, x1 - x0, channels), dtype=values.dtype)
+    if channels == 3:  # points and colours: a fixed-length copy per pixel, row by row (several times faster)
+        for r in range(y1 - y0):
+            source, target = values[(r + y0) * step], crop[r]
+            for c in range(x1 - x0):
+                pixel = source[(c + x0) * step]
+                target[c, 0], target[c, 1], target[c, 2] = pixel[0], pixel[1], pixel[2]
+        return crop
     for r in range(y1 - y0):
         for c in range(x1 - x0):
             for k in range(channels):
