@@ -155,8 +155,18 @@ def upsampled_labels(
 
 
 @njit(cache=True, nogil=True)
+def _run_end(labels: np.ndarray, r: int, c: int) -> int:
+    """The column after the run of equal labels that starts at ``labels[r, c]`` (exclusive)."""
+    label, cols = labels[r, c], labels.shape[1]
+    c += 1
+    while c < cols and labels[r, c] == label:
+        c += 1
+    return c
+
+
+@njit(cache=True, nogil=True)
 def label_pixels(labels: np.ndarray, top: int, left: int, width: int) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
-    """See :func:`annotators.geometry.grid_kernels.label_pixels`."""
+    """See :func:`annotators.geometry.grid_kernels.label_pixels` (row by row, one run of equal labels at a time)."""
     rows, cols = labels.shape
     count = 0
     for r in range(rows):
@@ -166,22 +176,30 @@ def label_pixels(labels: np.ndarray, top: int, left: int, width: int) -> tuple[n
     boxes = np.zeros((count + 1, 4), dtype=np.int64)
     boxes[:, 0], boxes[:, 1] = cols, rows
     for r in range(rows):
-        for c in range(cols):
+        c = 0
+        while c < cols:
             label = labels[r, c]
+            end = _run_end(labels, r, c)
             if label > 0:
-                starts[label + 1] += 1
+                starts[label + 1] += end - c
                 boxes[label, 0], boxes[label, 1] = min(boxes[label, 0], c), min(boxes[label, 1], r)
-                boxes[label, 2], boxes[label, 3] = max(boxes[label, 2], c + 1), max(boxes[label, 3], r + 1)
+                boxes[label, 2], boxes[label, 3] = max(boxes[label, 2], end), max(boxes[label, 3], r + 1)
+            c = end
     for label in range(1, count + 2):
         starts[label] += starts[label - 1]
     pixels = np.empty(starts[count + 1], dtype=np.int64)
     filled = starts[:-1].copy()
     for r in range(rows):
-        for c in range(cols):
+        c = 0
+        while c < cols:
             label = labels[r, c]
+            end = _run_end(labels, r, c)
             if label > 0:
-                pixels[filled[label]] = (r + top) * width + c + left
-                filled[label] += 1
+                first, offset = filled[label], (r + top) * width + left
+                for k in range(c, end):
+                    pixels[first + k - c] = offset + k
+                filled[label] = first + end - c
+            c = end
     for label in range(count + 1):
         if starts[label + 1] == starts[label]:
             boxes[label] = 0
@@ -190,21 +208,23 @@ def label_pixels(labels: np.ndarray, top: int, left: int, width: int) -> tuple[n
 
 @njit(cache=True, nogil=True)
 def fill_label_masks(labels: np.ndarray, slots: np.ndarray, masks: np.ndarray, top: int, left: int) -> np.ndarray:
-    """See :func:`annotators.geometry.grid_kernels.label_masks`."""
+    """See :func:`annotators.geometry.grid_kernels.label_masks` (row by row, one run of equal labels at a time)."""
     rows, cols = labels.shape
     boxes = np.zeros((masks.shape[0], 4), dtype=np.int64)
     boxes[:, 0], boxes[:, 1] = cols, rows
     seen = np.zeros(masks.shape[0], dtype=np.bool_)
     for r in range(rows):
-        for c in range(cols):
+        c = 0
+        while c < cols:
             label = labels[r, c]
-            if label <= 0 or label >= slots.size or slots[label] < 0:
-                continue
-            slot = slots[label]
-            masks[slot, r + top, c + left] = True
-            seen[slot] = True
-            boxes[slot, 0], boxes[slot, 1] = min(boxes[slot, 0], c), min(boxes[slot, 1], r)
-            boxes[slot, 2], boxes[slot, 3] = max(boxes[slot, 2], c + 1), max(boxes[slot, 3], r + 1)
+            end = _run_end(labels, r, c)
+            if 0 < label < slots.size and slots[label] >= 0:
+                slot = slots[label]
+                masks[slot, r + top, c + left : end + left] = True
+                seen[slot] = True
+                boxes[slot, 0], boxes[slot, 1] = min(boxes[slot, 0], c), min(boxes[slot, 1], r)
+                boxes[slot, 2], boxes[slot, 3] = max(boxes[slot, 2], end), max(boxes[slot, 3], r + 1)
+            c = end
     for slot in range(masks.shape[0]):
         if not seen[slot]:
             boxes[slot] = 0
@@ -847,6 +867,13 @@ def strided_crop(values: np.ndarray, step: int, x0: int, y0: int, x1: int, y1: i
     """See :func:`annotators.geometry.grid_kernels.strided_crop`."""
     channels = values.shape[2]
     crop = np.empty((y1 - y0, x1 - x0, channels), dtype=values.dtype)
+    if channels == 3:  # points and colours: a fixed-length copy per pixel, row by row (several times faster)
+        for r in range(y1 - y0):
+            source, target = values[(r + y0) * step], crop[r]
+            for c in range(x1 - x0):
+                pixel = source[(c + x0) * step]
+                target[c, 0], target[c, 1], target[c, 2] = pixel[0], pixel[1], pixel[2]
+        return crop
     for r in range(y1 - y0):
         for c in range(x1 - x0):
             for k in range(channels):

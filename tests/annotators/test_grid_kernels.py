@@ -256,11 +256,13 @@ def test_window_counts_count_the_labels_of_a_window_in_place() -> None:
     np.testing.assert_array_equal(counts, np.bincount(window.reshape(-1), minlength=int(labels.max()) + 1))
 
 
-@pytest.mark.parametrize("channels", [0, 3])
-def test_strided_crop_is_the_contiguous_copy_of_the_subsampled_window(channels: int) -> None:
+@pytest.mark.parametrize("dtype", [np.float32, np.uint8])
+@pytest.mark.parametrize("channels", [0, 3, 4])  # 3: the fixed-length copy; others the general loop
+def test_strided_crop_is_the_contiguous_copy_of_the_subsampled_window(channels: int, dtype: type) -> None:
     shape = (47, 61, channels) if channels else (47, 61)
-    values = np.random.default_rng(channels).random(shape).astype(np.float32)
-    values[3, 4] = np.nan
+    values = (np.random.default_rng(channels).random(shape) * 255).astype(dtype)
+    if dtype == np.float32:
+        values[3, 4] = np.nan
     crop = strided_crop(values, 2, (3, 1, 29, 22))
     expected = np.ascontiguousarray(values[::2, ::2][1:22, 3:29])
     np.testing.assert_array_equal(crop, expected)
