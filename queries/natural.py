@@ -18,6 +18,9 @@ stop / cancel [task] N, stop all                ``stop { task: N }``, ``task: al
 noun words (unknown words joined by ``_``)      ``obj: { type: cereal_box }``
 plural head noun                                singular ``type``, no result limit
 a / an / the / this / my ... + singular noun    ``max_results: 1`` (detect, track)
+all / two / 3 (of) the / my / these + noun      the quantity sets the limit, not ``the``
+the red one / the red ones                      ``one`` names no class: ``color: red``
+find me / get me                                ``detect`` (``me`` is not the object)
 two ... ten, or a number, before the noun       ``max_results: N`` (detect, track)
 colour adjective (red, dark red, grey...)       ``color: red`` (several: a list)
 size adjective (small, little, big, tiny...)    ``size: small`` / ``large``
@@ -63,6 +66,7 @@ from queries.lexicon import (
     IRREGULAR_PLURALS,
     LIMITING_DETERMINERS,
     OPEN_DETERMINERS,
+    PARTITIVE_OF,
     PLACEMENT_VERBS,
     PLURAL_ONLY,
     PLURAL_SUFFIXES,
@@ -388,17 +392,7 @@ class _PhraseParser:
         if start is None:
             raise self.error("expected an object")
         phrase = _ObjectPhrase(start.span, start.span)
-        word = self.word()
-        if word in LIMITING_DETERMINERS:
-            phrase.limit_span = self.take()[0].span
-        elif word in OPEN_DETERMINERS:
-            self.take()
-        elif word is not None and word in COUNT_WORDS:
-            phrase.limit = COUNT_WORDS[word]
-            phrase.limit_span = self.take()[0].span
-        elif start.kind == "number":
-            phrase.limit = int(self.whole_number(start, "the number of objects").value)
-            phrase.limit_span = self.take()[0].span
+        self.determiners(phrase, start)
         pronoun = self.word()
         if pronoun in INDEFINITE_PRONOUNS:
             token = self.take()[0]
@@ -423,6 +417,35 @@ class _PhraseParser:
         self.noun_words(phrase, words)
         phrase.end = self.last_span()
         return phrase
+
+    def determiners(self, phrase: _ObjectPhrase, start: PhraseToken) -> None:
+        """Read the determiners before the noun: one (``the``, ``all``, ``two``, ``3``), or a quantity followed
+        by another determiner, with or without ``of`` (``all the``, ``all of my``, ``one of the``, ``2 of these``),
+        which then limits nothing itself."""
+        word = self.word()
+        quantity = True
+        if word == "one" and self.word(1) == PARTITIVE_OF:
+            phrase.limit = 1
+            phrase.limit_span = self.take()[0].span
+        elif word in LIMITING_DETERMINERS:
+            phrase.limit_span = self.take()[0].span
+            quantity = False
+        elif word in OPEN_DETERMINERS:
+            self.take()
+        elif word is not None and word in COUNT_WORDS:
+            phrase.limit = COUNT_WORDS[word]
+            phrase.limit_span = self.take()[0].span
+        elif start.kind == "number":
+            phrase.limit = int(self.whole_number(start, "the number of objects").value)
+            phrase.limit_span = self.take()[0].span
+        else:
+            quantity = False
+        if not quantity:
+            return
+        if self.word() == PARTITIVE_OF and self.word(1) in LIMITING_DETERMINERS:
+            self.take()
+        if self.word() in LIMITING_DETERMINERS:
+            self.take()
 
     def noun_words(self, phrase: _ObjectPhrase, words: list[PhraseToken]) -> None:
         """Split words into adjectives and the (possibly compound) head noun."""
