@@ -45,7 +45,12 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
         "--yes", action="store_true", help="confirm --clear without QUERY: forget every belief and its history"
     )
     parser.add_argument("--all", action="store_true", help="include objects marked gone")
-    parser.add_argument("--store", type=Path, default=None, help="belief store file (default: see above)")
+    parser.add_argument(
+        "--store",
+        type=Path,
+        default=None,
+        help="belief store file (default: $ROBOKUDO_BELIEF_STORE or the user data dir)",
+    )
 
 
 class _RefusedError(Exception):
