@@ -154,6 +154,18 @@ SIZES: MappingProxyType[str, str] = MappingProxyType(
 )
 """Size adjectives and the ``size`` value they give."""
 
+SUPERLATIVES: MappingProxyType[str, str] = MappingProxyType(
+    {
+        "smallest": "small",
+        "littlest": "small",
+        "tiniest": "tiny",
+        "biggest": "large",
+        "largest": "large",
+        "hugest": "large",
+    }
+)
+"""Superlatives (they compare the objects seen, which no query key does) and the size word to suggest instead."""
+
 SHAPES: MappingProxyType[str, str] = MappingProxyType(
     {
         "round": "sphere",

@@ -20,6 +20,7 @@ plural head noun                                singular ``type``, no result lim
 a / an / the / this / my ... + singular noun    ``max_results: 1`` (detect, track)
 all / two / 3 (of) the / my / these + noun      the quantity sets the limit, not ``the``
 the red one / the red ones                      ``one`` names no class: ``color: red``
+the smallest / biggest X                        an error suggesting ``small X`` / ``large X``
 find me / get me                                ``detect`` (``me`` is not the object)
 two ... ten, or a number, before the noun       ``max_results: N`` (detect, track)
 colour adjective (red, dark red, grey...)       ``color: red`` (several: a list)
@@ -46,6 +47,7 @@ located :class:`QueryError` at the first such token.
 
 from __future__ import annotations
 
+import difflib
 from collections.abc import Collection, Iterable
 from dataclasses import dataclass, field
 
@@ -79,6 +81,7 @@ from queries.lexicon import (
     SHAPE_NOUNS,
     STOP_ALL_WORDS,
     STOP_TASK_WORDS,
+    SUPERLATIVES,
     TEXT_MARKERS,
     VERBS,
 )
@@ -307,7 +310,7 @@ class _PhraseParser:
             verb = self.match(VERBS)
             if verb is None:
                 raise self.error(
-                    f"expected a verb such as {', '.join(VERB_EXAMPLES[:-1])} or stop",
+                    f"expected a verb such as {', '.join(VERB_EXAMPLES[:-1])} or stop{self.verb_guess()}",
                     VERB_EXAMPLES,
                 )
             verb_tokens = self.take(len(verb))
@@ -334,6 +337,15 @@ class _PhraseParser:
         query = Query(kind, body, self.text, kind_span)
         validate_query(query)
         return query
+
+    def verb_guess(self) -> str:
+        """``; did you mean 'find'?`` when the first word is a near miss of a one-word verb, else nothing."""
+        word = self.word()
+        if word is None:
+            return ""
+        verbs = sorted({words[0] for words in VERBS if len(words) == 1})
+        close = difflib.get_close_matches(word, verbs, n=1, cutoff=0.7)
+        return f"; did you mean '{close[0]}'?" if close else ""
 
     def pointing_question(self) -> Query | None:
         """``which object is the person pointing at`` (also ``what ... point at``, ``which region / place ...``,
@@ -463,6 +475,13 @@ class _PhraseParser:
                 phrase.add_adjective("color", Symbol(f"{word}_{COLORS[following]}"), token.span)
                 position += 2
                 continue
+            if word in SUPERLATIVES:
+                instead = " ".join(SUPERLATIVES.get(t.text, t.text) for t in words)
+                raise self.error_at(
+                    token.span,
+                    f"'{word}' compares the objects seen, which a query cannot ask; ask for a size instead, "
+                    f"e.g. '{instead}'",
+                )
             if word in CONJUNCTIONS:
                 if position == 0 or following is None or not self.is_adjective(following):
                     raise self.error_at(
