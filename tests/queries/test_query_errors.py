@@ -38,6 +38,7 @@ BAD_QUERIES: list[tuple[Parser, str, int, int, str]] = [
     (parse_query, "detect { obj: { width: -1cm } }", 1, 17, "'width' must not be negative"),
     (parse_query, "detect { obj: { width: -2cm..1cm } }", 1, 17, "'width' must not be negative"),
     (parse_query, "detect { obj: { size: 5cm..12cm } }", 1, 17, "'size' takes a size word"),
+    (parse_query, '{"type": "detect", "obj": {"type": "Milk"}}', 1, 20, 'write it as {"detect": {"obj": {...}}}'),
     (parse_query, "detect { obj: { type: Milk }, max_results: two }", 1, 31, "'max_results' takes a number, not 'two'"),
     (parse_query, "detect {\n  obj: { type: Milk },\n  timeout: soon\n}", 3, 3, "'timeout' takes a number"),
     (parse_query, 'inspect { obj: { id: "three" } }', 1, 18, "'id' takes a number, not 'three'"),
