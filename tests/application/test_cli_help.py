@@ -6,6 +6,9 @@ from __future__ import annotations
 import argparse
 from collections.abc import Iterator
 
+import pytest
+
+from robokudo.application import cli
 from robokudo.application.cli import build_parser
 
 
@@ -36,3 +39,15 @@ def test_every_belief_store_option_names_its_default() -> None:
     assert {c for c, _, _ in stores} >= {"robokudo beliefs", "robokudo query", "robokudo serve"}
     for command, option, text in stores:
         assert "$ROBOKUDO_BELIEF_STORE" in text, (command, option, text)
+
+
+def test_an_unknown_option_is_reported_by_the_command_that_was_given(capsys: pytest.CaptureFixture[str]) -> None:
+    with pytest.raises(SystemExit) as caught:
+        cli.main(["ask", "--port", "9391", "find milk"])
+    assert caught.value.code == 2
+    err = capsys.readouterr().err
+    assert "usage: robokudo ask" in err and "robokudo ask: error: unrecognized arguments: --port" in err
+    with pytest.raises(SystemExit):
+        cli.main(["ontology", "show", "Milk", "--colour", "red"])
+    err = capsys.readouterr().err
+    assert "usage: robokudo ontology show" in err and "unrecognized arguments: --colour red" in err
