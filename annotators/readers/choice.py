@@ -55,7 +55,7 @@ SUPPORTED_LAYOUTS = (
     "a TUM RGB-D sequence folder (rgb.txt, depth.txt)",
     "a uoc folder (NNNNNN-color.png, NNNNNN-depth.png, camera_params.json) or one of its NNNNNN-color.png",
     "a PCL ImageGrabber folder (tiff/ with pclzf/*.xml) or its tiff/ folder",
-    "an organized .pcd file, or a folder of them",
+    "a .pcd file, organized or unorganized (HEIGHT 1; --intrinsics gives its camera), or a folder of them",
     "a TUM-style colour/depth pair: a colour file named *color* or *rgb* with the *depth* file beside it, "
     "or a folder of such pairs",
 )
