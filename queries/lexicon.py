@@ -186,6 +186,14 @@ SHAPE_NOUNS: MappingProxyType[str, str] = MappingProxyType(
 """Head nouns that name a shape, not a class: ``a small red cylinder`` -> ``shape: cylinder`` and no ``type``
 (a compound such as ``cereal box`` stays a class)."""
 
+PERSONAL_PRONOUNS: MappingProxyType[str, bool] = MappingProxyType(
+    {"me": True, "him": True, "her": True, "us": False, "them": False}
+)
+"""Pronouns that, standing alone as the object (``follow me``), mean a person; True when they mean one."""
+
+PERSON_NOUN = "person"
+"""The noun a personal pronoun stands for."""
+
 INDEFINITE_PRONOUNS: MappingProxyType[str, bool] = MappingProxyType(
     {"something": True, "anything": False, "everything": False}
 )

@@ -22,6 +22,7 @@ all / two / 3 (of) the / my / these + noun      the quantity sets the limit, not
 the red one / the red ones                      ``one`` names no class: ``color: red``
 the smallest / biggest X                        an error suggesting ``small X`` / ``large X``
 find me / get me                                ``detect`` (``me`` is not the object)
+me / him / her / us / them (alone)              ``type: person`` (``follow me``)
 two ... ten, or a number, before the noun       ``max_results: N`` (detect, track)
 colour adjective (red, dark red, grey...)       ``color: red`` (several: a list)
 size adjective (small, little, big, tiny...)    ``size: small`` / ``large``
@@ -69,6 +70,8 @@ from queries.lexicon import (
     LIMITING_DETERMINERS,
     OPEN_DETERMINERS,
     PARTITIVE_OF,
+    PERSON_NOUN,
+    PERSONAL_PRONOUNS,
     PLACEMENT_VERBS,
     PLURAL_ONLY,
     PLURAL_SUFFIXES,
@@ -264,6 +267,14 @@ class _PhraseParser:
             or (self.match(TEXT_MARKERS) and self.text_after_marker() is not None)
         )
 
+    def is_boundary_after(self, ahead: int) -> bool:
+        """Whether the token ``ahead`` of the current one ends a run of noun words."""
+        self.index += ahead
+        try:
+            return self.is_boundary()
+        finally:
+            self.index -= ahead
+
     def text_after_marker(self) -> PhraseToken | None:
         marker = self.match(TEXT_MARKERS)
         if marker is None:
@@ -404,6 +415,12 @@ class _PhraseParser:
         if start is None:
             raise self.error("expected an object")
         phrase = _ObjectPhrase(start.span, start.span)
+        pronoun = self.word()
+        if pronoun in PERSONAL_PRONOUNS and (self.index + 1 == len(self.tokens) or self.is_boundary_after(1)):
+            token = self.take()[0]
+            phrase.noun, phrase.noun_span, phrase.plural = PERSON_NOUN, token.span, not PERSONAL_PRONOUNS[pronoun]
+            phrase.limit_span = token.span
+            return phrase
         self.determiners(phrase, start)
         pronoun = self.word()
         if pronoun in INDEFINITE_PRONOUNS:

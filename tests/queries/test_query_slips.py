@@ -55,3 +55,17 @@ def test_a_superlative_is_refused_with_what_to_say_instead(phrase: str, column: 
         parse_query(phrase)
     assert (caught.value.line, caught.value.column) == (1, column)
     assert instead in caught.value.message
+
+
+@pytest.mark.parametrize(
+    ("phrase", "expected"),
+    [
+        ("follow me", "track { obj: { type: person }, max_results: 1 }"),
+        ("track her", "track { obj: { type: person }, max_results: 1 }"),
+        ("find them", "detect { obj: { type: person } }"),
+        ("find us in the kitchen", "detect { obj: { type: person, location: { in: kitchen } } }"),
+        ("track her cup", "track { obj: { type: cup }, max_results: 1 }"),
+    ],
+)
+def test_a_personal_pronoun_as_the_object_is_a_person(phrase: str, expected: str) -> None:
+    assert format_query(parse_query(phrase)) == expected
