@@ -7,7 +7,8 @@ parser; the word tables are data in :mod:`queries.lexicon`.  The mapping:
 phrase                                          model
 ==============================================  =====================================
 find / detect / locate / get / search (for) /   ``detect``
-look for / where is / is there / show me
+look for / where is / is there / show (me) /
+list / (do you) see / what is + place
 track / follow / keep track of                  ``track``
 inspect / examine / look at / check             ``inspect``
 what color / size / shape is X                  ``inspect { obj: { ..., color: ? } }``
@@ -303,6 +304,9 @@ class _PhraseParser:
         pointing = self.pointing_question()
         if pointing is not None:
             return pointing
+        seen = self.what_is_question()
+        if seen is not None:
+            return seen
         asked_key: str | None = None
         placement = self.match(PLACEMENT_VERBS)
         if placement is not None:
@@ -346,6 +350,31 @@ class _PhraseParser:
             if watch is not None:
                 body = Block((*body.fields, watch))
         query = Query(kind, body, self.text, kind_span)
+        validate_query(query)
+        return query
+
+    def what_is_question(self) -> Query | None:
+        """``what is on the table`` / ``what are the objects in the fridge``: a detect query for any object in the
+        place; None (nothing consumed) when the phrase is no such question (``what is the colour of ...``)."""
+        if self.word() != "what" or self.word(1) not in ("is", "are"):
+            return None
+        start = self.index
+        verb_tokens = self.take(2)
+        try:
+            if self.match(PREPOSITIONS):
+                phrase = _ObjectPhrase(self.tokens[self.index].span, self.tokens[self.index].span)
+            else:
+                phrase = self.object_phrase()
+            self.modifiers(phrase)
+            self.expect_end()
+        except QueryError:
+            phrase = None
+        if phrase is None or (phrase.noun and not phrase.generic) or not phrase.locations:
+            self.index = start
+            return None
+        phrase.limit_span = None
+        kind_span = _join_span(verb_tokens[0].span, verb_tokens[-1].span)
+        query = Query("detect", self.object_body("detect", phrase), self.text, kind_span)
         validate_query(query)
         return query
 

@@ -69,3 +69,25 @@ def test_a_superlative_is_refused_with_what_to_say_instead(phrase: str, column: 
 )
 def test_a_personal_pronoun_as_the_object_is_a_person(phrase: str, expected: str) -> None:
     assert format_query(parse_query(phrase)) == expected
+
+
+@pytest.mark.parametrize(
+    ("phrase", "expected"),
+    [
+        ("do you see a cup", "detect { obj: { type: cup }, max_results: 1 }"),
+        ("can you see the milk", "detect { obj: { type: milk }, max_results: 1 }"),
+        ("list all objects", "detect { obj: { type: object } }"),
+        ("show the red cups", "detect { obj: { type: cup, color: red } }"),
+        ("what is on the table", "detect { obj: { location: { on: table } } }"),
+        ("what's in the fridge", "detect { obj: { location: { in: fridge } } }"),
+        ("what are the objects on the table", "detect { obj: { location: { on: table } } }"),
+    ],
+)
+def test_everyday_ways_of_asking_what_is_seen_are_detect_queries(phrase: str, expected: str) -> None:
+    assert format_query(parse_query(phrase)) == expected
+
+
+def test_what_is_without_a_place_is_still_refused_at_the_start() -> None:
+    with pytest.raises(QueryError) as caught:
+        parse_query("what is the colour of the mug")
+    assert (caught.value.line, caught.value.column) == (1, 1)
