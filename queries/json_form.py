@@ -153,7 +153,12 @@ class _Converter:
             return self.tagged_query(pairs)
         if len(pairs) != 1:
             where = pairs[1][0] if len(pairs) > 1 else node
-            raise self.error(where, "expected exactly one key, the query kind")
+            message = "expected exactly one key, the query kind"
+            if "type" in keys:  # the object designator of a served goal's "obj" field, given as a query
+                message += (
+                    ' (a "type" key is the served goal\'s designator form): write it as {"detect": {"obj": {...}}}'
+                )
+            raise self.error(where, message)
         key, body = pairs[0]
         if body.tag != "object":
             raise self.error(body, f"expected an object as the body of '{key.payload}'")

@@ -12,6 +12,8 @@ from types import MappingProxyType
 VERBS: MappingProxyType[tuple[str, ...], str] = MappingProxyType(
     {
         ("find",): "detect",
+        ("find", "me"): "detect",
+        ("get", "me"): "detect",
         ("detect",): "detect",
         ("locate",): "detect",
         ("get",): "detect",
@@ -23,6 +25,10 @@ VERBS: MappingProxyType[tuple[str, ...], str] = MappingProxyType(
         ("is", "there"): "detect",
         ("are", "there"): "detect",
         ("show", "me"): "detect",
+        ("show",): "detect",
+        ("list",): "detect",
+        ("see",): "detect",
+        ("do", "you", "see"): "detect",
         ("recognize",): "detect",
         ("recognise",): "detect",
         ("identify",): "detect",
@@ -78,15 +84,19 @@ IGNORED_WORDS: frozenset[str] = frozenset({"please", "thanks"})
 """Words skipped anywhere in a phrase."""
 
 LIMITING_DETERMINERS: frozenset[str] = frozenset(
-    {"a", "an", "the", "this", "that", "one", "my", "your", "our", "his", "her", "their"}
+    {"a", "an", "the", "this", "that", "these", "those", "one", "my", "your", "our", "his", "her", "their"}
 )
 """Determiners that, before a singular noun, ask for one result."""
 
 OPEN_DETERMINERS: frozenset[str] = frozenset({"some", "any", "all", "every", "each"})
 """Determiners that set no result limit."""
 
+PARTITIVE_OF: str = "of"
+"""The word of ``all of the cups`` / ``two of the mugs``: after a quantity, it and a determiner are skipped."""
+
 COUNT_WORDS: MappingProxyType[str, int] = MappingProxyType(
     {
+        "both": 2,
         "two": 2,
         "three": 3,
         "four": 4,
@@ -98,7 +108,7 @@ COUNT_WORDS: MappingProxyType[str, int] = MappingProxyType(
         "ten": 10,
     }
 )
-"""Number words that set ``max_results``."""
+"""Number words that set ``max_results`` (``one`` limits as a determiner; ``one of the`` sets 1)."""
 
 COLORS: MappingProxyType[str, str] = MappingProxyType(
     {
@@ -148,6 +158,18 @@ SIZES: MappingProxyType[str, str] = MappingProxyType(
 )
 """Size adjectives and the ``size`` value they give."""
 
+SUPERLATIVES: MappingProxyType[str, str] = MappingProxyType(
+    {
+        "smallest": "small",
+        "littlest": "small",
+        "tiniest": "tiny",
+        "biggest": "large",
+        "largest": "large",
+        "hugest": "large",
+    }
+)
+"""Superlatives (they compare the objects seen, which no query key does) and the size word to suggest instead."""
+
 SHAPES: MappingProxyType[str, str] = MappingProxyType(
     {
         "round": "sphere",
@@ -167,6 +189,14 @@ SHAPE_NOUNS: MappingProxyType[str, str] = MappingProxyType(
 )
 """Head nouns that name a shape, not a class: ``a small red cylinder`` -> ``shape: cylinder`` and no ``type``
 (a compound such as ``cereal box`` stays a class)."""
+
+PERSONAL_PRONOUNS: MappingProxyType[str, bool] = MappingProxyType(
+    {"me": True, "him": True, "her": True, "us": False, "them": False}
+)
+"""Pronouns that, standing alone as the object (``follow me``), mean a person; True when they mean one."""
+
+PERSON_NOUN = "person"
+"""The noun a personal pronoun stands for."""
 
 INDEFINITE_PRONOUNS: MappingProxyType[str, bool] = MappingProxyType(
     {"something": True, "anything": False, "everything": False}
@@ -243,7 +273,7 @@ RELATIVE_CLAUSES: frozenset[tuple[str, ...]] = frozenset(
 )
 """Openings of ``the cup that is red``: adjectives may follow."""
 
-GENERIC_NOUNS: frozenset[str] = frozenset({"object", "item", "thing"})
+GENERIC_NOUNS: frozenset[str] = frozenset({"object", "item", "thing", "one"})
 """Nouns that name no class; they set no ``type`` unless nothing else is said."""
 
 ID_MARKERS: frozenset[str] = frozenset({"number", "no", "id"})
@@ -289,6 +319,7 @@ IRREGULAR_PLURALS: MappingProxyType[str, str] = MappingProxyType(
         "geese": "goose",
         "men": "man",
         "women": "woman",
+        "ones": "one",
         "cookies": "cookie",
         "movies": "movie",
         "pies": "pie",

@@ -7,7 +7,8 @@ parser; the word tables are data in :mod:`queries.lexicon`.  The mapping:
 phrase                                          model
 ==============================================  =====================================
 find / detect / locate / get / search (for) /   ``detect``
-look for / where is / is there / show me
+look for / where is / is there / show (me) /
+list / (do you) see / what is + place
 track / follow / keep track of                  ``track``
 inspect / examine / look at / check             ``inspect``
 what color / size / shape is X                  ``inspect { obj: { ..., color: ? } }``
@@ -18,6 +19,11 @@ stop / cancel [task] N, stop all                ``stop { task: N }``, ``task: al
 noun words (unknown words joined by ``_``)      ``obj: { type: cereal_box }``
 plural head noun                                singular ``type``, no result limit
 a / an / the / this / my ... + singular noun    ``max_results: 1`` (detect, track)
+all / two / 3 (of) the / my / these + noun      the quantity sets the limit, not ``the``
+the red one / the red ones                      ``one`` names no class: ``color: red``
+the smallest / biggest X                        an error suggesting ``small X`` / ``large X``
+find me / get me                                ``detect`` (``me`` is not the object)
+me / him / her / us / them (alone)              ``type: person`` (``follow me``)
 two ... ten, or a number, before the noun       ``max_results: N`` (detect, track)
 colour adjective (red, dark red, grey...)       ``color: red`` (several: a list)
 size adjective (small, little, big, tiny...)    ``size: small`` / ``large``
@@ -43,6 +49,7 @@ located :class:`QueryError` at the first such token.
 
 from __future__ import annotations
 
+import difflib
 from collections.abc import Collection, Iterable
 from dataclasses import dataclass, field
 
@@ -63,6 +70,9 @@ from queries.lexicon import (
     IRREGULAR_PLURALS,
     LIMITING_DETERMINERS,
     OPEN_DETERMINERS,
+    PARTITIVE_OF,
+    PERSON_NOUN,
+    PERSONAL_PRONOUNS,
     PLACEMENT_VERBS,
     PLURAL_ONLY,
     PLURAL_SUFFIXES,
@@ -75,6 +85,7 @@ from queries.lexicon import (
     SHAPE_NOUNS,
     STOP_ALL_WORDS,
     STOP_TASK_WORDS,
+    SUPERLATIVES,
     TEXT_MARKERS,
     VERBS,
 )
@@ -257,6 +268,14 @@ class _PhraseParser:
             or (self.match(TEXT_MARKERS) and self.text_after_marker() is not None)
         )
 
+    def is_boundary_after(self, ahead: int) -> bool:
+        """Whether the token ``ahead`` of the current one ends a run of noun words."""
+        self.index += ahead
+        try:
+            return self.is_boundary()
+        finally:
+            self.index -= ahead
+
     def text_after_marker(self) -> PhraseToken | None:
         marker = self.match(TEXT_MARKERS)
         if marker is None:
@@ -285,6 +304,9 @@ class _PhraseParser:
         pointing = self.pointing_question()
         if pointing is not None:
             return pointing
+        seen = self.what_is_question()
+        if seen is not None:
+            return seen
         asked_key: str | None = None
         placement = self.match(PLACEMENT_VERBS)
         if placement is not None:
@@ -303,7 +325,7 @@ class _PhraseParser:
             verb = self.match(VERBS)
             if verb is None:
                 raise self.error(
-                    f"expected a verb such as {', '.join(VERB_EXAMPLES[:-1])} or stop",
+                    f"expected a verb such as {', '.join(VERB_EXAMPLES[:-1])} or stop{self.verb_guess()}",
                     VERB_EXAMPLES,
                 )
             verb_tokens = self.take(len(verb))
@@ -330,6 +352,40 @@ class _PhraseParser:
         query = Query(kind, body, self.text, kind_span)
         validate_query(query)
         return query
+
+    def what_is_question(self) -> Query | None:
+        """``what is on the table`` / ``what are the objects in the fridge``: a detect query for any object in the
+        place; None (nothing consumed) when the phrase is no such question (``what is the colour of ...``)."""
+        if self.word() != "what" or self.word(1) not in ("is", "are"):
+            return None
+        start = self.index
+        verb_tokens = self.take(2)
+        try:
+            if self.match(PREPOSITIONS):
+                phrase = _ObjectPhrase(self.tokens[self.index].span, self.tokens[self.index].span)
+            else:
+                phrase = self.object_phrase()
+            self.modifiers(phrase)
+            self.expect_end()
+        except QueryError:
+            phrase = None
+        if phrase is None or (phrase.noun and not phrase.generic) or not phrase.locations:
+            self.index = start
+            return None
+        phrase.limit_span = None
+        kind_span = _join_span(verb_tokens[0].span, verb_tokens[-1].span)
+        query = Query("detect", self.object_body("detect", phrase), self.text, kind_span)
+        validate_query(query)
+        return query
+
+    def verb_guess(self) -> str:
+        """``; did you mean 'find'?`` when the first word is a near miss of a one-word verb, else nothing."""
+        word = self.word()
+        if word is None:
+            return ""
+        verbs = sorted({words[0] for words in VERBS if len(words) == 1})
+        close = difflib.get_close_matches(word, verbs, n=1, cutoff=0.7)
+        return f"; did you mean '{close[0]}'?" if close else ""
 
     def pointing_question(self) -> Query | None:
         """``which object is the person pointing at`` (also ``what ... point at``, ``which region / place ...``,
@@ -388,17 +444,13 @@ class _PhraseParser:
         if start is None:
             raise self.error("expected an object")
         phrase = _ObjectPhrase(start.span, start.span)
-        word = self.word()
-        if word in LIMITING_DETERMINERS:
-            phrase.limit_span = self.take()[0].span
-        elif word in OPEN_DETERMINERS:
-            self.take()
-        elif word is not None and word in COUNT_WORDS:
-            phrase.limit = COUNT_WORDS[word]
-            phrase.limit_span = self.take()[0].span
-        elif start.kind == "number":
-            phrase.limit = int(self.whole_number(start, "the number of objects").value)
-            phrase.limit_span = self.take()[0].span
+        pronoun = self.word()
+        if pronoun in PERSONAL_PRONOUNS and (self.index + 1 == len(self.tokens) or self.is_boundary_after(1)):
+            token = self.take()[0]
+            phrase.noun, phrase.noun_span, phrase.plural = PERSON_NOUN, token.span, not PERSONAL_PRONOUNS[pronoun]
+            phrase.limit_span = token.span
+            return phrase
+        self.determiners(phrase, start)
         pronoun = self.word()
         if pronoun in INDEFINITE_PRONOUNS:
             token = self.take()[0]
@@ -424,6 +476,35 @@ class _PhraseParser:
         phrase.end = self.last_span()
         return phrase
 
+    def determiners(self, phrase: _ObjectPhrase, start: PhraseToken) -> None:
+        """Read the determiners before the noun: one (``the``, ``all``, ``two``, ``3``), or a quantity followed
+        by another determiner, with or without ``of`` (``all the``, ``all of my``, ``one of the``, ``2 of these``),
+        which then limits nothing itself."""
+        word = self.word()
+        quantity = True
+        if word == "one" and self.word(1) == PARTITIVE_OF:
+            phrase.limit = 1
+            phrase.limit_span = self.take()[0].span
+        elif word in LIMITING_DETERMINERS:
+            phrase.limit_span = self.take()[0].span
+            quantity = False
+        elif word in OPEN_DETERMINERS:
+            self.take()
+        elif word is not None and word in COUNT_WORDS:
+            phrase.limit = COUNT_WORDS[word]
+            phrase.limit_span = self.take()[0].span
+        elif start.kind == "number":
+            phrase.limit = int(self.whole_number(start, "the number of objects").value)
+            phrase.limit_span = self.take()[0].span
+        else:
+            quantity = False
+        if not quantity:
+            return
+        if self.word() == PARTITIVE_OF and self.word(1) in LIMITING_DETERMINERS:
+            self.take()
+        if self.word() in LIMITING_DETERMINERS:
+            self.take()
+
     def noun_words(self, phrase: _ObjectPhrase, words: list[PhraseToken]) -> None:
         """Split words into adjectives and the (possibly compound) head noun."""
         head = words[-1]
@@ -440,6 +521,13 @@ class _PhraseParser:
                 phrase.add_adjective("color", Symbol(f"{word}_{COLORS[following]}"), token.span)
                 position += 2
                 continue
+            if word in SUPERLATIVES:
+                instead = " ".join(SUPERLATIVES.get(t.text, t.text) for t in words)
+                raise self.error_at(
+                    token.span,
+                    f"'{word}' compares the objects seen, which a query cannot ask; ask for a size instead, "
+                    f"e.g. '{instead}'",
+                )
             if word in CONJUNCTIONS:
                 if position == 0 or following is None or not self.is_adjective(following):
                     raise self.error_at(

@@ -3,7 +3,8 @@
 * a word starts with an ASCII letter and goes on with letters, digits,
   ``_``, ``-`` and ``'``; it is lower-cased, ``-`` becomes ``_`` and a
   possessive ``'s`` or other apostrophes are dropped; ``where's``,
-  ``what's`` and ``there's`` become two words (``where is``) with one span;
+  ``what's``, ``there's``, ``that's`` and ``that're`` become two words
+  (``where is``) with one span;
 * a number is digits with an optional fraction and unit (``12``, ``0.5m``);
 * quoted text is ``"..."`` or ``“...”``; there are no escapes;
 * ``? . ! , ; : #`` are skipped; any other character is an error.
@@ -25,7 +26,13 @@ TokenKind = Literal["word", "number", "string"]
 _SKIPPED = frozenset("?.!,;:#")
 _QUOTES: MappingProxyType[str, str] = MappingProxyType({'"': '"', "\u201c": "\u201d"})
 _CONTRACTIONS: MappingProxyType[str, tuple[str, ...]] = MappingProxyType(
-    {"where's": ("where", "is"), "what's": ("what", "is"), "there's": ("there", "is")}
+    {
+        "where's": ("where", "is"),
+        "what's": ("what", "is"),
+        "there's": ("there", "is"),
+        "that's": ("that", "is"),
+        "that're": ("that", "are"),
+    }
 )
 
 

@@ -93,6 +93,10 @@ WORD_ONLY_KEYS: MappingProxyType[str, str] = MappingProxyType(
 FRACTION_KEYS: frozenset[str] = frozenset({"confidence"})
 """Keys whose number is a plain fraction from 0 to 1."""
 
+NUMBER_ONLY_KEYS: frozenset[str] = (NON_NEGATIVE_KEYS | FRACTION_KEYS) - {"task"}
+"""Keys that take numbers (or ranges of them), never a word: ``max_results: two`` would otherwise be ignored.
+``task`` is left out: ``stop { task: all }``."""
+
 
 def check_length(text: str, limit: int = MAX_QUERY_LENGTH) -> None:
     """Raise :class:`QueryError` if ``text`` is longer than ``limit`` characters."""
@@ -175,6 +179,9 @@ def _check_field(query: Query, item: Field, depth: int) -> list[tuple[Block, int
             _check_range(query, item, value)
         elif isinstance(value, Number):
             _check_number(query, item, value)
+        elif item.key in NUMBER_ONLY_KEYS and isinstance(value, Symbol | String):
+            shown = value.name if isinstance(value, Symbol) else value.text
+            raise _error(query, item.span, f"'{item.key}' takes a number, not '{shown}'")
     return nested
 
 
@@ -254,6 +261,7 @@ __all__ = [
     "MAX_DEPTH",
     "MAX_QUERY_LENGTH",
     "NON_NEGATIVE_KEYS",
+    "NUMBER_ONLY_KEYS",
     "WHOLE_NUMBER_KEYS",
     "WORD_ONLY_KEYS",
     "check_length",

@@ -55,7 +55,7 @@ SUPPORTED_LAYOUTS = (
     "a TUM RGB-D sequence folder (rgb.txt, depth.txt)",
     "a uoc folder (NNNNNN-color.png, NNNNNN-depth.png, camera_params.json) or one of its NNNNNN-color.png",
     "a PCL ImageGrabber folder (tiff/ with pclzf/*.xml) or its tiff/ folder",
-    "an organized .pcd file, or a folder of them",
+    "a .pcd file, organized or unorganized (HEIGHT 1; --intrinsics gives its camera), or a folder of them",
     "a TUM-style colour/depth pair: a colour file named *color* or *rgb* with the *depth* file beside it, "
     "or a folder of such pairs",
 )
@@ -116,10 +116,20 @@ def _bag_choice(path: Path, frame: int) -> ReaderChoice:
     return ReaderChoice(reader, {"path": str(path), "frame": frame})
 
 
+def _describe_numbers(numbers: list[int]) -> str:
+    """``frames 0 to 4`` for a run without gaps, else ``frames 0, 2, 7`` (sorted, non-empty ``numbers``)."""
+    if numbers == list(range(numbers[0], numbers[-1] + 1)) and len(numbers) > 1:
+        return f"frames {numbers[0]} to {numbers[-1]}"
+    return ("frame " if len(numbers) == 1 else "frames ") + ", ".join(map(str, numbers))
+
+
 def _folder_choice(folder: Path, frame: int, intrinsics: CameraIntrinsics | None = None) -> ReaderChoice:
     if is_tum_sequence(folder):
         return ReaderChoice(TumSequenceReader, {"folder": str(folder), "frame": frame})
-    if (folder / CAMERA_PARAMS_FILE).is_file() and any(_UOC_COLOR.match(p.name) for p in folder.iterdir()):
+    numbers = sorted(int(m.group(1)) for p in folder.iterdir() if (m := _UOC_COLOR.match(p.name)))
+    if (folder / CAMERA_PARAMS_FILE).is_file() and numbers:
+        if frame not in numbers:
+            raise ValueError(f"{folder} holds {_describe_numbers(numbers)}, no frame {frame}")
         return ReaderChoice(ColorDepthPairReader, {"folder": str(folder), "frame": frame})
     if is_tiff_sequence(folder):
         return ReaderChoice(TiffSequenceReader, {"folder": str(folder), "frame": frame})

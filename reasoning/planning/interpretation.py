@@ -15,6 +15,7 @@ from __future__ import annotations
 
 from dataclasses import dataclass, replace
 
+from queries.errors import located_error
 from queries.model import (
     ANYWHERE,
     CONTINUOUS_KINDS,
@@ -85,7 +86,10 @@ def interpret(
     if isinstance(pointing, Block):
         return _interpret_pointing(query, pointing, depth, camera_pose, kb)
     obj = _target(query)
-    object_class = _object_class(obj.get("type"), kb)
+    try:
+        object_class = _object_class(obj.get("type"), kb)
+    except PlanningError as error:
+        raise _located(query, obj.field("type"), error) from None
     hypothesis = kb.hypothesis_type(object_class) if object_class is not None else "ObjectHypothesis"
     if hypothesis != "ObjectHypothesis":
         return _interpret_specialised(query, obj, object_class, hypothesis)
@@ -107,9 +111,12 @@ def interpret(
     for field in obj.fields:
         if field.key in _STRUCTURAL_KEYS or (field.key == TEXT_KEY and switch is not None):
             continue
-        annotation_type = _annotation_type(field.key, kb)
-        for value in _values(field.value):
-            name = _value_name(annotation_type, value, kb)
+        try:
+            annotation_type = _annotation_type(field.key, kb)
+            names = [_value_name(annotation_type, value, kb) for value in _values(field.value)]
+        except PlanningError as error:
+            raise _located(query, field, error) from None
+        for name in names:
             constraints.append(Constraint(field.key, annotation_type, name))
             asked = f"query asks {field.key} = {name}" if name is not None else f"query asks for {field.key}"
             domain_value = name if kb.value_kind(annotation_type) is not None else None
@@ -129,7 +136,10 @@ def interpret(
     elif query.kind not in CONTINUOUS_KINDS and not obj.get(TEXT_KEY) and _names_objects(requirements):
         requirements += _text_for_any_class(query.kind, kb, colour, text_told, inferences)
     location = obj.get("location")
-    region_box = _region(location, kb, camera_pose)
+    try:
+        region_box = _region(location, kb, camera_pose)
+    except PlanningError as error:
+        raise _located(query, _place_field(obj), error) from None
     if _is_anywhere(location):
         inferences.append("the query says anywhere, so the search covers the whole view")
     elif region_box is None and object_class is not None:
@@ -447,6 +457,22 @@ def _footprint(block: Block, kb: KnowledgeBase) -> tuple[tuple[float, float], st
     return (bound, bound), (
         f"{object_class} is {size_class} (largest extent below {bound:g} m), so room for a {bound:g} m square is asked"
     )
+
+
+def _located(query: Query, field: Field | None, error: PlanningError) -> PlanningError:
+    """``error`` told where ``field`` was said in the query (line, column and the source line with a caret), so
+    a wrong word deep in a nested query is found at once; unchanged for a query without source positions."""
+    if field is None or field.span.line <= 0 or not query.source:
+        return error
+    return PlanningError(str(located_error(query.source, str(error), field.span.line, field.span.column)))
+
+
+def _place_field(obj: Block) -> Field | None:
+    """The field that names the place: the relation inside ``location: { in: fridge }``, else ``location``."""
+    location = obj.field("location")
+    if location is not None and isinstance(location.value, Block):
+        return next((f for f in location.value.fields if f.key in _RELATIONS), location)
+    return location
 
 
 def _word(value: Value, what: str) -> str:

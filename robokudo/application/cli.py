@@ -64,12 +64,31 @@ def main(argv: Sequence[str] | None = None) -> int:
 
 
 def _run(argv: Sequence[str] | None) -> int:
-    args = build_parser().parse_args(list(sys.argv[1:] if argv is None else argv))
+    parser = build_parser()
+    args, unknown = parser.parse_known_args(list(sys.argv[1:] if argv is None else argv))
+    if unknown:  # told by the (sub)command given, with its usage, not by the top-level parser
+        _given_command(parser, args).error(f"unrecognized arguments: {' '.join(unknown)}")
     try:
         return int(args.handler(args))
     except (KeyError, ValueError) as error:
         print(f"robokudo: {error.args[0] if error.args else error}", file=sys.stderr)
         return 2
+
+
+def _given_command(parser: argparse.ArgumentParser, args: argparse.Namespace) -> argparse.ArgumentParser:
+    """The innermost sub-command parser ``args`` were parsed by (``robokudo ontology show``)."""
+    while True:
+        chosen = next(
+            (
+                action.choices.get(getattr(args, action.dest, None) or "")
+                for action in parser._actions
+                if isinstance(action, argparse._SubParsersAction)
+            ),
+            None,
+        )
+        if chosen is None:
+            return parser
+        parser = chosen
 
 
 if __name__ == "__main__":

@@ -115,3 +115,19 @@ def test_missing_real_data_skips_without_ci_and_fails_with_ci(tmp_path: Path, mo
     monkeypatch.setenv("CI", "true")
     with pytest.raises(pytest.fail.Exception, match="missing"):
         require_folder(tmp_path / "missing")
+
+
+def test_the_supported_inputs_a_user_is_shown_do_not_restrict_pcd_files_to_organized_ones(tmp_path: Path) -> None:
+    from annotators.readers.choice import SUPPORTED_LAYOUTS, reader_choice
+
+    cloud = tmp_path / "scan.pcd"
+    cloud.write_text(
+        "VERSION .7\nFIELDS x y z rgb\nSIZE 4 4 4 4\nTYPE F F F F\nCOUNT 1 1 1 1\nWIDTH 2\nHEIGHT 1\n"
+        "VIEWPOINT 0 0 0 1 0 0 0\nPOINTS 2\nDATA ascii\n0 0 1 0\n0.1 0 1 0\n"
+    )
+    assert reader_choice(str(cloud)).name == "PcdReader"  # an unorganized cloud (HEIGHT 1) is an input
+    (pcd_line,) = [line for line in SUPPORTED_LAYOUTS if ".pcd" in line]
+    assert "unorganized" in pcd_line
+    with pytest.raises(ValueError) as caught:
+        reader_choice(str(tmp_path / "missing.pcd"))
+    assert pcd_line in str(caught.value)

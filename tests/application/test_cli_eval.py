@@ -121,3 +121,11 @@ def test_paths_that_are_not_labelled_scenes_are_refused(capsys: pytest.CaptureFi
     unlabelled = require_folder(SHARED_DATA / "pcl_tabletop_pcd") / "table_scene_mug_stereo_textured.pcd"
     status, out, err = evaluate(capsys, str(unlabelled))
     assert (status, out) == (2, "") and "no label field" in err
+
+
+def test_a_missing_path_is_called_missing(capsys: pytest.CaptureFixture[str], tmp_path: Path) -> None:
+    status, out, err = evaluate(capsys, str(tmp_path / "learn99.pcd"))
+    assert (status, out) == (2, "") and "learn99.pcd: no such file or folder" in err
+    (tmp_path / "notes.txt").write_text("not a cloud")
+    status, out, err = evaluate(capsys, str(tmp_path / "notes.txt"))
+    assert (status, out) == (2, "") and "is not a .pcd file or a folder of them" in err

@@ -135,3 +135,12 @@ def test_remove_object_with_an_unusable_store_removes_nothing(
     assert cli.main(["ontology", "remove-object", "OatMilk", "--store", str(store)]) == 2
     assert "is not usable" in capsys.readouterr().err
     assert cli.main(["ontology", "show", "OatMilk"]) == 0
+
+
+def test_an_unknown_word_of_a_bare_memory_question_is_located_in_what_was_typed(
+    capsys: pytest.CaptureFixture[str], store: Path
+) -> None:
+    status, out, err = beliefs(capsys, store, "milk in the garage")
+    assert (status, out) == (2, "")
+    assert "unknown region or region class 'garage'" in err and "at line 1, column 6" in err
+    assert err.splitlines()[-2:] == ["  milk in the garage", "       ^"]

@@ -144,3 +144,18 @@ def test_the_annotated_image_boxes_the_answered_objects(capsys: pytest.CaptureFi
     rows, columns = np.nonzero(box)
     assert box.sum() > 200
     assert drawn.shape[:2] == (480, 640) and columns.min() > 150 and columns.max() < 500 and rows.min() > 50
+
+
+def test_a_frame_a_uoc_folder_lacks_is_refused_before_anything_runs(
+    capsys: pytest.CaptureFixture[str], tmp_path: Path
+) -> None:
+    for number in (0, 1, 2):
+        cv2.imwrite(str(tmp_path / f"{number:06d}-color.png"), np.zeros((48, 64, 3), dtype=np.uint8))
+        cv2.imwrite(str(tmp_path / f"{number:06d}-depth.png"), np.zeros((48, 64), dtype=np.uint16))
+    (tmp_path / "camera_params.json").write_text('{"fx": 60, "fy": 60, "x_offset": 32, "y_offset": 24}')
+    assert reader_choice(str(tmp_path), 2).parameters["frame"] == 2
+    with pytest.raises(ValueError, match=r"holds frames 0 to 2, no frame 7"):
+        reader_choice(str(tmp_path), 7)
+    assert cli.main(["plan", "find milk", "--input", str(tmp_path), "--frame", "7"]) == 2
+    out, err = capsys.readouterr()
+    assert out == "" and "no frame 7" in err

@@ -18,7 +18,8 @@ import json
 import sys
 from pathlib import Path
 
-from queries import QueryError, parse_query
+from queries import Block, Field, ListValue, Query, QueryError, String, Symbol, parse_query
+from queries.errors import located_error
 from reasoning.beliefs.answer import Answer, answer_from_memory
 from reasoning.beliefs.filters import belief_filter
 from reasoning.beliefs.store import BeliefFilter, BeliefStore, BeliefStoreError
@@ -45,7 +46,12 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
         "--yes", action="store_true", help="confirm --clear without QUERY: forget every belief and its history"
     )
     parser.add_argument("--all", action="store_true", help="include objects marked gone")
-    parser.add_argument("--store", type=Path, default=None, help="belief store file (default: see above)")
+    parser.add_argument(
+        "--store",
+        type=Path,
+        default=None,
+        help="belief store file (default: $ROBOKUDO_BELIEF_STORE or the user data dir)",
+    )
 
 
 class _RefusedError(Exception):
@@ -127,17 +133,46 @@ def _check_ids(query_filter: BeliefFilter, store: BeliefStore | None) -> None:
 def _filter(text: str | None, include_gone: bool, kb: KnowledgeBase | None) -> BeliefFilter:
     if not text:
         return BeliefFilter(include_gone=include_gone)
+    added = ""
     try:
         query = parse_query(text)
     except QueryError as error:
-        try:  # a memory question may name just the object: "milk in fridge" means "find milk in fridge"
-            query = parse_query(f"find {text}")
+        added = "find "  # a memory question may name just the object: "milk in fridge" means "find milk in fridge"
+        try:
+            query = parse_query(added + text)
         except QueryError:
             raise _RefusedError(str(error)) from error
     try:
         return belief_filter(query, kb, include_gone=include_gone, strict=True)
     except TermError as error:
-        raise _RefusedError(str(error)) from error
+        raise _RefusedError(_located(text, query, error, len(added))) from error
+
+
+def _located(text: str, query: Query, error: TermError, added: int) -> str:
+    """The message of ``error`` told where ``text`` said the unknown word (line, column and excerpt), as
+    ``robokudo query`` tells it; ``added`` characters were put before ``text`` to parse it."""
+    word = getattr(error, "word", None)
+    said = _field_saying(query.body, word.lower()) if isinstance(word, str) else None
+    if said is None or said.span.line <= 0:
+        return str(error)
+    column = said.span.column - (added if said.span.line == 1 else 0)
+    return str(located_error(text, str(error), said.span.line, max(1, column)))
+
+
+def _field_saying(block: Block, word: str) -> Field | None:
+    """The innermost field of ``block`` whose value (or one of its values) is ``word``."""
+    for item in block.fields:
+        values = item.value.items if isinstance(item.value, ListValue) else (item.value,)
+        for value in values:
+            if isinstance(value, Block):
+                inner = _field_saying(value, word)
+                if inner is not None:
+                    return inner
+            elif (isinstance(value, Symbol) and value.name.lower() == word) or (
+                isinstance(value, String) and value.text.lower() == word
+            ):
+                return item
+    return None
 
 
 def _print(answer: Answer, args: argparse.Namespace, note: str | None) -> int:

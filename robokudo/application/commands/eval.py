@@ -82,6 +82,8 @@ def scene_files(paths: list[str]) -> list[Path]:
             found.extend(files)
         elif path.is_file() and path.suffix.lower() == ".pcd":
             found.append(path)
+        elif not path.exists():
+            raise ValueError(f"{path}: no such file or folder")
         else:
             raise ValueError(f"{path} is not a .pcd file or a folder of them")
     return found
