@@ -28,6 +28,7 @@ from robokudo.core.types import (
     AnswersTo,
     ColorHistogram,
     ObjectHypothesis,
+    PersonHypothesis,
     Pose,
     Size,
 )
@@ -55,6 +56,13 @@ MAX_EXTENT = 2.0
 MAX_FOOTPRINT = 0.5
 """An object whose middle extent (metres) is above this is furniture-sized in two directions (a table top, a patch
 of floor or wall): long thin things (a broom) pass, broad ones are no object a robot handles."""
+
+MAX_PERSON_EXTENT = 2.5
+"""A person's largest extent (metres) above this is a merge of surfaces: the tallest people with an arm raised."""
+
+MAX_PERSON_SPAN = 2.2
+"""A person's middle extent (metres) above this is a merge of surfaces: about the widest arm span. A person is
+broader than any object a robot handles (arms out, waving), so :data:`MAX_FOOTPRINT` is not theirs."""
 
 ROBUST_PERCENTILES = (2.0, 98.0)
 """The bulk of an object's points: the percentiles its robust box spans on every axis."""
@@ -307,7 +315,7 @@ def _merge_group(
         total = summed.sum()
         appearance = summed / total if total > 0 else None
     position = placed_on_points(np.asarray(position, dtype=np.float64), points)
-    doubt = geometry_doubt(dimensions, points)
+    doubt = geometry_doubt(dimensions, points, person=any(isinstance(h, PersonHypothesis) for h in members))
     evidence = [e for h in members for e in hypothesis_evidence(h, context.time, reader)]
     answering = [
         Evidence(CLASS_ATTRIBUTE, a.class_name.strip(), a.confidence, a.source or "unknown", context.time)
@@ -353,10 +361,11 @@ def placed_on_points(position: np.ndarray, points: np.ndarray | None) -> np.ndar
     return (low + high) / 2.0
 
 
-def geometry_doubt(dimensions: np.ndarray | None, points: np.ndarray | None) -> str:
+def geometry_doubt(dimensions: np.ndarray | None, points: np.ndarray | None, *, person: bool = False) -> str:
     """Why an object's stated size and support are not to be trusted, or "" (see :data:`BULK_TOLERANCE`).
 
-    ``points`` are the object's valid points (None when the frame has no cloud: then only the size is checked).
+    ``points`` are the object's valid points (None when the frame has no cloud: then only the size is checked);
+    a ``person`` is held to a person's size (:data:`MAX_PERSON_EXTENT`, :data:`MAX_PERSON_SPAN`).
     """
     if points is not None and points.shape[0] < MIN_POINTS:
         return f"only {points.shape[0]} valid points"
@@ -367,7 +376,8 @@ def geometry_doubt(dimensions: np.ndarray | None, points: np.ndarray | None) -> 
             return f"tiny ({largest * 100:.1f} cm)"
         if smallest < FLAT_EXTENT:
             return f"flat ({smallest * 1000:.0f} mm thick): a patch of a surface"
-        if largest > MAX_EXTENT or middle > MAX_FOOTPRINT:
+        longest, broadest = (MAX_PERSON_EXTENT, MAX_PERSON_SPAN) if person else (MAX_EXTENT, MAX_FOOTPRINT)
+        if largest > longest or middle > broadest:
             return f"implausibly large ({' x '.join(f'{e:.2f}' for e in extents)} m)"
     if points is None:
         return ""

@@ -175,6 +175,9 @@ def test_a_person_gets_keypoint_dots_on_the_joints_and_a_skeleton(service: Answe
     original = cas.view(ColorImage)
     assert original is not None and not np.array_equal(original.image, picture)  # drawn on a copy
     print(outcome.answer.summary())
+    # the waving person (an arm out to the side: broader than any object a robot handles) is answered
+    (answered,) = outcome.answer.objects
+    assert answered.class_label == "human"
 
 
 def test_free_places_cover_only_free_shelf_and_are_numbered(service: AnsweringService, tmp_path: Path) -> None:

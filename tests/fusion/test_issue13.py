@@ -217,3 +217,10 @@ def test_a_newer_store_is_refused_untouched(tmp_path: Path) -> None:
     with pytest.raises(BeliefStoreError, match="newer than this robokudo"):
         BeliefStore(path)
     assert path.read_bytes() == content
+
+
+def test_a_person_is_held_to_a_persons_size_not_an_objects() -> None:
+    waving = np.array([1.9, 0.9, 0.3])  # tall, an arm out to the side: broader than any handled object
+    assert "implausibly large" in geometry_doubt(waving, None)
+    assert geometry_doubt(waving, None, person=True) == ""
+    assert "implausibly large" in geometry_doubt(np.array([3.0, 2.5, 0.3]), None, person=True)  # a wall
