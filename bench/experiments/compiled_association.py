@@ -48,7 +48,7 @@ from reasoning.fusion.association import (  # noqa: E402
     gated_costs,
     typical_sizes,
 )
-from reasoning.fusion.frame import WORLD_FRAME, frame_objects  # noqa: E402
+from reasoning.fusion.frame import WORLD_FRAME  # noqa: E402
 from reasoning.fusion.tracking import BeliefTracker  # noqa: E402
 
 
@@ -155,12 +155,7 @@ def main() -> int:
     args = parser.parse_args()
     with tempfile.TemporaryDirectory() as name:
         path = Path(name) / "seed.sqlite"
-        seeded = bench.seed_file(path, 10_000, np.random.default_rng(5), named_regions=False)
-        rng = np.random.default_rng(7)
-        views = bench.fixed_views(seeded, rng, 10, 20)
-        half = args.frames // 2
-        frames = [frame_objects(bench.hypotheses_near(seeded, rng, 20)) for _ in range(half)]
-        frames += [frame_objects(bench.hypotheses_near(seeded, rng, 20, views[k % 10])) for k in range(half)]
+        frames = frame_python.seeded_frames(path, args.frames)
         tracker = BeliefTracker(class_test=bench.is_subclass)
         store = BeliefStore(path, tracker=tracker)
         captured = frame_python.captured_frames(store, frames)

@@ -50,6 +50,18 @@ def captured_frames(store: BeliefStore, frames: list[list[FrameObject]]) -> list
     return captured
 
 
+def seeded_frames(path: Path, count: int) -> list[list[FrameObject]]:
+    """Seed a 10,000-belief store at ``path`` and make ``count`` frames of 20: half at random places, half from
+    10 fixed camera views (as ``bench_beliefs.py`` does)."""
+    seeded = bench.seed_file(path, 10_000, np.random.default_rng(5), named_regions=False)
+    rng = np.random.default_rng(7)
+    views = bench.fixed_views(seeded, rng, 10, 20)
+    half = count // 2
+    frames = [frame_objects(bench.hypotheses_near(seeded, rng, 20)) for _ in range(half)]
+    frames += [frame_objects(bench.hypotheses_near(seeded, rng, 20, views[k % 10])) for k in range(half)]
+    return frames
+
+
 def main() -> int:
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("--frames", type=int, default=150)
@@ -57,12 +69,7 @@ def main() -> int:
     args = parser.parse_args()
     with tempfile.TemporaryDirectory() as name:
         path = Path(name) / "seed.sqlite"
-        seeded = bench.seed_file(path, 10_000, np.random.default_rng(5), named_regions=False)
-        rng = np.random.default_rng(7)
-        views = bench.fixed_views(seeded, rng, 10, 20)
-        half = args.frames // 2
-        frames = [frame_objects(bench.hypotheses_near(seeded, rng, 20)) for _ in range(half)]
-        frames += [frame_objects(bench.hypotheses_near(seeded, rng, 20, views[k % 10])) for k in range(half)]
+        frames = seeded_frames(path, args.frames)
         tracker = BeliefTracker(class_test=bench.is_subclass)
         store = BeliefStore(path, tracker=tracker)
         captured = captured_frames(store, frames)
