@@ -123,6 +123,29 @@ def store(tmp_path: Path, monkeypatch: pytest.MonkeyPatch) -> Path:
     return tmp_path / "answers.sqlite"
 
 
+def answered(capsys: pytest.CaptureFixture, store: Path, scene: Path, query: str, *options: str) -> list[dict]:
+    """The objects ``robokudo query QUERY --input SCENE --json OPTIONS`` answers (it must succeed)."""
+    code = cli.main(["query", query, "--input", str(scene), "--store", str(store), "--json", *options])
+    out = capsys.readouterr().out
+    assert code == 0, out
+    return json.loads(out)["objects"]
+
+
+def holding(objects: list[dict], pixel: tuple[int, int]) -> list[dict]:
+    """The answered objects whose box holds ``pixel``."""
+    x, y = pixel
+    return [o for o in objects if o["roi"] and o["roi"][0] <= x < o["roi"][2] and o["roi"][1] <= y < o["roi"][3]]
+
+
+def answer_at(
+    capsys: pytest.CaptureFixture, store: Path, scene: Path, query: str, pixel: tuple[int, int], *options: str
+) -> dict:
+    """The smallest answered object whose box holds ``pixel``."""
+    found = holding(answered(capsys, store, scene, query, *options), pixel)
+    assert found, f"no answered object holds {pixel}"
+    return min(found, key=lambda o: (o["roi"][2] - o["roi"][0]) * (o["roi"][3] - o["roi"][1]))
+
+
 @pytest.mark.real_data
 @pytest.mark.parametrize("frame, box", [(0, (500, 250)), (1, (480, 320))], ids=["frame0-fit", "frame1-held-out"])
 def test_find_the_cracker_box_answers_the_cheez_it_box(
@@ -130,15 +153,8 @@ def test_find_the_cracker_box_answers_the_cheez_it_box(
 ) -> None:
     """OCR reads "CHEEZ-IT" on the box; the ontology knows Cheez-It is a brand of crackers, so the answer is the
     box, named as the product, with a confident class."""
-    code = cli.main(
-        ["query", "find the cracker box", "--input", str(uoc_folder), "--frame", str(frame), "--store", str(store),
-         "--json"]
-    )  # fmt: skip
-    out = capsys.readouterr().out
-    assert code == 0, out
-    objects = json.loads(out)["objects"]
-    x, y = box
-    (found,) = [o for o in objects if o["roi"] and o["roi"][0] <= x < o["roi"][2] and o["roi"][1] <= y < o["roi"][3]]
+    objects = answered(capsys, store, uoc_folder, "find the cracker box", "--frame", str(frame))
+    (found,) = holding(objects, box)
     assert found["class"]["label"] == "Cheez-It crackers", found
     assert found["attributes"][Classification.attribute]["confidence"] > 0.5, found
     assert len(objects) == 1, [o["class"]["label"] for o in objects]  # the drill, the bowls, the cans are not it
@@ -155,18 +171,7 @@ def test_find_all_objects_reads_text_and_names_the_cheez_it_box_by_its_brand(
     answers = {}
     for query in ("find all objects", "detect { obj: { type: object, text: false } }"):
         own_store = store.with_name(f"answers{len(answers)}.sqlite")  # the text read once is not fused into the other
-        code = cli.main(
-            ["query", query, "--input", str(uoc_folder), "--frame", str(frame), "--store", str(own_store), "--json"]
-        )
-        out = capsys.readouterr().out
-        assert code == 0, out
-        x, y = box
-        holding = [
-            o
-            for o in json.loads(out)["objects"]
-            if o["roi"] and o["roi"][0] <= x < o["roi"][2] and o["roi"][1] <= y < o["roi"][3]
-        ]
-        answers[query] = min(holding, key=lambda o: (o["roi"][2] - o["roi"][0]) * (o["roi"][3] - o["roi"][1]))
+        answers[query] = answer_at(capsys, own_store, uoc_folder, query, box, "--frame", str(frame))
     read, unread = answers.values()
     assert read["class"]["label"] == "Cheez-It crackers", read
     assert "CHEEZ" in read["attributes"]["text"]["value"], read
@@ -183,16 +188,7 @@ def test_find_all_soup_cans_answers_the_campbells_can_by_its_colours(
     """No text is read on the soup can, so only its look speaks: a small, closed, white (and red) cylinder. With
     its colours known the Campbell's can fits best (before, a white salt or yogurt pot of the same form did), so
     the query's class may break the tie: the can is answered as a Campbell's soup, hedged (its brand went unread)."""
-    code = cli.main(
-        ["query", "find all soup cans", "--input", str(uoc_folder), "--frame", str(frame), "--store", str(store),
-         "--json"]
-    )  # fmt: skip
-    out = capsys.readouterr().out
-    assert code == 0, out
-    x, y = can
-    (found,) = [
-        o for o in json.loads(out)["objects"] if o["roi"][0] <= x < o["roi"][2] and o["roi"][1] <= y < o["roi"][3]
-    ]
+    (found,) = holding(answered(capsys, store, uoc_folder, "find all soup cans", "--frame", str(frame)), can)
     stated = found["attributes"][Classification.attribute]
     assert stated["value"] == "CampbellsTomatoSoup", found
     assert stated["confidence"] < 0.5, found  # a guess: the brand that would tell went unread
@@ -207,18 +203,6 @@ def toffifee_scene(shared_data: Path) -> Path:
 
 
 TOFFIFEE = (394, 258)
-
-
-def answer_at(capsys: pytest.CaptureFixture, store: Path, scene: Path, query: str, pixel: tuple[int, int]) -> dict:
-    code = cli.main(["query", query, "--input", str(scene), "--store", str(store), "--json"])
-    out = capsys.readouterr().out
-    assert code == 0, out
-    x, y = pixel
-    holding = [
-        o for o in json.loads(out)["objects"] if o["roi"][0] <= x < o["roi"][2] and o["roi"][1] <= y < o["roi"][3]
-    ]
-    assert holding, out
-    return min(holding, key=lambda o: (o["roi"][2] - o["roi"][0]) * (o["roi"][3] - o["roi"][1]))
 
 
 @pytest.mark.real_data

@@ -37,7 +37,9 @@ def test_folders_are_recognised_by_their_layout(tmp_path: Path) -> None:
     uoc = tmp_path / "uoc"
     touch_image(uoc / "000002-color.png")
     (uoc / "camera_params.json").write_text(json.dumps({}))
-    assert reader_name_for(str(uoc)) == "ColorDepthPairReader"
+    assert reader_name_for(str(uoc), 2) == "ColorDepthPairReader"
+    with pytest.raises(ValueError, match="holds frame 2, no frame 0"):  # a frame the folder lacks, up front
+        reader_choice(str(uoc), 0)
     single = reader_choice(str(uoc / "000002-color.png"))
     assert single.name == "ColorDepthPairReader" and single.parameters == {"folder": str(uoc), "frame": 2}
 
