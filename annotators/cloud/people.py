@@ -24,9 +24,8 @@ from annotators.cloud.plane import plane_basis, plane_distances, ransac_support_
 from annotators.cloud.point_cloud import cloud_problem
 from robokudo.core.annotator import Annotator
 from robokudo.core.capability import Capability
-from robokudo.core.types import CameraInfo, CasType, Classification, PersonHypothesis, PointCloud, Pose
+from robokudo.core.types import PERSON_CLASS, CameraInfo, CasType, Classification, PersonHypothesis, PointCloud, Pose
 
-HUMAN = "Human"
 """The ontology class of a person."""
 
 IMAGE_UP = np.array([0.0, -1.0, 0.0])
@@ -170,7 +169,7 @@ def person_hypothesis(segment: PersonSegment, source: str, confidence: float) ->
     hypothesis.annotations.append(
         Pose(position=segment.centroid, orientation=np.array([0.0, 0.0, 0.0, 1.0]), source=source)
     )
-    hypothesis.annotations.append(Classification(class_name=HUMAN, source=source, confidence=confidence))
+    hypothesis.annotations.append(Classification(class_name=PERSON_CLASS, source=source, confidence=confidence))
     return hypothesis
 
 
@@ -183,7 +182,7 @@ class DepthPeopleDetector(Annotator):
     capability: ClassVar[Capability] = Capability(
         label="depth people detector",
         synonyms=("ground-based people detector",),
-        classes=(HUMAN,),
+        classes=(PERSON_CLASS,),
         preconditions=("NeedsDepth",),
         cost_ms=130.0,
         reliability=0.6,

@@ -24,13 +24,14 @@ from typing import Any, ClassVar
 
 import numpy as np
 
-from annotators.cloud.people import HUMAN, IMAGE_UP, PeopleParameters, PersonSegment, find_people, ground_plane
+from annotators.cloud.people import IMAGE_UP, PeopleParameters, PersonSegment, find_people, ground_plane
 from annotators.cloud.plane import plane_distances, up_in_camera
 from annotators.people.body_points import body_mask, centroid, support_surfaces
 from robokudo.core.annotator import Annotator
 from robokudo.core.capability import Capability
 from robokudo.core.resources import Guarded
 from robokudo.core.types import (
+    PERSON_CLASS,
     BodyKeypoints,
     CameraInfo,
     CasType,
@@ -286,7 +287,7 @@ class HumanPoseDetector(Annotator):
     capability: ClassVar[Capability] = Capability(
         label="human pose detector",
         synonyms=("pose estimator", "body keypoint detector", "skeleton tracker"),
-        classes=(HUMAN,),
+        classes=(PERSON_CLASS,),
         cost_ms=1000.0,
         reliability=0.85,
     )
@@ -616,7 +617,7 @@ class HumanPoseDetector(Annotator):
             hypothesis.annotations.append(
                 Pose(position=position, orientation=np.array([0.0, 0.0, 0.0, 1.0]), source=self.name)
             )
-        hypothesis.annotations.append(Classification(class_name=HUMAN, source=self.name, confidence=confidence))
+        hypothesis.annotations.append(Classification(class_name=PERSON_CLASS, source=self.name, confidence=confidence))
         if xyz is None:
             xyz = np.full((pixels.shape[0], 3), np.nan)
         hypothesis.annotations.append(

@@ -6,9 +6,7 @@ from typing import ClassVar
 
 from annotators.tracking.tracker import TargetTracker
 from robokudo.core.capability import Capability
-from robokudo.core.types import CameraInfo, CasType, PersonHypothesis, PersonTrack, PointCloud
-
-HUMAN = "Human"
+from robokudo.core.types import PERSON_CLASS, CameraInfo, CasType, PersonHypothesis, PersonTrack, PointCloud
 
 
 class HumanTracker(TargetTracker):
@@ -21,7 +19,7 @@ class HumanTracker(TargetTracker):
     capability: ClassVar[Capability] = Capability(
         label="human tracker",
         synonyms=("people tracker", "person follower"),
-        classes=(HUMAN,),
+        classes=(PERSON_CLASS,),
         cost_ms=2.0,
         reliability=0.8,
     )
@@ -30,4 +28,4 @@ class HumanTracker(TargetTracker):
 
     def target_name(self) -> str:
         """A person."""
-        return HUMAN
+        return PERSON_CLASS

@@ -73,7 +73,7 @@ from robokudo.core.resources import SharedResources
 from robokudo.core.slot import Idle, PerceiveThenTask, TaskSlot
 from robokudo.core.structure import running_leaves
 from robokudo.core.threaded import has_workers, stop_workers
-from robokudo.core.types import CameraInfo, CameraIntrinsics, QueryAnswer
+from robokudo.core.types import PERSON_CLASS, CameraInfo, CameraIntrinsics, QueryAnswer
 from trees.answer_step import AnswerStep
 from trees.synthesis import build_task_tree
 
@@ -489,7 +489,7 @@ class AnsweringService:
         if isinstance(self.stream, KitchenCameraStream):
             region = query_plan.interpretation.task.region or self._remembered_region(parsed)
             task = query_plan.plan.task
-            people = self.stream.person is not None and (task.pointing is not None or task.object_class == "Human")
+            people = self.stream.person is not None and (task.pointing is not None or task.object_class == PERSON_CLASS)
             self.stream.set_view(kitchen_view_for(region, people=people))
         with self._lock:
             previous, self._current = self._current, handle

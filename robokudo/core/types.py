@@ -219,6 +219,10 @@ class PersonHypothesis(ObjectHypothesis):
     """An object hypothesis that is a person: its segment, plus the body keypoints and pose experts attach."""
 
 
+PERSON_CLASS = "Human"
+"""The ontology class a :class:`PersonHypothesis` is classified as (the class the query word "human" names)."""
+
+
 @dataclass(eq=False, kw_only=True)
 class BodyKeypoints(Annotation):
     """A person's body landmarks: ``names`` (N), image positions ``pixels`` (Nx2, pixels), camera-frame
