@@ -5,7 +5,8 @@ constant velocity with random accelerations (white noise of ``acceleration`` m/s
 detection nearest to the estimate, if it lies within the gate: ``gate`` metres plus three times the estimate's
 spread, so the gate widens while the target goes unseen. Weighting multiplies each particle's weight by the
 Gaussian likelihood of the associated detection (``measurement_noise`` m per axis); resampling is systematic and
-happens when the effective sample size drops below half the particles. Pure numpy; deterministic for a seeded
+happens when the effective sample size drops below half the particles. Particles drawn around a detection come in
+opposite pairs, so the draw adds no offset of its own to the estimate. Pure numpy; deterministic for a seeded
 generator.
 """
 
@@ -60,6 +61,7 @@ class ParticleFilter:
         self.states = np.zeros((0, 6))
         self.weights = np.zeros(0)
         self.time = 0.0
+        self.last_step = 0.0
 
     @property
     def started(self) -> bool:
@@ -71,8 +73,8 @@ class ParticleFilter:
         position = _point(position)
         count = self.settings.particles
         self.states = np.empty((count, 6))
-        self.states[:, :3] = position + self.rng.normal(0.0, self.settings.measurement_noise, (count, 3))
-        self.states[:, 3:] = self.rng.normal(0.0, self.settings.initial_speed, (count, 3))
+        self.states[:, :3] = position + _symmetric_normal(self.rng, self.settings.measurement_noise, count)
+        self.states[:, 3:] = _symmetric_normal(self.rng, self.settings.initial_speed, count)
         self.weights = np.full(count, 1.0 / count)
         self.time = float(time)
 
@@ -81,6 +83,7 @@ class ParticleFilter:
         self._require_started()
         dt = min(float(time) - self.time, self.settings.max_step)
         self.time = max(self.time, float(time))
+        self.last_step = max(dt, 0.0)
         if dt <= 0:
             return
         accel = self.rng.normal(0.0, self.settings.acceleration, (self.states.shape[0], 3))
@@ -120,7 +123,11 @@ class ParticleFilter:
         When the predicted particles hardly cover the detection (a long step spread them far wider than the
         detection noise), a share of them is drawn afresh around the detection, keeping the velocities of the
         particles nearest to it: otherwise the few particles that happen to lie near the detection decide the
-        estimate and a still target's estimate wanders by centimetres.
+        estimate and a still target's estimate wanders by centimetres. After a step long enough for the random
+        accelerations to have changed the velocities by more than the initial speed spread (a stalled tree, a
+        target unseen for a while), those velocities say nothing any more, and the drawn particles get velocities
+        as on a first sighting; kept, the few of them would carry a still target's estimate away in the frames
+        that follow.
         """
         self._require_started()
         point = _point(detection)
@@ -141,8 +148,10 @@ class ParticleFilter:
         self.resample()
         count = self.weights.size
         fresh = self.rng.random(count) < share
-        noise = self.rng.normal(0.0, self.settings.measurement_noise, (int(fresh.sum()), 3))
-        self.states[fresh, :3] = detection + noise
+        drawn = int(fresh.sum())
+        self.states[fresh, :3] = detection + _symmetric_normal(self.rng, self.settings.measurement_noise, drawn)
+        if self.last_step * self.settings.acceleration > self.settings.initial_speed:
+            self.states[fresh, 3:] = _symmetric_normal(self.rng, self.settings.initial_speed, drawn)
 
     def resample(self) -> None:
         """Systematic resampling: particles drawn in proportion to their weights, weights made equal."""
@@ -162,6 +171,13 @@ class ParticleFilter:
 _WELL_COVERED = 0.2
 """The mean likelihood of the predicted particles (1 at the detection, e^-0.5 one noise sigma away per axis) below
 which particles are drawn afresh around the detection."""
+
+
+def _symmetric_normal(rng: np.random.Generator, scale: float, count: int) -> np.ndarray:
+    """``count`` normal 3-vectors (standard deviation ``scale``) in opposite pairs, so their mean is exactly zero:
+    drawn particles then centre on what they are drawn around instead of on a random offset of the draw."""
+    half = rng.normal(0.0, scale, (count // 2, 3))
+    return np.concatenate([half, -half, np.zeros((count % 2, 3))])
 
 
 def _point(value: np.ndarray) -> np.ndarray:
