@@ -208,7 +208,7 @@ class _Converter:
             return scalar_from_text(node.payload)
         if node.payload is None:
             return Asked()
-        raise self.error(node, "expected a string, number, list, object or null")
+        return Symbol("true" if node.payload else "false")  # JSON true / false: the nested form's bare words
 
     def number(self, node: JsonNode, value: object, unit: object) -> Number:
         if isinstance(value, bool) or not isinstance(value, (int, float)):

@@ -129,6 +129,7 @@ CASES = [
     case("track { obj: { type: object } }", "KnowledgeClassifier", "TextReader"),
     case("detect { obj: { type: object, text: false } }", "KnowledgeClassifier", "TextReader", inference="text: false"),
     case("scan { region: table, text: false }", "", "TextReader", inference="text: false", region="table"),
+    case('{"detect": {"obj": {"type": "object", "text": false}}}', "KnowledgeClassifier", "TextReader"),  # JSON false
     case("detect { obj: { type: CheezIt, text: false } }", "KnowledgeClassifier", "TextReader"),
     case("detect { obj: { color: red, text: true } }", "TextReader SemanticColorAnnotator", "KnowledgeClassifier"),
 ]

@@ -61,7 +61,7 @@ BAD_QUERIES: list[tuple[Parser, str, int, int, str]] = [
     (parse_query, '{"detect": 1}', 1, 12, "expected an object as the body"),
     (parse_query, '{"fetch": {"a": 1}}', 1, 2, "unknown query kind 'fetch'"),
     (parse_query, '{"detect": {"a b": 1}}', 1, 13, "expected an identifier as a key"),
-    (parse_query, '{"detect": {"a": true}}', 1, 18, "expected a string, number, list, object or null"),
+    (parse_query, '{"detect": {"max_results": true}}', 1, 13, "'max_results' takes a number, not 'true'"),
     (parse_query, '{"detect": {}, "track": {}}', 1, 16, "expected exactly one key"),
     (parse_query, '{\n "detect": {\n  "obj": {"type": "milk"},\n  "obj": {"type": "cup"}\n }\n}', 4, 3, "twice"),
     (parse_json, "[1, 2]", 1, 1, "expected a JSON object"),

@@ -228,3 +228,10 @@ def test_nested_form_is_not_rewritten() -> None:
     assert parse_query("detect { obj: { location: Fridge } }").get("obj.location") == Symbol("Fridge")
     block_form = parse_query("detect { obj: { location: { on: Table } } }").get("obj.location")
     assert block_form == Block((Field("on", Symbol("Table")),))
+
+
+def test_json_true_and_false_are_the_nested_forms_bare_words() -> None:
+    for word in ("true", "false"):
+        written = parse_query(f'{{"detect": {{"obj": {{"type": "Cup", "text": {word}}}}}}}')
+        assert written == parse_nested(f"detect {{ obj: {{ type: Cup, text: {word} }} }}")
+        assert written.body.get("obj").get("text") == Symbol(word)
