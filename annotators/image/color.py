@@ -46,7 +46,9 @@ from annotators.image.color_surfaces import (
     DEFAULT_PARAMETERS,
     NamingParameters,
     Surface,
+    is_shade_of,
     is_unsaturated,
+    look,
     objects_pixels,
     objects_surfaces,
     tint,
@@ -211,6 +213,17 @@ def _shade_links(labs_per_object: list[list[np.ndarray]], max_difference: float)
     return links
 
 
+def _shade_sides(labs: list[np.ndarray], parameters: NamingParameters) -> np.ndarray:
+    """Which pairs of an object's lit saturated colours (CIELAB) are one paint lit and in shade (either way
+    round, :func:`~annotators.image.color_surfaces.is_shade_of`): a square boolean matrix."""
+    looks = [look(lab, parameters) for lab in labs]
+    sides = np.zeros((len(labs), len(labs)), dtype=bool)
+    for i in range(len(labs)):
+        for j in range(i):
+            sides[i, j] = is_shade_of(looks[i], looks[j], parameters) or is_shade_of(looks[j], looks[i], parameters)
+    return sides
+
+
 def _pool_shades(
     surfaces: list[Surface],
     names: list[SurfaceName],
@@ -299,7 +312,10 @@ def name_objects_colors(
         [surfaces[i].lab for i in _lit_chromatic(surfaces, names)]
         for (surfaces, _), (_, names) in zip(found, named, strict=True)
     ]
-    links = _shade_links(lit_labs, parameters.shade_delta_e)
+    links = [
+        close | _shade_sides(labs, parameters)
+        for close, labs in zip(_shade_links(lit_labs, parameters.shade_delta_e), lit_labs, strict=True)
+    ]
     return [
         _object_colors(surfaces, _pool_shades(surfaces, names, votes, linked), count, parameters)
         for (surfaces, count), (votes, names), linked in zip(found, named, links, strict=True)
