@@ -40,7 +40,12 @@ measured against main, the others on top of the kept one):
 * denim: an unsaturated surface with tint >= 0.5 is grey, not black: tune 54, held_out 40 (power drills lose their
   black), fresh 16 (faded jeans + , dark jeans -);
 * black beside grey on one object is the grey's shaded side (left out, as grey beside white): tune 55 (learn43's
-  dark tin), held_out 41 (the black chair base -> grey), fresh 17 (faded jeans -> grey).
+  dark tin), held_out 41 (the black chair base -> grey), fresh 17 (faded jeans -> grey);
+* lightness anchored to the frame's white (linear light scaled so that the 99th percentile of the frame's
+  luminance is 1, the highest-luminance rule): tune 51 (four cookie tins brown -> orange), held_out 42, fresh 15;
+* a colour too colourful for brown (C* >= ``brown_max_chroma``: "a yellow or orange seen in less light") voted at
+  the lightness, at its own chromaticity, where the prototypes match it best (luminance x 1 .. 3): tune 56,
+  held_out 41 (a red print -> pink), fresh 16.
 """
 
 from __future__ import annotations
