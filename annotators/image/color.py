@@ -16,10 +16,11 @@ Each surface is named (:func:`name_surface`):
   counts only when it is a sizeable part of the object or has the name of one of its lit surfaces (shadows are
   dropped).
 
-Lit saturated surfaces that are shades of one colour (CIEDE2000 neighbours) are named together by their pooled
-votes (:func:`_pool_shades`). A name's share is the share of the named pixels its surfaces hold; grey beside white
-is the white's shaded side and is left out (it names no colour of its own, and counted with the white it would hide
-a print as large as the white it is printed on). The dominant colour is the largest share; a second colour is
+Lit saturated surfaces that are shades of one colour (CIEDE2000 neighbours, or one paint lit and in shade: a darker
+surface of about the same hue, whichever is larger) are named together by their pooled votes
+(:func:`_pool_shades`). A name's share is the share of the named pixels its surfaces hold; grey beside white is the
+white's shaded side and is left out (it names no colour of its own, and counted with the white it would hide a print
+as large as the white it is printed on). The dominant colour is the largest share; a second colour is
 reported when its share and its confidence (share x certainty) are large enough.
 
 The annotator names all the hypotheses of a frame together (:func:`name_objects_colors`): their pixels are
@@ -46,7 +47,9 @@ from annotators.image.color_surfaces import (
     DEFAULT_PARAMETERS,
     NamingParameters,
     Surface,
+    is_shade_of,
     is_unsaturated,
+    look,
     objects_pixels,
     objects_surfaces,
     tint,
@@ -211,6 +214,17 @@ def _shade_links(labs_per_object: list[list[np.ndarray]], max_difference: float)
     return links
 
 
+def _shade_sides(labs: list[np.ndarray], parameters: NamingParameters) -> np.ndarray:
+    """Which pairs of an object's lit saturated colours (CIELAB) are one paint lit and in shade (either way
+    round, :func:`~annotators.image.color_surfaces.is_shade_of`): a square boolean matrix."""
+    looks = [look(lab, parameters) for lab in labs]
+    sides = np.zeros((len(labs), len(labs)), dtype=bool)
+    for i in range(len(labs)):
+        for j in range(i):
+            sides[i, j] = is_shade_of(looks[i], looks[j], parameters) or is_shade_of(looks[j], looks[i], parameters)
+    return sides
+
+
 def _pool_shades(
     surfaces: list[Surface],
     names: list[SurfaceName],
@@ -218,7 +232,8 @@ def _pool_shades(
     links: np.ndarray,
 ) -> list[SurfaceName]:
     """The names with the lit saturated surfaces (:func:`_lit_chromatic`) that are shades of one colour (linked
-    in a chain by ``links``, from :func:`_shade_links` with ``shade_delta_e``) named together, by their
+    in a chain by ``links``: CIEDE2000 neighbours from :func:`_shade_links` with ``shade_delta_e``, or lit and
+    shaded sides from :func:`_shade_sides`) named together, by their
     pixel-weighted term votes (``votes``: each surface's, None for the surfaces named by lightness): a brown tin
     whose print and shading spread it over reddish, pinkish and orange-brown surfaces is brown, one colour."""
     chromatic = _lit_chromatic(surfaces, names)
@@ -299,7 +314,10 @@ def name_objects_colors(
         [surfaces[i].lab for i in _lit_chromatic(surfaces, names)]
         for (surfaces, _), (_, names) in zip(found, named, strict=True)
     ]
-    links = _shade_links(lit_labs, parameters.shade_delta_e)
+    links = [
+        close | _shade_sides(labs, parameters)
+        for close, labs in zip(_shade_links(lit_labs, parameters.shade_delta_e), lit_labs, strict=True)
+    ]
     return [
         _object_colors(surfaces, _pool_shades(surfaces, names, votes, linked), count, parameters)
         for (surfaces, count), (votes, names), linked in zip(found, named, links, strict=True)

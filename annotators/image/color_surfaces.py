@@ -279,12 +279,8 @@ def _merge_shaded(surfaces: list[Surface], parameters: NamingParameters) -> list
         host_index = None
         unsaturated, hue, saturation, lightness = _look(surface.lab, parameters)
         if not unsaturated:
-            for index, (host_unsaturated, host_hue, host_saturation, host_lightness) in enumerate(kept_looks):
-                offset = abs((hue - host_hue + 180.0) % 360.0 - 180.0)
-                darker = host_lightness - lightness >= parameters.shade_lightness
-                ratio = saturation / max(host_saturation, 1e-9)
-                alike = offset <= parameters.shade_hue and ratio <= parameters.shade_saturation
-                if not host_unsaturated and alike and darker:
+            for index, host_look in enumerate(kept_looks):
+                if is_shade_of((unsaturated, hue, saturation, lightness), host_look, parameters):
                     host_index = index
                     break
         if host_index is None:
@@ -296,9 +292,34 @@ def _merge_shaded(surfaces: list[Surface], parameters: NamingParameters) -> list
     return kept
 
 
-def _look(lab: np.ndarray, parameters: NamingParameters) -> tuple[bool, float, float, float]:
-    """What :func:`_merge_shaded` compares of a colour: whether it is unsaturated, its hue, saturation and L*."""
+Look = tuple[bool, float, float, float]
+"""What :func:`is_shade_of` compares of a colour: whether it is unsaturated, its hue, saturation and L*."""
+
+
+def _look(lab: np.ndarray, parameters: NamingParameters) -> Look:
     return is_unsaturated(lab, parameters), _hue(lab), _saturation(lab), float(lab[0])
+
+
+def look(lab: np.ndarray, parameters: NamingParameters = DEFAULT_PARAMETERS) -> Look:
+    """What :func:`is_shade_of` compares of a colour (CIELAB)."""
+    return _look(lab, parameters)
+
+
+def is_shade_of(shaded: Look, lit: Look, parameters: NamingParameters = DEFAULT_PARAMETERS) -> bool:
+    """Whether a saturated colour can be a saturated ``lit`` colour's shaded side: a hue within ``shade_hue``
+    degrees, at most ``shade_saturation`` times as saturated and at least ``shade_lightness`` darker (see
+    :func:`_merge_shaded`)."""
+    unsaturated, hue, saturation, lightness = shaded
+    lit_unsaturated, lit_hue, lit_saturation, lit_lightness = lit
+    if unsaturated or lit_unsaturated:
+        return False
+    offset = abs((hue - lit_hue + 180.0) % 360.0 - 180.0)
+    ratio = saturation / max(lit_saturation, 1e-9)
+    return (
+        offset <= parameters.shade_hue
+        and ratio <= parameters.shade_saturation
+        and lit_lightness - lightness >= parameters.shade_lightness
+    )
 
 
 DARK_GROUP = 1

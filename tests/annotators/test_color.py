@@ -246,3 +246,13 @@ def test_a_print_is_measured_against_the_white_not_the_whites_shaded_side() -> N
     shaded_white = patch((225, 235, 195), 0.2, count=270, seed=1)
     assert names(shaded_white) == ["grey"]
     assert names(np.vstack([white, shaded_white, patch((200, 30, 35), count=280, seed=2)])) == ["white", "red"]
+
+
+def test_a_colour_lit_and_in_shade_is_one_colour_even_where_the_shaded_side_is_larger() -> None:
+    # a crisps tube as in mOSD frames: a narrow lit yellow side, a wider shaded side of the same hue (orange alone)
+    # and a white band larger than either side but smaller than both; the tube's colour is the dominant one
+    lit, shaded = patch((215, 175, 20), count=200), patch((170, 120, 30), count=330, seed=1)
+    assert (names(lit), names(shaded)) == (["yellow"], ["orange"])
+    tube = np.vstack([lit, shaded, patch((236, 232, 225), count=420, seed=2)])
+    assert names(tube)[0] in ("yellow", "orange")
+    assert names(tube)[1:] == ["white"]
