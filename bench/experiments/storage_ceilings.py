@@ -3,6 +3,9 @@
 The same frames are integrated into fresh copies of one seeded store, the modes alternating per round:
 
 * ``wal``: the store as it ships (WAL, ``synchronous=NORMAL``);
+* ``cache``: ``wal`` with a page cache of 256 MiB (the default is 2 MiB);
+* ``no-object-index``: ``wal`` without the index ``attribute_index_object`` and without the statement that needs it
+  (the delete of a new belief's entries, which finds none in these frames): the most dropping it could save;
 * ``memory``: the seeded file copied into an in-memory SQLite database (``Connection.backup``): no file I/O at all,
   what is left is SQLite's C work and Python;
 * ``memory+log``: ``memory`` plus one ``os.write`` per frame of the frame's write log (``marshal``), the least a
@@ -37,11 +40,22 @@ sys.path.insert(0, str(BENCH))
 
 import bench_beliefs as bench  # noqa: E402
 
+import reasoning.beliefs.store as store_module  # noqa: E402
 from reasoning.beliefs.store import BeliefStore  # noqa: E402
 from reasoning.fusion.frame import FrameContext, FrameObject, frame_objects  # noqa: E402
 from reasoning.fusion.tracking import BeliefTracker  # noqa: E402
 
-MODES = ("wal", "mmap", "memory", "memory+log", "off")
+MODES = ("wal", "mmap", "cache", "no-object-index", "memory", "memory+log", "off")
+
+
+_WRITE = store_module._write
+_OBJECT_DELETE = "DELETE FROM attribute_index WHERE object_id = ?"
+
+
+def _without_object_deletes(conn: sqlite3.Connection, log: list, statement: str, rows: list[tuple]) -> None:
+    """The store's ``_write``, skipping the deletes by object id (mode ``no-object-index``)."""
+    if statement != _OBJECT_DELETE:
+        _WRITE(conn, log, statement, rows)
 
 
 def _remove(path: Path) -> None:
@@ -69,6 +83,10 @@ def open_store(path: Path, mode: str) -> tuple[BeliefStore, Callable[[], None]]:
 
     if mode == "mmap":
         store._conn.execute("PRAGMA mmap_size = 1073741824")
+    if mode == "cache":
+        store._conn.execute("PRAGMA cache_size = -262144")
+    if mode == "no-object-index":
+        store._conn.execute("DROP INDEX IF EXISTS attribute_index_object")
     if mode == "off":
         store._conn.execute("PRAGMA journal_mode = OFF")
         store._conn.execute("PRAGMA synchronous = OFF")
@@ -78,6 +96,8 @@ def open_store(path: Path, mode: str) -> tuple[BeliefStore, Callable[[], None]]:
 def run(path: Path, mode: str, frames: list[list[FrameObject]], record: bool) -> tuple[float, float, list]:
     """Seconds of CPU and wall over the frames' integrate calls (the first frame is a warm-up), and the write log."""
     store, after = open_store(path, mode)
+    if mode == "no-object-index":
+        store_module._write = _without_object_deletes
     if record:
         store.write_log = []
     store.integrate(frames[0], 999.0)
@@ -91,6 +111,7 @@ def run(path: Path, mode: str, frames: list[list[FrameObject]], record: bool) ->
         cpu += time.process_time() - c0
         wall += time.perf_counter() - w0
     log = list(store.write_log or []) if record else []
+    store_module._write = _WRITE
     store.close()
     return cpu, wall, log
 
