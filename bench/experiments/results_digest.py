@@ -3,8 +3,7 @@
 
 It seeds 10,000 beliefs as ``bench_beliefs.py`` does, integrates 150 frames at random places and 150 from 10 fixed
 views, and hashes every step (each changed belief in full, its log-odds not rounded; assigned, created, missed, gone,
-the association) and, at the end, every table of the store. A second digest leaves out the schema version row of
-``meta``, so trees of different schema versions can be compared on everything else.
+the association) and, at the end, every table of the store.
 
 Run: ``PYTHONPATH=. .venv/bin/python bench/experiments/results_digest.py``
 """
@@ -49,7 +48,6 @@ def belief_text(b: ObjectBelief) -> str:
 
 def main() -> int:
     digest = hashlib.sha256()
-    unversioned = hashlib.sha256()
     with tempfile.TemporaryDirectory() as name:
         path = Path(name) / "seed.sqlite"
         seeded = bench.seed_file(path, 10_000, np.random.default_rng(5), named_regions=False)
@@ -61,19 +59,15 @@ def main() -> int:
         for index, frame in enumerate(frames):
             step = store.integrate(frame, 1000.0 + index * 0.5)
             for belief in step.changed:
-                for h in (digest, unversioned):
-                    h.update(belief_text(belief).encode())
-            for h in (digest, unversioned):
-                h.update(repr((step.assigned, step.created, step.missed, step.gone, step.association)).encode())
+                digest.update(belief_text(belief).encode())
+            digest.update(repr((step.assigned, step.created, step.missed, step.gone, step.association)).encode())
         store.close()
         conn = sqlite3.connect(path)
         for table in TABLES:
             rows = sorted(conn.execute(f"SELECT * FROM {table}").fetchall(), key=repr)
             digest.update(repr(rows).encode())
-            unversioned.update(repr([row for row in rows if table != "meta" or row[0] != "version"]).encode())
         conn.close()
     print(digest.hexdigest())
-    print(unversioned.hexdigest(), "(without the schema version)")
     return 0
 
 

@@ -72,14 +72,13 @@ from robokudo.core.text_match import text_matches
 from robokudo.core.types import Text
 
 SCHEMA_NAME = "robokudo-beliefs"
-SCHEMA_VERSION = 4
+SCHEMA_VERSION = 3
 MIGRATIONS = {
     1: (
         "ALTER TABLE objects ADD COLUMN recording TEXT NOT NULL DEFAULT ''",
         "ALTER TABLE observations ADD COLUMN recording TEXT NOT NULL DEFAULT ''",
     ),
     2: (),  # and the attribute column rewritten from JSON to packed supports (_pack_attribute_column)
-    3: ("DROP INDEX IF EXISTS attribute_index_object",),
 }
 """Version -> the statements that bring a store of that version to the next one."""
 SQLITE_HEADER = b"SQLite format 3\x00"
@@ -203,6 +202,7 @@ _SCHEMA = (
         recording TEXT NOT NULL DEFAULT ''
     )""",
     "CREATE UNIQUE INDEX IF NOT EXISTS observations_object ON observations (object_id, seq)",
+    "CREATE INDEX IF NOT EXISTS attribute_index_object ON attribute_index (object_id)",
     "CREATE TABLE IF NOT EXISTS classes (name TEXT PRIMARY KEY) WITHOUT ROWID",
     _INTERNED_TABLE,
 )
@@ -377,9 +377,6 @@ class BeliefStore:
         version = int(found[0]) if found is not None else SCHEMA_VERSION
         for step in range(version, SCHEMA_VERSION):
             for statement in MIGRATIONS[step]:
-                if not statement.startswith("ALTER TABLE"):
-                    conn.execute(statement)
-                    continue
                 table = statement.split()[2]
                 column = statement.split()[5]
                 present = {row[1] for row in conn.execute(f"PRAGMA table_info({table})")}
@@ -476,11 +473,11 @@ class BeliefStore:
                     else update.pack(made[0], made[1], write)
                     for made in updated
                 ]
-                self._write_rows(conn, written, loaded, writes, next_id)
+                self._write_rows(conn, written, loaded, writes)
             else:
                 beliefs = [_belief_from_row(row, self._interned, conn) for row in rows]
                 step = tracker.step(beliefs, objects, time, new_id, camera)
-                written = self._write_beliefs(conn, step.changed, tracker.class_test, loaded, writes, next_id)
+                written = self._write_beliefs(conn, step.changed, tracker.class_test, loaded, writes)
             counts = {row[0]: row[20] for row in written}
             self._write_observations(conn, objects, [(i, counts.get(i, 0)) for i in step.assigned], time, writes)
             if allocated[0] != next_id:
@@ -593,9 +590,9 @@ class BeliefStore:
         """Forget the beliefs ``ids`` and their history (unknown ids are skipped); returns how many were forgotten."""
         rows = [(int(i),) for i in set(ids)]
         with self._transaction() as conn:
-            conn.executemany(_DELETE_INDEX_ENTRY, _stored_index_entries(conn, [i for (i,) in rows]))
             count = conn.executemany("DELETE FROM objects WHERE id = ?", rows).rowcount
             conn.executemany("DELETE FROM objects_place WHERE id = ?", rows)
+            conn.executemany("DELETE FROM attribute_index WHERE object_id = ?", rows)
             conn.executemany("DELETE FROM observations WHERE object_id = ?", rows)
         return count
 
@@ -653,7 +650,6 @@ class BeliefStore:
         class_test: ClassTest | None,
         loaded: Mapping[int, tuple] | None = None,
         writes: list[tuple[str, list[tuple]]] | None = None,
-        unstored_from: int | None = None,
     ) -> list[tuple]:
         """Write the object rows of ``beliefs`` (:meth:`_write_rows`); returns the rows written."""
         if not beliefs:
@@ -664,7 +660,7 @@ class BeliefStore:
         latest = {b.id: b for b in beliefs}  # a belief given twice is written as its last object is
         written = beliefs if len(latest) == len(beliefs) else [latest[b.id] for b in beliefs]
         rows = [_object_row(b, class_test, cache, self._interned, conn, write) for b in written]
-        self._write_rows(conn, rows, loaded, log, unstored_from)
+        self._write_rows(conn, rows, loaded, log)
         return rows
 
     def _write_rows(
@@ -673,7 +669,6 @@ class BeliefStore:
         rows: Sequence[tuple],
         loaded: Mapping[int, tuple] | None,
         log: list[tuple[str, list[tuple]]],
-        unstored_from: int | None = None,
     ) -> None:
         """Write object rows, their R*Tree entries and attribute-index entries (noted in ``log``).
 
@@ -683,17 +678,10 @@ class BeliefStore:
         ``RTREE_SLACK`` around a recent position; it is rewritten only when the belief has moved more than half of
         that from the entry's centre, so the true position always lies inside the entry and look-ups by position
         miss nothing.
-
-        The attribute-index entries of a belief that is not in ``loaded`` but stored are those of its stored
-        ``indexed`` column (read here, unless its id is at or above ``unstored_from``: ids this transaction
-        allocated, not stored yet); they are deleted by key (no index by object id to keep up per new belief).
         """
         if not rows:
             return
         loaded = loaded or {}
-        replaced = _stored_index_entries(
-            conn, [row[0] for row in rows if row[0] not in loaded and (unstored_from is None or row[0] < unstored_from)]
-        )
         fresh: list[tuple] = []
         volatile: list[tuple] = []
         relabelled: list[tuple] = []
@@ -734,9 +722,8 @@ class BeliefStore:
             class_name = row[1]
             if class_name and class_name != (state[1] if state is not None else None):
                 classes.add((class_name,))
-        if replaced:
-            _write(conn, log, _DELETE_INDEX_ENTRY, replaced)
         if fresh:
+            _write(conn, log, "DELETE FROM attribute_index WHERE object_id = ?", [(row[0],) for row in fresh])
             _write(conn, log, f"INSERT OR REPLACE INTO objects ({_OBJECT_COLUMNS}) VALUES ({_PLACEHOLDERS})", fresh)
         if volatile:
             _write(conn, log, _UPDATE_VOLATILE, volatile)
@@ -748,7 +735,7 @@ class BeliefStore:
                     relabelled,
                 )
         if removed:
-            _write(conn, log, _DELETE_INDEX_ENTRY, removed)
+            _write(conn, log, "DELETE FROM attribute_index WHERE name = ? AND value = ? AND object_id = ?", removed)
         if added:
             _write(conn, log, "INSERT OR IGNORE INTO attribute_index VALUES (?, ?, ?)", added)
         if moved:
@@ -966,7 +953,6 @@ class BeliefStore:
 # ---------------------------------------------------------------------------------------- row mapping
 
 
-_DELETE_INDEX_ENTRY = "DELETE FROM attribute_index WHERE name = ? AND value = ? AND object_id = ?"
 _MARK_GONE = "UPDATE objects SET status = 'gone' WHERE misses > 0 AND status = 'present' AND last_seen <= ?"
 
 
@@ -1183,18 +1169,6 @@ def _unpack_evidence(
         (text(conn, numbers[i]), text(conn, numbers[i + 1]), numbers[i + 2], text(conn, numbers[i + 3]))
         for i in range(0, len(numbers), 4)
     )
-
-
-def _stored_index_entries(conn: sqlite3.Connection, ids: Sequence[int]) -> list[tuple[str, str, int]]:
-    """The attribute-index entries (name, value, id) of the stored beliefs among ``ids`` (from their ``indexed``
-    column, which the index entries of a belief always follow)."""
-    entries: list[tuple[str, str, int]] = []
-    for begin in range(0, len(ids), 500):
-        chunk = ids[begin : begin + 500]
-        found = conn.execute(f"SELECT id, indexed FROM objects WHERE id IN ({', '.join('?' * len(chunk))})", chunk)
-        for object_id, indexed in found:
-            entries.extend((name, value, object_id) for name, value in sorted(_index_entries(indexed)))
-    return entries
 
 
 def _index_entries(indexed: str) -> set[tuple[str, str]]:
