@@ -4,8 +4,9 @@ The same frames are integrated into fresh copies of one seeded store, the modes 
 
 * ``wal``: the store as it ships (WAL, ``synchronous=NORMAL``);
 * ``cache``: ``wal`` with a page cache of 256 MiB (the default is 2 MiB);
-* ``object-index``: ``wal`` as schema 3 wrote (before store12): with the index ``attribute_index_object`` and the
-  delete of each new belief's entries by object id before its row is written (which finds none);
+* ``no-object-index``: ``wal`` without the index ``attribute_index_object`` and without the statement that needs it
+  (the delete of a new belief's entries by object id, which finds none in these frames): what dropping it saves
+  (store12 built that with deletes by key, schema 4, and measured it: see bench/profiles/store12-analysis.txt);
 * ``memory``: the seeded file copied into an in-memory SQLite database (``Connection.backup``): no file I/O at all,
   what is left is SQLite's C work and Python;
 * ``memory+log``: ``memory`` plus one ``os.write`` per frame of the frame's write log (``marshal``), the least a
@@ -45,18 +46,17 @@ from reasoning.beliefs.store import BeliefStore  # noqa: E402
 from reasoning.fusion.frame import FrameContext, FrameObject, frame_objects  # noqa: E402
 from reasoning.fusion.tracking import BeliefTracker  # noqa: E402
 
-MODES = ("wal", "mmap", "cache", "object-index", "memory", "memory+log", "off")
+MODES = ("wal", "mmap", "cache", "no-object-index", "memory", "memory+log", "off")
 
 
 _WRITE = store_module._write
 _OBJECT_DELETE = "DELETE FROM attribute_index WHERE object_id = ?"
 
 
-def _with_object_deletes(conn: sqlite3.Connection, log: list, statement: str, rows: list[tuple]) -> None:
-    """The store's ``_write``, deleting the index entries of new rows by object id first (mode ``object-index``)."""
-    if statement.startswith("INSERT OR REPLACE INTO objects ("):
-        _WRITE(conn, log, _OBJECT_DELETE, [(row[0],) for row in rows])
-    _WRITE(conn, log, statement, rows)
+def _without_object_deletes(conn: sqlite3.Connection, log: list, statement: str, rows: list[tuple]) -> None:
+    """The store's ``_write``, skipping the deletes by object id (mode ``no-object-index``)."""
+    if statement != _OBJECT_DELETE:
+        _WRITE(conn, log, statement, rows)
 
 
 def _remove(path: Path) -> None:
@@ -86,8 +86,8 @@ def open_store(path: Path, mode: str) -> tuple[BeliefStore, Callable[[], None]]:
         store._conn.execute("PRAGMA mmap_size = 1073741824")
     if mode == "cache":
         store._conn.execute("PRAGMA cache_size = -262144")
-    if mode == "object-index":
-        store._conn.execute("CREATE INDEX IF NOT EXISTS attribute_index_object ON attribute_index (object_id)")
+    if mode == "no-object-index":
+        store._conn.execute("DROP INDEX attribute_index_object")
     if mode == "off":
         store._conn.execute("PRAGMA journal_mode = OFF")
         store._conn.execute("PRAGMA synchronous = OFF")
@@ -97,8 +97,8 @@ def open_store(path: Path, mode: str) -> tuple[BeliefStore, Callable[[], None]]:
 def run(path: Path, mode: str, frames: list[list[FrameObject]], record: bool) -> tuple[float, float, list]:
     """Seconds of CPU and wall over the frames' integrate calls (the first frame is a warm-up), and the write log."""
     store, after = open_store(path, mode)
-    if mode == "object-index":
-        store_module._write = _with_object_deletes
+    if mode == "no-object-index":
+        store_module._write = _without_object_deletes
     if record:
         store.write_log = []
     store.integrate(frames[0], 999.0)
