@@ -549,13 +549,27 @@ def _named_region(value: Value | None, kb: KnowledgeBase) -> RegionBox | None:
     try:
         found = kb.resolve(word, ("region", "region_class"))
     except TermError as error:
-        raise PlanningError(str(error)) from None
+        raise PlanningError(_not_a_place(word, kb) or str(error)) from None
     if found.kind == "region":
         return kb.region(found.name)
     boxes = kb.regions_of_class(found.name)
     if not boxes:
         raise PlanningError(f"the semantic map has no region of class {found.name}")
     return boxes[0]
+
+
+def _not_a_place(word: str, kb: KnowledgeBase) -> str | None:
+    """Why an object class named as the place cannot be searched (``the can in the bowl``), None when ``word``
+    names no object class (then it is an unknown word)."""
+    try:
+        found = kb.resolve(word, ("class",))
+    except TermError:
+        return None
+    return (
+        f"{word!r} is an object, not a place ({kb.label(found.name)}): a query searches a region of the semantic map "
+        f"(the fridge, the table) and cannot place one object relative to another; leave the place out, ask for "
+        f"both objects and compare their positions"
+    )
 
 
 def _default_region(object_class: str, kb: KnowledgeBase, camera_pose: bool) -> tuple[RegionBox | None, str]:
