@@ -465,7 +465,7 @@ def _designate(
         class_name = supported_class
     size_attribute = attributes.get(Size.attribute)
     answers = None
-    if asked_class:
+    if asked_class and _local(asked_class) != ROOTS["class"]:  # asking for any object asks for no class
         values = _with_answering(belief.attributes.get(CLASS_ATTRIBUTE), answering)
         answers = answer_probability(values, asked_class, class_test) if values else 0.0
     return ObjectDesignator(
