@@ -137,7 +137,7 @@ def interpret(
         requirements += _text_for_any_class(query.kind, kb, colour, text_told, inferences)
     location = obj.get("location")
     try:
-        region_box = _region(location, kb, camera_pose)
+        region_box = _region(location, kb, camera_pose, inferences)
     except PlanningError as error:
         raise _located(query, _place_field(obj), error) from None
     if _is_anywhere(location):
@@ -525,9 +525,21 @@ def _is_anywhere(value: Value | None) -> bool:
     return isinstance(value, Symbol | String) and _word(value, "location").strip().lower() == ANYWHERE
 
 
-def _region(value: Value | None, kb: KnowledgeBase, camera_pose: bool) -> RegionBox | None:
-    """The region box the query names (None for none or anywhere); PlanningError when it cannot be applied."""
+def _region(
+    value: Value | None, kb: KnowledgeBase, camera_pose: bool, inferences: list[str] | None = None
+) -> RegionBox | None:
+    """The region box the query names (None for none or anywhere); PlanningError when it cannot be applied.
+
+    Without a camera pose a region cannot be placed in the view; but what stands *on* a supporting surface (the
+    table, the counter, the floor) is what the segmentation finds on the support plane it fits, so with
+    ``inferences`` given such a place is read as that plane (None, and a note saying so)."""
     box = _named_region(value, kb)
+    if box is not None and not camera_pose and inferences is not None and _on_a_surface(value, box, kb):
+        inferences.append(
+            f"the input gives no camera pose to place {box.name!r} in the semantic map, so the surface the objects "
+            f"stand on (the support plane found in the view) is taken for it"
+        )
+        return None
     if box is not None and not camera_pose:
         raise PlanningError(
             f"region {box.name!r} cannot be searched: the input gives no camera pose, so its points cannot be placed "
@@ -535,6 +547,17 @@ def _region(value: Value | None, kb: KnowledgeBase, camera_pose: bool) -> Region
             f"view, or use an input with a camera pose (the built-in kitchen)"
         )
     return box
+
+
+def _on_a_surface(value: Value | None, box: RegionBox, kb: KnowledgeBase) -> bool:
+    """Whether the query asks for what stands on ``box`` (``location: { on: table }``) and it is a supporting
+    surface."""
+    if not isinstance(value, Block) or value.get("on") is None:
+        return False
+    try:
+        return kb.is_subclass(box.region_class, "SupportingRegion")
+    except LookupError:
+        return False
 
 
 def _named_region(value: Value | None, kb: KnowledgeBase) -> RegionBox | None:

@@ -80,3 +80,19 @@ def test_no_drill_is_made_of_a_table_without_one(capsys: pytest.CaptureFixture[s
     """uoc frame 4 holds wipes, a can of cashews, a Duplo brick and a cup: "find the drill" answers nothing (the
     brick's knobs look like a handle to the form expert, but it is too flat for a drill standing on its battery)."""
     assert answered_at(capsys, "find the drill", uoc(), 4) == []
+
+
+@pytest.mark.real_data
+def test_on_the_table_of_a_frame_without_camera_pose_is_the_support_plane(capsys: pytest.CaptureFixture[str]) -> None:
+    """Asking "what is on the table" of any real input (none has a camera pose) was refused ("region 'table' cannot
+    be searched"); the table is read as the support plane the objects stand on, and the plan says so. A place that
+    is no supporting surface (in the fridge) is still refused."""
+    every = query(capsys, "find objects anywhere", "--input", uoc(), "--frame", "2")
+    on_table = query(capsys, "what is on the table", "--input", uoc(), "--frame", "2")
+    assert len(on_table) == len(every) >= 8
+    found = answered_at(capsys, "find the mug on the table", uoc(), 2)
+    assert [label for label, _ in found] == ["mug"] and inside((480, 135), found[0][1])
+    assert cli.main(["plan", "--explain", "find the mug on the table", "--input", uoc()]) == 0
+    assert "the support plane found in the view) is taken for it" in capsys.readouterr().out
+    assert cli.main(["query", "find the mustard bottle in the fridge", "--input", uoc()]) == 2
+    assert "region 'fridge' cannot be searched" in capsys.readouterr().err
