@@ -107,6 +107,10 @@ def interpret(
     if object_class is not None:
         constraints.append(Constraint("type", "Classification", object_class))
         requirements.append(Requirement("Classification", object_class, f"query asks type = {object_class}"))
+    elif query.kind == "detect" and all(f.key in _STRUCTURAL_KEYS for f in obj.fields) and obj.get("id") is None:
+        why = "the query names no class and no property, so it asks what the objects are: they are classified"
+        inferences.append(why)
+        requirements.append(Requirement("Classification", None, why))
     switch = text_switch(obj.get(TEXT_KEY))
     for field in obj.fields:
         if field.key in _STRUCTURAL_KEYS or (field.key == TEXT_KEY and switch is not None):

@@ -96,3 +96,16 @@ def test_on_the_table_of_a_frame_without_camera_pose_is_the_support_plane(capsys
     assert "the support plane found in the view) is taken for it" in capsys.readouterr().out
     assert cli.main(["query", "find the mustard bottle in the fridge", "--input", uoc()]) == 2
     assert "region 'fridge' cannot be searched" in capsys.readouterr().err
+
+
+@pytest.mark.real_data
+@pytest.mark.parametrize("text", ["what is on the table", "find objects anywhere"])
+def test_a_question_naming_no_class_or_property_says_what_the_objects_are(
+    capsys: pytest.CaptureFixture[str], text: str
+) -> None:
+    """Asking "what is on the table" got ``#1 unknown object at (...), by PoseAnnotator`` for each object: where, never
+    what. Asked of uoc frame 2 it names the Cheez-It box, the bowls and the mug, with their colours."""
+    lines = query(capsys, text, "--input", uoc(), "--frame", "2")
+    assert any(line.startswith("#1 Cheez-It crackers (red)") for line in lines)
+    assert sum(" bowl (" in line for line in lines) == 2 and any(" mug (blue)" in line for line in lines)
+    assert all("KnowledgeClassifier" in line for line in lines)
