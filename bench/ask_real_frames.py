@@ -84,6 +84,9 @@ QUESTIONS: list[dict] = [
             "find the largest box",
             "find the big box",
             "find the blue mug",
+            "what is on the table",
+            "find the mug on the table",
+            "find objects anywhere",
         ],
     },
     {
