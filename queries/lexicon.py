@@ -32,6 +32,7 @@ VERBS: MappingProxyType[tuple[str, ...], str] = MappingProxyType(
         ("recognize",): "detect",
         ("recognise",): "detect",
         ("identify",): "detect",
+        ("count",): "detect",
         ("track",): "track",
         ("follow",): "track",
         ("keep", "track", "of"): "track",
@@ -60,6 +61,25 @@ QUESTION_ATTRIBUTES: MappingProxyType[str, str] = MappingProxyType(
     {"color": "color", "colour": "color", "size": "size", "shape": "shape"}
 )
 """``what <attribute> is the X`` asks for this key of an ``inspect`` query."""
+
+COUNT_QUESTIONS: frozenset[tuple[str, ...]] = frozenset({("how", "many")})
+"""Openings of a question for every object of a kind: ``how many cans are there``."""
+
+COUNT_TAILS: frozenset[tuple[str, ...]] = frozenset(
+    {
+        ("are", "there"),
+        ("is", "there"),
+        ("there", "are"),
+        ("there", "is"),
+        ("do", "you", "see"),
+        ("can", "you", "see"),
+        ("you", "see"),
+        ("do", "i", "have"),
+        ("are", "visible"),
+        ("are", "left"),
+    }
+)
+"""The verb of a ``how many`` question, wherever it stands (``how many cans are there on the table``)."""
 
 QUESTION_VERBS: frozenset[str] = frozenset({"is", "are", "does", "do"})
 """Words allowed between ``what <attribute>`` and the object."""

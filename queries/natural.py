@@ -12,6 +12,7 @@ list / (do you) see / what is + place
 track / follow / keep track of                  ``track``
 inspect / examine / look at / check             ``inspect``
 what color / size / shape is X                  ``inspect { obj: { ..., color: ? } }``
+how many X (are there) / count X                ``detect`` every X (no result limit)
 scan X [for Y]                                  ``scan { region: X, for: Y }``
 find / look for free space on X                 ``scan { region: X, for: free_space }``
 where can I put / place / set X on Y            ``scan { free_space: { region: Y, for: X } }``
@@ -36,6 +37,7 @@ noun + number (``object 12``, ``cup no 3``)     ``id: 12``; object/item/thing se
 in / inside / on / at / near / next to /        ``location: { in: fridge }`` etc.
 under / behind / above / in front of X
 "quoted text" (``with "..."``, ``labelled``)    ``text: "..."``
+find "text" (the quoted text as the object)     ``obj: { text: "..." }``
 that is / which is + adjectives                 the same keys as the adjectives
 with X (not quoted)                             ``with: X``
 ==============================================  =====================================
@@ -60,6 +62,8 @@ from queries.lexicon import (
     COLOR_MODIFIERS,
     COLORS,
     CONJUNCTIONS,
+    COUNT_QUESTIONS,
+    COUNT_TAILS,
     COUNT_WORDS,
     FILLERS,
     GENERIC_NOUNS,
@@ -307,6 +311,9 @@ class _PhraseParser:
         seen = self.what_is_question()
         if seen is not None:
             return seen
+        counted = self.how_many_question()
+        if counted is not None:
+            return counted
         asked_key: str | None = None
         placement = self.match(PLACEMENT_VERBS)
         if placement is not None:
@@ -378,11 +385,37 @@ class _PhraseParser:
         validate_query(query)
         return query
 
+    def how_many_question(self) -> Query | None:
+        """``how many cans are there (on the table)`` / ``how many cups do you see``: a detect query for every such
+        object (the answer lists them, one line each); None when the phrase does not start with ``how many``."""
+        opening = self.match(COUNT_QUESTIONS)
+        if opening is None:
+            return None
+        verb_tokens = self.take(len(opening))
+        start = self.index
+        kept = list(self.tokens[:start])
+        while self.current() is not None:
+            tail = self.match(COUNT_TAILS)  # "are there", "do you see": the question's verb, not the object
+            taken = self.take(len(tail) if tail is not None else 1)
+            if tail is None:
+                kept.extend(taken)
+        self.tokens, self.index = kept, start
+        phrase = self.object_phrase()
+        self.modifiers(phrase)
+        self.expect_end()
+        phrase.limit, phrase.limit_span = None, None
+        kind_span = _join_span(verb_tokens[0].span, verb_tokens[-1].span)
+        query = Query("detect", self.object_body("detect", phrase), self.text, kind_span)
+        validate_query(query)
+        return query
+
     def verb_guess(self) -> str:
         """``; did you mean 'find'?`` when the first word is a near miss of a one-word verb, else nothing."""
         word = self.word()
         if word is None:
             return ""
+        if word == "how":  # "how" is no misspelt "show": the one how-question is a count
+            return "; to count objects ask 'how many cups are there'"
         verbs = sorted({words[0] for words in VERBS if len(words) == 1})
         close = difflib.get_close_matches(word, verbs, n=1, cutoff=0.7)
         return f"; did you mean '{close[0]}'?" if close else ""
@@ -459,6 +492,13 @@ class _PhraseParser:
             phrase.noun, phrase.generic, phrase.noun_span = "object", True, token.span
             self.relative_adjectives(phrase, required=False)
             phrase.end = self.last_span()
+            return phrase
+        quoted = self.current()
+        if quoted is not None and quoted.kind == "string":  # find "CHEEZ": whatever reads that text
+            self.take()
+            phrase.noun, phrase.generic, phrase.noun_span = "object", True, quoted.span
+            phrase.extras.append(Field("text", String(quoted.text), quoted.span))
+            phrase.end = quoted.span
             return phrase
         words: list[PhraseToken] = []
         while not self.is_boundary():

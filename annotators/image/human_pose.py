@@ -18,6 +18,9 @@ score thresholds (the graph's are cleared) and keeps a person only when its tors
 
 from __future__ import annotations
 
+import contextlib
+import io
+import sys
 import weakref
 from dataclasses import dataclass
 from typing import Any, ClassVar
@@ -64,8 +67,9 @@ def load_pose_model(video: bool = False) -> Any:
     ``video`` for consecutive images of one person: it finds the person once and then runs only the landmark
     model on the region its previous landmarks give (a third of the time)."""
     try:
-        import mediapipe as mp
-
+        with contextlib.redirect_stderr(io.StringIO()) as said:  # its protobuf bindings' harmless complaint
+            import mediapipe as mp
+        _pass_on(said.getvalue())
         return mp.solutions.pose.Pose(
             static_image_mode=not video,
             model_complexity=1,
@@ -75,6 +79,17 @@ def load_pose_model(video: bool = False) -> Any:
         )
     except Exception as error:  # ImportError, or mediapipe's own errors when its graph cannot start
         raise PoseModelError(f"the mediapipe pose model cannot be loaded: {error}") from None
+
+
+BINDINGS_NOISE = "'MessageFactory' object has no attribute 'GetPrototype'"
+"""What mediapipe's protobuf bindings print on import with protobuf >= 5 (harmless: the pose solution runs)."""
+
+
+def _pass_on(printed: str) -> None:
+    """Write what importing mediapipe printed to stderr, but for the bindings' harmless line, which users read as
+    a crash."""
+    kept = [line for line in printed.splitlines(keepends=True) if BINDINGS_NOISE not in line]
+    sys.stderr.write("".join(kept))
 
 
 def detect_landmarks(model: Any, image: np.ndarray) -> tuple[np.ndarray, np.ndarray] | None:

@@ -231,6 +231,12 @@ class PlacementDesignator:
         )
 
 
+def _has_class(found: ObjectDesignator) -> bool:
+    """Whether a class probability means something to people: a query asked for a class, or the object has one
+    (an unknown object's probability is that no class fits, which reads as confidence in a class)."""
+    return found.answers is not None or (found.class_label is not None and found.class_label != UNKNOWN_LABEL)
+
+
 def _local(class_name: str) -> str:
     return class_name.replace("#", "/").rsplit("/", 1)[-1]
 
@@ -341,7 +347,7 @@ class Answer:
                 + (f" ({colour.value})" if colour else "")
                 + f" at ({p[0]:.3f}, {p[1]:.3f}, {p[2]:.3f}) [{o.pose.frame}]"
                 + (f" in {o.region}" if o.region else "")
-                + (f", class {probability:.2f}" if probability is not None and o.class_label else "")
+                + (f", class {probability:.2f}" if probability is not None and _has_class(o) else "")
                 + f", exists {o.confidence:.2f}, by {', '.join(o.experts) or 'nobody'}"
             )
         return lines
@@ -459,7 +465,7 @@ def _designate(
         class_name = supported_class
     size_attribute = attributes.get(Size.attribute)
     answers = None
-    if asked_class:
+    if asked_class and _local(asked_class) != ROOTS["class"]:  # asking for any object asks for no class
         values = _with_answering(belief.attributes.get(CLASS_ATTRIBUTE), answering)
         answers = answer_probability(values, asked_class, class_test) if values else 0.0
     return ObjectDesignator(

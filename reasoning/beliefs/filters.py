@@ -20,6 +20,7 @@ filters the attribute of the same name.
 from __future__ import annotations
 
 from collections.abc import Callable, Collection, Sequence
+from dataclasses import replace
 from typing import Protocol
 
 from queries import ANYWHERE, Block, ListValue, Number, Query, String, Symbol, Value
@@ -246,3 +247,12 @@ def _known_or_equal(relation: Callable[[str, str], bool]) -> Callable[[str, str]
             return a == b
 
     return class_test
+
+
+def searched_only(found: BeliefFilter, searched_region: str | None) -> BeliefFilter:
+    """``found`` for the answer of a plan that searched ``searched_region``: when the plan searched the whole view
+    (None: a table read as the support plane of an input without a camera pose), the answer is not narrowed to a
+    region either (its beliefs have no place in the semantic map to be found in)."""
+    if searched_region is not None or found.region is None:
+        return found
+    return replace(found, region=None, region_boxes=())

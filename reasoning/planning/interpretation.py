@@ -107,6 +107,10 @@ def interpret(
     if object_class is not None:
         constraints.append(Constraint("type", "Classification", object_class))
         requirements.append(Requirement("Classification", object_class, f"query asks type = {object_class}"))
+    elif query.kind == "detect" and all(f.key in _STRUCTURAL_KEYS for f in obj.fields) and obj.get("id") is None:
+        why = "the query names no class and no property, so it asks what the objects are: they are classified"
+        inferences.append(why)
+        requirements.append(Requirement("Classification", None, why))
     switch = text_switch(obj.get(TEXT_KEY))
     for field in obj.fields:
         if field.key in _STRUCTURAL_KEYS or (field.key == TEXT_KEY and switch is not None):
@@ -137,7 +141,7 @@ def interpret(
         requirements += _text_for_any_class(query.kind, kb, colour, text_told, inferences)
     location = obj.get("location")
     try:
-        region_box = _region(location, kb, camera_pose)
+        region_box = _region(location, kb, camera_pose, inferences)
     except PlanningError as error:
         raise _located(query, _place_field(obj), error) from None
     if _is_anywhere(location):
@@ -525,9 +529,21 @@ def _is_anywhere(value: Value | None) -> bool:
     return isinstance(value, Symbol | String) and _word(value, "location").strip().lower() == ANYWHERE
 
 
-def _region(value: Value | None, kb: KnowledgeBase, camera_pose: bool) -> RegionBox | None:
-    """The region box the query names (None for none or anywhere); PlanningError when it cannot be applied."""
+def _region(
+    value: Value | None, kb: KnowledgeBase, camera_pose: bool, inferences: list[str] | None = None
+) -> RegionBox | None:
+    """The region box the query names (None for none or anywhere); PlanningError when it cannot be applied.
+
+    Without a camera pose a region cannot be placed in the view; but what stands *on* a supporting surface (the
+    table, the counter, the floor) is what the segmentation finds on the support plane it fits, so with
+    ``inferences`` given such a place is read as that plane (None, and a note saying so)."""
     box = _named_region(value, kb)
+    if box is not None and not camera_pose and inferences is not None and _on_a_surface(value, box, kb):
+        inferences.append(
+            f"the input gives no camera pose to place {box.name!r} in the semantic map, so the surface the objects "
+            f"stand on (the support plane found in the view) is taken for it"
+        )
+        return None
     if box is not None and not camera_pose:
         raise PlanningError(
             f"region {box.name!r} cannot be searched: the input gives no camera pose, so its points cannot be placed "
@@ -535,6 +551,17 @@ def _region(value: Value | None, kb: KnowledgeBase, camera_pose: bool) -> Region
             f"view, or use an input with a camera pose (the built-in kitchen)"
         )
     return box
+
+
+def _on_a_surface(value: Value | None, box: RegionBox, kb: KnowledgeBase) -> bool:
+    """Whether the query asks for what stands on ``box`` (``location: { on: table }``) and it is a supporting
+    surface."""
+    if not isinstance(value, Block) or value.get("on") is None:
+        return False
+    try:
+        return kb.is_subclass(box.region_class, "SupportingRegion")
+    except LookupError:
+        return False
 
 
 def _named_region(value: Value | None, kb: KnowledgeBase) -> RegionBox | None:
@@ -549,13 +576,27 @@ def _named_region(value: Value | None, kb: KnowledgeBase) -> RegionBox | None:
     try:
         found = kb.resolve(word, ("region", "region_class"))
     except TermError as error:
-        raise PlanningError(str(error)) from None
+        raise PlanningError(_not_a_place(word, kb) or str(error)) from None
     if found.kind == "region":
         return kb.region(found.name)
     boxes = kb.regions_of_class(found.name)
     if not boxes:
         raise PlanningError(f"the semantic map has no region of class {found.name}")
     return boxes[0]
+
+
+def _not_a_place(word: str, kb: KnowledgeBase) -> str | None:
+    """Why an object class named as the place cannot be searched (``the can in the bowl``), None when ``word``
+    names no object class (then it is an unknown word)."""
+    try:
+        found = kb.resolve(word, ("class",))
+    except TermError:
+        return None
+    return (
+        f"{word!r} is an object, not a place ({kb.label(found.name)}): a query searches a region of the semantic map "
+        f"(the fridge, the table) and cannot place one object relative to another; leave the place out, ask for "
+        f"both objects and compare their positions"
+    )
 
 
 def _default_region(object_class: str, kb: KnowledgeBase, camera_pose: bool) -> tuple[RegionBox | None, str]:

@@ -52,7 +52,7 @@ from annotators.catalog import AnnotatorCatalog
 from annotators.readers.streams import PERCEPTION_PIPELINE, FrameStream, KitchenCameraStream, StreamReader
 from queries import CONTINUOUS_KINDS, LOST_AFTER_KEY, Number, Query, parse_query
 from reasoning.beliefs.answer import Answer, answer_from_memory
-from reasoning.beliefs.filters import belief_filter, kb_class_test
+from reasoning.beliefs.filters import belief_filter, kb_class_test, searched_only
 from reasoning.beliefs.store import BeliefStore
 from reasoning.fusion.tracking import BeliefTracker, TrackStep
 from reasoning.knowledge.knowledge_base import KnowledgeBase
@@ -446,7 +446,7 @@ class AnsweringService:
         step = AnswerStep(
             self.store,
             tracker=BeliefTracker(class_test=kb_class_test(self.kb), regions=self.kb.regions()),
-            filter_for=lambda q: belief_filter(q, self.kb),
+            filter_for=lambda q: searched_only(belief_filter(q, self.kb), query_plan.plan.task.region),
             label_of=self.kb.label,
             on_integrated=self._beliefs_changed,
             free_space=query_plan.plan.task.footprint is not None,

@@ -370,3 +370,24 @@ def test_the_summary_marks_a_doubtful_class_and_shows_both_confidences() -> None
 
     assert one(0.3).startswith("#7 cup? at") and ", class 0.30, exists 0.90" in one(0.3)
     assert one(0.8).startswith("#7 cup at") and ", class 0.80, exists 0.90" in one(0.8)
+
+
+def test_the_summary_shows_no_class_confidence_for_an_unknown_object() -> None:
+    """An object the classifier could give no class (it stays a PhysicalObject, "unknown object") was shown as
+    ``unknown object (white) ..., class 0.99``, which reads as 99 % sure of a class (real uoc and PCL frames)."""
+    stays_unknown = AttributeDesignator(value="PhysicalObject", confidence=0.99, experts=("KnowledgeClassifier",))
+    unknown = ObjectDesignator(
+        id=4,
+        class_iri=class_iri("PhysicalObject"),
+        class_label="unknown object",
+        pose=PoseDesignator(position=(0.1, 0.2, 0.3), orientation=(0.0, 0.0, 0.0, 1.0), frame="camera"),
+        size=None,
+        size_class=None,
+        region=None,
+        attributes={"class": stays_unknown},
+        experts=("KnowledgeClassifier",),
+        confidence=0.8,
+    )
+    line = Answer(query="find all objects", objects=(unknown,)).summary()
+    assert line.startswith("#4 unknown object at (0.100, 0.200, 0.300) [camera], exists 0.80")
+    assert "class" not in line.split(" by ")[0]

@@ -41,3 +41,21 @@ def test_an_unknown_word_is_reported_at_its_line_and_column(
     shown_line, caret = text.splitlines()[-2:]
     assert caret.strip() == "^"
     assert shown_line.strip() == query.splitlines()[line - 1].strip()
+
+
+@pytest.mark.parametrize(
+    ("query", "label", "column"),
+    [("find the can in the bowl", "bowl", 14), ("find the cup next to the cheez-it box", "Cheez-It crackers", 14)],
+)
+def test_an_object_named_as_a_place_is_told_apart_from_an_unknown_word(
+    query: str, label: str, column: int, kb: KnowledgeBase
+) -> None:
+    """``find the can in the bowl`` on uoc frame 2 (a can standing in the teal bowl) said "unknown region or region
+    class 'bowl'", as if the robot did not know bowls."""
+    with pytest.raises(PlanningError) as caught:
+        plan_query(parse_query(query), kb, sensor_source(kb, None))
+    text = str(caught.value)
+    assert "unknown region" not in text
+    assert f"is an object, not a place ({label})" in text
+    assert "leave the place out" in text
+    assert f"at line 1, column {column}" in text
