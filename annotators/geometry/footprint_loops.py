@@ -88,15 +88,75 @@ def convex_hull(points: np.ndarray) -> np.ndarray:
 
 
 @njit(cache=True, nogil=True)
-def _rank(count: int, share: float) -> int:
+def quantile_rank(count: int, share: float) -> int:
     """The index ``round(share * (count - 1))`` (half to even) of the ``share`` quantile of ``count`` sorted
     values."""
     return int(np.rint(share * (count - 1)))
 
 
 @njit(cache=True, nogil=True)
+def _select(values: np.ndarray, low: int, high: int, rank: int) -> None:
+    """Reorder ``values[low:high]`` (no NaN) so that ``values[rank]`` holds the value of that rank in sorted order,
+    with no greater value before it and no smaller one after it (Hoare's selection, median-of-three pivots)."""
+    high -= 1
+    while high > low:
+        middle = (low + high) // 2
+        if values[middle] < values[low]:
+            values[middle], values[low] = values[low], values[middle]
+        if values[high] < values[low]:
+            values[high], values[low] = values[low], values[high]
+        if values[high] < values[middle]:
+            values[high], values[middle] = values[middle], values[high]
+        pivot = values[middle]
+        i, j = low, high
+        while i <= j:
+            while values[i] < pivot:
+                i += 1
+            while values[j] > pivot:
+                j -= 1
+            if i <= j:
+                values[i], values[j] = values[j], values[i]
+                i += 1
+                j -= 1
+        if rank <= j:
+            high = j
+        elif rank >= i:
+            low = i
+        else:
+            return
+
+
+@njit(cache=True, nogil=True)
+def ranked_values(values: np.ndarray, ranks: np.ndarray) -> np.ndarray:
+    """float64: the values of 1-D ``values`` at the (ascending) ``ranks`` of their sorted order - what
+    ``np.sort(values)[ranks]`` gives, NaN sorted last - by selection (``values`` is reordered)."""
+    picked = np.empty(ranks.size)
+    for value in values:
+        if np.isnan(value):
+            ordered = np.sort(values)
+            for k in range(ranks.size):
+                picked[k] = ordered[ranks[k]]
+            return picked
+    high = values.size
+    for k in range(ranks.size - 1, -1, -1):
+        if k < ranks.size - 1 and ranks[k] == ranks[k + 1]:
+            picked[k] = picked[k + 1]
+            continue
+        _select(values, 0, high, ranks[k])
+        picked[k] = values[ranks[k]]
+        high = ranks[k]
+    return picked
+
+
+@njit(cache=True, nogil=True)
 def outside_extents(near: np.ndarray, heights: np.ndarray) -> np.ndarray:
     """See :func:`annotators.geometry.grid_kernels.outside_extents`."""
+    return rim_outside_extents(near, heights[quantile_rank(heights.size, 0.95)])
+
+
+@njit(cache=True, nogil=True)
+def rim_outside_extents(near: np.ndarray, rim: float) -> np.ndarray:
+    """:func:`outside_extents` of a part whose 95 % height (the rim) is known."""
     count = near.shape[0]
     result = np.full(8, np.nan)
     cx = 0.0
@@ -115,13 +175,11 @@ def outside_extents(near: np.ndarray, heights: np.ndarray) -> np.ndarray:
     for i in range(count):
         across[i] = -ay * near[i, 0] + ax * near[i, 1]
         along[i] = ax * near[i, 0] + ay * near[i, 1]
-    low, middle, high = _rank(count, 0.05), _rank(count, 0.5), _rank(count, 0.95)
-    across = np.partition(across, np.array([low, high]))
-    along = np.partition(along, np.array([low, middle]))
+    low, middle, high = quantile_rank(count, 0.05), quantile_rank(count, 0.5), quantile_rank(count, 0.95)
     result[0], result[1] = ax, ay
-    result[2], result[3] = across[low], across[high]
-    result[4] = heights[_rank(heights.size, 0.95)]
-    result[5], result[6] = along[low], along[middle]
+    result[2:4] = ranked_values(across, np.array([low, high]))
+    result[4] = rim
+    result[5:7] = ranked_values(along, np.array([low, middle]))
     result[7] = distance
     return result
 
@@ -195,7 +253,8 @@ def sight_extents(points: np.ndarray, ax: float, ay: float) -> np.ndarray:
     for i in range(count):
         across[i] = -ay * points[i, 0] + ax * points[i, 1]
         along[i] = ax * points[i, 0] + ay * points[i, 1]
-    low, middle, high = _rank(count, 0.05), _rank(count, 0.5), _rank(count, 0.95)
-    across = np.partition(across, np.array([low, high]))
-    along = np.partition(along, np.array([middle, high]))
-    return np.array([across[low], across[high], along[middle], along[high]])
+    low, middle, high = quantile_rank(count, 0.05), quantile_rank(count, 0.5), quantile_rank(count, 0.95)
+    extents = np.empty(4)
+    extents[:2] = ranked_values(across, np.array([low, high]))
+    extents[2:] = ranked_values(along, np.array([middle, high]))
+    return extents
