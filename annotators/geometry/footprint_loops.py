@@ -142,7 +142,14 @@ def ranked_values(values: np.ndarray, ranks: np.ndarray) -> np.ndarray:
         if k < ranks.size - 1 and ranks[k] == ranks[k + 1]:
             picked[k] = picked[k + 1]
             continue
-        _select(values, 0, high, ranks[k])
+        if ranks[k] == high - 1:  # the greatest of the values up to the rank picked last: moved to its rank
+            at = 0
+            for i in range(1, high):
+                if values[i] > values[at]:
+                    at = i
+            values[at], values[high - 1] = values[high - 1], values[at]
+        else:
+            _select(values, 0, high, ranks[k])
         picked[k] = values[ranks[k]]
         high = ranks[k]
     return picked

@@ -27,8 +27,9 @@ def test_ranked_values_are_those_of_the_sorted_values(seed: int) -> None:
     if seed % 3 == 2:
         values[rng.integers(0, size, 3)] = np.nan  # sorted last, as numpy does
     ranks = np.unique(np.rint(np.array([0.05, 0.5, 0.5, 0.95, 0.99]) * (size - 1)).astype(np.int64))
-    expected = np.sort(values)[ranks]
-    assert np.array_equal(ranked_values(values.copy(), ranks), expected.astype(np.float64), equal_nan=True)
+    for picks in (ranks, np.array([(size - 1) // 2, size // 2]), np.arange(max(0, size - 4), size)):
+        expected = np.sort(values)[picks]  # adjacent ranks too (a median of an even count, the top few)
+        assert np.array_equal(ranked_values(values.copy(), picks), expected.astype(np.float64), equal_nan=True)
 
 
 def test_sampled_pixels_are_every_kth_pixel_of_the_labels_asked() -> None:
