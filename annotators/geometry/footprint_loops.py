@@ -19,32 +19,40 @@ def _turn(ox: float, oy: float, ax: float, ay: float, bx: float, by: float) -> f
 def convex_hull(points: np.ndarray) -> np.ndarray:
     """Kx2 (``points``' dtype): the convex hull of Nx2 ``points``, counter-clockwise, without collinear vertices.
 
-    The points strictly inside the quadrilateral of the four extreme points (least and largest x and y) cannot be
-    vertices and are dropped first (Akl-Toussaint); the rest are sorted by x, then y, and the monotone chain
-    builds the lower and upper hulls."""
+    The points strictly inside the octagon of the eight extreme points (least and largest x, y, x + y and x - y)
+    cannot be vertices and are dropped first (Akl-Toussaint); the rest are sorted by x, then y, and the monotone
+    chain builds the lower and upper hulls."""
     count = points.shape[0]
     if count < 3:
         return points.copy()
     x = points[:, 0].astype(np.float64)
     y = points[:, 1].astype(np.float64)
-    west = east = south = north = 0
+    # counter-clockwise around the points: west, south-west, south, south-east, east, north-east, north, north-west
+    corners = np.zeros(8, dtype=np.int64)
     for i in range(1, count):
-        if x[i] < x[west]:
-            west = i
-        if x[i] > x[east]:
-            east = i
-        if y[i] < y[south]:
-            south = i
-        if y[i] > y[north]:
-            north = i
-    corners = (west, south, east, north)  # counter-clockwise around the points
+        if x[i] < x[corners[0]]:
+            corners[0] = i
+        if x[i] + y[i] < x[corners[1]] + y[corners[1]]:
+            corners[1] = i
+        if y[i] < y[corners[2]]:
+            corners[2] = i
+        if x[i] - y[i] > x[corners[3]] - y[corners[3]]:
+            corners[3] = i
+        if x[i] > x[corners[4]]:
+            corners[4] = i
+        if x[i] + y[i] > x[corners[5]] + y[corners[5]]:
+            corners[5] = i
+        if y[i] > y[corners[6]]:
+            corners[6] = i
+        if y[i] - x[i] > y[corners[7]] - x[corners[7]]:
+            corners[7] = i
     kept = np.empty(count, dtype=np.int64)
     size = 0
     for i in range(count):
         inside = True
-        for k in range(4):
-            a, b = corners[k], corners[(k + 1) % 4]
-            if _turn(x[a], y[a], x[b], y[b], x[i], y[i]) <= 0.0:
+        for k in range(8):
+            a, b = corners[k], corners[(k + 1) % 8]
+            if a != b and _turn(x[a], y[a], x[b], y[b], x[i], y[i]) <= 0.0:
                 inside = False
                 break
         if not inside:
