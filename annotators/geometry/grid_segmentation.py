@@ -434,7 +434,7 @@ class _PartEvidence:
         self,
         labels: np.ndarray,
         depth: np.ndarray,
-        plane_coordinates: Callable[[np.ndarray], np.ndarray],
+        plane_coordinates: Callable[[np.ndarray], np.ndarray] | np.ndarray,
         pairs: np.ndarray,
     ):
         self.pixels, self.starts = label_groups(labels)
@@ -442,9 +442,13 @@ class _PartEvidence:
         self.pairs = pairs
         sampled, self.offsets = sampled_pixels(self.pixels, self.starts, np.unique(pairs), 400)
         touching = np.flatnonzero(np.diff(self.offsets)).tolist()
-        self.points = np.concatenate(
-            [plane_coordinates(sampled[self.offsets[k] : self.offsets[k + 1]]) for k in touching], dtype=np.float32
-        )
+        if isinstance(plane_coordinates, np.ndarray):
+            self.points = np.asarray(plane_coordinates[sampled], dtype=np.float32)
+        else:
+            self.points = np.concatenate(
+                [plane_coordinates(sampled[self.offsets[k] : self.offsets[k + 1]]) for k in touching],
+                dtype=np.float32,
+            )
         self.heights = self.points[:, 2].copy()
         for k in touching:
             self.heights[self.offsets[k] : self.offsets[k + 1]].sort()
@@ -607,7 +611,7 @@ class MergeRules:
 def merge_parts(
     labels: np.ndarray,
     depth: np.ndarray,
-    plane_coordinates: Callable[[np.ndarray], np.ndarray],
+    plane_coordinates: Callable[[np.ndarray], np.ndarray] | np.ndarray,
     rules: MergeRules,
     surface: Boundaries | None = None,
     stand_apart: Callable[[np.ndarray, np.ndarray], bool] | None = None,
@@ -615,7 +619,8 @@ def merge_parts(
     """Join touching parts that are pieces of one object; labels renumbered 1..n (0 = none).
 
     ``plane_coordinates(pixels)`` gives Nx3 float32 ``(u, v, height)`` on the supporting plane for flat pixel
-    indices. Two touching parts are pieces of one object when
+    indices (or ``plane_coordinates`` is that table of every pixel, HWx3). Two touching parts are pieces of one
+    object when
 
     * their footprints (convex hulls on the plane) share more than ``rules.overlap`` of the smaller one: objects
       standing side by side have (nearly) disjoint footprints, while the pieces one object was cut into by a
