@@ -105,33 +105,30 @@ def quantile_rank(count: int, share: float) -> int:
 @njit(cache=True, nogil=True)
 def _select(values: np.ndarray, low: int, high: int, rank: int) -> None:
     """Reorder ``values[low:high]`` (no NaN) so that ``values[rank]`` holds the value of that rank in sorted order,
-    with no greater value before it and no smaller one after it (Hoare's selection, median-of-three pivots)."""
-    high -= 1
-    while high > low:
-        middle = (low + high) // 2
-        if values[middle] < values[low]:
-            values[middle], values[low] = values[low], values[middle]
-        if values[high] < values[low]:
-            values[high], values[low] = values[low], values[high]
-        if values[high] < values[middle]:
-            values[high], values[middle] = values[middle], values[high]
-        pivot = values[middle]
-        i, j = low, high
-        while i <= j:
-            while values[i] < pivot:
-                i += 1
-            while values[j] > pivot:
-                j -= 1
-            if i <= j:
-                values[i], values[j] = values[j], values[i]
-                i += 1
-                j -= 1
-        if rank <= j:
-            high = j
-        elif rank >= i:
-            low = i
-        else:
+    with no greater value before it and no smaller one after it. Each round moves the values below a pivot (the
+    median of three) to the front and then those equal to it after them, both by branch-free swaps (Lomuto's
+    scheme without a branch per value: the order of the values is not predictable, so branches would miss)."""
+    while high - low > 1:
+        first, middle, last = values[low], values[(low + high) // 2], values[high - 1]
+        pivot = max(min(first, middle), min(max(first, middle), last))
+        below = low
+        for i in range(low, high):
+            value = values[i]
+            values[i] = values[below]
+            values[below] = value
+            below += value < pivot
+        if rank < below:
+            high = below
+            continue
+        equal = below
+        for i in range(below, high):
+            value = values[i]
+            values[i] = values[equal]
+            values[equal] = value
+            equal += value <= pivot
+        if rank < equal:
             return
+        low = equal
 
 
 @njit(cache=True, nogil=True)
