@@ -17,6 +17,7 @@ from annotators.geometry.footprint_loops import (
     rim_outside_extents,
     sight_extents,
 )
+from annotators.geometry.grid_loops import sampled_median
 
 
 @njit(cache=True, nogil=True)
@@ -145,7 +146,8 @@ def pair_evidence(
         for label in pair:
             if not known[label, 2]:
                 known[label, 2] = True
-                depths[label] = _median_depth(depth, pixels[starts[label] : starts[label + 1]])
+                own = pixels[starts[label] : starts[label + 1]]
+                depths[label] = sampled_median(depth, own, max(1, own.size // 500))
         near, far = (second, first) if depths[second] < depths[first] else (first, second)
         if not known[near, 3]:
             known[near, 3] = True
@@ -187,21 +189,3 @@ def _could_hold(
     if far_low < low - margin or far_high > high + margin:
         return False
     return not (far_middle <= middle or far_back > front + depth_ratio * (high - low))
-
-
-@njit(cache=True, nogil=True)
-def _median_depth(depth: np.ndarray, own: np.ndarray) -> float:
-    """The median of every ``own.size // 500``-th depth of a part's pixels ``own`` (float64; NaN when one is NaN):
-    what :func:`annotators.geometry.grid_kernels.sampled_median` gives, picked by selection."""
-    step = max(1, own.size // 500)
-    count = (own.size + step - 1) // step
-    if count == 0:
-        return np.nan
-    picked = np.empty(count, dtype=np.float64)
-    for k in range(count):
-        value = depth[own[k * step]]
-        if np.isnan(value):
-            return np.nan
-        picked[k] = value
-    middle = ranked_values(picked, np.array([(count - 1) // 2, count // 2]))
-    return (middle[0] + middle[1]) / 2.0
