@@ -103,7 +103,7 @@ def quantile_rank(count: int, share: float) -> int:
 
 
 @njit(cache=True, nogil=True)
-def _select(values: np.ndarray, low: int, high: int, rank: int) -> None:
+def select_rank(values: np.ndarray, low: int, high: int, rank: int) -> None:
     """Reorder ``values[low:high]`` (no NaN) so that ``values[rank]`` holds the value of that rank in sorted order,
     with no greater value before it and no smaller one after it. Each round moves the values below a pivot (the
     median of three) to the front and then those equal to it after them, both by branch-free swaps (Lomuto's
@@ -154,7 +154,7 @@ def ranked_values(values: np.ndarray, ranks: np.ndarray) -> np.ndarray:
                     at = i
             values[at], values[high - 1] = values[high - 1], values[at]
         else:
-            _select(values, 0, high, ranks[k])
+            select_rank(values, 0, high, ranks[k])
         picked[k] = values[ranks[k]]
         high = ranks[k]
     return picked
