@@ -1,11 +1,12 @@
-"""The compiled merge evidence (annotators/geometry/merge_loops.py through grid_kernels) against the Python rules of
-grid_segmentation it stands for: the same quantiles, hulls and decisions on random parts."""
+"""The compiled merge evidence (annotators/geometry/merge_loops.py through grid_kernels) and the branch-free selection
+of footprint_loops against what they stand for: the same quantiles, hulls and decisions on random parts."""
 
 from __future__ import annotations
 
 import numpy as np
 import pytest
 
+from annotators.geometry.footprint_loops import ranked_values
 from annotators.geometry.grid_kernels import convex_hull, pair_evidence, part_hulls, sampled_pixels
 from annotators.geometry.grid_segmentation import (
     FLOOR_FLATNESS,
@@ -16,7 +17,6 @@ from annotators.geometry.grid_segmentation import (
     label_groups,
     looks_like_inside,
 )
-from annotators.geometry.merge_loops import ranked_values
 
 
 @pytest.mark.parametrize("seed", range(6))
