@@ -103,32 +103,51 @@ def quantile_rank(count: int, share: float) -> int:
 
 
 @njit(cache=True, nogil=True)
-def select_rank(values: np.ndarray, low: int, high: int, rank: int) -> None:
-    """Reorder ``values[low:high]`` (no NaN) so that ``values[rank]`` holds the value of that rank in sorted order,
-    with no greater value before it and no smaller one after it. Each round moves the values below a pivot (the
-    median of three) to the front and then those equal to it after them, both by branch-free swaps (Lomuto's
-    scheme without a branch per value: the order of the values is not predictable, so branches would miss)."""
-    while high - low > 1:
-        first, middle, last = values[low], values[(low + high) // 2], values[high - 1]
-        pivot = max(min(first, middle), min(max(first, middle), last))
-        below = low
-        for i in range(low, high):
+def select_rank(values: np.ndarray, first: int, end: int, rank: int) -> float:
+    """The value of rank ``rank`` among ``values[first:end]`` (no NaN), found by quickselect in place: afterwards
+    ``values[rank]`` holds it, with no greater value before it and no smaller one after it (within first:end).
+
+    Each partition is branch-free (every value is swapped, the boundary advances by the comparison), so its cost
+    does not depend on how well the processor guesses the comparisons. The pivot is the median of three values at
+    pseudo-random positions (a fixed sequence), since points in pixel order are far from random: their distances
+    to the centre fall and rise again, which defeats pivots taken at fixed positions."""
+    state = np.uint64(0x9E3779B97F4A7C15)
+    while end - first > 16:
+        span = end - first
+        state = state * np.uint64(6364136223846793005) + np.uint64(1442695040888963407)  # Knuth's LCG
+        a = values[first + int((state >> np.uint64(33)) % np.uint64(span))]
+        state = state * np.uint64(6364136223846793005) + np.uint64(1442695040888963407)
+        b = values[first + int((state >> np.uint64(33)) % np.uint64(span))]
+        state = state * np.uint64(6364136223846793005) + np.uint64(1442695040888963407)
+        c = values[first + int((state >> np.uint64(33)) % np.uint64(span))]
+        pivot = max(min(a, b), min(max(a, b), c))  # the median of three
+        store = first
+        for i in range(first, end):  # the values below the pivot to the front
             value = values[i]
-            values[i] = values[below]
-            values[below] = value
-            below += value < pivot
-        if rank < below:
-            high = below
-            continue
-        equal = below
-        for i in range(below, high):
-            value = values[i]
-            values[i] = values[equal]
-            values[equal] = value
-            equal += value <= pivot
-        if rank < equal:
-            return
-        low = equal
+            values[i] = values[store]
+            values[store] = value
+            store += value < pivot
+        if store == first:  # none below: the pivot is the least, split off the values equal to it
+            for i in range(first, end):
+                value = values[i]
+                values[i] = values[store]
+                values[store] = value
+                store += value <= pivot
+            if rank < store:
+                return pivot
+            first = store
+        elif rank < store:
+            end = store
+        else:
+            first = store
+    for i in range(first + 1, end):  # insertion sort of the few left
+        value = values[i]
+        j = i - 1
+        while j >= first and values[j] > value:
+            values[j + 1] = values[j]
+            j -= 1
+        values[j + 1] = value
+    return values[rank]
 
 
 @njit(cache=True, nogil=True)
