@@ -251,7 +251,7 @@ def segment_clutter(
     # (u, v, height) of every grid point on the plane
     plane_grid = plane_coordinates(grid.reshape(-1, 3), to_plane, offset)
     labels = merge_parts(
-        labels, depth, plane_grid.__getitem__, p.merge_rules(), stand_apart=one_stands_inside if p.join_rims else None
+        labels, depth, plane_grid, p.merge_rules(), stand_apart=one_stands_inside if p.join_rims else None
     )
     if colors is not None and p.use_color:
         colors_crop = strided_crop(colors, step, (x0, y0, x1, y1))

@@ -16,6 +16,8 @@ from numba import njit
 from numba.core import types
 from numba.extending import intrinsic
 
+from annotators.geometry.footprint_loops import select_rank
+
 _BLOCK = 128
 """NumPy's pairwise-summation block: shorter runs are added with eight interleaved accumulators."""
 
@@ -73,53 +75,6 @@ def reduced_sum(values: np.ndarray, start: int, count: int) -> float:
 
 
 @njit(cache=True, nogil=True)
-def _select(values: np.ndarray, first: int, end: int, rank: int) -> float:
-    """The value of rank ``rank`` among ``values[first:end]`` (no NaN), found by quickselect in place.
-
-    Each partition is branch-free (every value is swapped, the boundary advances by the comparison), so its cost
-    does not depend on how well the processor guesses the comparisons. The pivot is the median of three values at
-    pseudo-random positions (a fixed sequence), since points in pixel order are far from random: their distances
-    to the centre fall and rise again, which defeats pivots taken at fixed positions."""
-    state = np.uint64(0x9E3779B97F4A7C15)
-    while end - first > 16:
-        span = end - first
-        state = state * np.uint64(6364136223846793005) + np.uint64(1442695040888963407)  # Knuth's LCG
-        a = values[first + int((state >> np.uint64(33)) % np.uint64(span))]
-        state = state * np.uint64(6364136223846793005) + np.uint64(1442695040888963407)
-        b = values[first + int((state >> np.uint64(33)) % np.uint64(span))]
-        state = state * np.uint64(6364136223846793005) + np.uint64(1442695040888963407)
-        c = values[first + int((state >> np.uint64(33)) % np.uint64(span))]
-        pivot = max(min(a, b), min(max(a, b), c))  # the median of three
-        store = first
-        for i in range(first, end):  # the values below the pivot to the front
-            value = values[i]
-            values[i] = values[store]
-            values[store] = value
-            store += value < pivot
-        if store == first:  # none below: the pivot is the least, split off the values equal to it
-            for i in range(first, end):
-                value = values[i]
-                values[i] = values[store]
-                values[store] = value
-                store += value <= pivot
-            if rank < store:
-                return pivot
-            first = store
-        elif rank < store:
-            end = store
-        else:
-            first = store
-    for i in range(first + 1, end):  # insertion sort of the few left
-        value = values[i]
-        j = i - 1
-        while j >= first and values[j] > value:
-            values[j + 1] = values[j]
-            j -= 1
-        values[j + 1] = value
-    return values[rank]
-
-
-@njit(cache=True, nogil=True)
 def _least(values: np.ndarray, first: int, end: int) -> float:
     """The least of ``values[first:end]`` (not empty)."""
     least = values[first]
@@ -148,8 +103,8 @@ def _rank_pair(values: np.ndarray, rank: int, scratch: np.ndarray) -> tuple[floa
         for k in range(_SAMPLE):
             sample[k] = values[(k * count) // _SAMPLE]
         slot = (rank * _SAMPLE) // count
-        low = _select(sample, 0, _SAMPLE, slot - _MARGIN) if slot - _MARGIN >= 0 else -np.inf
-        high = _select(sample, 0, _SAMPLE, slot + _MARGIN + 1) if slot + _MARGIN + 1 < _SAMPLE else np.inf
+        low = select_rank(sample, 0, _SAMPLE, slot - _MARGIN) if slot - _MARGIN >= 0 else -np.inf
+        high = select_rank(sample, 0, _SAMPLE, slot + _MARGIN + 1) if slot + _MARGIN + 1 < _SAMPLE else np.inf
         below, inside = 0, 0
         for i in range(count):
             value = values[i]
@@ -157,10 +112,10 @@ def _rank_pair(values: np.ndarray, rank: int, scratch: np.ndarray) -> tuple[floa
             scratch[inside] = value
             inside += (value >= low) & (value <= high)
         if below <= rank and rank + 1 < below + inside:
-            first = _select(scratch, 0, inside, rank - below)
+            first = select_rank(scratch, 0, inside, rank - below)
             return first, _least(scratch, rank - below + 1, inside)
     scratch[:count] = values
-    first = _select(scratch, 0, count, rank)
+    first = select_rank(scratch, 0, count, rank)
     return first, _least(scratch, rank + 1, count)
 
 

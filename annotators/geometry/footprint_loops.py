@@ -19,32 +19,40 @@ def _turn(ox: float, oy: float, ax: float, ay: float, bx: float, by: float) -> f
 def convex_hull(points: np.ndarray) -> np.ndarray:
     """Kx2 (``points``' dtype): the convex hull of Nx2 ``points``, counter-clockwise, without collinear vertices.
 
-    The points strictly inside the quadrilateral of the four extreme points (least and largest x and y) cannot be
-    vertices and are dropped first (Akl-Toussaint); the rest are sorted by x, then y, and the monotone chain
-    builds the lower and upper hulls."""
+    The points strictly inside the octagon of the eight extreme points (least and largest x, y, x + y and x - y)
+    cannot be vertices and are dropped first (Akl-Toussaint); the rest are sorted by x, then y, and the monotone
+    chain builds the lower and upper hulls."""
     count = points.shape[0]
     if count < 3:
         return points.copy()
     x = points[:, 0].astype(np.float64)
     y = points[:, 1].astype(np.float64)
-    west = east = south = north = 0
+    # counter-clockwise around the points: west, south-west, south, south-east, east, north-east, north, north-west
+    corners = np.zeros(8, dtype=np.int64)
     for i in range(1, count):
-        if x[i] < x[west]:
-            west = i
-        if x[i] > x[east]:
-            east = i
-        if y[i] < y[south]:
-            south = i
-        if y[i] > y[north]:
-            north = i
-    corners = (west, south, east, north)  # counter-clockwise around the points
+        if x[i] < x[corners[0]]:
+            corners[0] = i
+        if x[i] + y[i] < x[corners[1]] + y[corners[1]]:
+            corners[1] = i
+        if y[i] < y[corners[2]]:
+            corners[2] = i
+        if x[i] - y[i] > x[corners[3]] - y[corners[3]]:
+            corners[3] = i
+        if x[i] > x[corners[4]]:
+            corners[4] = i
+        if x[i] + y[i] > x[corners[5]] + y[corners[5]]:
+            corners[5] = i
+        if y[i] > y[corners[6]]:
+            corners[6] = i
+        if y[i] - x[i] > y[corners[7]] - x[corners[7]]:
+            corners[7] = i
     kept = np.empty(count, dtype=np.int64)
     size = 0
     for i in range(count):
         inside = True
-        for k in range(4):
-            a, b = corners[k], corners[(k + 1) % 4]
-            if _turn(x[a], y[a], x[b], y[b], x[i], y[i]) <= 0.0:
+        for k in range(8):
+            a, b = corners[k], corners[(k + 1) % 8]
+            if a != b and _turn(x[a], y[a], x[b], y[b], x[i], y[i]) <= 0.0:
                 inside = False
                 break
         if not inside:
@@ -88,15 +96,98 @@ def convex_hull(points: np.ndarray) -> np.ndarray:
 
 
 @njit(cache=True, nogil=True)
-def _rank(count: int, share: float) -> int:
+def quantile_rank(count: int, share: float) -> int:
     """The index ``round(share * (count - 1))`` (half to even) of the ``share`` quantile of ``count`` sorted
     values."""
     return int(np.rint(share * (count - 1)))
 
 
 @njit(cache=True, nogil=True)
+def select_rank(values: np.ndarray, first: int, end: int, rank: int) -> float:
+    """The value of rank ``rank`` among ``values[first:end]`` (no NaN), found by quickselect in place: afterwards
+    ``values[rank]`` holds it, with no greater value before it and no smaller one after it (within first:end).
+
+    Each partition is branch-free (every value is swapped, the boundary advances by the comparison), so its cost
+    does not depend on how well the processor guesses the comparisons. The pivot is the median of three values at
+    pseudo-random positions (a fixed sequence), since points in pixel order are far from random: their distances
+    to the centre fall and rise again, which defeats pivots taken at fixed positions."""
+    state = np.uint64(0x9E3779B97F4A7C15)
+    while end - first > 16:
+        span = end - first
+        state = state * np.uint64(6364136223846793005) + np.uint64(1442695040888963407)  # Knuth's LCG
+        a = values[first + int((state >> np.uint64(33)) % np.uint64(span))]
+        state = state * np.uint64(6364136223846793005) + np.uint64(1442695040888963407)
+        b = values[first + int((state >> np.uint64(33)) % np.uint64(span))]
+        state = state * np.uint64(6364136223846793005) + np.uint64(1442695040888963407)
+        c = values[first + int((state >> np.uint64(33)) % np.uint64(span))]
+        pivot = max(min(a, b), min(max(a, b), c))  # the median of three
+        store = first
+        for i in range(first, end):  # the values below the pivot to the front
+            value = values[i]
+            values[i] = values[store]
+            values[store] = value
+            store += value < pivot
+        if store == first:  # none below: the pivot is the least, split off the values equal to it
+            for i in range(first, end):
+                value = values[i]
+                values[i] = values[store]
+                values[store] = value
+                store += value <= pivot
+            if rank < store:
+                return pivot
+            first = store
+        elif rank < store:
+            end = store
+        else:
+            first = store
+    for i in range(first + 1, end):  # insertion sort of the few left
+        value = values[i]
+        j = i - 1
+        while j >= first and values[j] > value:
+            values[j + 1] = values[j]
+            j -= 1
+        values[j + 1] = value
+    return values[rank]
+
+
+@njit(cache=True, nogil=True)
+def ranked_values(values: np.ndarray, ranks: np.ndarray) -> np.ndarray:
+    """float64: the values of 1-D ``values`` at the (ascending) ``ranks`` of their sorted order - what
+    ``np.sort(values)[ranks]`` gives, NaN sorted last - by selection (``values`` is reordered)."""
+    picked = np.empty(ranks.size)
+    for value in values:
+        if np.isnan(value):
+            ordered = np.sort(values)
+            for k in range(ranks.size):
+                picked[k] = ordered[ranks[k]]
+            return picked
+    high = values.size
+    for k in range(ranks.size - 1, -1, -1):
+        if k < ranks.size - 1 and ranks[k] == ranks[k + 1]:
+            picked[k] = picked[k + 1]
+            continue
+        if ranks[k] == high - 1:  # the greatest of the values up to the rank picked last: moved to its rank
+            at = 0
+            for i in range(1, high):
+                if values[i] > values[at]:
+                    at = i
+            values[at], values[high - 1] = values[high - 1], values[at]
+        else:
+            select_rank(values, 0, high, ranks[k])
+        picked[k] = values[ranks[k]]
+        high = ranks[k]
+    return picked
+
+
+@njit(cache=True, nogil=True)
 def outside_extents(near: np.ndarray, heights: np.ndarray) -> np.ndarray:
     """See :func:`annotators.geometry.grid_kernels.outside_extents`."""
+    return rim_outside_extents(near, heights[quantile_rank(heights.size, 0.95)])
+
+
+@njit(cache=True, nogil=True)
+def rim_outside_extents(near: np.ndarray, rim: float) -> np.ndarray:
+    """:func:`outside_extents` of a part whose 95 % height (the rim) is known."""
     count = near.shape[0]
     result = np.full(8, np.nan)
     cx = 0.0
@@ -115,13 +206,11 @@ def outside_extents(near: np.ndarray, heights: np.ndarray) -> np.ndarray:
     for i in range(count):
         across[i] = -ay * near[i, 0] + ax * near[i, 1]
         along[i] = ax * near[i, 0] + ay * near[i, 1]
-    low, middle, high = _rank(count, 0.05), _rank(count, 0.5), _rank(count, 0.95)
-    across = np.partition(across, np.array([low, high]))
-    along = np.partition(along, np.array([low, middle]))
+    low, middle, high = quantile_rank(count, 0.05), quantile_rank(count, 0.5), quantile_rank(count, 0.95)
     result[0], result[1] = ax, ay
-    result[2], result[3] = across[low], across[high]
-    result[4] = heights[_rank(heights.size, 0.95)]
-    result[5], result[6] = along[low], along[middle]
+    result[2:4] = ranked_values(across, np.array([low, high]))
+    result[4] = rim
+    result[5:7] = ranked_values(along, np.array([low, middle]))
     result[7] = distance
     return result
 
@@ -195,7 +284,8 @@ def sight_extents(points: np.ndarray, ax: float, ay: float) -> np.ndarray:
     for i in range(count):
         across[i] = -ay * points[i, 0] + ax * points[i, 1]
         along[i] = ax * points[i, 0] + ay * points[i, 1]
-    low, middle, high = _rank(count, 0.05), _rank(count, 0.5), _rank(count, 0.95)
-    across = np.partition(across, np.array([low, high]))
-    along = np.partition(along, np.array([middle, high]))
-    return np.array([across[low], across[high], along[middle], along[high]])
+    low, middle, high = quantile_rank(count, 0.05), quantile_rank(count, 0.5), quantile_rank(count, 0.95)
+    extents = np.empty(4)
+    extents[:2] = ranked_values(across, np.array([low, high]))
+    extents[2:] = ranked_values(along, np.array([middle, high]))
+    return extents

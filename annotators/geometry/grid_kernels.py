@@ -386,3 +386,75 @@ def sight_extents(points: np.ndarray, along: np.ndarray) -> np.ndarray:
     return _footprint_loops().sight_extents(
         np.ascontiguousarray(points, dtype=np.float32), float(along[0]), float(along[1])
     )
+
+
+@functools.cache
+def _merge_loops() -> ModuleType:
+    """:mod:`annotators.geometry.merge_loops`, imported (and numba with it) on first use."""
+    from annotators.geometry import merge_loops
+
+    return merge_loops
+
+
+def sampled_pixels(
+    pixels: np.ndarray, starts: np.ndarray, labels: np.ndarray, most: int
+) -> tuple[np.ndarray, np.ndarray]:
+    """About ``most`` evenly sampled pixels of each of the ``labels`` (label k owns ``pixels[starts[k]:starts[k +
+    1]]``): ``own[::max(1, own.size // most)]`` of each, concatenated, and ``offsets`` (one more than labels in
+    ``starts``) so label k's sample is ``sampled[offsets[k]:offsets[k + 1]]`` (empty for the labels not asked)."""
+    return _merge_loops().sampled_pixels(
+        np.ascontiguousarray(pixels), np.ascontiguousarray(starts, dtype=np.int64), np.asarray(labels, np.int64), most
+    )
+
+
+def part_hulls(coordinates: np.ndarray, offsets: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """The :func:`convex_hull` of the ``(u, v)`` of each part k's plane coordinates ``coordinates[offsets[k]:offsets[k
+    + 1]]`` (float32, Nx3), concatenated, and their offsets (the same form; empty for a part without coordinates)."""
+    return _merge_loops().part_hulls(
+        np.ascontiguousarray(coordinates, dtype=np.float32), np.ascontiguousarray(offsets, dtype=np.int64)
+    )
+
+
+def pair_evidence(
+    coordinates: np.ndarray,
+    heights: np.ndarray,
+    offsets: np.ndarray,
+    depth: np.ndarray,
+    pixels: np.ndarray,
+    starts: np.ndarray,
+    pairs: np.ndarray,
+    overlapping: np.ndarray,
+    unjoined: np.ndarray,
+    tolerances: tuple[float, float, float, float, float, float],
+    inside: bool,
+) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """What merging needs to know of touching pairs of parts (``pairs``, Px2), in one pass.
+
+    Part k has the (float32, Nx3 ``(u, v, height)``) plane ``coordinates[offsets[k]:offsets[k + 1]]`` of its sampled
+    pixels, their heights sorted in ``heights`` (the same offsets), and owns ``pixels[starts[k]:starts[k + 1]]``
+    (flat indices into the 1-D float ``depth``). ``tolerances`` are the nest tolerance, the inside tolerance, the
+    inside depth ratio, the rim band, the floor flatness and the inner spread of
+    :mod:`~annotators.geometry.grid_segmentation`. Returns, per pair:
+
+    * for the ``overlapping`` pairs, whether their heights nest (``heights_nest``), and when they do not, whether
+      the first (bit 1) or the second (bit 2) passes the height and flatness tests of a floor within the other
+      (``is_floor_within`` without its hull test);
+    * for the ``unjoined`` pairs (with ``inside``), whether the outside of the nearer (the median depth of every
+      ``size // 500``-th pixel) could hold the farther (``ContainerOutside.could_hold``).
+
+    Quantiles are sorted-order quantiles at index ``round(q (n - 1))``; each part's are computed once, when first
+    needed.
+    """
+    return _merge_loops().pair_evidence(
+        np.ascontiguousarray(coordinates, dtype=np.float32),
+        np.ascontiguousarray(heights, dtype=np.float32),
+        np.ascontiguousarray(offsets, dtype=np.int64),
+        np.ascontiguousarray(depth).reshape(-1),
+        np.ascontiguousarray(pixels),
+        np.ascontiguousarray(starts, dtype=np.int64),
+        np.ascontiguousarray(pairs, dtype=np.int64).reshape(-1, 2),
+        np.ascontiguousarray(overlapping, dtype=bool),
+        np.ascontiguousarray(unjoined, dtype=bool),
+        np.array(tolerances, dtype=np.float64),
+        inside,
+    )

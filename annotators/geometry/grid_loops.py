@@ -9,6 +9,8 @@ from llvmlite import ir
 from numba import njit, types
 from numba.extending import intrinsic
 
+from annotators.geometry.footprint_loops import ranked_values
+
 
 @njit(cache=True, nogil=True)
 def _looked_up(table: np.ndarray, keys: np.ndarray) -> np.ndarray:
@@ -977,6 +979,5 @@ def sampled_median(values: np.ndarray, indices: np.ndarray, step: int) -> float:
         if np.isnan(value):
             return np.nan
         picked[k] = value
-    low, high = (count - 1) // 2, count // 2
-    ordered = np.partition(picked, np.array([low, high]))
-    return (ordered[low] + ordered[high]) / 2.0
+    middle = ranked_values(picked, np.array([(count - 1) // 2, count // 2]))
+    return (middle[0] + middle[1]) / 2.0

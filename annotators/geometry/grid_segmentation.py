@@ -16,7 +16,6 @@ import numpy as np
 from annotators.geometry.grid_kernels import (
     boundary_pairs,
     connected_parts,
-    convex_hull,
     footprint_shares,
     groups_unless_apart,
     joined_labels,
@@ -24,7 +23,9 @@ from annotators.geometry.grid_kernels import (
     nearest_labels_within,
     nearest_seed_labels,
     outside_extents,
-    sampled_median,
+    pair_evidence,
+    part_hulls,
+    sampled_pixels,
     seam_pixels,
     sight_extents,
     surface_growth,
@@ -423,54 +424,79 @@ def _median(values: np.ndarray) -> np.floating:
     return (ordered[low] + ordered[high]) / values.dtype.type(2)
 
 
-class _Parts:
-    """Per-label data merge decisions need, computed once on demand: plane coordinates, hull, median depth."""
+class _PartEvidence:
+    """What :func:`merge_parts` asks of the touching parts (those of ``pairs``, Kx2): each part's plane coordinates
+    (of about 400 of its pixels, evenly sampled), their heights sorted and the footprint hull, computed at once
+    (:func:`~annotators.geometry.grid_kernels.part_hulls`); the nesting, floor and container tests of the pairs
+    (:meth:`evidence`)."""
 
-    def __init__(self, labels: np.ndarray, depth: np.ndarray, plane_coordinates: Callable[[np.ndarray], np.ndarray]):
+    def __init__(
+        self,
+        labels: np.ndarray,
+        depth: np.ndarray,
+        plane_coordinates: Callable[[np.ndarray], np.ndarray] | np.ndarray,
+        pairs: np.ndarray,
+    ):
         self.pixels, self.starts = label_groups(labels)
-        self.depth = depth.reshape(-1)
-        self.plane_coordinates = plane_coordinates
-        self._coordinates: dict[int, np.ndarray] = {}
-        self._hulls: dict[int, np.ndarray] = {}
-        self._sorted: dict[int, np.ndarray] = {}
-        self._depths: dict[int, float] = {}
-        self._outsides: dict[tuple[int, float], ContainerOutside | None] = {}
-
-    def own(self, label: int) -> np.ndarray:
-        return self.pixels[self.starts[label] : self.starts[label + 1]]
+        self.depth = depth
+        self.pairs = pairs
+        sampled, self.offsets = sampled_pixels(self.pixels, self.starts, np.unique(pairs), 400)
+        touching = np.flatnonzero(np.diff(self.offsets)).tolist()
+        if isinstance(plane_coordinates, np.ndarray):
+            self.points = np.asarray(plane_coordinates[sampled], dtype=np.float32)
+        else:
+            self.points = np.concatenate(
+                [plane_coordinates(sampled[self.offsets[k] : self.offsets[k + 1]]) for k in touching],
+                dtype=np.float32,
+            )
+        self.heights = self.points[:, 2].copy()
+        for k in touching:
+            self.heights[self.offsets[k] : self.offsets[k + 1]].sort()
+        self.hulls, self.hull_offsets = part_hulls(self.points, self.offsets)
 
     def coordinates(self, label: int) -> np.ndarray:
         """Plane coordinates of about 400 of the part's pixels, evenly sampled."""
-        if label not in self._coordinates:
-            own = self.own(label)
-            self._coordinates[label] = self.plane_coordinates(own[:: max(1, own.size // 400)])
-        return self._coordinates[label]
-
-    def sorted_coordinates(self, label: int) -> np.ndarray:
-        """:meth:`coordinates` with each column sorted (for quantiles)."""
-        if label not in self._sorted:
-            self._sorted[label] = np.sort(self.coordinates(label), axis=0)
-        return self._sorted[label]
+        return self.points[self.offsets[label] : self.offsets[label + 1]]
 
     def hull(self, label: int) -> np.ndarray:
         """The convex hull of the part's footprint (Kx2)."""
-        if label not in self._hulls:
-            self._hulls[label] = convex_hull(self.coordinates(label)[:, :2])
-        return self._hulls[label]
+        return self.hulls[self.hull_offsets[label] : self.hull_offsets[label + 1]]
 
-    def outside(self, label: int, tolerance: float) -> ContainerOutside | None:
-        """The part as the outside of a possible container (:func:`container_outside`)."""
-        if (label, tolerance) not in self._outsides:
-            heights = self.sorted_coordinates(label)[:, 2]
-            self._outsides[label, tolerance] = container_outside(self.coordinates(label), tolerance, heights)
-        return self._outsides[label, tolerance]
+    def evidence(
+        self, overlapping: np.ndarray, unjoined: np.ndarray, rules: MergeRules
+    ) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+        """Per pair: whether the heights of the ``overlapping`` ones nest; if not, which of them may be a floor
+        within the other (bits 1, 2: the first, the second; :meth:`floor_within` asks the hulls); whether the nearer
+        of the ``unjoined`` ones could hold the farther (:func:`~annotators.geometry.grid_kernels.pair_evidence`)."""
+        tolerances = (
+            rules.nest_tolerance,
+            rules.inside_tolerance,
+            rules.inside_depth_ratio,
+            RIM_BAND,
+            FLOOR_FLATNESS,
+            INNER_SPREAD,
+        )
+        return pair_evidence(
+            self.points,
+            self.heights,
+            self.offsets,
+            self.depth,
+            self.pixels,
+            self.starts,
+            self.pairs,
+            overlapping,
+            unjoined,
+            tolerances,
+            rules.inside,
+        )
 
-    def depth_of(self, label: int) -> float:
-        """The median depth of the part."""
-        if label not in self._depths:
-            own = self.own(label)
-            self._depths[label] = sampled_median(self.depth, own, max(1, own.size // 500))
-        return self._depths[label]
+    def floor_within(self, first: int, second: int, floors: int, cell: float) -> bool:
+        """:func:`is_floor_within` of two parts, whose height and flatness tests ``floors`` holds (bit 1: the first
+        as the floor, bit 2: the second)."""
+        for bit, floor, walls in ((1, first, second), (2, second, first)):
+            if floors & bit and inside_share(self.hull(floor), self.hull(walls), cell) >= FLOOR_INSIDE:
+                return True
+        return False
 
 
 @dataclass(frozen=True)
@@ -585,7 +611,7 @@ class MergeRules:
 def merge_parts(
     labels: np.ndarray,
     depth: np.ndarray,
-    plane_coordinates: Callable[[np.ndarray], np.ndarray],
+    plane_coordinates: Callable[[np.ndarray], np.ndarray] | np.ndarray,
     rules: MergeRules,
     surface: Boundaries | None = None,
     stand_apart: Callable[[np.ndarray, np.ndarray], bool] | None = None,
@@ -593,7 +619,8 @@ def merge_parts(
     """Join touching parts that are pieces of one object; labels renumbered 1..n (0 = none).
 
     ``plane_coordinates(pixels)`` gives Nx3 float32 ``(u, v, height)`` on the supporting plane for flat pixel
-    indices. Two touching parts are pieces of one object when
+    indices (or ``plane_coordinates`` is that table of every pixel, HWx3). Two touching parts are pieces of one
+    object when
 
     * their footprints (convex hulls on the plane) share more than ``rules.overlap`` of the smaller one: objects
       standing side by side have (nearly) disjoint footprints, while the pieces one object was cut into by a
@@ -618,7 +645,7 @@ def merge_parts(
     pairs = touching_pairs(labels)
     if pairs.shape[0] == 0:
         return labels
-    parts = _Parts(labels, depth, plane_coordinates)
+    parts = _PartEvidence(labels, depth, plane_coordinates, pairs)
     sizes = np.diff(parts.starts)
     lengths: dict[tuple[int, int], float] = {}
     smooth: set[tuple[int, int]] = set()
@@ -659,27 +686,28 @@ def merge_parts(
     overlapping = {
         pair for pair, share in zip(footprint_pairs, overlaps.tolist(), strict=True) if share > rules.overlap
     }
+    listed = pairs.tolist()
+    nests, floor_tests, holding = parts.evidence(
+        np.array([tuple(pair) in overlapping for pair in listed], dtype=bool),
+        np.array([tuple(pair) not in smooth for pair in listed], dtype=bool),
+        rules,
+    )
     allowed: list[tuple[int, int]] = []
-    for first, second in pairs.tolist():
+    for (first, second), nest, floors, holds in zip(
+        listed, nests.tolist(), floor_tests.tolist(), holding.tolist(), strict=True
+    ):
         if (first, second) in smooth:
             allowed.append((first, second))
             continue
         stacked = False
         if (first, second) in overlapping:
-            ordered = (parts.sorted_coordinates(first), parts.sorted_coordinates(second))
-            if (
-                not rules.nested
-                or _sorted_heights_nest(ordered[0][:, 2], ordered[1][:, 2], rules.nest_tolerance)
-                or _sorted_floor_within(*ordered, parts.hull(first), parts.hull(second), rules)
-            ) and (stand_apart is None or not stand_apart(parts.coordinates(first), parts.coordinates(second))):
+            if (not rules.nested or nest or parts.floor_within(first, second, floors, rules.cell)) and (
+                stand_apart is None or not stand_apart(parts.coordinates(first), parts.coordinates(second))
+            ):
                 allowed.append((first, second))
                 continue
             stacked = True
-        near, far = sorted((first, second), key=parts.depth_of)
-        outside = parts.outside(near, rules.inside_tolerance) if rules.inside else None
-        if outside is not None and outside.could_hold(
-            parts.coordinates(far), rules.inside_depth_ratio, parts.sorted_coordinates(far)[:, 2]
-        ):
+        if holds:
             allowed.append((first, second))
         elif stacked:
             creases.append((first, second))  # one stands on the other: never joined, not even through a third

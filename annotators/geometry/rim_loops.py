@@ -9,6 +9,8 @@ import math
 import numpy as np
 from numba import njit
 
+from annotators.geometry.footprint_loops import ranked_values
+
 
 @njit(cache=True, nogil=True)
 def share_value(values: np.ndarray, share: float) -> float:
@@ -16,7 +18,7 @@ def share_value(values: np.ndarray, share: float) -> float:
     if values.size == 0:
         return np.nan
     rank = round(share * (values.size - 1))
-    return float(np.partition(values, rank)[rank])
+    return float(ranked_values(values.copy(), np.array([rank]))[0])
 
 
 @njit(cache=True, nogil=True)

@@ -7,31 +7,7 @@ from __future__ import annotations
 import numpy as np
 from numba import njit
 
-
-@njit(cache=True, nogil=True)
-def _select(values: np.ndarray, first: int, last: int, rank: int) -> None:
-    """Reorder ``values[first:last]`` (no NaN) in place so that ``values[rank]`` is the value of that rank in sorted
-    order, none larger before it and none smaller after it (quickselect, median-of-three pivots)."""
-    low, high = first, last - 1
-    while low < high:
-        a, b, c = values[low], values[(low + high) // 2], values[high]
-        pivot = max(min(a, b), min(max(a, b), c))
-        i, j = low, high
-        while i <= j:
-            while values[i] < pivot:
-                i += 1
-            while values[j] > pivot:
-                j -= 1
-            if i <= j:
-                values[i], values[j] = values[j], values[i]
-                i += 1
-                j -= 1
-        if rank <= j:
-            high = j
-        elif rank >= i:
-            low = i
-        else:
-            return
+from annotators.geometry.footprint_loops import select_rank
 
 
 @njit(cache=True, nogil=True)
@@ -119,7 +95,7 @@ def piece_summary(
             lowest = starts[label]
             for q in range(3):  # ranks increase: each lies among the values at or above the one before
                 rank = starts[label] + int(np.rint(shares[q] * (size - 1)))
-                _select(heights, lowest, starts[label + 1], rank)
+                select_rank(heights, lowest, starts[label + 1], rank)
                 quantiles[q, label] = heights[rank]
                 lowest = rank
     return sizes, quantiles[0], quantiles[1], quantiles[2], feet, starts, boxes, pairs, border

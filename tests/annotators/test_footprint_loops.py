@@ -106,3 +106,34 @@ def test_sight_extents_are_the_quantiles_of_the_projections() -> None:
     # index round(q * 299): 14.95 -> 15, 284.05 -> 284, 149.5 -> 150 (half to even)
     expected = [on_across[15], on_across[284], on_along[150], on_along[284]]
     assert sight_extents(points, along) == pytest.approx(expected, rel=1e-9, abs=1e-12)
+
+
+def _monotone_chain(points: np.ndarray) -> list[list[float]]:
+    """The hull of all points by Andrew's monotone chain (no points dropped first), counter-clockwise from the least
+    (x, y), without collinear vertices: the reference for the compiled hull's filter."""
+    ordered = sorted(map(tuple, points.astype(np.float64).tolist()))
+
+    def turn(o: tuple, a: tuple, b: tuple) -> float:
+        return (a[0] - o[0]) * (b[1] - o[1]) - (a[1] - o[1]) * (b[0] - o[0])
+
+    chain: list[tuple] = []
+    for sweep in (ordered, ordered[::-1]):
+        start = len(chain)
+        for point in sweep:
+            while len(chain) >= start + 2 and turn(chain[-2], chain[-1], point) <= 0.0:
+                chain.pop()
+            chain.append(point)
+        chain.pop()
+    return [list(point) for point in chain]
+
+
+@pytest.mark.parametrize("seed", range(6))
+def test_convex_hull_drops_no_vertex_with_its_octagon_filter(seed: int) -> None:
+    rng = np.random.default_rng(seed)
+    for _ in range(40):
+        count = int(rng.integers(3, 500))
+        points = rng.normal(size=(count, 2)) * rng.uniform(0.005, 0.1, 2) + rng.uniform(-0.5, 0.5, 2)
+        if seed % 2:
+            points = np.round(points, 2)  # a lattice: repeated points, collinear edges, ties in x and y
+        points = points.astype(np.float32)
+        assert convex_hull(points).astype(np.float64).tolist() == _monotone_chain(points)
