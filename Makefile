@@ -3,6 +3,7 @@ PYTHON ?= python3
 VENV := .venv
 PY := $(VENV)/bin/python
 STAMP := $(VENV)/.installed
+KERNELS_CHECKED := $(VENV)/.kernels-checked
 
 .PHONY: demo test setup system-deps bench bench-all lint
 
@@ -16,7 +17,14 @@ test: setup
 lint: setup
 	$(VENV)/bin/ruff check .
 
-setup: system-deps $(STAMP)
+setup: system-deps $(STAMP) $(KERNELS_CHECKED)
+
+# numba checks a cached compiled kernel against its own module's file only: a kernel that calls a kernel of another
+# module keeps the old compiled code after that module changes. So when any annotator source is newer than the last
+# check, every cached kernel is dropped (they compile again on first use).
+$(KERNELS_CHECKED): $(wildcard annotators/*/*.py)
+	@find annotators -path '*/__pycache__/*' \( -name '*.nbi' -o -name '*.nbc' \) -delete
+	@mkdir -p $(VENV) && touch $@
 
 # open3d needs libusb-1.0; graphviz renders trees as SVG; HermiT (ontology reasoning) needs Java; the live view's
 # browser test drives Debian's headless Chromium. Each is installed only when missing.
