@@ -11,6 +11,10 @@ each ``Topic`` object its own): subscribing again with the same topic and id cha
 id ends that subscription and without one every subscription to the topic. A client receives each publication once
 however many subscriptions to its topic it has. It may hold :data:`MAX_SUBSCRIPTIONS` at a time; one more gets a
 ``status`` error naming the cap (the connection keeps working) until an unsubscribe frees a place.
+
+Cancelling a goal that already ended (its result and the cancel crossed on the wire) is no error: the result was
+sent, and nothing else is. A cancel of a goal id the client never sent (among its last :data:`REMEMBERED_GOALS`) gets
+a ``status`` error naming it.
 """
 
 from __future__ import annotations
@@ -18,6 +22,7 @@ from __future__ import annotations
 import asyncio
 import hmac
 import json
+from collections import OrderedDict
 from collections.abc import Mapping
 from concurrent.futures import Future
 from typing import Any
@@ -47,6 +52,9 @@ MAX_OPEN_GOALS = 64
 
 MAX_SUBSCRIPTIONS = 32
 """Subscriptions (topic and subscription id) one client may hold at a time."""
+
+REMEMBERED_GOALS = 1024
+"""How many of a client's latest goal ids a session remembers, to tell a cancel that came late from a wrong one."""
 
 TOPICS = (TREE_STATUS_TOPIC, BELIEFS_TOPIC, IMAGE_TOPIC, DEPTH_TOPIC)
 
@@ -92,6 +100,8 @@ class Session:
         """Replaced, never changed in place: the engine thread reads it to decide what to publish."""
         """(topic, subscription id) of each subscription; the id is None when the client gave none."""
         self._loop = asyncio.get_running_loop()
+        self._sent_goals: OrderedDict[str, None] = OrderedDict()
+        """The ids of this client's latest goals (at most :data:`REMEMBERED_GOALS`), oldest first."""
         self._outbox: asyncio.Queue[dict[str, Any] | None] = asyncio.Queue()
         self._calls: set[asyncio.Task[None]] = set()
 
@@ -167,6 +177,7 @@ class Session:
 
     def _send_goal(self, message: dict[str, Any]) -> None:
         goal_id = message["id"]
+        self._remember(goal_id)  # every goal sent gets a result, refused and aborted ones included
         if message["action"] != QUERY_ACTION:
             self.send(action_result(goal_id, 0, {"error": f"no action {message['action']!r}"}, result=False))
             raise ProtocolError(f"unknown action {message['action']!r}; this server has {QUERY_ACTION!r}", goal_id)
@@ -184,9 +195,16 @@ class Session:
             raise ProtocolError(error, goal_id)
         self.goals.submit(Goal(goal_id, query, self, self.send))
 
+    def _remember(self, goal_id: str) -> None:
+        self._sent_goals[goal_id] = None
+        self._sent_goals.move_to_end(goal_id)
+        while len(self._sent_goals) > REMEMBERED_GOALS:
+            self._sent_goals.popitem(last=False)
+
     def _cancel_goal(self, message: dict[str, Any]) -> None:
-        if not self.goals.cancel(message["id"], self):
-            raise ProtocolError(f"no open goal {message['id']!r} of this client", message["id"])
+        goal_id = message["id"]
+        if not self.goals.cancel(goal_id, self) and goal_id not in self._sent_goals:
+            raise ProtocolError(f"no goal {goal_id!r} of this client to cancel", goal_id)
 
     def _call_service(self, message: dict[str, Any]) -> None:
         name = message["service"]
