@@ -4,7 +4,8 @@ Replies go through an outbox drained by one writer task, so the worker thread ha
 ``loop.call_soon_threadsafe`` and never touches the socket. A message that fails validation gets a ``status``
 error and the connection keeps working; a client that must authenticate (the server has a token) and sends any
 other op first, or a wrong token, gets a ``status`` error and is disconnected. When the connection closes, the
-client's open goals are cancelled.
+client's open goals are cancelled. A call of a service the server lacks, or with arguments it refuses, is answered
+as rosbridge does, with a failed ``service_response`` holding the reason (a client waits for that response).
 
 A client's subscriptions are told apart, as in rosbridge, by topic and the ``subscribe`` op's ``id`` (roslibpy gives
 each ``Topic`` object its own): subscribing again with the same topic and id changes nothing, ``unsubscribe`` with an
@@ -207,16 +208,18 @@ class Session:
             raise ProtocolError(f"no goal {goal_id!r} of this client to cancel", goal_id)
 
     def _call_service(self, message: dict[str, Any]) -> None:
-        name = message["service"]
+        name, request_id = message["service"], message.get("id")
         handler = self.services.get(name)
-        if handler is None:
-            raise ProtocolError(f"unknown service {name!r}; this server has {', '.join(self.services)}")
         arguments = message.get("args", {})
-        problem = handler.problem(name, arguments)
-        if problem is not None:
-            raise ProtocolError(problem)
+        if handler is None:
+            problem = f"unknown service {name!r}; this server has {', '.join(self.services)}"
+        else:
+            problem = handler.problem(name, arguments)
+        if handler is None or problem is not None:  # the call is answered, as rosbridge does: a failed response
+            self.send(service_response(name, request_id, {"error": problem}, result=False))
+            return
         future = self.goals.call(lambda service: handler.handler(service, arguments))
-        call = asyncio.create_task(self._respond(name, message.get("id"), future))
+        call = asyncio.create_task(self._respond(name, request_id, future))
         self._calls.add(call)  # the loop keeps only weak references to tasks
         call.add_done_callback(self._calls.discard)
 
