@@ -5,7 +5,8 @@ Replies go through an outbox drained by one writer task, so the worker thread ha
 error and the connection keeps working; a client that must authenticate (the server has a token) and sends any
 other op first, or a wrong token, gets a ``status`` error and is disconnected. When the connection closes, the
 client's open goals are cancelled. A call of a service the server lacks, or with arguments it refuses, is answered
-as rosbridge does, with a failed ``service_response`` holding the reason (a client waits for that response).
+as rosbridge does, with a failed ``service_response`` holding the reason (a client waits for that response); a
+refused goal (no such action, no query, too many open goals) gets its failed ``action_result`` and nothing else.
 
 A client's subscriptions are told apart, as in rosbridge, by topic and the ``subscribe`` op's ``id`` (roslibpy gives
 each ``Topic`` object its own): subscribing again with the same topic and id changes nothing, ``unsubscribe`` with an
@@ -180,20 +181,21 @@ class Session:
         goal_id = message["id"]
         self._remember(goal_id)  # every goal sent gets a result, refused and aborted ones included
         if message["action"] != QUERY_ACTION:
-            self.send(action_result(goal_id, 0, {"error": f"no action {message['action']!r}"}, result=False))
-            raise ProtocolError(f"unknown action {message['action']!r}; this server has {QUERY_ACTION!r}", goal_id)
+            error = f"no action {message['action']!r}; this server has {QUERY_ACTION!r}"
+            self.send(action_result(goal_id, 0, {"error": error}, result=False))
+            return
         try:
             query = goal_query(message["args"])
         except MissingQueryError as error:
             self.send(action_result(goal_id, 0, {"error": str(error)}, result=False))
-            raise ProtocolError(str(error), goal_id) from None
+            return
         except GoalError as error:  # a designator that makes no query: the goal is aborted with the reason
             self.send(action_result(goal_id, GoalStatus.ABORTED, {"reason": str(error)}))
             return
         if self.goals.open_goals(self) >= MAX_OPEN_GOALS:
             error = f"too many open goals (at most {MAX_OPEN_GOALS} per client)"
             self.send(action_result(goal_id, 0, {"error": error}, result=False))
-            raise ProtocolError(error, goal_id)
+            return
         self.goals.submit(Goal(goal_id, query, self, self.send))
 
     def _remember(self, goal_id: str) -> None:

@@ -9,25 +9,13 @@ import json
 from websockets.sync.client import connect
 
 from tests.application.server.conftest import Served
-from tests.application.server.test_protocol import WAIT, beliefs_call, goal, receive
+from tests.application.server.test_protocol import beliefs_call, goal, receive, replies_until_the_service_response
 
 ACTION = "/robokudo/query"
 
 
 def cancel(goal_id: str) -> str:
     return json.dumps({"op": "cancel_action_goal", "id": goal_id, "action": ACTION})
-
-
-def replies_until_the_service_response(connection: object, call_id: str) -> list[dict[str, object]]:
-    """The messages up to the response to ``call_id`` (feedback and publications left out)."""
-    replies = []
-    while True:
-        message = json.loads(connection.recv(timeout=WAIT))  # type: ignore[attr-defined]
-        if message["op"] in ("action_feedback", "publish"):
-            continue
-        replies.append(message)
-        if message["op"] == "service_response" and message.get("id") == call_id:
-            return replies
 
 
 def test_cancelling_a_goal_that_just_ended_is_no_error(kitchen_server: Served) -> None:
