@@ -177,6 +177,8 @@ class TaskHandle:
         """When a continuous task's target counts as lost (None for a one-shot task)."""
         self.runs = 0
         """Finished runs of a continuous task's loop seen so far."""
+        self.last_failure = ""
+        """Why the last run of a continuous task that analysed a frame failed ("" when none failed)."""
         self._deadline = None if timeout is None else started + timeout
         self._service = service
         self._answers: queue.SimpleQueue[Answer | None] = queue.SimpleQueue()
@@ -695,12 +697,16 @@ class AnsweringService:
             if answer is not None:
                 handle._publish(answer)
             info = pipeline.cas.view(CameraInfo)
-            stamp = info.timestamp if info is not None and info.timestamp > 0 else time.monotonic()
+            if info is None:  # the run read no frame (perception between two frames): it saw nothing, nor missed
+                return
+            stamp = info.timestamp if info.timestamp > 0 else time.monotonic()
             seen = answer is not None and (answer.track.seen if answer.track is not None else bool(answer.objects))
+            if not seen and pipeline.status is Status.FAILURE:
+                handle.last_failure = failure_reason(pipeline)
             lost = handle.watch.observe(stamp, seen) if handle.watch is not None else None
             if lost is not None:
-                if loop.last_failure and not seen:
-                    lost += f"; the last run failed: {loop.last_failure}"
+                if handle.last_failure and not seen:
+                    lost += f"; the last run failed: {handle.last_failure}"
                 self._finish(handle, lost)
                 return
         if loop.status is Status.FAILURE:

@@ -2,7 +2,9 @@
 
 The watch is told, after every run of the task's loop, the time of the frame the run analysed and whether the run
 saw the target. Until the first sighting the time counts from the first run's frame. Frame times are the frames'
-timestamps, so the time an expert needs to analyse a frame does not make a target lost that was in view.
+timestamps, so the time an expert needs to analyse a frame does not make a target lost that was in view. A frame
+stamped earlier than the one before (a looped recording starting again) counts as one frame period (the last gap
+between two frames) after it, so the watch's time goes on across loops.
 """
 
 from __future__ import annotations
@@ -19,6 +21,12 @@ class TargetWatch:
     target: str = "the target"
     first: float | None = field(default=None, init=False)
     last_seen: float | None = field(default=None, init=False)
+    _previous: float | None = field(default=None, init=False)
+    """The stamp of the last frame observed, as the source gave it."""
+    _now: float = field(default=0.0, init=False)
+    """The watch's time of the last frame observed (frame stamps, continued across loops)."""
+    _period: float = field(default=0.0, init=False)
+    """The last positive gap between two frames' stamps."""
 
     def __post_init__(self) -> None:
         if isinstance(self.lost_after, bool) or not isinstance(self.lost_after, int | float):
@@ -33,6 +41,7 @@ class TargetWatch:
 
     def observe(self, stamp: float, seen: bool) -> str | None:
         """Record a run; the reason the task ends when the target is now lost, else None."""
+        stamp = self._continued(stamp)
         if self.first is None:
             self.first = stamp
         if seen:
@@ -42,3 +51,16 @@ class TargetWatch:
         if unseen > self.lost_after:
             return f"target lost: {self.target} not seen for {unseen:.2f} s (lost after {self.lost_after:g} s)"
         return None
+
+    def _continued(self, stamp: float) -> float:
+        """``stamp`` on the watch's time: the source's stamps, shifted so that a backward jump (a loop) goes on."""
+        if self._previous is None:
+            self._now = stamp
+        elif stamp >= self._previous:
+            gap = stamp - self._previous
+            self._period = gap if gap > 0 else self._period
+            self._now += gap
+        else:
+            self._now += self._period
+        self._previous = stamp
+        return self._now

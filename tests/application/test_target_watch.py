@@ -35,3 +35,22 @@ def test_lost_exactly_when_the_time_since_the_last_sighting_exceeds_lost_after(
 def test_a_bad_lost_after_is_refused(bad: float) -> None:
     with pytest.raises(ValueError, match="lost_after"):
         TargetWatch(bad)
+
+
+def test_time_goes_on_when_a_looped_recording_starts_its_stamps_again() -> None:
+    watch = TargetWatch(1.0, "the human")
+    loop = [1000.0, 1000.25, 1000.5]
+    reasons = [watch.observe(stamp, False) for stamp in loop * 3]
+    # watch time: 0, .25, .5, then .75, 1.0, 1.25 (each restart one frame period on): lost at the sixth frame
+    assert reasons[:5] == [None] * 5
+    assert reasons[5] == "target lost: the human not seen for 1.25 s (lost after 1 s)"
+
+
+def test_a_sighting_after_a_loop_restart_resets_the_unseen_time() -> None:
+    watch = TargetWatch(0.6, "the cup")
+    assert watch.observe(10.0, True) is None
+    assert watch.observe(10.25, False) is None
+    assert watch.observe(10.0, True) is None  # the loop restarted: watch time 0.5, seen
+    assert watch.observe(10.25, False) is None  # 0.25 unseen
+    assert watch.observe(10.5, False) is None  # 0.5 unseen
+    assert watch.observe(10.0, False) is not None  # 0.75 unseen

@@ -4,13 +4,19 @@ Replies go through an outbox drained by one writer task, so the worker thread ha
 ``loop.call_soon_threadsafe`` and never touches the socket. A message that fails validation gets a ``status``
 error and the connection keeps working; a client that must authenticate (the server has a token) and sends any
 other op first, or a wrong token, gets a ``status`` error and is disconnected. When the connection closes, the
-client's open goals are cancelled.
+client's open goals are cancelled. A call of a service the server lacks, or with arguments it refuses, is answered
+as rosbridge does, with a failed ``service_response`` holding the reason (a client waits for that response); a
+refused goal (no such action, no query, too many open goals) gets its failed ``action_result`` and nothing else.
 
 A client's subscriptions are told apart, as in rosbridge, by topic and the ``subscribe`` op's ``id`` (roslibpy gives
 each ``Topic`` object its own): subscribing again with the same topic and id changes nothing, ``unsubscribe`` with an
 id ends that subscription and without one every subscription to the topic. A client receives each publication once
 however many subscriptions to its topic it has. It may hold :data:`MAX_SUBSCRIPTIONS` at a time; one more gets a
 ``status`` error naming the cap (the connection keeps working) until an unsubscribe frees a place.
+
+Cancelling a goal that already ended (its result and the cancel crossed on the wire) is no error: the result was
+sent, and nothing else is. A cancel of a goal id the client never sent (among its last :data:`REMEMBERED_GOALS`) gets
+a ``status`` error naming it.
 """
 
 from __future__ import annotations
@@ -18,6 +24,7 @@ from __future__ import annotations
 import asyncio
 import hmac
 import json
+from collections import OrderedDict
 from collections.abc import Mapping
 from concurrent.futures import Future
 from typing import Any
@@ -47,6 +54,9 @@ MAX_OPEN_GOALS = 64
 
 MAX_SUBSCRIPTIONS = 32
 """Subscriptions (topic and subscription id) one client may hold at a time."""
+
+REMEMBERED_GOALS = 1024
+"""How many of a client's latest goal ids a session remembers, to tell a cancel that came late from a wrong one."""
 
 TOPICS = (TREE_STATUS_TOPIC, BELIEFS_TOPIC, IMAGE_TOPIC, DEPTH_TOPIC)
 
@@ -92,6 +102,8 @@ class Session:
         """Replaced, never changed in place: the engine thread reads it to decide what to publish."""
         """(topic, subscription id) of each subscription; the id is None when the client gave none."""
         self._loop = asyncio.get_running_loop()
+        self._sent_goals: OrderedDict[str, None] = OrderedDict()
+        """The ids of this client's latest goals (at most :data:`REMEMBERED_GOALS`), oldest first."""
         self._outbox: asyncio.Queue[dict[str, Any] | None] = asyncio.Queue()
         self._calls: set[asyncio.Task[None]] = set()
 
@@ -167,38 +179,49 @@ class Session:
 
     def _send_goal(self, message: dict[str, Any]) -> None:
         goal_id = message["id"]
+        self._remember(goal_id)  # every goal sent gets a result, refused and aborted ones included
         if message["action"] != QUERY_ACTION:
-            self.send(action_result(goal_id, 0, {"error": f"no action {message['action']!r}"}, result=False))
-            raise ProtocolError(f"unknown action {message['action']!r}; this server has {QUERY_ACTION!r}", goal_id)
+            error = f"no action {message['action']!r}; this server has {QUERY_ACTION!r}"
+            self.send(action_result(goal_id, 0, {"error": error}, result=False))
+            return
         try:
             query = goal_query(message["args"])
         except MissingQueryError as error:
             self.send(action_result(goal_id, 0, {"error": str(error)}, result=False))
-            raise ProtocolError(str(error), goal_id) from None
+            return
         except GoalError as error:  # a designator that makes no query: the goal is aborted with the reason
             self.send(action_result(goal_id, GoalStatus.ABORTED, {"reason": str(error)}))
             return
         if self.goals.open_goals(self) >= MAX_OPEN_GOALS:
             error = f"too many open goals (at most {MAX_OPEN_GOALS} per client)"
             self.send(action_result(goal_id, 0, {"error": error}, result=False))
-            raise ProtocolError(error, goal_id)
+            return
         self.goals.submit(Goal(goal_id, query, self, self.send))
 
+    def _remember(self, goal_id: str) -> None:
+        self._sent_goals[goal_id] = None
+        self._sent_goals.move_to_end(goal_id)
+        while len(self._sent_goals) > REMEMBERED_GOALS:
+            self._sent_goals.popitem(last=False)
+
     def _cancel_goal(self, message: dict[str, Any]) -> None:
-        if not self.goals.cancel(message["id"], self):
-            raise ProtocolError(f"no open goal {message['id']!r} of this client", message["id"])
+        goal_id = message["id"]
+        if not self.goals.cancel(goal_id, self) and goal_id not in self._sent_goals:
+            raise ProtocolError(f"no goal {goal_id!r} of this client to cancel", goal_id)
 
     def _call_service(self, message: dict[str, Any]) -> None:
-        name = message["service"]
+        name, request_id = message["service"], message.get("id")
         handler = self.services.get(name)
-        if handler is None:
-            raise ProtocolError(f"unknown service {name!r}; this server has {', '.join(self.services)}")
         arguments = message.get("args", {})
-        problem = handler.problem(name, arguments)
-        if problem is not None:
-            raise ProtocolError(problem)
+        if handler is None:
+            problem = f"unknown service {name!r}; this server has {', '.join(self.services)}"
+        else:
+            problem = handler.problem(name, arguments)
+        if handler is None or problem is not None:  # the call is answered, as rosbridge does: a failed response
+            self.send(service_response(name, request_id, {"error": problem}, result=False))
+            return
         future = self.goals.call(lambda service: handler.handler(service, arguments))
-        call = asyncio.create_task(self._respond(name, message.get("id"), future))
+        call = asyncio.create_task(self._respond(name, request_id, future))
         self._calls.add(call)  # the loop keeps only weak references to tasks
         call.add_done_callback(self._calls.discard)
 

@@ -93,8 +93,9 @@ def test_the_ontology_service_edits_the_user_layer_the_next_goal_uses(tmp_path: 
         assert served.stop() == 0
 
 
-def test_an_ontology_call_without_an_action_gets_a_status_error(kitchen_server: Served) -> None:
+def test_an_ontology_call_without_an_action_gets_a_failed_response(kitchen_server: Served) -> None:
     with connect(kitchen_server.url) as connection:
         connection.send(json.dumps({"op": "call_service", "id": "o", "service": "/robokudo/ontology", "args": {}}))
-        problem = receive(connection, "status")
-        assert "needs the argument 'action'" in problem["msg"]
+        response = receive(connection, "service_response")
+        assert response["id"] == "o" and response["result"] is False
+        assert "needs the argument 'action'" in response["values"]["error"]

@@ -32,6 +32,18 @@ def receive(connection: ClientConnection, op: str, goal_id: str | None = None) -
             return message
 
 
+def replies_until_the_service_response(connection: ClientConnection, call_id: str) -> list[dict[str, object]]:
+    """The messages up to the response to ``call_id`` (feedback and publications left out)."""
+    replies = []
+    while True:
+        message = json.loads(connection.recv(timeout=WAIT))
+        if message["op"] in ("action_feedback", "publish"):
+            continue
+        replies.append(message)
+        if message["op"] == "service_response" and message.get("id") == call_id:
+            return replies
+
+
 def task_in_slot(tree: dict[str, Any]) -> str:
     """The name of what the task slot holds, in a ``/robokudo/tree_status`` tree."""
     slot = next(child for child in tree["children"] if child["name"] == "task")
@@ -88,6 +100,22 @@ def test_a_goal_without_query_text_is_refused(kitchen_server: Served) -> None:
         connection.send(json.dumps({"op": "send_action_goal", "id": "g", "action": ACTION, "args": {}}))
         result = receive(connection, "action_result", "g")
         assert result["result"] is False and "'query' (the query text) or 'obj'" in result["values"]["error"]
+
+
+@pytest.mark.parametrize(
+    ("action", "args", "problem"),
+    [(ACTION, {"query": "  "}, "'query' (the query text)"), ("/robokudo/qery", {"query": "find milk"}, "no action")],
+    ids=["blank-query", "unknown-action"],
+)
+def test_a_refused_goal_gets_its_failed_result_and_no_status_error_besides(
+    kitchen_server: Served, action: str, args: dict[str, Any], problem: str
+) -> None:
+    with connect(kitchen_server.url) as connection:
+        connection.send(json.dumps({"op": "send_action_goal", "id": "r", "action": action, "args": args}))
+        connection.send(beliefs_call("after"))
+        replies = replies_until_the_service_response(connection, "after")
+    assert [m["op"] for m in replies] == ["action_result", "service_response"], replies
+    assert replies[0]["result"] is False and problem in replies[0]["values"]["error"]
 
 
 def test_a_structured_designator_goal_finds_the_milk_in_the_fridge(kitchen_server: Served) -> None:
