@@ -38,6 +38,7 @@ from robokudo.core.types import (
     DepthImage,
     FreePlacement,
     ObjectHypothesis,
+    PersonTrack,
     PointCloud,
     PointingTarget,
     QueryAnswer,
@@ -46,8 +47,11 @@ from robokudo.core.types import (
 )
 
 
-def camera_model(info: CameraInfo, depth: np.ndarray | None = None) -> CameraModel:
-    """The visibility model of a frame: world frame when the camera pose is known, else the camera frame."""
+def camera_model(
+    info: CameraInfo, depth: np.ndarray | None = None, looks_for: Callable[[str], bool] | None = None
+) -> CameraModel:
+    """The visibility model of a frame: world frame when the camera pose is known, else the camera frame;
+    ``looks_for``: the stored classes the frame's detectors report (None: all)."""
     known = info.cam_to_world is not None
     return CameraModel(
         intrinsics=info.intrinsics,
@@ -55,6 +59,7 @@ def camera_model(info: CameraInfo, depth: np.ndarray | None = None) -> CameraMod
         frame=WORLD_FRAME if known else info.frame_id,
         depth=depth,
         recording=info.recording,
+        looks_for=looks_for,
     )
 
 
@@ -95,10 +100,14 @@ class AnswerStep(Annotator):
         label_of: Callable[[str], str] = class_label,
         on_integrated: Callable[[TrackStep], None] | None = None,
         free_space: bool = False,
+        looks_for: Callable[[str], bool] | None = None,
         name: str | None = None,
     ) -> None:
+        """``looks_for``: the stored classes the tree's detectors report (None: every class); a known object of
+        another class in view is not missed (a tree that finds people says nothing of the cup it did not look for)."""
         super().__init__(name=name)
         self.free_space = free_space
+        self.looks_for = looks_for
         self.on_integrated = on_integrated
         """Told every frame's changes to the store once they are written (e.g. to publish them)."""
         self._store_source = store
@@ -143,7 +152,13 @@ class AnswerStep(Annotator):
             recording=info.recording if info is not None else "",
         )
         objects = frame_objects(hypotheses, context, min_overlap=self.min_overlap, read=self.attached)
-        camera = camera_model(info, depth.depth if depth is not None else None) if info is not None else None
+        tracks = self.annotations(TargetTrack)
+        track = tracks[0] if tracks else None
+        camera = None
+        # a loop following one person reports only that person between its searches: its frames say nothing of
+        # anything else in view, so they miss nothing
+        if info is not None and not isinstance(track, PersonTrack):
+            camera = camera_model(info, depth.depth if depth is not None else None, self.looks_for)
         store = self.store
         step = store.integrate(objects, stamp, camera=camera, tracker=self.tracker)
         if self.on_integrated is not None:
@@ -152,8 +167,6 @@ class AnswerStep(Annotator):
         seen = {i: o for i, o in zip(step.assigned, objects, strict=True) if i}
         if belief_filter.ids is not None:  # the query names objects (``id:``): answer only those of them seen here
             seen = {i: o for i, o in seen.items() if i in belief_filter.ids}
-        tracks = self.annotations(TargetTrack)
-        track = tracks[0] if tracks else None
         tracked = _tracked_object(track, seen) if track is not None else None
         if track is not None:  # a continuous task answers with its one target
             seen = {tracked: seen[tracked]} if tracked is not None else {}

@@ -362,6 +362,9 @@ class CameraModel:
     depth: np.ndarray | None = None
     recording: str = ""
     """The recording of the frame; beliefs of another recording are not in view unless ``frame`` is fixed."""
+    looks_for: Callable[[str], bool] | None = None
+    """Whether the frame's detectors report objects of a stored class ("" for no class): a belief of a class they do
+    not look for (a person, for a tree that segments objects only) is not missed when in view. None: every class."""
     max_range: float = 4.0
     border: int = 5
     occlusion_margin: float = 0.05

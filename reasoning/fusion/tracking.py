@@ -244,8 +244,14 @@ class BeliefTracker:
 
     def unseen(self, belief: ObjectBelief, time: float, camera: CameraModel | None) -> tuple[bool, bool]:
         """Apply a frame that did not match ``belief`` (changed in place): whether it was missed (in view of
-        ``camera``: existence lowered) and whether it is now gone (missed and not seen for ``gone_after``)."""
-        missed = camera is not None and same_world(belief, camera) and visible_from(belief.position, camera)
+        ``camera`` and of a class its detectors look for: existence lowered) and whether it is now gone (missed and
+        not seen for ``gone_after``)."""
+        missed = (
+            camera is not None
+            and (camera.looks_for is None or camera.looks_for(belief.class_name or ""))
+            and same_world(belief, camera)
+            and visible_from(belief.position, camera)
+        )
         if missed:
             belief.existence = max(belief.existence - self.config.miss_log_odds, -MAX_LOG_ODDS)
             belief.misses += 1

@@ -73,7 +73,14 @@ from robokudo.core.resources import SharedResources
 from robokudo.core.slot import Idle, PerceiveThenTask, TaskSlot
 from robokudo.core.structure import running_leaves
 from robokudo.core.threaded import has_workers, stop_workers
-from robokudo.core.types import PERSON_CLASS, CameraInfo, CameraIntrinsics, QueryAnswer
+from robokudo.core.types import (
+    PERSON_CLASS,
+    CameraInfo,
+    CameraIntrinsics,
+    ObjectHypothesis,
+    PersonHypothesis,
+    QueryAnswer,
+)
 from trees.answer_step import AnswerStep
 from trees.synthesis import build_task_tree
 
@@ -452,6 +459,7 @@ class AnsweringService:
             label_of=self.kb.label,
             on_integrated=self._beliefs_changed,
             free_space=query_plan.plan.task.footprint is not None,
+            looks_for=self._looked_for(query_plan),
         )
         step.reason = ANSWER_REASON
         tree = build_task_tree(
@@ -459,6 +467,21 @@ class AnsweringService:
         )
         place_remote(tree, self.remote, self.remote_hints)
         return tree
+
+    def _looked_for(self, query_plan: QueryPlan) -> Callable[[str], bool] | None:
+        """The stored classes the plan's detectors report: people only, everything but people, or (None) both."""
+        outputs = {output for step in query_plan.plan.steps() for output in step.outputs}
+        finds_people, finds_objects = PersonHypothesis.__name__ in outputs, ObjectHypothesis.__name__ in outputs
+        if finds_people == finds_objects:
+            return None
+        class_test = kb_class_test(self.kb)  # names it does not know ("" for no class) are no person
+        if class_test is None:
+            return None
+
+        def is_person(name: str) -> bool:
+            return class_test(name, PERSON_CLASS)
+
+        return is_person if finds_people else lambda name: not is_person(name)
 
     # ------------------------------------------------------------------ running
 

@@ -268,6 +268,18 @@ def test_a_missed_object_is_gone_after_the_configured_time_even_out_of_view(stor
         assert len(store.beliefs(include_gone=True)) == 2
 
 
+def test_a_frame_misses_only_the_classes_its_detectors_look_for(store_path: Path) -> None:
+    in_view = _camera_at((0.0, -1.0, 0.8))
+    people_only = CameraModel(CAMERA, in_view, looks_for=lambda name: name == "Human")
+    with BeliefStore(store_path) as store:
+        store.integrate([thing((0.0, 0.0, 0.8), "Cup", "red"), thing((0.3, 0.0, 0.8), "Human", "blue")], 0.0)
+        step = store.integrate([], 1.0, camera=people_only)  # a tree that finds people says nothing of the cup
+        assert step.missed == (2,)
+        assert store.get(1).misses == 0 and store.get(2).misses == 1  # type: ignore[union-attr]
+        step = store.integrate([], 2.0, camera=CameraModel(CAMERA, in_view))  # one that looks for everything
+        assert set(step.missed) == {1, 2}
+
+
 def _camera_at(eye: tuple[float, float, float]) -> np.ndarray:
     """cam_to_world of an optical frame at ``eye`` looking horizontally at the world origin's column."""
     forward = -np.array([eye[0], eye[1], 0.0])
