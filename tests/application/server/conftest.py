@@ -13,6 +13,7 @@ from dataclasses import dataclass
 from pathlib import Path
 
 import pytest
+import roslibpy
 
 REPO = Path(__file__).resolve().parents[3]
 START_LIMIT = 120.0
@@ -88,6 +89,15 @@ def kitchen_server(tmp_path_factory: pytest.TempPathFactory) -> Iterator[Served]
     served = start_server(tmp_path_factory.mktemp("served"))
     yield served
     served.stop()
+
+
+@pytest.fixture(scope="module")
+def ros(kitchen_server: Served) -> Iterator[roslibpy.Ros]:
+    """A roslibpy client connected to the kitchen server (one per test module)."""
+    client = roslibpy.Ros(host=kitchen_server.host, port=kitchen_server.port)
+    client.run()
+    yield client
+    client.close()
 
 
 TOKEN = "s3cret"

@@ -5,10 +5,8 @@ from __future__ import annotations
 
 import threading
 import time
-from collections.abc import Iterator
 from typing import Any
 
-import pytest
 import roslibpy
 
 from tests.application.server.conftest import TOKEN, Served
@@ -40,14 +38,6 @@ class GoalRecord:
     def on_error(self, error: Any) -> None:
         self.error = error
         self.ended.set()
-
-
-@pytest.fixture(scope="module")
-def ros(kitchen_server: Served) -> Iterator[roslibpy.Ros]:
-    client = roslibpy.Ros(host=kitchen_server.host, port=kitchen_server.port)
-    client.run()
-    yield client
-    client.close()
 
 
 def send(action: roslibpy.ActionClient, query: str) -> tuple[str, GoalRecord]:

@@ -4,22 +4,10 @@ that never comes (a ``status`` error is not an answer to the call)."""
 
 from __future__ import annotations
 
-from collections.abc import Iterator
-
 import pytest
 import roslibpy
 
-from tests.application.server.conftest import Served
-
 WAIT = 30.0
-
-
-@pytest.fixture(scope="module")
-def ros(kitchen_server: Served) -> Iterator[roslibpy.Ros]:
-    client = roslibpy.Ros(host=kitchen_server.host, port=kitchen_server.port)
-    client.run()
-    yield client
-    client.close()
 
 
 def refusal(ros: roslibpy.Ros, name: str, service_type: str, arguments: dict[str, object]) -> str:
