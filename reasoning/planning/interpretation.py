@@ -406,7 +406,10 @@ def _interpret_scan(
         isinstance(v, Symbol | String) and _word(v, "for").lower() == FREE_SPACE_KEY for v in _values(wanted or Block())
     )
     inner = block if isinstance(block, Block) else Block()
-    region_box = _region(inner.get("region") or query.get("region"), kb, camera_pose)
+    try:
+        region_box = _region(inner.get("region") or query.get("region"), kb, camera_pose)
+    except PlanningError as error:
+        raise _located(query, inner.field("region") or query.body.field("region"), error) from None
     requirements = [
         Requirement("Plane", None, "a scan needs the supporting surface"),
         Requirement("ObjectHypothesis", None, "a scan needs the objects occupying the surface"),

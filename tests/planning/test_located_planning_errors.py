@@ -3,6 +3,8 @@ so a mistake deep in a nested query is found at once."""
 
 from __future__ import annotations
 
+from pathlib import Path
+
 import pytest
 
 from queries import parse_query
@@ -28,6 +30,8 @@ def kb(tmp_path_factory: pytest.TempPathFactory) -> KnowledgeBase:
         ("detect {\n  obj: {\n    type: Milk,\n    location: { in: frige }\n  }\n}", "'frige'", 4, 17),
         ("find the rde mug", "unknown object class 'rde_mug'", 1, 10),
         ("find milk in the frige", "'frige'", 1, 11),
+        ("find free space on the tabel", "'tabel'", 1, 17),
+        ("scan {\n  free_space: { region: tabel } }", "'tabel'", 2, 17),
     ],
 )
 def test_an_unknown_word_is_reported_at_its_line_and_column(
@@ -59,3 +63,14 @@ def test_an_object_named_as_a_place_is_told_apart_from_an_unknown_word(
     assert f"is an object, not a place ({label})" in text
     assert "leave the place out" in text
     assert f"at line 1, column {column}" in text
+
+
+@pytest.mark.real_data
+def test_a_scan_of_a_region_an_input_cannot_place_is_refused_where_it_names_it(kb: KnowledgeBase) -> None:
+    """``find free space on the table`` on a frame without a camera pose said why without saying where."""
+    uoc = str(Path(__file__).resolve().parents[2].parent / "shared" / "data" / "uoc_tabletop_realsense")
+    with pytest.raises(PlanningError) as caught:
+        plan_query(parse_query("find free space on the table"), kb, sensor_source(kb, uoc))
+    text = str(caught.value)
+    assert "region 'table' cannot be searched: the input gives no camera pose" in text
+    assert "at line 1, column 17" in text and text.splitlines()[-1].strip() == "^"
