@@ -468,14 +468,6 @@ class _PartEvidence:
         """Per pair: whether the heights of the ``overlapping`` ones nest; if not, which of them may be a floor
         within the other (bits 1, 2: the first, the second; :meth:`floor_within` asks the hulls); whether the nearer
         of the ``unjoined`` ones could hold the farther (:func:`~annotators.geometry.grid_kernels.pair_evidence`)."""
-        tolerances = (
-            rules.nest_tolerance,
-            rules.inside_tolerance,
-            rules.inside_depth_ratio,
-            RIM_BAND,
-            FLOOR_FLATNESS,
-            INNER_SPREAD,
-        )
         return pair_evidence(
             self.points,
             self.heights,
@@ -486,7 +478,7 @@ class _PartEvidence:
             self.pairs,
             overlapping,
             unjoined,
-            tolerances,
+            rules.pair_tolerances(),
             rules.inside,
         )
 
@@ -606,6 +598,17 @@ class MergeRules:
     inside: bool = True
     nested: bool = False
     nest_tolerance: float = 0.003
+
+    def pair_tolerances(self) -> tuple[float, float, float, float, float, float]:
+        """The tolerances :func:`~annotators.geometry.grid_kernels.pair_evidence` takes, in its order."""
+        return (
+            self.nest_tolerance,
+            self.inside_tolerance,
+            self.inside_depth_ratio,
+            RIM_BAND,
+            FLOOR_FLATNESS,
+            INNER_SPREAD,
+        )
 
 
 def merge_parts(

@@ -10,8 +10,6 @@ from annotators.geometry.footprint_loops import ranked_values
 from annotators.geometry.grid_kernels import convex_hull, pair_evidence, part_hulls, sampled_pixels
 from annotators.geometry.grid_segmentation import (
     FLOOR_FLATNESS,
-    INNER_SPREAD,
-    RIM_BAND,
     MergeRules,
     heights_nest,
     label_groups,
@@ -99,19 +97,11 @@ def test_pair_evidence_decides_as_the_python_rules(seed: int) -> None:
     starts = np.arange(0, depth.size + 1, 7, dtype=np.int64)
     pairs = np.array([(a, b) for a in range(count) for b in range(a + 1, count)], dtype=np.int64)
     rules = MergeRules(inside_tolerance=0.01, inside_depth_ratio=1.5, nest_tolerance=0.003)
-    tolerances = (
-        rules.nest_tolerance,
-        rules.inside_tolerance,
-        rules.inside_depth_ratio,
-        RIM_BAND,
-        FLOOR_FLATNESS,
-        INNER_SPREAD,
-    )
     overlapping = rng.random(pairs.shape[0]) < 0.7
     overlapping[-1] = True  # the bowl's floor and walls
     unjoined = rng.random(pairs.shape[0]) < 0.8
     nest, floors, holds = pair_evidence(
-        points, heights, offsets, depth, pixels, starts, pairs, overlapping, unjoined, tolerances, True
+        points, heights, offsets, depth, pixels, starts, pairs, overlapping, unjoined, rules.pair_tolerances(), True
     )
     part = [points[offsets[k] : offsets[k + 1]] for k in range(count)]
     median = [float(np.median(depth[pixels[starts[k] : starts[k + 1]]])) for k in range(count)]
