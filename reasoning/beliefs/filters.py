@@ -7,7 +7,8 @@ knowledge base's LookupError (e.g. ``unknown object class 'unicorn'``) is raised
 An ``id`` (``inspect object 3``, ``inspect {obj: {id: 3}}``) selects that stored belief.
 A list of words under an attribute key (``color: [red, blue]``, from ``red or blue cup`` or a robot's designator)
 selects objects with any of those values: an object has one dominant colour, shape and size, so "all of them"
-would match nothing, and RoboKudo's designator lists mean alternatives too.
+would match nothing, and RoboKudo's designator lists mean alternatives too. A colour no expert reports is asked
+as the basic colours a person names it by (``teal``: blue or green; ``KnowledgeBase.reported_as``).
 
 The class test of the filter is :func:`kb_query_class_test`: an object answers a query for a class it is, or for the
 container it is typically packaged in (``rk:packagedIn``: a mustard for "find all bottles").
@@ -51,6 +52,8 @@ class Vocabulary(Protocol):
     def annotation_type_for_key(self, key: str) -> str: ...
 
     def value_kind(self, annotation_type: str) -> str | None: ...
+
+    def reported_as(self, annotation_type: str, value: str) -> tuple[str, ...]: ...
 
     def region(self, name: str) -> RegionBox: ...
 
@@ -150,7 +153,15 @@ def _attributes(blocks: list[Block], kb: Vocabulary | None, strict: bool) -> dic
         asked = words.get(annotation_type)
         if asked is not None:
             kind = None if kb is None else kb.value_kind(annotation_type.type_name())
-            names = tuple(dict.fromkeys(word if kind is None else _resolve(kb, word, kind, strict) for word in asked))
+            names = tuple(
+                dict.fromkeys(
+                    reported
+                    for word in asked
+                    for reported in (
+                        (word,) if kind is None else _reported(kb, annotation_type, _resolve(kb, word, kind, strict))
+                    )
+                )
+            )
             found[annotation_type.attribute] = names[0] if len(names) == 1 else names
     return found
 
@@ -189,6 +200,17 @@ def _region_word(blocks: list[Block]) -> str | None:
                     if word is not None:
                         return word
     return None
+
+
+def _reported(kb: Vocabulary | None, annotation_type: type[Annotation], name: str) -> tuple[str, ...]:
+    """The values experts report for an asked value: a colour no expert says is matched by the basic colours a
+    person names it by (teal: blue or green), any other value by itself."""
+    if kb is None:
+        return (name,)
+    try:
+        return kb.reported_as(annotation_type.type_name(), name)
+    except LookupError:
+        return (name,)
 
 
 def _resolve(kb: Vocabulary | None, word: str, kind: str, strict: bool = False) -> str:

@@ -183,6 +183,8 @@ class OntologyIndex:
     """The names of the annotators with a class domain (``class_domain``)."""
     rank_notes: Mapping[str, str] = field(default_factory=dict)
     """Annotator -> its name with its rank: ``Name (reliability 0.9, 12 ms)`` (for the reasons of alternatives)."""
+    basic_colors: Mapping[str, tuple[str, ...]] = field(default_factory=dict)
+    """Colour -> the basic colours a person names it by (``rk:basicColor``: Teal -> Blue, Green), sorted."""
 
     def mask(self, types: Iterable[str]) -> int:
         """The bit mask of CAS types (names that are no CAS type are left out)."""
@@ -241,6 +243,7 @@ class _Builder:
         words, word_labels = self._words(regions)
         size_bounds = self._size_bounds()
         inspected_types = self._inspected_types()
+        basic_colors = self._basic_colors()
         if self.problems:
             raise OntologyError(sorted(set(self.problems)))
         annotator_conditions = {
@@ -307,6 +310,7 @@ class _Builder:
             class_annotators=self._class_annotators(ranked),
             class_domain_names=frozenset(spec.name for spec in ranked if spec.classes),
             rank_notes={s.name: f"{s.name} (reliability {s.reliability:g}, {s.cost_ms:g} ms)" for s in ranked},
+            basic_colors=basic_colors,
         )
 
     @staticmethod
@@ -606,6 +610,18 @@ class _Builder:
             declared = [own[c] for level in self._levels(name) for c in sorted(level) if c in own]
             found[name] = declared[0] if declared else "ObjectHypothesis"
         return found
+
+    def _basic_colors(self) -> dict[str, tuple[str, ...]]:
+        """Per colour the basic colours a person names it by (``rk:basicColor``); both must be colours."""
+        colors = self.down.get("Color", frozenset())
+        found: dict[str, set[str]] = defaultdict(set)
+        for subject, value in self.graph.subject_objects(RK.basicColor):
+            name, basic = local_name(subject), local_name(value)
+            if name not in colors or basic not in colors or name == basic:
+                self.problems.append(f"{name}: rk:basicColor must link a colour to another colour, not {basic}")
+                continue
+            found[name].add(basic)
+        return {name: tuple(sorted(basics)) for name, basics in found.items()}
 
     def _levels(self, name: str) -> list[set[str]]:
         """``name``, then its parents, then their parents, ... (each class at its shortest distance)."""

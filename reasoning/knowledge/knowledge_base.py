@@ -287,6 +287,19 @@ class KnowledgeBase:
         """The synonyms (skos:altLabel) of a term."""
         return self._index.synonyms.get(name, ())
 
+    def basic_colors(self, name: str) -> tuple[str, ...]:
+        """The basic colours a person names a colour by when only the basic terms may be used (``rk:basicColor``:
+        Teal -> Blue, Green); () for a basic colour and for any other term."""
+        return self._index.basic_colors.get(name, ())
+
+    def reported_as(self, annotation_type: str, value: str) -> tuple[str, ...]:
+        """The values an expert reports for an asked ``value`` of ``annotation_type``: the value itself, or, for a
+        colour no annotator reports that has basic colours (:meth:`basic_colors`), those (teal -> blue, green)."""
+        basics = self.basic_colors(value)
+        if basics and not self.providers(annotation_type, value=value):
+            return basics
+        return (value,)
+
     def names_of_kind(self, kind: Kind) -> list[str]:
         """All terms of a kind, sorted (e.g. every colour)."""
         if kind == "region":

@@ -120,6 +120,7 @@ def interpret(
             names = [_value_name(annotation_type, value, kb) for value in _values(field.value)]
         except PlanningError as error:
             raise _located(query, field, error) from None
+        names = _reportable(annotation_type, names, kb, inferences)
         for name in names:
             constraints.append(Constraint(field.key, annotation_type, name))
             asked = f"query asks {field.key} = {name}" if name is not None else f"query asks for {field.key}"
@@ -526,6 +527,26 @@ def _value_name(annotation_type: str, value: Value, kb: KnowledgeBase) -> str | 
         return kb.resolve(word, (kind,)).name
     except TermError as error:
         raise PlanningError(str(error)) from None
+
+
+def _reportable(
+    annotation_type: str, names: list[str | None], kb: KnowledgeBase, inferences: list[str]
+) -> list[str | None]:
+    """The asked values with each colour no expert reports replaced by the basic colours a person names it by
+    (:meth:`~reasoning.knowledge.knowledge_base.KnowledgeBase.reported_as`: ``teal`` -> blue or green, the colour
+    namer says only basic terms), noted in ``inferences``; other values as they are (a value nothing reports and
+    that has no basic colours is refused by the planner, saying why)."""
+    found: list[str | None] = []
+    for name in names:
+        reported = (name,) if name is None else kb.reported_as(annotation_type, name)
+        if reported != (name,):
+            said = " or ".join(kb.label(value) for value in reported)
+            inferences.append(
+                f"no expert reports the colour {kb.label(name)!r}; it is asked as {said}, the basic colours a person "
+                f"names it by"
+            )
+        found.extend(reported)
+    return list(dict.fromkeys(found))
 
 
 def _is_anywhere(value: Value | None) -> bool:

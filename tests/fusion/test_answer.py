@@ -213,7 +213,7 @@ def test_the_answer_step_can_fail_when_nothing_matches(tmp_path: Path) -> None:
 class FakeKnowledgeBase:
     """A Vocabulary (what the belief filter asks the KnowledgeBase) over a few words."""
 
-    words: ClassVar[dict[str, str]] = {"milk": "Milk", "cup": "Cup", "red": "Red", "fridge": "fridge"}
+    words: ClassVar[dict[str, str]] = {"milk": "Milk", "cup": "Cup", "red": "Red", "teal": "Teal", "fridge": "fridge"}
 
     def resolve(self, word: str, kinds: Collection[str] | None = None) -> Resolved:
         if word.lower() not in self.words:
@@ -235,6 +235,9 @@ class FakeKnowledgeBase:
     def value_kind(self, annotation_type: str) -> str | None:
         return {"SemanticColor": "color", "Shape": "shape", "Size": "size"}.get(annotation_type)
 
+    def reported_as(self, annotation_type: str, value: str) -> tuple[str, ...]:
+        return ("Blue", "Green") if value == "Teal" else (value,)
+
     def region(self, name: str) -> RegionBox:
         if name.lower() != "fridge":
             raise KeyError(name)
@@ -254,6 +257,8 @@ def test_query_to_filter_with_a_fake_knowledge_base() -> None:
     assert f.class_test is not None and f.class_test("LactoseFreeMilk", "Milk")
     f = belief_filter(parse("find the red cup"), FakeKnowledgeBase())
     assert f.object_class == "Cup" and f.attributes == {"color": "Red"} and f.limit == 1
+    teal = belief_filter(parse("find the teal cup"), FakeKnowledgeBase())  # no expert says teal: its basic colours
+    assert teal.attributes == {"color": ("Blue", "Green")}
     nested = belief_filter(parse("detect { type: milk, location: { in: fridge }, color: white }"), None)
     assert nested.object_class == "milk" and nested.region == "fridge" and nested.attributes == {"color": "white"}
 

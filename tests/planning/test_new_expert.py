@@ -15,7 +15,6 @@ from py_trees.common import Status
 from annotators.catalog import AnnotatorCatalog
 from queries import parse_query
 from reasoning.knowledge.knowledge_base import KnowledgeBase
-from reasoning.planning.planner import PlanningError
 from reasoning.planning.query_planner import plan_query
 from robokudo.application.sensor_sources import sensor_source
 from robokudo.application.service import AnsweringService
@@ -24,7 +23,7 @@ from robokudo.core.engine import Engine
 from robokudo.core.types import ObjectHypothesis, SemanticColor
 from trees.synthesis import SynthesisError, build_tree
 
-QUERY = "detect { obj: { color: teal } }"  # no shipped expert can report teal
+QUERY = "detect { obj: { color: teal } }"  # no shipped expert can report teal (asked as blue or green)
 
 EXPERT_MODULE = '''
 """A user's own expert, in a module of its own."""
@@ -74,14 +73,16 @@ def teal_spotter(tmp_path: Path, monkeypatch: pytest.MonkeyPatch) -> type:
 def test_a_new_expert_class_is_planned_built_and_run(tmp_path: Path, teal_spotter: type) -> None:
     query = parse_query(QUERY)
     shipped = KnowledgeBase.load(tmp_path / "user.ttl", annotators=AnnotatorCatalog.discover().values())
-    with pytest.raises(PlanningError, match="Teal"):
-        plan_query(query, shipped, sensor_source(shipped, None))
+    asked_as_basic = plan_query(query, shipped, sensor_source(shipped, None)).plan
+    assert "SemanticColorAnnotator" in asked_as_basic.annotator_names()  # no shipped expert says teal
+    assert any("asked as blue or green" in note for note in asked_as_basic.task.inferences)
 
     kb = KnowledgeBase.load(tmp_path / "user.ttl", annotators=[*AnnotatorCatalog.discover().values(), teal_spotter])
     spec = kb.annotator("TealSpotter")
     assert spec.colors == {"Teal"} and spec.implemented_by == "my_teal_expert.TealSpotter"
     plan = plan_query(query, kb, sensor_source(kb, None)).plan
     assert "TealSpotter" in plan.annotator_names()
+    assert not any("asked as" in note for note in plan.task.inferences)  # an expert says teal: asked as it is
 
     pipeline = build_tree(plan, query=query, catalog=AnnotatorCatalog.discover(extra=[teal_spotter]))
     (expert,) = [node for node in pipeline.iterate() if isinstance(node, teal_spotter)]

@@ -63,7 +63,7 @@ def test_bad_query_exits_2_with_the_reason(
 ) -> None:
     monkeypatch.setenv("ROBOKUDO_BELIEF_STORE", str(tmp_path / "beliefs.sqlite"))
     monkeypatch.setenv("ROBOKUDO_USER_ONTOLOGY", str(tmp_path / "user.ttl"))
-    assert cli.main(["plan", "detect { obj: { color: teal } }"]) == 2
+    assert cli.main(["plan", "detect { obj: { color: silver } }"]) == 2
     assert "SemanticColorAnnotator can report only" in capsys.readouterr().err
     assert cli.main(["query", "detect { obj: { type: Milk, } }"]) == 2
     assert "line 1, column" in capsys.readouterr().err

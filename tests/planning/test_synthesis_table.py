@@ -135,7 +135,7 @@ CASES = [
 ]
 
 FAILURES = [
-    ("detect { obj: { color: teal } }", "SemanticColor with value 'Teal'.*SemanticColorAnnotator can report only"),
+    ("detect { obj: { color: silver } }", "SemanticColor with value 'Silver'.*SemanticColorAnnotator can report only"),
     ("stop { task: 7 }", "cancels a running task"),
     ("find the flux capacitor", "unknown object class 'flux_capacitor'"),
     ("detect { obj: { flavour: sweet } }", "query key 'flavour'"),

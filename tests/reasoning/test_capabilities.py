@@ -71,6 +71,14 @@ def test_providers_rank_by_reliability_then_cost(test_kb: KnowledgeBase) -> None
     assert names(test_kb.providers("SemanticColor", value="white")) == ["SemanticColorAnnotator"]
 
 
+def test_a_colour_no_expert_reports_is_asked_as_its_basic_colours(kb: KnowledgeBase, test_kb: KnowledgeBase) -> None:
+    assert kb.basic_colors("Teal") == ("Blue", "Green") and kb.basic_colors("Blue") == ()
+    assert kb.reported_as("SemanticColor", "Teal") == ("Blue", "Green")  # the shipped namer says no teal
+    assert kb.reported_as("SemanticColor", "Red") == ("Red",)
+    assert kb.reported_as("SemanticColor", "Silver") == ("Silver",)  # no basic colours: refused by the planner
+    assert test_kb.reported_as("SemanticColor", "Teal") == ("Teal",)  # CheapColor says teal
+
+
 def test_detector_of_a_subclass_serves_a_query_for_the_superclass(test_kb: KnowledgeBase) -> None:
     assert "BowlDetector" in names(test_kb.providers("Classification", value="Bowl"))
     assert "BowlDetector" in names(test_kb.providers("ObjectHypothesis", object_class="Bowl"))
