@@ -20,6 +20,7 @@ from dataclasses import dataclass, replace
 from typing import Any
 
 from reasoning.beliefs.ranking import answer_order
+from reasoning.beliefs.seen_together import SEEN_TOGETHER, last_stated
 from reasoning.beliefs.store import BeliefFilter, BeliefStore
 from reasoning.fusion.rule import (
     CLASS_ATTRIBUTE,
@@ -80,6 +81,9 @@ class AttributeDesignator:
     experts: tuple[str, ...]
     alternatives: tuple[Alternative, ...] = ()
     conflict: bool = False
+    seen_with: tuple[str, ...] = ()
+    """The other values stated with the fused one when the attribute was last stated, for an attribute whose values
+    an object holds at once (:mod:`reasoning.beliefs.seen_together`: the red of a white-and-red can)."""
 
 
 @dataclass(frozen=True, slots=True)
@@ -141,6 +145,7 @@ class ObjectDesignator:
                     "confidence": round(a.confidence, 6),
                     "experts": list(a.experts),
                     "conflict": a.conflict,
+                    **({"seen_with": list(a.seen_with)} if a.seen_with else {}),
                     "alternatives": [
                         {"value": alt.value, "confidence": round(alt.confidence, 6), "experts": list(alt.experts)}
                         for alt in a.alternatives
@@ -344,7 +349,7 @@ class Answer:
             probability = o.class_probability()
             lines.append(
                 f"#{o.id} {o.shown_label()}"
-                + (f" ({colour.value})" if colour else "")
+                + (f" ({' and '.join((colour.value, *colour.seen_with))})" if colour else "")
                 + f" at ({p[0]:.3f}, {p[1]:.3f}, {p[2]:.3f}) [{o.pose.frame}]"
                 + (f" in {o.region}" if o.region else "")
                 + (f", class {probability:.2f}" if probability is not None and _has_class(o) else "")
@@ -371,13 +376,14 @@ class _BeliefView:
     """The fused class when evidence supports it and no class test is needed to fuse it."""
 
 
-def _attribute_designator(fused: FusedAttribute) -> AttributeDesignator:
+def _attribute_designator(fused: FusedAttribute, seen_with: tuple[str, ...] = ()) -> AttributeDesignator:
     return AttributeDesignator(
         value=fused.value,
         confidence=fused.confidence,
         experts=fused.sources,
         alternatives=tuple(Alternative(s.value, s.confidence, s.sources) for s in fused.support),
         conflict=fused.conflict,
+        seen_with=seen_with,
     )
 
 
@@ -392,7 +398,8 @@ def _belief_view(belief: ObjectBelief) -> _BeliefView:
             attributes.append((name, None))
             continue
         fused = fuse_values(name, attribute.values)  # one class value: the class test changes nothing
-        attributes.append((name, _attribute_designator(fused)))
+        together = last_stated(attribute.values) if name in SEEN_TOGETHER and len(attribute.values) > 1 else []
+        attributes.append((name, _attribute_designator(fused, tuple(v for v in together if v != fused.value))))
         if name == CLASS_ATTRIBUTE and fused.supported:
             supported_class = fused.value
     x, y, z = belief.position.tolist()

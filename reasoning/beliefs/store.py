@@ -18,7 +18,8 @@ Tables: ``objects`` (one row per belief: class, pose, size, region, recording, e
 experts and the support of every attribute value, packed: one binary record per value, see :data:`SUPPORT`),
 ``interned`` (the attribute names, values and expert sets those records refer to by code, append-only),
 ``objects_place`` (R*Tree over positions),
-``attribute_index`` (the attribute values each belief holds more likely than not, for queries),
+``attribute_index`` (the attribute values each belief holds more likely than not, for queries; colours also as last
+seen, :mod:`reasoning.beliefs.seen_together`),
 ``observations`` (every sighting
 with its recording and the experts' statements, packed, bounded per object), ``classes`` and ``meta``.
 """
@@ -55,6 +56,7 @@ from reasoning.beliefs.packed import (
     supports_packing,
 )
 from reasoning.beliefs.row_update import RowUpdate, Support, belief_of
+from reasoning.beliefs.seen_together import SEEN_TOGETHER, last_stated
 from reasoning.fusion.association import CameraModel, in_view
 from reasoning.fusion.frame import WORLD_FRAME, FrameObject
 from reasoning.fusion.rule import (
@@ -108,9 +110,11 @@ class BeliefFilter:
     ``class_test(a, b)`` tells whether class ``a`` is ``b`` or a subclass of it (default: equal names, case
     ignored). A belief is in ``region`` when its stored region has that name (case ignored) or when its world
     position lies in one of ``region_boxes``. ``attributes`` (e.g. ``{"color": "red"}``, case ignored) match the
-    fused value or any value more likely than not; ``text`` matches when each of its words is read in such a
-    value, tolerating OCR errors (:func:`~robokudo.core.text_match.text_matches`). An attribute given several values
-    (``{"color": ("red", "blue")}``) matches when any of them does. ``ids`` restricts the answer to those beliefs.
+    fused value or any value more likely than not (a colour also any of those stated when the belief's colour was
+    last stated: a red-and-white can answers to "red" and to "white"); ``text`` matches when each of its words is
+    read in such a value, tolerating OCR errors (:func:`~robokudo.core.text_match.text_matches`). An attribute given
+    several values (``{"color": ("red", "blue")}``) matches when any of them does. ``ids`` restricts the answer to
+    those beliefs.
     """
 
     object_class: str | None = None
@@ -1080,6 +1084,8 @@ def _pack_attributes(
             continue
         fused = fuse_values(name, attribute.values, class_test if name == CLASS_ATTRIBUTE else None)
         entries.extend(f"{name}={s.value}" for s in fused.support if s.value == fused.value or s.confidence > 0.5)
+        if name in SEEN_TOGETHER:
+            entries.extend(f"{name}={value}" for value in last_stated(values) if f"{name}={value}" not in entries)
     return supports_packing(len(flat) // FIELDS).pack(*flat), INDEX_SEPARATOR.join(sorted(entries))
 
 
