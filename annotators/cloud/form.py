@@ -22,7 +22,9 @@ Measured on the hypothesis' points in the upright support frame (:mod:`annotator
   points up to ``HANDLE_POINTS``; the confidence that there is none grows with how much of the middle part was
   seen but falls with the share of it that sticks out without forming a handle, to 0 at ``HANDLE_SHARE`` (about
   what a handle seen from the side holds: a handle seen end-on or cut apart by the segmenter looks like that, a
-  plain cup's or can's side does not).
+  plain cup's or can's side does not). When most of the middle part (``FLARE_SHARE``) sticks out of that circle,
+  the body is wider above its foot (a bowl's flaring wall): that is no handle, and the confidence that there is
+  none is taken from the body profile instead, which follows the flare.
   "None" means none in view: a handle straight behind the body shows at most as a sliver over the far rim, a few
   pixels high from a tabletop view (the blue mug of the first RealSense frame), which the depth image does not
   resolve. From the elevations of a tabletop view a handle hides behind a round body in about a quarter of the
@@ -83,6 +85,9 @@ HANDLE_POINTS = 20
 HANDLE_SHARE = 0.1
 """Share of the middle part a handle seen from the side holds: sticking out that much, the points leave it open
 whether there is a handle (no confidence that there is none)."""
+FLARE_SHARE = 0.5
+"""Share of the middle part sticking out of the foot circle beyond which that is the body, wider above its foot (a
+bowl's flaring wall), not a handle: a handle holds about ``HANDLE_SHARE`` of it, never most of it."""
 THROUGH = 0.15
 """A point is seen through the object when its line of sight crosses the hull for this share of the extent."""
 THROUGH_MIN = 0.01
@@ -154,20 +159,63 @@ def profile_handle(points: np.ndarray, bottom: float, height: float) -> tuple[bo
 
 def handle_evidence(points: np.ndarray, bottom: float, height: float) -> tuple[bool, float]:
     """Whether a handle sticks out of the body's side, and the confidence of that (see the module docstring); the
-    points should hold no grazing ones."""
+    points should hold no grazing ones. When most of the middle part sticks out of the foot circle
+    (:data:`FLARE_SHARE`) the body itself is wider above its foot (a bowl): the circle then says nothing about a
+    handle either way, and the confidence that there is none is the body profile's, which follows the flare."""
     circle = foot_circle_handle(points, bottom, height)
     if circle[0]:  # the circle's handle (and confidence) stands whatever the profile finds
         return circle
     found, confidence = profile_handle(points, bottom, height)
-    return (True, confidence) if found else circle
+    if found:
+        return True, confidence
+    if foot_flare_share(points, bottom, height) > FLARE_SHARE:
+        return False, profile_none_confidence(points, bottom, height)
+    return circle
+
+
+def _foot_and_middle(points: np.ndarray, bottom: float, height: float) -> tuple[np.ndarray, np.ndarray]:
+    """The x, y of the lowest part (the foot, up to ``BODY_SLICE`` of the height) and of the middle part
+    (``HANDLE_BAND``)."""
+    z = points[:, 2] - bottom
+    body = points[z <= BODY_SLICE * height, :2]
+    middle = points[(z >= HANDLE_BAND[0] * height) & (z <= HANDLE_BAND[1] * height), :2]
+    return body, middle
+
+
+def foot_flare_share(points: np.ndarray, bottom: float, height: float) -> float:
+    """The share of the middle part lying farther than the handle reach from the circle fitted to the foot (0 when
+    there is no usable foot circle)."""
+    body, middle = _foot_and_middle(points, bottom, height)
+    if body.shape[0] < 10 or middle.shape[0] < 20:
+        return 0.0
+    fit = circle_fit(body)
+    if fit is None or not np.isfinite(fit[1]) or fit[1] <= 0.005:
+        return 0.0
+    centre, radius = fit
+    reach = radius + max(0.01, HANDLE_GAP * radius)
+    return float(np.count_nonzero(np.linalg.norm(middle - centre, axis=1) > reach)) / middle.shape[0]
+
+
+def profile_none_confidence(points: np.ndarray, bottom: float, height: float) -> float:
+    """The confidence that no handle sticks out of the body profile (:mod:`annotators.cloud.body_profile`): growing
+    with how much of the middle part was seen, falling to 0 when ``HANDLE_SHARE`` of it sticks out of the profile
+    by more than the handle gap (as :func:`foot_circle_handle` weighs it against the foot circle); 0 without a
+    profile."""
+    profile = body_profile(points, bottom, height)
+    z = points[:, 2] - bottom
+    middle = (z >= HANDLE_BAND[0] * height) & (z <= HANDLE_BAND[1] * height)
+    if profile is None or np.count_nonzero(middle) < 20:
+        return 0.0
+    radius = profile.radius_at(z[middle])
+    excess = np.linalg.norm(points[middle, :2] - profile.centre, axis=1) - radius
+    sticking_out = np.count_nonzero(excess > np.maximum(0.01, HANDLE_GAP * radius)) / excess.size
+    return min(1.0, excess.size / FULL_EVIDENCE) * max(0.0, 1.0 - sticking_out / HANDLE_SHARE)
 
 
 def foot_circle_handle(points: np.ndarray, bottom: float, height: float) -> tuple[bool, float]:
     """Whether a handle sticks out of the circle fitted to the foot, and the confidence of that (see the module
     docstring)."""
-    z = points[:, 2] - bottom
-    body = points[z <= BODY_SLICE * height, :2]
-    middle = points[(z >= HANDLE_BAND[0] * height) & (z <= HANDLE_BAND[1] * height), :2]
+    body, middle = _foot_and_middle(points, bottom, height)
     if body.shape[0] < 10 or middle.shape[0] < 20:
         return False, 0.0
     fit = circle_fit(body)

@@ -82,6 +82,26 @@ def test_a_wide_base_is_no_handle_and_a_bowl_is_flat_for_its_width() -> None:
     assert bowl is not None and bowl.height_to_width < 0.5 and bowl.open_top
 
 
+def flaring_side(foot: float, rim: float, height: float, rng: np.random.Generator, n: int = 2000) -> np.ndarray:
+    """Points of the near half of a bowl's wall, its radius growing from ``foot`` at the bottom to ``rim`` at the top
+    (a truncated cone)."""
+    angles = rng.uniform(np.pi, 2 * np.pi, n)
+    z = rng.uniform(0.0, height, n)
+    radius = foot + (rim - foot) * z / height
+    return np.column_stack([CENTRE[0] + radius * np.cos(angles), CENTRE[1] + radius * np.sin(angles), z])
+
+
+@pytest.mark.parametrize("seed", range(3))
+def test_a_bowl_flaring_above_its_foot_surely_has_no_handle(seed: int) -> None:
+    """A bowl's wall flares out of the circle of its foot all around (the white and teal bowls of the real uoc
+    frames): that is its body, not a handle seen end-on, so the form cue is sure there is none (it was not sure at
+    all, and the classifier could then not rule out a handle hidden behind)."""
+    rng = np.random.default_rng(seed)
+    points = np.vstack([flaring_side(0.03, 0.075, 0.06, rng), inner_far_wall(0.075, 0.06, rng)])
+    bowl = measure_form(points, FRAME)
+    assert bowl is not None and not bowl.has_handle and bowl.handle_confidence > 0.5
+
+
 def test_too_few_points_measure_nothing() -> None:
     assert measure_form(np.zeros((5, 3)), FRAME) is None
 
