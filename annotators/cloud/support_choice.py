@@ -5,14 +5,15 @@ mobile robot's head camera looking at a desk from a few metres away sees more fl
 plane is the floor. What a person means by "the table" is the surface the things are on: a raised surface
 parallel to the dominant one, with objects standing on it, rather than the floor the table itself stands on.
 
-So the dominant plane is one candidate, and every raised surface parallel to it that holds a sizeable share of the
-view's points (a peak of the heights above the dominant plane, refitted by RANSAC among the points of that peak)
-is another. Each candidate is scored by what stands on it: the separate object-like clusters rising from it (points
-from just above it up to the height of a graspable object, over its surface's convex footprint, split where the
-depth jumps so that an object in front of a wall is not one cluster with the wall). The candidate with the most
-clusters is the support; on a tie the dominant plane stays (a box top with one box stacked on it carries no more
-than the table the box stands on). The search costs one height pass over a coarse grid when there is no raised
-surface, as on every view looking down at a table.
+So the dominant plane is one candidate, and every surface parallel to it raised above it by more than the tallest
+graspable object, holding a sizeable share of the view's points (a peak of the heights above the dominant plane,
+refitted by RANSAC among the points of that peak), is another: furniture, not the top of a box standing on the
+table. Each is scored by what stands on it: the separate object-like clusters rising from it (points from just
+above it up to the height of a graspable object, over its surface's convex footprint, split where the depth
+jumps, and not going on higher - a chair's column or a table's leg is part of something larger). The highest raised
+surface carrying at least one such cluster and at least as many as the dominant plane is the support; else the
+dominant plane stays. The search costs one height pass over a coarse grid when there is no raised surface, as on
+every view looking down at a table.
 """
 
 from __future__ import annotations
@@ -53,7 +54,8 @@ class SupportChoiceRules:
 
 def raised_peaks(heights: np.ndarray, inliers: int, rules: SupportChoiceRules) -> list[float]:
     """The heights (metres) of the histogram peaks of ``heights`` (finite, above the dominant plane, coarse grid)
-    above ``object_height`` holding at least ``min_share`` of the dominant plane's ``inliers`` (counted on the same grid), largest first."""
+    above ``object_height`` holding at least ``min_share`` of the dominant plane's ``inliers`` (counted on the same
+    grid), largest first."""
     raised = heights[heights > rules.object_height]
     if raised.size == 0:
         return []
@@ -113,7 +115,7 @@ def standing_clusters(
     edges[:, 1:] |= jump_right
     edges[:-1] |= jump_down
     edges[1:] |= jump_down
-    count, labels, stats, _ = cv2.connectedComponentsWithStats((standing & ~edges).view(np.uint8), connectivity=4)
+    _, labels, stats, _ = cv2.connectedComponentsWithStats((standing & ~edges).view(np.uint8), connectivity=4)
     large = stats[:, cv2.CC_STAT_AREA] >= rules.min_cluster
     large[0] = False
     # a cluster that goes on above the tallest object without a depth jump is part of something larger
