@@ -31,18 +31,20 @@ class SupportChoiceRules:
     """How raised candidate surfaces are found and scored.
 
     ``step``: the coarse grid (every ``step``-th row and column) heights are read on; ``bin``: the width (metres)
-    of the height histogram a raised surface shows up as a peak in; ``min_share``: the share of the dominant
-    plane's inliers a peak must hold (a surface large enough to put several things on); ``max_candidates``: the
-    raised peaks tried, largest first; ``lift``: the height (metres) above a surface from which a point belongs to
-    something standing on it (above its noise band); ``object_height``: the tallest graspable object (metres) -
-    points higher above a surface belong to something else (the table above the floor, a wall);
+    of the height histogram a raised surface shows up as a peak in, holding at least ``min_points`` coarse points;
+    ``min_area``: the area (square metres) a raised surface must cover, room for a few objects; ``max_candidates``:
+    the raised peaks tried, the fullest first; ``lift``: the height (metres) above a surface from which a point
+    belongs to something standing on it (above its noise band); ``object_height``: the tallest graspable object
+    (metres) - points higher above a surface belong to something else (the table above the floor, a wall), and a
+    raised surface is furniture only above it;
     ``jump_absolute`` and ``jump_relative``: a depth step between coarse neighbours of more than ``jump_absolute +
     jump_relative * depth`` separates clusters; ``min_cluster``: the coarse pixels of an object-like cluster;
     ``cell``: the raster cell (metres) of a surface's footprint."""
 
     step: int = 2
     bin: float = 0.02
-    min_share: float = 0.25
+    min_points: int = 50
+    min_area: float = 0.1
     max_candidates: int = 3
     lift: float = 0.02
     object_height: float = 0.5
@@ -52,12 +54,11 @@ class SupportChoiceRules:
     cell: float = 0.02
 
 
-def raised_peaks(heights: np.ndarray, inliers: int, rules: SupportChoiceRules) -> list[float]:
-    """The heights (metres) of the histogram peaks of ``heights`` (finite, above the dominant plane, coarse grid)
-    above ``object_height`` holding at least ``min_share`` of the dominant plane's ``inliers`` (counted on the same
-    grid), largest first."""
+def raised_peaks(heights: np.ndarray, rules: SupportChoiceRules) -> list[float]:
+    """The heights (metres) of the histogram peaks of ``heights`` (finite, above the dominant plane) above
+    ``object_height``, each holding at least ``min_points`` of them, at most ``max_candidates`` (the fullest)."""
     raised = heights[heights > rules.object_height]
-    if raised.size == 0:
+    if raised.size < rules.min_points:
         return []
     counts = np.bincount((raised / rules.bin).astype(np.int64))
     # a surface fitted with a slight tilt or noise spreads over two neighbouring bins: count them together
@@ -65,11 +66,23 @@ def raised_peaks(heights: np.ndarray, inliers: int, rules: SupportChoiceRules) -
     peaks = [
         int(k)
         for k in np.argsort(-pairs, kind="stable")
-        if pairs[k] >= rules.min_share * inliers
+        if pairs[k] >= rules.min_points
         and pairs[k] >= (pairs[k - 1] if k > 0 else 0)
         and pairs[k] >= (pairs[k + 1] if k + 1 < pairs.size else 0)
     ]
     return [(k + 1.0) * rules.bin for k in peaks[: rules.max_candidates]]
+
+
+def surface_area(surface: np.ndarray, normal: np.ndarray, cell: float) -> float:
+    """The area (square metres) the Nx3 ``surface`` points cover on a ``cell`` raster of the plane with unit
+    ``normal``: their occupied cells."""
+    basis = plane_basis(np.asarray(normal, dtype=np.float64)).astype(np.float32)
+    cells = np.floor(surface @ basis.T / cell).astype(np.int64)
+    if cells.shape[0] == 0:
+        return 0.0
+    cells -= cells.min(axis=0)
+    keys = cells[:, 0] * (int(cells[:, 1].max()) + 1) + cells[:, 1]
+    return float(np.unique(keys).size * cell * cell)
 
 
 def grid_points(points: np.ndarray, indices: np.ndarray, shape: tuple[int, int], step: int) -> np.ndarray:
@@ -145,8 +158,7 @@ def choose_support(
     with np.errstate(invalid="ignore"):
         valid = mask[::step, ::step] & np.isfinite(coarse[..., 2])
     heights = plane_distances(coarse, dominant.model)
-    inliers = max(1, dominant.inlier_indices.size // (step * step))
-    peaks = raised_peaks(heights[valid], inliers, rules)
+    peaks = raised_peaks(heights[valid], rules)
     if not peaks:
         return dominant
     surface = grid_points(coarse, dominant.inlier_indices, mask.shape, step)
@@ -159,6 +171,8 @@ def choose_support(
         if fit is None:
             continue
         raised = coarse.reshape(-1, 3)[fit.inlier_indices]
+        if surface_area(raised, fit.model[:3], rules.cell) < rules.min_area:
+            continue
         if len(standing_clusters(coarse, valid, fit.model, raised, rules)[1]) < needed:
             continue
         with np.errstate(invalid="ignore"):
