@@ -154,6 +154,12 @@ def choose_support(
     has, else ``dominant``. Candidates are fitted on the coarse grid, the chosen one again on the whole grid."""
     rules = rules or SupportChoiceRules()
     step = rules.step
+    # first on a grid twice as coarse: a view looking down at a table has next to nothing that high above it
+    sparse = np.ascontiguousarray(points[:: 2 * step, :: 2 * step], dtype=np.float32)
+    with np.errstate(invalid="ignore"):
+        high = mask[:: 2 * step, :: 2 * step] & (plane_distances(sparse, dominant.model) > rules.object_height)
+    if np.count_nonzero(high) < rules.min_points // 4:
+        return dominant
     coarse = np.ascontiguousarray(points[::step, ::step], dtype=np.float32)
     with np.errstate(invalid="ignore"):
         valid = mask[::step, ::step] & np.isfinite(coarse[..., 2])
