@@ -16,7 +16,18 @@ import numpy as np
 import pytest
 from py_trees.common import Status
 
-from annotators.cloud.support_choice import SupportChoiceRules, find_support_plane, raised_peaks, surface_area
+from annotators.cloud.filters import range_mask
+from annotators.cloud.plane import ransac_support_plane
+from annotators.cloud.point_cloud import back_project, pixel_rays
+from annotators.cloud.support_choice import (
+    SupportChoiceRules,
+    choose_support,
+    find_support_plane,
+    grid_points,
+    raised_peaks,
+    standing_clusters,
+    surface_area,
+)
 from annotators.simulation import kitchen_scene
 from annotators.simulation.kitchen_scene import RenderedScene, SceneObject
 from robokudo.core.annotator import Annotator
@@ -109,6 +120,27 @@ def test_a_box_top_carrying_a_cup_is_not_the_table() -> None:
     scene = kitchen_scene.render_kitchen("table", moved=moved, extra=[(box, (40, 160, 60))])
     plane, _ = run_tree(scene, posed=False)
     assert height_of_plane(scene, plane) == pytest.approx(kitchen_scene.TABLE_TOP_HEIGHT, abs=0.03)
+
+
+def test_the_table_legs_are_no_objects_on_the_floor_and_each_table_object_stands_on_the_table() -> None:
+    scene = render((0.0, -0.6, 0.35))
+    points = np.ascontiguousarray(back_project(scene.depth, pixel_rays(scene.intrinsics)), dtype=np.float32)
+    mask = range_mask(points, np.isfinite(points[..., 2]), 0.2, 2.5)
+    floor = ransac_support_plane(points, mask)
+    assert floor is not None
+    table = choose_support(points, mask, floor)
+    rules = SupportChoiceRules()
+    coarse = np.ascontiguousarray(points[:: rules.step, :: rules.step])
+    valid = mask[:: rules.step, :: rules.step] & np.isfinite(coarse[..., 2])
+    ids = scene.object_ids[:: rules.step, :: rules.step]
+    owners = {}
+    for name, fit in (("floor", floor), ("table", table)):
+        surface = grid_points(coarse, fit.inlier_indices, mask.shape, rules.step)
+        labels, kept = standing_clusters(coarse, valid, fit.model, surface, rules)
+        owners[name] = [set(np.unique(ids[labels == label]).tolist()) for label in kept]
+    assert owners["floor"] == []  # the legs go on up to the table top: part of something larger
+    assert all(len(owner) == 1 for owner in owners["table"]), owners
+    assert set().union(*owners["table"]) == {scene.object(name).object_id for name in TABLE_OBJECTS}
 
 
 def test_raised_peaks_are_the_full_height_bins_above_the_tallest_object() -> None:
