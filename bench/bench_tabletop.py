@@ -42,9 +42,9 @@ sys.path.insert(0, str(ROOT))
 
 from annotators.cloud.clutter import ClutterParameters, segment_clutter  # noqa: E402
 from annotators.cloud.filters import range_mask  # noqa: E402
-from annotators.cloud.plane import ransac_support_plane  # noqa: E402
 from annotators.cloud.point_cloud import back_project, pixel_rays  # noqa: E402
 from annotators.cloud.pose import PoseAnnotator, hypothesis_points  # noqa: E402
+from annotators.cloud.support_choice import find_support_plane  # noqa: E402
 from annotators.geometry.boxes import object_box  # noqa: E402
 from annotators.image.color import SemanticColorAnnotator, name_color  # noqa: E402
 from annotators.image.pixel_expert import hypothesis_pixels  # noqa: E402
@@ -88,7 +88,7 @@ def bare_frame(frame, rays, timings: dict[str, list[float]]) -> int:
     points = timed("PointCloudGenerator", lambda: back_project(frame.depth, rays))
     valid = np.isfinite(points[..., 2])
     mask = timed("RangeFilter", lambda: range_mask(points, valid, 0.2, 2.5))
-    fit = timed("SupportPlaneSegmenter", lambda: ransac_support_plane(points, mask))
+    fit = timed("SupportPlaneSegmenter", lambda: find_support_plane(points, mask))
     segments = timed(
         "ClutterSegmenter",
         lambda: segment_clutter(points, mask, fit.model, fit.inlier_indices, ClutterParameters(), frame.color),

@@ -24,8 +24,8 @@ def prepare(folder: Path) -> list[str]:
     """Write each input's ``points``, ``mask``, ``model``, ``plane`` and ``colors`` to ``folder``; their names."""
     sys.path.insert(0, str(ROOT))
     from annotators.cloud.filters import range_mask
-    from annotators.cloud.plane import ransac_support_plane
     from annotators.cloud.point_cloud import back_project, pixel_rays
+    from annotators.cloud.support_choice import find_support_plane
     from annotators.readers.frame_io import FrameError, read_color_depth_pair
     from annotators.readers.pcd_io import read_pcd
     from annotators.readers.tiff_io import read_tiff_frame
@@ -53,7 +53,7 @@ def prepare(folder: Path) -> list[str]:
     for name, (points, colors) in frames.items():
         points = np.ascontiguousarray(points, dtype=np.float32)
         mask = range_mask(points, np.isfinite(points[..., 2]), 0.2, 2.5)
-        fit = ransac_support_plane(points, mask)
+        fit = find_support_plane(points, mask)
         np.savez(
             folder / f"{name}.npz", points=points, mask=mask, model=fit.model, plane=fit.inlier_indices, colors=colors
         )

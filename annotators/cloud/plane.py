@@ -217,7 +217,8 @@ def up_in_camera(camera: CameraInfo | None) -> np.ndarray | None:
 
 class SupportPlaneSegmenter(Annotator):
     """Finds the supporting plane (table, shelf): the dominant roughly horizontal plane when the camera pose is
-    known, else the dominant plane; its normal points toward the camera."""
+    known, else the dominant plane, or a raised surface parallel to it that carries the objects (a desk above the
+    floor, :mod:`~annotators.cloud.support_choice`); its normal points toward the camera."""
 
     inputs: ClassVar[tuple[type[CasType], ...]] = (PointCloud,)
     optional_inputs: ClassVar[tuple[type[CasType], ...]] = (CameraInfo,)
@@ -248,8 +249,10 @@ class SupportPlaneSegmenter(Annotator):
         problem = cloud_problem(cloud)
         if problem:
             self.fail(problem)
+        from annotators.cloud.support_choice import find_support_plane  # it builds on this module's RANSAC
+
         up = up_in_camera(self.optional_view(CameraInfo))
-        fit = ransac_support_plane(
+        fit = find_support_plane(
             cloud.points,
             cloud.mask,
             distance=self.distance,
