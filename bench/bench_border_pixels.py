@@ -27,8 +27,9 @@ from annotators.cloud.clusters import standing_region  # noqa: E402
 from annotators.cloud.clutter import ClutterParameters, segment_clutter  # noqa: E402
 from annotators.cloud.filters import RangeFilter  # noqa: E402
 from annotators.cloud.normals import grid_normals  # noqa: E402
-from annotators.cloud.plane import SupportPlaneSegmenter, plane_distances  # noqa: E402
+from annotators.cloud.plane import plane_distances  # noqa: E402
 from annotators.cloud.point_cloud import PointCloudGenerator  # noqa: E402
+from annotators.cloud.support_choice import SupportPlaneSegmenter  # noqa: E402
 from annotators.geometry.border_pixels import claim_border_pixels, plane_noise  # noqa: E402
 from annotators.geometry.grid_segmentation import bounding_box  # noqa: E402
 from annotators.readers.choice import reader_for  # noqa: E402

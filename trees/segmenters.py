@@ -22,7 +22,7 @@ from annotators.cloud.clusters import ClusterExtractor
 from annotators.cloud.clutter import ClutterSegmenter
 from annotators.cloud.filters import RangeFilter
 from annotators.cloud.open3d_baseline import plane_dbscan_labels
-from annotators.cloud.plane import SupportPlaneSegmenter
+from annotators.cloud.support_choice import SupportPlaneSegmenter
 from annotators.readers.frame_io import Frame
 from annotators.readers.frame_readers import FileFrameReader
 from robokudo.core.annotator import Annotator

@@ -9,9 +9,9 @@ from __future__ import annotations
 
 from annotators.cloud.clutter import ClutterSegmenter
 from annotators.cloud.filters import RangeFilter
-from annotators.cloud.plane import SupportPlaneSegmenter
 from annotators.cloud.point_cloud import PointCloudGenerator
 from annotators.cloud.pose import PoseAnnotator
+from annotators.cloud.support_choice import SupportPlaneSegmenter
 from annotators.image.color import SemanticColorAnnotator
 from annotators.readers.choice import reader_for
 from annotators.readers.frame_readers import KitchenSceneReader

@@ -11,16 +11,12 @@ or the underside of a shelf is never the support.
 from __future__ import annotations
 
 from dataclasses import dataclass
-from typing import ClassVar
 
 import cv2
 import numpy as np
 
 from annotators.cloud.cloud_loops import centred_scatter, plane_band
-from annotators.cloud.point_cloud import cloud_problem
-from robokudo.core.annotator import Annotator
-from robokudo.core.capability import Capability
-from robokudo.core.types import CameraInfo, CasType, Plane, PointCloud
+from robokudo.core.types import CameraInfo
 
 MIN_PLANE_POINTS = 50
 
@@ -213,55 +209,3 @@ def up_in_camera(camera: CameraInfo | None) -> np.ndarray | None:
     rotation = np.asarray(camera.cam_to_world, dtype=np.float64)[:3, :3]
     up = rotation.T @ np.array([0.0, 0.0, 1.0])
     return up if np.all(np.isfinite(up)) and np.linalg.norm(up) > 0.5 else None
-
-
-class SupportPlaneSegmenter(Annotator):
-    """Finds the supporting plane (table, shelf): the dominant roughly horizontal plane when the camera pose is
-    known, else the dominant plane, or a raised surface parallel to it that carries the objects (a desk above the
-    floor, :mod:`~annotators.cloud.support_choice`); its normal points toward the camera."""
-
-    inputs: ClassVar[tuple[type[CasType], ...]] = (PointCloud,)
-    optional_inputs: ClassVar[tuple[type[CasType], ...]] = (CameraInfo,)
-    outputs: ClassVar[tuple[type[CasType], ...]] = (Plane,)
-    capability: ClassVar[Capability] = Capability(
-        label="support plane segmenter",
-        cost_ms=25.0,
-        reliability=0.9,
-    )
-
-    def __init__(
-        self,
-        distance: float = 0.01,
-        iterations: int = 400,
-        seed: int = 0,
-        max_tilt_degrees: float = 20.0,
-        name: str | None = None,
-    ) -> None:
-        super().__init__(name=name)
-        self.distance = distance
-        self.iterations = iterations
-        self.seed = seed
-        self.max_tilt_degrees = max_tilt_degrees
-
-    def analyse(self) -> None:
-        """Fit the plane and write it; fail when no plane is supported by enough points."""
-        cloud = self.view(PointCloud)
-        problem = cloud_problem(cloud)
-        if problem:
-            self.fail(problem)
-        from annotators.cloud.support_choice import find_support_plane  # it builds on this module's RANSAC
-
-        up = up_in_camera(self.optional_view(CameraInfo))
-        fit = find_support_plane(
-            cloud.points,
-            cloud.mask,
-            distance=self.distance,
-            iterations=self.iterations,
-            seed=self.seed,
-            up=up,
-            max_tilt_degrees=self.max_tilt_degrees,
-        )
-        if fit is None:
-            kind = "roughly horizontal plane" if up is not None else "plane"
-            self.fail(f"no {kind} with at least {MIN_PLANE_POINTS} inliers within {self.distance} m")
-        self.write(Plane(model=fit.model, inlier_indices=fit.inlier_indices, source=self.name))

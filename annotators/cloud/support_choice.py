@@ -19,11 +19,23 @@ every view looking down at a table.
 from __future__ import annotations
 
 from dataclasses import dataclass
+from typing import ClassVar
 
 import cv2
 import numpy as np
 
-from annotators.cloud.plane import PlaneFit, plane_basis, plane_distances, ransac_support_plane
+from annotators.cloud.plane import (
+    MIN_PLANE_POINTS,
+    PlaneFit,
+    plane_basis,
+    plane_distances,
+    ransac_support_plane,
+    up_in_camera,
+)
+from annotators.cloud.point_cloud import cloud_problem
+from robokudo.core.annotator import Annotator
+from robokudo.core.capability import Capability
+from robokudo.core.types import CameraInfo, CasType, Plane, PointCloud
 
 
 @dataclass(frozen=True)
@@ -210,3 +222,53 @@ def find_support_plane(
     if dominant is None:
         return None
     return choose_support(points, mask, dominant, distance, max_tilt_degrees, seed, rules)
+
+
+class SupportPlaneSegmenter(Annotator):
+    """Finds the supporting plane (table, shelf): the dominant roughly horizontal plane when the camera pose is
+    known, else the dominant plane, or a raised surface parallel to it that carries the objects (a desk above the
+    floor, :mod:`~annotators.cloud.support_choice`); its normal points toward the camera."""
+
+    inputs: ClassVar[tuple[type[CasType], ...]] = (PointCloud,)
+    optional_inputs: ClassVar[tuple[type[CasType], ...]] = (CameraInfo,)
+    outputs: ClassVar[tuple[type[CasType], ...]] = (Plane,)
+    capability: ClassVar[Capability] = Capability(
+        label="support plane segmenter",
+        cost_ms=25.0,
+        reliability=0.9,
+    )
+
+    def __init__(
+        self,
+        distance: float = 0.01,
+        iterations: int = 400,
+        seed: int = 0,
+        max_tilt_degrees: float = 20.0,
+        name: str | None = None,
+    ) -> None:
+        super().__init__(name=name)
+        self.distance = distance
+        self.iterations = iterations
+        self.seed = seed
+        self.max_tilt_degrees = max_tilt_degrees
+
+    def analyse(self) -> None:
+        """Fit the plane and write it; fail when no plane is supported by enough points."""
+        cloud = self.view(PointCloud)
+        problem = cloud_problem(cloud)
+        if problem:
+            self.fail(problem)
+        up = up_in_camera(self.optional_view(CameraInfo))
+        fit = find_support_plane(
+            cloud.points,
+            cloud.mask,
+            distance=self.distance,
+            iterations=self.iterations,
+            seed=self.seed,
+            up=up,
+            max_tilt_degrees=self.max_tilt_degrees,
+        )
+        if fit is None:
+            kind = "roughly horizontal plane" if up is not None else "plane"
+            self.fail(f"no {kind} with at least {MIN_PLANE_POINTS} inliers within {self.distance} m")
+        self.write(Plane(model=fit.model, inlier_indices=fit.inlier_indices, source=self.name))

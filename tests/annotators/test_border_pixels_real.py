@@ -18,7 +18,7 @@ from py_trees.common import Status
 
 from annotators.cloud.clutter import ClutterSegmenter
 from annotators.cloud.filters import RangeFilter
-from annotators.cloud.plane import SupportPlaneSegmenter
+from annotators.cloud.support_choice import SupportPlaneSegmenter
 from annotators.readers.frame_readers import PcdReader
 from reasoning.evaluation.mosd import object_labels
 from reasoning.evaluation.segmentation import score_segmentation

@@ -27,11 +27,11 @@ from annotators.cloud.form import FormAnnotator
 from annotators.cloud.free_space import FreeSpaceEstimator
 from annotators.cloud.normals import NormalEstimator
 from annotators.cloud.people import DepthPeopleDetector
-from annotators.cloud.plane import SupportPlaneSegmenter
 from annotators.cloud.point_cloud import PointCloudGenerator
 from annotators.cloud.pose import PoseAnnotator
 from annotators.cloud.shape import ShapeAnnotator
 from annotators.cloud.size import SizeAnnotator
+from annotators.cloud.support_choice import SupportPlaneSegmenter
 from annotators.image.color import SemanticColorAnnotator
 from annotators.image.histogram import ColorHistogramAnnotator
 from annotators.image.human_pose import LANDMARKS, HumanPoseDetector
