@@ -308,6 +308,8 @@ class BeliefStore:
         self._settings = (synchronous.upper(), busy_timeout)
         self._lock = threading.RLock()
         self._conn = self._open(synchronous.upper(), busy_timeout, check)
+        if write_behind:  # started with the store, as its connection is (later ones start when a frame needs them)
+            self._writer = FrameWriter(self.path, synchronous.upper(), busy_timeout, WAL_AUTOCHECKPOINT_PAGES)
 
     # ------------------------------------------------------------------ opening
 
