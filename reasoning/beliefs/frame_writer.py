@@ -109,6 +109,9 @@ class FrameWriter:
 
 def serve(path: str, synchronous: str, busy_timeout: float, autocheckpoint: int) -> int:
     """The writer's loop (see the module docstring); returns the exit code."""
+    if hasattr(os, "SCHED_BATCH"):  # throughput work: waking it (a frame sent) must not preempt the fusing process
+        with contextlib.suppress(OSError):
+            os.sched_setscheduler(0, os.SCHED_BATCH, os.sched_param(0))
     conn = sqlite3.connect(path, timeout=busy_timeout, isolation_level=None)
     conn.execute(f"PRAGMA busy_timeout = {int(busy_timeout * 1000)}")
     conn.execute(f"PRAGMA synchronous = {synchronous}")
@@ -130,10 +133,12 @@ def serve(path: str, synchronous: str, busy_timeout: float, autocheckpoint: int)
         except sqlite3.Error as error:
             if conn.in_transaction:
                 conn.execute("ROLLBACK")
-            _write_record(sink, (seq, (type(error).__name__, str(error))))
+            with contextlib.suppress(BrokenPipeError):
+                _write_record(sink, (seq, (type(error).__name__, str(error))))
             conn.close()
             return 1
-        _write_record(sink, (seq, None))
+        with contextlib.suppress(BrokenPipeError):  # the store's process ended: go on committing what it sent
+            _write_record(sink, (seq, None))
     conn.close()
     return 0
 
