@@ -14,6 +14,7 @@ up (:func:`rtree_bounds`), so an overlaid row equals the row SQLite would return
 
 from __future__ import annotations
 
+from array import array
 from collections import deque
 from collections.abc import Iterable, Sequence
 from dataclasses import dataclass
@@ -29,22 +30,21 @@ PRESENT = "present"
 GONE = "gone"
 
 
-def rtree_bounds(boxes: np.ndarray) -> list[tuple[float, ...]]:
+def rtree_bounds(boxes: Sequence[Sequence[float]]) -> list[tuple[float, ...]]:
     """Rows ``(id, x0, x1, y0, y1, z0, z1)`` as a 32-bit SQLite R*Tree stores them and returns them: each bound cast
     to a float, lower bounds not above and upper bounds not below the given value (SQLite's ``rtreeValueDown`` and
     ``rtreeValueUp``: a cast that went the wrong way is redone on the value scaled by one float epsilon)."""
-    values = np.asarray(boxes, dtype=np.float64)[:, 1:]
-    rounded = values.astype(np.float32).astype(np.float64)
-    lower = np.zeros(values.shape, dtype=bool)
-    lower[:, 0::2] = True
-    wrong = np.where(lower, rounded > values, rounded < values)
-    if wrong.any():
-        negative = values < 0
-        scale = np.where(lower == negative, _AWAY, _TOWARDS)
-        redone = (values * scale).astype(np.float32).astype(np.float64)
-        rounded = np.where(wrong, redone, rounded)
-    ids = np.asarray(boxes)[:, 0].astype(np.int64).tolist()
-    return [(i, *bounds) for i, bounds in zip(ids, rounded.tolist(), strict=True)]
+    stored = []
+    for box in boxes:
+        values = [float(v) for v in box[1:]]
+        rounded = array("f", values).tolist()  # C's double -> float cast, as SQLite's
+        for k, (value, bound) in enumerate(zip(values, rounded, strict=True)):
+            lower = k % 2 == 0
+            if bound > value if lower else bound < value:
+                scale = _AWAY if lower == (value < 0) else _TOWARDS
+                rounded[k] = array("f", [value * scale])[0]
+        stored.append((int(box[0]), *rounded))
+    return stored
 
 
 @dataclass(slots=True)

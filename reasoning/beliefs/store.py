@@ -548,7 +548,7 @@ class BeliefStore:
             step, written, loaded, moved, after = self._fuse(
                 conn, objects, time, camera, tracker, next_id, write, writes, pending if pending else None
             )
-            stored_moves = {entry[0]: entry for entry in rtree_bounds(np.array(moved))} if moved else {}
+            stored_moves = {entry[0]: entry for entry in rtree_bounds(moved)}
             rows = entries_of(written, stored_moves, loaded, _COLUMN_COUNT)
             if self._writer is None:
                 synchronous, busy_timeout = self._settings

@@ -216,7 +216,7 @@ def test_rtree_bounds_are_what_sqlite_stores(tmp_path: Path) -> None:
     conn.execute("CREATE VIRTUAL TABLE place USING rtree (id, x0, x1, y0, y1, z0, z1)")
     conn.executemany("INSERT INTO place VALUES (?, ?, ?, ?, ?, ?, ?)", boxes.tolist())
     stored = conn.execute("SELECT * FROM place ORDER BY id").fetchall()
-    assert rtree_bounds(boxes) == stored
+    assert rtree_bounds(boxes.tolist()) == stored
     assert stored != [tuple(row) for row in boxes.tolist()]  # the rounding is not a no-op
 
 
