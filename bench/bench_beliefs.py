@@ -625,9 +625,9 @@ def main() -> int:
     parser.add_argument(
         "--write-behind",
         type=int,
-        default=1,
-        help="frames the store may commit behind (its writer process) for the goal figure; 0: off. Each trial runs "
-        "the store with and without it, alternating",
+        default=0,
+        help="also run each trial on a store committing up to this many frames behind (its writer process), "
+        "alternating with the store as shipped (write-behind off, the goal figure); 0: not run",
     )
     parser.add_argument("--no-serve", action="store_true", help="skip the RSS of robokudo serve")
     parser.add_argument(
@@ -662,28 +662,23 @@ def main() -> int:
         for size in args.update_sizes:
             for cameras in (0, args.cameras):
                 r = bench_updates(size, args.frames, args.per_frame, args.trials, folder, cameras, args.write_behind)
-                goal_figure, best = (
-                    (r["behind"], r["behind best"]) if args.write_behind else (r["integrate"], r["integrate best"])
-                )
-                ok = goal_figure >= UPDATE_GOAL
+                ok = r["integrate"] >= UPDATE_GOAL
                 met.append(ok)
                 where = f"from {cameras} fixed cameras in turn" if cameras else "each at a random place"
                 print(
                     f"updates, {size} stored, frames {where} ({args.trials} trials of {args.frames} frames x "
                     f"{args.per_frame} hypotheses, {r['created']:.0f} new objects in {r['hypotheses']:.0f} hypotheses):"
                 )
-                mode = f"write-behind {args.write_behind}" if args.write_behind else "write-behind off"
                 print(
-                    f"  store.integrate (association + fusion + transaction), {mode}: {goal_figure:8.0f} hypotheses/s "
-                    f"median (best {best:.0f}, committed frames)   goal >= {UPDATE_GOAL:.0f}: "
-                    f"{'met' if ok else 'NOT met'}"
+                    f"  store.integrate (association + fusion + transaction) {r['integrate']:8.0f} hypotheses/s median "
+                    f"(best {r['integrate best']:.0f})   goal >= {UPDATE_GOAL:.0f}: {'met' if ok else 'NOT met'}"
                 )
                 if args.write_behind:
                     ratios = " ".join(f"{x:.2f}" for x in r["behind ratios"])
                     print(
-                        f"  same store, write-behind off (same trials, alternating) {r['integrate']:8.0f} hypotheses/s "
-                        f"median (best {r['integrate best']:.0f});  write-behind / off {r['behind ratio']:.2f} median "
-                        f"(per trial {ratios})"
+                        f"  same store, write-behind {args.write_behind} (same trials, alternating, timed to the last "
+                        f"commit) {r['behind']:8.0f} hypotheses/s median (best {r['behind best']:.0f});  write-behind / "
+                        f"off {r['behind ratio']:.2f} median (per trial {ratios})"
                     )
                 print(
                     f"  plain sqlite3 executemany, same rows (reference)   {r['reference']:8.0f} hypotheses/s median   "

@@ -8,6 +8,15 @@
   20 hypotheses writes some 60 to 80 pages, so at most the last 50 to 70 frames, about two seconds at 30 Hz). The store
   rolls back to an earlier consistent state and never corrupts. Pass ``synchronous="FULL"`` to also survive power
   loss, at the cost of an fsync per commit.
+* ``write_behind=N`` (off by default): :meth:`BeliefStore.integrate` hands each frame's transaction to a writer
+  process (:mod:`reasoning.beliefs.frame_writer`) and returns with at most N frames uncommitted; the next frame is
+  fused through an overlay of the pending ones (:mod:`reasoning.beliefs.pending`), so the results are those of
+  committing each frame at once. Every other method first waits for the pending frames; :meth:`BeliefStore.flush`
+  or ``integrate(..., wait=True)`` commit them on demand. What a crash may lose grows by those N frames: a SIGKILL
+  of the store's process loses none the writer has read whole (it commits them, then exits), a SIGKILL of both or a
+  power loss loses up to N more than above; a failed write loses its frame and the frames fused after it (raised by
+  the next call). The store must be the file's only writer while it runs this way (a frame whose ``next_id`` was
+  changed by another writer fails rather than reuse ids).
 * A file that is not a valid belief store is never modified: opening it raises :class:`BeliefStoreError`
   naming the file and how to move it aside. A store of schema version 1 (before recordings were stored) is
   migrated in one transaction: its beliefs and sightings get an empty recording, so its camera-frame beliefs are
