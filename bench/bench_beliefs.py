@@ -677,8 +677,8 @@ def main() -> int:
                     ratios = " ".join(f"{x:.2f}" for x in r["behind ratios"])
                     print(
                         f"  same store, write-behind {args.write_behind} (same trials, alternating, timed to the last "
-                        f"commit) {r['behind']:8.0f} hypotheses/s median (best {r['behind best']:.0f});  write-behind / "
-                        f"off {r['behind ratio']:.2f} median (per trial {ratios})"
+                        f"commit) {r['behind']:8.0f} hypotheses/s median (best {r['behind best']:.0f});  "
+                        f"write-behind / off {r['behind ratio']:.2f} median (per trial {ratios})"
                     )
                 print(
                     f"  plain sqlite3 executemany, same rows (reference)   {r['reference']:8.0f} hypotheses/s median   "
