@@ -42,6 +42,7 @@ import tempfile
 import time
 from dataclasses import dataclass
 from pathlib import Path
+from typing import Any
 
 import numpy as np
 import scipy.optimize  # noqa: F401 - the assignment imports it on first use: not what the parts measure
@@ -240,11 +241,13 @@ class Rates:
 
 
 def bench_store(
-    path: Path, prepared: list[list[ObjectHypothesis]], record: bool
+    path: Path, prepared: list[list[ObjectHypothesis]], record: bool, write_behind: int = 0
 ) -> tuple[Rates, float, int, list[Recorded]]:
     """Integrate the prepared frames; hypotheses/s of integrate, of frame_objects + integrate, objects created, and
-    (when ``record``) the statements and rows each frame wrote."""
-    store = BeliefStore(path, tracker=BeliefTracker(class_test=is_subclass))
+    (when ``record``) the statements and rows each frame wrote. With ``write_behind`` the timed region ends with the
+    writer's last commit (:meth:`BeliefStore.flush`): committed frames, not handed-over ones; the CPU figure is this
+    process's only (not the writer's)."""
+    store = BeliefStore(path, tracker=BeliefTracker(class_test=is_subclass), write_behind=write_behind)
     if record:
         store.write_log = []
     t_fuse = t_integrate = c_integrate = 0.0
@@ -261,6 +264,10 @@ def bench_store(
         t_integrate += end - middle
         count += len(hypotheses)
         created += len(step.created)
+    start, cpu = time.perf_counter(), time.process_time()
+    store.flush()
+    t_integrate += time.perf_counter() - start
+    c_integrate += time.process_time() - cpu
     recorded = store.write_log or []
     store.close()
     return Rates(count / t_integrate, count / c_integrate), count / (t_fuse + t_integrate), created, recorded
@@ -303,10 +310,12 @@ def fixed_views(seeded: Seeded, rng: np.random.Generator, cameras: int, per_fram
 
 
 def bench_updates(
-    size: int, frames: int, per_frame: int, trials: int, folder: Path, cameras: int = 0
-) -> dict[str, float]:
+    size: int, frames: int, per_frame: int, trials: int, folder: Path, cameras: int = 0, write_behind: int = 0
+) -> dict[str, Any]:
     """Median over trials (each on a fresh copy of one seeded store) of the store's and the reference's rates;
-    frames anywhere in the world, or (``cameras`` > 0) from that many fixed cameras in turn."""
+    frames anywhere in the world, or (``cameras`` > 0) from that many fixed cameras in turn. With ``write_behind``,
+    each trial also runs the same frames on a store with that write-behind (the two in alternating order), and the
+    ``behind`` figures are its rates."""
     template = folder / f"seed-{size}.sqlite"
     for suffix in ("", "-wal", "-shm"):
         Path(f"{template}{suffix}").unlink(missing_ok=True)
@@ -314,6 +323,7 @@ def bench_updates(
     store_rates: list[Rates] = []
     reference_rates: list[Rates] = []
     end_to_end: list[float] = []
+    behind_rates: list[Rates] = []
     created = 0
     for trial in range(trials):
         rng = np.random.default_rng(trial + 1)
@@ -322,13 +332,22 @@ def bench_updates(
             hypotheses_near(seeded, rng, per_frame, views[k % len(views)] if views else None) for k in range(frames + 1)
         ]
         warm = folder / "warm.sqlite"
-        shutil.copy(template, warm)
-        bench_store(warm, prepared[:1], record=False)  # lazy imports, statement cache
-        for suffix in ("", "-wal", "-shm"):
-            Path(f"{warm}{suffix}").unlink(missing_ok=True)
+        for mode in sorted({0, write_behind}):
+            shutil.copy(template, warm)
+            bench_store(warm, prepared[:1], record=False, write_behind=mode)  # lazy imports, statement cache
+            for suffix in ("", "-wal", "-shm"):
+                Path(f"{warm}{suffix}").unlink(missing_ok=True)
         trial_path = folder / f"trial-{size}.sqlite"
-        shutil.copy(template, trial_path)
-        rate, full, made, recorded = bench_store(trial_path, prepared[1:], record=True)
+        behind_path = folder / f"behind-{size}.sqlite"
+        for mode in [0, write_behind][:: 1 if trial % 2 == 0 else -1] if write_behind else [0]:
+            if mode:
+                shutil.copy(template, behind_path)
+                behind_rates.append(bench_store(behind_path, prepared[1:], record=False, write_behind=mode)[0])
+                for suffix in ("", "-wal", "-shm"):
+                    Path(f"{behind_path}{suffix}").unlink(missing_ok=True)
+            else:
+                shutil.copy(template, trial_path)
+                rate, full, made, recorded = bench_store(trial_path, prepared[1:], record=True)
         reference_path = folder / f"reference-{size}.sqlite"
         shutil.copy(template, reference_path)
         reference_rates.append(bench_reference(reference_path, recorded, per_frame))
@@ -340,7 +359,18 @@ def bench_updates(
             for suffix in ("", "-wal", "-shm"):
                 Path(f"{path}{suffix}").unlink(missing_ok=True)
     pairs = list(zip(store_rates, reference_rates, strict=True))
-    return {
+    behind = {}
+    if behind_rates:
+        behind = {
+            "behind": statistics.median(b.wall for b in behind_rates),
+            "behind best": max(b.wall for b in behind_rates),
+            "behind ratio": statistics.median(b.wall / s.wall for b, s in zip(behind_rates, store_rates, strict=True)),
+            "behind ratios": [b.wall / s.wall for b, s in zip(behind_rates, store_rates, strict=True)],
+            "behind reference ratio": statistics.median(
+                b.wall / r.wall for b, r in zip(behind_rates, reference_rates, strict=True)
+            ),
+        }
+    return behind | {
         "integrate": statistics.median(s.wall for s in store_rates),
         "integrate best": max(s.wall for s in store_rates),
         "integrate cpu": statistics.median(s.cpu for s in store_rates),
@@ -592,6 +622,13 @@ def main() -> int:
     parser.add_argument("--cameras", type=int, default=30, help="fixed cameras of the second update scenario")
     parser.add_argument("--repeats", type=int, default=300)
     parser.add_argument("--trials", type=int, default=3)
+    parser.add_argument(
+        "--write-behind",
+        type=int,
+        default=0,
+        help="also run each trial on a store committing up to this many frames behind (its writer process), "
+        "alternating with the store as shipped (write-behind off, the goal figure); 0: not run",
+    )
     parser.add_argument("--no-serve", action="store_true", help="skip the RSS of robokudo serve")
     parser.add_argument(
         "--floor-variants", action="store_true", help="only replay the write log per variant of the storage design"
@@ -624,7 +661,7 @@ def main() -> int:
         folder = Path(name)
         for size in args.update_sizes:
             for cameras in (0, args.cameras):
-                r = bench_updates(size, args.frames, args.per_frame, args.trials, folder, cameras)
+                r = bench_updates(size, args.frames, args.per_frame, args.trials, folder, cameras, args.write_behind)
                 ok = r["integrate"] >= UPDATE_GOAL
                 met.append(ok)
                 where = f"from {cameras} fixed cameras in turn" if cameras else "each at a random place"
@@ -636,11 +673,21 @@ def main() -> int:
                     f"  store.integrate (association + fusion + transaction) {r['integrate']:8.0f} hypotheses/s median "
                     f"(best {r['integrate best']:.0f})   goal >= {UPDATE_GOAL:.0f}: {'met' if ok else 'NOT met'}"
                 )
+                if args.write_behind:
+                    ratios = " ".join(f"{x:.2f}" for x in r["behind ratios"])
+                    print(
+                        f"  same store, write-behind {args.write_behind} (same trials, alternating, timed to the last "
+                        f"commit) {r['behind']:8.0f} hypotheses/s median (best {r['behind best']:.0f});  "
+                        f"write-behind / off {r['behind ratio']:.2f} median (per trial {ratios})"
+                    )
                 print(
                     f"  plain sqlite3 executemany, same rows (reference)   {r['reference']:8.0f} hypotheses/s median   "
                     f"(the store's own {r['statements']:.1f} write statements, {r['rows']:.1f} rows per frame)"
                 )
-                print(f"  ratio store / reference                            {r['ratio']:8.2f}")
+                print(
+                    f"  ratio store / reference                            {r['ratio']:8.2f} write-behind off"
+                    + (f", {r['behind reference ratio']:.2f} write-behind" if args.write_behind else "")
+                )
                 print(
                     f"  in CPU time of the process: store {r['integrate cpu']:.0f}, reference "
                     f"{r['reference cpu']:.0f} hypotheses/s, ratio {r['ratio cpu']:.2f}"

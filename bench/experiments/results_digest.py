@@ -5,11 +5,13 @@ It seeds 10,000 beliefs as ``bench_beliefs.py`` does, integrates 150 frames at r
 views, and hashes every step (each changed belief in full, its log-odds not rounded; assigned, created, missed, gone,
 the association) and, at the end, every table of the store.
 
-Run: ``PYTHONPATH=. .venv/bin/python bench/experiments/results_digest.py``
+Run: ``PYTHONPATH=. .venv/bin/python bench/experiments/results_digest.py [--write-behind N]`` (``--write-behind``:
+the store commits its frames in its writer process, up to N frames behind; the digest must not change).
 """
 
 from __future__ import annotations
 
+import argparse
 import hashlib
 import sqlite3
 import sys
@@ -27,6 +29,11 @@ from reasoning.beliefs.store import BeliefStore  # noqa: E402
 from reasoning.fusion.frame import frame_objects  # noqa: E402
 from reasoning.fusion.tracking import BeliefTracker, ObjectBelief  # noqa: E402
 
+SLOW_TRIGGER = (
+    "CREATE TRIGGER slow_writer AFTER INSERT ON observations BEGIN SELECT count(*) FROM (WITH RECURSIVE c(x) AS "
+    "(SELECT 1 UNION ALL SELECT x + 1 FROM c WHERE x < 400) SELECT x FROM c); END"
+)
+"""Work in every sighting's insert (the digest hashes the tables, not the schema, so it does not change it)."""
 TABLES = ("objects", "objects_place", "attribute_index", "observations", "classes", "interned", "meta")
 
 
@@ -47,6 +54,14 @@ def belief_text(b: ObjectBelief) -> str:
 
 
 def main() -> int:
+    parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    parser.add_argument("--write-behind", type=int, default=0, help="frames the store may commit behind (0: off)")
+    parser.add_argument(
+        "--slow-writer",
+        action="store_true",
+        help="a trigger slows every sighting's insert, so the writer lags and every frame is fused on pending ones",
+    )
+    args = parser.parse_args()
     digest = hashlib.sha256()
     with tempfile.TemporaryDirectory() as name:
         path = Path(name) / "seed.sqlite"
@@ -55,7 +70,11 @@ def main() -> int:
         views = bench.fixed_views(seeded, rng, 10, 20)
         frames = [frame_objects(bench.hypotheses_near(seeded, rng, 20)) for _ in range(150)]
         frames += [frame_objects(bench.hypotheses_near(seeded, rng, 20, views[k % 10])) for k in range(150)]
-        store = BeliefStore(path, tracker=BeliefTracker(class_test=bench.is_subclass))
+        if args.slow_writer:
+            with sqlite3.connect(path) as conn:
+                conn.execute(SLOW_TRIGGER)
+        store = BeliefStore(path, tracker=BeliefTracker(class_test=bench.is_subclass),
+                            write_behind=args.write_behind)  # fmt: skip
         for index, frame in enumerate(frames):
             step = store.integrate(frame, 1000.0 + index * 0.5)
             for belief in step.changed:

@@ -8,6 +8,15 @@
   20 hypotheses writes some 60 to 80 pages, so at most the last 50 to 70 frames, about two seconds at 30 Hz). The store
   rolls back to an earlier consistent state and never corrupts. Pass ``synchronous="FULL"`` to also survive power
   loss, at the cost of an fsync per commit.
+* ``write_behind=N`` (off by default): :meth:`BeliefStore.integrate` hands each frame's transaction to a writer
+  process (:mod:`reasoning.beliefs.frame_writer`) and returns with at most N frames uncommitted; the next frame is
+  fused through an overlay of the pending ones (:mod:`reasoning.beliefs.pending`), so the results are those of
+  committing each frame at once. Every other method first waits for the pending frames; :meth:`BeliefStore.flush`
+  or ``integrate(..., wait=True)`` commit them on demand. What a crash may lose grows by those N frames: a SIGKILL
+  of the store's process loses none the writer has read whole (it commits them, then exits), a SIGKILL of both or a
+  power loss loses up to N more than above; a failed write loses its frame and the frames fused after it (raised by
+  the next call). The store must be the file's only writer while it runs this way (a frame whose ``next_id`` was
+  changed by another writer fails rather than reuse ids).
 * A file that is not a valid belief store is never modified: opening it raises :class:`BeliefStoreError`
   naming the file and how to move it aside. A store of schema version 1 (before recordings were stored) is
   migrated in one transaction: its beliefs and sightings get an empty recording, so its camera-frame beliefs are
@@ -43,7 +52,8 @@ from typing import TypeVar
 import numpy as np
 import platformdirs
 
-from reasoning.beliefs.interned import InternedTexts, decoded_supports
+from reasoning.beliefs.frame_writer import FrameWriter, WriterGoneError
+from reasoning.beliefs.interned import INTERN, InternedTexts, decoded_supports
 from reasoning.beliefs.packed import (
     FIELDS,
     INDEX_SEPARATOR,
@@ -55,6 +65,7 @@ from reasoning.beliefs.packed import (
     rounded_cached,
     supports_packing,
 )
+from reasoning.beliefs.pending import PendingFrame, PendingFrames, entries_of, rtree_bounds
 from reasoning.beliefs.row_update import RowUpdate, Support, belief_of
 from reasoning.beliefs.seen_together import SEEN_TOGETHER, last_stated
 from reasoning.fusion.association import CameraModel, in_view
@@ -282,6 +293,7 @@ class BeliefStore:
         busy_timeout: float = 10.0,
         check: bool = True,
         history_limit: int = 100,
+        write_behind: int = 0,
     ) -> None:
         self.path = Path(path).expanduser()
         if synchronous.upper() not in SYNCHRONOUS_MODES:
@@ -298,8 +310,19 @@ class BeliefStore:
         """The codes of the attribute names, values and expert sets in the packed supports."""
         self._row_updates: RowUpdate | None = None
         """The row-level update of :meth:`integrate`, for the last tracker configuration."""
+        if write_behind < 0:
+            raise ValueError(f"write_behind must be 0 (off) or a number of frames, not {write_behind}")
+        self.write_behind = write_behind
+        """Frames :meth:`integrate` may return before they are committed (0: each is committed before it returns)."""
+        self._pending = PendingFrames()
+        """The frames fused and handed to the writer process but not known to be committed (write-behind)."""
+        self._writer: FrameWriter | None = None
+        self._frames_sent = 0
+        self._settings = (synchronous.upper(), busy_timeout)
         self._lock = threading.RLock()
         self._conn = self._open(synchronous.upper(), busy_timeout, check)
+        if write_behind:  # started with the store, as its connection is (later ones start when a frame needs them)
+            self._writer = FrameWriter(self.path, synchronous.upper(), busy_timeout, WAL_AUTOCHECKPOINT_PAGES)
 
     # ------------------------------------------------------------------ opening
 
@@ -398,9 +421,57 @@ class BeliefStore:
         return Path(platformdirs.user_data_dir("robokudo")) / "beliefs.sqlite"
 
     def close(self) -> None:
-        """Close the connection (idempotent)."""
+        """Commit the pending frames (write-behind), end the writer and close the connection (idempotent); a failed
+        pending frame raises here, after everything is closed."""
         with self._lock:
-            self._conn.close()
+            try:
+                self.flush()
+            finally:
+                if self._writer is not None:
+                    self._writer.close()
+                    self._writer = None
+                self._conn.close()
+
+    def flush(self) -> None:
+        """Wait until every frame :meth:`integrate` has returned is committed (a no-op unless ``write_behind``).
+
+        Raises the error of a pending frame whose write failed (that frame and those fused after it are not stored;
+        every frame before it is)."""
+        with self._lock:
+            while self._pending:
+                self._settle()
+
+    def _settle(self) -> None:
+        """Wait for the writer's answer on the oldest pending frame. A failed frame empties the pending frames, ends
+        the writer and raises its error."""
+        writer = self._writer
+        if writer is None or not self._pending:
+            return
+        try:
+            seq, failure = writer.answer()
+        except WriterGoneError as gone:
+            self._abandon()
+            raise BeliefStoreError(f"belief store {self.path}: {gone}; the pending frames were not stored") from gone
+        if failure is None:
+            self._pending.committed(seq)
+            return
+        lost = len(self._pending)
+        self._abandon()
+        kind, message = failure
+        error_class = getattr(sqlite3, kind, sqlite3.DatabaseError)
+        if not (isinstance(error_class, type) and issubclass(error_class, sqlite3.Error)):
+            error_class = sqlite3.DatabaseError
+        raise error_class(
+            f"belief store {self.path}: writing a fused frame failed ({message}); it and the {lost - 1} frame(s) "
+            "fused after it were not stored, every earlier frame was"
+        )
+
+    def _abandon(self) -> None:
+        """Drop the pending frames and end the writer (after a failure; the next frame starts a new one)."""
+        self._pending.clear()
+        writer, self._writer = self._writer, None
+        if writer is not None:
+            writer.close()
 
     def __enter__(self) -> BeliefStore:
         return self
@@ -411,10 +482,13 @@ class BeliefStore:
     # ------------------------------------------------------------------ transactions
 
     @contextmanager
-    def _guard(self) -> Iterator[sqlite3.Connection]:
-        """Hold the lock and turn corruption found while running into a BeliefStoreError."""
+    def _guard(self, drain: bool = True) -> Iterator[sqlite3.Connection]:
+        """Hold the lock and turn corruption found while running into a BeliefStoreError; with ``drain``, first wait
+        for the pending frames (every read and write but :meth:`integrate` sees each frame integrated before it)."""
         with self._lock:
             try:
+                if drain and self._pending:
+                    self.flush()
                 yield self._conn
             except sqlite3.DatabaseError as error:
                 if getattr(error, "sqlite_errorname", "") in _CORRUPT_ERRORS:
@@ -443,6 +517,7 @@ class BeliefStore:
         *,
         camera: CameraModel | None = None,
         tracker: BeliefTracker | None = None,
+        wait: bool = False,
     ) -> TrackStep:
         """Fuse one frame's objects into the store in one transaction and record the observations.
 
@@ -453,46 +528,106 @@ class BeliefStore:
         With the plain :class:`BeliefTracker` (no named regions) the step runs on the stored rows: matched beliefs in
         the common case are updated on their rows (:mod:`reasoning.beliefs.row_update`) and the step's ``changed``
         makes their ``ObjectBelief`` only when read; results are those of ``tracker.step`` on decoded beliefs.
+
+        With ``write_behind`` the frame's transaction is committed by the writer process while the caller goes on
+        (:mod:`reasoning.beliefs.frame_writer`); the call returns with at most ``write_behind`` frames uncommitted,
+        or none with ``wait``. Every other method first waits for them; a failed write raises on the next call.
         """
         tracker = tracker or self.tracker
+        if self.write_behind:
+            step = self._integrate_behind(objects, time, camera, tracker)
+            if wait:
+                self.flush()
+            return step
         writes: list[tuple[str, list[tuple]]] = []
         with self._transaction() as conn:
-            rows, loaded = self._candidates(conn, objects, camera, tracker.config.association.gate_distance)
-            next_id = int(conn.execute("SELECT value FROM meta WHERE key = 'next_id'").fetchone()[0])
-            allocated = [next_id]
-
-            def new_id() -> int:
-                value = allocated[0]
-                allocated[0] += 1
-                return value
-
+            next_id = int(conn.execute(_NEXT_ID).fetchone()[0])
             write = functools.partial(_write, conn, writes)
-            if RowUpdate.applies(tracker):
-                step, updated = self._step_on_rows(conn, tracker, rows, objects, time, new_id, camera)
-                cache = self._sources_cache()
-                update = self._row_update(tracker)
-                written = [
-                    _object_row(made, tracker.class_test, cache, self._interned, conn, write)
-                    if isinstance(made, ObjectBelief)
-                    else update.pack(made[0], made[1], write)
-                    for made in updated
-                ]
-                self._write_rows(conn, written, loaded, writes)
-            else:
-                beliefs = [_belief_from_row(row, self._interned, conn) for row in rows]
-                step = tracker.step(beliefs, objects, time, new_id, camera)
-                written = self._write_beliefs(conn, step.changed, tracker.class_test, loaded, writes)
-            counts = {row[0]: row[20] for row in written}
-            self._write_observations(conn, objects, [(i, counts.get(i, 0)) for i in step.assigned], time, writes)
-            if allocated[0] != next_id:
-                _write(conn, writes, "UPDATE meta SET value = ? WHERE key = 'next_id'", [(str(allocated[0]),)])
-            seen = set(step.assigned)
-            self._prune_history(conn, [(row[0], row[20]) for row in written if row[0] in seen], writes)
-            # beliefs missed earlier and not seen since, wherever they are, are gone after gone_after seconds
-            _write(conn, writes, _MARK_GONE, [(time - tracker.config.gone_after,)])
+            step, *_ = self._fuse(conn, objects, time, camera, tracker, next_id, write, writes, None)
         if self.write_log is not None:
             self.write_log.append(writes)
         return step
+
+    def _integrate_behind(
+        self, objects: Sequence[FrameObject], time: float, camera: CameraModel | None, tracker: BeliefTracker
+    ) -> TrackStep:
+        """:meth:`integrate` with the frame's writes handed to the writer process: the candidate rows are read from
+        the committed store through the overlay of the pending frames (:mod:`reasoning.beliefs.pending`)."""
+        pending = self._pending
+        writes: list[tuple[str, list[tuple]]] = []
+        with self._guard(drain=False) as conn:
+            next_id = pending.next_id if pending else int(conn.execute(_NEXT_ID).fetchone()[0])
+            write = functools.partial(_write_behind, conn, writes)
+            step, written, loaded, moved, after = self._fuse(
+                conn, objects, time, camera, tracker, next_id, write, writes, pending if pending else None
+            )
+            stored_moves = {entry[0]: entry for entry in rtree_bounds(moved)}
+            rows = entries_of(written, stored_moves, loaded, _COLUMN_COUNT)
+            if self._writer is None:
+                synchronous, busy_timeout = self._settings
+                self._writer = FrameWriter(self.path, synchronous, busy_timeout, WAL_AUTOCHECKPOINT_PAGES)
+            self._frames_sent += 1
+            try:
+                self._writer.send(self._frames_sent, next_id, writes)
+            except WriterGoneError as gone:
+                self._abandon()
+                raise BeliefStoreError(f"belief store {self.path}: {gone}; this frame and the pending ones were not "
+                                       "stored") from gone  # fmt: skip
+            pending.add(PendingFrame(self._frames_sent, rows, time - tracker.config.gone_after, after))
+            while len(pending) > self.write_behind:  # answers are taken here only: the overlay is always in use
+                self._settle()
+        if self.write_log is not None:
+            self.write_log.append(writes)
+        return step
+
+    def _fuse(
+        self,
+        conn: sqlite3.Connection,
+        objects: Sequence[FrameObject],
+        time: float,
+        camera: CameraModel | None,
+        tracker: BeliefTracker,
+        next_id: int,
+        write: Callable[[str, list[tuple]], None],
+        writes: list[tuple[str, list[tuple]]],
+        pending: PendingFrames | None,
+    ) -> tuple[TrackStep, list[tuple], dict[int, tuple], list[tuple], int]:
+        """The step of one frame and its writes (through ``write``, into ``writes``), new ids from ``next_id``.
+        Returns the step, the object rows written, the candidate rows by id (with their R*Tree entries), the R*Tree
+        entries rewritten and ``meta.next_id`` after the frame."""
+        rows, loaded = self._candidates(conn, objects, camera, tracker.config.association.gate_distance, pending)
+        allocated = [next_id]
+
+        def new_id() -> int:
+            value = allocated[0]
+            allocated[0] += 1
+            return value
+
+        moved: list[tuple] = []
+        if RowUpdate.applies(tracker):
+            step, updated = self._step_on_rows(conn, tracker, rows, objects, time, new_id, camera)
+            cache = self._sources_cache()
+            update = self._row_update(tracker)
+            written = [
+                _object_row(made, tracker.class_test, cache, self._interned, conn, write)
+                if isinstance(made, ObjectBelief)
+                else update.pack(made[0], made[1], write)
+                for made in updated
+            ]
+            self._write_rows(conn, written, loaded, writes, write, moved)
+        else:
+            beliefs = [_belief_from_row(row, self._interned, conn) for row in rows]
+            step = tracker.step(beliefs, objects, time, new_id, camera)
+            written = self._write_beliefs(conn, step.changed, tracker.class_test, loaded, writes, write, moved)
+        counts = {row[0]: row[20] for row in written}
+        self._write_observations(conn, objects, [(i, counts.get(i, 0)) for i in step.assigned], time, write)
+        if allocated[0] != next_id:
+            write("UPDATE meta SET value = ? WHERE key = 'next_id'", [(str(allocated[0]),)])
+        seen = set(step.assigned)
+        self._prune_history([(row[0], row[20]) for row in written if row[0] in seen], write)
+        # beliefs missed earlier and not seen since, wherever they are, are gone after gone_after seconds
+        write(_MARK_GONE, [(time - tracker.config.gone_after,)])
+        return step, written, loaded, moved, allocated[0]
 
     def _row_update(self, tracker: BeliefTracker) -> RowUpdate:
         """The row-level update for ``tracker`` (one per tracker configuration, kept while it is the same)."""
@@ -606,9 +741,10 @@ class BeliefStore:
         objects: Sequence[FrameObject],
         camera: CameraModel | None,
         gate: float,
+        pending: PendingFrames | None = None,
     ) -> tuple[list[tuple], dict[int, tuple]]:
         """The rows of the present beliefs within ``gate`` of an observation or in view of ``camera`` (R*Tree
-        look-ups), by id.
+        look-ups), by id; with ``pending``, as they are once its frames are committed (:meth:`PendingFrames.overlaid`).
 
         Also returns each row by id with its R*Tree entry after its columns, so unchanged R*Tree entries and index
         columns are not rewritten.
@@ -626,6 +762,8 @@ class BeliefStore:
             parameters = bounds.ravel().tolist()
             found = conn.execute(_candidate_query(len(members)), (*parameters, frame, WORLD_FRAME, recording, PRESENT))
             found = found.fetchall()
+            if pending is not None:
+                found = pending.overlaid(found, bounds, frame, WORLD_FRAME, recording)
             if not found:
                 continue
             positions = np.array([row[3:6] for row in found], dtype=np.float64)
@@ -638,7 +776,9 @@ class BeliefStore:
             low, high = _frustum_bounds(camera)
             world = (camera.frame, WORLD_FRAME, camera.recording)
             box = (high[0], low[0], high[1], low[1], high[2], low[2])
-            found = conn.execute(_candidate_query(1), (*box, *world, PRESENT))
+            found = conn.execute(_candidate_query(1), (*box, *world, PRESENT)).fetchall()
+            if pending is not None:
+                found = pending.overlaid(found, np.array(box), *world)
             in_frustum = [row for row in found if row[0] not in rows]
             if in_frustum:
                 positions = np.array([(row[3], row[4], row[5]) for row in in_frustum], dtype=np.float64)
@@ -654,17 +794,20 @@ class BeliefStore:
         class_test: ClassTest | None,
         loaded: Mapping[int, tuple] | None = None,
         writes: list[tuple[str, list[tuple]]] | None = None,
+        write: Callable[[str, list[tuple]], None] | None = None,
+        moved: list[tuple] | None = None,
     ) -> list[tuple]:
-        """Write the object rows of ``beliefs`` (:meth:`_write_rows`); returns the rows written."""
+        """Write the object rows of ``beliefs`` (:meth:`_write_rows`; with ``write``, through it, else run on
+        ``conn`` and noted in ``writes``); returns the rows written."""
         if not beliefs:
             return []
-        log = [] if writes is None else writes
+        if write is None:
+            write = functools.partial(_write, conn, [] if writes is None else writes)
         cache = self._sources_cache()
-        write = functools.partial(_write, conn, log)
         latest = {b.id: b for b in beliefs}  # a belief given twice is written as its last object is
         written = beliefs if len(latest) == len(beliefs) else [latest[b.id] for b in beliefs]
         rows = [_object_row(b, class_test, cache, self._interned, conn, write) for b in written]
-        self._write_rows(conn, rows, loaded, log)
+        self._write_rows(conn, rows, loaded, writes, write, moved)
         return rows
 
     def _write_rows(
@@ -672,9 +815,12 @@ class BeliefStore:
         conn: sqlite3.Connection,
         rows: Sequence[tuple],
         loaded: Mapping[int, tuple] | None,
-        log: list[tuple[str, list[tuple]]],
+        log: list[tuple[str, list[tuple]]] | None,
+        write: Callable[[str, list[tuple]], None] | None = None,
+        moved_out: list[tuple] | None = None,
     ) -> None:
-        """Write object rows, their R*Tree entries and attribute-index entries (noted in ``log``).
+        """Write object rows, their R*Tree entries and attribute-index entries (through ``write``, else run on
+        ``conn`` and noted in ``log``); the R*Tree entries rewritten are added to ``moved_out``.
 
         ``loaded`` holds the stored rows of beliefs as the candidate search read them (their columns, then their
         R*Tree entry: x0, x1, y0, y1, z0, z1); those beliefs are updated in place, their indexed columns and index
@@ -685,6 +831,8 @@ class BeliefStore:
         """
         if not rows:
             return
+        if write is None:
+            write = functools.partial(_write, conn, [] if log is None else log)
         loaded = loaded or {}
         fresh: list[tuple] = []
         volatile: list[tuple] = []
@@ -727,25 +875,25 @@ class BeliefStore:
             if class_name and class_name != (state[1] if state is not None else None):
                 classes.add((class_name,))
         if fresh:
-            _write(conn, log, "DELETE FROM attribute_index WHERE object_id = ?", [(row[0],) for row in fresh])
-            _write(conn, log, f"INSERT OR REPLACE INTO objects ({_OBJECT_COLUMNS}) VALUES ({_PLACEHOLDERS})", fresh)
+            write("DELETE FROM attribute_index WHERE object_id = ?", [(row[0],) for row in fresh])
+            write(f"INSERT OR REPLACE INTO objects ({_OBJECT_COLUMNS}) VALUES ({_PLACEHOLDERS})", fresh)
         if volatile:
-            _write(conn, log, _UPDATE_VOLATILE, volatile)
+            write(_UPDATE_VOLATILE, volatile)
             if relabelled:
-                _write(
-                    conn,
-                    log,
+                write(
                     "UPDATE objects SET class_name = ?, region = ?, region_class = ?, indexed = ? WHERE id = ?",
                     relabelled,
                 )
         if removed:
-            _write(conn, log, "DELETE FROM attribute_index WHERE name = ? AND value = ? AND object_id = ?", removed)
+            write("DELETE FROM attribute_index WHERE name = ? AND value = ? AND object_id = ?", removed)
         if added:
-            _write(conn, log, "INSERT OR IGNORE INTO attribute_index VALUES (?, ?, ?)", added)
+            write("INSERT OR IGNORE INTO attribute_index VALUES (?, ?, ?)", added)
         if moved:
-            _write(conn, log, "INSERT OR REPLACE INTO objects_place VALUES (?, ?, ?, ?, ?, ?, ?)", moved)
+            if moved_out is not None:
+                moved_out.extend(moved)
+            write("INSERT OR REPLACE INTO objects_place VALUES (?, ?, ?, ?, ?, ?, ?)", moved)
         if classes:
-            _write(conn, log, "INSERT OR IGNORE INTO classes VALUES (?)", list(classes))
+            write("INSERT OR IGNORE INTO classes VALUES (?)", list(classes))
 
     def _write_observations(
         self,
@@ -753,13 +901,12 @@ class BeliefStore:
         objects: Sequence[FrameObject],
         assigned: Sequence[tuple[int, int]],
         time: float,
-        writes: list[tuple[str, list[tuple]]],
+        write: Callable[[str, list[tuple]], None],
     ) -> None:
         """Record each object's sighting under (belief id, its sighting number), its statements packed
-        (:data:`STATEMENT`)."""
+        (:data:`STATEMENT`), through ``write``."""
         cache = self._sources_cache()
         interned = self._interned
-        write = functools.partial(_write, conn, writes)
         rows = [
             (
                 object_id,
@@ -776,9 +923,7 @@ class BeliefStore:
             if object_id
         ]
         if rows:
-            _write(
-                conn,
-                writes,
+            write(
                 "INSERT OR REPLACE INTO observations (object_id, seq, time, frame, px, py, pz, roi, sources, evidence, "
                 "recording) VALUES (?, ?, ?, ?, ?, ?, ?, ?, ?, ?, ?)",
                 rows,
@@ -790,14 +935,12 @@ class BeliefStore:
             self._sources_text.clear()
         return self._sources_text
 
-    def _prune_history(
-        self, conn: sqlite3.Connection, seen: Sequence[tuple[int, int]], writes: list[tuple[str, list[tuple]]]
-    ) -> None:
+    def _prune_history(self, seen: Sequence[tuple[int, int]], write: Callable[[str, list[tuple]], None]) -> None:
         """Drop the oldest sightings of the ``seen`` (belief id, sightings) beyond ``history_limit`` (every 16th)."""
         limit = self.history_limit
         due = [(i, count - limit) for i, count in seen if count > limit and count % 16 == 0]
         if due:
-            _write(conn, writes, "DELETE FROM observations WHERE object_id = ? AND seq <= ?", due)
+            write("DELETE FROM observations WHERE object_id = ? AND seq <= ?", due)
 
     # ------------------------------------------------------------------ reading
 
@@ -958,11 +1101,23 @@ class BeliefStore:
 
 
 _MARK_GONE = "UPDATE objects SET status = 'gone' WHERE misses > 0 AND status = 'present' AND last_seen <= ?"
+_NEXT_ID = "SELECT value FROM meta WHERE key = 'next_id'"
 
 
 def _write(conn: sqlite3.Connection, log: list[tuple[str, list[tuple]]], statement: str, rows: list[tuple]) -> None:
     """Run one write statement over ``rows`` and note it in ``log`` (what the benchmark's reference replays)."""
     conn.executemany(statement, rows)
+    log.append((statement, rows))
+
+
+def _write_behind(
+    conn: sqlite3.Connection, log: list[tuple[str, list[tuple]]], statement: str, rows: list[tuple]
+) -> None:
+    """Note one write statement over ``rows`` in ``log`` for the writer process; texts to intern are interned at once
+    on ``conn`` (committed on their own: the table is append-only and a code never changes, so the frame's reads know
+    their codes; the writer's repetition of the statement then changes nothing)."""
+    if statement == INTERN:
+        conn.executemany(statement, rows)
     log.append((statement, rows))
 
 

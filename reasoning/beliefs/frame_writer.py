@@ -1,0 +1,147 @@
+"""A belief store's write-behind writer: a child process that commits the frames a store has fused, one transaction
+per frame, while the store's process fuses the next frame (issue 19).
+
+A process and not a thread: ``sqlite3`` releases the GIL around each statement step only, so a writer thread takes
+the GIL back after every row and waits behind the fusing thread's Python each time; a process runs its SQLite calls
+on the second core without that hand-over.
+
+Protocol (both ways: a 4-byte little-endian length, then a :mod:`marshal` record):
+
+* store -> writer: ``(seq, next_id, writes)``: the frame's number, the ``meta.next_id`` the frame read (``None``:
+  not checked), and its ``(statement, rows)`` pairs in order. The writer runs them in ``BEGIN IMMEDIATE`` ...
+  ``COMMIT`` after checking that ``meta.next_id`` still holds ``next_id`` (another writer of the same file would
+  otherwise hand out the same ids).
+* writer -> store: ``(seq, None)`` once the frame is committed, or ``(seq, (error class, message))`` when it failed;
+  the failed frame is rolled back and the writer exits without running any later frame (they were fused on top of it).
+
+At the end of its input (the store closed, or its process died) the writer commits the frames it has read whole and
+exits. This module imports the standard library only: the writer runs as ``python -I frame_writer.py <path>
+<synchronous> <busy timeout s> <autocheckpoint pages>``.
+"""
+
+from __future__ import annotations
+
+import contextlib
+import marshal
+import os
+import sqlite3
+import struct
+import subprocess
+import sys
+from pathlib import Path
+
+LENGTH = struct.Struct("<I")
+"""The length prefix of every record."""
+
+NEXT_ID = "SELECT value FROM meta WHERE key = 'next_id'"
+
+
+class WriterGoneError(Exception):
+    """The writer process ended without answering for every frame sent."""
+
+
+def _read_exactly(fd: int, count: int) -> bytes | None:
+    """``count`` bytes from ``fd`` (None at the end of input, also when it ends part-way)."""
+    chunks: list[bytes] = []
+    left = count
+    while left:
+        chunk = os.read(fd, left)
+        if not chunk:
+            return None
+        chunks.append(chunk)
+        left -= len(chunk)
+    return b"".join(chunks)
+
+
+def _read_record(fd: int) -> object | None:
+    header = _read_exactly(fd, LENGTH.size)
+    if header is None:
+        return None
+    body = _read_exactly(fd, LENGTH.unpack(header)[0])
+    return None if body is None else marshal.loads(body)
+
+
+def _write_record(fd: int, record: object) -> None:
+    body = marshal.dumps(record)
+    view = memoryview(LENGTH.pack(len(body)) + body)
+    while view:
+        view = view[os.write(fd, view) :]
+
+
+class FrameWriter:
+    """The store's side of one writer process: send frames, collect what became of them."""
+
+    def __init__(self, path: Path, synchronous: str, busy_timeout: float, autocheckpoint: int) -> None:
+        self.process = subprocess.Popen(
+            [sys.executable, "-I", __file__, str(path), synchronous, str(busy_timeout), str(autocheckpoint)],
+            stdin=subprocess.PIPE,
+            stdout=subprocess.PIPE,
+            close_fds=True,
+        )
+        assert self.process.stdin is not None and self.process.stdout is not None
+        self._out = self.process.stdin.fileno()
+        self._in = self.process.stdout.fileno()
+
+    def send(self, seq: int, next_id: int | None, writes: list[tuple[str, list[tuple]]]) -> None:
+        """Hand one frame's writes to the writer (raises :class:`WriterGoneError` when it has ended)."""
+        try:
+            _write_record(self._out, (seq, next_id, writes))
+        except BrokenPipeError as error:
+            raise WriterGoneError(f"the writer process ended (exit code {self.process.poll()})") from error
+
+    def answer(self) -> tuple[int, tuple[str, str] | None]:
+        """The next frame's outcome (waiting for it): ``(seq, None)`` committed, ``(seq, (error class, message))``
+        failed. Raises :class:`WriterGoneError` when the writer ended without answering."""
+        record = _read_record(self._in)
+        if record is None:
+            code = self.process.wait()
+            raise WriterGoneError(f"the writer process ended without committing every frame (exit code {code})")
+        return record  # type: ignore[return-value]
+
+    def close(self) -> None:
+        """End the writer's input and wait for it (it commits what it has read first)."""
+        assert self.process.stdin is not None and self.process.stdout is not None
+        with contextlib.suppress(BrokenPipeError):
+            self.process.stdin.close()
+        self.process.wait()
+        self.process.stdout.close()
+
+
+def serve(path: str, synchronous: str, busy_timeout: float, autocheckpoint: int) -> int:
+    """The writer's loop (see the module docstring); returns the exit code."""
+    if hasattr(os, "SCHED_BATCH"):  # throughput work: waking it (a frame sent) must not preempt the fusing process
+        with contextlib.suppress(OSError):
+            os.sched_setscheduler(0, os.SCHED_BATCH, os.sched_param(0))
+    conn = sqlite3.connect(path, timeout=busy_timeout, isolation_level=None)
+    conn.execute(f"PRAGMA busy_timeout = {int(busy_timeout * 1000)}")
+    conn.execute(f"PRAGMA synchronous = {synchronous}")
+    conn.execute(f"PRAGMA wal_autocheckpoint = {autocheckpoint}")
+    source, sink = sys.stdin.fileno(), sys.stdout.fileno()
+    while (record := _read_record(source)) is not None:
+        seq, next_id, writes = record  # type: ignore[misc]
+        try:
+            conn.execute("BEGIN IMMEDIATE")
+            if next_id is not None:
+                stored = int(conn.execute(NEXT_ID).fetchone()[0])
+                if stored != next_id:
+                    raise sqlite3.OperationalError(
+                        f"another writer changed the store (next id {stored}, the frame was fused at {next_id})"
+                    )
+            for statement, rows in writes:
+                conn.executemany(statement, rows)
+            conn.execute("COMMIT")
+        except sqlite3.Error as error:
+            if conn.in_transaction:
+                conn.execute("ROLLBACK")
+            with contextlib.suppress(BrokenPipeError):
+                _write_record(sink, (seq, (type(error).__name__, str(error))))
+            conn.close()
+            return 1
+        with contextlib.suppress(BrokenPipeError):  # the store's process ended: go on committing what it sent
+            _write_record(sink, (seq, None))
+    conn.close()
+    return 0
+
+
+if __name__ == "__main__":
+    sys.exit(serve(sys.argv[1], sys.argv[2], float(sys.argv[3]), int(sys.argv[4])))
