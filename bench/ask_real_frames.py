@@ -3,6 +3,7 @@ would: for each frame one answering service with a fresh belief store, every que
 (or the error a user sees) and writes the frame with the answer drawn to OUT/<tag>_q<N>.png, to be looked at.
 
     PYTHONPATH=. python bench/ask_real_frames.py [OUT]        (default OUT: /tmp/realtrial)
+    PYTHONPATH=. python bench/ask_real_frames.py [OUT] --new  (only NEW_QUESTIONS: the TUM desk, unused frames)
 
 The unorganized cloud is made here from mOSD learn35 (finite points shuffled, HEIGHT 1) and read with the
 PrimeSense intrinsics. Judging the answers is a person's job: the table holds the verdicts.
@@ -188,6 +189,33 @@ QUESTIONS: list[dict] = [
     },
 ]
 
+NEW_QUESTIONS: list[dict] = [
+    {
+        "tag": "ntum",
+        "input": "tum_rgbd_sample_open3d",
+        "frame": 0,
+        "queries": [
+            "what is on the table",
+            "how many bottles are there",
+            "find the green bottle",
+            "find something yellow",
+            "find the magazine",
+            "find the scissors",
+            "find the plastic bag",
+            "find the white cup",
+            "find the mug on the table",
+            "find the chair",
+        ],
+    },
+    {"tag": "n10", "input": "pcl_mosd_tabletop/learn/learn10.pcd", "frame": 0, "queries": ["find the red box"]},
+    {"tag": "n22", "input": "pcl_mosd_tabletop/learn/learn22.pcd", "frame": 0, "queries": ["how many boxes are there"]},
+    {"tag": "n28", "input": "pcl_mosd_tabletop/learn/learn28.pcd", "frame": 0, "queries": ["find the yellow box"]},
+    {"tag": "n40", "input": "pcl_mosd_tabletop/learn/learn40.pcd", "frame": 0, "queries": ["find something yellow"]},
+    {"tag": "n43", "input": "pcl_mosd_tabletop/learn/learn43.pcd", "frame": 0, "queries": ["how many cans are there"]},
+]
+"""Questions asked later (realtrial-table.txt, second section): ten on the TUM desk, one each on five mOSD frames
+no earlier question used."""
+
 
 def unorganized_copy(organized: Path, folder: Path) -> Path:
     """``organized`` as an unorganized cloud (its finite points shuffled, HEIGHT 1) in ``folder``."""
@@ -203,10 +231,10 @@ def unorganized_copy(organized: Path, folder: Path) -> Path:
     return path
 
 
-def ask(out: Path) -> None:
-    """Ask every question and write the pictures into ``out``."""
+def ask(out: Path, jobs: list[dict]) -> None:
+    """Ask every question of ``jobs`` and write the pictures into ``out``."""
     out.mkdir(parents=True, exist_ok=True)
-    for job in QUESTIONS:
+    for job in jobs:
         source, intrinsics = job["input"], None
         if source.startswith(UNORGANIZED):
             path, intrinsics = unorganized_copy(DATA / source.removeprefix(UNORGANIZED), out), PRIMESENSE
@@ -234,4 +262,8 @@ def ask(out: Path) -> None:
 
 
 if __name__ == "__main__":
-    ask(Path(sys.argv[1]) if len(sys.argv) > 1 else Path("/tmp/realtrial"))
+    arguments = [argument for argument in sys.argv[1:] if argument != "--new"]
+    ask(
+        Path(arguments[0]) if arguments else Path("/tmp/realtrial"),
+        NEW_QUESTIONS if "--new" in sys.argv[1:] else QUESTIONS,
+    )
