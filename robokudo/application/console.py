@@ -7,9 +7,13 @@ module imports only the interrupt handling, installs it, and then imports the CL
 
 from __future__ import annotations
 
+import os
 import sys
 
 from robokudo.application.interrupts import InterruptHandling
+
+BROKEN_PIPE_STATUS = 141
+"""The exit status when the output's reader went away: 128 + SIGPIPE, as a shell reports a killed pipe writer."""
 
 
 def main() -> int:
@@ -21,7 +25,14 @@ def main() -> int:
             if interrupts.received is None:
                 raise
             interrupts.exit()
-    return cli.main()
+    try:
+        status = cli.main()
+        sys.stdout.flush()
+    except BrokenPipeError:
+        # the reader of the output went away (``robokudo beliefs | head -1``): stop quietly, as Unix tools do
+        os.dup2(os.open(os.devnull, os.O_WRONLY), sys.stdout.fileno())  # the final flush must not fail again
+        return BROKEN_PIPE_STATUS
+    return status
 
 
 if __name__ == "__main__":
