@@ -65,6 +65,9 @@ QUESTION_ATTRIBUTES: MappingProxyType[str, str] = MappingProxyType(
 COUNT_QUESTIONS: frozenset[tuple[str, ...]] = frozenset({("how", "many")})
 """Openings of a question for every object of a kind: ``how many cans are there``."""
 
+COUNT_VERBS: frozenset[tuple[str, ...]] = frozenset({("count",)})
+"""Verbs (of :data:`VERBS`) that ask how many: ``count the bowls`` is answered with the number, as ``how many``."""
+
 COUNT_TAILS: frozenset[tuple[str, ...]] = frozenset(
     {
         ("are", "there"),

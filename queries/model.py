@@ -193,6 +193,8 @@ class Query:
     body: Block
     source: str = field(default="", compare=False)
     kind_span: Span = field(default=NO_SPAN, compare=False)
+    counted: bool = field(default=False, compare=False)
+    """A how-many question (``how many cans are there``): the same detection, and the answer says how many."""
 
     def get(self, path: str) -> Value | None:
         """Return the value at a dotted key path such as ``"obj.type"``."""

@@ -64,6 +64,7 @@ from queries.lexicon import (
     CONJUNCTIONS,
     COUNT_QUESTIONS,
     COUNT_TAILS,
+    COUNT_VERBS,
     COUNT_WORDS,
     FILLERS,
     GENERIC_NOUNS,
@@ -315,6 +316,7 @@ class _PhraseParser:
         if counted is not None:
             return counted
         asked_key: str | None = None
+        verb: tuple[str, ...] | None = None
         placement = self.match(PLACEMENT_VERBS)
         if placement is not None:
             verb_tokens = self.take(len(placement))
@@ -356,7 +358,7 @@ class _PhraseParser:
                 body = self.object_body(kind, phrase)
             if watch is not None:
                 body = Block((*body.fields, watch))
-        query = Query(kind, body, self.text, kind_span)
+        query = Query(kind, body, self.text, kind_span, counted=kind == "detect" and verb in COUNT_VERBS)
         validate_query(query)
         return query
 
@@ -387,7 +389,7 @@ class _PhraseParser:
 
     def how_many_question(self) -> Query | None:
         """``how many cans are there (on the table)`` / ``how many cups do you see``: a detect query for every such
-        object (the answer lists them, one line each); None when the phrase does not start with ``how many``."""
+        object (the answer says how many and lists them); None when the phrase does not start with ``how many``."""
         opening = self.match(COUNT_QUESTIONS)
         if opening is None:
             return None
@@ -405,7 +407,7 @@ class _PhraseParser:
         self.expect_end()
         phrase.limit, phrase.limit_span = None, None
         kind_span = _join_span(verb_tokens[0].span, verb_tokens[-1].span)
-        query = Query("detect", self.object_body("detect", phrase), self.text, kind_span)
+        query = Query("detect", self.object_body("detect", phrase), self.text, kind_span, counted=True)
         validate_query(query)
         return query
 

@@ -185,7 +185,8 @@ class AnswerStep(Annotator):
                 if b.id == pointing.object_id
             ][:1]
         query_view = self.optional_view(QueryView)
-        text = query_view.query.source if query_view is not None and isinstance(query_view.query, Query) else ""
+        asked = query_view.query if query_view is not None and isinstance(query_view.query, Query) else None
+        text = asked.source if asked is not None else ""
         answer = Answer(
             query=str(text or ""),
             objects=tuple(
@@ -204,6 +205,7 @@ class AnswerStep(Annotator):
             track=None if track is None else _track_designator(track, tracked),
             pointing=pointing,
             placements=self._placements() if self.free_space else None,
+            counted=asked is not None and asked.counted,
         )
         self.write(QueryAnswer(answer))
         if self.fail_when_empty and not matching:

@@ -302,6 +302,9 @@ class Answer:
     """The pointing target of a pointing query (None for other queries, and then absent from the JSON)."""
     placements: tuple[PlacementDesignator, ...] | None = None
     """Free places, largest first, when the query asked for free space (None when it did not)."""
+    counted: bool = False
+    """The query asked how many (``how many cans are there``): the summary starts with the number and the JSON
+    has ``count``."""
 
     def to_dict(self) -> dict[str, Any]:
         """A JSON-ready dict (``placements`` only when the query asked for free space)."""
@@ -317,6 +320,8 @@ class Answer:
             found["pointing"] = self.pointing.to_dict()
         if self.placements is not None:
             found["placements"] = [p.to_dict() for p in self.placements]
+        if self.counted:
+            found["count"] = len(self.objects)
         return found
 
     def to_json(self, indent: int | None = 2) -> str:
@@ -329,6 +334,8 @@ class Answer:
         right), ``exists`` the confidence that the object is there; then the free places
         when the query asked for free space."""
         lines = self._object_lines()
+        if self.counted:
+            lines.insert(0, f"count: {len(self.objects)}")
         if self.placements is not None:
             lines += [p.summary() for p in self.placements] or ["no free place for the footprint"]
         return "\n".join(lines)
@@ -507,9 +514,12 @@ def _with_answering(classes: AttributeBelief | None, answering: Sequence[Evidenc
     return merged.values
 
 
-def answer_from_memory(store: BeliefStore, belief_filter: BeliefFilter, query: str = "", **options: Any) -> Answer:
+def answer_from_memory(
+    store: BeliefStore, belief_filter: BeliefFilter, query: str = "", *, counted: bool = False, **options: Any
+) -> Answer:
     """Answer a query from the store alone (no perception): the matching known objects, most confident first; with
-    a ``limit``, the ones most likely to be what was asked (:func:`~reasoning.beliefs.ranking.answer_order`)."""
+    a ``limit``, the ones most likely to be what was asked (:func:`~reasoning.beliefs.ranking.answer_order`);
+    ``counted``: the query asked how many."""
     if belief_filter.limit is not None:
         views = store.query_views(replace(belief_filter, limit=None), _belief_view)
         views.sort(key=lambda v: answer_order(v.belief, belief_filter))
@@ -521,4 +531,4 @@ def answer_from_memory(store: BeliefStore, belief_filter: BeliefFilter, query: s
         _designate(v, class_test=belief_filter.class_test, asked_class=belief_filter.object_class, **options)
         for v in views
     )
-    return Answer(query=query, objects=designators, from_memory=True)
+    return Answer(query=query, objects=designators, from_memory=True, counted=counted)

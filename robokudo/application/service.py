@@ -585,7 +585,9 @@ class AnsweringService:
 
     def _remembered(self, query: Query, *, timed_out: bool = False) -> Answer:
         """The stored beliefs matching ``query``, as an answer from memory."""
-        answer = answer_from_memory(self.store, belief_filter(query, self.kb), query.source, label_of=self.kb.label)
+        answer = answer_from_memory(
+            self.store, belief_filter(query, self.kb), query.source, counted=query.counted, label_of=self.kb.label
+        )
         return replace(answer, timed_out=timed_out)
 
     def start(self, query: str | Query, *, on_tick: Callable[[TickProgress], None] | None = None) -> TaskHandle:

@@ -109,3 +109,28 @@ def test_a_question_naming_no_class_or_property_says_what_the_objects_are(
     assert any(line.startswith("#1 Cheez-It crackers (red)") for line in lines)
     assert sum(" bowl (" in line for line in lines) == 2 and any(" mug (blue)" in line for line in lines)
     assert all("KnowledgeClassifier" in line for line in lines)
+
+
+@pytest.mark.real_data
+def test_how_many_is_answered_with_the_number_first(capsys: pytest.CaptureFixture[str]) -> None:
+    """uoc frame 0 holds three cans (soup, Spam, a small can): "how many cans are there" listed them and never said
+    how many; the answer now starts with the number, in the text and in the JSON, and it is the number listed."""
+    lines = query(capsys, "how many cans are there", "--input", uoc(), "--frame", "0")
+    assert lines[0] == f"count: {len(lines) - 1}"
+    assert len(lines) - 1 == 3
+    assert cli.main(["query", "--json", "how many cans are there", "--input", uoc(), "--frame", "0"]) == 0
+    document = json.loads(capsys.readouterr().out)
+    assert document["count"] == len(document["objects"]) == 3
+    assert cli.main(["query", "--json", "find the cans", "--input", uoc(), "--frame", "0"]) == 0
+    assert "count" not in json.loads(capsys.readouterr().out)
+
+
+@pytest.mark.real_data
+def test_how_many_asked_of_memory_says_the_number_too(capsys: pytest.CaptureFixture[str]) -> None:
+    """After frame 0 was seen, "how many objects are there" asked of the stored beliefs (``robokudo beliefs``)
+    answers with the number of the objects it lists: the eleven seen."""
+    seen = query(capsys, "find all objects", "--input", uoc(), "--frame", "0")
+    assert cli.main(["beliefs", "how many objects are there"]) == 0, capsys.readouterr().err
+    lines = capsys.readouterr().out.splitlines()
+    assert lines[0] == f"count: {len(seen)}"
+    assert len([line for line in lines if line.startswith("#")]) == len(seen) >= 10

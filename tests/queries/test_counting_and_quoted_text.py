@@ -49,3 +49,19 @@ def test_how_many_without_an_object_is_located_after_it() -> None:
     with pytest.raises(QueryError) as caught:
         parse_query("how many are there")
     assert "expected an object" in caught.value.message
+
+
+@pytest.mark.parametrize(
+    ("phrase", "counted"),
+    [
+        ("how many cans are there", True),
+        ("How many cups do you see?", True),
+        ("count the bowls", True),
+        ("count all the objects on the table", True),
+        ("find the cans", False),
+        ("find all bowls", False),
+        ("show me the cups", False),
+    ],
+)
+def test_a_count_question_is_marked_so_its_answer_says_how_many(phrase: str, counted: bool) -> None:
+    assert parse_query(phrase).counted is counted

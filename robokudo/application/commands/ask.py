@@ -106,11 +106,12 @@ def _report(message: dict[str, Any], as_json: bool) -> int:
 
 
 def summary(answer: dict[str, Any]) -> str:
-    """One line per object of a served answer: id, class, region, position and existence confidence."""
+    """One line per object of a served answer: id, class, region, position and existence confidence (after the
+    number of them when the question asked how many)."""
     objects = answer.get("objects", [])
+    lines = [f"count: {answer['count']}"] if "count" in answer else []
     if not objects:
-        return "no matching object"
-    lines = []
+        return "\n".join([*lines, "no matching object"])
     for o in objects:
         position = ", ".join(f"{v:.2f}" for v in o["pose"]["position"])
         where = f" in {o['region']}" if o.get("region") else ""

@@ -68,7 +68,7 @@ def run(args: argparse.Namespace) -> int:
         if args.clear and not args.query:
             return _clear_everything(path, args)
         kb = load_knowledge_base() if args.query else None
-        query_filter = _filter(args.query, args.all, kb)
+        query_filter, counted = _filter(args.query, args.all, kb)
         if not path.exists():  # reading never creates the store
             _check_ids(query_filter, None)
             if args.clear:
@@ -80,7 +80,7 @@ def run(args: argparse.Namespace) -> int:
                 ids = tuple(b.id for b in store.query(query_filter))
                 return _print_cleared(store.forget(ids), ids, path, args)
             options = {"label_of": kb.label} if kb is not None else {}
-            answer = answer_from_memory(store, query_filter, args.query or "", **options)
+            answer = answer_from_memory(store, query_filter, args.query or "", counted=counted, **options)
         return _print(answer, args, None)
     except (BeliefStoreError, _RefusedError) as error:
         print(f"robokudo beliefs: {error}", file=sys.stderr)
@@ -130,9 +130,10 @@ def _check_ids(query_filter: BeliefFilter, store: BeliefStore | None) -> None:
             raise _RefusedError(f"no object {object_id}")
 
 
-def _filter(text: str | None, include_gone: bool, kb: KnowledgeBase | None) -> BeliefFilter:
+def _filter(text: str | None, include_gone: bool, kb: KnowledgeBase | None) -> tuple[BeliefFilter, bool]:
+    """The belief filter of a memory question and whether it asks how many."""
     if not text:
-        return BeliefFilter(include_gone=include_gone)
+        return BeliefFilter(include_gone=include_gone), False
     added = ""
     try:
         query = parse_query(text)
@@ -143,7 +144,7 @@ def _filter(text: str | None, include_gone: bool, kb: KnowledgeBase | None) -> B
         except QueryError:
             raise _RefusedError(str(error)) from error
     try:
-        return belief_filter(query, kb, include_gone=include_gone, strict=True)
+        return belief_filter(query, kb, include_gone=include_gone, strict=True), query.counted
     except TermError as error:
         raise _RefusedError(_located(text, query, error, len(added))) from error
 
