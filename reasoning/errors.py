@@ -29,12 +29,16 @@ class TermError(KeyError):
 
 
 class UnknownTermError(TermError):
-    """A word or name the ontology does not know; ``suggestions`` holds close matches."""
+    """A word or name the ontology does not know; ``suggestions`` holds close matches; ``advice`` (said when there
+    are none) what to ask or do instead."""
 
-    def __init__(self, word: str, what: str = "term", suggestions: Sequence[str] = ()) -> None:
+    def __init__(self, word: str, what: str = "term", suggestions: Sequence[str] = (), advice: str = "") -> None:
         self.word = word
         self.suggestions = tuple(suggestions)
-        hint = f"; did you mean {', '.join(repr(s) for s in self.suggestions)}?" if self.suggestions else ""
+        if self.suggestions:
+            hint = f"; did you mean {', '.join(repr(s) for s in self.suggestions)}?"
+        else:
+            hint = f"; {advice}" if advice else ""
         super().__init__(f"unknown {what} {word!r}{hint}")
 
 

@@ -32,13 +32,16 @@ from reasoning.knowledge.model import (
     Resolved,
 )
 from reasoning.knowledge.sources import Sources, Stamp, defined_names, file_stamp, merge_graphs, parse_turtle
-from reasoning.knowledge.words import singular_keys, word_key
+from reasoning.knowledge.words import close_keys, singular_keys, word_key
 from robokudo.core.regions import RegionBox
 
 if TYPE_CHECKING:
     from robokudo.core.annotator import Annotator
 
 log = logging.getLogger(__name__)
+
+UNKNOWN_CLASS_ADVICE = "'find all objects' shows every object seen, and a new class can be added to the user ontology"
+"""Said with an unknown object class that resembles no known one (a person asked for something not modelled)."""
 
 _ALL_CONDITIONS = Conditions()
 _CLASS_KINDS: tuple[Kind, ...] = ("class", "region_class", "color", "shape", "size", "material")
@@ -215,7 +218,8 @@ class KnowledgeBase:
             return exact
         found = self._lookup(word, kinds)
         if not found:
-            raise UnknownTermError(word, self._what(kinds), self._suggestions(word, kinds))
+            advice = UNKNOWN_CLASS_ADVICE if kinds is not None and set(kinds) == {"class"} else ""
+            raise UnknownTermError(word, self._what(kinds), self._suggestions(word, kinds), advice)
         same = [r for r in found if r.kind == found[0].kind]
         if len(same) > 1:
             raise AmbiguousTermError(word, [r.name for r in same])
@@ -251,8 +255,7 @@ class KnowledgeBase:
     def _suggestions(self, word: str, kinds: Collection[Kind] | None) -> list[str]:
         index = self._index
         keys = [k for k, found in index.words.items() if kinds is None or any(r.kind in kinds for r in found)]
-        close = difflib.get_close_matches(word_key(word), keys, n=3, cutoff=0.6)
-        return [index.word_labels[k] for k in close]
+        return [index.word_labels[k] for k in close_keys(word_key(word), keys)]
 
     @staticmethod
     def _what(kinds: Collection[Kind] | None) -> str:
@@ -402,7 +405,7 @@ class KnowledgeBase:
         found = self._index.query_keys.get(word_key(key))
         if found is None:
             keys = sorted(self._index.query_keys)
-            raise UnknownTermError(key, "query key", difflib.get_close_matches(word_key(key), keys, n=3, cutoff=0.6))
+            raise UnknownTermError(key, "query key", close_keys(word_key(key), keys))
         return found
 
     def value_kind(self, annotation_type: str) -> Kind | None:

@@ -4,6 +4,7 @@ from __future__ import annotations
 
 import re
 import unicodedata
+from collections.abc import Iterable
 
 MAX_NAME_LENGTH = 64
 """Longest class name accepted by ontology edits, in characters."""
@@ -60,3 +61,34 @@ def camel_words(name: str) -> str:
 def camel_case(text: str) -> str:
     """A CamelCase name made of the words of ``text`` ("oat milk" -> "OatMilk")."""
     return "".join(part[:1].upper() + part[1:] for part in re.split(r"[^0-9A-Za-z]+", text) if part)
+
+
+LETTERS_PER_TYPO = 3
+"""A suggestion for an unknown word may differ from it by one slip (a wrong, missing, extra or swapped letter) per
+this many letters of the word, at least one: "mlik" is "milk", "botle" "bottle"; "chair" is no "dairy"."""
+
+
+def typo_distance(typed: str, known: str) -> int:
+    """The number of slips between two keys: wrong, missing or extra letters and swapped neighbours (optimal string
+    alignment distance)."""
+    rows = [list(range(len(known) + 1))]
+    for i, letter in enumerate(typed, start=1):
+        row = [i] + [0] * len(known)
+        for j, other in enumerate(known, start=1):
+            row[j] = min(rows[-1][j] + 1, row[j - 1] + 1, rows[-1][j - 1] + (letter != other))
+            if i > 1 and j > 1 and letter == known[j - 2] and typed[i - 2] == other:
+                row[j] = min(row[j], rows[-2][j - 2] + 1)
+        rows.append(row)
+    return rows[-1][-1]
+
+
+def close_keys(typed: str, keys: Iterable[str], count: int = 3) -> list[str]:
+    """Up to ``count`` of ``keys`` a person may have meant by ``typed`` (a key, :func:`word_key`): within its slips
+    (:data:`LETTERS_PER_TYPO`), fewest slips first, then as listed."""
+    allowed = max(1, len(typed) // LETTERS_PER_TYPO)
+    scored = (
+        (typo_distance(typed, key), index, key)
+        for index, key in enumerate(keys)
+        if abs(len(key) - len(typed)) <= allowed  # more slips than that in the length alone
+    )
+    return [key for slips, _, key in sorted(s for s in scored if s[0] <= allowed)][:count]
