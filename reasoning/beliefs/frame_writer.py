@@ -34,6 +34,7 @@ LENGTH = struct.Struct("<I")
 """The length prefix of every record."""
 
 NEXT_ID = "SELECT value FROM meta WHERE key = 'next_id'"
+"""The statement that reads the next belief id the store hands out."""
 
 
 class WriterGoneError(Exception):

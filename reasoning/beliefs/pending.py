@@ -24,8 +24,8 @@ import numpy as np
 _TOWARDS = 1.0 - 1.0 / 8388608.0
 _AWAY = 1.0 + 1.0 / 8388608.0
 
-STATUS, LAST_SEEN, MISSES = 16, 18, 19
-"""Columns of an ``objects`` row the gone rule reads."""
+FRAME, STATUS, LAST_SEEN, MISSES, RECORDING = 2, 16, 18, 19, 23
+"""Columns of an ``objects`` row the candidate search and the gone rule read."""
 PRESENT = "present"
 GONE = "gone"
 
@@ -116,7 +116,7 @@ class PendingFrames:
         candidates = [
             row
             for row in latest.values()
-            if row[STATUS] == PRESENT and row[2] == frame and (row[2] == world or row[23] == recording)
+            if row[STATUS] == PRESENT and row[FRAME] == frame and (row[FRAME] == world or row[RECORDING] == recording)
         ]
         if candidates:
             n = len(candidates[0]) - 6

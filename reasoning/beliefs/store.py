@@ -52,7 +52,7 @@ from typing import TypeVar
 import numpy as np
 import platformdirs
 
-from reasoning.beliefs.frame_writer import FrameWriter, WriterGoneError
+from reasoning.beliefs.frame_writer import NEXT_ID, FrameWriter, WriterGoneError
 from reasoning.beliefs.interned import INTERN, InternedTexts, decoded_supports
 from reasoning.beliefs.packed import (
     FIELDS,
@@ -541,7 +541,7 @@ class BeliefStore:
             return step
         writes: list[tuple[str, list[tuple]]] = []
         with self._transaction() as conn:
-            next_id = int(conn.execute(_NEXT_ID).fetchone()[0])
+            next_id = int(conn.execute(NEXT_ID).fetchone()[0])
             write = functools.partial(_write, conn, writes)
             step, *_ = self._fuse(conn, objects, time, camera, tracker, next_id, write, writes, None)
         if self.write_log is not None:
@@ -556,7 +556,7 @@ class BeliefStore:
         pending = self._pending
         writes: list[tuple[str, list[tuple]]] = []
         with self._guard(drain=False) as conn:
-            next_id = pending.next_id if pending else int(conn.execute(_NEXT_ID).fetchone()[0])
+            next_id = pending.next_id if pending else int(conn.execute(NEXT_ID).fetchone()[0])
             write = functools.partial(_write_behind, conn, writes)
             step, written, loaded, moved, after = self._fuse(
                 conn, objects, time, camera, tracker, next_id, write, writes, pending if pending else None
@@ -1101,7 +1101,6 @@ class BeliefStore:
 
 
 _MARK_GONE = "UPDATE objects SET status = 'gone' WHERE misses > 0 AND status = 'present' AND last_seen <= ?"
-_NEXT_ID = "SELECT value FROM meta WHERE key = 'next_id'"
 
 
 def _write(conn: sqlite3.Connection, log: list[tuple[str, list[tuple]]], statement: str, rows: list[tuple]) -> None:

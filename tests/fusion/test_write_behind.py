@@ -11,13 +11,15 @@ import pytest
 from hypothesis import HealthCheck, given, settings
 from hypothesis import strategies as st
 
+from reasoning.beliefs import pending
 from reasoning.beliefs.pending import rtree_bounds
-from reasoning.beliefs.store import BeliefFilter, BeliefStore
+from reasoning.beliefs.store import _OBJECT_COLUMNS, BeliefFilter, BeliefStore
 from reasoning.fusion.association import CameraModel
 from reasoning.fusion.frame import FrameObject
 from reasoning.fusion.rule import Evidence
 from reasoning.fusion.tracking import BeliefTracker, ObjectBelief, TrackerConfig
 from robokudo.core.types import CameraIntrinsics
+from tests.fusion.camera_poses import camera_looking_at_origin
 
 SLOW_WRITER = (
     "CREATE TRIGGER slow_writer AFTER INSERT ON observations BEGIN SELECT count(*) FROM (WITH RECURSIVE c(x) AS "
@@ -29,21 +31,10 @@ INTRINSICS = CameraIntrinsics(500.0, 500.0, 320.0, 240.0, 640, 480)
 ANCHORS = np.array([[0.0, 0.0, 0.8], [0.3, 0.1, 0.8], [0.31, 0.12, 0.8], [1.5, -0.5, 0.9], [-0.8, 0.6, 0.7]])
 
 
-def _camera_at(eye: tuple[float, float, float]) -> np.ndarray:
-    """cam_to_world of an optical frame at ``eye`` looking horizontally at the world origin's column."""
-    forward = -np.array([eye[0], eye[1], 0.0])
-    forward /= np.linalg.norm(forward)
-    right = np.cross(forward, [0.0, 0.0, 1.0])
-    down = np.cross(forward, right)
-    pose = np.eye(4)
-    pose[:3, 0], pose[:3, 1], pose[:3, 2], pose[:3, 3] = right, down, forward, eye
-    return pose
-
-
 CAMERAS = (
     None,
-    CameraModel(INTRINSICS, _camera_at((0.0, -1.5, 0.8))),
-    CameraModel(INTRINSICS, _camera_at((2.0, 1.0, 0.9))),
+    CameraModel(INTRINSICS, camera_looking_at_origin((0.0, -1.5, 0.8))),
+    CameraModel(INTRINSICS, camera_looking_at_origin((2.0, 1.0, 0.9))),
 )
 
 observation = st.builds(
@@ -223,3 +214,10 @@ def test_rtree_bounds_are_what_sqlite_stores(tmp_path: Path) -> None:
 def test_write_behind_must_not_be_negative(tmp_path: Path) -> None:
     with pytest.raises(ValueError, match="write_behind"):
         BeliefStore(tmp_path / "beliefs.sqlite", write_behind=-1)
+
+
+def test_the_overlay_reads_the_columns_it_names() -> None:
+    """The overlay reads ``objects`` rows by position; each position names the column the store writes there."""
+    columns = [c.strip() for c in _OBJECT_COLUMNS.split(",")]
+    for name in ("frame", "status", "last_seen", "misses", "recording"):
+        assert columns[getattr(pending, name.upper())] == name
