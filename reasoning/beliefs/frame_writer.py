@@ -33,6 +33,11 @@ from pathlib import Path
 LENGTH = struct.Struct("<I")
 """The length prefix of every record."""
 
+MAX_WRITE_BEHIND = 256
+"""The most frames a store may leave uncommitted: their answers (about 15 bytes each) wait unread in the writer's
+output pipe, which must hold them all (at least one 4 KiB page on every system), or the writer blocks on them while
+the store blocks sending it the next frame."""
+
 NEXT_ID = "SELECT value FROM meta WHERE key = 'next_id'"
 """The statement that reads the next belief id the store hands out."""
 

@@ -12,6 +12,7 @@ from hypothesis import HealthCheck, given, settings
 from hypothesis import strategies as st
 
 from reasoning.beliefs import pending
+from reasoning.beliefs.frame_writer import MAX_WRITE_BEHIND
 from reasoning.beliefs.pending import rtree_bounds
 from reasoning.beliefs.store import _OBJECT_COLUMNS, BeliefFilter, BeliefStore
 from reasoning.fusion.association import CameraModel
@@ -214,6 +215,18 @@ def test_rtree_bounds_are_what_sqlite_stores(tmp_path: Path) -> None:
 def test_write_behind_must_not_be_negative(tmp_path: Path) -> None:
     with pytest.raises(ValueError, match="write_behind"):
         BeliefStore(tmp_path / "beliefs.sqlite", write_behind=-1)
+
+
+def test_write_behind_is_bounded_so_the_writers_answers_never_fill_their_pipe(tmp_path: Path) -> None:
+    """Unread answers pile up in the writer's output pipe: beyond what it holds the writer would block on them while
+    the store blocks sending it the next frame (1e6 hung after about 4,700 empty frames)."""
+    with pytest.raises(ValueError, match="write_behind"):
+        BeliefStore(tmp_path / "beliefs.sqlite", write_behind=MAX_WRITE_BEHIND + 1)
+    with BeliefStore(tmp_path / "beliefs.sqlite", write_behind=MAX_WRITE_BEHIND) as store:
+        for t in range(3 * MAX_WRITE_BEHIND):
+            store.integrate([_seen((float(t), 0.0, 0.8))] if t % 100 == 0 else [], float(t))
+    with BeliefStore(tmp_path / "beliefs.sqlite") as reopened:
+        assert sorted(b.last_seen for b in reopened.beliefs()) == [0.0, 100.0, 200.0, 300.0, 400.0, 500.0, 600.0, 700.0]
 
 
 def test_the_overlay_reads_the_columns_it_names() -> None:
