@@ -28,6 +28,7 @@ import sqlite3
 import struct
 import subprocess
 import sys
+import weakref
 from pathlib import Path
 
 LENGTH = struct.Struct("<I")
@@ -87,6 +88,8 @@ class FrameWriter:
         assert self.process.stdin is not None and self.process.stdout is not None
         self._out = self.process.stdin.fileno()
         self._in = self.process.stdout.fileno()
+        # a store dropped without close: the writer's input ends with it, not with the interpreter
+        self._ended = weakref.finalize(self, _end_writer, self.process)
 
     def send(self, seq: int, next_id: int | None, writes: list[tuple[str, list[tuple]]]) -> None:
         """Hand one frame's writes to the writer (raises :class:`WriterGoneError` when it has ended)."""
@@ -106,11 +109,16 @@ class FrameWriter:
 
     def close(self) -> None:
         """End the writer's input and wait for it (it commits what it has read first)."""
-        assert self.process.stdin is not None and self.process.stdout is not None
-        with contextlib.suppress(BrokenPipeError):
-            self.process.stdin.close()
-        self.process.wait()
-        self.process.stdout.close()
+        self._ended()
+
+
+def _end_writer(process: subprocess.Popen) -> None:
+    """End the writer's input, wait for it to commit what it has read and exit, and close its output."""
+    assert process.stdin is not None and process.stdout is not None
+    with contextlib.suppress(BrokenPipeError):
+        process.stdin.close()
+    process.wait()
+    process.stdout.close()
 
 
 def serve(path: str, synchronous: str, busy_timeout: float, autocheckpoint: int) -> int:

@@ -3,6 +3,7 @@ that commits each frame itself, every read sees the frames integrated before it,
 
 from __future__ import annotations
 
+import gc
 import sqlite3
 from pathlib import Path
 
@@ -234,3 +235,20 @@ def test_the_overlay_reads_the_columns_it_names() -> None:
     columns = [c.strip() for c in _OBJECT_COLUMNS.split(",")]
     for name in ("frame", "status", "last_seen", "misses", "recording"):
         assert columns[getattr(pending, name.upper())] == name
+
+
+def test_a_store_dropped_unclosed_ends_its_writer_which_commits_the_pending_frames(tmp_path: Path) -> None:
+    """Without close the writer's input stayed open for the life of the process: the writer went on running."""
+    path = tmp_path / "beliefs.sqlite"
+    BeliefStore(path).close()
+    with sqlite3.connect(path) as conn:
+        conn.execute(SLOW_WRITER)
+    store = BeliefStore(path, write_behind=2)
+    process = store._writer.process  # type: ignore[union-attr]
+    for t in (10.0, 11.0, 12.0):
+        store.integrate([_seen((t, 0.0, 0.8))], t)
+    del store
+    gc.collect()
+    assert process.poll() == 0
+    with BeliefStore(path) as reopened:
+        assert sorted(b.last_seen for b in reopened.beliefs()) == [10.0, 11.0, 12.0]
