@@ -107,14 +107,18 @@ def _seen(position: tuple[float, float, float], color: str = "red") -> FrameObje
     )
 
 
-@pytest.fixture
-def lagging(tmp_path: Path) -> BeliefStore:
-    """A write-behind store whose writer lags (two frames may be pending), holding two frames."""
-    path = tmp_path / "beliefs.sqlite"
+def lagging_store(path: Path) -> BeliefStore:
+    """A new write-behind store at ``path`` whose writer lags (two frames may be pending)."""
     BeliefStore(path).close()
     with sqlite3.connect(path) as conn:
         conn.execute(SLOW_WRITER)
-    store = BeliefStore(path, write_behind=2)
+    return BeliefStore(path, write_behind=2)
+
+
+@pytest.fixture
+def lagging(tmp_path: Path) -> BeliefStore:
+    """A write-behind store whose writer lags (two frames may be pending), holding two frames."""
+    store = lagging_store(tmp_path / "beliefs.sqlite")
     store.integrate([_seen((0.0, 0.0, 0.8)), _seen((1.0, 0.0, 0.8))], 10.0)
     store.integrate([_seen((0.0, 0.0, 0.8), "blue"), _seen((2.0, 0.0, 0.8))], 11.0)
     return store
@@ -240,10 +244,7 @@ def test_the_overlay_reads_the_columns_it_names() -> None:
 def test_a_store_dropped_unclosed_ends_its_writer_which_commits_the_pending_frames(tmp_path: Path) -> None:
     """Without close the writer's input stayed open for the life of the process: the writer went on running."""
     path = tmp_path / "beliefs.sqlite"
-    BeliefStore(path).close()
-    with sqlite3.connect(path) as conn:
-        conn.execute(SLOW_WRITER)
-    store = BeliefStore(path, write_behind=2)
+    store = lagging_store(path)
     process = store._writer.process  # type: ignore[union-attr]
     for t in (10.0, 11.0, 12.0):
         store.integrate([_seen((t, 0.0, 0.8))], t)
