@@ -121,14 +121,20 @@ def standing_clusters(
     basis = plane_basis(np.asarray(model[:3], dtype=np.float64)).astype(np.float32)
     feet = surface @ basis.T
     low = feet.min(axis=0)
-    hull = np.round((cv2.convexHull(feet.astype(np.float32)).reshape(-1, 2) - low) / rules.cell).astype(np.int32)
-    size = hull.max(axis=0) + 1
-    raster = np.zeros((int(size[1]), int(size[0])), dtype=np.uint8)
-    cv2.fillConvexPoly(raster, hull, 1)
+    hull = np.round((cv2.convexHull(feet.astype(np.float32)).reshape(-1, 2) - low) / rules.cell).astype(np.int64)
     over = points[standing] @ basis.T
     cells = np.round((over - low) / rules.cell).astype(np.int64)
-    inside = (cells[:, 0] >= 0) & (cells[:, 1] >= 0) & (cells[:, 0] < size[0]) & (cells[:, 1] < size[1])
-    inside[inside] = raster[cells[inside, 1], cells[inside, 0]] > 0
+    # the footprint is drawn only where standing points fall (a stray inlier far off spans no raster)
+    inside = np.zeros(cells.shape[0], dtype=bool)
+    if cells.shape[0]:
+        start = np.maximum(hull.min(axis=0), cells.min(axis=0))
+        end = np.minimum(hull.max(axis=0), cells.max(axis=0)) + 1
+        inside = np.all((cells >= start) & (cells < end), axis=1)
+    if inside.any():
+        size = end - start
+        raster = np.zeros((int(size[1]), int(size[0])), dtype=np.uint8)
+        cv2.fillConvexPoly(raster, (hull - start).astype(np.int32), 1)
+        inside[inside] = raster[cells[inside, 1] - start[1], cells[inside, 0] - start[0]] > 0
     standing[standing] = inside
     depth = points[..., 2]
     with np.errstate(invalid="ignore"):

@@ -28,12 +28,19 @@ import sqlite3
 import struct
 import subprocess
 import sys
+import weakref
 from pathlib import Path
 
 LENGTH = struct.Struct("<I")
 """The length prefix of every record."""
 
+MAX_WRITE_BEHIND = 256
+"""The most frames a store may leave uncommitted: their answers (about 15 bytes each) wait unread in the writer's
+output pipe, which must hold them all (at least one 4 KiB page on every system), or the writer blocks on them while
+the store blocks sending it the next frame."""
+
 NEXT_ID = "SELECT value FROM meta WHERE key = 'next_id'"
+"""The statement that reads the next belief id the store hands out."""
 
 
 class WriterGoneError(Exception):
@@ -81,6 +88,8 @@ class FrameWriter:
         assert self.process.stdin is not None and self.process.stdout is not None
         self._out = self.process.stdin.fileno()
         self._in = self.process.stdout.fileno()
+        # a store dropped without close: the writer's input ends with it, not with the interpreter
+        self._ended = weakref.finalize(self, _end_writer, self.process)
 
     def send(self, seq: int, next_id: int | None, writes: list[tuple[str, list[tuple]]]) -> None:
         """Hand one frame's writes to the writer (raises :class:`WriterGoneError` when it has ended)."""
@@ -100,11 +109,16 @@ class FrameWriter:
 
     def close(self) -> None:
         """End the writer's input and wait for it (it commits what it has read first)."""
-        assert self.process.stdin is not None and self.process.stdout is not None
-        with contextlib.suppress(BrokenPipeError):
-            self.process.stdin.close()
-        self.process.wait()
-        self.process.stdout.close()
+        self._ended()
+
+
+def _end_writer(process: subprocess.Popen) -> None:
+    """End the writer's input, wait for it to commit what it has read and exit, and close its output."""
+    assert process.stdin is not None and process.stdout is not None
+    with contextlib.suppress(BrokenPipeError):
+        process.stdin.close()
+    process.wait()
+    process.stdout.close()
 
 
 def serve(path: str, synchronous: str, busy_timeout: float, autocheckpoint: int) -> int:

@@ -24,8 +24,8 @@ import numpy as np
 _TOWARDS = 1.0 - 1.0 / 8388608.0
 _AWAY = 1.0 + 1.0 / 8388608.0
 
-STATUS, LAST_SEEN, MISSES = 16, 18, 19
-"""Columns of an ``objects`` row the gone rule reads."""
+FRAME, STATUS, LAST_SEEN, MISSES, RECORDING = 2, 16, 18, 19, 23
+"""Columns of an ``objects`` row the candidate search and the gone rule read."""
 PRESENT = "present"
 GONE = "gone"
 
@@ -116,21 +116,21 @@ class PendingFrames:
         candidates = [
             row
             for row in latest.values()
-            if row[STATUS] == PRESENT and row[2] == frame and (row[2] == world or row[23] == recording)
+            if row[STATUS] == PRESENT and row[FRAME] == frame and (row[FRAME] == world or row[RECORDING] == recording)
         ]
         if candidates:
-            n = len(candidates[0]) - 6
-            entries = np.array([row[n:] for row in candidates], dtype=np.float64)
-            b = np.asarray(boxes, dtype=np.float64).reshape(-1, 6)
+            entry_start = len(candidates[0]) - 6  # the R*Tree entry follows the row's columns
+            entries = np.array([row[entry_start:] for row in candidates], dtype=np.float64)
+            search = np.asarray(boxes, dtype=np.float64).reshape(-1, 6)
             hit = (
-                (entries[:, None, 0] <= b[None, :, 0])
-                & (entries[:, None, 1] >= b[None, :, 1])
-                & (entries[:, None, 2] <= b[None, :, 2])
-                & (entries[:, None, 3] >= b[None, :, 3])
-                & (entries[:, None, 4] <= b[None, :, 4])
-                & (entries[:, None, 5] >= b[None, :, 5])
+                (entries[:, None, 0] <= search[None, :, 0])
+                & (entries[:, None, 1] >= search[None, :, 1])
+                & (entries[:, None, 2] <= search[None, :, 2])
+                & (entries[:, None, 3] >= search[None, :, 3])
+                & (entries[:, None, 4] <= search[None, :, 4])
+                & (entries[:, None, 5] >= search[None, :, 5])
             ).any(axis=1)
-            kept.extend(row for row, h in zip(candidates, hit.tolist(), strict=True) if h)
+            kept.extend(row for row, meets in zip(candidates, hit.tolist(), strict=True) if meets)
         return kept
 
 

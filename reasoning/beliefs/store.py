@@ -8,8 +8,9 @@
   20 hypotheses writes some 60 to 80 pages, so at most the last 50 to 70 frames, about two seconds at 30 Hz). The store
   rolls back to an earlier consistent state and never corrupts. Pass ``synchronous="FULL"`` to also survive power
   loss, at the cost of an fsync per commit.
-* ``write_behind=N`` (off by default): :meth:`BeliefStore.integrate` hands each frame's transaction to a writer
-  process (:mod:`reasoning.beliefs.frame_writer`) and returns with at most N frames uncommitted; the next frame is
+* ``write_behind=N`` (off by default; N at most :data:`~reasoning.beliefs.frame_writer.MAX_WRITE_BEHIND`):
+  :meth:`BeliefStore.integrate` hands each frame's transaction to a writer process
+  (:mod:`reasoning.beliefs.frame_writer`) and returns with at most N frames uncommitted; the next frame is
   fused through an overlay of the pending ones (:mod:`reasoning.beliefs.pending`), so the results are those of
   committing each frame at once. Every other method first waits for the pending frames; :meth:`BeliefStore.flush`
   or ``integrate(..., wait=True)`` commit them on demand. What a crash may lose grows by those N frames: a SIGKILL
@@ -52,7 +53,7 @@ from typing import TypeVar
 import numpy as np
 import platformdirs
 
-from reasoning.beliefs.frame_writer import FrameWriter, WriterGoneError
+from reasoning.beliefs.frame_writer import MAX_WRITE_BEHIND, NEXT_ID, FrameWriter, WriterGoneError
 from reasoning.beliefs.interned import INTERN, InternedTexts, decoded_supports
 from reasoning.beliefs.packed import (
     FIELDS,
@@ -310,8 +311,10 @@ class BeliefStore:
         """The codes of the attribute names, values and expert sets in the packed supports."""
         self._row_updates: RowUpdate | None = None
         """The row-level update of :meth:`integrate`, for the last tracker configuration."""
-        if write_behind < 0:
-            raise ValueError(f"write_behind must be 0 (off) or a number of frames, not {write_behind}")
+        if not 0 <= write_behind <= MAX_WRITE_BEHIND:
+            raise ValueError(
+                f"write_behind must be 0 (off) or a number of frames up to {MAX_WRITE_BEHIND}, not {write_behind}"
+            )
         self.write_behind = write_behind
         """Frames :meth:`integrate` may return before they are committed (0: each is committed before it returns)."""
         self._pending = PendingFrames()
@@ -541,7 +544,7 @@ class BeliefStore:
             return step
         writes: list[tuple[str, list[tuple]]] = []
         with self._transaction() as conn:
-            next_id = int(conn.execute(_NEXT_ID).fetchone()[0])
+            next_id = int(conn.execute(NEXT_ID).fetchone()[0])
             write = functools.partial(_write, conn, writes)
             step, *_ = self._fuse(conn, objects, time, camera, tracker, next_id, write, writes, None)
         if self.write_log is not None:
@@ -556,7 +559,7 @@ class BeliefStore:
         pending = self._pending
         writes: list[tuple[str, list[tuple]]] = []
         with self._guard(drain=False) as conn:
-            next_id = pending.next_id if pending else int(conn.execute(_NEXT_ID).fetchone()[0])
+            next_id = pending.next_id if pending else int(conn.execute(NEXT_ID).fetchone()[0])
             write = functools.partial(_write_behind, conn, writes)
             step, written, loaded, moved, after = self._fuse(
                 conn, objects, time, camera, tracker, next_id, write, writes, pending if pending else None
@@ -1101,7 +1104,6 @@ class BeliefStore:
 
 
 _MARK_GONE = "UPDATE objects SET status = 'gone' WHERE misses > 0 AND status = 'present' AND last_seen <= ?"
-_NEXT_ID = "SELECT value FROM meta WHERE key = 'next_id'"
 
 
 def _write(conn: sqlite3.Connection, log: list[tuple[str, list[tuple]]], statement: str, rows: list[tuple]) -> None:

@@ -618,7 +618,7 @@ class _Builder:
         for subject, value in self.graph.subject_objects(RK.basicColor):
             name, basic = local_name(subject), local_name(value)
             if name not in colors or basic not in colors or name == basic:
-                self.problems.append(f"{name}: rk:basicColor must link a colour to another colour, not {basic}")
+                self.problems.append(f"{name} rk:basicColor {basic}: it links a colour to another colour")
                 continue
             found[name].add(basic)
         return {name: tuple(sorted(basics)) for name, basics in found.items()}

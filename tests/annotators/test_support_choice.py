@@ -163,3 +163,23 @@ def test_surface_area_counts_the_covered_cells() -> None:
 def test_no_plane_without_points() -> None:
     points = np.full((48, 64, 3), np.nan, dtype=np.float32)
     assert find_support_plane(points, np.ones((48, 64), dtype=bool)) is None
+
+
+def test_a_stray_surface_point_far_away_does_not_blow_up_the_footprint() -> None:
+    """The footprint raster covers only where standing points can fall: one surface inlier 100 km off (a bad
+    depth reading on the plane) leaves the box standing on the patch found, instead of a raster of the whole span."""
+    rules = SupportChoiceRules()
+    v, u = np.mgrid[0:40, 0:40] * 0.02  # a 0.8 m square patch, the plane z = 0 (height along z)
+    heights = np.zeros_like(u)
+    heights[15:25, 15:25] = 0.1  # a 0.2 m box standing on it
+    points = np.stack([u, v, heights], axis=-1).astype(np.float32)
+    valid = np.ones(u.shape, dtype=bool)
+    patch = points[heights == 0]
+    model = np.array([0.0, 0.0, 1.0, 0.0])
+    labels, kept = standing_clusters(points, valid, model, patch, rules)
+    (box,) = kept
+    for far in (1e5, -1e5):
+        stray = np.concatenate([patch, [[far, far, 0.0]]]).astype(np.float32)
+        labels_stray, kept_stray = standing_clusters(points, valid, model, stray, rules)
+        assert len(kept_stray) == 1
+        assert np.array_equal(labels_stray == kept_stray[0], labels == box)

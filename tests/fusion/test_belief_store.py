@@ -17,6 +17,7 @@ from reasoning.fusion.rule import AttributeBelief, Evidence, ValueSupport
 from reasoning.fusion.tracking import GONE, PRESENT, BeliefTracker, ObjectBelief, TrackerConfig
 from robokudo.core.regions import RegionBox
 from robokudo.core.types import CameraIntrinsics
+from tests.fusion.camera_poses import camera_looking_at_origin
 
 SUBCLASSES = {("LactoseFreeMilk", "Milk"), ("Milk", "Drink"), ("LactoseFreeMilk", "Drink")}
 
@@ -253,8 +254,8 @@ def test_a_reader_opens_and_reads_while_a_write_transaction_is_open(store_path: 
 
 
 def test_a_missed_object_is_gone_after_the_configured_time_even_out_of_view(store_path: Path) -> None:
-    looking_at_origin = CameraModel(CAMERA, _camera_at((0.0, -1.0, 0.8)))
-    looking_away = CameraModel(CAMERA, _camera_at((0.0, 1.0, 0.8)))
+    looking_at_origin = CameraModel(CAMERA, camera_looking_at_origin((0.0, -1.0, 0.8)))
+    looking_away = CameraModel(CAMERA, camera_looking_at_origin((0.0, 1.0, 0.8)))
     tracker = BeliefTracker(TrackerConfig(gone_after=5.0))
     with BeliefStore(store_path, tracker=tracker) as store:
         store.integrate([thing((0.0, 0.0, 0.8), "Cup", "red")], 0.0, camera=looking_at_origin)
@@ -269,7 +270,7 @@ def test_a_missed_object_is_gone_after_the_configured_time_even_out_of_view(stor
 
 
 def test_a_frame_misses_only_the_classes_its_detectors_look_for(store_path: Path) -> None:
-    in_view = _camera_at((0.0, -1.0, 0.8))
+    in_view = camera_looking_at_origin((0.0, -1.0, 0.8))
     people_only = CameraModel(CAMERA, in_view, looks_for=lambda name: name == "Human")
     with BeliefStore(store_path) as store:
         store.integrate([thing((0.0, 0.0, 0.8), "Cup", "red"), thing((0.3, 0.0, 0.8), "Human", "blue")], 0.0)
@@ -278,14 +279,3 @@ def test_a_frame_misses_only_the_classes_its_detectors_look_for(store_path: Path
         assert store.get(1).misses == 0 and store.get(2).misses == 1  # type: ignore[union-attr]
         step = store.integrate([], 2.0, camera=CameraModel(CAMERA, in_view))  # one that looks for everything
         assert set(step.missed) == {1, 2}
-
-
-def _camera_at(eye: tuple[float, float, float]) -> np.ndarray:
-    """cam_to_world of an optical frame at ``eye`` looking horizontally at the world origin's column."""
-    forward = -np.array([eye[0], eye[1], 0.0])
-    forward /= np.linalg.norm(forward)
-    right = np.cross(forward, [0.0, 0.0, 1.0])
-    down = np.cross(forward, right)
-    pose = np.eye(4)
-    pose[:3, 0], pose[:3, 1], pose[:3, 2], pose[:3, 3] = right, down, forward, eye
-    return pose

@@ -55,3 +55,15 @@ def test_a_two_coloured_object_answers_to_both_colours_as_last_seen(tmp_path: Pa
         assert (
             "(white)" in whites.summary() and "seen_with" not in whites.to_dict()["objects"][0]["attributes"]["color"]
         )
+
+
+def test_a_sighting_without_colour_keeps_the_colours_last_stated(tmp_path: Path) -> None:
+    """The colours are those of the last sighting that stated any: one where the colour expert said nothing (its
+    region too small, say) leaves the can red and white."""
+    with BeliefStore(tmp_path / "beliefs.sqlite", tracker=BeliefTracker()) as store:
+        store.integrate([can((0.0, 0.0, 0.8), ("white", 0.37), ("red", 0.27))], 1.0)
+        store.integrate([can((0.0, 0.0, 0.8))], 2.0)
+        (soup,) = (b.id for b in store.beliefs())
+        assert found(store, "red") == [soup] and found(store, "white") == [soup]
+        answer = answer_from_memory(store, BeliefFilter(attributes={"color": "red"}), "find the red can")
+        assert "(white and red)" in answer.summary()

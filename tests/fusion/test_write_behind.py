@@ -3,6 +3,7 @@ that commits each frame itself, every read sees the frames integrated before it,
 
 from __future__ import annotations
 
+import gc
 import sqlite3
 from pathlib import Path
 
@@ -11,13 +12,16 @@ import pytest
 from hypothesis import HealthCheck, given, settings
 from hypothesis import strategies as st
 
+from reasoning.beliefs import pending
+from reasoning.beliefs.frame_writer import MAX_WRITE_BEHIND
 from reasoning.beliefs.pending import rtree_bounds
-from reasoning.beliefs.store import BeliefFilter, BeliefStore
+from reasoning.beliefs.store import _OBJECT_COLUMNS, BeliefFilter, BeliefStore
 from reasoning.fusion.association import CameraModel
 from reasoning.fusion.frame import FrameObject
 from reasoning.fusion.rule import Evidence
 from reasoning.fusion.tracking import BeliefTracker, ObjectBelief, TrackerConfig
 from robokudo.core.types import CameraIntrinsics
+from tests.fusion.camera_poses import camera_looking_at_origin
 
 SLOW_WRITER = (
     "CREATE TRIGGER slow_writer AFTER INSERT ON observations BEGIN SELECT count(*) FROM (WITH RECURSIVE c(x) AS "
@@ -29,21 +33,10 @@ INTRINSICS = CameraIntrinsics(500.0, 500.0, 320.0, 240.0, 640, 480)
 ANCHORS = np.array([[0.0, 0.0, 0.8], [0.3, 0.1, 0.8], [0.31, 0.12, 0.8], [1.5, -0.5, 0.9], [-0.8, 0.6, 0.7]])
 
 
-def _camera_at(eye: tuple[float, float, float]) -> np.ndarray:
-    """cam_to_world of an optical frame at ``eye`` looking horizontally at the world origin's column."""
-    forward = -np.array([eye[0], eye[1], 0.0])
-    forward /= np.linalg.norm(forward)
-    right = np.cross(forward, [0.0, 0.0, 1.0])
-    down = np.cross(forward, right)
-    pose = np.eye(4)
-    pose[:3, 0], pose[:3, 1], pose[:3, 2], pose[:3, 3] = right, down, forward, eye
-    return pose
-
-
 CAMERAS = (
     None,
-    CameraModel(INTRINSICS, _camera_at((0.0, -1.5, 0.8))),
-    CameraModel(INTRINSICS, _camera_at((2.0, 1.0, 0.9))),
+    CameraModel(INTRINSICS, camera_looking_at_origin((0.0, -1.5, 0.8))),
+    CameraModel(INTRINSICS, camera_looking_at_origin((2.0, 1.0, 0.9))),
 )
 
 observation = st.builds(
@@ -114,14 +107,18 @@ def _seen(position: tuple[float, float, float], color: str = "red") -> FrameObje
     )
 
 
-@pytest.fixture
-def lagging(tmp_path: Path) -> BeliefStore:
-    """A write-behind store whose writer lags (two frames may be pending), holding two frames."""
-    path = tmp_path / "beliefs.sqlite"
+def lagging_store(path: Path) -> BeliefStore:
+    """A new write-behind store at ``path`` whose writer lags (two frames may be pending)."""
     BeliefStore(path).close()
     with sqlite3.connect(path) as conn:
         conn.execute(SLOW_WRITER)
-    store = BeliefStore(path, write_behind=2)
+    return BeliefStore(path, write_behind=2)
+
+
+@pytest.fixture
+def lagging(tmp_path: Path) -> BeliefStore:
+    """A write-behind store whose writer lags (two frames may be pending), holding two frames."""
+    store = lagging_store(tmp_path / "beliefs.sqlite")
     store.integrate([_seen((0.0, 0.0, 0.8)), _seen((1.0, 0.0, 0.8))], 10.0)
     store.integrate([_seen((0.0, 0.0, 0.8), "blue"), _seen((2.0, 0.0, 0.8))], 11.0)
     return store
@@ -223,3 +220,36 @@ def test_rtree_bounds_are_what_sqlite_stores(tmp_path: Path) -> None:
 def test_write_behind_must_not_be_negative(tmp_path: Path) -> None:
     with pytest.raises(ValueError, match="write_behind"):
         BeliefStore(tmp_path / "beliefs.sqlite", write_behind=-1)
+
+
+def test_write_behind_is_bounded_so_the_writers_answers_never_fill_their_pipe(tmp_path: Path) -> None:
+    """Unread answers pile up in the writer's output pipe: beyond what it holds the writer would block on them while
+    the store blocks sending it the next frame (1e6 hung after about 4,700 empty frames)."""
+    with pytest.raises(ValueError, match="write_behind"):
+        BeliefStore(tmp_path / "beliefs.sqlite", write_behind=MAX_WRITE_BEHIND + 1)
+    with BeliefStore(tmp_path / "beliefs.sqlite", write_behind=MAX_WRITE_BEHIND) as store:
+        for t in range(3 * MAX_WRITE_BEHIND):
+            store.integrate([_seen((float(t), 0.0, 0.8))] if t % 100 == 0 else [], float(t))
+    with BeliefStore(tmp_path / "beliefs.sqlite") as reopened:
+        assert sorted(b.last_seen for b in reopened.beliefs()) == [0.0, 100.0, 200.0, 300.0, 400.0, 500.0, 600.0, 700.0]
+
+
+def test_the_overlay_reads_the_columns_it_names() -> None:
+    """The overlay reads ``objects`` rows by position; each position names the column the store writes there."""
+    columns = [c.strip() for c in _OBJECT_COLUMNS.split(",")]
+    for name in ("frame", "status", "last_seen", "misses", "recording"):
+        assert columns[getattr(pending, name.upper())] == name
+
+
+def test_a_store_dropped_unclosed_ends_its_writer_which_commits_the_pending_frames(tmp_path: Path) -> None:
+    """Without close the writer's input stayed open for the life of the process: the writer went on running."""
+    path = tmp_path / "beliefs.sqlite"
+    store = lagging_store(path)
+    process = store._writer.process  # type: ignore[union-attr]
+    for t in (10.0, 11.0, 12.0):
+        store.integrate([_seen((t, 0.0, 0.8))], t)
+    del store
+    gc.collect()
+    assert process.poll() == 0
+    with BeliefStore(path) as reopened:
+        assert sorted(b.last_seen for b in reopened.beliefs()) == [10.0, 11.0, 12.0]

@@ -2,15 +2,18 @@
 
 from __future__ import annotations
 
+from pathlib import Path
+
 import pytest
 
-from reasoning.errors import UnknownTermError
+from reasoning.errors import OntologyError, UnknownTermError
 from reasoning.knowledge.knowledge_base import KnowledgeBase
 from reasoning.knowledge.model import Conditions
 from robokudo.application.knowledge import load_knowledge_base
 from robokudo.core.annotator import Annotator
 from robokudo.core.capability import Capability
 from robokudo.core.types import CameraInfo, Classification, ColorImage, ObjectHypothesis, PointCloud, SemanticColor
+from tests.reasoning.helpers import write_ttl
 
 
 class BowlDetector(Annotator):
@@ -137,3 +140,18 @@ def test_inputs_of_an_annotator(kb: KnowledgeBase) -> None:
     assert spec.outputs == ("PointCloud",)
     assert spec.implemented_by == "annotators.cloud.point_cloud.PointCloudGenerator"
     assert spec.cost_ms > 0 and 0 < spec.reliability <= 1
+
+
+def test_a_user_colour_is_asked_as_its_basic_colours_and_basic_colours_must_link_colours(tmp_path: Path) -> None:
+    extra = write_ttl(
+        tmp_path / "colours.ttl",
+        'rk:Mint a owl:Class ; rdfs:subClassOf rk:Color ; rdfs:label "mint"@en ; rk:basicColor rk:Green .\n'
+        'rk:Ochre a owl:Class ; rdfs:subClassOf rk:Color ; rdfs:label "ochre"@en .\n',
+    )
+    user = KnowledgeBase.load(tmp_path / "user.ttl", extra_files=[extra])
+    assert user.reported_as("SemanticColor", "Mint") == ("Green",)
+    assert user.reported_as("SemanticColor", "Ochre") == ("Ochre",)  # no basic colour: asked as itself
+    wrong = write_ttl(tmp_path / "wrong.ttl", "rk:Cup rk:basicColor rk:Blue .\nrk:Teal rk:basicColor rk:Teal .\n")
+    with pytest.raises(OntologyError) as error:
+        KnowledgeBase.load(tmp_path / "user.ttl", extra_files=[wrong])
+    assert "Cup rk:basicColor Blue" in str(error.value) and "Teal rk:basicColor Teal" in str(error.value)
