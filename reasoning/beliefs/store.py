@@ -325,7 +325,11 @@ class BeliefStore:
         self._lock = threading.RLock()
         self._conn = self._open(synchronous.upper(), busy_timeout, check)
         if write_behind:  # started with the store, as its connection is (later ones start when a frame needs them)
-            self._writer = FrameWriter(self.path, synchronous.upper(), busy_timeout, WAL_AUTOCHECKPOINT_PAGES)
+            try:
+                self._writer = FrameWriter(self.path, synchronous.upper(), busy_timeout, WAL_AUTOCHECKPOINT_PAGES)
+            except BaseException:
+                self._conn.close()  # no store was made: nothing else would ever close its connection
+                raise
 
     # ------------------------------------------------------------------ opening
 

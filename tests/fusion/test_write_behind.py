@@ -13,6 +13,7 @@ from hypothesis import HealthCheck, given, settings
 from hypothesis import strategies as st
 
 from reasoning.beliefs import pending
+from reasoning.beliefs import store as store_module
 from reasoning.beliefs.frame_writer import MAX_WRITE_BEHIND
 from reasoning.beliefs.pending import rtree_bounds
 from reasoning.beliefs.store import _OBJECT_COLUMNS, BeliefFilter, BeliefStore
@@ -253,3 +254,26 @@ def test_a_store_dropped_unclosed_ends_its_writer_which_commits_the_pending_fram
     assert process.poll() == 0
     with BeliefStore(path) as reopened:
         assert sorted(b.last_seen for b in reopened.beliefs()) == [10.0, 11.0, 12.0]
+
+
+def test_a_writer_that_cannot_start_leaves_no_open_connection(tmp_path: Path, monkeypatch: pytest.MonkeyPatch) -> None:
+    """When the writer process cannot be started (no process slots, no interpreter), the store is not made; the
+    connection it had opened is closed, not left to the garbage collector with the file's locks."""
+    opened: list[sqlite3.Connection] = []
+    real_open = BeliefStore._open
+
+    def remembering_open(self: BeliefStore, *args: object) -> sqlite3.Connection:
+        conn = real_open(self, *args)  # type: ignore[arg-type]
+        opened.append(conn)
+        return conn
+
+    def failing_writer(*_: object) -> None:
+        raise OSError("no writer process")
+
+    monkeypatch.setattr(BeliefStore, "_open", remembering_open)
+    monkeypatch.setattr(store_module, "FrameWriter", failing_writer)
+    with pytest.raises(OSError, match="no writer process"):
+        BeliefStore(tmp_path / "beliefs.sqlite", write_behind=1)
+    assert len(opened) == 1
+    with pytest.raises(sqlite3.ProgrammingError):
+        opened[0].execute("SELECT 1")
