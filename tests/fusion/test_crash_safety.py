@@ -57,25 +57,23 @@ def test_sigkill_at_random_points_keeps_the_store_sound_and_every_commit(tmp_pat
     committed: dict[int, int] = {}
     env = {**os.environ, "PYTHONPATH": str(REPO_ROOT)}
     for round_index in range(ROUNDS):
-        writer = subprocess.Popen(
+        with subprocess.Popen(
             [sys.executable, "-c", WRITER, str(path), str(round_index * 1_000_000), str(write_behind)],
             stdout=subprocess.PIPE,
             stderr=subprocess.PIPE,
             text=True,
             cwd=REPO_ROOT,
             env=env,
-        )
-        assert writer.stdout is not None
-        ready = writer.stdout.readline()
-        assert ready == "ready\n", writer.stderr.read() if writer.stderr else ready
-        time.sleep(rng.uniform(0.0, 0.25))
-        writer.send_signal(signal.SIGKILL)
-        # Read on through the same buffered file object as readline() above: communicate() would read the pipe's
-        # file descriptor directly and lose whatever readline() had already buffered, splitting a line there.
-        out = writer.stdout.read()
-        writer.wait(timeout=10)
-        if writer.stderr is not None:
-            writer.stderr.close()
+        ) as writer:
+            assert writer.stdout is not None
+            ready = writer.stdout.readline()
+            assert ready == "ready\n", writer.stderr.read() if writer.stderr else ready
+            time.sleep(rng.uniform(0.0, 0.25))
+            writer.send_signal(signal.SIGKILL)
+            # Read on through the same buffered file object as readline() above: communicate() would read the pipe's
+            # file descriptor directly and lose whatever readline() had already buffered, splitting a line there.
+            out = writer.stdout.read()
+            writer.wait(timeout=10)
         assert writer.returncode == -signal.SIGKILL
         for line in out.split("\n")[:-1]:  # the text after the last newline was cut off by the kill
             match = re.fullmatch(r"(\d+) (\d+)", line)
