@@ -64,12 +64,13 @@ the cues cannot tell the two classes apart) is asserted with its own (low) calib
 lifts a poor fit (a class named by printed text whose text went unread is named only as a guess: it must tie with
 every fitting class, and the calibration's unread term keeps its probability low; the root class breaks no tie;
 a class packaged in the query's class counts as one of it: a mustard for "find all bottles"),
-and it decides only what the form cues leave open: no settled form cue (said with confidence 1) may speak against
-it - a mug seen surely closed is no mug, whatever else ties with it - and it must stay the best fitting class
-(within ``margin``) however the unsettled ones turn out (:func:`cue_outcomes`): the open top as the form expert said
-it, and the handle either way, as a view hides or shows it by chance. A mug whose handle the form expert could not
-make out ties with a cup, but its handle seen would make it a mug, so "find a cup" does not answer it; nor is half
-a bowl, flaring like a handle, a mug for "find all mugs" (surely without a handle it would be a cup).
+and it decides only what the form cues leave open: no settled form cue (said with confidence 1) may speak against it - a
+mug seen surely closed is no mug, whatever else ties with it - nor may its proportions rule the class out
+(:func:`ruled_out`: a cup on its saucer, four times as wide as high, is no jug) - and it must stay the best fitting
+class (within ``margin``) however the unsettled ones turn out (:func:`cue_outcomes`): the open top as the form expert
+said it, and the handle either way, as a view hides or shows it by chance. A mug whose handle the form expert could not
+make out ties with a cup, but its handle seen would make it a mug, so "find a cup" does not answer it; nor is half a
+bowl, flaring like a handle, a mug for "find all mugs" (surely without a handle it would be a cup).
 Otherwise the most specific class above the best one (with or without a profile of its own) that, taken as a
 whole, fits and reaches :data:`ASSERT_PROBABILITY` is asserted: its score is the best of its own and its
 subclasses' profiles, its lead that over the best profile outside it (cues that cannot tell a white ceramic bowl
@@ -568,11 +569,12 @@ def contradicted(profile: Profile, cues: Cues) -> bool:
 def holds_up(pick: Match, matches: Sequence[Match], cues: Cues | None, min_score: float, margin: float) -> bool:
     """True when the query may decide for ``pick``: however the unsettled form cues turn out (:func:`cue_outcomes`,
     the same profiles as ``matches`` scored again), and as the settled ones are, no form cue rules its class out
-    (:func:`contradicted`) and it stays within ``margin`` of every fitting class not related to it; always without
-    ``cues``."""
+    (:func:`contradicted`; nor a height over width or elongation where the class agrees not at all,
+    :func:`ruled_out`: a cup on its saucer, four times as wide as high, is no jug for 'find a bottle') and it stays
+    within ``margin`` of every fitting class not related to it; always without ``cues``."""
     if cues is None:
         return True
-    if contradicted(pick.profile, cues):
+    if contradicted(pick.profile, cues) or ruled_out(pick.profile, cues):
         return False
     for outcome in cue_outcomes(cues):
         if contradicted(pick.profile, outcome):

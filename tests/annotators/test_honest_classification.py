@@ -15,7 +15,9 @@ import pytest
 
 from annotators.classification.calibration import FITTED, fit
 from annotators.classification.knowledge_classifier import (
+    MIN_SCORE,
     RATIO_FALLOFF,
+    TIE_MARGIN,
     UNKNOWN_CLASS,
     Cues,
     KnowledgeClassifier,
@@ -23,6 +25,7 @@ from annotators.classification.knowledge_classifier import (
     contradicted,
     cue_outcomes,
     decide,
+    holds_up,
     lead,
     ruled_out,
     score,
@@ -315,3 +318,21 @@ def test_a_ratio_rules_a_class_out_exactly_where_it_agrees_not_at_all() -> None:
         profile = Profile.from_mapping({"class": "Thing", "height_to_width": (low, high)})
         agreement = score(profile, Cues(height_to_width=ratio)).score
         assert ruled_out(profile, Cues(height_to_width=ratio)) == (agreement <= 0.0), (low, high, ratio)
+
+
+WHITE_JUG = {"class": "Jug", "colors": ("white",), "shape": "cylinder", "size": "medium", "handle": True,
+             "height_to_width": (1.4, 2.5), "ancestors": ("Jug", "Bottle", "Container", "PhysicalObject")}  # fmt: skip
+
+
+def test_the_query_does_not_decide_for_a_class_the_proportions_rule_out() -> None:
+    """The TUM desk's cup on its saucer (white, a handle, four times as wide as high) was a 'bottle?' for 'find a
+    bottle': the query decided for a jug, which is at least 1.4 times as high as wide."""
+    jug = Profile.from_mapping(WHITE_JUG)
+    profiles = [jug, *FORM_PROFILES]
+    seen = Cues(color=("white", 1.0), shape=("cylinder", 0.4), size=("medium", 1.0), handle=(True, 1.0),
+                open_top=(False, 0.8), height_to_width=1.8)  # fmt: skip
+    flat = replace(seen, height_to_width=0.23)
+    assert flat.height_to_width * RATIO_FALLOFF <= WHITE_JUG["height_to_width"][0]  # agrees not at all
+    for cues, decides in ((seen, True), (flat, False)):
+        matches = [score(p, cues) for p in profiles]
+        assert holds_up(score(jug, cues), matches, cues, MIN_SCORE, TIE_MARGIN) is decides
