@@ -54,6 +54,9 @@ WAL_FRAMES = struct.Struct("=I")
 32-bit unsigned integer at byte 16 (https://www.sqlite.org/walformat.html, "The WAL-Index Header")."""
 WAL_FRAMES_OFFSET = 16
 
+CATCH_UP = 2
+"""The WAL length, in multiples of the checkpoint bound, from which the committing connection checkpoints itself."""
+
 
 class WriterGoneError(Exception):
     """The writer process ended without answering for every frame sent."""
@@ -141,7 +144,12 @@ class Checkpointer:
     applies after a commit), wakes the thread, which runs a PASSIVE checkpoint on its own connection: SQLite lets
     one writer append to the WAL while it is checkpointed, and releases the GIL while it copies and syncs, so the
     next frames are committed meanwhile. What is stored and synced is SQLite's affair as before; only which
-    connection checkpoints changes."""
+    connection checkpoints changes.
+
+    SQLite starts the WAL over only after a checkpoint that copied all of it, and frames committed during a
+    checkpoint are left for the next one; so that a steady stream of frames cannot grow the WAL without end, the
+    committing connection checkpoints itself (as autocheckpoint does: the rest, a few frames) once the WAL holds
+    :data:`CATCH_UP` times ``pages`` and the thread is idle."""
 
     def __init__(self, path: str, synchronous: str, pages: int) -> None:
         self.pages = pages
@@ -155,12 +163,27 @@ class Checkpointer:
         self._thread = threading.Thread(target=self._run, name="checkpointer", daemon=True)
         self._thread.start()
 
-    def committed(self) -> None:
-        """A frame was committed: wake the thread when the WAL has reached the bound and it is not checkpointing."""
+    def wal_pages(self) -> int:
+        """The pages the WAL holds (0 when the WAL index cannot be read)."""
         header = os.pread(self._shm, WAL_FRAMES.size, WAL_FRAMES_OFFSET)
-        if len(header) == WAL_FRAMES.size and WAL_FRAMES.unpack(header)[0] >= self.pages and self._idle.is_set():
-            self._idle.clear()
-            self._wanted.set()
+        return WAL_FRAMES.unpack(header)[0] if len(header) == WAL_FRAMES.size else 0
+
+    def committed(self, conn: sqlite3.Connection) -> None:
+        """A frame was committed on ``conn``: when the WAL has reached the bound and no checkpoint runs, wake the
+        thread, or from :data:`CATCH_UP` times the bound on checkpoint on ``conn`` (see the class docstring)."""
+        pages = self.wal_pages()
+        if pages < self.pages or not self._idle.is_set():
+            return
+        if pages >= CATCH_UP * self.pages:
+            with contextlib.suppress(sqlite3.Error):  # as the thread's: the next commit asks again
+                conn.execute("PRAGMA wal_checkpoint(PASSIVE)").fetchall()
+            return
+        self._idle.clear()
+        self._wanted.set()
+
+    def settle(self) -> None:
+        """Wait until no checkpoint runs."""
+        self._idle.wait()
 
     def _run(self) -> None:
         while True:
@@ -175,6 +198,7 @@ class Checkpointer:
 
     def close(self) -> None:
         """Let a running checkpoint finish, end the thread and close its connection."""
+        self.settle()
         self._stop = True
         self._wanted.set()
         self._thread.join()
@@ -234,7 +258,7 @@ def _commit_frames(conn: sqlite3.Connection, checkpointer: Checkpointer | None) 
         with contextlib.suppress(BrokenPipeError):  # the store's process ended: go on committing what it sent
             _write_record(sink, (seq, None))
         if checkpointer is not None:
-            checkpointer.committed()
+            checkpointer.committed(conn)
     return 0
 
 
