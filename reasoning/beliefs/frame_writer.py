@@ -15,8 +15,14 @@ Protocol (both ways: a 4-byte little-endian length, then a :mod:`marshal` record
   the failed frame is rolled back and the writer exits without running any later frame (they were fused on top of it).
 
 At the end of its input (the store closed, or its process died) the writer commits the frames it has read whole and
-exits. This module imports the standard library only: the writer runs as ``python -I frame_writer.py <path>
-<synchronous> <busy timeout s> <autocheckpoint pages>``.
+exits.
+
+Checkpoints run beside the commits (:class:`Checkpointer`): a checkpoint that syncs the files takes tens of ms, and
+run by the committing connection (SQLite's autocheckpoint) it would hold up every frame behind it, and with them the
+store, which waits for the frame before its last one.
+
+This module imports the standard library only: the writer runs as ``python -I frame_writer.py <path> <synchronous>
+<busy timeout s> <autocheckpoint pages>``.
 """
 
 from __future__ import annotations
@@ -28,6 +34,7 @@ import sqlite3
 import struct
 import subprocess
 import sys
+import threading
 import weakref
 from pathlib import Path
 
@@ -41,6 +48,14 @@ the store blocks sending it the next frame."""
 
 NEXT_ID = "SELECT value FROM meta WHERE key = 'next_id'"
 """The statement that reads the next belief id the store hands out."""
+
+WAL_FRAMES = struct.Struct("=I")
+"""``mxFrame`` of the WAL-index header at the start of the ``-shm`` file: the frames (pages) the WAL holds, a native
+32-bit unsigned integer at byte 16 (https://www.sqlite.org/walformat.html, "The WAL-Index Header")."""
+WAL_FRAMES_OFFSET = 16
+
+CATCH_UP = 2
+"""The WAL length, in multiples of the checkpoint bound, from which the committing connection checkpoints itself."""
 
 
 class WriterGoneError(Exception):
@@ -121,6 +136,85 @@ def _end_writer(process: subprocess.Popen) -> None:
     process.stdout.close()
 
 
+class Checkpointer:
+    """Checkpoints of one store's WAL on a thread of their own, beside the writer's commits.
+
+    The committing connection does not checkpoint (``wal_autocheckpoint = 0``); after each commit :meth:`committed`
+    reads how many pages the WAL holds from the WAL index and, from ``pages`` on (the bound SQLite's autocheckpoint
+    applies after a commit), wakes the thread, which runs a PASSIVE checkpoint on its own connection: SQLite lets
+    one writer append to the WAL while it is checkpointed, and releases the GIL while it copies and syncs, so the
+    next frames are committed meanwhile. What is stored and synced is SQLite's affair as before; only which
+    connection checkpoints changes.
+
+    SQLite starts the WAL over only after a checkpoint that copied all of it, and frames committed during a
+    checkpoint are left for the next one; so that a steady stream of frames cannot grow the WAL without end, the
+    committing connection checkpoints itself (as autocheckpoint does: the rest, a few frames) once the WAL holds
+    :data:`CATCH_UP` times ``pages`` and the thread is idle."""
+
+    def __init__(self, path: str, synchronous: str, pages: int) -> None:
+        self.pages = pages
+        self._shm = os.open(f"{path}-shm", os.O_RDONLY)  # the store's connection has made it (WAL mode)
+        self._conn = sqlite3.connect(path, isolation_level=None, check_same_thread=False)
+        self._conn.execute(f"PRAGMA synchronous = {synchronous}")
+        self._wanted = threading.Event()
+        self._idle = threading.Event()
+        self._idle.set()
+        self._stop = False
+        self._thread = threading.Thread(target=self._run, name="checkpointer", daemon=True)
+        self._thread.start()
+
+    def wal_pages(self) -> int:
+        """The pages the WAL holds (0 when the WAL index cannot be read)."""
+        header = os.pread(self._shm, WAL_FRAMES.size, WAL_FRAMES_OFFSET)
+        return WAL_FRAMES.unpack(header)[0] if len(header) == WAL_FRAMES.size else 0
+
+    def committed(self, conn: sqlite3.Connection) -> None:
+        """A frame was committed on ``conn``: when the WAL has reached the bound and no checkpoint runs, wake the
+        thread, or from :data:`CATCH_UP` times the bound on checkpoint on ``conn`` (see the class docstring)."""
+        pages = self.wal_pages()
+        if pages < self.pages or not self._idle.is_set():
+            return
+        if pages >= CATCH_UP * self.pages:
+            with contextlib.suppress(sqlite3.Error):  # as the thread's: the next commit asks again
+                conn.execute("PRAGMA wal_checkpoint(PASSIVE)").fetchall()
+            return
+        self._idle.clear()
+        self._wanted.set()
+
+    def settle(self) -> None:
+        """Wait until no checkpoint runs."""
+        self._idle.wait()
+
+    def _run(self) -> None:
+        while True:
+            self._wanted.wait()
+            self._wanted.clear()
+            if self._stop:
+                return
+            # a failed checkpoint loses nothing (the WAL holds every commit); the next commit asks again
+            with contextlib.suppress(sqlite3.Error):
+                self._conn.execute("PRAGMA wal_checkpoint(PASSIVE)").fetchall()
+            self._idle.set()
+
+    def close(self) -> None:
+        """Let a running checkpoint finish, end the thread and close its connection."""
+        self.settle()
+        self._stop = True
+        self._wanted.set()
+        self._thread.join()
+        self._conn.close()
+        os.close(self._shm)
+
+
+def _checkpointer(path: str, synchronous: str, pages: int) -> Checkpointer | None:
+    """A checkpointer for the store at ``path``, or None when its WAL index cannot be read (the writer's connection
+    then checkpoints as SQLite's autocheckpoint does)."""
+    try:
+        return Checkpointer(path, synchronous, pages)
+    except (OSError, sqlite3.Error):
+        return None
+
+
 def serve(path: str, synchronous: str, busy_timeout: float, autocheckpoint: int) -> int:
     """The writer's loop (see the module docstring); returns the exit code."""
     if hasattr(os, "SCHED_BATCH"):  # throughput work: waking it (a frame sent) must not preempt the fusing process
@@ -129,7 +223,18 @@ def serve(path: str, synchronous: str, busy_timeout: float, autocheckpoint: int)
     conn = sqlite3.connect(path, timeout=busy_timeout, isolation_level=None)
     conn.execute(f"PRAGMA busy_timeout = {int(busy_timeout * 1000)}")
     conn.execute(f"PRAGMA synchronous = {synchronous}")
-    conn.execute(f"PRAGMA wal_autocheckpoint = {autocheckpoint}")
+    checkpointer = _checkpointer(path, synchronous, autocheckpoint) if autocheckpoint > 0 else None
+    conn.execute(f"PRAGMA wal_autocheckpoint = {0 if checkpointer else autocheckpoint}")
+    try:
+        return _commit_frames(conn, checkpointer)
+    finally:
+        if checkpointer is not None:
+            checkpointer.close()
+        conn.close()
+
+
+def _commit_frames(conn: sqlite3.Connection, checkpointer: Checkpointer | None) -> int:
+    """Commit each frame read from the input and answer for it (see the module docstring); the exit code."""
     source, sink = sys.stdin.fileno(), sys.stdout.fileno()
     while (record := _read_record(source)) is not None:
         seq, next_id, writes = record  # type: ignore[misc]
@@ -149,11 +254,11 @@ def serve(path: str, synchronous: str, busy_timeout: float, autocheckpoint: int)
                 conn.execute("ROLLBACK")
             with contextlib.suppress(BrokenPipeError):
                 _write_record(sink, (seq, (type(error).__name__, str(error))))
-            conn.close()
             return 1
         with contextlib.suppress(BrokenPipeError):  # the store's process ended: go on committing what it sent
             _write_record(sink, (seq, None))
-    conn.close()
+        if checkpointer is not None:
+            checkpointer.committed(conn)
     return 0
 
 
