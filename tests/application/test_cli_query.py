@@ -55,7 +55,7 @@ def test_a_timeout_that_passes_answers_from_memory_at_once(capsys: pytest.Captur
 
 def test_a_timeout_stops_the_running_tree_and_a_track_task(tmp_path: Path) -> None:
     with AnsweringService.open(tmp_path / "beliefs.sqlite") as service:
-        outcome = service.answer("detect {obj: {type: Milk}, timeout: 0.3s}")
+        outcome = service.answer("detect {obj: {type: Milk}, timeout: 0.05s}")
         assert outcome.answer.timed_out and outcome.answer.objects == ()
         assert service.engine.tasks.slot("task").subtree.name == "idle"  # the stopped tree was taken out
         handle = service.start("track {obj: {type: cup, color: red}, timeout: 1s}")
