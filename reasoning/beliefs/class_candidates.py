@@ -26,6 +26,6 @@ def candidate_class_clauses(classes: list[str]) -> list[tuple[str, list[object],
             "class_name IS NULL AND id IN "
             f"(SELECT object_id FROM attribute_index WHERE name = ? AND value IN ({marks}))",
             [CLASS_ATTRIBUTE, *classes],
-            True,  # the class index holds the beliefs without a supported class first: most stores have few
+            False,
         ),
     ]
