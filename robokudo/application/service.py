@@ -369,15 +369,19 @@ class AnsweringService:
         remote_hints: Placement | None = None,
         lost_after: float = DEFAULT_LOST_AFTER,
         person: str | None = None,
+        write_behind: int = 0,
     ) -> AnsweringService:
         """A service over the shipped and user ontology and the belief store at ``store_path`` (default store
         when None), with the annotators of ``catalog`` (default: this project's); the annotators named in
         ``remote`` run on Ray actors (with ``remote_hints``, default their classes' placement hints).
+        ``write_behind`` frames may be fused before their commit (the store's writer process; 0: each frame is
+        committed before the next is fused).
 
         The store is opened (and checked) first, so an unusable store raises BeliefStoreError before the
         knowledge base is loaded or anything runs.
         """
-        store = BeliefStore(Path(store_path) if store_path is not None else BeliefStore.default_path())
+        path = Path(store_path) if store_path is not None else BeliefStore.default_path()
+        store = BeliefStore(path, write_behind=write_behind)
         try:
             catalog = catalog if catalog is not None else AnnotatorCatalog.discover()
             kb = load_knowledge_base(catalog=catalog)

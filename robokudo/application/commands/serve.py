@@ -9,10 +9,11 @@ one are aborted with that reason.
 Clients (roslibpy, roslibjs, ``robokudo ask``) send goals to the action ``/robokudo/query``, call the services
 ``/robokudo/plan`` and ``/robokudo/beliefs`` and subscribe to ``/robokudo/tree_status``
 (:mod:`robokudo.application.server`). Binding anything but a loopback address needs a token (``--token`` or
-``$ROBOKUDO_TOKEN``) that clients send in the ``auth`` op. ``--rerun FILE.rrd`` / ``--rerun-connect`` record every
-analysed frame, the belief changes and the tree's status changes with Rerun. SIGINT or SIGTERM aborts the running
-goals with the reason, closes the belief store (and finishes the Rerun file) and exits 0. Exit status 2 for a bad
-option or belief store.
+``$ROBOKUDO_TOKEN``) that clients send in the ``auth`` op. ``--write-behind N`` lets the belief store commit up to
+N frames behind in a writer process (many cameras on a machine with a free core). ``--rerun FILE.rrd`` /
+``--rerun-connect`` record every analysed frame, the belief changes and the tree's status changes with Rerun.
+SIGINT or SIGTERM aborts the running goals with the reason, closes the belief store (committing every frame
+fused, and finishing the Rerun file) and exits 0. Exit status 2 for a bad option or belief store.
 """
 
 from __future__ import annotations
@@ -29,6 +30,7 @@ from annotators.catalog import AnnotatorCatalog
 from annotators.readers.bag_io import ANY_TOPICS, BagTopics, is_bag, named_topics
 from annotators.readers.frame_io import FrameError
 from annotators.readers.streams import FrameStream, KitchenCameraStream, stream_for
+from reasoning.beliefs.frame_writer import MAX_WRITE_BEHIND
 from reasoning.beliefs.store import BeliefStoreError
 from reasoning.errors import OntologyError
 from robokudo.application.cluster import ClusterError
@@ -80,6 +82,15 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
         help="seconds a continuous goal's target may go unseen before the goal ends, when the query gives no "
         f"lost_after (default {DEFAULT_LOST_AFTER:g})",
     )
+    parser.add_argument(
+        "--write-behind",
+        type=int,
+        default=0,
+        metavar="N",
+        help="let the belief store commit up to N frames behind, in a writer process on another core (faster "
+        "updates with a free core; a crash of both processes or a power failure loses up to N frames more; "
+        "default 0: every frame is committed before the next)",
+    )
     add_rerun_arguments(parser)
     add_remote_arguments(parser)
 
@@ -109,6 +120,9 @@ def run(args: argparse.Namespace) -> int:
         problem = f"--sensor-rate must be positive, got {args.sensor_rate:g}"
     elif not args.lost_after >= 0 or args.lost_after == float("inf"):
         problem = f"--lost-after must be a number of seconds >= 0, got {args.lost_after:g}"
+    elif not 0 <= args.write_behind <= MAX_WRITE_BEHIND:
+        limit = MAX_WRITE_BEHIND
+        problem = f"--write-behind must be 0 (off) or a number of frames up to {limit}, got {args.write_behind}"
     elif token is None and not is_loopback(args.host):
         problem = f"binding {args.host} (not a loopback address) needs a token: --token or ${TOKEN_VARIABLE}"
     if problem is not None:
@@ -148,6 +162,7 @@ def _serve(args: argparse.Namespace, token: str | None, rerun_log: RerunLog | No
             remote=args.remote,
             remote_hints=hints,
             lost_after=args.lost_after,
+            write_behind=args.write_behind,
         )
     except (BeliefStoreError, OntologyError) as error:
         stream.close()
