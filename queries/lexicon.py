@@ -181,17 +181,77 @@ SIZES: MappingProxyType[str, str] = MappingProxyType(
 )
 """Size adjectives and the ``size`` value they give."""
 
-SUPERLATIVES: MappingProxyType[str, str] = MappingProxyType(
+SELECTION_WORDS: MappingProxyType[str, str] = MappingProxyType(
     {
-        "smallest": "small",
-        "littlest": "small",
-        "tiniest": "tiny",
-        "biggest": "large",
-        "largest": "large",
-        "hugest": "large",
+        "top": "top",
+        "topmost": "top",
+        "uppermost": "top",
+        "upper": "top",
+        "highest": "top",
+        "bottom": "bottom",
+        "bottommost": "bottom",
+        "lowest": "bottom",
+        "lower": "bottom",
+        "leftmost": "leftmost",
+        "left": "leftmost",
+        "rightmost": "rightmost",
+        "right": "rightmost",
+        "closest": "closest",
+        "nearest": "closest",
+        "closer": "closest",
+        "nearer": "closest",
+        "farthest": "farthest",
+        "furthest": "farthest",
+        "biggest": "biggest",
+        "largest": "biggest",
+        "hugest": "biggest",
+        "bigger": "biggest",
+        "larger": "biggest",
+        "smallest": "smallest",
+        "tiniest": "smallest",
+        "littlest": "smallest",
+        "smaller": "smallest",
     }
 )
-"""Superlatives (they compare the objects seen, which no query key does) and the size word to suggest instead."""
+"""Words before the noun that pick objects by a relation among those found (``the top box``, ``the biggest
+bowl``) and the selection they name (:data:`queries.selection.SELECTIONS`); the comparative (``the bigger one``)
+picks the same way."""
+
+SELECTION_PHRASES: MappingProxyType[tuple[str, ...], str] = MappingProxyType(
+    {
+        ("on", "the", "left"): "leftmost",
+        ("on", "the", "right"): "rightmost",
+        ("at", "the", "left"): "leftmost",
+        ("at", "the", "right"): "rightmost",
+        ("to", "the", "left"): "leftmost",
+        ("to", "the", "right"): "rightmost",
+        ("from", "the", "left"): "leftmost",
+        ("from", "the", "right"): "rightmost",
+        ("on", "top"): "top",
+        ("at", "the", "top"): "top",
+        ("from", "the", "top"): "top",
+        ("at", "the", "bottom"): "bottom",
+        ("from", "the", "bottom"): "bottom",
+    }
+)
+"""Phrases after the noun that select the same way (``the box on the left``, ``the second cup from the left``); a
+longer place phrase wins (``on top of the shelf`` is a place, ``to the left of the cup`` a relation to it)."""
+
+ORDINALS: MappingProxyType[str, int] = MappingProxyType(
+    {
+        "first": 1,
+        "second": 2,
+        "third": 3,
+        "fourth": 4,
+        "fifth": 5,
+        "sixth": 6,
+        "seventh": 7,
+        "eighth": 8,
+        "ninth": 9,
+        "tenth": 10,
+    }
+)
+"""Ordinals before a selection give its rank: ``the second biggest bowl`` -> ``select: { by: biggest, rank: 2 }``."""
 
 SHAPES: MappingProxyType[str, str] = MappingProxyType(
     {

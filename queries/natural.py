@@ -21,8 +21,13 @@ noun words (unknown words joined by ``_``)      ``obj: { type: cereal_box }``
 plural head noun                                singular ``type``, no result limit
 a / an / the / this / my ... + singular noun    ``max_results: 1`` (detect, track)
 all / two / 3 (of) the / my / these + noun      the quantity sets the limit, not ``the``
+the / these two / 3 + noun                      the quantity sets the limit
 the red one / the red ones                      ``one`` names no class: ``color: red``
-the smallest / biggest X                        an error suggesting ``small X`` / ``large X``
+the top / leftmost / closest / biggest X         ``select: top`` (one object: ``max_results: 1``)
+(also bottom, rightmost, farthest, smallest,
+highest, nearest, left, right...)
+X on the left / at the top / from the right     ``select: leftmost`` / ``top`` / ``rightmost``
+the second biggest X / second X from the left   ``select: { by: biggest, rank: 2 }``
 find me / get me                                ``detect`` (``me`` is not the object)
 me / him / her / us / them (alone)              ``type: person`` (``follow me``)
 two ... ten, or a number, before the noun       ``max_results: N`` (detect, track)
@@ -75,6 +80,7 @@ from queries.lexicon import (
     IRREGULAR_PLURALS,
     LIMITING_DETERMINERS,
     OPEN_DETERMINERS,
+    ORDINALS,
     PARTITIVE_OF,
     PERSON_NOUN,
     PERSONAL_PRONOUNS,
@@ -87,10 +93,11 @@ from queries.lexicon import (
     RELATIVE_CLAUSES,
     SCAN_FOR,
     SCAN_TARGETS,
+    SELECTION_PHRASES,
+    SELECTION_WORDS,
     SHAPE_NOUNS,
     STOP_ALL_WORDS,
     STOP_TASK_WORDS,
-    SUPERLATIVES,
     TEXT_MARKERS,
     VERBS,
 )
@@ -110,6 +117,7 @@ from queries.model import (
     Value,
 )
 from queries.natural_tokens import PhraseToken, tokenize_phrase
+from queries.selection import SELECT_KEY
 from queries.units import UnitError, parse_quantity
 from queries.validation import MAX_QUERY_LENGTH, check_length, validate_query
 
@@ -117,7 +125,9 @@ VERB_EXAMPLES: tuple[str, ...] = ("find", "track", "inspect", "scan", "stop")
 """The verbs named when a phrase starts with none."""
 
 _LONGEST_PHRASE = max(
-    len(words) for table in (VERBS, PLACEMENT_VERBS, PREPOSITIONS, FILLERS, TEXT_MARKERS) for words in table
+    len(words)
+    for table in (VERBS, PLACEMENT_VERBS, PREPOSITIONS, FILLERS, TEXT_MARKERS, SELECTION_PHRASES)
+    for words in table
 )
 
 
@@ -175,6 +185,10 @@ class _ObjectPhrase:
     locations: list[Field] = field(default_factory=list)
     location_span: Span | None = None
     anywhere: Span | None = None
+    selection: str | None = None
+    selection_span: Span | None = None
+    rank: int = 1
+    rank_span: Span | None = None
 
     def add_adjective(self, key: str, value: Value, span: Span) -> None:
         found = self.adjectives.get(key)
@@ -202,6 +216,25 @@ class _ObjectPhrase:
 
     def is_bare(self) -> bool:
         return not (self.adjectives or self.extras or self.locations or self.anywhere)
+
+    def select(self, selection: str, span: Span) -> None:
+        """Record the selection said at ``span``; a second one is an error (the caller locates it)."""
+        if self.selection is not None and self.selection != selection:
+            raise ValueError(f"expected one selection: '{self.selection}' is already asked")
+        self.selection, self.selection_span = selection, self.selection_span or span
+
+    def select_field(self) -> Field | None:
+        """The ``select`` field (a block when a rank other than the first is asked), None without a selection."""
+        if self.selection is None:
+            return None
+        span = self.selection_span or self.start
+        if self.rank == 1:
+            return Field(SELECT_KEY, Symbol(self.selection), span)
+        rank_span = self.rank_span or span
+        by = Field("by", Symbol(self.selection), span)
+        return Field(
+            SELECT_KEY, Block((by, Field("rank", Number(float(self.rank)), rank_span))), _join_span(rank_span, span)
+        )
 
 
 class _PhraseParser:
@@ -268,10 +301,26 @@ class _PhraseParser:
             return False
         return bool(
             self.match(PREPOSITIONS)
+            or self.selection_phrase() is not None
             or self.match(RELATIVE_CLAUSES)
             or word in SCAN_FOR
             or (self.match(TEXT_MARKERS) and self.text_after_marker() is not None)
         )
+
+    def selection_phrase(self) -> tuple[str, ...] | None:
+        """A selection phrase starting here (``on the left``) that no longer place phrase covers (``on top of``,
+        ``to the left of``) and that ends the object phrase or is followed by another modifier (``on the left
+        shelf`` is a place)."""
+        found = self.match(SELECTION_PHRASES)
+        if found is None:
+            return None
+        place = self.match(PREPOSITIONS)
+        if place is not None and len(place) >= len(found):
+            return None
+        after = self.index + len(found)
+        if after < len(self.tokens) and not self.is_boundary_after(len(found)):
+            return None
+        return found
 
     def is_boundary_after(self, ahead: int) -> bool:
         """Whether the token ``ahead`` of the current one ends a run of noun words."""
@@ -462,8 +511,12 @@ class _PhraseParser:
             raise self.error(f"could not place '{shown}'")
 
     def object_body(self, kind: str, phrase: _ObjectPhrase) -> Block:
+        self.check_rank(phrase)
         span = _join_span(phrase.start, phrase.end)
         fields = [Field("obj", phrase.block(), span)]
+        selected = phrase.select_field()
+        if selected is not None:
+            fields.append(selected)
         if kind in ("detect", "track"):
             limit = phrase.limit
             if limit is None and phrase.limit_span is not None and not phrase.plural:
@@ -530,6 +583,12 @@ class _PhraseParser:
         elif word in LIMITING_DETERMINERS:
             phrase.limit_span = self.take()[0].span
             quantity = False
+            after = self.current()  # ``the two biggest bowls``, ``these 3 cups``: the quantity sets the limit
+            if after is not None and after.kind == "word" and after.text in COUNT_WORDS:
+                phrase.limit, phrase.limit_span = COUNT_WORDS[after.text], self.take()[0].span
+            elif after is not None and after.kind == "number" and not self.is_boundary_after(1):
+                phrase.limit = int(self.whole_number(after, "the number of objects").value)
+                phrase.limit_span = self.take()[0].span
         elif word in OPEN_DETERMINERS:
             self.take()
         elif word is not None and word in COUNT_WORDS:
@@ -563,13 +622,14 @@ class _PhraseParser:
                 phrase.add_adjective("color", Symbol(f"{word}_{COLORS[following]}"), token.span)
                 position += 2
                 continue
-            if word in SUPERLATIVES:
-                instead = " ".join(SUPERLATIVES.get(t.text, t.text) for t in words)
-                raise self.error_at(
-                    token.span,
-                    f"'{word}' compares the objects seen, which a query cannot ask; ask for a size instead, "
-                    f"e.g. '{instead}'",
-                )
+            if word in ORDINALS and phrase.rank_span is None and not nouns:
+                phrase.rank, phrase.rank_span = ORDINALS[word], token.span
+                position += 1
+                continue
+            if word in SELECTION_WORDS and not nouns:
+                self.select(phrase, SELECTION_WORDS[word], token.span)
+                position += 1
+                continue
             if word in CONJUNCTIONS:
                 if position == 0 or following is None or not self.is_adjective(following):
                     raise self.error_at(
@@ -581,15 +641,36 @@ class _PhraseParser:
             if not self.add_adjective_word(phrase, word, token.span):
                 nouns.append(word)
             position += 1
+        if head.text in SELECTION_WORDS and not nouns:  # ``find the highest``: the highest object
+            self.select(phrase, SELECTION_WORDS[head.text], head.span)
+            phrase.generic, phrase.noun, phrase.noun_span = True, "object", head.span
+            return
         singular, plural = singularise(head.text)
         phrase.plural = plural
         if not nouns and singular in SHAPE_NOUNS:
             phrase.add_adjective("shape", Symbol(SHAPE_NOUNS[singular]), head.span)
             singular = "object"
         phrase.generic = not nouns and singular in GENERIC_NOUNS
+        if phrase.generic and phrase.selection is not None:  # ``the biggest one``: the biggest object
+            singular = "object"
         phrase.noun = "_".join([*nouns, singular])
         first = next((token for token in before if token.text in nouns), head)
         phrase.noun_span = _join_span(first.span, head.span)
+
+    def select(self, phrase: _ObjectPhrase, selection: str, span: Span) -> None:
+        """Record a selection in ``phrase``; a second, different one is an error located at ``span``."""
+        try:
+            phrase.select(selection, span)
+        except ValueError as error:
+            raise self.error_at(span, str(error)) from None
+
+    def check_rank(self, phrase: _ObjectPhrase) -> None:
+        """An ordinal needs a selection to count in: ``the second biggest``, ``the second from the left``."""
+        if phrase.rank_span is not None and phrase.selection is None:
+            raise self.error_at(
+                phrase.rank_span,
+                "an ordinal counts along a selection, e.g. 'the second biggest box' or 'the second box from the left'",
+            )
 
     @staticmethod
     def is_adjective(word: str) -> bool:
@@ -614,6 +695,9 @@ class _PhraseParser:
                 self.take()
                 span = _join_span(marker[0].span, quoted.span)
                 phrase.extras.append(Field("text", String(quoted.text), span))
+            elif (selecting := self.selection_phrase()) is not None:
+                taken = self.take(len(selecting))
+                self.select(phrase, SELECTION_PHRASES[selecting], _join_span(taken[0].span, taken[-1].span))
             elif (preposition := self.match(PREPOSITIONS)) is not None:
                 if phrase.anywhere is not None:
                     raise self.error("expected one place: 'anywhere' lifts the place restriction")

@@ -8,7 +8,9 @@ bounds are scalars of one type, numbers share a unit and ``low <= high``;
 ``confidence`` is a plain number from 0 to 1; ``size`` is a size word (the
 answer is filtered by size class, so a metric size or range is refused here
 rather than ignored later); a ``free_space`` block of a ``scan`` holds only ``region``, ``for`` and
-``footprint`` (one or two positive lengths); nesting is at most :data:`MAX_DEPTH` deep.  Whether an object class exists
+``footprint`` (one or two positive lengths); a top-level ``select`` of a ``detect`` or ``inspect`` query names a
+known selection (:mod:`queries.selection`), alone or in a block with a whole ``rank`` of at least 1; nesting is at
+most :data:`MAX_DEPTH` deep.  Whether an object class exists
 is left to the reasoning layer.
 """
 
@@ -35,6 +37,7 @@ from queries.model import (
     Symbol,
     Value,
 )
+from queries.selection import SELECT_KEY, SELECT_KEYS, SELECTIONS
 
 MAX_QUERY_LENGTH = 10_000
 """Longest query text accepted, in characters."""
@@ -121,6 +124,9 @@ def validate_query(query: Query) -> None:
     free_space = query.body.field(FREE_SPACE_KEY)
     if free_space is not None:
         _check_free_space(query, free_space)
+    selection = query.body.field(SELECT_KEY)
+    if selection is not None:
+        _check_selection(query, selection)
     stack: list[tuple[Block, int]] = [(query.body, 1)]
     while stack:
         block, depth = stack.pop()
@@ -213,6 +219,44 @@ def _check_free_space(query: Query, item: Field) -> None:
                 _span(block, "footprint"),
                 "'footprint' takes one or two positive lengths, width and depth, such as [10cm, 8cm] or 0.1",
             )
+
+
+SELECTING_KINDS: tuple[str, ...] = ("detect", "inspect")
+"""The kinds whose answer may be a selection among the objects found."""
+
+
+def _check_selection(query: Query, item: Field) -> None:
+    """Check a ``select``: a known selection name, or a block of one (``by``) and a whole ``rank`` of at least 1."""
+    if query.kind not in SELECTING_KINDS:
+        raise _error(
+            query, item.span, f"'{SELECT_KEY}' belongs to a {' or '.join(SELECTING_KINDS)} query, not '{query.kind}'"
+        )
+    names = tuple(SELECTIONS)
+    value = item.value
+    name_span = item.span
+    if isinstance(value, Block):
+        for entry in value.fields:
+            if entry.key not in SELECT_KEYS:
+                message = f"'{SELECT_KEY}' has no key '{entry.key}' (expected {', '.join(SELECT_KEYS)})"
+                raise _error(query, entry.span, message, SELECT_KEYS)
+        rank = value.field("rank")
+        if rank is not None and not (
+            isinstance(rank.value, Number)
+            and rank.value.unit is None
+            and rank.value.value.is_integer()
+            and rank.value.value >= 1
+        ):
+            raise _error(query, rank.span, "'rank' must be a whole number of at least 1 (1 is the first)")
+        by = value.field("by")
+        if by is None:
+            raise _error(query, item.span, f"'{SELECT_KEY}' needs 'by': {describe_alternatives(names)}", names)
+        value, name_span = by.value, by.span
+    if not isinstance(value, Symbol):
+        message = f"'{SELECT_KEY}' takes a selection such as top, leftmost, closest or biggest"
+        raise _error(query, name_span, message, names)
+    if value.name.lower() not in SELECTIONS:
+        message = f"unknown selection '{value.name}', expected {describe_alternatives(names)}"
+        raise _error(query, name_span, message, names)
 
 
 def _span(block: Block, key: str) -> Span:

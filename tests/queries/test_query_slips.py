@@ -43,21 +43,6 @@ def test_a_contracted_relative_clause_reads_as_its_words(phrase: str, expected: 
 
 
 @pytest.mark.parametrize(
-    ("phrase", "column", "instead"),
-    [
-        ("find the smallest cup", 10, "'small cup'"),
-        ("find the biggest red box on the table", 10, "'large red box'"),
-        ("find the largest bowls", 10, "'large bowls'"),
-    ],
-)
-def test_a_superlative_is_refused_with_what_to_say_instead(phrase: str, column: int, instead: str) -> None:
-    with pytest.raises(QueryError) as caught:
-        parse_query(phrase)
-    assert (caught.value.line, caught.value.column) == (1, column)
-    assert instead in caught.value.message
-
-
-@pytest.mark.parametrize(
     ("phrase", "expected"),
     [
         ("follow me", "track { obj: { type: person }, max_results: 1 }"),
