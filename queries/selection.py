@@ -29,10 +29,10 @@ class Measure:
     description: str
 
 
-HEIGHT = Measure("height", "m", "height above the support plane")
-IMAGE_X = Measure("image_x", "m", "position along the camera's x axis (image left to right)")
+HEIGHT = Measure("height", "m", "height")
+IMAGE_X = Measure("camera_x", "m", "camera x (image left to right)")
 DISTANCE = Measure("distance", "m", "distance from the camera")
-VOLUME = Measure("volume", "m^3", "volume of the bounding box")
+VOLUME = Measure("volume", "m^3", "volume")
 
 MEASURES: tuple[Measure, ...] = (HEIGHT, IMAGE_X, DISTANCE, VOLUME)
 """Every measure a selection may order by."""
@@ -48,7 +48,7 @@ class Selection:
 
     @property
     def description(self) -> str:
-        """In words: ``greatest height above the support plane``."""
+        """In words: ``greatest height``."""
         return f"{'greatest' if self.greatest else 'least'} {self.measure.description}"
 
 

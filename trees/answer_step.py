@@ -26,6 +26,7 @@ from reasoning.beliefs.answer import (
     designator,
 )
 from reasoning.beliefs.ranking import best_first
+from reasoning.beliefs.selection import SelectionNote, Viewpoint, select
 from reasoning.beliefs.store import BeliefFilter, BeliefStore
 from reasoning.fusion.association import CameraModel
 from reasoning.fusion.frame import FUSED_TYPES, WORLD_FRAME, FrameContext, FrameObject, frame_objects
@@ -39,6 +40,7 @@ from robokudo.core.types import (
     FreePlacement,
     ObjectHypothesis,
     PersonTrack,
+    Plane,
     PointCloud,
     PointingTarget,
     QueryAnswer,
@@ -83,7 +85,8 @@ class AnswerStep(Annotator):
 
     inputs: ClassVar[tuple[type[CasType], ...]] = (ObjectHypothesis,)
     optional_inputs: ClassVar[tuple[type[CasType], ...]] = (
-        CameraInfo, PointCloud, DepthImage, QueryView, TargetTrack, PointingTarget, FreePlacement, *FUSED_TYPES,
+        CameraInfo, PointCloud, DepthImage, QueryView, TargetTrack, PointingTarget, FreePlacement, Plane,
+        *FUSED_TYPES,
     )  # fmt: skip
     outputs: ClassVar[tuple[type[CasType], ...]] = (QueryAnswer,)
 
@@ -173,7 +176,12 @@ class AnswerStep(Annotator):
         matching = store.query(replace(belief_filter, ids=tuple(seen), limit=None))
         guesses = self._guessed(store, belief_filter, seen, {b.id for b in matching})
         matching += guesses.values()
-        if belief_filter.limit is not None:  # asked for N objects: the N most likely to be what was asked
+        selected: SelectionNote | None = None
+        if belief_filter.selection is not None:  # ``the top box``: by its measure, the usual order deciding ties
+            ordered = best_first(matching, replace(belief_filter, limit=None))
+            viewpoint = self._viewpoint(info)
+            matching, selected = select(ordered, belief_filter.selection, viewpoint, belief_filter.limit)
+        elif belief_filter.limit is not None:  # asked for N objects: the N most likely to be what was asked
             matching = best_first(matching, belief_filter)
         else:
             matching.sort(key=lambda b: (-b.confidence, b.id))
@@ -206,6 +214,7 @@ class AnswerStep(Annotator):
             pointing=pointing,
             placements=self._placements() if self.free_space else None,
             counted=asked is not None and asked.counted,
+            selection=selected,
         )
         self.write(QueryAnswer(answer))
         if self.fail_when_empty and not matching:
@@ -238,6 +247,14 @@ class AnswerStep(Annotator):
             direction=tuple(float(v) for v in direction),
             frame=frame,
         )
+
+    def _viewpoint(self, info: CameraInfo | None) -> Viewpoint:
+        """Where a selection's measures are taken from: the camera pose and the frame's support plane (the plane
+        with the most inliers)."""
+        planes = self.annotations(Plane)
+        plane = max(planes, key=lambda p: len(p.inlier_indices)).model if planes else None
+        pose = info.cam_to_world if info is not None else None
+        return Viewpoint(cam_to_world=None if pose is None else np.asarray(pose, dtype=np.float64), plane=plane)
 
     def _placements(self) -> tuple[PlacementDesignator, ...]:
         """The CAS's free placements as designators, largest first."""

@@ -21,6 +21,7 @@ from typing import Any
 
 from reasoning.beliefs.ranking import answer_order
 from reasoning.beliefs.seen_together import SEEN_TOGETHER, last_stated
+from reasoning.beliefs.selection import SelectionNote, Viewpoint, select
 from reasoning.beliefs.store import BeliefFilter, BeliefStore
 from reasoning.fusion.rule import (
     CLASS_ATTRIBUTE,
@@ -305,6 +306,9 @@ class Answer:
     counted: bool = False
     """The query asked how many (``how many cans are there``): the summary starts with the number and the JSON
     has ``count``."""
+    selection: SelectionNote | None = None
+    """How the objects were selected when the query asked for a selection (``the top box``; ``selection`` in the
+    JSON only then)."""
 
     def to_dict(self) -> dict[str, Any]:
         """A JSON-ready dict (``placements`` only when the query asked for free space)."""
@@ -322,6 +326,8 @@ class Answer:
             found["placements"] = [p.to_dict() for p in self.placements]
         if self.counted:
             found["count"] = len(self.objects)
+        if self.selection is not None:
+            found["selection"] = self.selection.to_dict()
         return found
 
     def to_json(self, indent: int | None = 2) -> str:
@@ -334,6 +340,8 @@ class Answer:
         right), ``exists`` the confidence that the object is there; then the free places
         when the query asked for free space."""
         lines = self._object_lines()
+        if self.selection is not None and (self.objects or self.selection.unmeasured):
+            lines.append(self.selection.summary())
         if self.counted:
             lines.insert(0, f"count: {len(self.objects)}")
         if self.placements is not None:
@@ -519,8 +527,16 @@ def answer_from_memory(
 ) -> Answer:
     """Answer a query from the store alone (no perception): the matching known objects, most confident first; with
     a ``limit``, the ones most likely to be what was asked (:func:`~reasoning.beliefs.ranking.answer_order`);
-    ``counted``: the query asked how many."""
-    if belief_filter.limit is not None:
+    with a selection, the ones it selects (measured as the beliefs were stored: no camera pose or support plane is
+    known to memory); ``counted``: the query asked how many."""
+    note = None
+    if belief_filter.selection is not None:
+        views = store.query_views(replace(belief_filter, limit=None), _belief_view)
+        views.sort(key=lambda v: answer_order(v.belief, belief_filter))
+        by_id = {v.belief.id: v for v in views}
+        chosen, note = select([v.belief for v in views], belief_filter.selection, Viewpoint(), belief_filter.limit)
+        views = [by_id[b.id] for b in chosen]
+    elif belief_filter.limit is not None:
         views = store.query_views(replace(belief_filter, limit=None), _belief_view)
         views.sort(key=lambda v: answer_order(v.belief, belief_filter))
         views = views[: belief_filter.limit]
@@ -531,4 +547,4 @@ def answer_from_memory(
         _designate(v, class_test=belief_filter.class_test, asked_class=belief_filter.object_class, **options)
         for v in views
     )
-    return Answer(query=query, objects=designators, from_memory=True, counted=counted)
+    return Answer(query=query, objects=designators, from_memory=True, counted=counted, selection=note)

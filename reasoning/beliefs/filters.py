@@ -4,7 +4,8 @@ The object description is the query's body or its ``obj`` block (the natural fro
 are resolved with the knowledge base (any :class:`Vocabulary`, e.g. the KnowledgeBase); a word it does not
 know is used as it is, so memory can still be searched by name, unless the filter is ``strict``: then the
 knowledge base's LookupError (e.g. ``unknown object class 'unicorn'``) is raised, as planning the query would.
-An ``id`` (``inspect object 3``, ``inspect {obj: {id: 3}}``) selects that stored belief.
+An ``id`` (``inspect object 3``, ``inspect {obj: {id: 3}}``) selects that stored belief. A ``select`` (``the top
+box``) is kept in the filter for the answer to apply.
 A list of words under an attribute key (``color: [red, blue]``, from ``red or blue cup`` or a robot's designator)
 selects objects with any of those values: an object has one dominant colour, shape and size, so "all of them"
 would match nothing, and RoboKudo's designator lists mean alternatives too. A colour no expert reports is asked
@@ -26,6 +27,7 @@ from typing import Protocol
 
 from queries import ANYWHERE, Block, ListValue, Number, Query, String, Symbol, Value
 from queries.model import text_switch
+from queries.selection import SELECT_KEY, selection_request
 from reasoning.beliefs.store import BeliefFilter
 from reasoning.knowledge.model import Resolved
 from robokudo.core.regions import RegionBox
@@ -91,6 +93,7 @@ def belief_filter(
         min_confidence=0.0 if min_confidence is None else min_confidence,
         limit=None if limit is None else int(limit),
         ids=None if object_id is None else (int(object_id),),
+        selection=selection_request(query.body.get(SELECT_KEY)),
     )
 
 

@@ -53,6 +53,7 @@ from typing import TypeVar
 import numpy as np
 import platformdirs
 
+from queries.selection import SelectionRequest
 from reasoning.beliefs.frame_writer import MAX_WRITE_BEHIND, NEXT_ID, FrameWriter, WriterGoneError
 from reasoning.beliefs.interned import INTERN, InternedTexts, decoded_supports
 from reasoning.beliefs.packed import (
@@ -126,7 +127,8 @@ class BeliefFilter:
     last stated: a red-and-white can answers to "red" and to "white"); ``text`` matches when each of its words is
     read in such a value, tolerating OCR errors (:func:`~robokudo.core.text_match.text_matches`). An attribute given
     several values (``{"color": ("red", "blue")}``) matches when any of them does. ``ids`` restricts the answer to
-    those beliefs.
+    those beliefs. ``selection`` (``the top box``) is applied by the answer (:mod:`reasoning.beliefs.selection`),
+    not by the store.
     """
 
     object_class: str | None = None
@@ -138,6 +140,7 @@ class BeliefFilter:
     min_confidence: float = 0.0
     limit: int | None = None
     ids: tuple[int, ...] | None = None
+    selection: SelectionRequest | None = None
 
 
 @dataclass(frozen=True, slots=True)

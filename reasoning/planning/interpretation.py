@@ -8,7 +8,9 @@ a camera pose is a planning error. A class whose variants differ only by printed
 does a one-shot query that names no class but asks what the objects are (``find all objects``, ``scan { region:
 table }``; not ``find the red thing``) when there is a colour image and the ontology knows classes that only their
 printed text or brand tells apart; ``text: false`` skips the reading, ``text: true`` (or ``text: ?``) asks for it.
-Each requirement carries the sentence that explains it.
+A ``select`` (``the top box``, ``the leftmost cup``) is a step on the answer: the objects found are ordered by the
+selection's measure (:mod:`reasoning.beliefs.selection`); selecting by height needs the support plane, and every
+selection needs depth to measure the objects in 3-D. Each requirement carries the sentence that explains it.
 """
 
 from __future__ import annotations
@@ -34,6 +36,7 @@ from queries.model import (
     Value,
     text_switch,
 )
+from queries.selection import HEIGHT, SELECT_KEY, SelectionRequest, selection_request
 from reasoning.errors import TermError
 from reasoning.knowledge.knowledge_base import KnowledgeBase
 from reasoning.planning.plan import Constraint, Task
@@ -151,6 +154,7 @@ def interpret(
         region_box, note = _default_region(object_class, kb, camera_pose)
         if note:
             inferences.append(note)
+    selection = _selection(query, depth, requirements, inferences)
     task = Task(
         kind=query.kind,
         object_class=object_class,
@@ -160,8 +164,34 @@ def interpret(
         max_results=_whole(query.get("max_results")),
         object_id=object_id,
         min_confidence=min_confidence,
+        selection=selection,
     )
     return Interpretation(task, (*requirements, *_tracking(query)), region_box, transparent)
+
+
+def _selection(
+    query: Query, depth: bool, requirements: list[Requirement], inferences: list[str]
+) -> SelectionRequest | None:
+    """The query's selection (``select: top``), with what it needs added to ``requirements`` and what the answer
+    does with it to ``inferences``; a selection on a sensor without depth is a located planning error."""
+    request = selection_request(query.get(SELECT_KEY))
+    if request is None:
+        return None
+    selection = request.selection
+    if not depth:
+        error = PlanningError(
+            f"selecting the {selection.name} object measures objects in 3-D; the sensor measures no depth"
+        )
+        raise _located(query, query.body.field(SELECT_KEY), error)
+    rank = f" from number {request.rank} on" if request.rank != 1 else ""
+    inferences.append(
+        f"the answer selects by '{selection.name}': the objects found are ordered by {selection.description} "
+        f"and answered{rank} up to the query's limit"
+    )
+    if selection.measure is HEIGHT:
+        why = f"selecting the {selection.name} object measures heights above the support plane"
+        requirements.append(Requirement("Plane", None, why))
+    return request
 
 
 def _inspection(object_id: int, required: set[str], kb: KnowledgeBase) -> list[Requirement]:

@@ -10,6 +10,8 @@ from collections.abc import Iterator
 from dataclasses import dataclass, field
 from typing import Any
 
+from queries.selection import SelectionRequest
+
 
 @dataclass(frozen=True)
 class Constraint:
@@ -36,6 +38,8 @@ class Task:
     """What a pointing query asks for (``object`` or ``region``), None for other queries."""
     footprint: tuple[float, float] | None = None
     """Width and depth (metres) of what a free-space scan looks for room for; None when it looks for none."""
+    selection: SelectionRequest | None = None
+    """How the answer picks among the objects found (``the top box``); None when it answers every one."""
 
     def constraint(self, key: str) -> Constraint | None:
         """The constraint on ``key``, or None."""
