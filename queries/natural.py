@@ -292,8 +292,8 @@ class _PhraseParser:
             message += f" after '{context}'"
         return located_error(self.text, message, line, column, expected)
 
-    def is_boundary(self) -> bool:
-        """Whether the current token ends a run of noun words."""
+    def is_boundary(self, selections: bool = True) -> bool:
+        """Whether the current token ends a run of noun words (``selections``: a selection phrase counts)."""
         word = self.word()
         if word is None or word == "with" or word in ANYWHERE_WORDS:
             return True
@@ -301,7 +301,7 @@ class _PhraseParser:
             return False
         return bool(
             self.match(PREPOSITIONS)
-            or self.selection_phrase() is not None
+            or (selections and self.selection_phrase() is not None)
             or self.match(RELATIVE_CLAUSES)
             or word in SCAN_FOR
             or (self.match(TEXT_MARKERS) and self.text_after_marker() is not None)
@@ -318,15 +318,15 @@ class _PhraseParser:
         if place is not None and len(place) >= len(found):
             return None
         after = self.index + len(found)
-        if after < len(self.tokens) and not self.is_boundary_after(len(found)):
+        if after < len(self.tokens) and not self.is_boundary_after(len(found), selections=False):
             return None
         return found
 
-    def is_boundary_after(self, ahead: int) -> bool:
+    def is_boundary_after(self, ahead: int, selections: bool = True) -> bool:
         """Whether the token ``ahead`` of the current one ends a run of noun words."""
         self.index += ahead
         try:
-            return self.is_boundary()
+            return self.is_boundary(selections)
         finally:
             self.index -= ahead
 

@@ -24,7 +24,7 @@ from queries import (
 )
 from queries.lexicon import ORDINALS, SELECTION_PHRASES, SELECTION_WORDS
 from queries.selection import SELECTIONS, selection_request
-from tests.queries.test_query_properties import FAST
+from tests.queries.test_query_properties import FAST, only_query_errors
 
 NOUNS = st.sampled_from(["cup", "bowl", "can", "bottle", "cereal box", "mug", "milk"])
 """Class nouns (no lexicon word among them)."""
@@ -168,3 +168,24 @@ def test_the_model_of_a_ranked_selection_is_a_block() -> None:
     query = parse_query("find the third biggest bowl")
     value = query.get("select")
     assert value == Block((Field("by", Symbol("biggest")), Field("rank", Number(3))))
+
+
+selection_phrase_words = st.sampled_from(
+    [
+        *sorted(SELECTION_WORDS),
+        *sorted(ORDINALS),
+        *(" ".join(p) for p in SELECTION_PHRASES),
+        *("find", "the", "two", "cup", "cups", "box", "of", "on the table", "on top of", "left of", "and", "one", "3"),
+    ]
+)
+
+
+@FAST
+@given(st.lists(selection_phrase_words, max_size=12).map(" ".join))
+def test_random_selection_phrases_give_a_model_or_a_located_error(text: str) -> None:
+    only_query_errors(parse_query, text)
+
+
+def test_a_long_run_of_selection_phrases_is_read_without_running_out_of_stack() -> None:
+    query = parse_query("find the cup" + " on the left" * 800)
+    assert selected(query) == ("leftmost", 1)
