@@ -320,10 +320,8 @@ def _why_text_matters(object_class: str, kb: KnowledgeBase) -> str:
     """Why text must be read to recognise ``object_class`` ("" when it need not be).
 
     Text matters when the class's variants differ only by printed text, when the class is a branded product (the
-    brand printed on it is what tells it from other products of its kind), when another, unrelated class looks
-    the same (same colours, shape and size) and the class carries printed text that tells them apart, or when the
-    class carries a printed label (``rk:printedLabel`` true: a can, a wipes canister): so do packages of many other
-    kinds, named by the text printed on them, and a package whose text went unread could not be told from it.
+    brand printed on it is what tells it from other products of its kind), or when another, unrelated class looks
+    the same (same colours, shape and size) and the class carries printed text that tells them apart.
     """
     if kb.variants_differ_by_text(object_class):
         return f"{object_class} differs from its sibling classes only by printed text, so text must be read"
@@ -332,11 +330,6 @@ def _why_text_matters(object_class: str, kb: KnowledgeBase) -> str:
         return (
             f"{object_class} is sold under the brand {profile.brand!r}; only the brand printed on it tells it from "
             "other products of its kind, so text must be read"
-        )
-    if profile.printed and not profile.texts:
-        return (
-            f"{object_class} carries a printed label, as packages of other kinds do; only the text printed on them "
-            "tells those apart, so text must be read"
         )
     if not profile.texts:
         return ""
