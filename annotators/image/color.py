@@ -12,7 +12,8 @@ Each surface is named (:func:`name_surface`):
   term's prototypes vote with a Gaussian of their distance (``kernel_width``) averaged per term, and the winning
   term's share of the votes is the name's certainty; brown gets no vote from a colour whose saturation
   C*/(L* + 16) is at least ``brown_max_saturation`` (brown surfaces are of moderate saturation; a dim yellow or
-  orange print is not brown, however dark);
+  orange print is not brown, however dark), nor from a lit surface about as light as a white of the same object
+  (``brown_below_white``: a cream or tan in dim light, which the survey's light browns match by colour alone);
 * the near-black pool is a dark colour (a navy mug) when its mean colour is clearly saturated, else black; it
   counts only when it is a sizeable part of the object or has the name of one of its lit surfaces (shadows are
   dropped).
@@ -127,18 +128,54 @@ _BROWN = CHROMATIC_TERMS.index("brown")
 
 
 def _without_saturated_brown(votes: np.ndarray, labs: np.ndarray, parameters: NamingParameters) -> np.ndarray:
-    """The votes with brown's taken away (the others' shares renormalised) for colours whose saturation
-    C*/(L* + 16) is at least ``brown_max_saturation``: too saturated for a brown surface, they are a yellow, orange
-    or olive seen in less light (dimming lowers L* and C* together, not their ratio); a colour whose every vote is
-    brown keeps them."""
-    colourful = np.hypot(labs[:, 1], labs[:, 2]) >= parameters.brown_max_saturation * (labs[:, 0] + 16.0)
+    """The votes with brown's taken away for colours whose saturation C*/(L* + 16) is at least
+    ``brown_max_saturation``: too saturated for a brown surface, they are a yellow, orange or olive seen in less
+    light (dimming lowers L* and C* together, not their ratio)."""
+    saturated = np.hypot(labs[:, 1], labs[:, 2]) >= parameters.brown_max_saturation * (labs[:, 0] + 16.0)
+    return _without_brown(votes, saturated)
+
+
+def _without_brown(votes: np.ndarray, chosen: np.ndarray) -> np.ndarray:
+    """The votes (S x terms) with brown's share taken away and the others' renormalised in the ``chosen`` rows;
+    a row whose every vote is brown keeps them."""
     rest = 1.0 - votes[:, _BROWN]
-    change = colourful & (rest > 1e-12)
+    change = chosen & (rest > 1e-12)
     if np.any(change):
         votes = votes.copy()
         votes[change, _BROWN] = 0.0
         votes[change] /= rest[change, None]
     return votes
+
+
+def _luminance(lightness: float) -> float:
+    """The relative luminance Y (white 1) of a CIELAB lightness above 8."""
+    return ((lightness + 16.0) / 116.0) ** 3
+
+
+def _without_brown_beside_white(
+    surfaces: list[Surface],
+    votes: list[np.ndarray | None],
+    names: list[SurfaceName],
+    parameters: NamingParameters,
+) -> tuple[list[np.ndarray | None], list[SurfaceName]]:
+    """One object's surface votes and names with brown's votes taken away (and the name taken again) for the
+    lit surfaces as light as ``brown_below_white`` of the object's lightest white surface or lighter: lit by the
+    same light as that white, they are a cream, tan or pale orange, not a brown (brown is a yellow or orange
+    clearly darker than white); an object without a white surface is left as it is."""
+    whites = [
+        float(surface.lab[0])
+        for surface, vote, name in zip(surfaces, votes, names, strict=True)
+        if vote is None and surface.kind != "dark" and name.name == "white"
+    ]
+    if not whites:
+        return votes, names
+    limit = parameters.brown_below_white * _luminance(max(whites))
+    votes, names = list(votes), list(names)
+    for index, (surface, vote) in enumerate(zip(surfaces, votes, strict=True)):
+        if vote is not None and surface.kind != "dark" and _luminance(float(surface.lab[0])) >= limit:
+            votes[index] = _without_brown(vote[None, :], np.ones(1, dtype=bool))[0]
+            names[index] = _name_of_votes(votes[index])
+    return votes, names
 
 
 def _name_of_votes(votes: np.ndarray) -> SurfaceName:
@@ -311,7 +348,7 @@ def name_objects_colors(
             _lightness_name(surface, light.surround, parameters) if lab is None else next(all_names)
             for surface, lab in zip(surfaces, labs, strict=True)
         ]
-        named.append((votes, names))
+        named.append(_without_brown_beside_white(surfaces, votes, names, parameters))
     lit_labs = [
         [surfaces[i].lab for i in _lit_chromatic(surfaces, names)]
         for (surfaces, _), (_, names) in zip(found, named, strict=True)

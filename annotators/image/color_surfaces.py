@@ -108,6 +108,11 @@ class NamingParameters:
     midway between its most saturated brown surface (a cardboard box, 0.55) and its least saturated yellow the
     prototypes call brown (a crisps tube, 0.76). A limit on C* alone (the former rule) let a dim olive print of
     the same saturation as a bright yellow be brown because it was dark."""
+    brown_below_white: float = 0.40
+    """A lit surface whose luminance is at least this fraction of the lightest white surface of its object is not
+    brown. Not tuned: the ISCC-NBS colour names put "light brown" at Munsell value 6.5 at most (Y = 0.35), white
+    paper is about value 9.5 (Y = 0.88), and 0.35 / 0.88 = 0.40; the object's white is lit by the same light, so
+    the ratio does not depend on how dim the frame is."""
     second_share: float = 0.3
     """A second colour is reported when its share of the named pixels is at least this ..."""
     second_confidence: float = 0.1
