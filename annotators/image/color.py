@@ -10,10 +10,10 @@ Each surface is named (:func:`name_surface`):
 * a saturated surface is named in CIELAB by CIEDE2000 distances to the colour-name prototypes of
   :mod:`annotators.image.color_prototypes` (the xkcd colour survey), as a kernel density classifier: each
   term's prototypes vote with a Gaussian of their distance (``kernel_width``) averaged per term, and the winning
-  term's share of the votes is the name's certainty; brown gets no vote from a colour whose saturation
-  C*/(L* + 16) is at least ``brown_max_saturation`` (brown surfaces are of moderate saturation; a dim yellow or
-  orange print is not brown, however dark), nor from a lit surface about as light as a white of the same object
-  (``brown_below_white``: a cream or tan in dim light, which the survey's light browns match by colour alone);
+  term's share of the votes is the name's certainty; brown gets no vote from a colour of chroma C* at least
+  ``brown_max_chroma`` (brown surfaces are of moderate chroma; a dim yellow or orange print is not brown), nor
+  from a lit surface about as light as a white of the same object (``brown_below_white``: a cream or tan in dim
+  light, which the survey's light browns match by colour alone);
 * the near-black pool is a dark colour (a navy mug) when its mean colour is clearly saturated, else black; it
   counts only when it is a sizeable part of the object or has the name of one of its lit surfaces (shadows are
   dropped).
@@ -121,18 +121,16 @@ def _term_votes(labs: np.ndarray, parameters: NamingParameters) -> np.ndarray:
     votes = density / np.where(far, 1.0, total)[:, None]
     if np.any(far):
         votes[far] = np.eye(len(CHROMATIC_TERMS))[_PROTOTYPE_CODES[np.argmin(distances[far], axis=1)]]
-    return _without_saturated_brown(votes, labs, parameters)
+    return _without_colourful_brown(votes, labs, parameters)
 
 
 _BROWN = CHROMATIC_TERMS.index("brown")
 
 
-def _without_saturated_brown(votes: np.ndarray, labs: np.ndarray, parameters: NamingParameters) -> np.ndarray:
-    """The votes with brown's taken away for colours whose saturation C*/(L* + 16) is at least
-    ``brown_max_saturation``: too saturated for a brown surface, they are a yellow, orange or olive seen in less
-    light (dimming lowers L* and C* together, not their ratio)."""
-    saturated = np.hypot(labs[:, 1], labs[:, 2]) >= parameters.brown_max_saturation * (labs[:, 0] + 16.0)
-    return _without_brown(votes, saturated)
+def _without_colourful_brown(votes: np.ndarray, labs: np.ndarray, parameters: NamingParameters) -> np.ndarray:
+    """The votes with brown's taken away for colours whose chroma C* is at least ``brown_max_chroma``: too
+    colourful for a brown surface, they are a yellow or orange seen in less light."""
+    return _without_brown(votes, np.hypot(labs[:, 1], labs[:, 2]) >= parameters.brown_max_chroma)
 
 
 def _without_brown(votes: np.ndarray, chosen: np.ndarray) -> np.ndarray:

@@ -101,13 +101,10 @@ class NamingParameters:
     are named together."""
     kernel_width: float = 8.0
     """Width (CIEDE2000 units) of each prototype's vote."""
-    brown_max_saturation: float = 0.65
-    """A surface at least this saturated (C*/(L* + 16), which a uniform change of light leaves unchanged) is not
-    brown: brown surfaces (wood, cardboard, tins) are of moderate saturation, while the survey's browns are display
-    colours that a dimly lit yellow or orange print matches by lightness alone. Tuned on the "tune" split only:
-    midway between its most saturated brown surface (a cardboard box, 0.55) and its least saturated yellow the
-    prototypes call brown (a crisps tube, 0.76). A limit on C* alone (the former rule) let a dim olive print of
-    the same saturation as a bright yellow be brown because it was dark."""
+    brown_max_chroma: float = 48.0
+    """A surface at least this colourful (C*) is not brown: brown surfaces (wood, cardboard, tins) are of moderate
+    chroma, while the survey's browns are display colours that a dim yellow or orange print matches by lightness
+    alone (tuned on the "tune" split: its browns reach C* 33, its yellows named brown 57)."""
     brown_below_white: float = 0.40
     """A lit surface whose luminance is at least this fraction of the lightest white surface of its object is not
     brown. Not tuned: the ISCC-NBS colour names put "light brown" at Munsell value 6.5 at most (Y = 0.35), white

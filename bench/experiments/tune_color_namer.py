@@ -43,9 +43,9 @@ measured against main, the others on top of the kept one):
   dark tin), held_out 41 (the black chair base -> grey), fresh 17 (faded jeans -> grey);
 * lightness anchored to the frame's white (linear light scaled so that the 99th percentile of the frame's
   luminance is 1, the highest-luminance rule): tune 51 (four cookie tins brown -> orange), held_out 42, fresh 15;
-* a colour too colourful for brown (C* >= the former ``brown_max_chroma``: "a yellow or orange seen in less
-  light") voted at the lightness, at its own chromaticity, where the prototypes match it best (luminance x 1 ..
-  3): tune 56, held_out 41 (a red print -> pink), fresh 16;
+* a colour too colourful for brown (C* >= ``brown_max_chroma``: "a yellow or orange seen in less light") voted at
+  the lightness, at its own chromaticity, where the prototypes match it best (luminance x 1 .. 3): tune 56,
+  held_out 41 (a red print -> pink), fresh 16;
 * white against the frame's white instead of its median (an unsaturated surface is white at half the luminance of
   the 99th percentile or more, for the grey shirt): tune 55 (uoc0's soup can white/red -> grey/red), held_out 41,
   fresh 16.
