@@ -11,9 +11,10 @@ Each surface is named (:func:`name_surface`):
   :mod:`annotators.image.color_prototypes` (the xkcd colour survey), as a kernel density classifier: each
   term's prototypes vote with a Gaussian of their distance (``kernel_width``) averaged per term, and the winning
   term's share of the votes is the name's certainty; brown gets no vote from a colour of chroma C* at least
-  ``brown_max_chroma`` (brown surfaces are of moderate chroma; a dim yellow or orange print is not brown), nor
-  from a lit surface about as light as a white of the same object (``brown_below_white``: a cream or tan in dim
-  light, which the survey's light browns match by colour alone);
+  ``brown_max_chroma`` (brown surfaces are of moderate chroma; a dim yellow or orange print is not brown);
+  yellow, orange and brown, which lightness against white tells apart, are named at the lightness the surface
+  has when its object's white is lifted to a white's luminance (``white_luminance``): brown is a yellow or
+  orange clearly darker than white, not one in a dim frame;
 * the near-black pool is a dark colour (a navy mug) when its mean colour is clearly saturated, else black; it
   counts only when it is a sizeable part of the object or has the name of one of its lit surfaces (shadows are
   dropped).
@@ -128,16 +129,12 @@ _BROWN = CHROMATIC_TERMS.index("brown")
 
 
 def _without_colourful_brown(votes: np.ndarray, labs: np.ndarray, parameters: NamingParameters) -> np.ndarray:
-    """The votes with brown's taken away for colours whose chroma C* is at least ``brown_max_chroma``: too
-    colourful for a brown surface, they are a yellow or orange seen in less light."""
-    return _without_brown(votes, np.hypot(labs[:, 1], labs[:, 2]) >= parameters.brown_max_chroma)
-
-
-def _without_brown(votes: np.ndarray, chosen: np.ndarray) -> np.ndarray:
-    """The votes (S x terms) with brown's share taken away and the others' renormalised in the ``chosen`` rows;
-    a row whose every vote is brown keeps them."""
+    """The votes with brown's taken away (the others' shares renormalised) for colours whose chroma C* is at
+    least ``brown_max_chroma``: too colourful for a brown surface, they are a yellow or orange seen in less light;
+    a colour whose every vote is brown keeps them."""
+    colourful = np.hypot(labs[:, 1], labs[:, 2]) >= parameters.brown_max_chroma
     rest = 1.0 - votes[:, _BROWN]
-    change = chosen & (rest > 1e-12)
+    change = colourful & (rest > 1e-12)
     if np.any(change):
         votes = votes.copy()
         votes[change, _BROWN] = 0.0
@@ -145,35 +142,62 @@ def _without_brown(votes: np.ndarray, chosen: np.ndarray) -> np.ndarray:
     return votes
 
 
-def _luminance(lightness: float) -> float:
-    """The relative luminance Y (white 1) of a CIELAB lightness above 8."""
-    return ((lightness + 16.0) / 116.0) ** 3
+LIGHTNESS_RELATIVE_TERMS: tuple[str, ...] = ("yellow", "orange", "brown")
+"""The hue names told apart by lightness against white more than by hue: brown is a yellow or orange seen clearly
+darker than white (the only hues whose dim version changes name; Buck 2015, "Brown", Current Biology 25(13)). A
+surface first named one of these is named again at its lightness relative to its object's white
+(:func:`_anchored_to_white`) and takes that name when it is one of these too."""
+
+_LIGHTNESS_RELATIVE = np.array([term in LIGHTNESS_RELATIVE_TERMS for term in CHROMATIC_TERMS])
 
 
-def _without_brown_beside_white(
-    surfaces: list[Surface],
-    votes: list[np.ndarray | None],
-    names: list[SurfaceName],
-    parameters: NamingParameters,
-) -> tuple[list[np.ndarray | None], list[SurfaceName]]:
-    """One object's surface votes and names with brown's votes taken away (and the name taken again) for the
-    lit surfaces as light as ``brown_below_white`` of the object's lightest white surface or lighter: lit by the
-    same light as that white, they are a cream, tan or pale orange, not a brown (brown is a yellow or orange
-    clearly darker than white); an object without a white surface is left as it is."""
+def _white_lightness(
+    surfaces: list[Surface], vote_labs: list[np.ndarray | None], surround: float, parameters: NamingParameters
+) -> float | None:
+    """The lit lightness (L*) of an object's lightest white surface (a lit surface named white by its lightness),
+    or None when it has none."""
     whites = [
         float(surface.lab[0])
-        for surface, vote, name in zip(surfaces, votes, names, strict=True)
-        if vote is None and surface.kind != "dark" and name.name == "white"
+        for surface, lab in zip(surfaces, vote_labs, strict=True)
+        if lab is None and surface.kind != "dark" and _lightness_name(surface, surround, parameters).name == "white"
     ]
-    if not whites:
-        return votes, names
-    limit = parameters.brown_below_white * _luminance(max(whites))
-    votes, names = list(votes), list(names)
-    for index, (surface, vote) in enumerate(zip(surfaces, votes, strict=True)):
-        if vote is not None and surface.kind != "dark" and _luminance(float(surface.lab[0])) >= limit:
-            votes[index] = _without_brown(vote[None, :], np.ones(1, dtype=bool))[0]
-            names[index] = _name_of_votes(votes[index])
-    return votes, names
+    return max(whites) if whites else None
+
+
+def _anchored_lab(lab: np.ndarray, white_lightness: float, parameters: NamingParameters) -> np.ndarray:
+    """A colour (CIELAB) at the lightness it has when its object's white (lit L* ``white_lightness``) is lifted to
+    the luminance of a white surface (``white_luminance``), its chromaticity (a*, b*) / (L* + 16) kept; a white
+    already as light leaves it as it is."""
+    white = ((white_lightness + 16.0) / 116.0) ** 3
+    gain = max(1.0, parameters.white_luminance / white)
+    luminance = min(1.0, ((float(lab[0]) + 16.0) / 116.0) ** 3 * gain)
+    lightness = 116.0 * luminance ** (1.0 / 3.0) - 16.0
+    return np.array([lightness, *(np.asarray(lab[1:], dtype=np.float64) * (lightness + 16.0) / (float(lab[0]) + 16.0))])
+
+
+def _anchored_to_white(
+    vote_rows: np.ndarray, labs: list[np.ndarray], whites: list[float | None], parameters: NamingParameters
+) -> np.ndarray:
+    """The surfaces' votes (one row per colour of ``labs``, each with its object's white lightness or None) with
+    those named by a :data:`LIGHTNESS_RELATIVE_TERMS` term replaced by the votes of their colour anchored to the
+    white (:func:`_anchored_lab`) when those name one of these terms too: a cream box in a dim frame is as light
+    against its white print as a cream is, not a brown; a yellow chair in a dark room is yellow, not orange."""
+    chosen = [
+        i
+        for i, (row, white) in enumerate(zip(vote_rows, whites, strict=True))
+        if white is not None
+        and _LIGHTNESS_RELATIVE[int(np.argmax(row))]
+        and parameters.white_luminance > ((white + 16.0) / 116.0) ** 3
+    ]
+    if not chosen:
+        return vote_rows
+    anchored = _term_votes(np.array([_anchored_lab(labs[i], whites[i], parameters) for i in chosen]), parameters)
+    keep = _LIGHTNESS_RELATIVE[anchored.argmax(axis=1)]
+    if not np.any(keep):
+        return vote_rows
+    vote_rows = vote_rows.copy()
+    vote_rows[np.array(chosen)[keep]] = anchored[keep]
+    return vote_rows
 
 
 def _name_of_votes(votes: np.ndarray) -> SurfaceName:
@@ -333,6 +357,16 @@ def name_objects_colors(
     vote_labs = [[_vote_lab(surface, parameters) for surface in surfaces] for surfaces, _ in found]
     voted = [lab for labs in vote_labs for lab in labs if lab is not None]
     vote_rows = _term_votes(np.array(voted), parameters) if voted else np.zeros((0, len(CHROMATIC_TERMS)))
+    whites = [
+        _white_lightness(surfaces, labs, light.surround, parameters)
+        for (surfaces, _), labs in zip(found, vote_labs, strict=True)
+    ]
+    vote_rows = _anchored_to_white(
+        vote_rows,
+        voted,
+        [white for labs, white in zip(vote_labs, whites, strict=True) for lab in labs if lab is not None],
+        parameters,
+    )
     winners = vote_rows.argmax(axis=1)  # each voted surface's name, as _name_of_votes picks it
     all_votes = iter(vote_rows)
     all_names = iter(
@@ -346,7 +380,7 @@ def name_objects_colors(
             _lightness_name(surface, light.surround, parameters) if lab is None else next(all_names)
             for surface, lab in zip(surfaces, labs, strict=True)
         ]
-        named.append(_without_brown_beside_white(surfaces, votes, names, parameters))
+        named.append((votes, names))
     lit_labs = [
         [surfaces[i].lab for i in _lit_chromatic(surfaces, names)]
         for (surfaces, _), (_, names) in zip(found, named, strict=True)
