@@ -12,9 +12,10 @@ Each surface is named (:func:`name_surface`):
   term's prototypes vote with a Gaussian of their distance (``kernel_width``) averaged per term, and the winning
   term's share of the votes is the name's certainty; brown gets no vote from a colour of chroma C* at least
   ``brown_max_chroma`` (brown surfaces are of moderate chroma; a dim yellow or orange print is not brown);
-  yellow, orange and brown, which lightness against white tells apart, are named at the lightness the surface
-  has when its object's white is lifted to a white's luminance (``white_luminance``): brown is a yellow or
-  orange clearly darker than white, not one in a dim frame;
+  against the object's own white, lit by the same light (:func:`_related_to_white`): brown gets no vote from a
+  surface nearly as light as that white (``brown_below_white``: brown is a yellow or orange clearly darker than
+  white, not a cream in a dim frame), and yellow and orange are told apart at the lightness the surface has when
+  the white is lifted to a white's luminance (``white_luminance``);
 * the near-black pool is a dark colour (a navy mug) when its mean colour is clearly saturated, else black; it
   counts only when it is a sizeable part of the object or has the name of one of its lit surfaces (shadows are
   dropped).
@@ -132,9 +133,14 @@ def _without_colourful_brown(votes: np.ndarray, labs: np.ndarray, parameters: Na
     """The votes with brown's taken away (the others' shares renormalised) for colours whose chroma C* is at
     least ``brown_max_chroma``: too colourful for a brown surface, they are a yellow or orange seen in less light;
     a colour whose every vote is brown keeps them."""
-    colourful = np.hypot(labs[:, 1], labs[:, 2]) >= parameters.brown_max_chroma
+    return _without_brown(votes, np.hypot(labs[:, 1], labs[:, 2]) >= parameters.brown_max_chroma)
+
+
+def _without_brown(votes: np.ndarray, chosen: np.ndarray) -> np.ndarray:
+    """The votes (S x terms) with brown's share taken away and the others' renormalised in the ``chosen`` rows;
+    a row whose every vote is brown keeps them."""
     rest = 1.0 - votes[:, _BROWN]
-    change = colourful & (rest > 1e-12)
+    change = chosen & (rest > 1e-12)
     if np.any(change):
         votes = votes.copy()
         votes[change, _BROWN] = 0.0
@@ -142,11 +148,11 @@ def _without_colourful_brown(votes: np.ndarray, labs: np.ndarray, parameters: Na
     return votes
 
 
-LIGHTNESS_RELATIVE_TERMS: tuple[str, ...] = ("yellow", "orange", "brown")
-"""The hue names told apart by lightness against white more than by hue: brown is a yellow or orange seen clearly
-darker than white (the only hues whose dim version changes name; Buck 2015, "Brown", Current Biology 25(13)). A
-surface first named one of these is named again at its lightness relative to its object's white
-(:func:`_anchored_to_white`) and takes that name when it is one of these too."""
+LIGHTNESS_RELATIVE_TERMS: tuple[str, ...] = ("yellow", "orange")
+"""The hue names a dim light moves between: a yellow seen darker looks orange, then brown (yellow is the hue whose
+dim version changes name; Buck 2015, "Brown", Current Biology 25(13)). A surface first named one of these is named
+again at its lightness relative to its object's white (:func:`_related_to_white`) and takes that name when it is
+one of these too. Brown is not among them: lifted by a dim white, a brown lid or tin would come out orange."""
 
 _LIGHTNESS_RELATIVE = np.array([term in LIGHTNESS_RELATIVE_TERMS for term in CHROMATIC_TERMS])
 
@@ -175,23 +181,35 @@ def _anchored_lab(lab: np.ndarray, white_lightness: float, parameters: NamingPar
     return np.array([lightness, *(np.asarray(lab[1:], dtype=np.float64) * (lightness + 16.0) / (float(lab[0]) + 16.0))])
 
 
-def _anchored_to_white(
+def _related_to_white(
     vote_rows: np.ndarray, labs: list[np.ndarray], whites: list[float | None], parameters: NamingParameters
 ) -> np.ndarray:
-    """The surfaces' votes (one row per colour of ``labs``, each with its object's white lightness or None) with
-    those named by a :data:`LIGHTNESS_RELATIVE_TERMS` term replaced by the votes of their colour anchored to the
-    white (:func:`_anchored_lab`) when those name one of these terms too: a cream box in a dim frame is as light
-    against its white print as a cream is, not a brown; a yellow chair in a dark room is yellow, not orange."""
+    """The surfaces' votes (one row per colour of ``labs``, each with its object's white lightness or None) judged
+    against that white: brown's votes taken away (:func:`_without_brown`) for a surface whose luminance is at
+    least ``brown_below_white`` of the white's (a cream box in a dim frame is as light against its white print as
+    a cream is); then those named by a :data:`LIGHTNESS_RELATIVE_TERMS` term replaced by the votes of their colour
+    anchored to the white (:func:`_anchored_lab`) when those name one of these terms too (a yellow chair in a dark
+    room is yellow, not orange)."""
+    near_white = np.array(
+        [
+            white is not None
+            and ((float(lab[0]) + 16.0) / 116.0) ** 3 >= parameters.brown_below_white * ((white + 16.0) / 116.0) ** 3
+            for lab, white in zip(labs, whites, strict=True)
+        ],
+        dtype=bool,
+    )
+    first = vote_rows.argmax(axis=1)
+    relative = _LIGHTNESS_RELATIVE[first] | (near_white & (first == _BROWN))  # a cream first named brown too
+    vote_rows = _without_brown(vote_rows, near_white)
     chosen = [
         i
-        for i, (row, white) in enumerate(zip(vote_rows, whites, strict=True))
-        if white is not None
-        and _LIGHTNESS_RELATIVE[int(np.argmax(row))]
-        and parameters.white_luminance > ((white + 16.0) / 116.0) ** 3
+        for i, white in enumerate(whites)
+        if relative[i] and white is not None and parameters.white_luminance > ((white + 16.0) / 116.0) ** 3
     ]
     if not chosen:
         return vote_rows
     anchored = _term_votes(np.array([_anchored_lab(labs[i], whites[i], parameters) for i in chosen]), parameters)
+    anchored = _without_brown(anchored, near_white[chosen])
     keep = _LIGHTNESS_RELATIVE[anchored.argmax(axis=1)]
     if not np.any(keep):
         return vote_rows
@@ -361,7 +379,7 @@ def name_objects_colors(
         _white_lightness(surfaces, labs, light.surround, parameters)
         for (surfaces, _), labs in zip(found, vote_labs, strict=True)
     ]
-    vote_rows = _anchored_to_white(
+    vote_rows = _related_to_white(
         vote_rows,
         voted,
         [white for labs, white in zip(vote_labs, whites, strict=True) for lab in labs if lab is not None],
