@@ -12,6 +12,10 @@ Each surface is named (:func:`name_surface`):
   term's prototypes vote with a Gaussian of their distance (``kernel_width``) averaged per term, and the winning
   term's share of the votes is the name's certainty; brown gets no vote from a colour of chroma C* at least
   ``brown_max_chroma`` (brown surfaces are of moderate chroma; a dim yellow or orange print is not brown);
+  against the object's own white, lit by the same light (:func:`_related_to_white`): brown gets no vote from a
+  surface nearly as light as that white (``brown_below_white``: brown is a yellow or orange clearly darker than
+  white, not a cream in a dim frame), and yellow and orange are told apart at the lightness the surface has when
+  the white is lifted to a white's luminance (``white_luminance``);
 * the near-black pool is a dark colour (a navy mug) when its mean colour is clearly saturated, else black; it
   counts only when it is a sizeable part of the object or has the name of one of its lit surfaces (shadows are
   dropped).
@@ -129,14 +133,89 @@ def _without_colourful_brown(votes: np.ndarray, labs: np.ndarray, parameters: Na
     """The votes with brown's taken away (the others' shares renormalised) for colours whose chroma C* is at
     least ``brown_max_chroma``: too colourful for a brown surface, they are a yellow or orange seen in less light;
     a colour whose every vote is brown keeps them."""
-    colourful = np.hypot(labs[:, 1], labs[:, 2]) >= parameters.brown_max_chroma
+    return _without_brown(votes, np.hypot(labs[:, 1], labs[:, 2]) >= parameters.brown_max_chroma)
+
+
+def _without_brown(votes: np.ndarray, chosen: np.ndarray) -> np.ndarray:
+    """The votes (S x terms) with brown's share taken away and the others' renormalised in the ``chosen`` rows;
+    a row whose every vote is brown keeps them."""
     rest = 1.0 - votes[:, _BROWN]
-    change = colourful & (rest > 1e-12)
+    change = chosen & (rest > 1e-12)
     if np.any(change):
         votes = votes.copy()
         votes[change, _BROWN] = 0.0
         votes[change] /= rest[change, None]
     return votes
+
+
+LIGHTNESS_RELATIVE_TERMS: tuple[str, ...] = ("yellow", "orange")
+"""The hue names a dim light moves between: a yellow seen darker looks orange, then brown (yellow is the hue whose
+dim version changes name; Buck 2015, "Brown", Current Biology 25(13)). A surface first named one of these is named
+again at its lightness relative to its object's white (:func:`_related_to_white`) and takes that name when it is
+one of these too. Brown is not among them: lifted by a dim white, a brown lid or tin would come out orange."""
+
+_LIGHTNESS_RELATIVE = np.array([term in LIGHTNESS_RELATIVE_TERMS for term in CHROMATIC_TERMS])
+
+
+def _white_lightness(
+    surfaces: list[Surface], vote_labs: list[np.ndarray | None], surround: float, parameters: NamingParameters
+) -> float | None:
+    """The lit lightness (L*) of an object's lightest white surface (a lit surface named white by its lightness),
+    or None when it has none."""
+    whites = [
+        float(surface.lab[0])
+        for surface, lab in zip(surfaces, vote_labs, strict=True)
+        if lab is None and surface.kind != "dark" and _lightness_name(surface, surround, parameters).name == "white"
+    ]
+    return max(whites) if whites else None
+
+
+def _anchored_lab(lab: np.ndarray, white_lightness: float, parameters: NamingParameters) -> np.ndarray:
+    """A colour (CIELAB) at the lightness it has when its object's white (lit L* ``white_lightness``) is lifted to
+    the luminance of a white surface (``white_luminance``), its chromaticity (a*, b*) / (L* + 16) kept; a white
+    already as light leaves it as it is."""
+    white = ((white_lightness + 16.0) / 116.0) ** 3
+    gain = max(1.0, parameters.white_luminance / white)
+    luminance = min(1.0, ((float(lab[0]) + 16.0) / 116.0) ** 3 * gain)
+    lightness = 116.0 * luminance ** (1.0 / 3.0) - 16.0
+    return np.array([lightness, *(np.asarray(lab[1:], dtype=np.float64) * (lightness + 16.0) / (float(lab[0]) + 16.0))])
+
+
+def _related_to_white(
+    vote_rows: np.ndarray, labs: list[np.ndarray], whites: list[float | None], parameters: NamingParameters
+) -> np.ndarray:
+    """The surfaces' votes (one row per colour of ``labs``, each with its object's white lightness or None) judged
+    against that white: brown's votes taken away (:func:`_without_brown`) for a surface whose luminance is at
+    least ``brown_below_white`` of the white's (a cream box in a dim frame is as light against its white print as
+    a cream is); then those named by a :data:`LIGHTNESS_RELATIVE_TERMS` term replaced by the votes of their colour
+    anchored to the white (:func:`_anchored_lab`) when those name one of these terms too (a yellow chair in a dark
+    room is yellow, not orange)."""
+    near_white = np.array(
+        [
+            white is not None
+            and ((float(lab[0]) + 16.0) / 116.0) ** 3 >= parameters.brown_below_white * ((white + 16.0) / 116.0) ** 3
+            for lab, white in zip(labs, whites, strict=True)
+        ],
+        dtype=bool,
+    )
+    first = vote_rows.argmax(axis=1)
+    relative = _LIGHTNESS_RELATIVE[first] | (near_white & (first == _BROWN))  # a cream first named brown too
+    vote_rows = _without_brown(vote_rows, near_white)
+    chosen = [
+        i
+        for i, white in enumerate(whites)
+        if relative[i] and white is not None and parameters.white_luminance > ((white + 16.0) / 116.0) ** 3
+    ]
+    if not chosen:
+        return vote_rows
+    anchored = _term_votes(np.array([_anchored_lab(labs[i], whites[i], parameters) for i in chosen]), parameters)
+    anchored = _without_brown(anchored, near_white[chosen])
+    keep = _LIGHTNESS_RELATIVE[anchored.argmax(axis=1)]
+    if not np.any(keep):
+        return vote_rows
+    vote_rows = vote_rows.copy()
+    vote_rows[np.array(chosen)[keep]] = anchored[keep]
+    return vote_rows
 
 
 def _name_of_votes(votes: np.ndarray) -> SurfaceName:
@@ -296,6 +375,16 @@ def name_objects_colors(
     vote_labs = [[_vote_lab(surface, parameters) for surface in surfaces] for surfaces, _ in found]
     voted = [lab for labs in vote_labs for lab in labs if lab is not None]
     vote_rows = _term_votes(np.array(voted), parameters) if voted else np.zeros((0, len(CHROMATIC_TERMS)))
+    whites = [
+        _white_lightness(surfaces, labs, light.surround, parameters)
+        for (surfaces, _), labs in zip(found, vote_labs, strict=True)
+    ]
+    vote_rows = _related_to_white(
+        vote_rows,
+        voted,
+        [white for labs, white in zip(vote_labs, whites, strict=True) for lab in labs if lab is not None],
+        parameters,
+    )
     winners = vote_rows.argmax(axis=1)  # each voted surface's name, as _name_of_votes picks it
     all_votes = iter(vote_rows)
     all_names = iter(

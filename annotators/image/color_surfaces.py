@@ -105,6 +105,16 @@ class NamingParameters:
     """A surface at least this colourful (C*) is not brown: brown surfaces (wood, cardboard, tins) are of moderate
     chroma, while the survey's browns are display colours that a dim yellow or orange print matches by lightness
     alone (tuned on the "tune" split: its browns reach C* 33, its yellows named brown 57)."""
+    brown_below_white: float = 0.56
+    """A lit surface whose luminance is at least this fraction of the lightest white surface of its object is not
+    brown: brown is a yellow or orange clearly darker than white (lit by the same light as the object's white, the
+    ratio does not depend on how dim the frame is). Not tuned: in the ISCC-NBS colour names the yellowish browns
+    give way to the pale and light orange yellows at Munsell value 7.5 (Y = 0.51; between the centroids of "light
+    yellowish brown", L* 67, and "pale orange yellow", L* 83), and a white surface is about value 9.5 (Y = 0.90):
+    0.51 / 0.90 = 0.56."""
+    white_luminance: float = 0.90
+    """The luminance (Y) of a white surface: Munsell value 9.5, white paper. Yellow and orange are told apart at
+    the lightness a surface has when its object's white is lifted to this (not tuned)."""
     second_share: float = 0.3
     """A second colour is reported when its share of the named pixels is at least this ..."""
     second_confidence: float = 0.1

@@ -71,6 +71,26 @@ def test_the_pairs_people_tell_apart(rgb: tuple[int, int, int], expected: str, n
     assert names(patch(rgb)) == [expected], not_this
 
 
+@pytest.mark.parametrize(
+    ("rgb", "expected"),
+    [
+        ((230, 190, 60), "yellow"),
+        ((225, 205, 150), "yellow"),  # a cream
+        ((110, 70, 40), "brown"),
+        ((150, 105, 60), "brown"),
+    ],
+)
+@pytest.mark.parametrize("light", [0.3, 0.5])
+def test_a_box_with_a_white_print_keeps_its_colour_in_a_dim_frame(
+    rgb: tuple[int, int, int], expected: str, light: float
+) -> None:
+    """A yellow or cream box is not brown (nor olive) when the whole frame is dim: its white print is as dim; a
+    brown box stays brown."""
+    white = (238, 238, 232)
+    pixels = np.vstack([patch(rgb, light, 600), patch(white, light, 400, seed=1)])
+    assert names(pixels) == [expected, "white"]
+
+
 @pytest.mark.parametrize("shading", [0.35, 0.5, 0.7])
 def test_an_object_in_half_shadow_keeps_the_name_of_its_lit_side(shading: float) -> None:
     for rgb, expected in (((205, 28, 30), "red"), ((32, 78, 200), "blue"), ((240, 224, 28), "yellow")):
