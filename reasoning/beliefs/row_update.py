@@ -208,13 +208,19 @@ class RowUpdate:
     ) -> None:
         """``ValueSupport.repeat`` of the observation's statements (summed per attribute: one value each here) at
         ``time`` into the single-valued supports ``by_name``: a view that repeats the belief's last one."""
+        logits = self.logits
+        if len(logits) > LOGIT_CACHE_LIMIT:
+            logits.clear()
         said: dict[str, list] = {}
         for e in observation.evidence:
+            log_odds = logits.get(e.confidence)
+            if log_odds is None:
+                log_odds = logits[e.confidence] = logit(e.confidence)
             held = said.get(e.attribute)
             if held is None:
-                said[e.attribute] = [logit(e.confidence), [e.source], e.value]
+                said[e.attribute] = [log_odds, [e.source], e.value]
             else:
-                held[0] += logit(e.confidence)
+                held[0] += log_odds
                 held[1].append(e.source)
         for name, (log_odds, sources, value) in said.items():
             r = by_name.get(name)
