@@ -4,7 +4,8 @@ store's encoding of the belief, without decoding the row into an ``ObjectBelief`
 A stored ``objects`` row and the observation matched to it give the new row directly: the position filtered and
 the size blended with Python floats (the same operations, in the same order, as the tracker's numpy ones), the
 frame's statements accumulated into the packed supports with the rule of ``ValueSupport.add``, and the supports
-packed again. The common case is: no colour histogram on either side, a 3-vector position, size and 4-vector
+packed again (a view that repeats the belief's last one as dependent evidence, :mod:`reasoning.fusion.views`).
+The common case is: no colour histogram on either side, a 3-vector position, size and 4-vector
 orientation in float64, every attribute single-valued before and after the update, and no named regions on the
 tracker. Anything else goes the general way (decode, ``BeliefTracker.update``, encode); both ways give the same
 row (``tests/fusion/test_row_update.py``). A new belief in the common case is made as a row the same way
@@ -28,13 +29,22 @@ from reasoning.beliefs.packed import (
     INDEX_SEPARATOR,
     SUPPORT,
     decoded_sources,
+    roi_from_text,
     roi_text,
     rounded_cached,
     supports_packing,
 )
 from reasoning.fusion.frame import FrameObject
-from reasoning.fusion.rule import CLASS_ATTRIBUTE, MAX_LOG_ODDS, AttributeBelief, ValueSupport, logit
+from reasoning.fusion.rule import (
+    CLASS_ATTRIBUTE,
+    MAX_LOG_ODDS,
+    AttributeBelief,
+    ValueSupport,
+    logit,
+    repeated_log_odds,
+)
 from reasoning.fusion.tracking import PRESENT, BeliefTracker, ObjectBelief
+from reasoning.fusion.views import repeats_view
 from robokudo.core.types import Location
 
 Support = list
@@ -103,8 +113,22 @@ class RowUpdate:
             if (r[_SUPPORT_VALUE] if r is not None else stated.setdefault(e.attribute, e.value)) != e.value:
                 return None  # a second value stated
         (object_id, _, frame, px, py, pz, _, _, _, _, sx, sy, sz, variance, appearance, existence, _, first_seen,
-         last_seen, _, observations, _, _, recording, _, sources, _, _) = row[:28]  # fmt: skip
-        self._accumulate(by_name, records, observation, time)
+         last_seen, _, observations, _, _, recording, last_roi, sources, _, _) = row[:28]  # fmt: skip
+        roi = roi_text(observation.roi)
+        repeated = (
+            roi is not None
+            and last_roi is not None
+            and frame == observation.frame
+            and recording == observation.recording
+            and (
+                roi == last_roi
+                or repeats_view(roi_from_text(last_roi), frame, recording, observation.roi, frame, recording)
+            )
+        )
+        if repeated:
+            self._repeat(by_name, records, observation, time)
+        else:
+            self._accumulate(by_name, records, observation, time)
         config = self.config
         predicted = variance + config.motion_sigma**2 * max(time - last_seen, 0.0)
         gain = predicted / (predicted + config.measurement_sigma**2 / max(observation.confidence, 0.1))
@@ -135,7 +159,7 @@ class RowUpdate:
             c,
             (1.0 - gain) * predicted,
             appearance,
-            min(existence + config.hit_log_odds, MAX_LOG_ODDS),
+            max(existence, config.hit_log_odds) if repeated else min(existence + config.hit_log_odds, MAX_LOG_ODDS),
             PRESENT,
             first_seen,
             float(max(last_seen, time)),
@@ -144,7 +168,7 @@ class RowUpdate:
             region or "",
             "",
             recording,
-            roi_text(observation.roi),
+            roi,
             text,
             None,
             INDEX_SEPARATOR.join(sorted(entries)),
@@ -176,6 +200,44 @@ class RowUpdate:
             if e.source not in r[_SUPPORT_EXPERTS]:
                 r[_SUPPORT_EXPERTS] = (*r[_SUPPORT_EXPERTS], e.source)
                 r[4] = None
+            if r[6] < time:
+                r[6] = time
+
+    def _repeat(
+        self, by_name: dict[str, Support], records: list[Support], observation: FrameObject, time: float
+    ) -> None:
+        """``ValueSupport.repeat`` of the observation's statements (summed per attribute: one value each here) at
+        ``time`` into the single-valued supports ``by_name``: a view that repeats the belief's last one."""
+        logits = self.logits
+        if len(logits) > LOGIT_CACHE_LIMIT:
+            logits.clear()
+        said: dict[str, list] = {}
+        for e in observation.evidence:
+            log_odds = logits.get(e.confidence)
+            if log_odds is None:
+                log_odds = logits[e.confidence] = logit(e.confidence)
+            held = said.get(e.attribute)
+            if held is None:
+                said[e.attribute] = [log_odds, [e.source], e.value]
+            else:
+                held[0] += log_odds
+                held[1].append(e.source)
+        for name, (log_odds, sources, value) in said.items():
+            r = by_name.get(name)
+            if r is None:
+                r = by_name[name] = [None, None, 0.0, 0, None, 0.0, 0.0, name, value, ()]
+                records.append(r)
+            if r[3] == 0 or time < r[5]:
+                r[5] = time
+            bounded = (
+                -MAX_LOG_ODDS if log_odds < -MAX_LOG_ODDS else MAX_LOG_ODDS if log_odds > MAX_LOG_ODDS else log_odds
+            )
+            r[2] = repeated_log_odds(r[2], bounded)
+            r[3] += len(sources)
+            for source in sources:
+                if source not in r[_SUPPORT_EXPERTS]:
+                    r[_SUPPORT_EXPERTS] = (*r[_SUPPORT_EXPERTS], source)
+                    r[4] = None
             if r[6] < time:
                 r[6] = time
 

@@ -5,6 +5,11 @@ Rule (log-odds accumulation over a categorical domain with an implicit "somethin
 * every statement "attribute = v with confidence c" adds ``logit(c)`` to the own log-odds ``L(v)``
   (``c`` clipped to [0.01, 0.99], the sum clipped to ``±MAX_LOG_ODDS`` so repeated frames of one expert
   cannot make a belief certain);
+* a statement from a view that repeats the belief's last one (:mod:`reasoning.fusion.views`) is dependent evidence:
+  it moves ``L(v)`` only as far as it goes beyond what is held in its direction, ``max(L, l)`` for a positive
+  ``l = logit(c)`` when ``L >= 0`` and ``min(L, l)`` for a negative one when ``L <= 0`` (N identical views say what
+  one says; ``l`` sums the repeated view's own statements of ``v``, independent experts); a repeat that contradicts
+  the held sign adds ``l`` as a new view does;
 * the score of a value also collects the positive own log-odds of its subclasses (class subsumption:
   ``LactoseFreeMilk`` from one expert supports ``Milk`` from another): ``S(v) = L(v) + Σ_{u ⊏ v} max(L(u), 0)``;
 * the probability of ``v`` is normalised against the values it conflicts with and "something else":
@@ -99,6 +104,27 @@ class ValueSupport:
         self.sources.update(sources)
         if self.last_seen < time:
             self.last_seen = time
+
+    def repeat(self, log_odds: float, sources: Iterable[str], time: float, count: int = 1) -> None:
+        """Take ``log_odds`` stated (by ``count`` statements) in a view that repeats the last one: dependent
+        evidence (:func:`repeated_log_odds`)."""
+        if self.count == 0 or time < self.first_seen:
+            self.first_seen = time
+        self.log_odds = repeated_log_odds(self.log_odds, log_odds)
+        self.count += count
+        self.sources.update(sources)
+        if self.last_seen < time:
+            self.last_seen = time
+
+
+def repeated_log_odds(held: float, stated: float) -> float:
+    """The log-odds of a value holding ``held`` after a repeated view states ``stated`` (dependent evidence: the
+    stronger of the two in the held direction, the bounded sum when they disagree in sign)."""
+    if stated >= 0.0 and held >= 0.0:
+        return held if held > stated else stated
+    if stated <= 0.0 and held <= 0.0:
+        return held if held < stated else stated
+    return _clamp(held + stated)
 
 
 @dataclass(frozen=True, slots=True)
@@ -282,10 +308,34 @@ def accumulate(evidence: Iterable[Evidence], time: float | None = None) -> dict[
 
 
 def accumulate_into(
-    beliefs: dict[str, AttributeBelief], evidence: Iterable[Evidence], time: float | None = None
+    beliefs: dict[str, AttributeBelief],
+    evidence: Iterable[Evidence],
+    time: float | None = None,
+    repeated: bool = False,
 ) -> None:
     """Accumulate statements into ``beliefs`` (by attribute, created when missing), stamped with ``time`` when given
-    (e.g. one frame's statements straight into a stored belief's attributes)."""
+    (e.g. one frame's statements straight into a stored belief's attributes); ``repeated`` when they come from a view
+    that repeats the belief's last one (dependent evidence, :meth:`ValueSupport.repeat`)."""
+    if repeated:
+        said: dict[tuple[str, str], tuple[float, list[str], float]] = {}
+        for item in evidence:  # the view's own statements add up (independent experts), as in any frame
+            key = (item.attribute, item.value)
+            held = said.get(key)
+            stamp = item.time if time is None else time
+            if held is None:
+                said[key] = (logit(item.confidence), [item.source], stamp)
+            else:
+                held[1].append(item.source)
+                said[key] = (held[0] + logit(item.confidence), held[1], max(held[2], stamp))
+        for (name, value), (log_odds, sources, stamp) in said.items():
+            belief = beliefs.get(name)
+            if belief is None:
+                belief = beliefs[name] = AttributeBelief(name)
+            support = belief.values.get(value)
+            if support is None:
+                support = belief.values[value] = ValueSupport()
+            support.repeat(_clamp(log_odds), sources, stamp, len(sources))
+        return
     for item in evidence:  # AttributeBelief.add of each statement, written out (the hot path of every update)
         belief = beliefs.get(item.attribute)
         if belief is None:

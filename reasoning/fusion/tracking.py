@@ -6,7 +6,10 @@ the changed beliefs. It is pure: loading and saving beliefs is the belief store'
 
 Per matched belief: the position is filtered (scalar Kalman gain, measurement noise shrinking with the
 observation's confidence, process noise growing with the time since the last sighting); size and appearance
-are blended; attribute evidence is accumulated with :mod:`reasoning.fusion.rule`; existence log-odds rise.
+are blended; attribute evidence is accumulated with :mod:`reasoning.fusion.rule`; existence log-odds rise. A
+sighting that repeats the belief's last view (:mod:`reasoning.fusion.views`) is dependent evidence: its statements
+take the stronger of held and stated support, and existence is raised to at least one sighting's ``hit_log_odds``
+(the object is still there) without accumulating.
 A belief that projects into the image in front of the measured surface but was not matched loses existence
 log-odds; once it has been missed and ``gone_after`` seconds have passed since it was last seen, it is gone.
 Beliefs of another world (another recording seen without a camera pose) are never matched nor missed. An
@@ -44,6 +47,7 @@ from reasoning.fusion.rule import (
     logit,
     sigmoid,
 )
+from reasoning.fusion.views import repeats_view
 from robokudo.core.regions import RegionBox, region_of
 from robokudo.core.types import Location, SemanticColor
 
@@ -346,8 +350,14 @@ class BeliefTracker:
             else:
                 blended = (1.0 - rate) * belief.appearance + rate * observation.appearance
                 belief.appearance = blended / max(float(blended.sum()), 1e-12)
-        accumulate_into(belief.attributes, observation.evidence, time)
-        belief.existence = min(belief.existence + config.hit_log_odds, MAX_LOG_ODDS)
+        repeated = repeats_view(
+            belief.roi, belief.frame, belief.recording, observation.roi, observation.frame, observation.recording
+        )
+        accumulate_into(belief.attributes, observation.evidence, time, repeated)
+        if repeated:  # still there, but no more certain than one sighting makes it (dependent evidence)
+            belief.existence = max(belief.existence, config.hit_log_odds)
+        else:
+            belief.existence = min(belief.existence + config.hit_log_odds, MAX_LOG_ODDS)
         belief.misses = 0
         belief.status = PRESENT
         belief.last_seen = max(belief.last_seen, time)

@@ -100,3 +100,19 @@ def test_the_trees_of_one_service_share_the_loaded_ocr_model(service: AnsweringS
         readers += [node for node in tree.iterate() if node.name == "TextReader"]
     assert len(readers) == 2 and readers[0] is not readers[1]
     assert readers[0].engine() is readers[1].engine()  # the second tree did not load the OCR models again
+
+
+def test_a_static_camera_watching_the_cup_does_not_make_it_certain(service: AnsweringService) -> None:
+    # the kitchen camera does not move and the cup stays put: every run sees the same view of it again, one piece
+    # of evidence however often it is repeated (before repeated views were told apart, ten runs made it 0.999)
+    handle = service.start("track the red cup")
+    answers = [handle.next_answer(timeout=60) for _ in range(10)]
+    handle.cancel()
+    assert all(a is not None for a in answers), handle.reason
+    first, last = answers[0].objects[0], answers[-1].objects[0]  # type: ignore[union-attr]
+    assert last.id == first.id
+    belief = service.store.get(last.id)
+    assert belief is not None and belief.observations >= 10
+    color = last.attributes["color"]
+    assert color.value == "red" and color.confidence == pytest.approx(first.attributes["color"].confidence)
+    assert color.confidence < 0.99 and last.confidence < 0.99
