@@ -53,6 +53,7 @@ from typing import TypeVar
 import numpy as np
 import platformdirs
 
+from reasoning.beliefs.class_candidates import candidate_class_clauses
 from reasoning.beliefs.frame_writer import MAX_WRITE_BEHIND, NEXT_ID, FrameWriter, WriterGoneError
 from reasoning.beliefs.interned import INTERN, InternedTexts, decoded_supports
 from reasoning.beliefs.packed import (
@@ -867,6 +868,8 @@ class BeliefStore:
                 new = _index_entries(indexed)
                 added.extend((name, value, belief_id) for name, value in new - old)
                 removed.extend((name, value, belief_id) for name, value in old - new)
+                # a leading class below 0.5 is indexed too: a query for it finds the belief as a candidate
+                classes.update((value,) for name, value in new - old if name == CLASS_ATTRIBUTE)
             x, y, z = row[3:6]
             if (
                 state is None
@@ -1012,12 +1015,13 @@ class BeliefStore:
                     return []
                 clauses.append(f"id IN ({', '.join('?' * len(f.ids))})")
                 parameters.extend(f.ids)
+            # the class a query asks for, each way a belief answers to it (:func:`candidate_class_clauses`)
+            class_ways: list[tuple[str, list[object], bool]] = [("", [], False)]
             if f.object_class:
                 classes = self._matching_classes(conn, f.object_class, f.class_test)
                 if not classes:
                     return []
-                clauses.append(f"class_name IN ({', '.join('?' * len(classes))})")
-                parameters.extend(classes)
+                class_ways = candidate_class_clauses(classes)
             texts = {name: value for name, value in f.attributes.items() if name == Text.attribute}
             for name, value in f.attributes.items():
                 if name in texts:
@@ -1049,14 +1053,15 @@ class BeliefStore:
                         )
                     )
             selects, values = [], []
-            for number, (extra, extra_parameters) in enumerate(branches):
-                where = " AND ".join(clauses + extra)
-                # without statistics SQLite may pick the region index and filter the class row by row; the class
-                # index (class, region) answers both at once (a box branch starts from the R*Tree's ids instead)
-                by_class = f.object_class and f.ids is None and number == 0
-                table = "objects INDEXED BY objects_class" if by_class else "objects"
-                selects.append(f"SELECT {_OBJECT_COLUMNS} FROM {table}" + (f" WHERE {where}" if where else ""))
-                values.extend(parameters + extra_parameters)
+            for class_clause, class_parameters, indexed_by_class in class_ways:
+                for number, (extra, extra_parameters) in enumerate(branches):
+                    where = " AND ".join(([class_clause] if class_clause else []) + clauses + extra)
+                    # without statistics SQLite may pick the region index and filter the class row by row; the
+                    # class index (class, region) answers both at once (a box branch starts from the R*Tree's ids)
+                    by_class = indexed_by_class and f.ids is None and number == 0
+                    table = "objects INDEXED BY objects_class" if by_class else "objects"
+                    selects.append(f"SELECT {_OBJECT_COLUMNS} FROM {table}" + (f" WHERE {where}" if where else ""))
+                    values.extend(class_parameters + parameters + extra_parameters)
             rows = conn.execute(" UNION ".join(selects) + " ORDER BY id", values).fetchall()
             if f.region and f.region_boxes:
                 rows = _in_named_region(rows, f)
