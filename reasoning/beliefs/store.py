@@ -53,7 +53,7 @@ from typing import TypeVar
 import numpy as np
 import platformdirs
 
-from reasoning.beliefs.class_candidates import candidate_class_clauses
+from reasoning.beliefs.class_candidates import BY_ID, GUESSED_CLASSES, candidate_class_clauses
 from reasoning.beliefs.frame_writer import MAX_WRITE_BEHIND, NEXT_ID, FrameWriter, WriterGoneError
 from reasoning.beliefs.interned import INTERN, InternedTexts, decoded_supports
 from reasoning.beliefs.packed import (
@@ -87,13 +87,14 @@ from robokudo.core.text_match import text_matches
 from robokudo.core.types import Text
 
 SCHEMA_NAME = "robokudo-beliefs"
-SCHEMA_VERSION = 3
+SCHEMA_VERSION = 4
 MIGRATIONS = {
     1: (
         "ALTER TABLE objects ADD COLUMN recording TEXT NOT NULL DEFAULT ''",
         "ALTER TABLE observations ADD COLUMN recording TEXT NOT NULL DEFAULT ''",
     ),
     2: (),  # and the attribute column rewritten from JSON to packed supports (_pack_attribute_column)
+    3: (),  # and the classes guessed for beliefs without a supported class listed in ``classes`` (GUESSED_CLASSES)
 }
 """Version -> the statements that bring a store of that version to the next one."""
 SQLITE_HEADER = b"SQLite format 3\x00"
@@ -369,6 +370,8 @@ class BeliefStore:
                 self._migrate(conn)
                 for statement in _SCHEMA:
                     conn.execute(statement)
+                if version is not None and version < 4:  # a guessed class is found from memory (class_candidates)
+                    conn.execute(f"INSERT OR IGNORE INTO classes {GUESSED_CLASSES}", (CLASS_ATTRIBUTE,))
                 conn.execute("INSERT OR IGNORE INTO meta VALUES ('schema', ?)", (SCHEMA_NAME,))
                 conn.execute("INSERT OR REPLACE INTO meta VALUES ('version', ?)", (str(SCHEMA_VERSION),))
                 conn.execute("INSERT OR IGNORE INTO meta VALUES ('next_id', '1')")
@@ -1016,12 +1019,12 @@ class BeliefStore:
                 clauses.append(f"id IN ({', '.join('?' * len(f.ids))})")
                 parameters.extend(f.ids)
             # the class a query asks for, each way a belief answers to it (:func:`candidate_class_clauses`)
-            class_ways: list[tuple[str, list[object], bool]] = [("", [], False)]
+            class_ways: list[tuple[str, list[object], str]] = [("", [], "")]
             if f.object_class:
                 classes = self._matching_classes(conn, f.object_class, f.class_test)
                 if not classes:
                     return []
-                class_ways = candidate_class_clauses(classes)
+                class_ways = candidate_class_clauses(classes, narrowed=bool(f.region) or f.ids is not None)
             texts = {name: value for name, value in f.attributes.items() if name == Text.attribute}
             for name, value in f.attributes.items():
                 if name in texts:
@@ -1053,13 +1056,16 @@ class BeliefStore:
                         )
                     )
             selects, values = [], []
-            for class_clause, class_parameters, indexed_by_class in class_ways:
+            for class_clause, class_parameters, reading in class_ways:
                 for number, (extra, extra_parameters) in enumerate(branches):
                     where = " AND ".join(([class_clause] if class_clause else []) + clauses + extra)
                     # without statistics SQLite may pick the region index and filter the class row by row; the
-                    # class index (class, region) answers both at once (a box branch starts from the R*Tree's ids)
-                    by_class = indexed_by_class and f.ids is None and number == 0
-                    table = "objects INDEXED BY objects_class" if by_class else "objects"
+                    # class index (class, region) answers both at once; a box branch starts from the R*Tree's ids
+                    # (never from the class index's beliefs without a supported class), a query by ids from them
+                    if not reading or f.ids is not None:
+                        table = "objects"
+                    else:
+                        table = f"objects {reading if number == 0 else BY_ID}"
                     selects.append(f"SELECT {_OBJECT_COLUMNS} FROM {table}" + (f" WHERE {where}" if where else ""))
                     values.extend(class_parameters + parameters + extra_parameters)
             rows = conn.execute(" UNION ".join(selects) + " ORDER BY id", values).fetchall()
