@@ -6,6 +6,7 @@ with "?", is counted by both)."""
 from __future__ import annotations
 
 import json
+import sqlite3
 from pathlib import Path
 
 import numpy as np
@@ -68,3 +69,36 @@ def test_how_many_cans_live_and_from_memory_on_a_real_frame(
     remembered, remembered_ids = _count(capsys, ["beliefs", question, "--store", store])
     assert live > 0
     assert (remembered, remembered_ids) == (live, live_ids)
+
+
+def test_a_guess_is_found_in_a_named_region_in_a_box_and_anywhere(tmp_path: Path) -> None:
+    """Each way of reading the store (a class anywhere, in a region by name, in a region box) finds the guessed can
+    and no guess of another class or place."""
+    from robokudo.core.regions import RegionBox
+
+    with BeliefStore(tmp_path / "b.sqlite") as store:
+        step = store.integrate(
+            [_object(0.0, [("CannedFood", 0.3)]), _object(3.0, [("CannedFood", 0.3)]), _object(0.5, [("Jar", 0.3)])],
+            1.0,
+        )
+        near, far, jar = step.assigned
+        box = RegionBox("shelf", "Shelf", "camera", (0.0, 0.0, 1.0), (0.0, 0.0, 0.0, 1.0), (1.0, 1.0, 1.0))
+        assert [b.id for b in store.query(BeliefFilter(object_class="CannedFood"))] == sorted([near, far])
+        assert [b.id for b in store.query(BeliefFilter(object_class="Jar"))] == [jar]
+        in_box = BeliefFilter(object_class="CannedFood", region="shelf", region_boxes=(box,))
+        assert [b.id for b in store.query(in_box)] == [near]
+        region = store.get(near).region
+        by_name = [b.id for b in store.query(BeliefFilter(object_class="CannedFood", region=region or "nowhere"))]
+        assert by_name == ([near, far] if region and store.get(far).region == region else [near] if region else [])
+
+
+def test_a_store_written_before_guesses_were_answered_finds_them_when_opened(tmp_path: Path) -> None:
+    """A store of schema 3 never listed a guessed class among its classes; opened again it answers the guess."""
+    path = tmp_path / "old.sqlite"
+    with BeliefStore(path) as store:
+        (guessed,) = store.integrate([_object(0.0, [("CannedFood", 0.3)])], 1.0).assigned
+    with sqlite3.connect(path) as conn:  # as an older robokudo left it
+        conn.execute("DELETE FROM classes WHERE name = 'CannedFood'")
+        conn.execute("UPDATE meta SET value = '3' WHERE key = 'version'")
+    with BeliefStore(path) as store:
+        assert [b.id for b in store.query(BeliefFilter(object_class="CannedFood"))] == [guessed]
