@@ -1056,18 +1056,20 @@ class BeliefStore:
                         )
                     )
             selects, values = [], []
-            for class_clause, class_parameters, reading in class_ways:
-                for number, (extra, extra_parameters) in enumerate(branches):
-                    where = " AND ".join(([class_clause] if class_clause else []) + clauses + extra)
-                    # without statistics SQLite may pick the region index and filter the class row by row; the
-                    # class index (class, region) answers both at once; a box branch starts from the R*Tree's ids
-                    # (never from the class index's beliefs without a supported class), a query by ids from them
-                    if not reading or f.ids is not None:
-                        table = "objects"
-                    else:
-                        table = f"objects {reading if number == 0 else BY_ID}"
-                    selects.append(f"SELECT {_OBJECT_COLUMNS} FROM {table}" + (f" WHERE {where}" if where else ""))
-                    values.extend(class_parameters + parameters + extra_parameters)
+            # (class way, region branch) pairs: the region by name (or none) once per class way, read through the
+            # class index; a box once, its objects' ids from the R*Tree, every class way tested per object
+            either = " OR ".join(f"({clause})" for clause, _, _ in class_ways if clause)
+            either_parameters = [value for _, way_parameters, _ in class_ways for value in way_parameters]
+            pairs = [(clause, way_parameters, reading, *branches[0]) for clause, way_parameters, reading in class_ways]
+            pairs += [(f"({either})" if either else "", either_parameters, BY_ID, *box) for box in branches[1:]]
+            for class_clause, class_parameters, reading, extra, extra_parameters in pairs:
+                where = " AND ".join(([class_clause] if class_clause else []) + clauses + extra)
+                # without statistics SQLite may pick the region index and filter the class row by row; the class
+                # index (class, region) answers both at once; a box starts from the R*Tree's ids (never from the
+                # class index's beliefs without a supported class), a query by ids from them
+                table = f"objects {reading}" if reading and f.ids is None else "objects"
+                selects.append(f"SELECT {_OBJECT_COLUMNS} FROM {table}" + (f" WHERE {where}" if where else ""))
+                values.extend(class_parameters + parameters + extra_parameters)
             rows = conn.execute(" UNION ".join(selects) + " ORDER BY id", values).fetchall()
             if f.region and f.region_boxes:
                 rows = _in_named_region(rows, f)
