@@ -30,8 +30,7 @@ from reasoning.beliefs.selection import SelectionNote, Viewpoint, select
 from reasoning.beliefs.store import BeliefFilter, BeliefStore
 from reasoning.fusion.association import CameraModel
 from reasoning.fusion.frame import FUSED_TYPES, WORLD_FRAME, FrameContext, FrameObject, frame_objects
-from reasoning.fusion.rule import CLASS_ATTRIBUTE
-from reasoning.fusion.tracking import BeliefTracker, ObjectBelief, TrackStep
+from reasoning.fusion.tracking import BeliefTracker, TrackStep
 from robokudo.core.annotator import Annotator
 from robokudo.core.types import (
     CameraInfo,
@@ -75,8 +74,9 @@ class AnswerStep(Annotator):
     first run. ``tracker`` (class test, regions, gates) defaults to the store's. The query's filter is
     ``belief_filter``, or ``filter_for(query)`` of the CAS's QueryView, or everything seen. The answer holds
     the matching objects seen in this frame, most confident first (under a limit, the most likely to be what was
-    asked: :mod:`reasoning.beliefs.ranking`), with their image ROI (an object an expert only
-    guessed to be of the asked class is a candidate too, see :meth:`_guessed`); when a tracker wrote the frame's
+    asked: :mod:`reasoning.beliefs.ranking`), with their image ROI (an object whose leading class is only a guess
+    of the asked class is a candidate too, by the rule the answer from memory applies:
+    :mod:`reasoning.beliefs.class_candidates`); when a tracker wrote the frame's
     TargetTrack (a continuous task), only the tracked object, with the track; ``label_of`` names classes (e.g.
     the knowledge base's labels). Objects whose geometry is in doubt confirm known beliefs but create none. With
     ``fail_when_empty`` the step fails when nothing matches. ``timestamp`` 0 in CameraInfo means unknown: ``clock()``
@@ -173,9 +173,8 @@ class AnswerStep(Annotator):
         tracked = _tracked_object(track, seen) if track is not None else None
         if track is not None:  # a continuous task answers with its one target
             seen = {tracked: seen[tracked]} if tracked is not None else {}
+        # the store's answer for the objects seen here: the rule of the answer from memory (class_candidates)
         matching = store.query(replace(belief_filter, ids=tuple(seen), limit=None))
-        guesses = self._guessed(store, belief_filter, seen, {b.id for b in matching})
-        matching += guesses.values()
         selected: SelectionNote | None = None
         if belief_filter.selection is not None:  # ``the top box``: by its measure, the usual order deciding ties
             ordered = best_first(matching, replace(belief_filter, limit=None))
@@ -203,7 +202,6 @@ class AnswerStep(Annotator):
                     class_test=belief_filter.class_test,
                     roi=seen[b.id].roi,
                     label_of=self.label_of,
-                    guessed_class=belief_filter.object_class if b.id in guesses else None,
                     asked_class=belief_filter.object_class,
                     answering=seen[b.id].answering,
                 )
@@ -275,31 +273,6 @@ class AnswerStep(Annotator):
             )
             for p in found
         )
-
-    @staticmethod
-    def _guessed(
-        store: BeliefStore, belief_filter: BeliefFilter, seen: dict[int, FrameObject], found: set[int]
-    ) -> dict[int, ObjectBelief]:
-        """Objects seen in this frame that an expert named the asked class (or a subclass of it) without evidence
-        to store (confidence 0.5 at most: a guess, e.g. the classifier deciding a tie by the query), or said
-        answers to it with no more (AnswersTo), and that match the rest of the filter, by id: answered as
-        candidates of the asked class, though their belief keeps no such class."""
-        wanted = belief_filter.object_class
-        if not wanted:
-            return {}
-        test = belief_filter.class_test or (lambda a, b: a.lower() == b.lower())
-        guessed = tuple(
-            i
-            for i, item in seen.items()
-            if i not in found
-            and any(
-                e.attribute == CLASS_ATTRIBUTE and e.confidence <= 0.5 and test(e.value, wanted)
-                for e in (*item.evidence, *item.answering)
-            )
-        )
-        if not guessed:
-            return {}
-        return {b.id: b for b in store.query(replace(belief_filter, object_class=None, ids=guessed, limit=None))}
 
     def _filter(self) -> BeliefFilter:
         if self.belief_filter is not None:

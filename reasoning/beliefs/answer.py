@@ -485,6 +485,9 @@ def _designate(
     class_name = guessed_class or belief.class_name
     if class_name is None:
         class_name = supported_class
+    if class_name is None and asked_class and CLASS_ATTRIBUTE in attributes:
+        # a candidate by its leading class, a guess (reasoning.beliefs.class_candidates): named by it, shown with "?"
+        class_name = attributes[CLASS_ATTRIBUTE].value
     size_attribute = attributes.get(Size.attribute)
     answers = None
     if asked_class and _local(asked_class) != ROOTS["class"]:  # asking for any object asks for no class

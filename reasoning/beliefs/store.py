@@ -54,6 +54,7 @@ import numpy as np
 import platformdirs
 
 from queries.selection import SelectionRequest
+from reasoning.beliefs.class_candidates import BY_ID, GUESSED_CLASSES, candidate_class_clauses
 from reasoning.beliefs.frame_writer import MAX_WRITE_BEHIND, NEXT_ID, FrameWriter, WriterGoneError
 from reasoning.beliefs.interned import INTERN, InternedTexts, decoded_supports
 from reasoning.beliefs.packed import (
@@ -87,13 +88,14 @@ from robokudo.core.text_match import text_matches
 from robokudo.core.types import Text
 
 SCHEMA_NAME = "robokudo-beliefs"
-SCHEMA_VERSION = 3
+SCHEMA_VERSION = 4
 MIGRATIONS = {
     1: (
         "ALTER TABLE objects ADD COLUMN recording TEXT NOT NULL DEFAULT ''",
         "ALTER TABLE observations ADD COLUMN recording TEXT NOT NULL DEFAULT ''",
     ),
     2: (),  # and the attribute column rewritten from JSON to packed supports (_pack_attribute_column)
+    3: (),  # and the classes guessed for beliefs without a supported class listed in ``classes`` (GUESSED_CLASSES)
 }
 """Version -> the statements that bring a store of that version to the next one."""
 SQLITE_HEADER = b"SQLite format 3\x00"
@@ -371,6 +373,8 @@ class BeliefStore:
                 self._migrate(conn)
                 for statement in _SCHEMA:
                     conn.execute(statement)
+                if version is not None and version < 4:  # a guessed class is found from memory (class_candidates)
+                    conn.execute(f"INSERT OR IGNORE INTO classes {GUESSED_CLASSES}", (CLASS_ATTRIBUTE,))
                 conn.execute("INSERT OR IGNORE INTO meta VALUES ('schema', ?)", (SCHEMA_NAME,))
                 conn.execute("INSERT OR REPLACE INTO meta VALUES ('version', ?)", (str(SCHEMA_VERSION),))
                 conn.execute("INSERT OR IGNORE INTO meta VALUES ('next_id', '1')")
@@ -870,6 +874,8 @@ class BeliefStore:
                 new = _index_entries(indexed)
                 added.extend((name, value, belief_id) for name, value in new - old)
                 removed.extend((name, value, belief_id) for name, value in old - new)
+                # a leading class below 0.5 is indexed too: a query for it finds the belief as a candidate
+                classes.update((value,) for name, value in new - old if name == CLASS_ATTRIBUTE)
             x, y, z = row[3:6]
             if (
                 state is None
@@ -1015,12 +1021,13 @@ class BeliefStore:
                     return []
                 clauses.append(f"id IN ({', '.join('?' * len(f.ids))})")
                 parameters.extend(f.ids)
+            # the class a query asks for, each way a belief answers to it (:func:`candidate_class_clauses`)
+            class_ways: list[tuple[str, list[object], str]] = [("", [], "")]
             if f.object_class:
                 classes = self._matching_classes(conn, f.object_class, f.class_test)
                 if not classes:
                     return []
-                clauses.append(f"class_name IN ({', '.join('?' * len(classes))})")
-                parameters.extend(classes)
+                class_ways = candidate_class_clauses(classes, narrowed=bool(f.region) or f.ids is not None)
             texts = {name: value for name, value in f.attributes.items() if name == Text.attribute}
             for name, value in f.attributes.items():
                 if name in texts:
@@ -1052,14 +1059,20 @@ class BeliefStore:
                         )
                     )
             selects, values = [], []
-            for number, (extra, extra_parameters) in enumerate(branches):
-                where = " AND ".join(clauses + extra)
+            # (class way, region branch) pairs: the region by name (or none) once per class way, read through the
+            # class index; a box once, its objects' ids from the R*Tree, every class way tested per object
+            either = " OR ".join(f"({clause})" for clause, _, _ in class_ways if clause)
+            either_parameters = [value for _, way_parameters, _ in class_ways for value in way_parameters]
+            pairs = [(clause, way_parameters, reading, *branches[0]) for clause, way_parameters, reading in class_ways]
+            pairs += [(f"({either})" if either else "", either_parameters, BY_ID, *box) for box in branches[1:]]
+            for class_clause, class_parameters, reading, extra, extra_parameters in pairs:
+                where = " AND ".join(([class_clause] if class_clause else []) + clauses + extra)
                 # without statistics SQLite may pick the region index and filter the class row by row; the class
-                # index (class, region) answers both at once (a box branch starts from the R*Tree's ids instead)
-                by_class = f.object_class and f.ids is None and number == 0
-                table = "objects INDEXED BY objects_class" if by_class else "objects"
+                # index (class, region) answers both at once; a box starts from the R*Tree's ids (never from the
+                # class index's beliefs without a supported class), a query by ids from them
+                table = f"objects {reading}" if reading and f.ids is None else "objects"
                 selects.append(f"SELECT {_OBJECT_COLUMNS} FROM {table}" + (f" WHERE {where}" if where else ""))
-                values.extend(parameters + extra_parameters)
+                values.extend(class_parameters + parameters + extra_parameters)
             rows = conn.execute(" UNION ".join(selects) + " ORDER BY id", values).fetchall()
             if f.region and f.region_boxes:
                 rows = _in_named_region(rows, f)
