@@ -78,8 +78,8 @@ from annotators.geometry.grid_segmentation import (
     merge_parts,
 )
 from annotators.geometry.inner_walls import InnerWallRules, join_inner_walls
-from annotators.geometry.occlusion import OcclusionRules, join_occluded
 from annotators.geometry.necks import NeckRules, join_necked_pieces
+from annotators.geometry.occlusion import OcclusionRules, join_occluded
 from annotators.geometry.rims import RimRules, join_rim_pieces, one_stands_inside
 from annotators.geometry.slabs import SlabRules, join_slab_pieces
 from annotators.geometry.support import (

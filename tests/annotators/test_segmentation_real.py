@@ -5,10 +5,11 @@
   matched by a hypothesis with point IoU >= 0.5.
 * uoc_tabletop_realsense frames 0-4: every listed object has its own hypothesis - also the soup can standing on
   the spam can in frames 2 and 3 - and the red Cheez-It box is named red and OCR reads "CHEEZ" inside its image box.
-  The power drill (orange body, black grip, battery below) is one hypothesis in frames 1, 2 and 3 (in frame 3 it
-  lies on its side and its grip ends behind the battery's raised edge: the pieces of one slab join); in frame 0 it
-  is not yet (cut where the grip enters the battery's top), nor is the clear water bottle in frame 3 (it reads the
-  table through the water): both are strict expected failures, their causes in bench/profiles/pieces3-analysis.txt.
+  The power drill (orange body, black grip, battery below) is one hypothesis in frames 0-3 (in frame 3 it lies on
+  its side and its grip ends behind the battery's raised edge: the pieces of one slab join; in frame 0 it is cut
+  where the grip enters the battery's top, and the body stands there on a neck far narrower than itself: they
+  join). The clear water bottle in frame 3 is not yet one (it reads the table through the water): a strict expected
+  failure, its cause in bench/profiles/pieces3-analysis.txt and bench/profiles/seg6-analysis.txt.
 * the white mug in frames 0 and 1 is one hypothesis with its inside (seen over the rim) and its handle: a body
   without its handle reads as a paper cup (in frame 1 the grouping cuts it in three - the inside's left half, the
   body, and the handle with the inside's right half and the body's right side down to the table - which the
