@@ -56,3 +56,11 @@ def test_a_wide_piece_on_a_narrow_neck_that_starts_below_the_lower_ones_top_stay
     drill = [((0.11, 0.14), (0.01, 0.11)), ((0.03, 0.23), (0.11, 0.18))]
     labels, plane_points = side_view({1: BATTERY, 2: drill})
     assert neck_partners(labels, plane_points, NeckRules()) == []
+
+
+def test_a_neck_under_pieces_apart_in_the_image_is_no_rigid_body() -> None:
+    # the grip and a body one row above it, unlabelled between: two surfaces, not one piece held on a neck
+    drill = [((0.11, 0.14), (0.05, 0.11)), ((0.03, 0.23), (0.114, 0.18))]
+    labels, plane_points = side_view({1: BATTERY, 2: drill})
+    assert neck_partners(labels, plane_points, NeckRules(one_surface=0.5)) == [(2, 1)]
+    assert neck_partners(labels, plane_points, NeckRules()) == []
