@@ -78,6 +78,7 @@ from annotators.geometry.grid_segmentation import (
     merge_parts,
 )
 from annotators.geometry.inner_walls import InnerWallRules, join_inner_walls
+from annotators.geometry.necks import NeckRules, join_necked_pieces
 from annotators.geometry.occlusion import OcclusionRules, join_occluded
 from annotators.geometry.rims import RimRules, join_rim_pieces, one_stands_inside
 from annotators.geometry.slabs import SlabRules, join_slab_pieces
@@ -109,6 +110,7 @@ class ClutterParameters(ClusterParameters):
     ``join_rims`` joins the pieces of one open container's rim that an object standing in it cuts apart, and its
     outer wall below the rim;
     ``join_slabs`` joins touching pieces of one slab (same lowest heights and tops, no depth jump between them);
+    ``join_necks`` joins a piece standing on another on a narrow neck to it (one rigid body);
     ``claim_floors`` gives an open container the floor seen over its rim, at table level;
     ``claim_borders`` gives the outline pixels the coarse grid
     left unlabelled and each object's foot (below ``min_height``) to the object they continue."""
@@ -138,6 +140,7 @@ class ClutterParameters(ClusterParameters):
     join_inner_walls: bool = True
     join_rims: bool = True
     join_slabs: bool = True
+    join_necks: bool = True
     claim_floors: bool = True
     claim_borders: bool = True
 
@@ -283,6 +286,8 @@ def segment_clutter(
         slab_rules = p.slab_rules()
         known = pieces if summary_step == slab_rules.sample_step else None
         labels = join_slab_pieces(labels, grid, normals, plane_grid, slab_rules, known)
+    if p.join_necks:
+        labels = join_necked_pieces(labels, plane_grid, NeckRules())
     floors = None
     if p.claim_floors:
         rules = FloorRules(min_height=p.min_height, margin=p.hull_margin, cell=p.hull_cell)
