@@ -78,7 +78,10 @@ def test_find_all_objects_names_the_class_above_leaves_it_cannot_tell_apart(
 ) -> None:
     found = classes_at(capsys, store, uoc_folder, frame, pixels, CUES_ONLY)
     assert found["cheez-it box"] in BOX_OF_FOOD_OR_DRINK, found
-    assert found["drill"] == UNKNOWN, found
+    # the drill in one piece is a power drill; a piece of it is no class the experts can name
+    assert found["drill"] in {UNKNOWN, "power drill"}, found
+    if frame == 0:  # upright on its battery: one hypothesis since the segmenter joins a piece on a narrow neck
+        assert found["drill"] == "power drill", found
     if frame == 0:
         assert found["blue mug"] in CONTAINER, found
         assert found["spam can"] in FOOD, found
