@@ -17,13 +17,6 @@ from tests.annotators.conftest import SHARED_DATA, require_folder
 LABELS = Path(__file__).resolve().parents[1] / "data" / "labels" / "real_objects.json"
 
 
-@pytest.fixture(autouse=True)
-def private_data(tmp_path: Path, monkeypatch: pytest.MonkeyPatch) -> Path:
-    monkeypatch.setenv("ROBOKUDO_USER_ONTOLOGY", str(tmp_path / "user.ttl"))
-    monkeypatch.setenv("ROBOKUDO_BELIEF_STORE", str(tmp_path / "beliefs.sqlite"))
-    return tmp_path
-
-
 def answered(capsys: pytest.CaptureFixture[str], *argv: str) -> dict:
     capsys.readouterr()
     assert cli.main([*argv[:1], "--json", *argv[1:]]) == 0, capsys.readouterr().err
