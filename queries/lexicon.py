@@ -80,9 +80,12 @@ COUNT_TAILS: frozenset[tuple[str, ...]] = frozenset(
         ("do", "i", "have"),
         ("are", "visible"),
         ("are", "left"),
+        ("are",),
+        ("is",),
     }
 )
-"""The verb of a ``how many`` question, wherever it stands (``how many cans are there on the table``)."""
+"""The verb of a ``how many`` question, wherever it stands (``how many cans are there on the table``, ``how many
+cups are on the table``)."""
 
 QUESTION_VERBS: frozenset[str] = frozenset({"is", "are", "does", "do"})
 """Words allowed between ``what <attribute>`` and the object."""

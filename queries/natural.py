@@ -454,6 +454,13 @@ class _PhraseParser:
         phrase = self.object_phrase()
         self.modifiers(phrase)
         self.expect_end()
+        if phrase.selection is not None and phrase.selection_span is not None:
+            # "on the left" picks one object; a count takes every such object, so the two cannot both be meant
+            raise self.error_at(
+                phrase.selection_span,
+                f"a count takes every such object, but '{phrase.selection}' picks one of them; "
+                "ask with 'find' for that one",
+            )
         phrase.limit, phrase.limit_span = None, None
         kind_span = _join_span(verb_tokens[0].span, verb_tokens[-1].span)
         query = Query("detect", self.object_body("detect", phrase), self.text, kind_span, counted=True)

@@ -65,3 +65,27 @@ def test_how_many_without_an_object_is_located_after_it() -> None:
 )
 def test_a_count_question_is_marked_so_its_answer_says_how_many(phrase: str, counted: bool) -> None:
     assert parse_query(phrase).counted is counted
+
+
+@pytest.mark.parametrize(
+    ("phrase", "expected"),
+    [
+        ("how many cups are on the table", "detect { obj: { type: cup, location: { on: table } } }"),
+        ("how many red cups are in the fridge", "detect { obj: { type: cup, color: red, location: { in: fridge } } }"),
+        ("how many bowls are there on the shelf", "detect { obj: { type: bowl, location: { on: shelf } } }"),
+        ("how many milk is in the fridge", "detect { obj: { type: milk, location: { in: fridge } } }"),
+    ],
+)
+def test_the_copula_of_a_count_question_is_its_verb_not_part_of_the_object(phrase: str, expected: str) -> None:
+    assert format_query(parse_query(phrase)) == expected
+
+
+@pytest.mark.parametrize(
+    ("phrase", "column"),
+    [("how many cups are on the left", 19), ("how many boxes are at the top", 20), ("how many biggest cups", 10)],
+)
+def test_a_count_question_that_also_picks_one_object_is_refused_where_it_picks(phrase: str, column: int) -> None:
+    with pytest.raises(QueryError) as caught:
+        parse_query(phrase)
+    assert "a count takes every such object" in caught.value.message
+    assert (caught.value.line, caught.value.column) == (1, column)
