@@ -86,6 +86,10 @@ CLASSES = [f"Thing{i}" for i in range(40)] + ["Milk", "LactoseFreeMilk", "WholeM
 PARENT = {"LactoseFreeMilk": "Milk", "WholeMilk": "Milk"}
 COLORS = ["red", "green", "blue", "white", "yellow", "black"]
 SHAPES = ["box", "cylinder", "sphere", "flat"]
+GUESS_SHARE = 0.2
+"""Share of the query benchmark's stored objects without a supported class: their experts' leading class is a guess
+below 0.5 with a rival (an object the classifier could not tell, answered with "?"), which a class query reads
+through the attribute index (``reasoning.beliefs.class_candidates``)."""
 
 
 def is_subclass(a: str, b: str) -> bool:
@@ -113,10 +117,17 @@ def room_of(x: np.ndarray, y: np.ndarray, side: float) -> np.ndarray:
     return ((y // ROOM_DEPTH) * per_row + x // ROOM_WIDTH).astype(np.int64)
 
 
-def template_belief(cls: str, color: str, shape: str) -> ObjectBelief:
-    """A stored belief of one class, colour and shape (id and place are filled per object)."""
+def template_belief(cls: str, color: str, shape: str, guessed: bool = False) -> ObjectBelief:
+    """A stored belief of one class, colour and shape (id and place are filled per object); ``guessed``: the class
+    is only the leading guess (p 0.45, a rival class at 0.40), so the belief has no supported class."""
+    rival = CLASSES[(CLASSES.index(cls) + 1) % len(CLASSES)]
+    stated = (
+        {cls: ValueSupport(-0.2, 1, {"Detector"}, 0.0, 0.0), rival: ValueSupport(-0.4, 1, {"Detector"}, 0.0, 0.0)}
+        if guessed
+        else {cls: ValueSupport(1.4, 1, {"Detector"}, 0.0, 0.0)}
+    )
     attributes = {
-        "class": AttributeBelief("class", {cls: ValueSupport(1.4, 1, {"Detector"}, 0.0, 0.0)}),
+        "class": AttributeBelief("class", stated),
         "color": AttributeBelief("color", {color: ValueSupport(0.8, 1, {"ColorExpert"}, 0.0, 0.0)}),
         "shape": AttributeBelief("shape", {shape: ValueSupport(0.8, 1, {"ShapeExpert"}, 0.0, 0.0)}),
         "size": AttributeBelief("size", {"medium": ValueSupport(0.8, 1, {"SizeExpert"}, 0.0, 0.0)}),
@@ -128,16 +139,19 @@ def template_belief(cls: str, color: str, shape: str) -> ObjectBelief:
         dimensions=np.array([0.2, 0.1, 0.07]),
         attributes=attributes,
         existence=1.4,
-        class_name=cls,
+        class_name=None if guessed else cls,
         sources={"Segmenter", "PoseExpert", "SizeExpert", "ColorExpert", "ShapeExpert", "Detector"},
         observations=1,
     )
 
 
-def seed_file(path: Path, count: int, rng: np.random.Generator, named_regions: bool = True) -> Seeded:
+def seed_file(
+    path: Path, count: int, rng: np.random.Generator, named_regions: bool = True, guess_share: float = 0.0
+) -> Seeded:
     """A belief store of ``count`` objects, written with ``executemany`` of rows the store's own encoder made for
-    each (class, colour, shape) and placed per object (50,000 rows per transaction); each object's region is its
-    room's name when ``named_regions``, else empty."""
+    each (class, colour, shape, guessed) and placed per object (50,000 rows per transaction); each object's region
+    is its room's name when ``named_regions``, else empty; a ``guess_share`` of the objects have no supported class
+    (:func:`template_belief`)."""
     BeliefStore(path).close()  # the schema
     side = world_side(count)
     positions = np.column_stack([rng.uniform(0, side, count), rng.uniform(0, side, count), np.full(count, 0.8)])
@@ -145,7 +159,7 @@ def seed_file(path: Path, count: int, rng: np.random.Generator, named_regions: b
     class_index = rng.integers(len(CLASSES), size=count)
     color_index = rng.integers(len(COLORS), size=count)
     rooms = room_of(positions[:, 0], positions[:, 1], side)
-    templates: dict[tuple[int, int, int], tuple[tuple, tuple, tuple, list[tuple[str, str]]]] = {}
+    templates: dict[tuple[int, int, int, bool], tuple[tuple, tuple, tuple, list[tuple[str, str]]]] = {}
     interned = InternedTexts()
     conn = sqlite3.connect(path, isolation_level=None)
     conn.execute("PRAGMA journal_mode = MEMORY")  # seeding only: the store switches the file back to WAL
@@ -158,14 +172,16 @@ def seed_file(path: Path, count: int, rng: np.random.Generator, named_regions: b
         conn.execute(f"DROP INDEX {index_name}")
     xs, ys, zs = positions.T.tolist()
     room_names = [f"room{r}" if named_regions else "" for r in rooms.tolist()]
-    keys = list(zip(class_index.tolist(), color_index.tolist(), [i % len(SHAPES) for i in range(count)], strict=True))
+    guessed = (rng.random(count) < guess_share).tolist() if guess_share > 0.0 else [False] * count
+    shapes = [i % len(SHAPES) for i in range(count)]
+    keys = list(zip(class_index.tolist(), color_index.tolist(), shapes, guessed, strict=True))
     for begin in range(0, count, 50_000):
         objects, places, entries = [], [], []
         for i in range(begin, min(begin + 50_000, count)):
             key = keys[i]
             found = templates.get(key)
             if found is None:
-                belief = template_belief(CLASSES[key[0]], COLORS[key[1]], SHAPES[key[2]])
+                belief = template_belief(CLASSES[key[0]], COLORS[key[1]], SHAPES[key[2]], key[3])
                 row = _object_row(belief, is_subclass, {}, interned, conn, functools.partial(replay, conn))
                 pairs = [tuple(entry.split("=", 1)) for entry in row[-1].split("\x1f")]
                 found = templates[key] = (row[1:3], row[6:21], row[22:], pairs)  # type: ignore[assignment]
@@ -521,7 +537,7 @@ def profile_queries(size: int, repeats: int, folder: Path, out: Path) -> None:
     median ms of each query to designators and the top entries by own and by cumulative time are written to
     ``out``."""
     path = folder / f"profile-queries-{size}.sqlite"
-    seed_file(path, size, np.random.default_rng(size + 1))
+    seed_file(path, size, np.random.default_rng(size + 1), guess_share=GUESS_SHARE)
     text = io.StringIO()
     with BeliefStore(path, tracker=BeliefTracker(class_test=is_subclass)) as store:
         queries = memory_queries(size)
@@ -710,11 +726,14 @@ def main() -> int:
         for size in args.query_sizes:
             path = folder / f"query-{size}.sqlite"
             start = time.perf_counter()
-            seed_file(path, size, np.random.default_rng(size + 1))
+            seed_file(path, size, np.random.default_rng(size + 1), guess_share=GUESS_SHARE)
             seeding = time.perf_counter() - start
             goal = goal_for(size)
             with BeliefStore(path, tracker=BeliefTracker(class_test=is_subclass)) as store:
-                print(f"queries, {store.count()} stored (seeded in {seeding:.1f} s), {args.repeats} runs each:")
+                print(
+                    f"queries, {store.count()} stored, {GUESS_SHARE:.0%} of them without a supported class (seeded in "
+                    f"{seeding:.1f} s), {args.repeats} runs each:"
+                )
                 print(
                     f"  {'query':48s} {'beliefs ms p50':>14s} {'p95':>7s} {'designators ms p50':>18s} {'p95':>7s} "
                     f"{'cpu p50':>7s} n"
