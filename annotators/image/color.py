@@ -337,6 +337,33 @@ def name_surface(surface: Surface, surround: float, parameters: NamingParameters
     return _name_of_votes(_term_votes(lab, parameters)[0])
 
 
+def _greys_in_shade(
+    surfaces: list[Surface], names: list[SurfaceName], parameters: NamingParameters
+) -> list[SurfaceName]:
+    """The names with every lit surface named black that is a lit grey surface's shaded side named grey: darker,
+    and of about its hue (within ``shade_hue`` degrees; shading changes how much light a surface sends, not its
+    chromaticity). A grey cloth's folds are the cloth in shade (people name a surface by its lit side), as a
+    white's shaded side, named grey, is the white's."""
+    greys = [
+        look(surface.lab, parameters)
+        for surface, named in zip(surfaces, names, strict=True)
+        if surface.kind != "dark" and named.name == "grey"
+    ]
+    if not greys:
+        return names
+    result = list(names)
+    for i, (surface, named) in enumerate(zip(surfaces, names, strict=True)):
+        if surface.kind == "dark" or named.name != "black":
+            continue
+        _, hue, _, lightness = look(surface.lab, parameters)
+        if any(
+            grey_lightness > lightness and abs((hue - grey_hue + 180.0) % 360.0 - 180.0) <= parameters.shade_hue
+            for _, grey_hue, _, grey_lightness in greys
+        ):
+            result[i] = SurfaceName("grey", named.certainty)
+    return result
+
+
 def _object_colors(
     surfaces: list[Surface], names: list[SurfaceName], count: int, parameters: NamingParameters
 ) -> tuple[NamedColor, ...]:
@@ -344,6 +371,7 @@ def _object_colors(
     weights: dict[str, float] = {}
     certainties: dict[str, float] = {}
     lit_names = {n.name for s, n in zip(surfaces, names, strict=True) if s.kind != "dark"}
+    names = _greys_in_shade(surfaces, names, parameters)
     for surface, named in zip(surfaces, names, strict=True):
         shadow = lit_names and named.name not in lit_names and surface.pixels < parameters.dark_keep_share * count
         if surface.kind == "dark" and shadow:
