@@ -24,8 +24,10 @@ Lit saturated surfaces that are shades of one colour (CIEDE2000 neighbours, or o
 surface of about the same hue, whichever is larger) are named together by their pooled votes
 (:func:`_pool_shades`). A name's share is the share of the named pixels its surfaces hold; grey beside white is the
 white's shaded side and is left out (it names no colour of its own, and counted with the white it would hide a print
-as large as the white it is printed on). The dominant colour is the largest share; a second colour is
-reported when its share and its confidence (share x certainty) are large enough.
+as large as the white it is printed on). Likewise a lit surface named black that is darker than a lit grey of
+about its hue is that grey in shade (:func:`_greys_in_shade`: a cloth's folds) and counts as grey. The dominant
+colour is the largest share; a second colour is reported when its share and its confidence (share x certainty) are
+large enough.
 
 The annotator names all the hypotheses of a frame together (:func:`name_objects_colors`): their pixels are
 picked and grouped in one pass over the frame, and every surface's prototype votes and every pair of shades come
@@ -337,12 +339,40 @@ def name_surface(surface: Surface, surround: float, parameters: NamingParameters
     return _name_of_votes(_term_votes(lab, parameters)[0])
 
 
+def _greys_in_shade(
+    surfaces: list[Surface], names: list[SurfaceName], parameters: NamingParameters
+) -> list[SurfaceName]:
+    """The names with each lit surface named black renamed grey when it is a lit grey surface's shaded side:
+    darker, and of about its hue (within ``shade_hue`` degrees; shading changes how much light a surface sends,
+    not its chromaticity). A grey cloth's folds are the cloth in shade (people name a surface by its lit side),
+    as a white's shaded side, named grey, is the white's."""
+    greys = [
+        look(surface.lab, parameters)
+        for surface, named in zip(surfaces, names, strict=True)
+        if surface.kind != "dark" and named.name == "grey"
+    ]
+    if not greys:
+        return names
+    result = list(names)
+    for i, (surface, named) in enumerate(zip(surfaces, names, strict=True)):
+        if surface.kind == "dark" or named.name != "black":
+            continue
+        _, hue, _, lightness = look(surface.lab, parameters)
+        if any(
+            grey_lightness > lightness and abs((hue - grey_hue + 180.0) % 360.0 - 180.0) <= parameters.shade_hue
+            for _, grey_hue, _, grey_lightness in greys
+        ):
+            result[i] = SurfaceName("grey", named.certainty)
+    return result
+
+
 def _object_colors(
     surfaces: list[Surface], names: list[SurfaceName], count: int, parameters: NamingParameters
 ) -> tuple[NamedColor, ...]:
     """The dominant colour and, when the object has two, the second one, from its named surfaces."""
     weights: dict[str, float] = {}
     certainties: dict[str, float] = {}
+    names = _greys_in_shade(surfaces, names, parameters)
     lit_names = {n.name for s, n in zip(surfaces, names, strict=True) if s.kind != "dark"}
     for surface, named in zip(surfaces, names, strict=True):
         shadow = lit_names and named.name not in lit_names and surface.pixels < parameters.dark_keep_share * count

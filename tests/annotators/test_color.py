@@ -268,6 +268,23 @@ def test_a_print_is_measured_against_the_white_not_the_whites_shaded_side() -> N
     assert names(np.vstack([white, shaded_white, patch((200, 30, 35), count=280, seed=2)])) == ["white", "red"]
 
 
+def test_a_grey_cloth_whose_folds_are_in_shade_is_grey_not_black() -> None:
+    # light bluish-grey denim in a dim room: the lit cloth (L* about 53) is grey, its folds in shade (0.45 of the
+    # light, L* about 37) are dark enough for black on their own; they are the cloth in shade: grey only
+    lit, folds = patch((118, 126, 140), count=450), patch((118, 126, 140), 0.45, count=400, seed=1)
+    light = FrameLight(gains=np.ones(3), surround=0.2)
+    assert (names(lit, light), names(folds, light)) == (["grey"], ["black"])
+    assert names(np.vstack([lit, folds]), light) == ["grey"]
+
+
+def test_a_black_part_of_another_hue_than_the_grey_stays_black() -> None:
+    # a dark tin: a black lid beside a lighter, warm grey body of another hue is black, not the body in shade
+    body, lid = patch((135, 125, 100), count=300), patch((62, 60, 66), count=600, seed=1)
+    light = FrameLight(gains=np.ones(3), surround=0.2)
+    assert (names(body, light), names(lid, light)) == (["grey"], ["black"])
+    assert names(np.vstack([body, lid]), light)[0] == "black"
+
+
 def test_a_colour_lit_and_in_shade_is_one_colour_even_where_the_shaded_side_is_larger() -> None:
     # a crisps tube as in mOSD frames: a narrow lit yellow side, a wider shaded side of the same hue (orange alone)
     # and a white band larger than either side but smaller than both; the tube's colour is the dominant one
