@@ -8,7 +8,10 @@ inliers continued by the far points within the Kinect v1 noise of the near plane
 candidates (points 1 cm to 0.5 m above the support), their inliers within the depth-resolution step
 ``2.8e-3 * z^2`` (Khoshelham & Elberink 2012: 7 cm at 5 m; at least 1 cm), split into 8-connected pieces; a piece
 longer in the plane than ``FURNITURE`` (0.5 m, the candidates' own ceiling: nothing graspable is that big) is a face
-of furniture (the shelf block's front, the partition) and is no candidate. Prints the segments as range3 did.
+of furniture (the shelf block's front, the partition) and is no candidate. Prints the segments as range3 did, a
+segment whose top lies within the resolution step of the 0.5 m ceiling marked (cut by the ceiling: part of something
+taller), for the near input, the far input, and the far input with a fixed 1 cm face tolerance (without cause B's
+resolution step).
 """
 
 from __future__ import annotations
@@ -21,11 +24,11 @@ import numpy as np
 
 sys.path.insert(0, str(Path(__file__).resolve().parent))
 
-from range3_far_desk import BOUND, FAR, KINECT_C, front  # noqa: E402
+from range3_far_desk import BOUND, FAR, KINECT_C, front
 
-from annotators.cloud.clutter import ClutterParameters, segment_clutter  # noqa: E402
-from annotators.cloud.plane import plane_basis, plane_distances, ransac_support_plane  # noqa: E402
-from robokudo.core.types import PointCloud  # noqa: E402
+from annotators.cloud.clutter import ClutterParameters, segment_clutter
+from annotators.cloud.plane import plane_basis, plane_distances, ransac_support_plane
+from robokudo.core.types import PointCloud
 
 RESOLUTION_C = 0.07 / 5.0**2
 """Kinect v1 depth resolution step = RESOLUTION_C * z^2 (Khoshelham & Elberink 2012: 7 cm at 5 m)."""
