@@ -32,8 +32,9 @@ experts and the support of every attribute value, packed: one binary record per 
 seen, :mod:`reasoning.beliefs.seen_together`),
 ``observations`` (every sighting
 with its recording and the experts' statements, packed, bounded per object), ``views`` (one row per recording and
-frame: the last camera pose and support plane seen from it, so that a selection from memory measures as the frame
-did, :meth:`BeliefStore.viewpoints`), ``classes`` and ``meta``. A store of version 4 gets an empty ``views`` table.
+frame: the last camera pose and support plane seen from it, so that a selection from memory measures as the last
+frame did, :meth:`BeliefStore.viewpoints`), ``classes`` and ``meta``. A store of version 4 gets an empty ``views``
+table.
 """
 
 from __future__ import annotations
@@ -238,6 +239,7 @@ _SCHEMA = (
         plane BLOB,
         PRIMARY KEY (recording, frame)
     ) WITHOUT ROWID""",
+    "CREATE INDEX IF NOT EXISTS views_latest ON views (frame, time)",
 )
 
 
@@ -1142,15 +1144,22 @@ class BeliefStore:
         return records
 
     def viewpoints(self, keys: Iterable[tuple[str, str]]) -> dict[tuple[str, str], Viewpoint]:
-        """The last view recorded of each ``(recording, frame)`` asked (those never recorded are left out): the
-        camera pose when ``frame`` is the world frame, and the support plane in that view's camera frame."""
+        """The view a belief of each ``(recording, frame)`` asked is measured from (those never seen are left out):
+        in a camera frame, the last view of that recording and frame (its support plane); in the world frame, which
+        all recordings with a camera pose share, the last view of any recording (its camera pose and support plane,
+        the plane in that view's camera frame)."""
         wanted = sorted(set(keys))
         found: dict[tuple[str, str], Viewpoint] = {}
         with self._guard() as conn:
             for recording, frame in wanted:
-                row = conn.execute(
-                    "SELECT pose, plane FROM views WHERE recording = ? AND frame = ?", (recording, frame)
-                ).fetchone()
+                if frame == WORLD_FRAME:
+                    row = conn.execute(
+                        "SELECT pose, plane FROM views WHERE frame = ? ORDER BY time DESC LIMIT 1", (frame,)
+                    ).fetchone()
+                else:
+                    row = conn.execute(
+                        "SELECT pose, plane FROM views WHERE recording = ? AND frame = ?", (recording, frame)
+                    ).fetchone()
                 if row is not None:
                     found[(recording, frame)] = Viewpoint(
                         cam_to_world=None if row[0] is None else np.frombuffer(row[0], dtype="<f8").reshape(4, 4),
