@@ -163,7 +163,8 @@ class AnswerStep(Annotator):
         if info is not None and not isinstance(track, PersonTrack):
             camera = camera_model(info, depth.depth if depth is not None else None, self.looks_for)
         store = self.store
-        step = store.integrate(objects, stamp, camera=camera, tracker=self.tracker)
+        viewpoint = self._viewpoint(info)  # kept with the frame's view: memory measures selections from it
+        step = store.integrate(objects, stamp, camera=camera, plane=viewpoint.plane, tracker=self.tracker)
         if self.on_integrated is not None:
             self.on_integrated(step)
         belief_filter = self._filter()
@@ -178,7 +179,6 @@ class AnswerStep(Annotator):
         selected: SelectionNote | None = None
         if belief_filter.selection is not None:  # ``the top box``: by its measure, the usual order deciding ties
             ordered = best_first(matching, replace(belief_filter, limit=None))
-            viewpoint = self._viewpoint(info)
             matching, selected = select(ordered, belief_filter.selection, viewpoint, belief_filter.limit)
         elif belief_filter.limit is not None:  # asked for N objects: the N most likely to be what was asked
             matching = best_first(matching, belief_filter)

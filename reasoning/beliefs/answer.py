@@ -530,14 +530,21 @@ def answer_from_memory(
 ) -> Answer:
     """Answer a query from the store alone (no perception): the matching known objects, most confident first; with
     a ``limit``, the ones most likely to be what was asked (:func:`~reasoning.beliefs.ranking.answer_order`);
-    with a selection, the ones it selects (measured as the beliefs were stored: no camera pose or support plane is
-    known to memory); ``counted``: the query asked how many."""
+    with a selection, the ones it selects (each measured from the last view the store keeps of its recording and
+    frame: the camera pose and support plane, as the frame measured it); ``counted``: the query asked how many."""
     note = None
     if belief_filter.selection is not None:
         views = store.query_views(replace(belief_filter, limit=None), _belief_view)
         views.sort(key=lambda v: answer_order(v.belief, belief_filter))
         by_id = {v.belief.id: v for v in views}
-        chosen, note = select([v.belief for v in views], belief_filter.selection, Viewpoint(), belief_filter.limit)
+        kept = store.viewpoints((v.belief.recording, v.belief.frame) for v in views)
+        chosen, note = select(
+            [v.belief for v in views],
+            belief_filter.selection,
+            Viewpoint(),
+            belief_filter.limit,
+            viewpoints=lambda b: kept.get((b.recording, b.frame), Viewpoint()),
+        )
         views = [by_id[b.id] for b in chosen]
     elif belief_filter.limit is not None:
         views = store.query_views(replace(belief_filter, limit=None), _belief_view)

@@ -9,6 +9,10 @@ beliefs and orders them. Measures are taken where the beliefs were seen from (:c
   needs the camera pose to be measured);
 * volume: the product of the belief's dimensions.
 
+Live, every belief is measured from the frame's viewpoint; from memory, each from the last view the store recorded
+of its recording and frame (``viewpoints``: the camera pose and support plane kept with it), so that memory measures
+what the frame did.
+
 A belief that cannot be measured is left out of a selection (the note names it). Objects whose measures differ by
 less than the measure's tolerance are a tie: the order among them is the answer's usual order (most likely to be
 what was asked first), and the note says so.
@@ -16,7 +20,7 @@ what was asked first), and the note says so.
 
 from __future__ import annotations
 
-from collections.abc import Sequence
+from collections.abc import Callable, Sequence
 from dataclasses import dataclass
 from typing import Any
 
@@ -107,12 +111,21 @@ def _in_camera(belief: ObjectBelief, viewpoint: Viewpoint) -> np.ndarray | None:
     return pose[:3, :3].T @ (position - pose[:3, 3])
 
 
-def _basis(measure: Measure, beliefs: Sequence[ObjectBelief], viewpoint: Viewpoint) -> str:
+def _basis(
+    measure: Measure,
+    beliefs: Sequence[ObjectBelief],
+    viewpoint: Viewpoint,
+    view_of: Callable[[ObjectBelief], Viewpoint],
+) -> str:
     if measure is VOLUME:
         return "of the bounding box"
     if measure is not HEIGHT:
         return CAMERA
-    if viewpoint.plane is not None and all(_in_camera(b, viewpoint) is not None for b in beliefs):
+    if not beliefs:
+        planes = viewpoint.plane is not None
+    else:
+        planes = all(view_of(b).plane is not None and _in_camera(b, view_of(b)) is not None for b in beliefs)
+    if planes:
         return SUPPORT_PLANE
     if beliefs and all(b.frame == WORLD_FRAME for b in beliefs):
         return WORLD_UP
@@ -149,18 +162,29 @@ def _ties(measure: Measure, a: float, b: float) -> bool:
 
 
 def select(
-    beliefs: Sequence[ObjectBelief], request: SelectionRequest, viewpoint: Viewpoint, limit: int | None = None
+    beliefs: Sequence[ObjectBelief],
+    request: SelectionRequest,
+    viewpoint: Viewpoint,
+    limit: int | None = None,
+    *,
+    viewpoints: Callable[[ObjectBelief], Viewpoint] | None = None,
 ) -> tuple[list[ObjectBelief], SelectionNote]:
     """The beliefs ``request`` selects, in its order from its rank on (cut to ``limit``), and the note saying how.
 
-    ``beliefs`` come in the answer's usual order, which decides among equal measures."""
+    ``beliefs`` come in the answer's usual order, which decides among equal measures. Each is measured from
+    ``viewpoint``, or, with ``viewpoints``, from the viewpoint it gives for that belief (memory: the last view of
+    the belief's recording and frame)."""
     selection = request.selection
     measure = selection.measure
-    basis = _basis(measure, beliefs, viewpoint)
+
+    def view_of(belief: ObjectBelief) -> Viewpoint:
+        return viewpoint if viewpoints is None else viewpoints(belief)
+
+    basis = _basis(measure, beliefs, viewpoint, view_of)
     measured: list[tuple[float, ObjectBelief]] = []
     unmeasured: list[int] = []
     for belief in beliefs:
-        value = measure_of(belief, measure, viewpoint, basis)
+        value = measure_of(belief, measure, view_of(belief), basis)
         if value is None or not np.isfinite(value):
             unmeasured.append(belief.id)
         else:

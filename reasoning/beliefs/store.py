@@ -31,7 +31,10 @@ experts and the support of every attribute value, packed: one binary record per 
 ``attribute_index`` (the attribute values each belief holds more likely than not, for queries; colours also as last
 seen, :mod:`reasoning.beliefs.seen_together`),
 ``observations`` (every sighting
-with its recording and the experts' statements, packed, bounded per object), ``classes`` and ``meta``.
+with its recording and the experts' statements, packed, bounded per object), ``views`` (one row per recording and
+frame: the last camera pose and support plane seen from it, so that a selection from memory measures as the last
+frame did, :meth:`BeliefStore.viewpoints`), ``classes`` and ``meta``. A store of version 4 gets an empty ``views``
+table.
 """
 
 from __future__ import annotations
@@ -44,7 +47,7 @@ import shlex
 import sqlite3
 import struct
 import threading
-from collections.abc import Callable, Iterator, Mapping, Sequence
+from collections.abc import Callable, Iterable, Iterator, Mapping, Sequence
 from contextlib import contextmanager
 from dataclasses import dataclass, field
 from pathlib import Path
@@ -71,6 +74,7 @@ from reasoning.beliefs.packed import (
 from reasoning.beliefs.pending import PendingFrame, PendingFrames, entries_of, rtree_bounds
 from reasoning.beliefs.row_update import RowUpdate, Support, belief_of
 from reasoning.beliefs.seen_together import SEEN_TOGETHER, last_stated
+from reasoning.beliefs.selection import Viewpoint
 from reasoning.fusion.association import CameraModel, in_view
 from reasoning.fusion.frame import WORLD_FRAME, FrameObject
 from reasoning.fusion.rule import (
@@ -88,7 +92,7 @@ from robokudo.core.text_match import text_matches
 from robokudo.core.types import Text
 
 SCHEMA_NAME = "robokudo-beliefs"
-SCHEMA_VERSION = 4
+SCHEMA_VERSION = 5
 MIGRATIONS = {
     1: (
         "ALTER TABLE objects ADD COLUMN recording TEXT NOT NULL DEFAULT ''",
@@ -96,6 +100,7 @@ MIGRATIONS = {
     ),
     2: (),  # and the attribute column rewritten from JSON to packed supports (_pack_attribute_column)
     3: (),  # and the classes guessed for beliefs without a supported class listed in ``classes`` (GUESSED_CLASSES)
+    4: (),  # and the ``views`` table (empty: an older store answers selections as before until a frame is seen)
 }
 """Version -> the statements that bring a store of that version to the next one."""
 SQLITE_HEADER = b"SQLite format 3\x00"
@@ -226,10 +231,27 @@ _SCHEMA = (
     "CREATE INDEX IF NOT EXISTS attribute_index_object ON attribute_index (object_id)",
     "CREATE TABLE IF NOT EXISTS classes (name TEXT PRIMARY KEY) WITHOUT ROWID",
     _INTERNED_TABLE,
+    """CREATE TABLE IF NOT EXISTS views (
+        recording TEXT NOT NULL,
+        frame TEXT NOT NULL,
+        time REAL NOT NULL,
+        pose BLOB,
+        plane BLOB,
+        PRIMARY KEY (recording, frame)
+    ) WITHOUT ROWID""",
+    "CREATE INDEX IF NOT EXISTS views_latest ON views (frame, time)",
 )
 
 
 _TABLES = {"meta", "objects", "objects_place", "attribute_index", "observations", "classes", "interned"}
+"""The tables of a complete store of schema 4 (schema 5 adds ``views``, :data:`_VIEW_TABLES`)."""
+_VIEW_TABLES = {"views"}
+
+_RECORD_VIEW = (
+    "INSERT INTO views VALUES (?, ?, ?, ?, ?) ON CONFLICT (recording, frame) DO UPDATE SET time = excluded.time, "
+    "pose = excluded.pose, plane = excluded.plane WHERE excluded.time >= views.time"
+)
+"""The last view of a recording and frame: the camera pose (world frame) and the support plane (camera frame)."""
 
 
 class _Candidate:
@@ -406,7 +428,8 @@ class BeliefStore:
                 f"belief store {self.path} has schema version {version}, newer than this robokudo "
                 f"({SCHEMA_VERSION}); upgrade robokudo or use another store path"
             )
-        return version if "next_id" in meta and tables >= _TABLES else None
+        required = _TABLES | _VIEW_TABLES if version >= 5 else _TABLES
+        return version if "next_id" in meta and tables >= required else None
 
     @staticmethod
     def _migrate(conn: sqlite3.Connection) -> None:
@@ -530,6 +553,7 @@ class BeliefStore:
         time: float,
         *,
         camera: CameraModel | None = None,
+        plane: Sequence[float] | None = None,
         tracker: BeliefTracker | None = None,
         wait: bool = False,
     ) -> TrackStep:
@@ -538,6 +562,9 @@ class BeliefStore:
         Beliefs near the observations (and, with ``camera``, in front of it) are loaded, associated and
         updated by the tracker; new objects get new ids; the changes and the sightings are written. Beliefs
         missed earlier and not seen for the tracker's ``gone_after`` seconds are marked gone, wherever they are.
+        With ``camera``, the view is recorded as the last of its recording and frame: the camera pose (world frame)
+        and ``plane``, the support plane ``(a, b, c, d)`` in the camera frame (None: none found), from which a
+        selection from memory measures (:meth:`viewpoints`).
 
         With the plain :class:`BeliefTracker` (no named regions) the step runs on the stored rows: matched beliefs in
         the common case are updated on their rows (:mod:`reasoning.beliefs.row_update`) and the step's ``changed``
@@ -549,7 +576,7 @@ class BeliefStore:
         """
         tracker = tracker or self.tracker
         if self.write_behind:
-            step = self._integrate_behind(objects, time, camera, tracker)
+            step = self._integrate_behind(objects, time, camera, tracker, plane)
             if wait:
                 self.flush()
             return step
@@ -557,13 +584,18 @@ class BeliefStore:
         with self._transaction() as conn:
             next_id = int(conn.execute(NEXT_ID).fetchone()[0])
             write = functools.partial(_write, conn, writes)
-            step, *_ = self._fuse(conn, objects, time, camera, tracker, next_id, write, writes, None)
+            step, *_ = self._fuse(conn, objects, time, camera, tracker, next_id, write, writes, None, plane)
         if self.write_log is not None:
             self.write_log.append(writes)
         return step
 
     def _integrate_behind(
-        self, objects: Sequence[FrameObject], time: float, camera: CameraModel | None, tracker: BeliefTracker
+        self,
+        objects: Sequence[FrameObject],
+        time: float,
+        camera: CameraModel | None,
+        tracker: BeliefTracker,
+        plane: Sequence[float] | None = None,
     ) -> TrackStep:
         """:meth:`integrate` with the frame's writes handed to the writer process: the candidate rows are read from
         the committed store through the overlay of the pending frames (:mod:`reasoning.beliefs.pending`)."""
@@ -573,7 +605,7 @@ class BeliefStore:
             next_id = pending.next_id if pending else int(conn.execute(NEXT_ID).fetchone()[0])
             write = functools.partial(_write_behind, conn, writes)
             step, written, loaded, moved, after = self._fuse(
-                conn, objects, time, camera, tracker, next_id, write, writes, pending if pending else None
+                conn, objects, time, camera, tracker, next_id, write, writes, pending if pending else None, plane
             )
             stored_moves = {entry[0]: entry for entry in rtree_bounds(moved)}
             rows = entries_of(written, stored_moves, loaded, _COLUMN_COUNT)
@@ -605,6 +637,7 @@ class BeliefStore:
         write: Callable[[str, list[tuple]], None],
         writes: list[tuple[str, list[tuple]]],
         pending: PendingFrames | None,
+        plane: Sequence[float] | None = None,
     ) -> tuple[TrackStep, list[tuple], dict[int, tuple], list[tuple], int]:
         """The step of one frame and its writes (through ``write``, into ``writes``), new ids from ``next_id``.
         Returns the step, the object rows written, the candidate rows by id (with their R*Tree entries), the R*Tree
@@ -641,6 +674,8 @@ class BeliefStore:
         self._prune_history([(row[0], row[20]) for row in written if row[0] in seen], write)
         # beliefs missed earlier and not seen since, wherever they are, are gone after gone_after seconds
         write(_MARK_GONE, [(time - tracker.config.gone_after,)])
+        if camera is not None:
+            write(_RECORD_VIEW, [_view_row(camera, time, plane)])
         return step, written, loaded, moved, allocated[0]
 
     def _row_update(self, tracker: BeliefTracker) -> RowUpdate:
@@ -735,7 +770,7 @@ class BeliefStore:
         """Forget every belief and its history; returns how many beliefs there were."""
         with self._transaction() as conn:
             count = int(conn.execute("SELECT COUNT(*) FROM objects").fetchone()[0])
-            for table in ("objects", "objects_place", "attribute_index", "observations", "classes"):
+            for table in ("objects", "objects_place", "attribute_index", "observations", "classes", "views"):
                 conn.execute(f"DELETE FROM {table}")
         return count
 
@@ -1108,6 +1143,30 @@ class BeliefStore:
         records.reverse()
         return records
 
+    def viewpoints(self, keys: Iterable[tuple[str, str]]) -> dict[tuple[str, str], Viewpoint]:
+        """The view a belief of each ``(recording, frame)`` asked is measured from (those never seen are left out):
+        in a camera frame, the last view of that recording and frame (its support plane); in the world frame, which
+        all recordings with a camera pose share, the last view of any recording (its camera pose and support plane,
+        the plane in that view's camera frame)."""
+        wanted = sorted(set(keys))
+        found: dict[tuple[str, str], Viewpoint] = {}
+        with self._guard() as conn:
+            for recording, frame in wanted:
+                if frame == WORLD_FRAME:
+                    row = conn.execute(
+                        "SELECT pose, plane FROM views WHERE frame = ? ORDER BY time DESC LIMIT 1", (frame,)
+                    ).fetchone()
+                else:
+                    row = conn.execute(
+                        "SELECT pose, plane FROM views WHERE recording = ? AND frame = ?", (recording, frame)
+                    ).fetchone()
+                if row is not None:
+                    found[(recording, frame)] = Viewpoint(
+                        cam_to_world=None if row[0] is None else np.frombuffer(row[0], dtype="<f8").reshape(4, 4),
+                        plane=None if row[1] is None else np.frombuffer(row[1], dtype="<f8"),
+                    )
+        return found
+
     def integrity_check(self) -> str:
         """SQLite's ``PRAGMA integrity_check`` result (``"ok"`` when sound)."""
         with self._guard() as conn:
@@ -1141,6 +1200,14 @@ def _write_behind(
     if statement == INTERN:
         conn.executemany(statement, rows)
     log.append((statement, rows))
+
+
+def _view_row(camera: CameraModel, time: float, plane: Sequence[float] | None) -> tuple:
+    """The ``views`` row of a frame seen by ``camera``: its recording and frame, the time, the camera pose (only in
+    the world frame) and the support plane, as little-endian float64."""
+    pose = np.asarray(camera.to_frame, dtype="<f8").tobytes() if camera.frame == WORLD_FRAME else None
+    packed_plane = None if plane is None else np.asarray(plane, dtype="<f8").reshape(4).tobytes()
+    return (camera.recording, camera.frame, float(time), pose, packed_plane)
 
 
 @functools.lru_cache(maxsize=64)

@@ -48,13 +48,13 @@ def covers_most_of(roi: list[int], mask: np.ndarray) -> bool:
 
 
 @pytest.mark.real_data
-@pytest.mark.parametrize("scene", ["learn17", "learn21"])
+@pytest.mark.parametrize("scene", [f"learn{n}" for n in range(17, 25)])
 def test_the_top_box_of_a_stack_is_the_upper_one_live_and_from_memory(
     capsys: pytest.CaptureFixture[str], scene: str
 ) -> None:
-    """learn17: a box lying on another; learn21: three boxes stacked. The answer is the one box whose image box
-    holds most of the upper labelled object, selected by its height above the support plane; memory (which keeps
-    no plane) answers the same box."""
+    """The eight stacked-box scenes of mOSD (learn17: a box lying on another; learn21: three boxes stacked...). The
+    answer is the one box whose image box holds most of the upper labelled object, selected by its height above the
+    support plane; memory, which keeps the frame's support plane, answers the same box by the same measure."""
     path = require_folder(SHARED_DATA / "pcl_mosd_tabletop" / "learn") / f"{scene}.pcd"
     _, mask = upper_object(path)
     live = answered(capsys, "query", "find the top box", "--input", str(path))
@@ -63,6 +63,8 @@ def test_the_top_box_of_a_stack_is_the_upper_one_live_and_from_memory(
     remembered = answered(capsys, "beliefs", "find the top box")
     assert [o["id"] for o in remembered["objects"]] == [live["objects"][0]["id"]]
     assert remembered["from_memory"] and remembered["selection"]["by"] == "top"
+    assert remembered["selection"]["basis"] == "above the support plane"
+    assert remembered["selection"]["values"] == live["selection"]["values"]
 
 
 @pytest.mark.real_data
@@ -95,7 +97,8 @@ def test_the_leftmost_and_rightmost_on_a_uoc_frame(
     capsys: pytest.CaptureFixture[str], frame: int, text: str, names: tuple[str, str]
 ) -> None:
     """Of the hand-labelled pixels (tests/data/labels/real_objects.json), the one furthest left in the image lies in
-    the answer to "find the leftmost X", the other in "find the X on the right"."""
+    the answer to "find the leftmost X", the other in "find the X on the right"; memory answers the same object by
+    the same measure."""
     folder = str(require_folder(SHARED_DATA / "uoc_tabletop_realsense"))
     pixels = labelled(frame, names)
     left, right = sorted(pixels.values())
@@ -103,6 +106,10 @@ def test_the_leftmost_and_rightmost_on_a_uoc_frame(
         live = answered(capsys, "query", phrase, "--input", folder, "--frame", str(frame))
         assert len(live["objects"]) == 1 and inside(pixel, live["objects"][0]["roi"])
         assert live["selection"]["measure"] == "camera_x"
+        remembered = answered(capsys, "beliefs", phrase)
+        assert [o["id"] for o in remembered["objects"]] == [live["objects"][0]["id"]]
+        assert remembered["selection"]["measure"] == "camera_x"
+        assert remembered["selection"]["values"] == live["selection"]["values"]
 
 
 @pytest.mark.real_data
