@@ -92,6 +92,7 @@ from annotators.geometry.support import (
     summarize_pieces,
 )
 from annotators.geometry.support_kernels import pixel_footprint
+from annotators.geometry.transparency import TransparencyRules, join_see_through
 from robokudo.core.annotator import Annotator
 from robokudo.core.capability import Capability
 from robokudo.core.types import CasType, ObjectHypothesis, Plane, PointCloud
@@ -111,6 +112,7 @@ class ClutterParameters(ClusterParameters):
     outer wall below the rim;
     ``join_slabs`` joins touching pieces of one slab (same lowest heights and tops, no depth jump between them);
     ``join_necks`` joins a piece standing on another on a narrow neck to it (one rigid body);
+    ``join_see_through`` joins the pieces of a tinted transparent object (one hue, depth holes of that hue inside);
     ``claim_floors`` gives an open container the floor seen over its rim, at table level;
     ``claim_borders`` gives the outline pixels the coarse grid
     left unlabelled and each object's foot (below ``min_height``) to the object they continue."""
@@ -141,6 +143,7 @@ class ClutterParameters(ClusterParameters):
     join_rims: bool = True
     join_slabs: bool = True
     join_necks: bool = True
+    join_see_through: bool = True
     claim_floors: bool = True
     claim_borders: bool = True
 
@@ -288,10 +291,12 @@ def segment_clutter(
         labels = join_slab_pieces(labels, grid, normals, plane_grid, slab_rules, known)
     if p.join_necks:
         labels = join_necked_pieces(labels, plane_grid, NeckRules())
+    valid = mask[::step, ::step][y0:y1, x0:x1] & np.isfinite(depth)  # measured, within the range filter's
+    if colors is not None and p.use_color and p.join_see_through:
+        labels = join_see_through(labels, valid, strided_crop(colors, step, (x0, y0, x1, y1)), TransparencyRules())
     floors = None
     if p.claim_floors:
         rules = FloorRules(min_height=p.min_height, margin=p.hull_margin, cell=p.hull_cell)
-        valid = mask[::step, ::step][y0:y1, x0:x1] & np.isfinite(depth)  # measured, within the range filter's
         labels, floors = claim_container_floors(labels, valid, plane_grid, rules)
         if touches_other_labels(labels, floors):  # the floor's pieces the noise lifted now touch their container
             labels = join_pieces(labels, grid, normals, plane_grid, support, appendages, joint)

@@ -246,9 +246,6 @@ def test_the_teal_bowl_with_a_can_standing_in_it_is_one_hypothesis_and_the_can_a
 WATER_BOTTLE = {"cap": (565, 35), "upper body": (550, 80), "middle": (560, 150), "lower body": (575, 185)}  # frame 3
 
 
-@pytest.mark.xfail(
-    reason="the clear bottle's lower half reads the table through the water: pieces at other depths", strict=True
-)
 def test_the_clear_water_bottle_is_one_hypothesis(uoc_folder: Path) -> None:
     """Below its cap and label band, up to 58 % of an image row of the bottle reads 3-7 cm behind its front
     surface (the water passes the projector's pattern), 8 % of the bottle reads the table and 14 % nothing: it
