@@ -34,12 +34,16 @@ Works like :mod:`annotators.cloud.clusters` on every ``stride``-th pixel of the 
 8. touching pieces that fill one slab - their lowest heights and tops agree, no depth jump along most of their
    shared border - join: a drill lying on its side, cut where its grip ends behind the battery's raised edge
    (:func:`annotators.geometry.slabs.join_slab_pieces`);
-9. the floor of an open container seen from above - within ``min_height`` of the plane, so no candidate - joins
+9. the pieces of a tinted transparent object - touching in the image, one saturated hue, and pixels of that hue
+   without depth inside their joint outline - join: a blue water bottle the projector's pattern passes, read in
+   pieces at the depths of its front, its water and the table
+   (:func:`annotators.geometry.transparency.join_see_through`);
+10. the floor of an open container seen from above - within ``min_height`` of the plane, so no candidate - joins
    the container whose footprint holds it, that surrounds it in the image on three sides at least and that does
    not hang over it
    (:func:`annotators.geometry.container_floors.claim_container_floors`); the floor's bits that the noise lifted
    above ``min_height`` then touch their container and join it as pieces that cannot stand by themselves;
-10. at full resolution, the outline pixels the coarse grid left unlabelled and the foot below the candidates'
+11. at full resolution, the outline pixels the coarse grid left unlabelled and the foot below the candidates'
    lowest height join the object whose surface they continue
    (:func:`annotators.geometry.border_pixels.claim_border_pixels`).
 """
