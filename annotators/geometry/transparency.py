@@ -26,6 +26,7 @@ from dataclasses import dataclass
 
 import cv2
 import numpy as np
+from scipy.ndimage import find_objects
 
 from annotators.geometry.grid_segmentation import chroma_image, join_labels
 
@@ -62,8 +63,11 @@ def tinted_neighbours(labels: np.ndarray, tints: np.ndarray, rules: Transparency
     if np.count_nonzero(tinted) < 2:
         return []
     kept = np.where(tinted[labels], labels, 0)
+    ys, xs = np.nonzero(kept)
+    kept = kept[ys.min() : ys.max() + 1, xs.min() : xs.max() + 1]  # the tinted pixels' box
     rows, cols = kept.shape
-    found: set[tuple[int, int]] = set()
+    count = tints.shape[0]
+    codes = []
     for dy in range(0, rules.reach + 1):
         for dx in range(-rules.reach, rules.reach + 1):
             if dy == 0 and dx <= 0:
@@ -71,25 +75,63 @@ def tinted_neighbours(labels: np.ndarray, tints: np.ndarray, rules: Transparency
             a = kept[: rows - dy, max(0, -dx) : cols - max(0, dx)]
             b = kept[dy:, max(0, dx) : cols - max(0, -dx)]
             touching = (a > 0) & (b > 0) & (a != b)
-            if touching.any():
-                pairs = np.unique(np.sort(np.column_stack([a[touching], b[touching]]), axis=1), axis=0)
-                found.update(map(tuple, pairs.tolist()))
-    return [(a, b) for a, b in sorted(found) if float(np.hypot(*(tints[a] - tints[b]))) <= rules.hue_distance]
+            low, high = np.minimum(a[touching], b[touching]), np.maximum(a[touching], b[touching])
+            codes.append(low.astype(np.int64) * count + high)
+    pairs = np.unique(np.concatenate(codes))
+    return [
+        (int(a), int(b))
+        for a, b in zip(pairs // count, pairs % count, strict=True)
+        if float(np.hypot(*(tints[a] - tints[b]))) <= rules.hue_distance
+    ]
+
+
+def tint_groups(pairs: list[tuple[int, int]]) -> list[list[int]]:
+    """The connected groups of labels the ``pairs`` link, each sorted."""
+    parent: dict[int, int] = {}
+
+    def root(label: int) -> int:
+        while parent.setdefault(label, label) != label:
+            label = parent[label]
+        return label
+
+    for a, b in pairs:
+        first, second = sorted((root(a), root(b)))
+        parent[second] = first
+    groups: dict[int, list[int]] = {}
+    for label in sorted(parent):
+        groups.setdefault(root(label), []).append(label)
+    return list(groups.values())
 
 
 def hole_share(
-    labels: np.ndarray, group: list[int], valid: np.ndarray, chroma: np.ndarray, rules: TransparencyRules
+    labels: np.ndarray,
+    group: list[int],
+    holes: np.ndarray,
+    chroma: np.ndarray,
+    rules: TransparencyRules,
+    box: tuple[slice, slice] | None = None,
 ) -> float:
-    """The unlabelled pixels without depth inside the convex hull of ``group``'s pixels whose chroma lies within
-    ``rules.hue_distance`` of the group's mean, as a share of the group's pixels."""
-    members = np.isin(labels, group)
+    """The ``holes`` (unlabelled pixels without depth) inside the convex hull of ``group``'s pixels whose chroma
+    lies within ``rules.hue_distance`` of the group's mean, as a share of the group's pixels; ``box`` (row and
+    column slices) holds the group's pixels when known."""
+    rows, cols = box or (slice(0, labels.shape[0]), slice(0, labels.shape[1]))
+    members = np.isin(labels[rows, cols], group)
     ys, xs = np.nonzero(members)
-    hull = np.zeros(labels.shape, dtype=np.uint8)
+    hull = np.zeros(members.shape, dtype=np.uint8)
     cv2.fillConvexPoly(hull, cv2.convexHull(np.column_stack([xs, ys]).astype(np.int32)), 1)
-    tint = chroma[members].mean(axis=0)
-    holes = (hull > 0) & ~valid & (labels == 0)
-    distance = np.hypot(*(chroma[holes] - tint).T)
+    window = chroma[rows, cols]
+    inside = (hull > 0) & holes[rows, cols]
+    distance = np.hypot(*(window[inside] - window[members].mean(axis=0)).T)
     return float(np.count_nonzero(distance <= rules.hue_distance)) / float(ys.size)
+
+
+def group_box(boxes: list[tuple[slice, slice] | None], group: list[int]) -> tuple[slice, slice]:
+    """The row and column slices holding every label of ``group`` (``boxes[label - 1]``: each label's box)."""
+    parts = [boxes[label - 1] for label in group if boxes[label - 1] is not None]
+    return (
+        slice(min(part[0].start for part in parts), max(part[0].stop for part in parts)),
+        slice(min(part[1].start for part in parts), max(part[1].stop for part in parts)),
+    )
 
 
 def see_through_groups(
@@ -105,12 +147,18 @@ def see_through_groups(
     pairs = tinted_neighbours(labels, tints, rules)
     if not pairs:
         return []
-    # each label's group (a 1 x (n + 1) row of the labels 0..n, joined; 0 stays 0)
-    grouped = join_labels(np.arange(int(labels.max()) + 1, dtype=np.int32)[None, :], pairs)[0]
-    groups: dict[int, list[int]] = {}
-    for label in np.unique(np.asarray(pairs)).tolist():
-        groups.setdefault(int(grouped[label]), []).append(label)
-    return [group for group in groups.values() if hole_share(labels, group, valid, chroma, rules) >= rules.hole_share]
+    holes = ~valid & (labels == 0)
+    sizes = np.bincount(labels.reshape(-1), minlength=tints.shape[0])
+    boxes = find_objects(labels)
+    found = []
+    for group in tint_groups(pairs):
+        box = group_box(boxes, group)
+        # a group with too few holes in its whole box cannot have enough of its tint inside its hull
+        if np.count_nonzero(holes[box]) < rules.hole_share * sizes[group].sum():
+            continue
+        if hole_share(labels, group, holes, chroma, rules, box) >= rules.hole_share:
+            found.append(group)
+    return found
 
 
 def join_see_through(
