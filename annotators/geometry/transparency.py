@@ -46,7 +46,7 @@ class TransparencyRules:
 
 
 def label_chroma(labels: np.ndarray, chroma: np.ndarray) -> np.ndarray:
-    """(n + 1)x2 mean chroma of each label 0..n (label 0 and empty labels: 0)."""
+    """(n + 1)x2 mean chroma of each label 0..n (row 0: the unlabelled pixels'; an empty label's: 0)."""
     count = int(labels.max()) + 1
     flat = labels.reshape(-1)
     sizes = np.maximum(np.bincount(flat, minlength=count), 1)
