@@ -34,12 +34,16 @@ Works like :mod:`annotators.cloud.clusters` on every ``stride``-th pixel of the 
 8. touching pieces that fill one slab - their lowest heights and tops agree, no depth jump along most of their
    shared border - join: a drill lying on its side, cut where its grip ends behind the battery's raised edge
    (:func:`annotators.geometry.slabs.join_slab_pieces`);
-9. the floor of an open container seen from above - within ``min_height`` of the plane, so no candidate - joins
+9. the pieces of a tinted transparent object - touching in the image, one saturated hue, and pixels of that hue
+   without depth inside their joint outline - join: a blue water bottle the projector's pattern passes, read in
+   pieces at the depths of its front, its water and the table
+   (:func:`annotators.geometry.transparency.join_see_through`);
+10. the floor of an open container seen from above - within ``min_height`` of the plane, so no candidate - joins
    the container whose footprint holds it, that surrounds it in the image on three sides at least and that does
    not hang over it
    (:func:`annotators.geometry.container_floors.claim_container_floors`); the floor's bits that the noise lifted
    above ``min_height`` then touch their container and join it as pieces that cannot stand by themselves;
-10. at full resolution, the outline pixels the coarse grid left unlabelled and the foot below the candidates'
+11. at full resolution, the outline pixels the coarse grid left unlabelled and the foot below the candidates'
    lowest height join the object whose surface they continue
    (:func:`annotators.geometry.border_pixels.claim_border_pixels`).
 """
@@ -92,6 +96,7 @@ from annotators.geometry.support import (
     summarize_pieces,
 )
 from annotators.geometry.support_kernels import pixel_footprint
+from annotators.geometry.transparency import TransparencyRules, join_see_through
 from robokudo.core.annotator import Annotator
 from robokudo.core.capability import Capability
 from robokudo.core.types import CasType, ObjectHypothesis, Plane, PointCloud
@@ -111,6 +116,7 @@ class ClutterParameters(ClusterParameters):
     outer wall below the rim;
     ``join_slabs`` joins touching pieces of one slab (same lowest heights and tops, no depth jump between them);
     ``join_necks`` joins a piece standing on another on a narrow neck to it (one rigid body);
+    ``join_see_through`` joins the pieces of a tinted transparent object (one hue, depth holes of that hue inside);
     ``claim_floors`` gives an open container the floor seen over its rim, at table level;
     ``claim_borders`` gives the outline pixels the coarse grid
     left unlabelled and each object's foot (below ``min_height``) to the object they continue."""
@@ -141,6 +147,7 @@ class ClutterParameters(ClusterParameters):
     join_rims: bool = True
     join_slabs: bool = True
     join_necks: bool = True
+    join_see_through: bool = True
     claim_floors: bool = True
     claim_borders: bool = True
 
@@ -288,10 +295,12 @@ def segment_clutter(
         labels = join_slab_pieces(labels, grid, normals, plane_grid, slab_rules, known)
     if p.join_necks:
         labels = join_necked_pieces(labels, plane_grid, NeckRules())
+    valid = mask[::step, ::step][y0:y1, x0:x1] & np.isfinite(depth)  # measured, within the range filter's
+    if colors is not None and p.use_color and p.join_see_through:
+        labels = join_see_through(labels, valid, strided_crop(colors, step, (x0, y0, x1, y1)), TransparencyRules())
     floors = None
     if p.claim_floors:
         rules = FloorRules(min_height=p.min_height, margin=p.hull_margin, cell=p.hull_cell)
-        valid = mask[::step, ::step][y0:y1, x0:x1] & np.isfinite(depth)  # measured, within the range filter's
         labels, floors = claim_container_floors(labels, valid, plane_grid, rules)
         if touches_other_labels(labels, floors):  # the floor's pieces the noise lifted now touch their container
             labels = join_pieces(labels, grid, normals, plane_grid, support, appendages, joint)
