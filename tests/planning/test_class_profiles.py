@@ -92,6 +92,12 @@ def test_without_a_handle_seen_the_query_cannot_make_a_cup_a_mug(profiles: dict[
     assert order.index("HandlelessCup") < order.index("Cup") < order.index("Mug")
     matches = [score(p, cues) for p in profiles.values()]
     assert decide(matches, expected="Mug").class_name != "Mug"
+    assert decide(matches, expected="Cup").class_name == "Cup"  # a cup; that it has no handle is not sure
+
+
+def test_find_a_cup_names_a_mug_seen_with_its_handle_a_mug(profiles: dict[str, Profile]) -> None:
+    cues = Cues(**SMALL_CYLINDER, handle=(True, 1.0), open_top=(True, 1.0), height_to_width=1.2)
+    assert decide([score(p, cues) for p in profiles.values()], expected="Cup").class_name == "Mug"
 
 
 def test_a_closed_cylinder_is_no_cup_and_a_squat_open_one_is_a_bowl(profiles: dict[str, Profile]) -> None:
