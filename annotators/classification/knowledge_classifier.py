@@ -73,8 +73,9 @@ make out ties with a cup, but its handle seen would make it a mug, so "find a cu
 bowl, flaring like a handle, a mug for "find all mugs" (surely without a handle it would be a cup). The query says
 which class, not which kind of it: when it decides for a subclass of its class that the cues do not tell from another
 kind of that class (:func:`kind_settled`: a mug whose handle is not seen ties a cup without a handle), the query's
-class itself is asserted ("cup"), with the probability that the object answers to it as a whole; a handle seen
-settles it (every kind without one is contradicted): a mug seen with its handle is a mug.
+class itself is asserted ("cup") when its own profile fits, with the probability that the object answers to it as a
+whole; a handle seen settles it (every kind without one is contradicted): a mug seen with its handle is a mug. A
+query's class without a profile of its own ("container") is no class the cues could name, and is not asserted.
 Otherwise the most specific class above the best one (with or without a profile of its own) that, taken as a
 whole, fits and reaches :data:`ASSERT_PROBABILITY` is asserted: its score is the best of its own and its
 subclasses' profiles, its lead that over the best profile outside it (cues that cannot tell a white ceramic bowl
@@ -672,10 +673,11 @@ def decide(
     pick = choose_expected(matches, expected, min_score, margin) if expected else None
     if pick is not None and holds_up(pick, matches, cues, min_score, margin):
         wanted = expected.lower() if expected else ""
-        if not kind_settled(pick, matches, wanted, cues, min_score, calibration, assert_probability):
+        own = [m for m in matches if m.profile.class_name.lower() == wanted and m.score >= min_score]
+        if own and not kind_settled(pick, matches, wanted, cues, min_score, calibration, assert_probability):
             answers = calibration.probability(*answering_evidence(wanted, matches, cues))
             return Decision(
-                expected or "",
+                own[0].profile.class_name,
                 answers,
                 best,
                 best_lead,
