@@ -1,14 +1,14 @@
 """Mugs and cups on real RealSense frames, classified by their form (issue 15, item 6).
 
 A mug is told from a cup, a bowl and a can by its features (a handle, an open top, its height over width), not by the
-query's class: the blue mug is ranked Mug by the classifier before any query names a class, the handle-less purple
-cup is not made a mug by "find the mug", "find the green mug" answers nothing on a table without one, the white
-mugs are seen open and a closed can is not made a cup by "find a cup". A cup may have a handle (rk:Mug) or not
-(rk:HandlelessCup), both below rk:Cup, which says nothing about a handle: "find a cup" answers mugs too, named mugs,
-and the purple cup, named a cup (that it has no handle is not seen for sure: a mug's may be behind it). Nor does the query decide what an unsettled form cue may still
-tell: half a bowl, or a can with a stray handle seen closed though not surely, is no mug for "find all mugs". The
-queries run through ``robokudo query`` on the frames in ../shared/data, read in place. Pixels are read off the
-colour images (tests/data/labels/real_objects.json labels the same objects).
+query's class: the blue mug is ranked Mug by the classifier before any query names a class, the handle-less purple cup
+is not made a mug by "find the mug", "find the green mug" answers nothing on a table without one, the white mugs are
+seen open and a closed can is not made a cup by "find a cup". A cup may have a handle (rk:Mug) or not
+(rk:HandlelessCup), both below rk:Cup, which says nothing about a handle: "find a cup" answers mugs too, named mugs, and
+the purple cup, named a cup (that it has no handle is not seen for sure: a mug's may be behind it). Nor does the query
+decide what an unsettled form cue may still tell: half a bowl, or a can with a stray handle seen closed though not
+surely, is no mug for "find all mugs". The queries run through ``robokudo query`` on the frames in ../shared/data, read
+in place. Pixels are read off the colour images (tests/data/labels/real_objects.json labels the same objects).
 """
 
 from __future__ import annotations
