@@ -70,7 +70,12 @@ mug seen surely closed is no mug, whatever else ties with it - nor may its propo
 class (within ``margin``) however the unsettled ones turn out (:func:`cue_outcomes`): the open top as the form expert
 said it, and the handle either way, as a view hides or shows it by chance. A mug whose handle the form expert could not
 make out ties with a cup, but its handle seen would make it a mug, so "find a cup" does not answer it; nor is half a
-bowl, flaring like a handle, a mug for "find all mugs" (surely without a handle it would be a cup).
+bowl, flaring like a handle, a mug for "find all mugs" (surely without a handle it would be a cup). The query says
+which class, not which kind of it: when it decides for a subclass of its class that the cues do not tell from another
+kind of that class (:func:`kind_settled`: a mug whose handle is not seen ties a cup without a handle), the query's
+class itself is asserted ("cup") when its own profile fits, with the probability that the object answers to it as a
+whole; a handle seen settles it (every kind without one is contradicted): a mug seen with its handle is a mug. A
+query's class without a profile of its own ("container") is no class the cues could name, and is not asserted.
 Otherwise the most specific class above the best one (with or without a profile of its own) that, taken as a
 whole, fits and reaches :data:`ASSERT_PROBABILITY` is asserted: its score is the best of its own and its
 subclasses' profiles, its lead that over the best profile outside it (cues that cannot tell a white ceramic bowl
@@ -590,6 +595,37 @@ def holds_up(pick: Match, matches: Sequence[Match], cues: Cues | None, min_score
     return True
 
 
+def kind_settled(
+    pick: Match,
+    matches: Sequence[Match],
+    wanted: str,
+    cues: Cues | None,
+    min_score: float,
+    calibration: Calibration,
+    assert_probability: float,
+) -> bool:
+    """True unless ``pick`` is a proper subclass of the query's class ``wanted`` (lower case) that the cues do not
+    tell from another of its kinds: a fitting match below ``wanted``, unrelated to ``pick`` and not contradicted by a
+    settled form cue (:func:`contradicted`), scores so close that ``pick`` is right with less than
+    ``assert_probability``. The query says which class, not which kind of it: a mug whose handle is not seen ties
+    a cup without a handle, and for "find a cup" it is a cup, not a cup without a handle; a handle seen contradicts
+    every kind without one, so a mug seen with its handle is a mug."""
+    if wanted not in pick.profile.ancestors or pick.profile.class_name.lower() == wanted:
+        return True
+    kinds = [
+        m.score
+        for m in matches
+        if wanted in m.profile.ancestors
+        and m.profile.class_name.lower() != wanted
+        and not m.profile.related(pick.profile)
+        and m.score >= min_score
+        and not (cues is not None and contradicted(m.profile, cues))
+    ]
+    if not kinds:
+        return True
+    return calibration.probability(pick.score, pick.score - max(kinds), pick.unread) >= assert_probability
+
+
 @dataclass(frozen=True)
 class Decision:
     """What the classifier says about one hypothesis and why.
@@ -636,6 +672,19 @@ def decide(
         return Decision(name, p, best, best_lead, p, f"fits {name} (score {best.score:.2f}, lead {best_lead:.2f})")
     pick = choose_expected(matches, expected, min_score, margin) if expected else None
     if pick is not None and holds_up(pick, matches, cues, min_score, margin):
+        wanted = expected.lower() if expected else ""
+        own = [m for m in matches if m.profile.class_name.lower() == wanted and m.score >= min_score]
+        if own and not kind_settled(pick, matches, wanted, cues, min_score, calibration, assert_probability):
+            answers = calibration.probability(*answering_evidence(wanted, matches, cues))
+            return Decision(
+                own[0].profile.class_name,
+                answers,
+                best,
+                best_lead,
+                p,
+                f"{pick.profile.class_name} fits (score {pick.score:.2f}) as well as any other class, but the cues do "
+                f"not tell it from other kinds of {expected}: the query's class decides for {expected}",
+            )
         pick_lead = lead(pick, matches, cues)
         pick_p = calibration.probability(pick.score, pick_lead, pick.unread)
         answering = None

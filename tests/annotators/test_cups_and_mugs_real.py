@@ -1,13 +1,14 @@
 """Mugs and cups on real RealSense frames, classified by their form (issue 15, item 6).
 
 A mug is told from a cup, a bowl and a can by its features (a handle, an open top, its height over width), not by the
-query's class: the blue mug is ranked Mug by the classifier before any query names a class, the handle-less purple
-cup is not made a mug by "find the mug", "find the green mug" answers nothing on a table without one, the white
-mugs are seen open and a closed can is not made a cup by "find a cup". Nor does the query decide what an unsettled
-form cue may still tell: a mug whose handle the form expert cannot make out is no cup for "find a cup"; half a bowl,
-or a can with a stray handle seen closed though not surely, is no mug for "find all mugs". The
-queries run through ``robokudo query`` on the frames in ../shared/data, read in place. Pixels are read off the
-colour images (tests/data/labels/real_objects.json labels the same objects).
+query's class: the blue mug is ranked Mug by the classifier before any query names a class, the handle-less purple cup
+is not made a mug by "find the mug", "find the green mug" answers nothing on a table without one, the white mugs are
+seen open and a closed can is not made a cup by "find a cup". A cup may have a handle (rk:Mug) or not
+(rk:HandlelessCup), both below rk:Cup, which says nothing about a handle: "find a cup" answers mugs too, named mugs, and
+the purple cup, named a cup (that it has no handle is not seen for sure: a mug's may be behind it). Nor does the query
+decide what an unsettled form cue may still tell: half a bowl, or a can with a stray handle seen closed though not
+surely, is no mug for "find all mugs". The queries run through ``robokudo query`` on the frames in ../shared/data, read
+in place. Pixels are read off the colour images (tests/data/labels/real_objects.json labels the same objects).
 """
 
 from __future__ import annotations
@@ -32,7 +33,7 @@ the table (1.03 m; the far rim 0.86 m). A handle was seen there only while the s
 its outside: the outside alone, tapered, stuck out of the circle fitted at its foot on its right (pixels x 229-250,
 y 228-241, heights 8-9 cm). Whether a mug whose handle is hidden is a mug is the classifier's question."""
 TOUCHING_MUG = (480, 135)
-"""The blue mug in frame 2: its handle touches the drill and the form expert cannot make out whether it has one."""
+"""The blue mug in frame 2: its handle touches the drill."""
 WHITE_MUG = {0: (300, 255), 1: (325, 275)}
 """The white mug in frames 0 and 1 (white, glossy inside: the depth camera sees its inside smoothed but deep)."""
 CANS = {
@@ -121,6 +122,18 @@ def test_a_cup_without_a_handle_is_a_cup_and_not_a_mug(
 
 
 @pytest.mark.real_data
+def test_find_all_cups_answers_both_mugs_and_names_the_one_whose_handle_is_hidden_a_cup(
+    uoc_folder: Path, store: Path, capsys: pytest.CaptureFixture
+) -> None:
+    """Frame 0: the white mug shows its handle, the blue one hides it behind its body. Both are cups; the white one is
+    named a mug, the blue one a cup - not a cup without a handle, which its hidden handle does not make it."""
+    objects = ask(capsys, store, "find all cups", uoc_folder, 0)
+    assert [o["class"]["label"] for o in covering(objects, WHITE_MUG[0])] == ["mug"], objects
+    assert [o["class"]["label"] for o in covering(objects, (205, 195))] == ["cup"], objects
+    assert len(objects) == 2, objects
+
+
+@pytest.mark.real_data
 @pytest.mark.parametrize("frame", [0, 3])
 def test_find_the_green_mug_answers_nothing_on_a_table_without_one(
     uoc_folder: Path, store: Path, capsys: pytest.CaptureFixture, frame: int
@@ -157,18 +170,20 @@ def test_the_spam_can_is_closed_and_scored_a_can_before_a_cup(uoc_folder: Path, 
 @pytest.mark.parametrize("frame", [1, 3])
 def test_find_a_cup_answers_no_can(uoc_folder: Path, store: Path, capsys: pytest.CaptureFixture, frame: int) -> None:
     objects = ask(capsys, store, "find a cup", uoc_folder, frame)
-    assert all(o["class"]["label"] == "cup" for o in objects), objects
+    assert all(o["class"]["label"] in ("cup", "mug", "cup without a handle") for o in objects), objects
     for name, pixel in CANS[frame].items():
         assert not covering(objects, pixel), name
 
 
 @pytest.mark.real_data
-def test_find_a_cup_answers_no_mug_whose_handle_is_not_made_out(
+def test_find_a_cup_answers_the_mug_and_says_it_is_a_mug(
     uoc_folder: Path, store: Path, capsys: pytest.CaptureFixture
 ) -> None:
+    """A mug is a cup (while Mug and Cup were disjoint, "find a cup" left it out); the answer says it is a mug, not a
+    cup without a handle."""
     objects = ask(capsys, store, "find a cup", uoc_folder, 2)
-    assert all(o["class"]["label"] == "cup" for o in objects), objects
-    assert not covering(objects, TOUCHING_MUG), objects
+    assert [o["class"]["label"] for o in covering(objects, TOUCHING_MUG)] == ["mug"], objects
+    assert all(o["class"]["label"] in ("cup", "mug") for o in objects), objects
 
 
 @pytest.mark.real_data
