@@ -179,23 +179,41 @@ class RowUpdate:
     ) -> None:
         """``ValueSupport.add`` of each of the observation's statements at ``time`` into the single-valued supports
         ``by_name`` (a new attribute's support appended to ``records``)."""
-        logits = self._logits()
+        logits = self.logits
+        if len(logits) > LOGIT_CACHE_LIMIT:
+            logits.clear()
         for e in observation.evidence:
-            r = _support_at(by_name, records, e.attribute, e.value, time)
-            log_odds = logits.get(e.confidence)
+            r = by_name.get(e.attribute)
+            if r is None:
+                r = by_name[e.attribute] = [None, None, 0.0, 0, None, 0.0, 0.0, e.attribute, e.value, ()]
+                records.append(r)
+            if r[3] == 0 or time < r[5]:
+                r[5] = time
+            confidence = e.confidence
+            log_odds = logits.get(confidence)
             if log_odds is None:
-                log_odds = logits[e.confidence] = logit(e.confidence)
+                log_odds = logits[confidence] = logit(confidence)
             total = r[2] + log_odds
             total = -MAX_LOG_ODDS if total < -MAX_LOG_ODDS else total
             r[2] = MAX_LOG_ODDS if total > MAX_LOG_ODDS else total
-            _credit(r, (e.source,), time)
+            r[3] += 1
+            if e.source not in r[_SUPPORT_EXPERTS]:
+                r[_SUPPORT_EXPERTS] = (*r[_SUPPORT_EXPERTS], e.source)
+                r[4] = None
+            if r[6] < time:
+                r[6] = time
 
     def _repeat(
         self, by_name: dict[str, Support], records: list[Support], observation: FrameObject, time: float
     ) -> None:
         """``ValueSupport.repeat`` of the observation's statements (summed per attribute: one value each here) at
-        ``time`` into the single-valued supports ``by_name``: a view that repeats the belief's last one."""
-        logits = self._logits()
+        ``time`` into the single-valued supports ``by_name``: a view that repeats the belief's last one.
+
+        Written out like :meth:`_accumulate` (the support lookup and the experts' credit repeat there): sharing them
+        through two helper functions cost 4-12% of the whole write path in ``bench_beliefs`` (A/B, 2026-11-28)."""
+        logits = self.logits
+        if len(logits) > LOGIT_CACHE_LIMIT:
+            logits.clear()
         said: dict[str, list] = {}
         for e in observation.evidence:
             log_odds = logits.get(e.confidence)
@@ -208,18 +226,23 @@ class RowUpdate:
                 held[0] += log_odds
                 held[1].append(e.source)
         for name, (log_odds, sources, value) in said.items():
-            r = _support_at(by_name, records, name, value, time)
+            r = by_name.get(name)
+            if r is None:
+                r = by_name[name] = [None, None, 0.0, 0, None, 0.0, 0.0, name, value, ()]
+                records.append(r)
+            if r[3] == 0 or time < r[5]:
+                r[5] = time
             bounded = (
                 -MAX_LOG_ODDS if log_odds < -MAX_LOG_ODDS else MAX_LOG_ODDS if log_odds > MAX_LOG_ODDS else log_odds
             )
             r[2] = repeated_log_odds(r[2], bounded)
-            _credit(r, sources, time)
-
-    def _logits(self) -> dict[float, float]:
-        """The cache of ``logit`` of the confidences met, emptied first when it has grown too large."""
-        if len(self.logits) > LOGIT_CACHE_LIMIT:
-            self.logits.clear()
-        return self.logits
+            r[3] += len(sources)
+            for source in sources:
+                if source not in r[_SUPPORT_EXPERTS]:
+                    r[_SUPPORT_EXPERTS] = (*r[_SUPPORT_EXPERTS], source)
+                    r[4] = None
+            if r[6] < time:
+                r[6] = time
 
     def create(self, observation: FrameObject, time: float, belief_id: int) -> tuple[tuple, list[Support]] | None:
         """The ``objects`` row and supports of the belief ``BeliefTracker.create`` makes of ``observation`` (id
@@ -292,30 +315,6 @@ class RowUpdate:
             rounded = rounded_cached(log_odds, 9) if log_odds else round(log_odds, 9)
             flat += (name_code, value_code, rounded, count, experts, first_seen, last_seen)
         return (*row[:26], supports_packing(len(records)).pack(*flat), row[27])
-
-
-def _support_at(by_name: dict[str, Support], records: list[Support], name: str, value: str, time: float) -> Support:
-    """The support of attribute ``name`` (made for ``value`` and appended to ``records`` when the belief has none),
-    its first sighting moved to ``time`` when that is earlier: what ``ValueSupport.add`` and ``repeat`` do first."""
-    r = by_name.get(name)
-    if r is None:
-        r = by_name[name] = [None, None, 0.0, 0, None, 0.0, 0.0, name, value, ()]
-        records.append(r)
-    if r[3] == 0 or time < r[5]:
-        r[5] = time
-    return r
-
-
-def _credit(r: Support, sources: Sequence[str], time: float) -> None:
-    """Count the statements of ``sources`` in support ``r`` (its expert set re-interned when it grows) and move its
-    last sighting to ``time`` when that is later: what ``ValueSupport.add`` and ``repeat`` do last."""
-    r[3] += len(sources)
-    for source in sources:
-        if source not in r[_SUPPORT_EXPERTS]:
-            r[_SUPPORT_EXPERTS] = (*r[_SUPPORT_EXPERTS], source)
-            r[4] = None
-    if r[6] < time:
-        r[6] = time
 
 
 def _class_region_entries(records: Sequence[Support]) -> tuple[str | None, str | None, list[str]]:
