@@ -28,6 +28,7 @@ import cv2
 import numpy as np
 from scipy.ndimage import find_objects
 
+from annotators.geometry.grid_kernels import graph_components
 from annotators.geometry.grid_segmentation import chroma_image, join_labels
 
 
@@ -85,21 +86,13 @@ def tinted_neighbours(labels: np.ndarray, tints: np.ndarray, rules: Transparency
     ]
 
 
-def tint_groups(pairs: list[tuple[int, int]]) -> list[list[int]]:
-    """The connected groups of labels the ``pairs`` link, each sorted."""
-    parent: dict[int, int] = {}
-
-    def root(label: int) -> int:
-        while parent.setdefault(label, label) != label:
-            label = parent[label]
-        return label
-
-    for a, b in pairs:
-        first, second = sorted((root(a), root(b)))
-        parent[second] = first
+def tint_groups(pairs: list[tuple[int, int]], count: int) -> list[list[int]]:
+    """The connected groups of labels (below ``count``) the ``pairs`` link, each sorted, in order of smallest label."""
+    components = graph_components(np.asarray(pairs, dtype=np.int64), count)
+    linked = np.unique(np.asarray(pairs, dtype=np.int64))
     groups: dict[int, list[int]] = {}
-    for label in sorted(parent):
-        groups.setdefault(root(label), []).append(label)
+    for label in linked.tolist():
+        groups.setdefault(int(components[label]), []).append(label)
     return list(groups.values())
 
 
@@ -151,7 +144,7 @@ def see_through_groups(
     sizes = np.bincount(labels.reshape(-1), minlength=tints.shape[0])
     boxes = find_objects(labels)
     found = []
-    for group in tint_groups(pairs):
+    for group in tint_groups(pairs, tints.shape[0]):
         box = group_box(boxes, group)
         # a group with too few holes in its whole box cannot have enough of its tint inside its hull
         if np.count_nonzero(holes[box]) < rules.hole_share * sizes[group].sum():
