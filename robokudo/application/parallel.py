@@ -97,12 +97,23 @@ def _in_order(ray: Any, task: Any, items: Sequence[T], shared: list[Any], in_fli
                     break
                 done, _ = ray.wait(list(running), num_returns=1)
                 for reference in done:
-                    results[running.pop(reference)] = _result(ray, reference)
+                    index = running.pop(reference)  # before the result, which may raise: an ended task is not cancelled
+                    results[index] = _result(ray, reference)
                     bar.update()
         finally:
-            for reference in running:
-                ray.cancel(reference)
+            _cancel_unfinished(ray, list(running))
     return results
+
+
+def _cancel_unfinished(ray: Any, references: list[Any]) -> None:
+    """Cancel the tasks of ``references`` that have not ended. Ray 2.60 aborts this process ("Tried to complete
+    task that was not pending") when a task is cancelled while its end is being recorded, so a task that has
+    ended already is left alone."""
+    if not references:
+        return
+    _, unfinished = ray.wait(references, num_returns=len(references), timeout=0)
+    for reference in unfinished:
+        ray.cancel(reference)
 
 
 def _result(ray: Any, reference: Any) -> Any:

@@ -16,6 +16,7 @@ import json
 import logging
 import os
 import signal
+import subprocess
 import sys
 import threading
 import time
@@ -57,6 +58,8 @@ from robokudo.core.remote import (
 from robokudo.core.types import CasType, ColorImage, DepthImage, ObjectHypothesis, Pose, SemanticColor, Text
 from tests.annotators.conftest import SHARED_DATA, require_folder
 from trees import tabletop
+
+REPOSITORY = Path(__file__).resolve().parents[2]
 
 DEADLINE = 60.0
 """Seconds a run may take on a loaded machine before the test gives up."""
@@ -419,6 +422,45 @@ def test_an_error_in_a_task_is_reported_as_in_one_process(
     capsys.readouterr()
     assert cli.main(["eval", "segmentation", str(unlabelled), "--workers", "2"]) == 2
     assert capsys.readouterr().err == f"robokudo eval: {unlabelled} has no label field to score against\n"
+
+
+FAILING_AMONG_RUNNING = """
+import logging, random, sys, time
+import ray
+from robokudo.application.parallel import map_on_cluster
+
+def work(item, failing):
+    time.sleep(random.random() * 0.02)
+    if item == failing:
+        raise ValueError(item)
+    return item
+
+ray.init(num_cpus=2, include_dashboard=False, log_to_driver=False, logging_level=logging.ERROR)
+failures = 0
+for run in range(int(sys.argv[1])):
+    try:
+        map_on_cluster(work, list(range(8)), run % 4, workers=2)
+    except ValueError:
+        failures += 1
+print("failures", failures)
+"""
+
+
+def test_many_evals_whose_task_fails_among_running_ones_leave_the_process_alive() -> None:
+    """A task's exception ends the map and the tasks still running are cancelled. Cancelling one that had ended
+    already made Ray 2.60 abort the whole process (exit 1, nothing printed: a test run just stopped), within a few
+    dozen such maps; so this runs in its own process."""
+    require_ray()
+    runs = 60
+    ended = subprocess.run(
+        [sys.executable, "-c", FAILING_AMONG_RUNNING, str(runs)],
+        cwd=REPOSITORY,
+        env={**os.environ, "PYTHONPATH": str(REPOSITORY)},
+        capture_output=True,
+        text=True,
+        timeout=600,
+    )
+    assert (ended.returncode, ended.stdout) == (0, f"failures {runs}\n"), ended.stderr[-2000:]
 
 
 # ------------------------------------------------------------------------------------------ without a cluster
