@@ -23,7 +23,7 @@ when read, Text) a profile gets an agreement in [0, 1]:
   extent 1 when equal, 0.25 when one class apart, 0 when two apart; 0.5 when the profile says nothing;
 * handle: 1 when both say there is one, 0 when one is seen on a class without, ``HANDLE_HIDDEN`` when none is
   seen on a class with one (it may be behind), ``NO_HANDLE`` when neither has one, 0.5 when the profile says
-  nothing;
+  nothing - but with none seen, a class whose kinds say (a bottle: plain, or a jug) agrees as its best kind;
 * open top: 1 when equal, 0 when not, 0.5 when the profile says nothing;
 * height over width: 1 inside the profile's range, falling to 0 at ``RATIO_FALLOFF`` times beyond a bound;
 * elongation (the longest extent the size expert measured over the second longest): as the height over width,
@@ -178,6 +178,13 @@ def _flag(data: Mapping[str, object], key: str) -> bool | None:
     return value
 
 
+def _flags(data: Mapping[str, object], key: str) -> frozenset[bool]:
+    values = data.get(key) or ()
+    if not isinstance(values, (list, tuple)) or not all(isinstance(value, bool) for value in values):
+        raise ValueError(f"a profile's {key!r} must be a list of true and false, got {values!r}")
+    return frozenset(values)
+
+
 def _ratio_range(value: object) -> tuple[float, float] | None:
     if value is None:
         return None
@@ -217,6 +224,9 @@ class Profile:
     brand: str | None = None
     kind_texts: frozenset[str] = frozenset()
     """The texts (of :attr:`texts`) the class inherits from its ancestors: read when its brand is read."""
+    kind_handles: frozenset[bool] = frozenset()
+    """For a class that does not say whether it has a handle (:attr:`handle` None): what its kinds say (a bottle
+    with none in view agrees as a plain bottle does)."""
 
     @property
     def named_by_text(self) -> bool:
@@ -255,6 +265,7 @@ class Profile:
             packaged_in=frozenset(_names(data.get("packaged_in"))),
             brand=brands[0] if brands else None,
             kind_texts=frozenset(_names(data.get("kind_texts"))) & frozenset(texts),
+            kind_handles=_flags(data, "kind_handles"),
         )
 
     def related(self, other: Profile) -> bool:
@@ -318,9 +329,13 @@ def _extent_agreement(extent: float, listed: str | None) -> float | None:
     return float(max(0.0, 1.0 - beyond / np.log(SIZE_FALLOFF)))
 
 
-def _handle_agreement(seen: bool, listed: bool | None) -> float:
+def _handle_agreement(seen: bool, listed: bool | None, kinds: frozenset[bool] = frozenset()) -> float:
+    """How a class's handle agrees with one seen or not. A class that does not say agrees halfway, unless none was
+    seen and its kinds say (a bottle with none in view agrees as a plain bottle does, a jug's handle may be behind);
+    a handle seen is what tells its kinds with one apart (a mug from a cup), so for the class that does not say it
+    stays halfway."""
     if listed is None:
-        return 0.5
+        return 0.5 if seen or not kinds else max(_handle_agreement(False, kind) for kind in kinds)
     if seen:
         return 1.0 if listed else 0.0
     return HANDLE_HIDDEN if listed else NO_HANDLE
@@ -352,7 +367,7 @@ def score(profile: Profile, cues: Cues) -> Match:
         total += WEIGHTS["size"] * _toward_neutral(agreement, cues.size[1])
         weight += WEIGHTS["size"]
     if cues.handle is not None:
-        agreement = _handle_agreement(cues.handle[0], profile.handle)
+        agreement = _handle_agreement(cues.handle[0], profile.handle, profile.kind_handles)
         total += WEIGHTS["handle"] * _toward_neutral(agreement, cues.handle[1])
         weight += WEIGHTS["handle"]
     if cues.open_top is not None:

@@ -34,7 +34,7 @@ SLOW_TRIGGER = (
     "(SELECT 1 UNION ALL SELECT x + 1 FROM c WHERE x < 400) SELECT x FROM c); END"
 )
 """Work in every sighting's insert (the digest hashes the tables, not the schema, so it does not change it)."""
-TABLES = ("objects", "objects_place", "attribute_index", "observations", "classes", "interned", "meta")
+TABLES = ("objects", "objects_place", "attribute_index", "observations", "classes", "interned", "meta", "views")
 
 
 def belief_text(b: ObjectBelief) -> str:

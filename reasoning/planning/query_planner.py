@@ -45,7 +45,8 @@ def class_profiles(kb: KnowledgeBase) -> tuple[dict[str, object], ...]:
     The ancestors come the most specific first (a classifier names the nearest one the cues leave no doubt about);
     ``packaged_in`` is the container class the objects are typically packaged in with its ancestors (what a query
     for that container also asks for), or (); ``brand`` the product's brand, ``kind_texts`` the printed texts it
-    inherits from its ancestors (what kind of product it is: reading the brand says that too).
+    inherits from its ancestors (what kind of product it is: reading the brand says that too); ``kind_handles``,
+    for a class that does not say whether it has a handle, what its kinds say (:func:`kind_handles`).
     """
     profiles = []
     for name in kb.names_of_kind("class"):
@@ -70,6 +71,7 @@ def class_profiles(kb: KnowledgeBase) -> tuple[dict[str, object], ...]:
                 "brand": profile.brand,
                 "kind_texts": tuple(t for t in profile.texts if t in inherited),
                 "handle": profile.handle,
+                "kind_handles": kind_handles(kb, name) if profile.handle is None else (),
                 "open_top": profile.open_top,
                 "printed": profile.printed,
                 "height_to_width": profile.height_to_width,
@@ -81,6 +83,14 @@ def class_profiles(kb: KnowledgeBase) -> tuple[dict[str, object], ...]:
             }
         )
     return tuple(profiles)
+
+
+def kind_handles(kb: KnowledgeBase, name: str) -> tuple[bool, ...]:
+    """Whether the kinds of class ``name`` have a handle, each value its subclasses state once (False first): a
+    bottle is a plain bottle or a jug, so it may have a handle or not."""
+    return tuple(
+        sorted({handle for kind in kb.subclasses(name) if (handle := kb.object_profile(kind).handle) is not None})
+    )
 
 
 def annotator_parameters(
