@@ -30,7 +30,7 @@ ROOT = Path(__file__).resolve().parents[2]
 sys.path.insert(0, str(ROOT))
 
 import annotators.cloud.clutter as clutter  # noqa: E402
-from annotators.geometry.convexity import dense_labels, grid_patches  # noqa: E402
+from annotators.geometry.convexity import dense_labels  # noqa: E402
 
 CELL = clutter.ClutterParameters().cell
 FACTORS = (0.0, 0.5, 1.0, 2.0, 4.0, 8.0)
@@ -39,11 +39,14 @@ Patches = Callable[[np.ndarray, int], np.ndarray]
 
 
 def shifted(dy: int, dx: int) -> Patches:
-    """Today's patches with the cells starting ``dy`` rows and ``dx`` columns before the crop's corner."""
+    """The patches of 78b3ec6 (cells counted from the crop's corner) with the cells starting ``dy`` rows and ``dx``
+    columns before the crop's corner."""
 
     def patches(surfaces: np.ndarray, cell: int) -> np.ndarray:
-        padded = np.pad(surfaces, ((dy, 0), (dx, 0)))
-        return grid_patches(padded, cell)[dy:, dx:]
+        rows, cols = np.indices(surfaces.shape)
+        across, down = (surfaces.shape[1] + dx) // cell + 1, (surfaces.shape[0] + dy) // cell + 1
+        keys = surfaces.astype(np.int64) * across * down + ((rows + dy) // cell) * across + (cols + dx) // cell + 1
+        return dense_labels(np.where(surfaces > 0, keys, 0))
 
     return patches
 
