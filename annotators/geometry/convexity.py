@@ -14,7 +14,6 @@ from __future__ import annotations
 
 from dataclasses import dataclass
 
-import cv2
 import numpy as np
 
 from annotators.geometry.grid_kernels import (
@@ -36,28 +35,11 @@ from annotators.geometry.grid_segmentation import (
     touching_pairs,
 )
 
-CELL_MARGIN = 2
-"""Coarse pixels between a group of surfaces' first row (column) and where its first row (column) of cells starts:
-the margin the segmenter's crop has always left around the candidates, so a lone group's cells lie where they did
-when cells were counted from the crop's corner."""
-
 
 def grid_patches(surfaces: np.ndarray, cell: int) -> np.ndarray:
     """Patch labels (int32, 0 = none, 1..n): each labelled surface of ``surfaces`` cut into ``cell`` x ``cell``
-    grid cells; a cell that two surfaces share gives one patch to each.
-
-    The cells are counted from the corner of each group of surfaces lying within ``cell`` pixels of one another
-    (its first row and column less :data:`CELL_MARGIN`), not from the corner of the grid: surfaces that could share
-    a cell share one grid of cells, while a surface farther away - anywhere else on the table - does not move them.
-    Where the cells start decides how a cell straddling two touching objects is cut, so an object's patches must not
-    depend on where other objects are."""
-    surfaces = np.ascontiguousarray(surfaces)
-    reach = cell // 2  # two surfaces at most ``cell`` pixels apart meet once each is grown by half of it
-    grown = cv2.dilate(
-        (surfaces > 0).view(np.uint8), cv2.getStructuringElement(cv2.MORPH_ELLIPSE, (2 * reach + 1,) * 2)
-    )
-    groups = cv2.connectedComponents(grown, connectivity=8, ltype=cv2.CV_32S)[1]
-    return cell_patches(surfaces, groups, cell, CELL_MARGIN)
+    grid cells; a cell that two surfaces share gives one patch to each."""
+    return cell_patches(np.ascontiguousarray(surfaces), cell)
 
 
 def dense_labels(keys: np.ndarray) -> np.ndarray:

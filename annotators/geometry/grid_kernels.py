@@ -227,12 +227,10 @@ def dense_keys(keys: np.ndarray) -> np.ndarray:
     return _loops().dense_keys(keys)
 
 
-def cell_patches(surfaces: np.ndarray, groups: np.ndarray, cell: int, margin: int) -> np.ndarray:
+def cell_patches(surfaces: np.ndarray, cell: int) -> np.ndarray:
     """:func:`~annotators.geometry.convexity.grid_patches`: each labelled surface cut into ``cell`` x ``cell``
-    cells counted from the first row and column, less ``margin``, of the surfaces' pixels in its group (``groups``:
-    HxW int32 group labels, read where ``surfaces`` is labelled), the (surface, cell) pairs numbered 1..n in
-    increasing order of surface, then cell (row-major)."""
-    return _loops().cell_patches(surfaces, groups, cell, margin)
+    cells, the (surface, cell) pairs numbered 1..n in increasing order of surface, then cell (row-major)."""
+    return _loops().cell_patches(surfaces, cell)
 
 
 def graph_components(pairs: np.ndarray, count: int) -> np.ndarray:

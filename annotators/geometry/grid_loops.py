@@ -726,32 +726,15 @@ def dense_keys(keys: np.ndarray) -> np.ndarray:
 
 
 @njit(cache=True, nogil=True)
-def cell_patches(surfaces: np.ndarray, groups: np.ndarray, cell: int, margin: int) -> np.ndarray:
+def cell_patches(surfaces: np.ndarray, cell: int) -> np.ndarray:
     """See :func:`annotators.geometry.grid_kernels.cell_patches`."""
     rows, cols = surfaces.shape
-    count = 0
-    for r in range(rows):
-        for c in range(cols):
-            if surfaces[r, c] > 0:
-                count = max(count, groups[r, c])
-    # each group's first row and column among its surfaces' pixels: where its cells start (less the margin)
-    first_row = np.full(count + 1, rows, dtype=np.int64)
-    first_col = np.full(count + 1, cols, dtype=np.int64)
-    for r in range(rows):
-        for c in range(cols):
-            if surfaces[r, c] > 0:
-                group = groups[r, c]
-                first_row[group] = min(first_row[group], r)
-                first_col[group] = min(first_col[group], c)
-    across, down = (cols + margin) // cell + 1, (rows + margin) // cell + 1
+    across, down = -(-cols // cell), -(-rows // cell)
     keys = np.zeros((rows, cols), dtype=np.int64)
     for r in range(rows):
         for c in range(cols):
             if surfaces[r, c] > 0:
-                group = groups[r, c]
-                cell_row = (r - first_row[group] + margin) // cell
-                cell_col = (c - first_col[group] + margin) // cell
-                keys[r, c] = np.int64(surfaces[r, c]) * (across * down) + cell_row * across + cell_col + 1
+                keys[r, c] = np.int64(surfaces[r, c]) * (across * down) + (r // cell) * across + c // cell + 1
     return dense_keys(keys)
 
 
