@@ -8,11 +8,16 @@ of the candidates' bounding box. This script moves where the cells start and seg
    right of column 480 and below row 150, as (roi, points).
 2. ``mosd``: the 45 labelled mOSD learn scenes scored per category (recall / precision at box IoU >= 0.5, overlap F,
    as bench/bench_segmentation.py scores them) for each phase; phase (0, 0) is today's segmenter.
-3. ``surface``: the same scores when each surface (connected candidates without a depth seam) gets cells of its
+3. ``counts``: the number of segments on every real guard input of bench/check_clutter_labels.py (uoc 0-4, the
+   pcl_grabber frames) and the rendered 15-object scene, per phase: how often today's count comes out.
+4. ``surface``: the same scores when each surface (connected candidates without a depth seam) gets cells of its
    own, counted from its own first row and column less ``margin`` (0 .. cell - 1): a rule in which far candidates
    cannot move an object's cells.
+5. ``cluster``: the same scores when each group of surfaces lying within a distance of one another (multiples of the
+   grouping's reach) gets cells of its own.
 
-Run from the repository root: ``PYTHONPATH=$PWD python bench/experiments/seg8_phases.py [tum|mosd|surface]``.
+Run from the repository root:
+``PYTHONPATH=$PWD python bench/experiments/seg8_phases.py [tum|mosd|counts|surface|cluster]``.
 """
 
 from __future__ import annotations
@@ -131,6 +136,36 @@ def tum() -> None:
         print(f"  {count:2d} x {near}")
 
 
+def counts() -> None:
+    """Per real guard input, the segment count of today's phase and how often each count comes out over the phases."""
+    import tempfile
+
+    sys.path.insert(0, str(ROOT / "bench"))
+    from check_clutter_labels import prepare
+
+    with tempfile.TemporaryDirectory() as temporary:
+        folder = Path(temporary)
+        names = [
+            name for name in prepare(folder) if not name.startswith("learn") and name != "milk_cartoon_all_small_clorox"
+        ]
+        for name in names:
+            data = np.load(folder / f"{name}.npz")
+            found: collections.Counter = collections.Counter()
+            for dy in range(CELL):
+                for dx in range(CELL):
+                    clutter.grid_patches = shifted(dy, dx)
+                    segments = clutter.segment_clutter(
+                        data["points"], data["mask"], data["model"], data["plane"], clutter.ClutterParameters(),
+                        data["colors"],
+                    )  # fmt: skip
+                    found[len(segments)] += 1
+                    if (dy, dx) == (0, 0):
+                        today = len(segments)
+            print(
+                f"{name}: today {today} segments; over {CELL * CELL} phases {dict(sorted(found.items()))}", flush=True
+            )
+
+
 def mosd(variants: dict[str, Patches]) -> None:
     """Per variant, the clutter segmenter's mOSD scores per category."""
     import bench.bench_segmentation as bench
@@ -150,12 +185,14 @@ def mosd(variants: dict[str, Patches]) -> None:
 
 def main() -> None:
     parser = argparse.ArgumentParser(description=__doc__.split("\n")[0])
-    parser.add_argument("part", choices=("tum", "mosd", "surface", "cluster"))
+    parser.add_argument("part", choices=("tum", "mosd", "counts", "surface", "cluster"))
     part = parser.parse_args().part
     if part == "tum":
         tum()
     elif part == "mosd":
         mosd({f"phase ({dy}, {dx})": shifted(dy, dx) for dy in range(CELL) for dx in range(CELL)})
+    elif part == "counts":
+        counts()
     elif part == "surface":
         mosd({f"margin {margin}": per_surface(margin) for margin in range(CELL)})
     else:
