@@ -21,6 +21,7 @@ from robokudo.core.types import ObjectHypothesis
 from tests.annotators.color_set import (
     FIRST_ROUND,
     SHARED_DATA,
+    SPLITS,
     ColorSample,
     is_named_as_labelled,
     load_frame,
@@ -108,7 +109,7 @@ def test_the_set_is_large_varied_and_split(results: dict[str, tuple[ColorSample,
     assert len(samples) >= 40
     assert len({Path(s.input).parts[0] for s in samples}) >= 5
     assert len({s.colors[0] for s in samples}) >= 10
-    assert {s.split for s in samples} == {"tune", "held_out", "fresh"}
+    assert {s.split for s in samples} == set(SPLITS)
 
 
 def _first_round(results: dict[str, tuple[ColorSample, list[str]]]) -> dict[str, tuple[ColorSample, list[str]]]:
