@@ -131,11 +131,27 @@ def _term_votes(labs: np.ndarray, parameters: NamingParameters) -> np.ndarray:
 _BROWN = CHROMATIC_TERMS.index("brown")
 
 
+def _hue_degrees(labs: np.ndarray) -> np.ndarray:
+    """The CIELAB hue angles h_ab (0..360 degrees) of colours (...x3)."""
+    return np.degrees(np.arctan2(labs[..., 2], labs[..., 1])) % 360.0
+
+
+BROWN_HUES: tuple[float, float] = (
+    float(_hue_degrees(_PROTOTYPE_LAB[np.array(_PROTOTYPE_TERMS) == "brown"]).min()),
+    float(_hue_degrees(_PROTOTYPE_LAB[np.array(_PROTOTYPE_TERMS) == "brown"]).max()),
+)
+"""The range of CIELAB hues (degrees) the survey's brown prototypes span, from the reddest ("reddish brown") to the
+greenest ("greenish brown"): no colour people called brown lies outside it."""
+
+
 def _without_colourful_brown(votes: np.ndarray, labs: np.ndarray, parameters: NamingParameters) -> np.ndarray:
     """The votes with brown's taken away (the others' shares renormalised) for colours whose chroma C* is at
-    least ``brown_max_chroma``: too colourful for a brown surface, they are a yellow or orange seen in less light;
-    a colour whose every vote is brown keeps them."""
-    return _without_brown(votes, np.hypot(labs[:, 1], labs[:, 2]) >= parameters.brown_max_chroma)
+    least ``brown_max_chroma`` (too colourful for a brown surface, they are a yellow or orange seen in less light)
+    or whose hue lies outside :data:`BROWN_HUES` (an olive print greener than any brown people named is a dark
+    green, whatever the many yellowish browns near it say); a colour whose every vote is brown keeps them."""
+    hue = _hue_degrees(labs)
+    outside = (hue < BROWN_HUES[0]) | (hue > BROWN_HUES[1])
+    return _without_brown(votes, (np.hypot(labs[:, 1], labs[:, 2]) >= parameters.brown_max_chroma) | outside)
 
 
 def _without_brown(votes: np.ndarray, chosen: np.ndarray) -> np.ndarray:

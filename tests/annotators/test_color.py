@@ -285,6 +285,17 @@ def test_a_black_part_of_another_hue_than_the_grey_stays_black() -> None:
     assert names(np.vstack([body, lid]), light)[0] == "black"
 
 
+def test_an_olive_print_greener_than_any_brown_is_green_not_brown() -> None:
+    # a dark olive print on a white carton (hue about 106 degrees): the survey's many yellowish browns are near
+    # it, but no colour people called brown is that green (the greenest, "greenish brown", is at 98); a dark
+    # khaki of a brown's hue (92) stays brown
+    olive, khaki, white = patch((90, 92, 25), count=300), patch((110, 95, 40), count=300), patch((236, 234, 230))
+    assert names(olive) == ["green"]
+    assert names(np.vstack([white, olive])) == ["white", "green"]
+    assert names(khaki) == ["brown"]
+    assert names(np.vstack([white, khaki])) == ["white", "brown"]
+
+
 def test_a_colour_lit_and_in_shade_is_one_colour_even_where_the_shaded_side_is_larger() -> None:
     # a crisps tube as in mOSD frames: a narrow lit yellow side, a wider shaded side of the same hue (orange alone)
     # and a white band larger than either side but smaller than both; the tube's colour is the dominant one

@@ -21,6 +21,7 @@ from robokudo.core.types import ObjectHypothesis
 from tests.annotators.color_set import (
     FIRST_ROUND,
     SHARED_DATA,
+    SPLITS,
     ColorSample,
     is_named_as_labelled,
     load_frame,
@@ -108,7 +109,7 @@ def test_the_set_is_large_varied_and_split(results: dict[str, tuple[ColorSample,
     assert len(samples) >= 40
     assert len({Path(s.input).parts[0] for s in samples}) >= 5
     assert len({s.colors[0] for s in samples}) >= 10
-    assert {s.split for s in samples} == {"tune", "held_out", "fresh"}
+    assert {s.split for s in samples} == set(SPLITS)
 
 
 def _first_round(results: dict[str, tuple[ColorSample, list[str]]]) -> dict[str, tuple[ColorSample, list[str]]]:
@@ -184,9 +185,22 @@ def test_cream_and_yellow_boxes_with_a_white_print_are_not_brown_in_a_dim_frame(
 
 
 def test_brown_things_stay_brown(results: dict[str, tuple[ColorSample, list[str]]]) -> None:
-    browns = {key: names for key, (sample, names) in results.items() if sample.colors[0] == "brown"}
+    # the rounds the namer has been tuned on; "fresh2" is the held-out check (its misses are reported by
+    # bench/bench_color.py, not pinned here, which would make it a tuning set)
+    browns = {
+        key: names
+        for key, (sample, names) in results.items()
+        if sample.colors[0] == "brown" and sample.split != "fresh2"
+    }
     assert len(browns) >= 10
     assert all(names[0] in ("brown", *results[key][0].alternatives) for key, names in browns.items()), browns
+
+
+def test_an_olive_print_on_a_white_carton_is_not_brown(results: dict[str, tuple[ColorSample, list[str]]]) -> None:
+    # the milk carton's dark olive print (hue about 106 degrees, greener than any brown people named) is green
+    sample, names = results["milk_cartoon_all_small_clorox#0:milk carton"]
+    assert "brown" not in names
+    assert is_named_as_labelled(sample, names), names
 
 
 @pytest.mark.parametrize("key", ["five_people#0:light jeans", "five_people#0:faded jeans"])
