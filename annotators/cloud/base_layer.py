@@ -3,11 +3,12 @@
 Found on the hypothesis' own points in the upright support frame (z up), from its width over height: the points
 below a step height form a flat layer (at most ``BASE_THICKNESS`` thick) whose footprint is wider than the points
 above by at least ``1 / STEP_RATIO`` and at least as wide across (a layer spreads beyond the body both ways; the
-near arc of a round body's foot, widened by depth noise, is as long but shallow), and what stands above is an upright body (at least as tall as the layer is
-thick) standing on the layer (its middle within the layer's footprint; a spoon on a saucer may widen the layer to
-one side). The step is the lowest of ``STEP_HEIGHTS`` at which that holds.
-A mug on the table, a bowl (narrower at its foot), a can on a can or a box on a box (the lower one is no thin
-layer) has no such base; the form expert then measures the whole hypothesis.
+near arc of a round body's foot, widened by depth noise, is as long but shallow), and what stands above is an
+upright body (at least as tall as the layer is thick) standing on the layer (its middle within the layer's
+footprint; a spoon on a saucer may widen the layer to one side). The step is the lowest of ``STEP_HEIGHTS`` at
+which that holds. A mug on the table, a bowl (narrower at its foot), a can on a can or a box on a box (the lower
+one is no thin layer: its points above the step widen the body as much) has no such base; the form expert then
+measures the whole hypothesis.
 """
 
 from __future__ import annotations
