@@ -4,11 +4,15 @@ Synthetic shapes in the upright support frame, as in tests/annotators/test_form.
 
 from __future__ import annotations
 
+from dataclasses import replace
+
 import numpy as np
 import pytest
 
+from annotators.classification.knowledge_classifier import Cues, Profile, body_extent, score
 from annotators.cloud.base_layer import find_base
 from annotators.cloud.form import measure_form
+from robokudo.core.types import FormFeatures
 from tests.annotators.test_form import CENTRE, FRAME, handle, inner_far_wall, lid, side
 
 
@@ -93,3 +97,25 @@ def test_a_flat_layer_alone_has_no_body_on_it() -> None:
     rng = np.random.default_rng(0)
     plate = disc(0.12, 0.02, rng)
     assert find_base(plate, 0.0, float(np.quantile(plate[:, 2], 0.98))) is None
+
+
+def test_a_cup_on_a_saucer_is_sized_by_the_cup() -> None:
+    """The size expert measures the saucer (23 cm: medium); the classifier grades the size of the body on it."""
+    on_saucer = FormFeatures(
+        height_to_width=0.9,
+        has_handle=False,
+        handle_confidence=1.0,
+        open_top=True,
+        open_confidence=1.0,
+        base_width=0.23,
+        body_width=0.09,
+    )
+    alone = replace(on_saucer, base_width=None, body_width=None)
+    assert body_extent(on_saucer) == pytest.approx(0.09)
+    assert body_extent(alone) is None
+    cup = Profile(class_name="Cup", size="small")
+    sized = [
+        score(cup, Cues(size=("medium", 1.0), extent=extent)).score
+        for extent in (body_extent(on_saucer), body_extent(alone) or 0.23)
+    ]
+    assert sized[0] > sized[1]
