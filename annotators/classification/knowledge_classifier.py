@@ -20,7 +20,9 @@ when read, Text) a profile gets an agreement in [0, 1]:
 * colour / shape: 1 when the profile lists the observed value, 0 when it lists others, 0.5 when it says nothing;
 * size class: from the largest extent the size expert measured, 1 inside the profile's size class bounds, falling
   to 0 at ``SIZE_FALLOFF`` times beyond a bound (a 13 cm can is nearly small, a 30 cm box is not); without an
-  extent 1 when equal, 0.25 when one class apart, 0 when two apart; 0.5 when the profile says nothing;
+  extent 1 when equal, 0.25 when one class apart, 0 when two apart; 0.5 when the profile says nothing; for a body
+  standing on a thin wide base (a cup on its saucer) the largest extent is the body's, as the form expert measured
+  it above the base (:func:`body_extent`);
 * handle: 1 when both say there is one, 0 when one is seen on a class without, ``HANDLE_HIDDEN`` when none is
   seen on a class with one (it may be behind), ``NO_HANDLE`` when neither has one, 0.5 when the profile says
   nothing - but with none seen, a class whose kinds say (a bottle: plain, or a jug) agrees as its best kind;
@@ -763,6 +765,15 @@ def elongation(dimensions: Sequence[float]) -> float | None:
     return float(dimensions[0] / dimensions[1])
 
 
+def body_extent(form: FormFeatures | None) -> float | None:
+    """The largest extent (metres) of the body standing on a thin wide base (a cup on its saucer), which the form
+    expert measured above the base: the class is the body's, the size expert's extents are the base's; None
+    without a base."""
+    if form is None or form.body_width is None:
+        return None
+    return max(form.body_width, form.height_to_width * form.body_width)
+
+
 class KnowledgeClassifier(Annotator):
     """Names each hypothesis' class from its colour, shape, size, form and text, compared with candidate profiles."""
 
@@ -807,7 +818,7 @@ class KnowledgeClassifier(Annotator):
             handle=(form.has_handle, form.handle_confidence) if form is not None else None,
             open_top=(form.open_top, form.open_confidence) if form is not None else None,
             height_to_width=form.height_to_width if form is not None else None,
-            extent=max(size.dimensions) if size is not None and size.dimensions else None,
+            extent=body_extent(form) or (max(size.dimensions) if size is not None and size.dimensions else None),
             printed=printed_cue(colors),
             elongation=elongation(size.dimensions) if size is not None else None,
         )

@@ -58,6 +58,7 @@ from typing import ClassVar
 import numpy as np
 from scipy.spatial import ConvexHull, QhullError
 
+from annotators.cloud.base_layer import BaseLayer, find_base
 from annotators.cloud.body_profile import body_profile
 from annotators.cloud.cloud_expert import CloudExpert
 from annotators.cloud.shape import circle_fit
@@ -114,6 +115,7 @@ class Form:
     handle_confidence: float
     open_top: bool
     open_confidence: float
+    base: BaseLayer | None = None
 
 
 def _extent(xy: np.ndarray) -> float:
@@ -322,10 +324,15 @@ def measure_form(points: np.ndarray, frame: SupportFrame, grazing: np.ndarray | 
     width = _extent(points[:, :2])
     if height <= 0.0 or width <= 0.0:
         return None
+    base = find_base(points, bottom, height)
+    if base is not None:  # the body above the step is measured; the base is noted in the Form
+        body = points[:, 2] >= bottom + base.step
+        points, bottom, height, width = points[body], bottom + base.step, height - base.step, base.body_width
+        grazing = None if grazing is None else grazing[body]
     seen = points if grazing is None else points[~grazing]
     handle, handle_confidence = handle_evidence(seen, bottom, height)
     open_top, open_confidence = open_evidence(points, bottom, height, frame.camera_to_frame[:3, 3], width)
-    return Form(height / width, handle, handle_confidence, open_top, open_confidence)
+    return Form(height / width, handle, handle_confidence, open_top, open_confidence, base)
 
 
 class FormAnnotator(CloudExpert):
@@ -373,6 +380,8 @@ class FormAnnotator(CloudExpert):
                     handle_confidence=form.handle_confidence * scale,
                     open_top=form.open_top,
                     open_confidence=form.open_confidence * scale,
+                    base_width=None if form.base is None else form.base.base_width,
+                    body_width=None if form.base is None else form.base.body_width,
                     confidence=scale,
                 ),
             )

@@ -13,6 +13,8 @@ from pathlib import Path
 import pytest
 
 from robokudo.application import cli
+from robokudo.application.service import AnsweringService
+from robokudo.core.types import FormFeatures, ObjectHypothesis
 from tests.annotators.conftest import SHARED_DATA, require_folder
 
 pytestmark = pytest.mark.real_data
@@ -63,3 +65,24 @@ def test_the_cup_on_its_saucer_is_no_bottle(capsys: pytest.CaptureFixture[str]) 
     assert on_cup(answered_rois(capsys, "find all objects"))  # the cup is seen
     rois = answered_rois(capsys, "find a bottle")
     assert not on_cup(rois), rois
+
+
+def test_the_cup_is_measured_above_its_saucer(private_data: Path) -> None:
+    """The teacup stands on a saucer twice as wide (tum2-analysis): the form expert measures the cup above the
+    saucer and notes the saucer (issue 15, item 6); the blue mug standing on the desk has no base."""
+    folder = str(require_folder(SHARED_DATA / "tum_rgbd_sample_open3d"))
+    with AnsweringService.open(private_data / "beliefs.sqlite", input_path=folder) as service:
+        hypotheses = service.answer("find all objects").tree.cas.annotations(ObjectHypothesis)
+
+    def form_at(x: int, y: int) -> FormFeatures:
+        hypothesis = max(hypotheses, key=lambda h: int(h.mask[y - 2 : y + 3, x - 2 : x + 3].sum()))
+        assert hypothesis.mask[y - 2 : y + 3, x - 2 : x + 3].any(), (x, y)
+        form = hypothesis.first(FormFeatures)
+        assert form is not None
+        return form
+
+    cup, mug = form_at(485, 215), form_at(543, 215)
+    assert cup.base_width is not None and cup.body_width is not None, cup
+    assert cup.base_width > 0.15 and cup.body_width < 0.12, cup  # a saucer about twice as wide as the cup on it
+    assert cup.height_to_width > 0.3 and not cup.has_handle, cup  # with the saucer: 0.23 and the saucer a 'handle'
+    assert mug.base_width is None and mug.has_handle, mug
