@@ -60,21 +60,28 @@ def per_surface(margin: int) -> Patches:
     """Patches with cells counted from each surface's own first row and column less ``margin``."""
 
     def patches(surfaces: np.ndarray, cell: int) -> np.ndarray:
-        rows, cols = np.nonzero(surfaces)
-        labels = surfaces[rows, cols].astype(np.int64)
-        count = int(labels.max(initial=0)) + 1
-        first_row, first_col = np.full(count, surfaces.shape[0]), np.full(count, surfaces.shape[1])
-        np.minimum.at(first_row, labels, rows)
-        np.minimum.at(first_col, labels, cols)
-        across = (surfaces.shape[1] + margin) // cell + 1
-        down = (surfaces.shape[0] + margin) // cell + 1
-        cell_row = (rows - first_row[labels] + margin) // cell
-        cell_col = (cols - first_col[labels] + margin) // cell
-        keys = np.zeros(surfaces.shape, dtype=np.int64)
-        keys[rows, cols] = labels * across * down + cell_row * across + cell_col + 1
-        return dense_labels(keys)
+        return cells_from_first_pixel(surfaces, surfaces, cell, margin)
 
     return patches
+
+
+def cells_from_first_pixel(surfaces: np.ndarray, owners: np.ndarray, cell: int, margin: int) -> np.ndarray:
+    """Patches: each surface pixel's cell, counted from the first row and column (less ``margin``) of its owner (a
+    label image: the surface itself, or the cluster it lies in)."""
+    rows, cols = np.nonzero(surfaces)
+    owner = owners[rows, cols].astype(np.int64)
+    count = int(owner.max(initial=0)) + 1
+    first_row, first_col = np.full(count, surfaces.shape[0]), np.full(count, surfaces.shape[1])
+    np.minimum.at(first_row, owner, rows)
+    np.minimum.at(first_col, owner, cols)
+    labels = surfaces[rows, cols].astype(np.int64)
+    across = (surfaces.shape[1] + margin) // cell + 1
+    down = (surfaces.shape[0] + margin) // cell + 1
+    cell_row = (rows - first_row[owner] + margin) // cell
+    cell_col = (cols - first_col[owner] + margin) // cell
+    keys = np.zeros(surfaces.shape, dtype=np.int64)
+    keys[rows, cols] = labels * across * down + cell_row * across + cell_col + 1
+    return dense_labels(keys)
 
 
 def per_cluster(reach: float, margin: int = 2) -> Patches:
@@ -86,20 +93,7 @@ def per_cluster(reach: float, margin: int = 2) -> Patches:
         disc = cv2.getStructuringElement(cv2.MORPH_ELLIPSE, (2 * radius + 1, 2 * radius + 1))
         near = cv2.dilate((surfaces > 0).astype(np.uint8), disc)
         clusters = cv2.connectedComponents(near, connectivity=8)[1]
-        rows, cols = np.nonzero(surfaces)
-        owner = clusters[rows, cols].astype(np.int64)
-        count = int(owner.max(initial=0)) + 1
-        first_row, first_col = np.full(count, surfaces.shape[0]), np.full(count, surfaces.shape[1])
-        np.minimum.at(first_row, owner, rows)
-        np.minimum.at(first_col, owner, cols)
-        labels = surfaces[rows, cols].astype(np.int64)
-        across = (surfaces.shape[1] + margin) // cell + 1
-        down = (surfaces.shape[0] + margin) // cell + 1
-        cell_row = (rows - first_row[owner] + margin) // cell
-        cell_col = (cols - first_col[owner] + margin) // cell
-        keys = np.zeros(surfaces.shape, dtype=np.int64)
-        keys[rows, cols] = labels * across * down + cell_row * across + cell_col + 1
-        return dense_labels(keys)
+        return cells_from_first_pixel(surfaces, clusters, cell, margin)
 
     return patches
 
