@@ -99,9 +99,7 @@ def probe() -> None:
     cup_profile = next(p for p in profiles if p["class"] == "Cup")
 
     def what_if(extra: list[dict[str, object]], seen: kc.Cues, label: str) -> None:
-        matches = sorted(
-            (kc.score(kc.Profile.from_mapping(p), seen) for p in profiles + extra), key=lambda m: -m.score
-        )
+        matches = sorted((kc.score(kc.Profile.from_mapping(p), seen) for p in profiles + extra), key=lambda m: -m.score)
         decision = kc.decide(matches, expected="Cup", cues=seen)
         top = ", ".join(f"{m.profile.class_name} {m.score:.3f}" for m in matches[:5])
         print(f"{label}: {decision.class_name} {decision.confidence:.2f} | {top}")
