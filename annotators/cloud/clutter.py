@@ -68,6 +68,7 @@ from annotators.cloud.plane import plane_basis, plane_distances
 from annotators.geometry.border_pixels import BorderRules, claim_border_pixels, plane_noise
 from annotators.geometry.container_floors import FloorRules, claim_container_floors, touches_other_labels
 from annotators.geometry.convexity import ConvexityRules, convex_groups, dense_labels, grid_patches, split_by_normals
+from annotators.geometry.flat_patches import flat_patches
 from annotators.geometry.grid_kernels import object_pieces, plane_coordinates, strided_crop
 from annotators.geometry.grid_segmentation import (
     MergeRules,
@@ -126,6 +127,8 @@ class ClutterParameters(ClusterParameters):
     normal_smoothing: int = 3
     cell: int = 6
     normal_spread: float = 0.15
+    grown_patches: bool = False
+    patch_weight: float = 16.0
     smooth_degrees: float = ConvexityRules.smooth_degrees
     concave_bending: float = ConvexityRules.concave_bending
     convex_share: float = ConvexityRules.convex_share
@@ -248,7 +251,10 @@ def segment_clutter(
     seams = depth_seams(depth, region, p.jump_absolute, p.jump_relative)
     normals = grid_normals(grid, p.normal_step, p.normal_smoothing, p.jump_absolute, p.jump_relative)
     surfaces = label_parts(region & ~seams, 1)
-    patches = split_by_normals(grid_patches(surfaces, p.cell), normals, p.normal_spread)
+    # grown patches take their boundaries from the data: the same patches wherever the crop starts
+    grown = p.grown_patches
+    cut = flat_patches(surfaces, normals, p.cell, p.patch_weight) if grown else grid_patches(surfaces, p.cell)
+    patches = split_by_normals(cut, normals, p.normal_spread)
     # patches without a trustworthy plane (a face seen edge-on, a few points) go with the object beside them
     reach = max(2.0 * p.cell, p.grow_distance / step)
     # the angle between neighbouring pixels, a property of the camera: measured once, on every few rows

@@ -1,0 +1,156 @@
+"""Evidence for seg9 (bench/profiles/seg9-analysis.txt): grown patches (annotators/geometry/flat_patches.py) against
+the grid cells in the clutter segmenter, over crop offsets.
+
+The inputs are those of bench/check_clutter_labels.py (prepared once into ``--inputs``). An offset ``(dy, dx)``
+starts the segmenter's crop ``dy`` rows and ``dx`` columns (coarse pixels) before the candidates' bounding box would:
+for the grid cells that is a cell phase (seg8's "phase"), for grown patches it should change nothing.
+
+Modes:
+* ``mosd``: the 45 labelled mOSD learn scenes scored per category (recall / precision at box IoU >= 0.5, overlap F,
+  as bench/bench_segmentation.py scores them) for each variant at each of the ``cell`` x ``cell`` offsets; per
+  category the median, minimum and maximum F over the offsets.
+* ``counts``: segment counts on the real guard inputs (uoc, grabber, fifteen objects) per offset.
+* ``same``: per input, at how many offsets the segments equal those at offset (0, 0) (pixel for pixel).
+
+Run from the repository root:
+``PYTHONPATH=$PWD python bench/experiments/seg9_grown.py mosd --variant grid --variant grown:16``.
+"""
+
+from __future__ import annotations
+
+import argparse
+import collections
+import statistics
+import sys
+from dataclasses import replace
+from pathlib import Path
+
+import numpy as np
+
+ROOT = Path(__file__).resolve().parents[2]
+sys.path.insert(0, str(ROOT))
+sys.path.insert(0, str(ROOT / "bench"))
+
+import annotators.cloud.clutter as clutter  # noqa: E402
+from annotators.readers.pcd_io import read_pcd  # noqa: E402
+from reasoning.evaluation.mosd import object_labels, scene_category  # noqa: E402
+from reasoning.evaluation.segmentation import score_segmentation, summarize  # noqa: E402
+
+DATA = ROOT.parent / "shared" / "data"
+CATEGORIES = ("boxes", "stacked", "occluded", "cylindric")
+ORIGINAL_BOX = clutter.bounding_box
+
+
+def with_offset(dy: int, dx: int) -> None:
+    """Make segment_clutter's crop (the bounding box of margin 2) start ``dy`` rows and ``dx`` columns earlier."""
+
+    def box(mask: np.ndarray, margin: int = 0) -> tuple[int, int, int, int]:
+        x0, y0, x1, y1 = ORIGINAL_BOX(mask, margin)
+        if margin == 2:
+            x0, y0 = max(0, x0 - dx), max(0, y0 - dy)
+        return x0, y0, x1, y1
+
+    clutter.bounding_box = box
+
+
+def parameters(variant: str) -> clutter.ClutterParameters:
+    """``grid`` (today's cells) or ``grown:WEIGHT[:CELL]`` (grown patches)."""
+    base = clutter.ClutterParameters()
+    if variant == "grid":
+        return base
+    parts = variant.split(":")
+    cell = int(parts[2]) if len(parts) > 2 else base.cell
+    return replace(base, grown_patches=True, patch_weight=float(parts[1]), cell=cell)
+
+
+def segment(data: dict, p: clutter.ClutterParameters) -> np.ndarray:
+    """HxW int32 labels of the clutter segments, larger first where masks overlap (as the bench's trees give)."""
+    found = clutter.segment_clutter(data["points"], data["mask"], data["model"], data["plane"], p, data["colors"])
+    labels = np.zeros(data["points"].shape[:2], dtype=np.int32)
+    for number, s in enumerate(sorted(found, key=lambda s: -int(np.count_nonzero(s.mask))), start=1):
+        labels[s.mask & (labels == 0)] = number
+    return labels
+
+
+def load(inputs: Path) -> dict[str, dict]:
+    """The prepared inputs by name (prepared on first use)."""
+    from check_clutter_labels import prepare
+
+    if not any(inputs.glob("*.npz")):
+        inputs.mkdir(parents=True, exist_ok=True)
+        prepare(inputs)
+    return {path.stem: dict(np.load(path)) for path in sorted(inputs.glob("*.npz"))}
+
+
+def mosd(inputs: dict[str, dict], variants: list[str], offsets: list[tuple[int, int]]) -> None:
+    """Per variant and offset the F per category; then the median / min / max over the offsets."""
+    learn = DATA / "pcl_mosd_tabletop" / "learn"
+    truths = {}
+    for name in inputs:
+        if name.startswith("learn"):
+            frame = read_pcd(learn / f"{name}.pcd")
+            truths[name] = (object_labels(frame.labels), np.isfinite(frame.points[..., 2]))
+    for variant in variants:
+        p = parameters(variant)
+        per_offset: dict[str, list[float]] = collections.defaultdict(list)
+        for dy, dx in offsets:
+            with_offset(dy, dx)
+            scores = collections.defaultdict(list)
+            for name, (truth, valid) in truths.items():
+                score = score_segmentation(truth, segment(inputs[name], p), valid)
+                scores[scene_category(f"{name}.pcd")].append(score)
+                scores["all"].append(score)
+            line = []
+            for category in (*CATEGORIES, "all"):
+                s = summarize(scores[category])
+                per_offset[category].append(s.overlap_f)
+                line.append(f"{category} {s.recall:.2f}/{s.precision:.3f}/{s.overlap_f:.4f}")
+            print(f"{variant} offset ({dy}, {dx}): " + "  ".join(line), flush=True)
+        for category in (*CATEGORIES, "all"):
+            values = per_offset[category]
+            print(
+                f"{variant} {category:<10} median {statistics.median(values):.4f}  min {min(values):.4f}  "
+                f"max {max(values):.4f}  (0,0) {values[0]:.4f}",
+                flush=True,
+            )
+    clutter.bounding_box = ORIGINAL_BOX
+
+
+def guards(inputs: dict[str, dict], variants: list[str], offsets: list[tuple[int, int]]) -> None:
+    """Per real guard input and variant: segment counts over the offsets, and at how many offsets the labels equal
+    those at the first offset."""
+    names = [n for n in inputs if not n.startswith("learn") and n != "milk_cartoon_all_small_clorox"]
+    for variant in variants:
+        p = parameters(variant)
+        for name in names:
+            counts: collections.Counter = collections.Counter()
+            same, first = 0, None
+            for dy, dx in offsets:
+                with_offset(dy, dx)
+                labels = segment(inputs[name], p)
+                counts[int(labels.max())] += 1
+                if first is None:
+                    first = labels
+                same += int(np.array_equal(labels, first))
+            print(f"{variant} {name}: counts {dict(sorted(counts.items()))}; same as first {same}/{len(offsets)}")
+    clutter.bounding_box = ORIGINAL_BOX
+
+
+def main() -> None:
+    parser = argparse.ArgumentParser(description=__doc__.split("\n")[0])
+    parser.add_argument("part", choices=("mosd", "guards"))
+    parser.add_argument("--variant", action="append", default=[])
+    parser.add_argument("--inputs", type=Path, default=Path("/tmp/seg9-inputs"))
+    parser.add_argument("--offsets", type=int, default=clutter.ClutterParameters().cell, help="n: n x n offsets")
+    args = parser.parse_args()
+    inputs = load(args.inputs)
+    offsets = [(dy, dx) for dy in range(args.offsets) for dx in range(args.offsets)]
+    variants = args.variant or ["grid"]
+    if args.part == "mosd":
+        mosd(inputs, variants, offsets)
+    else:
+        guards(inputs, variants, offsets)
+
+
+if __name__ == "__main__":
+    main()
