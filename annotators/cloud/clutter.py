@@ -50,6 +50,7 @@ Works like :mod:`annotators.cloud.clusters` on every ``stride``-th pixel of the 
 
 from __future__ import annotations
 
+import math
 from dataclasses import dataclass, fields, replace
 from functools import partial
 from typing import ClassVar
@@ -228,6 +229,18 @@ class ClutterParameters(ClusterParameters):
         return replace(super().merge_rules(), nested=True, overlap=0.15)
 
 
+SAMPLING_PERIOD = math.lcm(
+    FOOTPRINT_ROWS,
+    SupportRules.sample_step,
+    AppendageRules.sample_step,
+    SlabRules.sample_step,
+    NeckRules.sample_step,
+    FloorRules.sample_step,
+)
+"""Coarse pixels: the later steps read every few pixels or rows counted from the crop's corner; with the corner on a
+multiple of all their spacings they read the same pixels of the image wherever the candidates' box starts."""
+
+
 def segment_clutter(
     points: np.ndarray,
     mask: np.ndarray,
@@ -245,6 +258,8 @@ def segment_clutter(
     if not coarse.any():
         return []
     x0, y0, x1, y1 = bounding_box(coarse, margin=2)
+    if p.grown_patches:  # the sampled rows and pixels on the image's grid, not the crop's: the crop may start anywhere
+        x0, y0 = x0 - x0 % SAMPLING_PERIOD, y0 - y0 % SAMPLING_PERIOD
     region = coarse[y0:y1, x0:x1]
     grid = strided_crop(points, step, (x0, y0, x1, y1))
     depth = grid[..., 2]

@@ -142,9 +142,10 @@ def main() -> None:
     parser.add_argument("--variant", action="append", default=[])
     parser.add_argument("--inputs", type=Path, default=Path("/tmp/seg9-inputs"))
     parser.add_argument("--offsets", type=int, default=clutter.ClutterParameters().cell, help="n: n x n offsets")
+    parser.add_argument("--scale", type=int, default=1, help="offsets in steps of this many coarse pixels")
     args = parser.parse_args()
     inputs = load(args.inputs)
-    offsets = [(dy, dx) for dy in range(args.offsets) for dx in range(args.offsets)]
+    offsets = [(args.scale * dy, args.scale * dx) for dy in range(args.offsets) for dx in range(args.offsets)]
     variants = args.variant or ["grid"]
     if args.part == "mosd":
         mosd(inputs, variants, offsets)
