@@ -129,7 +129,9 @@ class ClutterParameters(ClusterParameters):
     cell: int = 6
     normal_spread: float = 0.15
     grown_patches: bool = False
+    patch_spacing: int = 6
     patch_weight: float = 16.0
+    patch_relative: float = 0.0
     smooth_degrees: float = ConvexityRules.smooth_degrees
     concave_bending: float = ConvexityRules.concave_bending
     convex_share: float = ConvexityRules.convex_share
@@ -267,8 +269,10 @@ def segment_clutter(
     normals = grid_normals(grid, p.normal_step, p.normal_smoothing, p.jump_absolute, p.jump_relative)
     surfaces = label_parts(region & ~seams, 1)
     # grown patches take their boundaries from the data: the same patches wherever the crop starts
-    grown = p.grown_patches
-    cut = flat_patches(surfaces, normals, p.cell, p.patch_weight) if grown else grid_patches(surfaces, p.cell)
+    if p.grown_patches:
+        cut = flat_patches(surfaces, normals, grid, p.patch_spacing, p.patch_weight, p.patch_relative)
+    else:
+        cut = grid_patches(surfaces, p.cell)
     patches = split_by_normals(cut, normals, p.normal_spread)
     # patches without a trustworthy plane (a face seen edge-on, a few points) go with the object beside them
     reach = max(2.0 * p.cell, p.grow_distance / step)

@@ -66,7 +66,13 @@ def flat_seeds(surfaces: np.ndarray, order: np.ndarray, bending: np.ndarray, rad
 
 @njit(cache=True, nogil=True)
 def grown_patches(
-    surfaces: np.ndarray, normals: np.ndarray, seeds: np.ndarray, spacing: float, weight: float
+    surfaces: np.ndarray,
+    normals: np.ndarray,
+    points: np.ndarray,
+    seeds: np.ndarray,
+    spacing: float,
+    weight: float,
+    relative: float,
 ) -> np.ndarray:
     """See :func:`annotators.geometry.flat_patches.grown_patches`."""
     rows, cols = surfaces.shape
@@ -96,6 +102,12 @@ def grown_patches(
             turn = 0.0
             if np.isfinite(normals[rr, cc, 0]):
                 turn = _bend(normals, sr, sc, rr, cc)
-            heapq.heappush(heap, (distance + weight * turn, pushed, np.int64(rr * cols + cc), label))
+            off = 0.0
+            if relative > 0.0:
+                for axis in range(3):
+                    off += (points[rr, cc, axis] - points[sr, sc, axis]) * normals[sr, sc, axis]
+                off /= relative * points[sr, sc, 2]
+            cost = distance + weight * turn + off * off
+            heapq.heappush(heap, (cost, pushed, np.int64(rr * cols + cc), label))
             pushed += 1
     return labels

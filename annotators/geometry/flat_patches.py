@@ -38,17 +38,35 @@ def flat_seeds(surfaces: np.ndarray, bending: np.ndarray, radius: int) -> np.nda
 
 
 def grown_patches(
-    surfaces: np.ndarray, normals: np.ndarray, seeds: np.ndarray, spacing: float, weight: float
+    surfaces: np.ndarray,
+    normals: np.ndarray,
+    points: np.ndarray,
+    seeds: np.ndarray,
+    spacing: float,
+    weight: float,
+    relative: float,
 ) -> np.ndarray:
     """HxW int32 patch labels (seed k gives label k + 1): every surface pixel reachable from a seed through its own
-    surface (4-neighbours) joins the seed of the lowest cost, ``d^2 / spacing^2 + weight (1 - n . n_seed)``."""
-    return _loops().grown_patches(np.ascontiguousarray(surfaces), np.ascontiguousarray(normals), seeds, spacing, weight)
+    surface (4-neighbours) joins the seed of the lowest cost, ``d^2 / spacing^2 + weight (1 - n . n_seed) +
+    (h / (relative z_seed))^2``: ``d`` pixels from the seed, ``h`` its height over the seed's tangent plane (with
+    ``relative`` 0, no height term)."""
+    return _loops().grown_patches(
+        np.ascontiguousarray(surfaces),
+        np.ascontiguousarray(normals),
+        np.ascontiguousarray(points),
+        seeds,
+        spacing,
+        weight,
+        relative,
+    )
 
 
-def flat_patches(surfaces: np.ndarray, normals: np.ndarray, spacing: int, weight: float) -> np.ndarray:
+def flat_patches(
+    surfaces: np.ndarray, normals: np.ndarray, points: np.ndarray, spacing: int, weight: float, relative: float
+) -> np.ndarray:
     """Patch labels (int32, 0 = none, 1..n) of the labelled ``surfaces`` (HxW) with the normals ``normals``
-    (HxWx3, NaN where unknown): seeds at least ``spacing`` pixels apart on each surface, grown by
-    :func:`grown_patches`. Pixels of a surface without any normal are left out."""
+    (HxWx3, NaN where unknown) of the ``points`` (HxWx3): seeds at least ``spacing`` pixels apart on each surface,
+    grown by :func:`grown_patches`. Pixels of a surface without any normal are left out."""
     bending = pixel_bending(surfaces, normals)
     seeds = flat_seeds(surfaces, bending, max(0, spacing - 1))
-    return grown_patches(surfaces, normals, seeds, float(spacing), weight)
+    return grown_patches(surfaces, normals, points, seeds, float(spacing), weight, relative)

@@ -54,13 +54,16 @@ def with_offset(dy: int, dx: int) -> None:
 
 
 def parameters(variant: str) -> clutter.ClutterParameters:
-    """``grid`` (today's cells) or ``grown:WEIGHT[:CELL]`` (grown patches)."""
+    """``grid`` (today's cells) or ``grown:WEIGHT[:SPACING[:RELATIVE]]`` (grown patches)."""
     base = clutter.ClutterParameters()
     if variant == "grid":
         return base
     parts = variant.split(":")
-    cell = int(parts[2]) if len(parts) > 2 else base.cell
-    return replace(base, grown_patches=True, patch_weight=float(parts[1]), cell=cell)
+    spacing = int(parts[2]) if len(parts) > 2 else base.patch_spacing
+    relative = float(parts[3]) if len(parts) > 3 else base.patch_relative
+    return replace(
+        base, grown_patches=True, patch_weight=float(parts[1]), patch_spacing=spacing, patch_relative=relative
+    )
 
 
 def segment(data: dict, p: clutter.ClutterParameters) -> np.ndarray:
@@ -136,12 +139,36 @@ def guards(inputs: dict[str, dict], variants: list[str], offsets: list[tuple[int
     clutter.bounding_box = ORIGINAL_BOX
 
 
+def render(inputs: dict[str, dict], variants: list[str], folder: Path, names: list[str]) -> None:
+    """Per input, a PNG with the colour image and each variant's segments (random colours, their pixel counts)."""
+    import cv2
+
+    folder.mkdir(parents=True, exist_ok=True)
+    for name in names:
+        data = inputs[name]
+        panels = [cv2.cvtColor(np.ascontiguousarray(data["colors"]), cv2.COLOR_RGB2BGR)]
+        for variant in variants:
+            labels = segment(data, parameters(variant))
+            palette = np.random.default_rng(1).integers(60, 255, (int(labels.max()) + 1, 3)).astype(np.uint8)
+            palette[0] = 0
+            panel = (0.35 * panels[0] + 0.65 * palette[labels]).astype(np.uint8)
+            for label in range(1, int(labels.max()) + 1):
+                rows, cols = np.nonzero(labels == label)
+                text = f"{label}:{rows.size}"
+                cv2.putText(panel, text, (int(cols.mean()) - 20, int(rows.mean())), 0, 0.4, (255, 255, 255), 1)
+            cv2.putText(panel, f"{variant} {int(labels.max())}", (5, 15), 0, 0.5, (0, 255, 255), 1)
+            panels.append(panel)
+        cv2.imwrite(str(folder / f"{name}.png"), np.hstack(panels))
+        print(f"wrote {folder / f'{name}.png'}", flush=True)
+
+
 def main() -> None:
     parser = argparse.ArgumentParser(description=__doc__.split("\n")[0])
-    parser.add_argument("part", choices=("mosd", "guards"))
+    parser.add_argument("part", choices=("mosd", "guards", "render"))
     parser.add_argument("--variant", action="append", default=[])
     parser.add_argument("--inputs", type=Path, default=Path("/tmp/seg9-inputs"))
     parser.add_argument("--offsets", type=int, default=clutter.ClutterParameters().cell, help="n: n x n offsets")
+    parser.add_argument("--name", action="append", default=[], help="render: the inputs to render")
     parser.add_argument("--scale", type=int, default=1, help="offsets in steps of this many coarse pixels")
     args = parser.parse_args()
     inputs = load(args.inputs)
@@ -149,8 +176,10 @@ def main() -> None:
     variants = args.variant or ["grid"]
     if args.part == "mosd":
         mosd(inputs, variants, offsets)
-    else:
+    elif args.part == "guards":
         guards(inputs, variants, offsets)
+    else:
+        render(inputs, variants, Path("/tmp/seg9-renders"), args.name)
 
 
 if __name__ == "__main__":
