@@ -129,9 +129,8 @@ class ClutterParameters(ClusterParameters):
     cell: int = 6
     normal_spread: float = 0.15
     grown_patches: bool = False
-    patch_spacing: int = 6
-    patch_weight: float = 16.0
-    patch_relative: float = 0.0
+    patch_spacing: int = 5
+    patch_weight: float = 8.0
     smooth_degrees: float = ConvexityRules.smooth_degrees
     concave_bending: float = ConvexityRules.concave_bending
     convex_share: float = ConvexityRules.convex_share
@@ -270,7 +269,7 @@ def segment_clutter(
     surfaces = label_parts(region & ~seams, 1)
     # grown patches take their boundaries from the data: the same patches wherever the crop starts
     if p.grown_patches:
-        cut = flat_patches(surfaces, normals, grid, p.patch_spacing, p.patch_weight, p.patch_relative)
+        cut = flat_patches(surfaces, normals, grid, p.patch_spacing, p.patch_weight, p.jump_relative)
     else:
         cut = grid_patches(surfaces, p.cell)
     patches = split_by_normals(cut, normals, p.normal_spread)

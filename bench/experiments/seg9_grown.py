@@ -39,6 +39,7 @@ from reasoning.evaluation.segmentation import score_segmentation, summarize  # n
 DATA = ROOT.parent / "shared" / "data"
 CATEGORIES = ("boxes", "stacked", "occluded", "cylindric")
 ORIGINAL_BOX = clutter.bounding_box
+ORIGINAL_PATCHES = clutter.flat_patches
 
 
 def with_offset(dy: int, dx: int) -> None:
@@ -54,16 +55,21 @@ def with_offset(dy: int, dx: int) -> None:
 
 
 def parameters(variant: str) -> clutter.ClutterParameters:
-    """``grid`` (today's cells) or ``grown:WEIGHT[:SPACING[:RELATIVE]]`` (grown patches)."""
+    """``grid`` (today's cells), ``grown`` (grown patches, their defaults) or ``grown:WEIGHT[:SPACING[:RELATIVE]]``
+    (RELATIVE: the height term's scale, by default the depth-jump scale ``jump_relative``; 0 for none)."""
     base = clutter.ClutterParameters()
     if variant == "grid":
         return base
     parts = variant.split(":")
+    weight = float(parts[1]) if len(parts) > 1 else base.patch_weight
     spacing = int(parts[2]) if len(parts) > 2 else base.patch_spacing
-    relative = float(parts[3]) if len(parts) > 3 else base.patch_relative
-    return replace(
-        base, grown_patches=True, patch_weight=float(parts[1]), patch_spacing=spacing, patch_relative=relative
-    )
+    relative = float(parts[3]) if len(parts) > 3 else None
+
+    def patches(*args: object) -> np.ndarray:  # the height term's scale alone replaced
+        return ORIGINAL_PATCHES(*args[:5], args[5] if relative is None else relative)
+
+    clutter.flat_patches = patches
+    return replace(base, grown_patches=True, patch_weight=weight, patch_spacing=spacing)
 
 
 def segment(data: dict, p: clutter.ClutterParameters) -> np.ndarray:
