@@ -9,8 +9,10 @@ Modes:
 * ``mosd``: the 45 labelled mOSD learn scenes scored per category (recall / precision at box IoU >= 0.5, overlap F,
   as bench/bench_segmentation.py scores them) for each variant at each of the ``cell`` x ``cell`` offsets; per
   category the median, minimum and maximum F over the offsets.
-* ``counts``: segment counts on the real guard inputs (uoc, grabber, fifteen objects) per offset.
-* ``same``: per input, at how many offsets the segments equal those at offset (0, 0) (pixel for pixel).
+* ``guards``: per real guard input, segment counts over the offsets and at how many offsets the labels equal those at
+  the first (pixel for pixel).
+* ``render``: PNGs of the colour image and each variant's segments (``--name`` inputs) in /tmp/seg9-renders.
+* ``timing``: least CPU ms of segment_clutter per ``--name`` input and variant, the variants alternating.
 
 Run from the repository root:
 ``PYTHONPATH=$PWD python bench/experiments/seg9_grown.py mosd --variant grid --variant grown:16``.
@@ -168,9 +170,28 @@ def render(inputs: dict[str, dict], variants: list[str], folder: Path, names: li
         print(f"wrote {folder / f'{name}.png'}", flush=True)
 
 
+def timing(inputs: dict[str, dict], variants: list[str], names: list[str], rounds: int = 10) -> None:
+    """Least CPU ms of segment_clutter per input and variant, the variants alternating in one process."""
+    import time
+
+    with_offset(0, 0)
+    least: dict[tuple[str, str], float] = collections.defaultdict(lambda: float("inf"))
+    for _ in range(rounds):
+        for name in names:
+            for variant in variants:
+                p = parameters(variant)
+                start = time.process_time()
+                segment(inputs[name], p)
+                least[name, variant] = min(least[name, variant], 1000 * (time.process_time() - start))
+    for name in names:
+        cells = "  ".join(f"{v} {least[name, v]:.1f}" for v in variants)
+        print(f"{name}: {cells}  ratio {least[name, variants[-1]] / least[name, variants[0]]:.2f}", flush=True)
+    clutter.bounding_box = ORIGINAL_BOX
+
+
 def main() -> None:
     parser = argparse.ArgumentParser(description=__doc__.split("\n")[0])
-    parser.add_argument("part", choices=("mosd", "guards", "render"))
+    parser.add_argument("part", choices=("mosd", "guards", "render", "timing"))
     parser.add_argument("--variant", action="append", default=[])
     parser.add_argument("--inputs", type=Path, default=Path("/tmp/seg9-inputs"))
     parser.add_argument("--offsets", type=int, default=clutter.ClutterParameters().cell, help="n: n x n offsets")
@@ -184,6 +205,8 @@ def main() -> None:
         mosd(inputs, variants, offsets)
     elif args.part == "guards":
         guards(inputs, variants, offsets)
+    elif args.part == "timing":
+        timing(inputs, variants, args.name)
     else:
         render(inputs, variants, Path("/tmp/seg9-renders"), args.name)
 
