@@ -108,7 +108,10 @@ from robokudo.core.types import CasType, ObjectHypothesis, Plane, PointCloud
 class ClutterParameters(ClusterParameters):
     """Thresholds of :func:`segment_clutter`: those of the cluster extractor (candidates, depth jumps, hue edges,
     merging), the normals (``normal_step`` / ``normal_smoothing`` coarse pixels), the patches (``cell`` x ``cell``
-    coarse pixels, split when their normals spread by more than ``normal_spread``), the grouping
+    coarse pixels, split when their normals spread by more than ``normal_spread``; with ``grown_patches`` grown from
+    seeds ``patch_spacing`` apart instead, :func:`~annotators.geometry.flat_patches.flat_patches` with the normal
+    weight ``patch_weight`` and the height term on the depth-jump scale ``jump_relative``: the same patches wherever
+    the crop starts, bench/profiles/seg9-analysis.txt), the grouping
     (:class:`~annotators.geometry.convexity.ConvexityRules`) and the share of a boundary that must be creased for a
     hue edge to split an object (``creased_share``); ``join_unsupported`` joins the pieces that could not stand by
     themselves to the object that holds them, ``join_jointly_held`` those two touching neighbours hold only
