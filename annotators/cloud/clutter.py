@@ -50,6 +50,7 @@ Works like :mod:`annotators.cloud.clusters` on every ``stride``-th pixel of the 
 
 from __future__ import annotations
 
+import math
 from dataclasses import dataclass, fields, replace
 from functools import partial
 from typing import ClassVar
@@ -68,6 +69,7 @@ from annotators.cloud.plane import plane_basis, plane_distances
 from annotators.geometry.border_pixels import BorderRules, claim_border_pixels, plane_noise
 from annotators.geometry.container_floors import FloorRules, claim_container_floors, touches_other_labels
 from annotators.geometry.convexity import ConvexityRules, convex_groups, dense_labels, grid_patches, split_by_normals
+from annotators.geometry.flat_patches import flat_patches
 from annotators.geometry.grid_kernels import object_pieces, plane_coordinates, strided_crop
 from annotators.geometry.grid_segmentation import (
     MergeRules,
@@ -106,7 +108,10 @@ from robokudo.core.types import CasType, ObjectHypothesis, Plane, PointCloud
 class ClutterParameters(ClusterParameters):
     """Thresholds of :func:`segment_clutter`: those of the cluster extractor (candidates, depth jumps, hue edges,
     merging), the normals (``normal_step`` / ``normal_smoothing`` coarse pixels), the patches (``cell`` x ``cell``
-    coarse pixels, split when their normals spread by more than ``normal_spread``), the grouping
+    coarse pixels, split when their normals spread by more than ``normal_spread``; with ``grown_patches`` grown from
+    seeds ``patch_spacing`` apart instead, :func:`~annotators.geometry.flat_patches.flat_patches` with the normal
+    weight ``patch_weight`` and the height term on the depth-jump scale ``jump_relative``: the same patches wherever
+    the crop starts, bench/profiles/seg9-analysis.txt), the grouping
     (:class:`~annotators.geometry.convexity.ConvexityRules`) and the share of a boundary that must be creased for a
     hue edge to split an object (``creased_share``); ``join_unsupported`` joins the pieces that could not stand by
     themselves to the object that holds them, ``join_jointly_held`` those two touching neighbours hold only
@@ -126,6 +131,9 @@ class ClutterParameters(ClusterParameters):
     normal_smoothing: int = 3
     cell: int = 6
     normal_spread: float = 0.15
+    grown_patches: bool = False
+    patch_spacing: int = 5
+    patch_weight: float = 8.0
     smooth_degrees: float = ConvexityRules.smooth_degrees
     concave_bending: float = ConvexityRules.concave_bending
     convex_share: float = ConvexityRules.convex_share
@@ -225,6 +233,18 @@ class ClutterParameters(ClusterParameters):
         return replace(super().merge_rules(), nested=True, overlap=0.15)
 
 
+SAMPLING_PERIOD = math.lcm(
+    FOOTPRINT_ROWS,
+    SupportRules.sample_step,
+    AppendageRules.sample_step,
+    SlabRules.sample_step,
+    NeckRules.sample_step,
+    FloorRules.sample_step,
+)
+"""Coarse pixels: the later steps read every few pixels or rows counted from the crop's corner; with the corner on a
+multiple of all their spacings they read the same pixels of the image wherever the candidates' box starts."""
+
+
 def segment_clutter(
     points: np.ndarray,
     mask: np.ndarray,
@@ -242,13 +262,20 @@ def segment_clutter(
     if not coarse.any():
         return []
     x0, y0, x1, y1 = bounding_box(coarse, margin=2)
+    if p.grown_patches:  # the sampled rows and pixels on the image's grid, not the crop's: the crop may start anywhere
+        x0, y0 = x0 - x0 % SAMPLING_PERIOD, y0 - y0 % SAMPLING_PERIOD
     region = coarse[y0:y1, x0:x1]
     grid = strided_crop(points, step, (x0, y0, x1, y1))
     depth = grid[..., 2]
     seams = depth_seams(depth, region, p.jump_absolute, p.jump_relative)
     normals = grid_normals(grid, p.normal_step, p.normal_smoothing, p.jump_absolute, p.jump_relative)
     surfaces = label_parts(region & ~seams, 1)
-    patches = split_by_normals(grid_patches(surfaces, p.cell), normals, p.normal_spread)
+    # grown patches take their boundaries from the data: the same patches wherever the crop starts
+    if p.grown_patches:
+        cut = flat_patches(surfaces, normals, grid, p.patch_spacing, p.patch_weight, p.jump_relative)
+    else:
+        cut = grid_patches(surfaces, p.cell)
+    patches = split_by_normals(cut, normals, p.normal_spread)
     # patches without a trustworthy plane (a face seen edge-on, a few points) go with the object beside them
     reach = max(2.0 * p.cell, p.grow_distance / step)
     # the angle between neighbouring pixels, a property of the camera: measured once, on every few rows

@@ -40,10 +40,12 @@ def desk() -> tuple[PointCloud, Plane]:
     return root.cas.view(PointCloud), max(root.cas.annotations(Plane), key=lambda p: p.inlier_indices.size)
 
 
-def segments(cloud: PointCloud, plane: Plane, mask: np.ndarray) -> list[Segment]:
+def segments(
+    cloud: PointCloud, plane: Plane, mask: np.ndarray, parameters: ClutterParameters | None = None
+) -> list[Segment]:
     """The clutter segments of the masked cloud on the plane."""
     model, inliers = np.asarray(plane.model), np.asarray(plane.inlier_indices)
-    return segment_clutter(cloud.points, mask, model, inliers, ClutterParameters(), cloud.colors)
+    return segment_clutter(cloud.points, mask, model, inliers, parameters or ClutterParameters(), cloud.colors)
 
 
 def mug_pixels(found: list[Segment], width: int) -> set[int]:
@@ -54,11 +56,21 @@ def mug_pixels(found: list[Segment], width: int) -> set[int]:
     return set(held[0].indices.tolist())
 
 
-@pytest.mark.xfail(strict=True, reason="cells counted from the candidates' corner (range4-analysis.txt)")
-def test_the_mug_does_not_change_when_the_board_top_is_cut_off(desk: tuple[PointCloud, Plane]) -> None:
+GRID = pytest.param(
+    ClutterParameters(),
+    marks=pytest.mark.xfail(strict=True, reason="cells counted from the candidates' corner (range4-analysis.txt)"),
+    id="grid cells",
+)
+GROWN = pytest.param(ClutterParameters(grown_patches=True), id="grown patches")
+
+
+@pytest.mark.parametrize("parameters", [GRID, GROWN])
+def test_the_mug_does_not_change_when_the_board_top_is_cut_off(
+    desk: tuple[PointCloud, Plane], parameters: ClutterParameters
+) -> None:
     cloud, plane = desk
     width = cloud.points.shape[1]
-    found = segments(cloud, plane, cloud.mask)
+    found = segments(cloud, plane, cloud.mask, parameters)
     whole = mug_pixels(found, width)
     top = min(int(segment.indices.min()) // width for segment in found)  # the board's top row
     assert top < MUG[1] - 60, top  # far above the mug
@@ -66,6 +78,6 @@ def test_the_mug_does_not_change_when_the_board_top_is_cut_off(desk: tuple[Point
     for cut in range(2, 14, 2):  # one to six coarse rows: every phase of a 6-row cell
         mask = cloud.mask.copy()
         mask[: top + cut] = False
-        if mug_pixels(segments(cloud, plane, mask), width) != whole:
+        if mug_pixels(segments(cloud, plane, mask, parameters), width) != whole:
             differing.append(cut)
     assert not differing, f"the mug's pixels change when the top {differing} rows of the candidates are cut off"
