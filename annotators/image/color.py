@@ -8,14 +8,15 @@ Each surface is named (:func:`name_surface`):
   balance errs) is white when its lit luminance is about the frame's surround luminance or above (and it is not
   dark in absolute terms), black when it is dark both absolutely and against the surround, else grey;
 * a saturated surface is named in CIELAB by CIEDE2000 distances to the colour-name prototypes of
-  :mod:`annotators.image.color_prototypes` (the xkcd colour survey), as a kernel density classifier: each
-  term's prototypes vote with a Gaussian of their distance (``kernel_width``) averaged per term, and the winning
-  term's share of the votes is the name's certainty; brown gets no vote from a colour of chroma C* at least
-  ``brown_max_chroma`` (brown surfaces are of moderate chroma; a dim yellow or orange print is not brown);
-  against the object's own white, lit by the same light (:func:`_related_to_white`): brown gets no vote from a
-  surface nearly as light as that white (``brown_below_white``: brown is a yellow or orange clearly darker than
-  white, not a cream in a dim frame), and yellow and orange are told apart at the lightness the surface has when
-  the white is lifted to a white's luminance (``white_luminance``);
+  :mod:`annotators.image.color_prototypes` (the xkcd colour survey), as a kernel density classifier: each term's
+  prototypes vote with a Gaussian of their distance (``kernel_width``) averaged per term, and the winning term's share
+  of the votes is the name's certainty; brown gets no vote from a colour of chroma C* at least ``brown_max_chroma``
+  (brown surfaces are of moderate chroma; a dim yellow or orange print is not brown) or of a hue outside the survey's
+  browns' (:data:`BROWN_HUES`), and a colour of a hue outside the survey's pinks' (:data:`PINK_HUES`) is not named
+  pink; against the object's own white, lit by the same light (:func:`_related_to_white`): brown gets no vote from a
+  surface nearly as light as that white (``brown_below_white``: brown is a yellow or orange clearly darker than white,
+  not a cream in a dim frame), and yellow and orange are told apart at the lightness the surface has when the white is
+  lifted to a white's luminance (``white_luminance``);
 * the near-black pool is a dark colour (a navy mug) when its mean colour is clearly saturated, else black; it
   counts only when it is a sizeable part of the object or has the name of one of its lit surfaces (shadows are
   dropped).
@@ -165,14 +166,21 @@ def _without_colourful_brown(votes: np.ndarray, labs: np.ndarray, parameters: Na
     """The votes with brown's taken away (the others' shares renormalised) for colours whose chroma C* is at
     least ``brown_max_chroma`` (too colourful for a brown surface, they are a yellow or orange seen in less light)
     or whose hue lies outside :data:`BROWN_HUES` (an olive print greener than any brown people named is a dark
-    green, whatever the many yellowish browns near it say); and pink's taken away for colours whose hue lies
-    outside :data:`PINK_HUES` (a pale reddish brown tin more orange than any pink people named is not pink). Both
-    terms have survey prototypes of low chroma, whose CIEDE2000 votes reach far in hue (the hue term counts
-    little at low chroma). A colour whose every vote is the one term keeps them."""
+    green, whatever the many yellowish browns near it say); a colour whose every vote is brown keeps them. Then
+    :func:`_not_pink_outside_its_hues`."""
     hue = _hue_degrees(labs)
     outside = _outside_arc(hue, BROWN_HUES)
     votes = _without_brown(votes, (np.hypot(labs[:, 1], labs[:, 2]) >= parameters.brown_max_chroma) | outside)
-    return _without_term(votes, _outside_arc(hue, PINK_HUES), _PINK)
+    return _not_pink_outside_its_hues(votes, hue)
+
+
+def _not_pink_outside_its_hues(votes: np.ndarray, hue: np.ndarray) -> np.ndarray:
+    """The votes with pink's taken away (the others' renormalised) for the colours they would name pink whose
+    hue (degrees) lies outside :data:`PINK_HUES`: a pale reddish brown tin in a bright frame, more orange than any
+    pink people named, takes its next name (brown). The survey's pinks reach down to low chroma, where CIEDE2000
+    counts hue differences little, so their votes reach far in hue; only the name is corrected, not every vote (a
+    small pink share of a colour named otherwise is left as it is)."""
+    return _without_term(votes, _outside_arc(hue, PINK_HUES) & (votes.argmax(axis=1) == _PINK), _PINK)
 
 
 def _without_brown(votes: np.ndarray, chosen: np.ndarray) -> np.ndarray:
