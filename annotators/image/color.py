@@ -150,7 +150,9 @@ def _prototype_hue_arc(term: str) -> tuple[float, float]:
 def _outside_arc(hue: np.ndarray, arc: tuple[float, float]) -> np.ndarray:
     """Which hues (degrees) lie outside an arc from :func:`_prototype_hue_arc`."""
     start, end = arc
-    return ((hue - start) % 360.0) > ((end - start) % 360.0)
+    if start <= end:
+        return (hue < start) | (hue > end)
+    return (hue > end) & (hue < start)  # the arc crosses 0
 
 
 BROWN_HUES: tuple[float, float] = _prototype_hue_arc("brown")
@@ -180,7 +182,10 @@ def _not_pink_outside_its_hues(votes: np.ndarray, hue: np.ndarray) -> np.ndarray
     pink people named, takes its next name (brown). The survey's pinks reach down to low chroma, where CIEDE2000
     counts hue differences little, so their votes reach far in hue; only the name is corrected, not every vote (a
     small pink share of a colour named otherwise is left as it is)."""
-    return _without_term(votes, _outside_arc(hue, PINK_HUES) & (votes.argmax(axis=1) == _PINK), _PINK)
+    named_pink = votes.argmax(axis=1) == _PINK
+    if not np.any(named_pink):
+        return votes
+    return _without_term(votes, named_pink & _outside_arc(hue, PINK_HUES), _PINK)
 
 
 def _without_brown(votes: np.ndarray, chosen: np.ndarray) -> np.ndarray:
