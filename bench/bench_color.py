@@ -4,7 +4,8 @@ For the objects of tests/data/colors/real_colors.json (frames read in place from
 namer was tuned on "tune" frames; "held_out" and "fresh" frames were not used for tuning; the objects of labelling
 round 2 were labelled later, before the namer was changed again, and split into "tune" and "fresh" by a fixed rule,
 see the json's "about"; from the third round on "held_out" is tuned on too and "fresh2", labelled in round 3, is the
-new held-out check) and overall, it prints:
+new held-out check; from the fourth round on "fresh2" is tuned on too and "fresh" is the only held-out check) and
+overall, it prints:
 
 * named as labelled: the reported names are what the label says (tests/annotators/color_set.py);
 * dominant right: the first reported name is one a person gave as the object's (main) colour;

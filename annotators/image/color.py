@@ -8,14 +8,15 @@ Each surface is named (:func:`name_surface`):
   balance errs) is white when its lit luminance is about the frame's surround luminance or above (and it is not
   dark in absolute terms), black when it is dark both absolutely and against the surround, else grey;
 * a saturated surface is named in CIELAB by CIEDE2000 distances to the colour-name prototypes of
-  :mod:`annotators.image.color_prototypes` (the xkcd colour survey), as a kernel density classifier: each
-  term's prototypes vote with a Gaussian of their distance (``kernel_width``) averaged per term, and the winning
-  term's share of the votes is the name's certainty; brown gets no vote from a colour of chroma C* at least
-  ``brown_max_chroma`` (brown surfaces are of moderate chroma; a dim yellow or orange print is not brown);
-  against the object's own white, lit by the same light (:func:`_related_to_white`): brown gets no vote from a
-  surface nearly as light as that white (``brown_below_white``: brown is a yellow or orange clearly darker than
-  white, not a cream in a dim frame), and yellow and orange are told apart at the lightness the surface has when
-  the white is lifted to a white's luminance (``white_luminance``);
+  :mod:`annotators.image.color_prototypes` (the xkcd colour survey), as a kernel density classifier: each term's
+  prototypes vote with a Gaussian of their distance (``kernel_width``) averaged per term, and the winning term's share
+  of the votes is the name's certainty; brown gets no vote from a colour of chroma C* at least ``brown_max_chroma``
+  (brown surfaces are of moderate chroma; a dim yellow or orange print is not brown) or of a hue outside the survey's
+  browns' (:data:`BROWN_HUES`), and a colour of a hue outside the survey's pinks' (:data:`PINK_HUES`) is not named
+  pink; against the object's own white, lit by the same light (:func:`_related_to_white`): brown gets no vote from a
+  surface nearly as light as that white (``brown_below_white``: brown is a yellow or orange clearly darker than white,
+  not a cream in a dim frame), and yellow and orange are told apart at the lightness the surface has when the white is
+  lifted to a white's luminance (``white_luminance``);
 * the near-black pool is a dark colour (a navy mug) when its mean colour is clearly saturated, else black; it
   counts only when it is a sizeable part of the object or has the name of one of its lit surfaces (shadows are
   dropped).
@@ -129,6 +130,7 @@ def _term_votes(labs: np.ndarray, parameters: NamingParameters) -> np.ndarray:
 
 
 _BROWN = CHROMATIC_TERMS.index("brown")
+_PINK = CHROMATIC_TERMS.index("pink")
 
 
 def _hue_degrees(labs: np.ndarray) -> np.ndarray:
@@ -136,32 +138,70 @@ def _hue_degrees(labs: np.ndarray) -> np.ndarray:
     return np.degrees(np.arctan2(labs[..., 2], labs[..., 1])) % 360.0
 
 
-BROWN_HUES: tuple[float, float] = (
-    float(_hue_degrees(_PROTOTYPE_LAB[np.array(_PROTOTYPE_TERMS) == "brown"]).min()),
-    float(_hue_degrees(_PROTOTYPE_LAB[np.array(_PROTOTYPE_TERMS) == "brown"]).max()),
-)
+def _prototype_hue_arc(term: str) -> tuple[float, float]:
+    """The shortest arc of CIELAB hues (start, end in degrees, counter-clockwise; start > end when it crosses
+    0) that holds the hue of every survey prototype of ``term``: the circle less the widest gap between them."""
+    hues = np.sort(_hue_degrees(_PROTOTYPE_LAB[np.array(_PROTOTYPE_TERMS) == term]))
+    gaps = np.diff(np.append(hues, hues[0] + 360.0))
+    widest = int(np.argmax(gaps))
+    return float(hues[(widest + 1) % len(hues)]), float(hues[widest])
+
+
+def _outside_arc(hue: np.ndarray, arc: tuple[float, float]) -> np.ndarray:
+    """Which hues (degrees) lie outside an arc from :func:`_prototype_hue_arc`."""
+    start, end = arc
+    if start <= end:
+        return (hue < start) | (hue > end)
+    return (hue > end) & (hue < start)  # the arc crosses 0
+
+
+BROWN_HUES: tuple[float, float] = _prototype_hue_arc("brown")
 """The range of CIELAB hues (degrees) the survey's brown prototypes span, from the reddest ("reddish brown") to the
 greenest ("greenish brown"): no colour people called brown lies outside it."""
+
+PINK_HUES: tuple[float, float] = _prototype_hue_arc("pink")
+"""The arc of CIELAB hues (degrees, crossing 0) the survey's pink prototypes span, from the bluest pinks (about
+327) to the most orange ones (about 34, "orange pink"): no colour people called pink is yellower than that."""
 
 
 def _without_colourful_brown(votes: np.ndarray, labs: np.ndarray, parameters: NamingParameters) -> np.ndarray:
     """The votes with brown's taken away (the others' shares renormalised) for colours whose chroma C* is at
     least ``brown_max_chroma`` (too colourful for a brown surface, they are a yellow or orange seen in less light)
     or whose hue lies outside :data:`BROWN_HUES` (an olive print greener than any brown people named is a dark
-    green, whatever the many yellowish browns near it say); a colour whose every vote is brown keeps them."""
+    green, whatever the many yellowish browns near it say); a colour whose every vote is brown keeps them. Then
+    :func:`_not_pink_outside_its_hues`."""
     hue = _hue_degrees(labs)
-    outside = (hue < BROWN_HUES[0]) | (hue > BROWN_HUES[1])
-    return _without_brown(votes, (np.hypot(labs[:, 1], labs[:, 2]) >= parameters.brown_max_chroma) | outside)
+    outside = _outside_arc(hue, BROWN_HUES)
+    votes = _without_brown(votes, (np.hypot(labs[:, 1], labs[:, 2]) >= parameters.brown_max_chroma) | outside)
+    return _not_pink_outside_its_hues(votes, hue)
+
+
+def _not_pink_outside_its_hues(votes: np.ndarray, hue: np.ndarray) -> np.ndarray:
+    """The votes with pink's taken away (the others' renormalised) for the colours they would name pink whose
+    hue (degrees) lies outside :data:`PINK_HUES`: a pale reddish brown tin in a bright frame, more orange than any
+    pink people named, takes its next name (brown). The survey's pinks reach down to low chroma, where CIEDE2000
+    counts hue differences little, so their votes reach far in hue; only the name is corrected, not every vote (a
+    small pink share of a colour named otherwise is left as it is)."""
+    named_pink = votes.argmax(axis=1) == _PINK
+    if not np.any(named_pink):
+        return votes
+    return _without_term(votes, named_pink & _outside_arc(hue, PINK_HUES), _PINK)
 
 
 def _without_brown(votes: np.ndarray, chosen: np.ndarray) -> np.ndarray:
     """The votes (S x terms) with brown's share taken away and the others' renormalised in the ``chosen`` rows;
     a row whose every vote is brown keeps them."""
-    rest = 1.0 - votes[:, _BROWN]
+    return _without_term(votes, chosen, _BROWN)
+
+
+def _without_term(votes: np.ndarray, chosen: np.ndarray, term: int) -> np.ndarray:
+    """The votes (S x terms) with term ``term``'s share taken away and the others' renormalised in the
+    ``chosen`` rows; a row whose every vote is that term keeps them."""
+    rest = 1.0 - votes[:, term]
     change = chosen & (rest > 1e-12)
     if np.any(change):
         votes = votes.copy()
-        votes[change, _BROWN] = 0.0
+        votes[change, term] = 0.0
         votes[change] /= rest[change, None]
     return votes
 

@@ -39,7 +39,8 @@ RING_PX = 14
 SPLITS = ("tune", "held_out", "fresh", "fresh2")
 """The labelled splits. Rounds 1-2 tuned the namer on "tune" only; "held_out" and "fresh" checked it. From the third
 tuning round on (branch colour10) "held_out" keeps its name but is tuned on as well: "fresh" and "fresh2" (labelled
-in round 3, before the namer was run on it) are the held-out checks."""
+in round 3, before the namer was run on it) are the held-out checks. From the fourth round on (branch colour11)
+"fresh2" is tuned on too: "fresh" (never tuned on) is the one held-out check."""
 
 FIRST_ROUND = 1
 """The labelling round the issue's goals were measured on (its "tune" and "held_out" objects, 84)."""

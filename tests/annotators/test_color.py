@@ -296,6 +296,17 @@ def test_an_olive_print_greener_than_any_brown_is_green_not_brown() -> None:
     assert names(np.vstack([white, khaki])) == ["white", "brown"]
 
 
+def test_a_pale_reddish_brown_more_orange_than_any_pink_is_brown_not_pink() -> None:
+    # a cookie tin's lit side in a bright frame (hue about 40 degrees): light enough that the survey's low-chroma
+    # pinks outvote the browns, but no colour people called pink is that orange (the most orange, "orange pink",
+    # is at 34); a dusty rose, a salmon and a magenta pink (hue 344: the pinks' hues cross 0) stay pink
+    tin = patch((178, 139, 129), count=600)
+    assert names(tin) == ["brown"]
+    assert names(np.vstack([tin, patch((236, 234, 230), count=300, seed=1)])) == ["brown", "white"]
+    for pink in ((180, 120, 125), (230, 150, 140), (235, 130, 190)):
+        assert names(patch(pink, count=600)) == ["pink"], pink
+
+
 def test_a_colour_lit_and_in_shade_is_one_colour_even_where_the_shaded_side_is_larger() -> None:
     # a crisps tube as in mOSD frames: a narrow lit yellow side, a wider shaded side of the same hue (orange alone)
     # and a white band larger than either side but smaller than both; the tube's colour is the dominant one
