@@ -3,8 +3,6 @@ this file). Importing this module imports numba; :mod:`~annotators.geometry.flat
 
 from __future__ import annotations
 
-import heapq
-
 import numpy as np
 from numba import njit
 
@@ -65,6 +63,48 @@ def flat_seeds(surfaces: np.ndarray, order: np.ndarray, bending: np.ndarray, rad
 
 
 @njit(cache=True, nogil=True)
+def _before(costs: np.ndarray, a: int, b: int) -> bool:
+    """Does entry ``a`` come before entry ``b``: a lower cost, then pushed earlier (entries are numbered in push
+    order)."""
+    return costs[a] < costs[b] or (costs[a] == costs[b] and a < b)
+
+
+@njit(cache=True, nogil=True)
+def _push(heap: np.ndarray, size: int, costs: np.ndarray, entry: int) -> int:
+    """Add ``entry`` to the binary heap ``heap`` of ``size`` entry numbers ordered by :func:`_before`; the new
+    size."""
+    i = size
+    while i > 0:
+        parent = (i - 1) // 2
+        if not _before(costs, entry, heap[parent]):
+            break
+        heap[i] = heap[parent]
+        i = parent
+    heap[i] = entry
+    return size + 1
+
+
+@njit(cache=True, nogil=True)
+def _pop(heap: np.ndarray, size: int, costs: np.ndarray) -> int:
+    """Remove the first entry of the heap of ``size`` entries (the caller has read it); the new size."""
+    size -= 1
+    last = heap[size]
+    i = 0
+    while True:
+        child = 2 * i + 1
+        if child >= size:
+            break
+        if child + 1 < size and _before(costs, heap[child + 1], heap[child]):
+            child += 1
+        if not _before(costs, heap[child], last):
+            break
+        heap[i] = heap[child]
+        i = child
+    heap[i] = last
+    return size
+
+
+@njit(cache=True, nogil=True)
 def grown_patches(
     surfaces: np.ndarray,
     normals: np.ndarray,
@@ -74,19 +114,29 @@ def grown_patches(
     weight: float,
     relative: float,
 ) -> np.ndarray:
-    """See :func:`annotators.geometry.flat_patches.grown_patches`."""
+    """See :func:`annotators.geometry.flat_patches.grown_patches`. A priority flood on a binary heap of entry
+    numbers (each entry's cost, pixel and seed in arrays); a pixel is queued again only at a lower cost than it
+    waits at already (a costlier entry, pushed later, could never be taken first)."""
     rows, cols = surfaces.shape
     labels = np.zeros((rows, cols), dtype=np.int32)
-    heap = [(0.0, np.int64(0), np.int64(0), np.int64(0))]
-    heap.pop()
-    pushed = np.int64(0)
+    waiting = np.full((rows, cols), np.inf)
+    capacity = seeds.size + 4 * rows * cols
+    costs = np.empty(capacity)
+    pixels = np.empty(capacity, dtype=np.int64)
+    owners = np.empty(capacity, dtype=np.int32)
+    heap = np.empty(capacity, dtype=np.int64)
+    size = 0
+    entries = 0
     for k in range(seeds.size):
-        heapq.heappush(heap, (0.0, pushed, seeds[k], np.int64(k + 1)))
-        pushed += 1
+        costs[entries], pixels[entries], owners[entries] = 0.0, seeds[k], k + 1
+        size = _push(heap, size, costs, entries)
+        entries += 1
     seed_rows = seeds // cols
     seed_cols = seeds % cols
-    while len(heap) > 0:
-        _, _, pixel, label = heapq.heappop(heap)
+    while size > 0:
+        entry = heap[0]
+        size = _pop(heap, size, costs)
+        pixel, label = pixels[entry], owners[entry]
         r, c = pixel // cols, pixel % cols
         if labels[r, c] != 0:
             continue
@@ -108,6 +158,10 @@ def grown_patches(
                     off += (points[rr, cc, axis] - points[sr, sc, axis]) * normals[sr, sc, axis]
                 off /= relative * points[sr, sc, 2]
             cost = distance + weight * turn + off * off
-            heapq.heappush(heap, (cost, pushed, np.int64(rr * cols + cc), label))
-            pushed += 1
+            if cost >= waiting[rr, cc]:
+                continue
+            waiting[rr, cc] = cost
+            costs[entries], pixels[entries], owners[entries] = cost, rr * cols + cc, label
+            size = _push(heap, size, costs, entries)
+            entries += 1
     return labels
