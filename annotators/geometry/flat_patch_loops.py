@@ -41,6 +41,19 @@ def pixel_bending(surfaces: np.ndarray, normals: np.ndarray) -> np.ndarray:
 
 
 @njit(cache=True, nogil=True)
+def ties_in_order(order: np.ndarray, values: np.ndarray) -> None:
+    """Sort each run of equal ``values[order]`` in ``order`` (sorted by value) by index, in place: what a stable
+    sort gives. Ties are rare (an insertion sort per run)."""
+    for k in range(1, order.size):
+        index = order[k]
+        j = k - 1
+        while j >= 0 and values[order[j]] == values[index] and order[j] > index:
+            order[j + 1] = order[j]
+            j -= 1
+        order[j + 1] = index
+
+
+@njit(cache=True, nogil=True)
 def flat_seeds(surfaces: np.ndarray, order: np.ndarray, bending: np.ndarray, radius: int) -> np.ndarray:
     """See :func:`annotators.geometry.flat_patches.flat_seeds`."""
     rows, cols = surfaces.shape
@@ -63,44 +76,40 @@ def flat_seeds(surfaces: np.ndarray, order: np.ndarray, bending: np.ndarray, rad
 
 
 @njit(cache=True, nogil=True)
-def _before(costs: np.ndarray, a: int, b: int) -> bool:
-    """Does entry ``a`` come before entry ``b``: a lower cost, then pushed earlier (entries are numbered in push
-    order)."""
-    return costs[a] < costs[b] or (costs[a] == costs[b] and a < b)
-
-
-@njit(cache=True, nogil=True)
-def _push(heap: np.ndarray, size: int, costs: np.ndarray, entry: int) -> int:
-    """Add ``entry`` to the binary heap ``heap`` of ``size`` entry numbers ordered by :func:`_before`; the new
-    size."""
+def _push(keys: np.ndarray, entries: np.ndarray, size: int, key: float, entry: int) -> int:
+    """Add ``entry`` at ``key`` to the binary heap (parallel arrays ``keys``, ``entries``) of ``size`` entries,
+    ordered by key, then entry number (entries are numbered in push order); the new size."""
     i = size
     while i > 0:
         parent = (i - 1) // 2
-        if not _before(costs, entry, heap[parent]):
+        if keys[parent] < key or (keys[parent] == key and entries[parent] < entry):
             break
-        heap[i] = heap[parent]
+        keys[i], entries[i] = keys[parent], entries[parent]
         i = parent
-    heap[i] = entry
+    keys[i], entries[i] = key, entry
     return size + 1
 
 
 @njit(cache=True, nogil=True)
-def _pop(heap: np.ndarray, size: int, costs: np.ndarray) -> int:
+def _pop(keys: np.ndarray, entries: np.ndarray, size: int) -> int:
     """Remove the first entry of the heap of ``size`` entries (the caller has read it); the new size."""
     size -= 1
-    last = heap[size]
+    key, entry = keys[size], entries[size]
     i = 0
     while True:
         child = 2 * i + 1
         if child >= size:
             break
-        if child + 1 < size and _before(costs, heap[child + 1], heap[child]):
-            child += 1
-        if not _before(costs, heap[child], last):
+        other = child + 1
+        if other < size and (
+            keys[other] < keys[child] or (keys[other] == keys[child] and entries[other] < entries[child])
+        ):
+            child = other
+        if key < keys[child] or (key == keys[child] and entry < entries[child]):
             break
-        heap[i] = heap[child]
+        keys[i], entries[i] = keys[child], entries[child]
         i = child
-    heap[i] = last
+    keys[i], entries[i] = key, entry
     return size
 
 
@@ -114,28 +123,28 @@ def grown_patches(
     weight: float,
     relative: float,
 ) -> np.ndarray:
-    """See :func:`annotators.geometry.flat_patches.grown_patches`. A priority flood on a binary heap of entry
-    numbers (each entry's cost, pixel and seed in arrays); a pixel is queued again only at a lower cost than it
-    waits at already (a costlier entry, pushed later, could never be taken first)."""
+    """See :func:`annotators.geometry.flat_patches.grown_patches`. A priority flood on a binary heap of
+    (cost, entry number) in two arrays (each entry's pixel and seed in two more); a pixel is queued again only at
+    a lower cost than it waits at already (a costlier entry, pushed later, could never be taken first)."""
     rows, cols = surfaces.shape
     labels = np.zeros((rows, cols), dtype=np.int32)
     waiting = np.full((rows, cols), np.inf)
     capacity = seeds.size + 4 * rows * cols
-    costs = np.empty(capacity)
     pixels = np.empty(capacity, dtype=np.int64)
     owners = np.empty(capacity, dtype=np.int32)
+    keys = np.empty(capacity)
     heap = np.empty(capacity, dtype=np.int64)
     size = 0
     entries = 0
     for k in range(seeds.size):
-        costs[entries], pixels[entries], owners[entries] = 0.0, seeds[k], k + 1
-        size = _push(heap, size, costs, entries)
+        pixels[entries], owners[entries] = seeds[k], k + 1
+        size = _push(keys, heap, size, 0.0, entries)
         entries += 1
     seed_rows = seeds // cols
     seed_cols = seeds % cols
     while size > 0:
         entry = heap[0]
-        size = _pop(heap, size, costs)
+        size = _pop(keys, heap, size)
         pixel, label = pixels[entry], owners[entry]
         r, c = pixel // cols, pixel % cols
         if labels[r, c] != 0:
@@ -161,7 +170,7 @@ def grown_patches(
             if cost >= waiting[rr, cc]:
                 continue
             waiting[rr, cc] = cost
-            costs[entries], pixels[entries], owners[entries] = cost, rr * cols + cc, label
-            size = _push(heap, size, costs, entries)
+            pixels[entries], owners[entries] = rr * cols + cc, label
+            size = _push(keys, heap, size, cost, entries)
             entries += 1
     return labels
