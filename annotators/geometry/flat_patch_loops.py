@@ -75,42 +75,10 @@ def flat_seeds(surfaces: np.ndarray, order: np.ndarray, bending: np.ndarray, rad
     return seeds[:count]
 
 
-@njit(cache=True, nogil=True)
-def _push(keys: np.ndarray, entries: np.ndarray, size: int, key: float, entry: int) -> int:
-    """Add ``entry`` at ``key`` to the binary heap (parallel arrays ``keys``, ``entries``) of ``size`` entries,
-    ordered by key, then entry number (entries are numbered in push order); the new size."""
-    i = size
-    while i > 0:
-        parent = (i - 1) // 2
-        if keys[parent] < key or (keys[parent] == key and entries[parent] < entry):
-            break
-        keys[i], entries[i] = keys[parent], entries[parent]
-        i = parent
-    keys[i], entries[i] = key, entry
-    return size + 1
-
-
-@njit(cache=True, nogil=True)
-def _pop(keys: np.ndarray, entries: np.ndarray, size: int) -> int:
-    """Remove the first entry of the heap of ``size`` entries (the caller has read it); the new size."""
-    size -= 1
-    key, entry = keys[size], entries[size]
-    i = 0
-    while True:
-        child = 2 * i + 1
-        if child >= size:
-            break
-        other = child + 1
-        if other < size and (
-            keys[other] < keys[child] or (keys[other] == keys[child] and entries[other] < entries[child])
-        ):
-            child = other
-        if key < keys[child] or (key == keys[child] and entry < entries[child]):
-            break
-        keys[i], entries[i] = keys[child], entries[child]
-        i = child
-    keys[i], entries[i] = key, entry
-    return size
+BUCKETS = 32768
+"""Bucket queue of :func:`grown_patches`: costs in steps of ``1 / STEPS``; every cost from ``BUCKETS / STEPS`` on
+shares the last bucket (a pixel that far from its seed, or turned that far, is last in any case)."""
+STEPS = 1024.0
 
 
 @njit(cache=True, nogil=True)
@@ -123,28 +91,38 @@ def grown_patches(
     weight: float,
     relative: float,
 ) -> np.ndarray:
-    """See :func:`annotators.geometry.flat_patches.grown_patches`. A priority flood on a binary heap of
-    (cost, entry number) in two arrays (each entry's pixel and seed in two more); a pixel is queued again only at
-    a lower cost than it waits at already (a costlier entry, pushed later, could never be taken first)."""
+    """See :func:`annotators.geometry.flat_patches.grown_patches`. A priority flood on a bucket queue: costs taken
+    in steps of ``1 / STEPS`` (a thousandth of a pixel ``spacing`` from the seed), first in first out within one
+    step; a pixel is queued again only at a lower cost than it waits at already."""
     rows, cols = surfaces.shape
     labels = np.zeros((rows, cols), dtype=np.int32)
     waiting = np.full((rows, cols), np.inf)
     capacity = seeds.size + 4 * rows * cols
     pixels = np.empty(capacity, dtype=np.int64)
     owners = np.empty(capacity, dtype=np.int32)
-    keys = np.empty(capacity)
-    heap = np.empty(capacity, dtype=np.int64)
-    size = 0
-    entries = 0
+    following = np.empty(capacity, dtype=np.int64)  # the next entry of the same bucket, -1 for none
+    heads = np.full(BUCKETS, -1, dtype=np.int64)
+    tails = np.full(BUCKETS, -1, dtype=np.int64)
+    entries, queued, current = 0, 0, 0
     for k in range(seeds.size):
-        pixels[entries], owners[entries] = seeds[k], k + 1
-        size = _push(keys, heap, size, 0.0, entries)
+        pixels[entries], owners[entries], following[entries] = seeds[k], k + 1, -1
+        if tails[0] < 0:
+            heads[0] = entries
+        else:
+            following[tails[0]] = entries
+        tails[0] = entries
         entries += 1
+        queued += 1
     seed_rows = seeds // cols
     seed_cols = seeds % cols
-    while size > 0:
-        entry = heap[0]
-        size = _pop(keys, heap, size)
+    while queued > 0:
+        while heads[current] < 0:
+            current += 1
+        entry = heads[current]
+        heads[current] = following[entry]
+        if heads[current] < 0:
+            tails[current] = -1
+        queued -= 1
         pixel, label = pixels[entry], owners[entry]
         r, c = pixel // cols, pixel % cols
         if labels[r, c] != 0:
@@ -170,7 +148,14 @@ def grown_patches(
             if cost >= waiting[rr, cc]:
                 continue
             waiting[rr, cc] = cost
-            pixels[entries], owners[entries] = rr * cols + cc, label
-            size = _push(keys, heap, size, cost, entries)
+            bucket = BUCKETS - 1 if cost * STEPS >= BUCKETS - 1 else max(0, int(cost * STEPS))
+            pixels[entries], owners[entries], following[entries] = rr * cols + cc, label, -1
+            if tails[bucket] < 0:
+                heads[bucket] = entries
+            else:
+                following[tails[bucket]] = entries
+            tails[bucket] = entries
             entries += 1
+            queued += 1
+            current = min(current, bucket)
     return labels
