@@ -77,8 +77,10 @@ class ConvexityRules:
     ``min_patch`` points, at most ``max_thickness`` (smallest / middle eigenvalue) and at least ``min_width``
     (middle / largest) for a plane; faces of fewer than
     ``min_face`` points are slivers; patches touch across up to ``gap_width`` pixels, and only when their centroids
-    are at most ``close_factor`` times their grid distance apart in 3-D; with ``small_joins_once`` a face of fewer
-    than ``min_face`` points joins only the one neighbour it agrees with most (a sliver cannot bridge two faces)."""
+    are at most ``close_factor`` times their grid distance apart in 3-D; with ``small_joins_once`` two faces of
+    fewer than ``min_face`` points join on fewer than ``min_votes`` convex votes only where one is the other's best
+    neighbour (the one it agrees with most), so a string of small faces cannot carry a join from one object to the
+    next; a small face still joins every large face it agrees with (a sliver along a box's edge)."""
 
     smooth_degrees: float = 20.0
     concave_bending: float = 20.0
@@ -259,7 +261,9 @@ def _join_faces(
         (share <= rules.convex_share) & both_large & (votes >= rules.min_votes)
     ]
     if rules.small_joins_once:
-        agree &= (strength >= rules.min_votes) | _best_of_small(first, second, strength, agree, large)
+        # a small face joins a large one on its convex majority, another small face only as its best neighbour
+        small_pair = ~large[first] & ~large[second]
+        agree &= (strength >= rules.min_votes) | ~small_pair | _best_of_small(first, second, strength, agree, large)
     order = np.argsort(-strength[agree], kind="stable")
     return join_unless_apart(count, np.column_stack([first, second])[agree][order], kept_apart)
 
@@ -268,7 +272,7 @@ def _best_of_small(
     first: np.ndarray, second: np.ndarray, strength: np.ndarray, agree: np.ndarray, large: np.ndarray
 ) -> np.ndarray:
     """Per face pair: is it, among the agreeing pairs, the strongest of a small face in it (the first in pair order
-    on ties)? Each small face so keeps one join, and no chain of small faces can link two large ones."""
+    on ties)?"""
     ends = np.concatenate([first, second])
     index = np.concatenate([np.arange(first.size)] * 2)
     pick = np.concatenate([agree, agree]) & ~large[ends]

@@ -1,8 +1,8 @@
-"""With grown patches (ClutterParameters(grown_patches=True)) a face too small to be trusted joins only the one
-neighbour it agrees with most unless it has the votes a large face needs (bench/profiles/seg10-analysis.txt).
+"""With grown patches (ClutterParameters(grown_patches=True)) two faces too small to be trusted join on fewer votes
+than large faces need only where one is the other's best neighbour (bench/profiles/seg10-analysis.txt).
 
 On uoc frame 2 grown patches cut the Cheez-It box and the drill beside it into a chain of small faces (6-60 points)
-that each joined both of their neighbours on one convex vote, so the box, the drill, the mug, the bowl and the can
+that each joined every neighbour on one convex vote, so the box, the drill, the mug, the bowl and the can
 in it became one segment; on uoc frame 1 the tall can joined the blue mug the same way.
 """
 
@@ -49,3 +49,9 @@ def test_objects_standing_apart_are_not_chained_into_one_segment(uoc_folder: Pat
     held = {name: int(found[row, col]) for name, (col, row) in APART[index].items()}
     assert all(held.values()), held  # each pixel lies on some segment
     assert len(set(held.values())) == len(held), held
+
+
+def test_the_drill_stays_one_segment(uoc_folder: Path) -> None:
+    found = labels(uoc_folder, 2)
+    body, battery = found[126, 367], found[175, 392]  # (row, column) on the drill's body and on its battery
+    assert body > 0 and body == battery, (body, battery)
