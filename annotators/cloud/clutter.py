@@ -160,8 +160,10 @@ class ClutterParameters(ClusterParameters):
     claim_borders: bool = True
 
     def convexity_rules(self) -> ConvexityRules:
-        """The thresholds of :func:`annotators.geometry.convexity.convex_groups`."""
-        return ConvexityRules(**{f.name: getattr(self, f.name) for f in fields(ConvexityRules)})
+        """The thresholds of :func:`annotators.geometry.convexity.convex_groups` (with grown patches two small
+        faces join on a weak vote only as one's best neighbour, ``small_joins_once``)."""
+        names = [f.name for f in fields(ConvexityRules) if f.name != "small_joins_once"]
+        return ConvexityRules(**{n: getattr(self, n) for n in names}, small_joins_once=self.grown_patches)
 
     def appendage_rules(self) -> AppendageRules:
         """The thresholds of :func:`annotators.geometry.support.join_appendages`: the merge rules' share of a

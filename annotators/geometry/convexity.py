@@ -77,7 +77,10 @@ class ConvexityRules:
     ``min_patch`` points, at most ``max_thickness`` (smallest / middle eigenvalue) and at least ``min_width``
     (middle / largest) for a plane; faces of fewer than
     ``min_face`` points are slivers; patches touch across up to ``gap_width`` pixels, and only when their centroids
-    are at most ``close_factor`` times their grid distance apart in 3-D."""
+    are at most ``close_factor`` times their grid distance apart in 3-D; with ``small_joins_once`` two faces of
+    fewer than ``min_face`` points join on fewer than ``min_votes`` convex votes only where one is the other's best
+    neighbour (the one it agrees with most), so a string of small faces cannot carry a join from one object to the
+    next; a small face still joins every large face it agrees with (a sliver along a box's edge)."""
 
     smooth_degrees: float = 20.0
     concave_bending: float = 20.0
@@ -90,6 +93,7 @@ class ConvexityRules:
     concave_share: float = 0.25
     gap_width: float = 2.0
     close_factor: float = 3.0
+    small_joins_once: bool = False
 
 
 @dataclass(frozen=True, eq=False)
@@ -250,13 +254,36 @@ def _join_faces(
     first, second = keys // count, keys % count
     large = np.bincount(faces, weights=planes_sizes(planes, count), minlength=count) >= rules.min_face
     both_large = large[first] & large[second]
-    agree = (share > rules.convex_share) & ((share * votes >= rules.min_votes) | ~both_large)
+    strength = share * votes
+    agree = (share > rules.convex_share) & ((strength >= rules.min_votes) | ~both_large)
     # one vote decides nothing: a single noisy connection neither joins two large faces nor keeps them apart
     kept_apart = np.column_stack([first, second])[
         (share <= rules.convex_share) & both_large & (votes >= rules.min_votes)
     ]
-    order = np.argsort(-(share * votes)[agree], kind="stable")
+    if rules.small_joins_once:
+        # a small face joins a large one on its convex majority, another small face only as its best neighbour
+        small_pair = ~large[first] & ~large[second]
+        agree &= (strength >= rules.min_votes) | ~small_pair | _best_of_small(first, second, strength, agree, large)
+    order = np.argsort(-strength[agree], kind="stable")
     return join_unless_apart(count, np.column_stack([first, second])[agree][order], kept_apart)
+
+
+def _best_of_small(
+    first: np.ndarray, second: np.ndarray, strength: np.ndarray, agree: np.ndarray, large: np.ndarray
+) -> np.ndarray:
+    """Per face pair: is it, among the agreeing pairs, the strongest of a small face in it (the first in pair order
+    on ties)?"""
+    ends = np.concatenate([first, second])
+    index = np.concatenate([np.arange(first.size)] * 2)
+    pick = np.concatenate([agree, agree]) & ~large[ends]
+    ends, index = ends[pick], index[pick]
+    order = np.lexsort((index, -strength[index], ends))
+    ends, index = ends[order], index[order]
+    lead = np.ones(ends.size, dtype=bool)
+    lead[1:] = ends[1:] != ends[:-1]
+    best = np.zeros(first.size, dtype=bool)
+    best[index[lead]] = True
+    return best
 
 
 def _dense(groups: np.ndarray, usable: np.ndarray) -> np.ndarray:

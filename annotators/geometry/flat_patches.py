@@ -33,7 +33,10 @@ def pixel_bending(surfaces: np.ndarray, normals: np.ndarray) -> np.ndarray:
 def flat_seeds(surfaces: np.ndarray, bending: np.ndarray, radius: int) -> np.ndarray:
     """Flat pixel indices of the seeds: pixels in order of increasing ``bending`` (ties in row-major order), each
     kept unless a kept seed of its surface lies within ``radius`` pixels (a square window)."""
-    order = np.argsort(bending.reshape(-1), kind="stable")
+    flat = bending.reshape(-1)
+    candidates = np.flatnonzero(np.isfinite(flat))  # the others can be no seed
+    order = candidates[np.argsort(flat[candidates])]  # quicksort, then ties put in row-major order
+    _loops().ties_in_order(order, flat)
     return _loops().flat_seeds(np.ascontiguousarray(surfaces), order, bending, radius)
 
 

@@ -170,7 +170,7 @@ def render(inputs: dict[str, dict], variants: list[str], folder: Path, names: li
         print(f"wrote {folder / f'{name}.png'}", flush=True)
 
 
-def timing(inputs: dict[str, dict], variants: list[str], names: list[str], rounds: int = 10) -> None:
+def timing(inputs: dict[str, dict], variants: list[str], names: list[str], rounds: int = 20) -> None:
     """Least CPU ms of segment_clutter per input and variant, the variants alternating in one process."""
     import time
 
