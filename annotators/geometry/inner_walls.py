@@ -6,15 +6,16 @@ the back arc, so the outside's footprint holds little of the inside's and :func:
 join_unsupported` leaves the inside alone - which by itself reads as some other object.
 
 The inner wall tells itself apart by its shape: it is concave toward the camera. Its normals (oriented toward the
-camera) point at the container's axis, which lies in front of the wall; the front of a solid object curves the
-other way, its normals spreading away from an axis behind it. A piece that cannot stand by itself (the candidates
-of :func:`~annotators.geometry.support.join_unsupported`: smaller than its neighbour, not reaching the table, its
-lowest heights in the lower half of the neighbour's), whose surface touches the neighbour's in 3-D along their
-shared border (the rim; an object hidden behind another is parted from it by a depth jump), whose wall curves
-around an axis in front of it, whose axis lies within the footprint of the two together - the container's floor -
-and whose neighbour's wall lies no nearer that axis - the outside surrounds the inside; a can standing in a bowl
-is nearer the bowl's axis than the bowl's inner wall - is that container's inside and joins it
-(:func:`join_inner_walls`).
+camera) point at the container's axis, which lies in front of the wall; the front of a solid object curves the other
+way, its normals spreading away from an axis behind it. A piece that does not reach the table beside its neighbour
+(its lowest heights above the neighbour's; it may be the larger of the two - a wide mug seen from above shows more
+inside than outside - and may end high up, where the front rim hides the rest: so not the candidates of
+:func:`~annotators.geometry.support.join_unsupported`, which must be smaller and reach down into their holder),
+whose surface touches the neighbour's in 3-D along their shared border (the rim; an object hidden behind another is
+parted from it by a depth jump), whose wall curves around an axis in front of it, whose axis lies within the
+footprint of the two together - the container's floor - and whose neighbour's wall lies no nearer that axis - the
+outside surrounds the inside; a can standing in a bowl is nearer the bowl's axis than the bowl's inner wall - is
+that container's inside and joins it (:func:`join_inner_walls`).
 """
 
 from __future__ import annotations
@@ -34,20 +35,20 @@ from annotators.geometry.support import (
     joint_hull,
     summarize_pieces,
 )
-from annotators.geometry.support_kernels import kept_labels, unsupported_candidates
+from annotators.geometry.support_kernels import kept_labels
 from annotators.geometry.support_kernels import pixel_footprint as footprint_angle
 
 
 @dataclass(frozen=True)
 class InnerWallRules:
-    """Thresholds of :func:`join_inner_walls`: which pieces cannot stand by themselves (``support``, as for
-    :func:`~annotators.geometry.support.join_unsupported`); the close border along which piece and holder must
-    touch in 3-D (``boundary_share`` times the square root of the piece's size, at least ``min_boundary`` pixel
-    pairs, depth jumps ``jump_absolute + jump_relative * nearer depth``); the wall points used (``wall_normal``: the
-    least horizontal component of their unit normals); how much the wall's normals must turn (``min_turn``: the
-    smaller eigenvalue of the mean of ``I - n n^T`` over its horizontal normals; a flat wall has 0 and no axis)
-    and how squarely they must face the axis (``facing``: the median distance to the axis along the normals at
-    least this share of the median distance to it)."""
+    """Thresholds of :func:`join_inner_walls`: the height noise by which an inside's lowest heights must lie above
+    its holder's and the sampling of heights and footprints (``support.tolerance``, ``support.sample_step``); the
+    close border along which piece and holder must touch in 3-D (``boundary_share`` times the square root of the
+    piece's size, at least ``min_boundary`` pixel pairs, depth jumps ``jump_absolute + jump_relative * nearer
+    depth``); the wall points used (``wall_normal``: the least horizontal component of their unit normals); how much
+    the wall's normals must turn (``min_turn``: the smaller eigenvalue of the mean of ``I - n n^T`` over its
+    horizontal normals; a flat wall has 0 and no axis) and how squarely they must face the axis (``facing``: the
+    median distance to the axis along the normals at least this share of the median distance to it)."""
 
     support: SupportRules = field(default_factory=SupportRules)
     boundary_share: float = 0.6
@@ -91,6 +92,15 @@ def wall_axis(points: np.ndarray, normals: np.ndarray, rules: InnerWallRules) ->
     return (axis, distance) if ahead > 0 and ahead >= rules.facing * distance else None
 
 
+def inside_candidates(pairs: np.ndarray, low: np.ndarray, tolerance: float) -> np.ndarray:
+    """Mx2 ``(piece, holder)`` of the touching ``pairs`` (Kx2), each way round (all pairs as given, then all
+    reversed), whose piece's 5 % height ``low`` lies above the holder's by more than ``tolerance``: it does not
+    reach the table beside the holder. Unlike a piece resting on another, an inside seen over the rim may be the
+    larger of the two (a wide mug from above) and may end high up (where the front rim hides the rest)."""
+    both = np.concatenate([pairs, pairs[:, ::-1]])
+    return both[low[both[:, 0]] > low[both[:, 1]] + tolerance]
+
+
 def bordering_long_enough(
     candidates: np.ndarray, pairs: np.ndarray, pieces: PieceSummary, rules: InnerWallRules
 ) -> np.ndarray:
@@ -123,9 +133,7 @@ def inner_wall_holders(
     pairs = pieces.touching_pairs(labels)
     if pairs.shape[0] == 0:
         return []
-    candidates = unsupported_candidates(
-        pairs, pieces.sizes, pieces.low, pieces.high, support.tolerance, support.reach_down
-    )
+    candidates = inside_candidates(pairs, pieces.low, support.tolerance)
     if pieces.border is not None:
         candidates = candidates[bordering_long_enough(candidates, pairs, pieces, rules)]
     if candidates.shape[0] == 0:

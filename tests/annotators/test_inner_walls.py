@@ -6,7 +6,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from annotators.geometry.inner_walls import InnerWallRules, wall_axis, wall_points
+from annotators.geometry.inner_walls import InnerWallRules, inside_candidates, wall_axis, wall_points
 
 
 def arc(centre: tuple[float, float], radius: float, start: float, stop: float, inward: bool) -> np.ndarray:
@@ -45,3 +45,14 @@ def test_floor_points_are_no_wall() -> None:
     normals = np.tile([0.0, 0.0, 1.0], (points.shape[0], 1))  # a horizontal surface: normals straight up
     wall, _ = wall_points(points, normals, InnerWallRules())
     assert wall.shape[0] == 0
+
+
+def test_an_inside_larger_than_its_outside_or_ending_high_up_is_a_candidate() -> None:
+    # piece 1: a wide mug's inside seen from above, larger than the outside and ending 5.7 cm up (the front rim hides
+    # the rest); piece 2: the outside, down to the table; piece 3: something beside it on the table
+    low = np.array([0.0, 0.057, 0.014, 0.012])
+    pairs = np.array([[1, 2], [2, 3]])
+    candidates = inside_candidates(pairs, low, InnerWallRules().support.tolerance).tolist()
+    assert [1, 2] in candidates
+    assert [2, 3] not in candidates and [3, 2] not in candidates  # both reach the table
+    assert [2, 1] not in candidates

@@ -1,0 +1,30 @@
+"""An open container's inside seen over its rim joins its outside even where the inside is the larger part in view
+or ends high up, hidden by the front rim (annotators/geometry/inner_walls.py).
+
+With grown patches (``ClutterParameters(grown_patches=True)``), uoc 1's white mug came out as its inside (with rim
+and handle, 3189 px) and its outer front wall (1986 px), and uoc 4's purple cup lost its far inner wall, whose lowest
+point is 5.7 cm up; both insides were refused as candidates because join_unsupported's rule for a piece resting on
+another (smaller than its holder, reaching down into it) was applied to them. Scored against the hand labels of
+tests/data/labels/guard_objects.json.
+"""
+
+from __future__ import annotations
+
+from dataclasses import replace
+
+import pytest
+
+from annotators.cloud.clutter import ClutterParameters
+from reasoning.evaluation.object_verdicts import load_labelled_objects, object_verdicts
+from tests.annotators.guard_frames import LABELS, segment_frame
+
+pytestmark = pytest.mark.real_data
+
+UOC = "uoc_tabletop_realsense"
+
+
+@pytest.mark.parametrize(("index", "name"), [(1, "white mug"), (4, "purple cup")])
+def test_the_inside_seen_over_the_rim_joins_the_outside(index: int, name: str) -> None:
+    objects = load_labelled_objects(LABELS)[(UOC, index)]
+    labels = segment_frame(UOC, index, replace(ClutterParameters(), grown_patches=True))
+    assert str(object_verdicts(labels, objects)[name]) == "whole"
