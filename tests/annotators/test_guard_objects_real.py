@@ -5,7 +5,7 @@ Every labelled object must come out whole: not cut into pieces, merged with anot
 or missed. The robot would otherwise report two half mugs, or one drill-and-box, or nothing.
 
 This holds for the crop each frame gives today. It is not a property of the grid cells in general: with the
-segmenter's crop started at the 35 other cell phases, up to 16 of these objects (median 9) are not whole
+segmenter's crop started at the 35 other cell phases, up to 15 of these objects (median 8) are not whole
 (``bench/score_guards.py --offsets 6``, bench/profiles/segscore-analysis.txt).
 """
 
