@@ -33,6 +33,8 @@ ROOT = Path(__file__).resolve().parents[2]
 sys.path.insert(0, str(ROOT))
 sys.path.insert(0, str(ROOT / "bench"))
 
+from score_guards import ORIGINAL_BOX, with_offset  # noqa: E402  (the crop moved as in the guard scores)
+
 import annotators.cloud.clutter as clutter  # noqa: E402
 from annotators.readers.pcd_io import read_pcd  # noqa: E402
 from reasoning.evaluation.mosd import object_labels, scene_category  # noqa: E402
@@ -40,20 +42,7 @@ from reasoning.evaluation.segmentation import score_segmentation, summarize  # n
 
 DATA = ROOT.parent / "shared" / "data"
 CATEGORIES = ("boxes", "stacked", "occluded", "cylindric")
-ORIGINAL_BOX = clutter.bounding_box
 ORIGINAL_PATCHES = clutter.flat_patches
-
-
-def with_offset(dy: int, dx: int) -> None:
-    """Make segment_clutter's crop (the bounding box of margin 2) start ``dy`` rows and ``dx`` columns earlier."""
-
-    def box(mask: np.ndarray, margin: int = 0) -> tuple[int, int, int, int]:
-        x0, y0, x1, y1 = ORIGINAL_BOX(mask, margin)
-        if margin == 2:
-            x0, y0 = max(0, x0 - dx), max(0, y0 - dy)
-        return x0, y0, x1, y1
-
-    clutter.bounding_box = box
 
 
 def parameters(variant: str) -> clutter.ClutterParameters:
