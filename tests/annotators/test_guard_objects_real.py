@@ -25,6 +25,6 @@ FRAMES = load_labelled_objects(LABELS)
 
 
 @pytest.mark.parametrize("key", sorted(FRAMES), ids=lambda key: f"{Path(key[0]).stem}-{key[1]}")
-def test_every_labelled_object_is_whole(key: tuple[str, int]) -> None:
+def test_every_labelled_object_is_whole(uoc_folder: Path, key: tuple[str, int]) -> None:
     verdicts = object_verdicts(segment_frame(*key, ClutterParameters()), FRAMES[key])
     assert {name: str(v) for name, v in verdicts.items() if v.kind != "whole"} == {}

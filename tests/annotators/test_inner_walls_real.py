@@ -11,6 +11,7 @@ tests/data/labels/guard_objects.json.
 from __future__ import annotations
 
 from dataclasses import replace
+from pathlib import Path
 
 import pytest
 
@@ -24,7 +25,7 @@ UOC = "uoc_tabletop_realsense"
 
 
 @pytest.mark.parametrize(("index", "name"), [(1, "white mug"), (4, "purple cup")])
-def test_the_inside_seen_over_the_rim_joins_the_outside(index: int, name: str) -> None:
+def test_the_inside_seen_over_the_rim_joins_the_outside(uoc_folder: Path, index: int, name: str) -> None:
     objects = load_labelled_objects(LABELS)[(UOC, index)]
     labels = segment_frame(UOC, index, replace(ClutterParameters(), grown_patches=True))
     assert str(object_verdicts(labels, objects)[name]) == "whole"
