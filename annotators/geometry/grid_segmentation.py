@@ -267,16 +267,18 @@ def _sorted_range(ordered: np.ndarray, low: float, high: float) -> tuple[float, 
 
 
 RIM_BAND = 0.5
-"""A part spanning at most this share of another's heights, in their upper part, lies in the band of a rim: a
-handle, or an inner wall seen over the rim of a cup or bowl. It is measured against the other's top (99 %), since
-the rim is a container's highest point and reaches above the body's 95 % height."""
+"""A part spanning at most this share of another's heights, or starting above this share of them, lies in the band
+of a rim: a handle, an inner wall seen over the rim of a cup or bowl, or the top of its outer wall (the rest hidden
+or cut off). It is measured against the other's top (99 %), since the rim is a container's highest point and
+reaches above the body's 95 % height. A neighbour standing beside the other on the table does neither."""
 
 
 def heights_nest(first: np.ndarray, second: np.ndarray, tolerance: float) -> bool:
     """Does the 5 %-95 % range of one set of heights above the plane lie within the other's (``tolerance`` metres
     of slack)? A container's inside or handle lies within its body's heights; an object standing on another lies
     above it. A part in the rim band (:data:`RIM_BAND`) may reach up to the other's top instead of its 95 % height;
-    a neighbour of about the same height never counts as in the rim band, so its top must nest strictly.
+    a neighbour of about the same height, standing beside it, never counts as in the rim band, so its top must nest
+    strictly.
     """
     return _sorted_heights_nest(np.sort(first), np.sort(second), tolerance)
 
@@ -287,7 +289,8 @@ def _sorted_heights_nest(first: np.ndarray, second: np.ndarray, tolerance: float
     tops = [_sorted_range(heights, 0.05, 0.99)[1] for heights in (first, second)]
     for inner, outer in ((0, 1), (1, 0)):
         (low_in, high_in), (low_out, high_out) = ranges[inner], ranges[outer]
-        in_band = high_in - low_in <= RIM_BAND * (high_out - low_out)
+        span = high_out - low_out
+        in_band = high_in - low_in <= RIM_BAND * span or low_in >= low_out + RIM_BAND * span
         top = tops[outer] if in_band else high_out
         if low_in >= low_out - tolerance and high_in <= top + tolerance:
             return True

@@ -79,7 +79,8 @@ def _height_quantiles(heights: np.ndarray, begin: int, end: int) -> np.ndarray:
 def _heights_nest(first: np.ndarray, second: np.ndarray, tolerance: float, rim_band: float) -> bool:
     """:func:`annotators.geometry.grid_segmentation.heights_nest` of two parts' height quantiles (5, 50, 95, 99 %)."""
     for inner, outer in ((first, second), (second, first)):
-        in_band = inner[2] - inner[0] <= rim_band * (outer[2] - outer[0])
+        span = outer[2] - outer[0]
+        in_band = inner[2] - inner[0] <= rim_band * span or inner[0] >= outer[0] + rim_band * span
         top = outer[3] if in_band else outer[2]
         if inner[0] >= outer[0] - tolerance and inner[2] <= top + tolerance:
             return True

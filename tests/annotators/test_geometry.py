@@ -135,6 +135,17 @@ def test_a_handle_reaching_the_rim_nests_in_its_body_and_what_stands_on_it_does_
     assert not heights_nest(neighbour, body, 0.003)
 
 
+def test_the_top_of_a_bowls_outer_wall_nests_in_its_inside_up_to_the_rim() -> None:
+    # the inside seen over the rim: floor to rim, few points on the rim itself (bench/profiles/segscore-analysis.txt,
+    # learn35's white bowl); the outer wall's upper half, the rest cut off as another piece, reaches the rim
+    inside = np.concatenate([_heights(0.017, 0.084, 470), _heights(0.084, 0.089, 25)])
+    outer_top = _heights(0.052, 0.0905)  # more than half the inside's heights, all in their upper half
+    assert heights_nest(outer_top, inside, 0.003)
+    # a neighbour beside it, seen from higher up, reaching as high: measured against the 95 % height
+    beside = _heights(0.030, 0.094)
+    assert not heights_nest(beside, inside, 0.003)
+
+
 def _disk(centre: tuple[float, float], radius: float, height: np.ndarray) -> np.ndarray:
     angles = np.linspace(0, 2 * np.pi, height.size, endpoint=False)
     radii = radius * np.sqrt(np.linspace(0.05, 1.0, height.size))
