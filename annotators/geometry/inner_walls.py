@@ -15,7 +15,9 @@ whose surface touches the neighbour's in 3-D along their shared border (the rim;
 parted from it by a depth jump), whose wall curves around an axis in front of it, whose axis lies within the
 footprint of the two together - the container's floor - and whose neighbour's wall lies no nearer that axis - the
 outside surrounds the inside; a can standing in a bowl is nearer the bowl's axis than the bowl's inner wall - is
-that container's inside and joins it (:func:`join_inner_walls`).
+that container's inside and joins it (:func:`join_inner_walls`). So does a concave piece beside another concave
+piece curving around the same axis with the same radius: the inside, cut in two where it bends faster than the
+convexity grouping's concave limit (:func:`one_wall`).
 """
 
 from __future__ import annotations
@@ -47,8 +49,9 @@ class InnerWallRules:
     piece's size, at least ``min_boundary`` pixel pairs, depth jumps ``jump_absolute + jump_relative * nearer
     depth``); the wall points used (``wall_normal``: the least horizontal component of their unit normals); how much
     the wall's normals must turn (``min_turn``: the smaller eigenvalue of the mean of ``I - n n^T`` over its
-    horizontal normals; a flat wall has 0 and no axis) and how squarely they must face the axis (``facing``: the
-    median distance to the axis along the normals at least this share of the median distance to it)."""
+    horizontal normals; a flat wall has 0 and no axis), how squarely they must face the axis (``facing``: the
+    median distance to the axis along the normals at least this share of the median distance to it) and how close
+    the axes and radii of two concave pieces of one inner wall are (``same_axis``, a share of the radius)."""
 
     support: SupportRules = field(default_factory=SupportRules)
     boundary_share: float = 0.6
@@ -58,6 +61,7 @@ class InnerWallRules:
     wall_normal: float = 0.5
     min_turn: float = 0.05
     facing: float = 0.5
+    same_axis: float = 0.25
 
 
 _MIN_WALL_POINTS = 10
@@ -90,6 +94,16 @@ def wall_axis(points: np.ndarray, normals: np.ndarray, rules: InnerWallRules) ->
     ahead = float(np.median(np.einsum("ni,ni->n", axis - points, normals)))
     distance = float(np.median(np.linalg.norm(axis - points, axis=1)))
     return (axis, distance) if ahead > 0 and ahead >= rules.facing * distance else None
+
+
+def one_wall(first: tuple[np.ndarray, float], second: tuple[np.ndarray, float] | None, share: float) -> bool:
+    """Are two concave walls (``wall_axis`` results) pieces of one round inner wall: their axes within ``share`` of
+    the first's radius of each other, and their radii within that too? The inside of a bowl seen over its rim is
+    cut where it bends faster than the concave limit; each piece curves around the same axis."""
+    if second is None:
+        return False
+    (axis, radius), (other_axis, other_radius) = first, second
+    return bool(np.linalg.norm(other_axis - axis) <= share * radius and abs(other_radius - radius) <= share * radius)
 
 
 def inside_candidates(pairs: np.ndarray, low: np.ndarray, tolerance: float) -> np.ndarray:
@@ -162,8 +176,13 @@ def inner_wall_holders(
         floor = joint_hull(pieces, piece, holder).reshape(-1, 1, 2).astype(np.float32)
         if floor.shape[0] < 3 or cv2.pointPolygonTest(floor, (float(axis[0]), float(axis[1])), False) <= 0:
             continue
-        outside, _ = walls(holder)  # the outer wall surrounds the inner one: no nearer the axis
+        outside, outside_normals = walls(holder)  # the outer wall surrounds the inner one: no nearer the axis
         if outside.shape[0] >= _MIN_WALL_POINTS and np.median(np.linalg.norm(outside - axis, axis=1)) >= radius:
+            shaped.append((piece, holder))
+            continue
+        if holder not in axes:
+            axes[holder] = wall_axis(outside, outside_normals, rules)
+        if one_wall((axis, radius), axes[holder], rules.same_axis):  # the holder is the rest of the inner wall
             shaped.append((piece, holder))
     if not shaped:
         return []

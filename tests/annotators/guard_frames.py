@@ -1,5 +1,5 @@
 """The hand-labelled uoc guard frames (tests/data/labels/guard_objects.json) and the default way the clutter segmenter
-is run on them, shared by the tests and bench/score_guards.py."""
+is run on them and on labelled mOSD scenes, shared by the tests and bench/score_guards.py."""
 
 from __future__ import annotations
 
@@ -12,6 +12,8 @@ from annotators.cloud.filters import range_mask
 from annotators.cloud.point_cloud import back_project, pixel_rays
 from annotators.cloud.support_choice import find_support_plane
 from annotators.readers.frame_io import read_color_depth_pair
+from annotators.readers.pcd_io import read_pcd
+from reasoning.evaluation.mosd import object_labels
 
 REPO_ROOT = Path(__file__).resolve().parents[2]
 SHARED_DATA = REPO_ROOT.parent / "shared" / "data"
@@ -22,9 +24,22 @@ def segment_frame(input_name: str, index: int, parameters: ClutterParameters) ->
     """HxW int32 segment numbers (0 none) of the clutter segmenter on a colour + depth frame, larger ones first."""
     frame = read_color_depth_pair(SHARED_DATA / input_name, index)
     points = np.ascontiguousarray(back_project(frame.depth, pixel_rays(frame.intrinsics)), dtype=np.float32)
+    return segment_points(points, frame.color, parameters)
+
+
+def segment_mosd_scene(path: Path, parameters: ClutterParameters) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """The segment numbers of :func:`segment_frame` on a labelled mOSD scene, its ground-truth object labels and its
+    valid (measured) pixels."""
+    frame = read_pcd(path)
+    points = np.ascontiguousarray(frame.points, dtype=np.float32)
+    return segment_points(points, frame.color, parameters), object_labels(frame.labels), np.isfinite(points[..., 2])
+
+
+def segment_points(points: np.ndarray, colors: np.ndarray, parameters: ClutterParameters) -> np.ndarray:
+    """Segment numbers of the clutter segmenter on an organized cloud, larger segments first."""
     mask = range_mask(points, np.isfinite(points[..., 2]), 0.2, 2.5)
     fit = find_support_plane(points, mask)
-    found = segment_clutter(points, mask, fit.model, fit.inlier_indices, parameters, frame.color)
+    found = segment_clutter(points, mask, fit.model, fit.inlier_indices, parameters, colors)
     labels = np.zeros(points.shape[:2], dtype=np.int32)
     for number, s in enumerate(sorted(found, key=lambda s: -int(np.count_nonzero(s.mask))), start=1):
         labels[s.mask & (labels == 0)] = number

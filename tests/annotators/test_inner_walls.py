@@ -6,7 +6,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from annotators.geometry.inner_walls import InnerWallRules, inside_candidates, wall_axis, wall_points
+from annotators.geometry.inner_walls import InnerWallRules, inside_candidates, one_wall, wall_axis, wall_points
 
 
 def arc(centre: tuple[float, float], radius: float, start: float, stop: float, inward: bool) -> np.ndarray:
@@ -56,3 +56,21 @@ def test_an_inside_larger_than_its_outside_or_ending_high_up_is_a_candidate() ->
     assert [1, 2] in candidates
     assert [2, 3] not in candidates and [3, 2] not in candidates  # both reach the table
     assert [2, 1] not in candidates
+
+
+def test_two_halves_of_one_inner_wall_are_one_wall_and_a_neighbouring_inside_is_not() -> None:
+    rules = InnerWallRules()
+
+    def axis_of(centre: tuple[float, float], radius: float, start: float, stop: float) -> tuple[np.ndarray, float]:
+        found = wall_axis(*wall_points(*arc(centre, radius, start, stop, inward=True), rules), rules)
+        assert found is not None
+        return found
+
+    left = axis_of((0.7, 0.3), 0.075, -np.pi / 2, 0.0)  # the back of a bowl's inside, cut in two
+    right = axis_of((0.7, 0.3), 0.075, 0.0, np.pi / 2)
+    assert one_wall(left, right, rules.same_axis) and one_wall(right, left, rules.same_axis)
+    beside = axis_of((0.7, 0.46), 0.075, -np.pi / 2, np.pi / 2)  # the inside of a second bowl standing beside it
+    assert not one_wall(left, beside, rules.same_axis)
+    nested = axis_of((0.7, 0.3), 0.03, -np.pi / 2, np.pi / 2)  # a cup standing in the bowl's middle
+    assert not one_wall(left, nested, rules.same_axis)
+    assert not one_wall(left, None, rules.same_axis)
