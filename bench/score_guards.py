@@ -21,15 +21,13 @@ import sys
 from dataclasses import replace
 from pathlib import Path
 
-import numpy as np
-
 ROOT = Path(__file__).resolve().parents[1]
 sys.path.insert(0, str(ROOT))
 
 import annotators.cloud.clutter as clutter  # noqa: E402
 from annotators.cloud.clutter import ClutterParameters  # noqa: E402
 from reasoning.evaluation.object_verdicts import load_labelled_objects, object_verdicts  # noqa: E402
-from tests.annotators.guard_frames import LABELS, segment_frame  # noqa: E402
+from tests.annotators.guard_frames import LABELS, crop_moved, segment_frame  # noqa: E402
 
 ORIGINAL_BOX = clutter.bounding_box
 
@@ -42,15 +40,7 @@ def parameters(variant: str) -> ClutterParameters:
 
 def with_offset(dy: int, dx: int) -> None:
     """Make the segmenter's crop (the candidates' box of margin 2) start ``dy`` rows and ``dx`` columns earlier."""
-    original = ORIGINAL_BOX
-
-    def box(mask: np.ndarray, margin: int = 0) -> tuple[int, int, int, int]:
-        x0, y0, x1, y1 = original(mask, margin)
-        if margin == 2:
-            x0, y0 = max(0, x0 - dx), max(0, y0 - dy)
-        return x0, y0, x1, y1
-
-    clutter.bounding_box = box
+    clutter.bounding_box = crop_moved(dy, dx)
 
 
 def over_offsets(variants: list[str], size: int) -> None:

@@ -3,6 +3,7 @@ is run on them and on labelled mOSD scenes, shared by the tests and bench/score_
 
 from __future__ import annotations
 
+from collections.abc import Callable
 from pathlib import Path
 
 import numpy as np
@@ -11,6 +12,7 @@ from annotators.cloud.clutter import ClutterParameters, segment_clutter
 from annotators.cloud.filters import range_mask
 from annotators.cloud.point_cloud import back_project, pixel_rays
 from annotators.cloud.support_choice import find_support_plane
+from annotators.geometry.grid_segmentation import bounding_box
 from annotators.readers.frame_io import read_color_depth_pair
 from annotators.readers.pcd_io import read_pcd
 from reasoning.evaluation.mosd import object_labels
@@ -44,3 +46,16 @@ def segment_points(points: np.ndarray, colors: np.ndarray, parameters: ClutterPa
     for number, s in enumerate(sorted(found, key=lambda s: -int(np.count_nonzero(s.mask))), start=1):
         labels[s.mask & (labels == 0)] = number
     return labels
+
+
+def crop_moved(dy: int, dx: int) -> Callable[[np.ndarray, int], tuple[int, int, int, int]]:
+    """A stand-in for the segmenter's ``bounding_box`` whose candidates' box (margin 2) starts ``dy`` rows and ``dx``
+    columns (coarse pixels) earlier: the grid cells' phase moves with the crop, grown patches do not."""
+
+    def box(mask: np.ndarray, margin: int = 0) -> tuple[int, int, int, int]:
+        x0, y0, x1, y1 = bounding_box(mask, margin)
+        if margin == 2:
+            x0, y0 = max(0, x0 - dx), max(0, y0 - dy)
+        return x0, y0, x1, y1
+
+    return box
