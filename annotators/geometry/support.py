@@ -229,7 +229,9 @@ class AppendageRules:
     """Thresholds of :func:`join_appendages`: a piece at most ``small_share`` of its neighbour's size, touching it
     in 3-D (close, see :class:`~annotators.geometry.grid_segmentation.Boundaries`) along at least ``close_share``
     of their shared border and ``boundary_share`` times the square root of its size (at least ``min_boundary``
-    pixel pairs), its heights (5 %-95 %) within the neighbour's (5 %-99 %, ``tolerance`` metres of slack); depth
+    pixel pairs), its heights (5 %-95 %) within the neighbour's (5 %-99 %, ``tolerance`` metres of slack) - or
+    reaching below the neighbour's 5 % height with the middle of its heights above it: the lower part of a tub
+    cut off with the neighbour's lowest points, not a support under it, which lies below; depth
     jumps as the segmenter's (``jump_absolute + jump_relative * nearer depth``); heights sampled on every
     ``sample_step``-th pixel."""
 

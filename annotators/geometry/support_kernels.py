@@ -92,7 +92,8 @@ def appendage_candidates(
 ) -> np.ndarray:
     """Mx2 ``(piece, owner)`` of the touching ``pairs`` (Kx2), each way round (all pairs as given, then all
     reversed), with the piece at most ``small_share`` of the owner's size, its heights (``low``-``high``) within
-    the owner's (``low``-``top``, ``tolerance`` of slack) and a shared ``border`` (pixel pairs, per pair) at least
+    the owner's (``low``-``top``, ``tolerance`` of slack; or reaching below the owner's ``low`` with their middle
+    above it) and a shared ``border`` (pixel pairs, per pair) at least
     ``max(min_boundary, boundary_share * sqrt(piece size))`` long: the candidates of
     :func:`~annotators.geometry.support.appendage_owners`."""
     return _loops().appendage_candidates(

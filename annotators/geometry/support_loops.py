@@ -163,7 +163,7 @@ def appendage_candidates(
             piece, owner = pairs[k, way], pairs[k, 1 - way]
             if (
                 sizes[piece] <= small_share * sizes[owner]
-                and low[piece] >= low[owner] - tolerance
+                and (low[piece] >= low[owner] - tolerance or 0.5 * (low[piece] + high[piece]) >= low[owner])
                 and high[piece] <= top[owner] + tolerance
                 and border[k] >= max(min_boundary, boundary_share * np.sqrt(np.float64(sizes[piece])))
             ):

@@ -115,7 +115,10 @@ def test_the_compiled_candidates_are_the_numpy_ones(seed: int) -> None:
         with np.errstate(invalid="ignore"):
             fits = (
                 (sizes[both[:, 0]] <= small_share * sizes[both[:, 1]])
-                & (low[both[:, 0]] >= low[both[:, 1]] - 0.003)
+                & (
+                    (low[both[:, 0]] >= low[both[:, 1]] - 0.003)
+                    | (0.5 * (low[both[:, 0]] + high[both[:, 0]]) >= low[both[:, 1]])
+                )
                 & (high[both[:, 0]] <= top[both[:, 1]] + 0.003)
                 & (border >= np.maximum(3, 0.6 * np.sqrt(sizes[both[:, 0]])))
             )
