@@ -41,7 +41,7 @@ def test_the_default_keeps_most_objects_whole_at_every_cell_phase(
 ) -> None:
     counts = [whole_objects(ClutterParameters(), monkeypatch, dy, dx) for dy, dx in PHASES]
     assert statistics.median(counts) >= 35, counts
-    assert min(counts) >= 28, counts
+    assert min(counts) >= 29, counts
 
 
 def test_grown_patches_keep_the_same_objects_whole_at_every_cell_phase(
@@ -50,4 +50,4 @@ def test_grown_patches_keep_the_same_objects_whole_at_every_cell_phase(
     grown = replace(ClutterParameters(), grown_patches=True)
     counts = [whole_objects(grown, monkeypatch, dy, dx) for dy, dx in PHASES]
     assert counts == [counts[0]] * len(PHASES)
-    assert counts[0] >= 38
+    assert counts[0] >= 39
