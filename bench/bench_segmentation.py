@@ -1,4 +1,5 @@
-"""Clutter segmentation: ours new (ClutterSegmenter) vs ours old (ClusterExtractor) vs untuned Open3D, in one run.
+"""Clutter segmentation: ours new (ClutterSegmenter) vs ours old (ClusterExtractor) vs untuned Open3D, in one run
+(and the new segmenter with grown patches, ``grown``, the alternative without a cell phase).
 
 1. Scores on the 45 labelled mOSD learn scenes (../shared/data/pcl_mosd_tabletop/learn), per category, as
    ``robokudo eval segmentation`` computes them: object recall and precision at 2-D box IoU >= 0.5, and the
@@ -43,7 +44,7 @@ MOSD = (ROOT.parent / "shared" / "data" / "pcl_mosd_tabletop" / "learn").resolve
 UOC = (ROOT.parent / "shared" / "data" / "uoc_tabletop_realsense").resolve()
 TUNED = ("boxes", "stacked")
 HELD_OUT = ("occluded", "cylindric")
-NAMES = {"clutter": "new", "clusters": "old", "open3d": "Open3D"}
+NAMES = {"clutter": "new", "clutter-grown": "grown", "clusters": "old", "open3d": "Open3D"}
 TICKS = 30
 SCENE_RUNS = 15
 SEGMENTATION_GOAL_MS = 40.0

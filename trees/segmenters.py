@@ -1,6 +1,9 @@
 """Segmenters by name, each run on a recorded frame as the tabletop tree runs it, for scoring against labels.
 
 * ``clutter``: the tabletop front (reader, range filter, support plane) and the ClutterSegmenter (convexity);
+* ``clutter-grown``: the same with patches grown from the flattest pixels instead of grid cells, which gives the
+  same segments wherever the candidates' box starts (``ClutterParameters.grown_patches``; not the default, see
+  bench/profiles/segscore-analysis.txt);
 * ``clusters``: the same front and the ClusterExtractor (depth jumps, hue edges, footprint merging);
 * ``open3d``: the untuned Open3D recipe (plane RANSAC + DBSCAN at 2 cm) on the frame's points.
 
@@ -84,6 +87,11 @@ SEGMENTERS: Mapping[str, Segmenter] = MappingProxyType(
     {
         "clutter": Segmenter(
             "clutter", "ClutterSegmenter: convexly connected surfaces (new)", _with_front(ClutterSegmenter)
+        ),
+        "clutter-grown": Segmenter(
+            "clutter-grown",
+            "ClutterSegmenter with patches grown from the flattest pixels: no cell phase (alternative)",
+            _with_front(lambda: ClutterSegmenter(grown_patches=True)),
         ),
         "clusters": Segmenter(
             "clusters", "ClusterExtractor: cuts and footprint merging (old)", _with_front(ClusterExtractor)

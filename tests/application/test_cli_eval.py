@@ -107,8 +107,10 @@ def test_the_table_has_scenes_categories_and_overall(capsys: pytest.CaptureFixtu
     assert overall[1:6] == ["4", "4", "4", "1.00", "1.00"]  # objects, segments, found, recall, precision
 
 
-def test_the_old_segmenter_and_open3d_can_be_scored_too(capsys: pytest.CaptureFixture[str], learn: Path) -> None:
-    for name in ("clusters", "open3d"):
+def test_the_old_segmenter_grown_patches_and_open3d_can_be_scored_too(
+    capsys: pytest.CaptureFixture[str], learn: Path
+) -> None:
+    for name in ("clusters", "clutter-grown", "open3d"):
         status, out, _ = evaluate(capsys, str(learn / "learn0.pcd"), "--segmenter", name, "--json")
         assert status == 0
         document = json.loads(out)
