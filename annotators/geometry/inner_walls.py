@@ -49,9 +49,9 @@ class InnerWallRules:
     piece's size, at least ``min_boundary`` pixel pairs, depth jumps ``jump_absolute + jump_relative * nearer
     depth``); the wall points used (``wall_normal``: the least horizontal component of their unit normals); how much
     the wall's normals must turn (``min_turn``: the smaller eigenvalue of the mean of ``I - n n^T`` over its
-    horizontal normals; a flat wall has 0 and no axis), how squarely they must face the axis (``facing``: the
-    median distance to the axis along the normals at least this share of the median distance to it) and how close
-    the axes and radii of two concave pieces of one inner wall are (``same_axis``, a share of the radius)."""
+    horizontal normals; a flat wall has 0 and no axis), how many must face the axis (``facing``: more than this
+    share of the wall points have normals pointing toward it; the rim or a handle in the same piece does not) and how
+    close the axes and radii of two concave pieces of one inner wall are (``same_axis``, a share of the radius)."""
 
     support: SupportRules = field(default_factory=SupportRules)
     boundary_share: float = 0.6
@@ -83,7 +83,7 @@ def wall_axis(points: np.ndarray, normals: np.ndarray, rules: InnerWallRules) ->
     """The ``(u, v)`` point that a wall's horizontal normals (Nx2 ``points`` and unit ``normals`` of
     :func:`wall_points`, normals toward the camera) point at, and the wall's median distance from it, when the wall
     curves around it concavely toward the camera: the least-squares meeting point of the normal lines, in front of
-    the wall (see :class:`InnerWallRules`); None for a flat, convex or too small wall."""
+    most of the wall (see :class:`InnerWallRules`); None for a flat, convex or too small wall."""
     if points.shape[0] < _MIN_WALL_POINTS:
         return None
     across = np.eye(2)[None] - normals[:, :, None] * normals[:, None, :]  # projections across each normal line
@@ -91,9 +91,9 @@ def wall_axis(points: np.ndarray, normals: np.ndarray, rules: InnerWallRules) ->
     if np.linalg.eigvalsh(matrix / points.shape[0])[0] < rules.min_turn:
         return None
     axis = np.linalg.solve(matrix, np.einsum("nij,nj->i", across, points))
-    ahead = float(np.median(np.einsum("ni,ni->n", axis - points, normals)))
+    facing = float(np.mean(np.einsum("ni,ni->n", axis - points, normals) > 0))
     distance = float(np.median(np.linalg.norm(axis - points, axis=1)))
-    return (axis, distance) if ahead > 0 and ahead >= rules.facing * distance else None
+    return (axis, distance) if facing > rules.facing else None
 
 
 def one_wall(first: tuple[np.ndarray, float], second: tuple[np.ndarray, float] | None, share: float) -> bool:
