@@ -24,9 +24,14 @@ LABELS = REPO_ROOT / "tests" / "data" / "labels" / "guard_objects.json"
 
 def segment_frame(input_name: str, index: int, parameters: ClutterParameters) -> np.ndarray:
     """HxW int32 segment numbers (0 none) of the clutter segmenter on a colour + depth frame, larger ones first."""
+    return segment_points(*frame_points(input_name, index), parameters)
+
+
+def frame_points(input_name: str, index: int) -> tuple[np.ndarray, np.ndarray]:
+    """The organized points (float32 HxWx3) and colours of a colour + depth frame of the shared data."""
     frame = read_color_depth_pair(SHARED_DATA / input_name, index)
     points = np.ascontiguousarray(back_project(frame.depth, pixel_rays(frame.intrinsics)), dtype=np.float32)
-    return segment_points(points, frame.color, parameters)
+    return points, frame.color
 
 
 def segment_mosd_scene(path: Path, parameters: ClutterParameters) -> tuple[np.ndarray, np.ndarray, np.ndarray]:

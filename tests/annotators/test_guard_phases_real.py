@@ -14,40 +14,51 @@ import statistics
 from dataclasses import replace
 from pathlib import Path
 
+import numpy as np
 import pytest
 
 import annotators.cloud.clutter as clutter
 from annotators.cloud.clutter import ClutterParameters
-from reasoning.evaluation.object_verdicts import load_labelled_objects, object_verdicts
-from tests.annotators.guard_frames import LABELS, crop_moved, segment_frame
+from reasoning.evaluation.object_verdicts import LabelledObject, load_labelled_objects, object_verdicts
+from tests.annotators.guard_frames import LABELS, crop_moved, frame_points, segment_points
 
 pytestmark = pytest.mark.real_data
 
 PHASES = [(dy, dx) for dy in (0, 2, 4) for dx in (0, 2, 4)]
 
+Frames = list[tuple[np.ndarray, np.ndarray, list[LabelledObject]]]
 
-def whole_objects(parameters: ClutterParameters, monkeypatch: pytest.MonkeyPatch, dy: int, dx: int) -> int:
+
+@pytest.fixture(scope="module")
+def frames(uoc_folder: Path) -> Frames:
+    """Each guard frame's points, colours and labelled objects, read once."""
+    return [(*frame_points(name, index), objects) for (name, index), objects in load_labelled_objects(LABELS).items()]
+
+
+def whole_objects(
+    frames: Frames, parameters: ClutterParameters, monkeypatch: pytest.MonkeyPatch, dy: int, dx: int
+) -> int:
     """Labelled guard objects left whole with the segmenter's crop started ``dy`` rows and ``dx`` columns earlier."""
     monkeypatch.setattr(clutter, "bounding_box", crop_moved(dy, dx))
     return sum(
         verdict.kind == "whole"
-        for (name, index), objects in load_labelled_objects(LABELS).items()
-        for verdict in object_verdicts(segment_frame(name, index, parameters), objects).values()
+        for points, colors, objects in frames
+        for verdict in object_verdicts(segment_points(points, colors, parameters), objects).values()
     )
 
 
 def test_the_default_keeps_most_objects_whole_at_every_cell_phase(
-    uoc_folder: Path, monkeypatch: pytest.MonkeyPatch
+    frames: Frames, monkeypatch: pytest.MonkeyPatch
 ) -> None:
-    counts = [whole_objects(ClutterParameters(), monkeypatch, dy, dx) for dy, dx in PHASES]
+    counts = [whole_objects(frames, ClutterParameters(), monkeypatch, dy, dx) for dy, dx in PHASES]
     assert statistics.median(counts) >= 36, counts
     assert min(counts) >= 29, counts
 
 
 def test_grown_patches_keep_the_same_objects_whole_at_every_cell_phase(
-    uoc_folder: Path, monkeypatch: pytest.MonkeyPatch
+    frames: Frames, monkeypatch: pytest.MonkeyPatch
 ) -> None:
     grown = replace(ClutterParameters(), grown_patches=True)
-    counts = [whole_objects(grown, monkeypatch, dy, dx) for dy, dx in PHASES]
+    counts = [whole_objects(frames, grown, monkeypatch, dy, dx) for dy, dx in PHASES]
     assert counts == [counts[0]] * len(PHASES)
     assert counts[0] >= 39
