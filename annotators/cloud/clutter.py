@@ -111,7 +111,8 @@ class ClutterParameters(ClusterParameters):
     coarse pixels, split when their normals spread by more than ``normal_spread``; with ``grown_patches`` grown from
     seeds ``patch_spacing`` apart instead, :func:`~annotators.geometry.flat_patches.flat_patches` with the normal
     weight ``patch_weight`` and the height term on the depth-jump scale ``jump_relative``: the same patches wherever
-    the crop starts, bench/profiles/seg9-analysis.txt), the grouping
+    the crop starts, bench/profiles/seg9-analysis.txt; their patches seen more than ``grazing_degrees`` from the line of
+    sight cast no convex vote where they bend inward), the grouping
     (:class:`~annotators.geometry.convexity.ConvexityRules`) and the share of a boundary that must be creased for a
     hue edge to split an object (``creased_share``); ``join_unsupported`` joins the pieces that could not stand by
     themselves to the object that holds them, ``join_jointly_held`` those two touching neighbours hold only
@@ -134,6 +135,7 @@ class ClutterParameters(ClusterParameters):
     grown_patches: bool = False
     patch_spacing: int = 5
     patch_weight: float = 8.0
+    grazing_degrees: float = 70.0
     smooth_degrees: float = ConvexityRules.smooth_degrees
     concave_bending: float = ConvexityRules.concave_bending
     convex_share: float = ConvexityRules.convex_share
@@ -160,10 +162,18 @@ class ClutterParameters(ClusterParameters):
     claim_borders: bool = True
 
     def convexity_rules(self) -> ConvexityRules:
-        """The thresholds of :func:`annotators.geometry.convexity.convex_groups` (with grown patches two small
-        faces join on a weak vote only as one's best neighbour, ``small_joins_once``)."""
-        names = [f.name for f in fields(ConvexityRules) if f.name != "small_joins_once"]
-        return ConvexityRules(**{n: getattr(self, n) for n in names}, small_joins_once=self.grown_patches)
+        """The thresholds of :func:`annotators.geometry.convexity.convex_groups`. With grown patches two small
+        faces join on a weak vote only as one's best neighbour (``small_joins_once``), and a grazing patch's
+        inward bend casts no convex vote (``grazing_degrees``): grown patches follow the data, so the stereo depth
+        ramp at an occluding edge is a patch of its own, where the grid's cells average it into the faces beside
+        it."""
+        names = [f.name for f in fields(ConvexityRules) if f.name not in ("small_joins_once", "grazing_degrees")]
+        grown = self.grown_patches
+        return ConvexityRules(
+            **{n: getattr(self, n) for n in names},
+            small_joins_once=grown,
+            grazing_degrees=self.grazing_degrees if grown else None,
+        )
 
     def appendage_rules(self) -> AppendageRules:
         """The thresholds of :func:`annotators.geometry.support.join_appendages`: the merge rules' share of a

@@ -80,7 +80,9 @@ class ConvexityRules:
     are at most ``close_factor`` times their grid distance apart in 3-D; with ``small_joins_once`` two faces of
     fewer than ``min_face`` points join on fewer than ``min_votes`` convex votes only where one is the other's best
     neighbour (the one it agrees with most), so a string of small faces cannot carry a join from one object to the
-    next; a small face still joins every large face it agrees with (a sliver along a box's edge)."""
+    next; a small face still joins every large face it agrees with (a sliver along a box's edge); with
+    ``grazing_degrees`` a connection touching a patch whose normal lies more than that many degrees from its line of
+    sight votes convex only where it bends outward (:func:`grazing_patches`)."""
 
     smooth_degrees: float = 20.0
     concave_bending: float = 20.0
@@ -94,6 +96,7 @@ class ConvexityRules:
     gap_width: float = 2.0
     close_factor: float = 3.0
     small_joins_once: bool = False
+    grazing_degrees: float | None = None
 
 
 @dataclass(frozen=True, eq=False)
@@ -208,15 +211,43 @@ def convex_groups(
     if footprint is None:
         footprint = pixel_footprint(points)
     pairs = pairs[close_in_space(patches, planes, pairs, footprint, rules.close_factor)]
-    parallel, in_planes = _alignment(planes, pairs, rules.smooth_degrees)
-    concave = connection_bending(planes, pairs) < -rules.concave_bending
-    continuous = parallel & in_planes & ~concave
+    continuous, convex, concave = connection_votes(planes, pairs, rules)
     faces = _components(pairs[continuous], count)
-    objects = _join_faces(faces, pairs, ~concave & (continuous | ~parallel), concave, planes, rules)
+    objects = _join_faces(faces, pairs, convex, concave, planes, rules)
     labels = _dense(objects[faces], usable)[kept]
     if grow > 0:
         labels = grow_from_seeds(labels, seeds, grow)
     return labels
+
+
+def connection_votes(
+    planes: PatchPlanes, pairs: np.ndarray, rules: ConvexityRules
+) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """For Kx2 touching patch labels: is each connection continuous (one face: normals and the centroid line within
+    ``rules.smooth_degrees``, no concave bend), and does it vote convex or concave (see :func:`convex_groups`)?"""
+    parallel, in_planes = _alignment(planes, pairs, rules.smooth_degrees)
+    bending = connection_bending(planes, pairs)
+    concave = bending < -rules.concave_bending
+    continuous = parallel & in_planes & ~concave
+    convex = ~concave & (continuous | ~parallel)
+    if rules.grazing_degrees is not None:
+        grazing = grazing_patches(planes, rules.grazing_degrees)
+        convex &= ~((grazing[pairs[:, 0]] | grazing[pairs[:, 1]]) & (bending < 0) & ~continuous)
+    return continuous, convex, concave
+
+
+def grazing_patches(planes: PatchPlanes, degrees: float) -> np.ndarray:
+    """Per patch label (index 0, no patch, False): is the patch's normal more than ``degrees`` from its line of
+    sight (the ray to its centroid)?
+
+    A surface seen that nearly edge-on is either the limb of a round object, bending on outward from the face
+    beside it, or the wall of a step down to a surface farther away - a box's side, or the stereo depth ramp that
+    smears an occluding edge over a few pixels to the surface behind it - which meets that far surface bending
+    inward, gently enough to pass as a convex vote. Such an inward connection is no evidence of one object."""
+    centroids = planes.centroids
+    distances = np.maximum(np.linalg.norm(centroids, axis=1), 1e-12)
+    facing = np.abs(np.einsum("ij,ij->i", planes.normals, centroids)) / distances
+    return np.concatenate([[False], facing < np.cos(np.radians(degrees))])
 
 
 def _alignment(planes: PatchPlanes, pairs: np.ndarray, degrees: float) -> tuple[np.ndarray, np.ndarray]:

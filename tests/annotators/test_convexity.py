@@ -1,0 +1,58 @@
+"""Connection votes of the convexity grouping (annotators/geometry/convexity.py) between hand-placed patch planes:
+a patch seen nearly edge-on that bends inward into its neighbour - the wall of a step, or the stereo depth ramp
+between an occluding edge and the surface behind it - casts no convex vote with ``grazing_degrees``; a round
+object's limb, bending outward, still does."""
+
+from __future__ import annotations
+
+import numpy as np
+
+from annotators.geometry.convexity import ConvexityRules, PatchPlanes, connection_votes, grazing_patches
+
+PAIR = np.array([[1, 2]])
+
+
+def normal(degrees: float) -> np.ndarray:
+    """A unit normal in the x-z plane, ``degrees`` from the line of sight along +z, facing the camera."""
+    angle = np.radians(degrees)
+    return np.array([np.sin(angle), 0.0, -np.cos(angle)])
+
+
+def two_patches(first: tuple[float, np.ndarray], second: tuple[float, np.ndarray]) -> PatchPlanes:
+    """Two trusted patches of 12 points: (degrees off the line of sight, centroid) each."""
+    (first_degrees, first_centroid), (second_degrees, second_centroid) = first, second
+    return PatchPlanes(
+        counts=np.array([12, 12]),
+        centroids=np.array([first_centroid, second_centroid], dtype=float),
+        normals=np.array([normal(first_degrees), normal(second_degrees)]),
+        thickness=np.zeros(2),
+        width=np.ones(2),
+    )
+
+
+def test_a_patch_is_grazing_when_its_normal_is_far_from_its_line_of_sight() -> None:
+    planes = two_patches((75.0, np.array([0.0, 0.0, 0.9])), (35.0, np.array([0.02, 0.0, 0.9])))
+    assert grazing_patches(planes, 70.0).tolist() == [False, True, False]
+    assert grazing_patches(planes, 80.0).tolist() == [False, False, False]
+
+
+def test_a_ramp_meeting_the_surface_behind_it_gently_inward_casts_no_convex_vote() -> None:
+    # the ramp seen 75 degrees off its line of sight, the far surface (35 degrees) 3 cm on and 1 cm deeper
+    planes = two_patches((75.0, np.array([0.0, 0.0, 0.9])), (35.0, np.array([0.03, 0.0, 0.91])))
+    _, convex, concave = connection_votes(planes, PAIR, ConvexityRules())
+    assert convex.tolist() == [True] and concave.tolist() == [False]  # too gentle for the concave limit
+    _, convex, concave = connection_votes(planes, PAIR, ConvexityRules(grazing_degrees=70.0))
+    assert convex.tolist() == [False] and concave.tolist() == [False]
+
+
+def test_a_limb_bending_outward_from_the_face_beside_it_still_votes_convex() -> None:
+    planes = two_patches((30.0, np.array([0.0, 0.0, 0.9])), (75.0, np.array([0.02, 0.0, 0.92])))
+    _, convex, _ = connection_votes(planes, PAIR, ConvexityRules(grazing_degrees=70.0))
+    assert convex.tolist() == [True]
+
+
+def test_without_a_grazing_patch_the_votes_are_those_of_the_plain_rules() -> None:
+    planes = two_patches((35.0, np.array([0.0, 0.0, 0.9])), (50.0, np.array([0.03, 0.0, 0.91])))
+    plain = connection_votes(planes, PAIR, ConvexityRules())
+    grazing = connection_votes(planes, PAIR, ConvexityRules(grazing_degrees=70.0))
+    assert all(a.tolist() == b.tolist() for a, b in zip(plain, grazing, strict=True))
