@@ -331,7 +331,13 @@ def test_a_new_graph_that_does_not_answer_has_its_actor_restarted_and_the_run_go
     try:
         assert run_to_end(engine) is Status.SUCCESS, node.feedback_message
         assert echoed(tree) == ["1 (48, 64, 3) depth 3072"]
-        assert node.compiled_calls().compiles == 2 and node.call_path == COMPILED_GRAPH
+        calls = node.compiled_calls()
+        assert calls.compiles == 2 and node.call_path == COMPILED_GRAPH, (
+            calls.compiles,
+            node.call_path,
+            calls.unavailable,
+            node.feedback_message,
+        )
         assert node.actor_process_id() != stopped[0]
         assert run_to_end(engine) is Status.SUCCESS and echoed(tree) == ["2 (48, 64, 3) depth 3072"]
     finally:
