@@ -645,8 +645,10 @@ def merge_parts(
 
     A pair whose shared boundary is mostly a depth jump (continuous on less than ``rules.occlusion`` of it) is an
     occluder and what it hides, or a container's rim and its inside: only the inside rule may join it. Parts
-    smaller than ``rules.small_part`` pixels join at most one neighbour (the one they share the longest boundary
-    with among those a rule allows), so a crumb between two objects cannot glue them together.
+    smaller than ``rules.small_part`` pixels join at most one neighbour among those a rule allows, so a crumb
+    between two objects cannot glue them together: the one they share the longest boundary with when ``surface``
+    measures the boundaries, else the first in label order (counting border pixels instead cut the PCL stereo mug's
+    inside off its outside: bench/profiles/segscore-analysis.txt, eighteenth session).
     """
     pairs = touching_pairs(labels)
     if pairs.shape[0] == 0:
