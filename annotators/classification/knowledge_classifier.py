@@ -38,23 +38,25 @@ when read, Text) a profile gets an agreement in [0, 1]:
   jar's or a mug's, may be both, and a cue every other profile is neutral about would only pull their scores
   toward 0.5). This is what tells a labelled can from a jar or a plain plastic tub of the same size, form and
   proportions;
+* waist (``rk:waisted``), only when one is seen (a middle narrower than the top and the bottom: a drill's grip
+  between its body and battery): 1 for a profile with one, 0 for a profile that never has one, not counted for the
+  others. None seen says nothing: most objects have none, and a drill lying on its side or seen end-on shows none;
 * text: the share of the profile's texts and brand found in the read text (case, spaces and punctuation ignored, one
   OCR error tolerated per 5 letters: :func:`robokudo.core.text_match.phrase_found`), ``TEXT_NONE`` when the profile
   has neither. A brand read also counts the texts the class inherits (``kind_texts``) as read: the brand names the
   product, and with it its kind - a box reading "CHEEZ-IT" is a box of crackers whether or not the small "crackers"
   on it was read - while a variant's own text still tells variants of one brand apart (Fizzy cola, Fizzy lemon).
 
-Colour, shape, size, handle, open-top and printed-label agreements are pulled toward 0.5 by the expert's confidence
-(``0.5 + (a - 0.5) * c``), so uncertain evidence counts less. The score is the weighted mean over the observed
-cues with :data:`WEIGHTS`
-(text is strong evidence). The best match is the top score (among related profiles with that score, the most
-specific one with the most matched texts when text matched, lactose-free milk over milk; else the most general
-one: no evidence for a variant); its lead is how far it scores above the best rival: a profile not related to it
-that no form cue rules out (:func:`ruled_out`: a settled open top the class rules out, a height over width or
-elongation where the class agrees not at all) - when none can rule out the best class itself, however the
-unsettled cues turn out (:func:`standing`; else every unrelated profile is a rival). A closed can, whatever its
-colour, is no rival of a mug surely seen open: knowing a blue can does not make a blue mug less surely a mug. The
-same holds for a class taken as a whole.
+Colour, shape, size, handle, open-top, printed-label and waist agreements are pulled toward 0.5 by the expert's
+confidence (``0.5 + (a - 0.5) * c``), so uncertain evidence counts less. The score is the weighted mean over the
+observed cues with :data:`WEIGHTS` (text is strong evidence). The best match is the top score (among related
+profiles with that score, the most specific one with the most matched texts when text matched, lactose-free milk
+over milk; else the most general one: no evidence for a variant); its lead is how far it scores above the best
+rival: a profile not related to it that no form cue rules out (:func:`ruled_out`: a settled open top the class rules
+out, a height over width or elongation where the class agrees not at all) - when none can rule out the best class
+itself, however the unsettled cues turn out (:func:`standing`; else every unrelated profile is a rival). A closed
+can, whatever its colour, is no rival of a mug surely seen open: knowing a blue can does not make a blue mug less
+surely a mug. The same holds for a class taken as a whole.
 
 Deciding. The score is not a probability: many classes share colour, shape and size (a cup, a mug and a glass
 are all small cylinders). The calibration (``calibration.FITTED``, fitted on labelled objects) turns the best
@@ -119,7 +121,17 @@ from robokudo.core.types import (
 )
 
 WEIGHTS: Mapping[str, float] = MappingProxyType(
-    {"color": 1.0, "shape": 1.0, "size": 1.0, "handle": 1.0, "open": 1.0, "ratio": 1.0, "printed": 1.0, "text": 3.0}
+    {
+        "color": 1.0,
+        "shape": 1.0,
+        "size": 1.0,
+        "handle": 1.0,
+        "open": 1.0,
+        "ratio": 1.0,
+        "printed": 1.0,
+        "waist": 1.0,
+        "text": 3.0,
+    }
 )
 """How much each cue counts in the score. The open top and the size class count as much as the handle: the open top
 is what tells a cup, a mug or a bowl from a closed can, jar or tub of the same size, shape and proportions; the size
@@ -221,6 +233,7 @@ class Profile:
     height_to_width: tuple[float, float] | None = None
     printed: bool | None = None
     elongation: tuple[float, float] | None = None
+    waisted: bool | None = None
     packaged_in: frozenset[str] = frozenset()
     """The container class the objects are typically packaged in and its ancestors (lower case), or empty."""
     brand: str | None = None
@@ -264,6 +277,7 @@ class Profile:
             height_to_width=_ratio_range(data.get("height_to_width")),
             printed=_flag(data, "printed"),
             elongation=_ratio_range(data.get("elongation")),
+            waisted=_flag(data, "waisted"),
             packaged_in=frozenset(_names(data.get("packaged_in"))),
             brand=brands[0] if brands else None,
             kind_texts=frozenset(_names(data.get("kind_texts"))) & frozenset(texts),
@@ -279,8 +293,9 @@ class Profile:
 class Cues:
     """The cues the experts gave about one hypothesis (None: not given): the most confident colour, shape and
     size class with their confidences, the text read on it, the form cues, the largest extent (metres) the size
-    class was named from, the longest extent over the second longest (elongation), and whether it shows several
-    colours (a printed label) with how sure that is."""
+    class was named from, the longest extent over the second longest (elongation), whether it shows several colours
+    (a printed label) and whether its middle is narrower than its top and bottom (a waist), each with how sure that
+    is."""
 
     color: tuple[str, float] | None = None
     shape: tuple[str, float] | None = None
@@ -292,6 +307,7 @@ class Cues:
     extent: float | None = None
     printed: tuple[bool, float] | None = None
     elongation: float | None = None
+    waist: tuple[bool, float] | None = None
 
 
 @dataclass(frozen=True)
@@ -387,6 +403,9 @@ def score(profile: Profile, cues: Cues) -> Match:
         agreement = float(profile.printed == cues.printed[0])
         total += WEIGHTS["printed"] * _toward_neutral(agreement, cues.printed[1])
         weight += WEIGHTS["printed"]
+    if cues.waist is not None and cues.waist[0] and profile.waisted is not None:
+        total += WEIGHTS["waist"] * _toward_neutral(float(profile.waisted), cues.waist[1])
+        weight += WEIGHTS["waist"]
     if cues.text:
         found = text_found(profile, cues.text)
         names = len(profile.texts) + (profile.brand is not None)
@@ -821,6 +840,7 @@ class KnowledgeClassifier(Annotator):
             extent=body_extent(form) or (max(size.dimensions) if size is not None and size.dimensions else None),
             printed=printed_cue(colors),
             elongation=elongation(size.dimensions) if size is not None else None,
+            waist=(form.waisted, form.waist_confidence) if form is not None else None,
         )
 
     def decide(self, cues: Cues) -> Decision:

@@ -50,6 +50,7 @@ PROFILE_PROPERTIES: Mapping[str, tuple[str, Kind | None]] = {
     "hasHandle": ("handle", None),
     "openTop": ("open_top", None),
     "printedLabel": ("printed", None),
+    "waisted": ("waisted", None),
     "minHeightToWidth": ("min_height_to_width", None),
     "maxHeightToWidth": ("max_height_to_width", None),
     "minElongation": ("min_elongation", None),
@@ -79,13 +80,14 @@ _SINGLE_FIELDS = (
     "brand",
     "handle",
     "printed",
+    "waisted",
     "open_top",
     "min_height_to_width",
     "max_height_to_width",
     "min_elongation",
     "max_elongation",
 )
-_BOOLEAN_FIELDS = ("transparent", "handle", "open_top", "printed")
+_BOOLEAN_FIELDS = ("transparent", "handle", "open_top", "printed", "waisted")
 _NUMBER_FIELDS = ("min_height_to_width", "max_height_to_width", "min_elongation", "max_elongation")
 
 
@@ -588,6 +590,7 @@ class _Builder:
                 origins=tuple(origins),
                 handle=values.get("handle"),  # type: ignore[arg-type]
                 printed=values.get("printed"),  # type: ignore[arg-type]
+                waisted=values.get("waisted"),  # type: ignore[arg-type]
                 open_top=values.get("open_top"),  # type: ignore[arg-type]
                 height_to_width=_ratio_range(name, values, self.problems),
                 elongation=_ratio_range(name, values, self.problems, "elongation"),

@@ -63,6 +63,9 @@ class ObjectProfile:
     tin's round); None: any."""
     printed: bool | None = None
     """A label printed in several colours (a can's), False: a plain one-coloured surface; None: either."""
+    waisted: bool | None = None
+    """Narrower across the middle of its height than across its top and bottom, standing as it typically stands (a
+    drill on its battery), False: never; None: either."""
     packaged_in: str | None = None
     """The container class objects of the class are typically sold and kept in (a mustard's bottle), or None."""
 

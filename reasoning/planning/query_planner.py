@@ -74,6 +74,7 @@ def class_profiles(kb: KnowledgeBase) -> tuple[dict[str, object], ...]:
                 "kind_handles": kind_handles(kb, name) if profile.handle is None else (),
                 "open_top": profile.open_top,
                 "printed": profile.printed,
+                "waisted": profile.waisted,
                 "height_to_width": profile.height_to_width,
                 "elongation": profile.elongation,
                 "ancestors": (name, *sorted(kb.superclasses(name), key=lambda a: -len(kb.superclasses(a)))),

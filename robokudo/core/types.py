@@ -281,10 +281,12 @@ class SemanticColor(Annotation):
 @dataclass(eq=False, kw_only=True)
 class FormFeatures(Annotation):
     """What the object's form says for telling classes apart: its height over its width (upright), whether a
-    handle sticks out of its side and whether it is open at the top (a cavity seen inside), each yes/no with the
-    evidence's confidence in [0, 1] (0: not seen). When the object stands on a thin wide base (a saucer, a plate, a
-    coaster: :mod:`annotators.cloud.base_layer`), the cues are the body's above it and ``base_width`` and
-    ``body_width`` (metres, the longer footprint extents) say so; both are None without a base."""
+    handle sticks out of its side, whether it is open at the top (a cavity seen inside) and whether it is narrower
+    across the middle of its height than across its top and bottom (a waist: a drill's grip between its body and
+    battery), each yes/no with the evidence's confidence in [0, 1] (0: not seen). When the object stands on a thin
+    wide base (a saucer, a plate, a coaster: :mod:`annotators.cloud.base_layer`), the cues are the body's above it
+    and ``base_width`` and ``body_width`` (metres, the longer footprint extents) say so; both are None without a
+    base."""
 
     height_to_width: float
     has_handle: bool
@@ -293,6 +295,8 @@ class FormFeatures(Annotation):
     open_confidence: float
     base_width: float | None = None
     body_width: float | None = None
+    waisted: bool = False
+    waist_confidence: float = 0.0
 
 
 @dataclass(eq=False, kw_only=True)

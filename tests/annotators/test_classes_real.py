@@ -89,6 +89,16 @@ def test_find_all_objects_names_the_class_above_leaves_it_cannot_tell_apart(
         assert found["teal bowl"] in {"container", "bowl"}, found
 
 
+@pytest.mark.parametrize("frame, drill", [(0, (345, 140)), (1, (380, 150))])  # fit, held out
+def test_a_drill_standing_on_its_battery_is_a_power_drill_by_its_waist(
+    uoc_folder: Path, store: Path, capsys: pytest.CaptureFixture, frame: int, drill: tuple[int, int]
+) -> None:
+    """Its grip is narrower than its body above and its battery below (the form expert's waist), which no box, can,
+    mug or bowl is. Frame 1's drill, held out, was "unknown object" before the waist cue: it led the next class by
+    0.08, too little for the calibration (bench/bench_calibration.py --details)."""
+    assert classes_at(capsys, store, uoc_folder, frame, {"drill": drill}, CUES_ONLY)["drill"] == "power drill"
+
+
 def test_the_milk_carton_is_food_or_drink_held_out(
     shared_data: Path, store: Path, capsys: pytest.CaptureFixture
 ) -> None:
