@@ -267,8 +267,8 @@ def waist_ratio(points: np.ndarray, bottom: float, height: float) -> tuple[float
     if points.shape[0] < 20 or height <= 0.0:
         return None
     xy = points[:, :2] - points[:, :2].mean(axis=0)
-    _, _, axes = np.linalg.svd(xy, full_matrices=False)
-    along = xy @ axes.T
+    _, axes = np.linalg.eigh(xy.T @ xy)  # the footprint's principal axes (columns)
+    along = xy @ axes
     z = (points[:, 2] - bottom) / height
     extents, counts = [], []
     for low, high in WAIST_BANDS:
@@ -276,7 +276,8 @@ def waist_ratio(points: np.ndarray, bottom: float, height: float) -> tuple[float
         if band.shape[0] < 10:
             return None
         counts.append(band.shape[0])
-        extents.append(float((np.quantile(band, 0.98, axis=0) - np.quantile(band, 0.02, axis=0)).max()))
+        low_end, high_end = np.quantile(band, (0.02, 0.98), axis=0)
+        extents.append(float((high_end - low_end).max()))
     narrower = min(extents[0], extents[2])
     if narrower <= 0.0:
         return None
