@@ -35,8 +35,9 @@ Measured on the hypothesis' points in the upright support frame (:mod:`annotator
   bands' extents, measured along the footprint's principal axes (points missing in a band's middle, hidden behind
   something in front, do not narrow it). The confidence grows with how far the ratio lies from ``WAIST_RATIO`` (full
   at ``WAIST_CLEAR`` times beyond it either way) and with the points in the sparsest band (full at
-  ``FULL_EVIDENCE``). Measured over the labelled objects of the shared frames (bench/profiles/waist-analysis.txt):
-  the upright drills 0.31-0.46, every other object 0.71 or more (112 mOSD objects 0.84 or more);
+  ``FULL_EVIDENCE``). Over the labelled objects of the shared frames (``bench/measure_waists.py``,
+  bench/profiles/waist-analysis.txt) the two upright drills measure 0.33 and 0.45, every other uoc object 0.75 or
+  more and every mOSD object 0.76 or more;
 * **open top**: by visibility. Every seen point of a closed (convex) object is seen from outside: the line of
   sight from it to the camera leaves the object's convex hull at once. The inside of an open object (a cup's
   far inner wall, a bowl's bottom) is seen through the opening: its line of sight crosses the hull for a good part
