@@ -4,15 +4,16 @@ The planner passes one profile per candidate class as plain data::
 
     {"class": "Milk", "colors": ("white",), "shape": "box", "size": "medium", "texts": ("milk",),
      "brand": None, "kind_texts": (), "handle": False, "open_top": False, "height_to_width": (1.2, 4.0),
-     "elongation": None, "ancestors": ("Milk", "Drink", "FoodOrDrink", "PhysicalObject"), "packaged_in": ()}
+     "elongation": None, "waisted": False, "ancestors": ("Milk", "Drink", "FoodOrDrink", "PhysicalObject"),
+     "packaged_in": ()}
 
 (colour, shape and size are the ontology's lower-case labels; the form cues - a handle, an open top, the ranges of
-height over width and of elongation - are the ontology's ``rk:hasHandle``, ``rk:openTop``,
-``rk:min/maxHeightToWidth``, ``rk:min/maxElongation``; ``packaged_in`` names the container class the objects are
-typically packaged in and its ancestors, ``rk:packagedIn``: a query for a bottle also asks for a mustard; ``brand``
-is the ``rk:brand`` of a branded product, ``kind_texts`` the printed texts it inherits from its ancestors (what kind
-of product it is: "crackers" for a Cheez-It box); any key but ``class`` may be missing or None: the class may have
-any value).
+height over width and of elongation, a waist - are the ontology's ``rk:hasHandle``, ``rk:openTop``,
+``rk:min/maxHeightToWidth``, ``rk:min/maxElongation``, ``rk:waisted``; ``packaged_in`` names the container class the
+objects are typically packaged in and its ancestors, ``rk:packagedIn``: a query for a bottle also asks for a
+mustard; ``brand`` is the ``rk:brand`` of a branded product, ``kind_texts`` the printed texts it inherits from its
+ancestors (what kind of product it is: "crackers" for a Cheez-It box); any key but ``class`` may be missing or None:
+the class may have any value).
 
 Scoring. For every cue the hypothesis carries (its most confident SemanticColor, Shape, Size, FormFeatures and,
 when read, Text) a profile gets an agreement in [0, 1]:
