@@ -23,34 +23,22 @@ ROOT = Path(__file__).resolve().parents[1]
 sys.path.insert(0, str(ROOT))
 
 from annotators.cloud.clutter import ClutterParameters  # noqa: E402
-from annotators.cloud.filters import range_mask  # noqa: E402
 from annotators.cloud.form import WAIST_RATIO, waist_ratio  # noqa: E402
-from annotators.cloud.support_choice import find_support_plane  # noqa: E402
-from annotators.geometry.support_frame import plane_frame  # noqa: E402
+from annotators.geometry.support_frame import SupportFrame, plane_frame  # noqa: E402
 from annotators.readers.pcd_io import read_pcd  # noqa: E402
 from reasoning.evaluation.mosd import object_labels, scene_category  # noqa: E402
 from reasoning.evaluation.object_verdicts import load_labelled_objects  # noqa: E402
-from tests.annotators.guard_frames import LABELS, frame_points, segment_points  # noqa: E402
+from tests.annotators.guard_frames import LABELS, frame_points, segment_points, support_plane  # noqa: E402
 
 MOSD = ROOT.parent / "shared" / "data" / "pcl_mosd_tabletop" / "learn"
 
 
 def upright_ratio(points: np.ndarray, model: np.ndarray) -> float | None:
     """The waist ratio of an object's Nx3 camera points standing on the plane ``model``, measured as the form
-    expert does (bottom on the plane, top at the 98 % height)."""
-    transform = plane_frame(model)
-    upright = points @ transform[:3, :3].T + transform[:3, 3]
-    if np.median(upright[:, 2]) < 0.0:  # the plane's normal faced away from the object
-        upright[:, 2] *= -1.0
-    height = float(np.quantile(upright[:, 2], 0.98))
-    measured = waist_ratio(upright, 0.0, height)
+    expert does (in the plane's frame, bottom on the plane, top at the 98 % height)."""
+    upright = SupportFrame(plane_frame(model), on_plane=True, guessed=False).points(points)
+    measured = waist_ratio(upright, 0.0, float(np.quantile(upright[:, 2], 0.98)))
     return None if measured is None else measured[0]
-
-
-def plane_of(points: np.ndarray) -> np.ndarray:
-    """The supporting plane's model of an organized cloud (as the guard frames' segmenter finds it)."""
-    mask = range_mask(points, np.isfinite(points[..., 2]), 0.2, 2.5)
-    return np.asarray(find_support_plane(points, mask).model, dtype=np.float64)
 
 
 def guard_objects() -> list[tuple[float, str]]:
@@ -59,7 +47,7 @@ def guard_objects() -> list[tuple[float, str]]:
     for (input_name, index), objects in load_labelled_objects(LABELS).items():
         points, colors = frame_points(input_name, index)
         labels = segment_points(points, colors, ClutterParameters())
-        model = plane_of(points)
+        model = np.asarray(support_plane(points)[1].model, dtype=np.float64)
         for labelled in objects:
             x, y = labelled.pixel
             if not labels[y, x]:
@@ -78,7 +66,7 @@ def mosd_objects() -> list[tuple[float, str]]:
         frame = read_pcd(path)
         points = np.ascontiguousarray(frame.points, dtype=np.float32)
         truth = object_labels(frame.labels)
-        model = plane_of(points)
+        model = np.asarray(support_plane(points)[1].model, dtype=np.float64)
         for number in np.unique(truth[truth > 0]):
             own = points[truth == number]
             own = own[np.isfinite(own).all(axis=1)]

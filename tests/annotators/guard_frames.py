@@ -11,7 +11,7 @@ import numpy as np
 from annotators.cloud.clutter import ClutterParameters, segment_clutter
 from annotators.cloud.filters import range_mask
 from annotators.cloud.point_cloud import back_project, pixel_rays
-from annotators.cloud.support_choice import find_support_plane
+from annotators.cloud.support_choice import PlaneFit, find_support_plane
 from annotators.geometry.grid_segmentation import bounding_box
 from annotators.readers.frame_io import read_color_depth_pair
 from annotators.readers.pcd_io import read_pcd
@@ -42,10 +42,15 @@ def segment_mosd_scene(path: Path, parameters: ClutterParameters) -> tuple[np.nd
     return segment_points(points, frame.color, parameters), object_labels(frame.labels), np.isfinite(points[..., 2])
 
 
+def support_plane(points: np.ndarray) -> tuple[np.ndarray, PlaneFit]:
+    """The points within the range filter's 0.2-2.5 m (HxW bool) and the supporting plane found among them."""
+    mask = range_mask(points, np.isfinite(points[..., 2]), 0.2, 2.5)
+    return mask, find_support_plane(points, mask)
+
+
 def segment_points(points: np.ndarray, colors: np.ndarray, parameters: ClutterParameters) -> np.ndarray:
     """Segment numbers of the clutter segmenter on an organized cloud, larger segments first."""
-    mask = range_mask(points, np.isfinite(points[..., 2]), 0.2, 2.5)
-    fit = find_support_plane(points, mask)
+    mask, fit = support_plane(points)
     found = segment_clutter(points, mask, fit.model, fit.inlier_indices, parameters, colors)
     labels = np.zeros(points.shape[:2], dtype=np.int32)
     for number, s in enumerate(sorted(found, key=lambda s: -int(np.count_nonzero(s.mask))), start=1):

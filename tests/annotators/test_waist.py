@@ -14,14 +14,12 @@ from hypothesis import strategies as st
 
 from annotators.classification.knowledge_classifier import Cues, Profile, score
 from annotators.cloud.clutter import ClutterParameters
-from annotators.cloud.filters import range_mask
 from annotators.cloud.form import WAIST_RATIO, measure_form, waist_evidence, waist_ratio
-from annotators.cloud.support_choice import find_support_plane
 from annotators.geometry.support_frame import SupportFrame, plane_frame
 from reasoning.evaluation.object_verdicts import load_labelled_objects
 from reasoning.knowledge.knowledge_base import KnowledgeBase
 from reasoning.planning.query_planner import class_profiles
-from tests.annotators.guard_frames import LABELS, frame_points, segment_points
+from tests.annotators.guard_frames import LABELS, frame_points, segment_points, support_plane
 
 CAMERA_TO_FRAME = np.eye(4)
 CAMERA_TO_FRAME[2, 3] = 0.5
@@ -168,8 +166,7 @@ def test_on_the_real_uoc_frames_only_the_drills_standing_on_their_batteries_are_
     for (input_name, index), objects in load_labelled_objects(LABELS).items():
         points, colors = frame_points(input_name, index)
         labels = segment_points(points, colors, ClutterParameters())
-        mask = range_mask(points, np.isfinite(points[..., 2]), 0.2, 2.5)
-        frame = SupportFrame(plane_frame(find_support_plane(points, mask).model), on_plane=True, guessed=False)
+        frame = SupportFrame(plane_frame(support_plane(points)[1].model), on_plane=True, guessed=False)
         for labelled in objects:
             x, y = labelled.pixel
             own = points[labels == labels[y, x]]
