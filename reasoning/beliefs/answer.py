@@ -488,6 +488,10 @@ def _designate(
     if class_name is None and asked_class and CLASS_ATTRIBUTE in attributes:
         # a candidate by its leading class, a guess (reasoning.beliefs.class_candidates): named by it, shown with "?"
         class_name = attributes[CLASS_ATTRIBUTE].value
+    if class_name is not None and asked_class and class_test is not None and not class_test(class_name, asked_class):
+        # a candidate by its leading refinement (food, perhaps canned food, for "find the can"): named by the stated
+        # class that answers the query best
+        class_name = _answering_alternative(attributes.get(CLASS_ATTRIBUTE), asked_class, class_test) or class_name
     size_attribute = attributes.get(Size.attribute)
     answers = None
     if asked_class and _local(asked_class) != ROOTS["class"]:  # asking for any object asks for no class
@@ -510,6 +514,14 @@ def _designate(
         status=belief.status,
         answers=answers,
     )
+
+
+def _answering_alternative(stated: AttributeDesignator | None, asked_class: str, class_test: ClassTest) -> str | None:
+    """The most probable stated class that answers a query for ``asked_class``, or None."""
+    if stated is None:
+        return None
+    answering = [a for a in stated.alternatives if class_test(a.value, asked_class)]
+    return max(answering, key=lambda a: a.confidence).value if answering else None
 
 
 def _with_answering(classes: AttributeBelief | None, answering: Sequence[Evidence]) -> Mapping[str, ValueSupport]:

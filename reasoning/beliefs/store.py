@@ -57,7 +57,13 @@ import numpy as np
 import platformdirs
 
 from queries.selection import SelectionRequest
-from reasoning.beliefs.class_candidates import BY_ID, GUESSED_CLASSES, candidate_class_clauses
+from reasoning.beliefs.class_candidates import (
+    BY_ID,
+    GUESSED_CLASSES,
+    candidate_class_clauses,
+    general_classes,
+    leading_refinement,
+)
 from reasoning.beliefs.frame_writer import MAX_WRITE_BEHIND, NEXT_ID, FrameWriter, WriterGoneError
 from reasoning.beliefs.interned import INTERN, InternedTexts, decoded_supports
 from reasoning.beliefs.packed import (
@@ -333,6 +339,9 @@ class BeliefStore:
         self._sources_text: dict[frozenset[str], str] = {}
         """JSON of the expert sets written (few distinct sets recur on every row)."""
         self._views: dict[tuple[object, tuple], object] = {}
+        self._class_ways: dict[tuple[int, str, ClassTest | None], tuple[list[str], list[str]]] = {}
+        """(known classes, asked class, class test) -> the classes answering it and those more general
+        (:meth:`_answering_classes`)."""
         """What :meth:`query_views` made, by (view, stored row)."""
         self._interned = InternedTexts()
         """The codes of the attribute names, values and expert sets in the packed supports."""
@@ -1059,10 +1068,12 @@ class BeliefStore:
             # the class a query asks for, each way a belief answers to it (:func:`candidate_class_clauses`)
             class_ways: list[tuple[str, list[object], str]] = [("", [], "")]
             if f.object_class:
-                classes = self._matching_classes(conn, f.object_class, f.class_test)
+                classes, general = self._answering_classes(conn, f.object_class, f.class_test)
                 if not classes:
                     return []
-                class_ways = candidate_class_clauses(classes, narrowed=bool(f.region) or f.ids is not None)
+                class_ways = candidate_class_clauses(
+                    classes, narrowed=bool(f.region) or f.ids is not None, general=general
+                )
             texts = {name: value for name, value in f.attributes.items() if name == Text.attribute}
             for name, value in f.attributes.items():
                 if name in texts:
@@ -1167,16 +1178,34 @@ class BeliefStore:
                     )
         return found
 
+    def _answering_classes(
+        self, conn: sqlite3.Connection, wanted: str, class_test: ClassTest | None
+    ) -> tuple[list[str], list[str]]:
+        """The stored class names answering a query for ``wanted`` and those more general than one of them
+        (:func:`~reasoning.beliefs.class_candidates.general_classes`), remembered while the ``classes`` table (which
+        only grows) keeps its size."""
+        known = [row[0] for row in conn.execute("SELECT name FROM classes")]
+        key = (len(known), wanted, class_test)
+        found = self._class_ways.get(key)
+        if found is None:
+            if len(self._class_ways) > SOURCES_CACHE_LIMIT:
+                self._class_ways.clear()
+            test = class_test or (lambda a, b: a.lower() == b.lower())
+            classes = _matching_classes(known, wanted, test)
+            found = self._class_ways[key] = (classes, general_classes(known, classes, test))
+        return found
+
     def integrity_check(self) -> str:
         """SQLite's ``PRAGMA integrity_check`` result (``"ok"`` when sound)."""
         with self._guard() as conn:
             return "; ".join(row[0] for row in conn.execute("PRAGMA integrity_check"))
 
-    def _matching_classes(self, conn: sqlite3.Connection, wanted: str, class_test: ClassTest | None) -> list[str]:
-        known = [row[0] for row in conn.execute("SELECT name FROM classes")]
-        canonical = next((name for name in known if name.lower() == wanted.lower()), wanted)
-        test: Callable[[str, str], bool] = class_test or (lambda a, b: a.lower() == b.lower())
-        return [name for name in known if name == canonical or test(name, canonical)]
+
+def _matching_classes(known: Sequence[str], wanted: str, test: ClassTest) -> list[str]:
+    """The ``known`` class names that answer a query for ``wanted`` (its stored spelling, or a class ``test``
+    accepts for it)."""
+    canonical = next((name for name in known if name.lower() == wanted.lower()), wanted)
+    return [name for name in known if name == canonical or test(name, canonical)]
 
 
 # ---------------------------------------------------------------------------------------- row mapping
@@ -1328,6 +1357,10 @@ def _pack_attributes(
             continue
         fused = fuse_values(name, attribute.values, class_test if name == CLASS_ATTRIBUTE else None)
         entries.extend(f"{name}={s.value}" for s in fused.support if s.value == fused.value or s.confidence > 0.5)
+        if name == CLASS_ATTRIBUTE and class_test is not None:
+            refinement = leading_refinement(fused, class_test)
+            if refinement is not None and f"{name}={refinement}" not in entries:
+                entries.append(f"{name}={refinement}")
         if name in SEEN_TOGETHER:
             entries.extend(f"{name}={value}" for value in last_stated(values) if f"{name}={value}" not in entries)
     return supports_packing(len(flat) // FIELDS).pack(*flat), INDEX_SEPARATOR.join(sorted(entries))
