@@ -57,7 +57,8 @@ def map_on_cluster(
     """``function(item, *extra)`` for each item as Ray tasks, at most ``workers`` at once (one CPU each, and a
     placement group of ``workers`` one-CPU bundles on a given cluster or a bigger one), on the cluster at
     ``address`` (None: a local one with ``workers`` CPUs); the results in the items' order. The task's own
-    exception when one fails; ClusterError without Ray (``PURPOSE needs Ray``) or a cluster."""
+    exception when one fails, once the tasks in flight have ended (an interrupt cancels them instead);
+    ClusterError without Ray (``PURPOSE needs Ray``) or a cluster."""
     if workers < 1:
         raise ValueError(f"workers must be at least 1, got {workers}")
     with ray_cluster(address, num_cpus=workers, purpose=purpose) as ray:
@@ -97,18 +98,26 @@ def _in_order(ray: Any, task: Any, items: Sequence[T], shared: list[Any], in_fli
                     break
                 done, _ = ray.wait(list(running), num_returns=1)
                 for reference in done:
-                    index = running.pop(reference)  # before the result, which may raise: an ended task is not cancelled
+                    index = running.pop(reference)  # before the result, which may raise
                     results[index] = _result(ray, reference)
                     bar.update()
-        finally:
+        except Exception:
+            # a task failed: the ones in flight (at most ``in_flight``) end on their own and their results are dropped;
+            # cancelling them would race with their end, which aborts Ray 2.60's whole process
+            if running:
+                ray.wait(list(running), num_returns=len(running))
+            raise
+        except BaseException:  # interrupted (Ctrl-C): stop the work in flight rather than wait for it
             _cancel_unfinished(ray, list(running))
+            raise
     return results
 
 
 def _cancel_unfinished(ray: Any, references: list[Any]) -> None:
     """Cancel the tasks of ``references`` that have not ended. Ray 2.60 aborts this process ("Tried to complete
     task that was not pending") when a task is cancelled while its end is being recorded, so a task that has
-    ended already is left alone."""
+    ended already is left alone; one that ends between that check and its cancel can still abort it, which is why
+    only an interrupted map cancels."""
     if not references:
         return
     _, unfinished = ray.wait(references, num_returns=len(references), timeout=0)

@@ -453,9 +453,10 @@ print("failures", failures)
 
 
 def test_many_evals_whose_task_fails_among_running_ones_leave_the_process_alive() -> None:
-    """A task's exception ends the map and the tasks still running are cancelled. Cancelling one that had ended
-    already made Ray 2.60 abort the whole process (exit 1, nothing printed: a test run just stopped), within a few
-    dozen such maps; so this runs in its own process."""
+    """A task's exception ends the map once the tasks still running have ended (their results dropped).
+    Cancelling them instead made Ray 2.60 abort the whole process now and then (exit 1, or a stack trace from
+    ``TaskManager::CompletePendingTask``) when one ended as it was cancelled, even after checking that it had not;
+    so this runs in its own process."""
     require_ray()
     runs = 60
     ended = subprocess.run(
