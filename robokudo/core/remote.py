@@ -227,6 +227,8 @@ class RemoteAnnotator(ThreadedAnnotator):
         self.where = placement
         self._actor: Any = None
         self._actor_failed = False
+        self._answered = False
+        """Whether this node's actor has answered a run yet (its first run also waits for its process to start)."""
         self.remote_seconds = 0.0
         """The expert's own run time on the actor in the last run that got an answer (seconds)."""
         self.call_times = CallTimes()
@@ -328,6 +330,7 @@ class RemoteAnnotator(ThreadedAnnotator):
                 called = stamp
                 answer = self._wait(ray, pending)
             status, message, writes, times.expert, (entered, left) = answer
+            self._answered = True
             stamp, times.answer = _lap(called)
             times.actor = left - entered
             times.to_actor, times.from_actor = entered - called, stamp - left
@@ -406,13 +409,26 @@ class RemoteAnnotator(ThreadedAnnotator):
             self._actor_failed = False
             return
 
+    def timeout_detail(self) -> str:
+        """Says when the actor never answered: its process may still be starting (tens of seconds on a loaded
+        machine) or the cluster may lack what it reserves."""
+        if self._answered:
+            return ""
+        reserved = self.where.describe().removeprefix("remote ").strip("()")
+        return (
+            f" (its actor had not answered yet: its process may still be starting, or no node has the {reserved} "
+            "it reserves free)"
+        )
+
     def stop_actor(self) -> None:
         """End the actor's process now (an actor also ends when the last handle to it is gone)."""
         if self._actor is not None:
             calls = self.compiled_calls()
+            # the actor first: a run still waiting for it (one that never started holds the graph's lock while it
+            # asks for its process) then ends, and the graph can be torn down
+            require_ray().kill(self._actor, no_restart=True)
             if calls is not None:
                 calls.reset()
-            require_ray().kill(self._actor, no_restart=True)
             self._actor = None
 
 

@@ -54,7 +54,7 @@ class ThreadedAnnotator(Annotator):
         if outcome is None:
             if time.perf_counter() - self._started_at > self.timeout:
                 self._cancel()
-                self.feedback_message = f"timed out after {self.timeout:g} s"
+                self.feedback_message = f"timed out after {self.timeout:g} s{self.timeout_detail()}"
                 return Status.FAILURE
             self.feedback_message = "working"
             return Status.RUNNING
@@ -65,6 +65,11 @@ class ThreadedAnnotator(Annotator):
         self.feedback_message = message
         self._active_run = None
         return status if status is not Status.INVALID else Status.FAILURE
+
+    def timeout_detail(self) -> str:
+        """What a timed-out run's message adds after "timed out after N s" (nothing here; a subclass that knows
+        more about why says it, starting with a space)."""
+        return ""
 
     def terminate(self, new_status: Status) -> None:
         """Cancel a run that is still working when the node is interrupted."""

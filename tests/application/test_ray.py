@@ -268,6 +268,22 @@ def test_a_timed_out_call_is_drained_and_the_next_run_gets_its_own_answer(cluste
         node.stop_actor()
 
 
+def test_a_run_whose_actor_never_answered_says_so_when_it_times_out(cluster: ModuleType) -> None:
+    """An actor that reserves a GPU on this CPU-only cluster never starts: the run times out, and the message says
+    that the actor had not answered yet and what it reserves (a robot's operator otherwise sees only "timed out")."""
+    tree = Pipeline("echo", [Frame([1], [(48, 64)]), Echo()])
+    [node] = place_remote(tree, ["echo"], Placement(remote=True, num_gpus=1))
+    node.timeout = 1.0
+    try:
+        assert run_to_end(Engine(tree, hz=1000)) is Status.FAILURE
+        assert node.feedback_message == (
+            "timed out after 1 s (its actor had not answered yet: its process may still be starting, or no node has "
+            "the 1 CPU, 1 GPU it reserves free)"
+        )
+    finally:
+        node.stop_actor()
+
+
 def test_an_interrupted_call_ends_its_worker_at_once_and_the_next_run_works(cluster: ModuleType) -> None:
     tree, node = echo_tree([1, 255, 2], [(48, 64)], timeout=15.0)
     engine = Engine(tree, hz=1000)
