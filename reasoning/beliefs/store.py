@@ -118,6 +118,8 @@ SOURCES_CACHE_LIMIT = 4096
 """Distinct expert sets a store keeps the JSON of (beyond that the cache starts afresh)."""
 VIEW_CACHE_LIMIT = 4096
 """Rows :meth:`BeliefStore.query_views` remembers the views of (beyond that the memo starts afresh)."""
+CLASS_WAYS_CACHE_LIMIT = 256
+"""(Asked class, class test) pairs a store remembers the answering classes of (beyond that it starts afresh)."""
 WAL_AUTOCHECKPOINT_PAGES = 4000
 """Checkpoint the WAL into the file every ~16 MB (fewer fsyncs than SQLite's default of 1000 pages)."""
 
@@ -339,10 +341,10 @@ class BeliefStore:
         self._sources_text: dict[frozenset[str], str] = {}
         """JSON of the expert sets written (few distinct sets recur on every row)."""
         self._views: dict[tuple[object, tuple], object] = {}
+        """What :meth:`query_views` made, by (view, stored row)."""
         self._class_ways: dict[tuple[int, str, ClassTest | None], tuple[list[str], list[str]]] = {}
         """(known classes, asked class, class test) -> the classes answering it and those more general
         (:meth:`_answering_classes`)."""
-        """What :meth:`query_views` made, by (view, stored row)."""
         self._interned = InternedTexts()
         """The codes of the attribute names, values and expert sets in the packed supports."""
         self._row_updates: RowUpdate | None = None
@@ -1188,7 +1190,7 @@ class BeliefStore:
         key = (len(known), wanted, class_test)
         found = self._class_ways.get(key)
         if found is None:
-            if len(self._class_ways) > SOURCES_CACHE_LIMIT:
+            if len(self._class_ways) > CLASS_WAYS_CACHE_LIMIT:
                 self._class_ways.clear()
             test = class_test or (lambda a, b: a.lower() == b.lower())
             classes = _matching_classes(known, wanted, test)
