@@ -26,6 +26,10 @@ RETRIES = 3
 """How often a task whose worker process died (e.g. killed by Ray's memory monitor when the machine runs low on
 memory) is run again; an exception the function raises is not retried."""
 
+FAILURE_WAIT_SECONDS = 60.0
+"""How long a map whose task failed waits for the tasks still in flight before it raises that task's exception;
+tasks still running then are left to the cluster (a local one stops them as it shuts down)."""
+
 T = TypeVar("T")
 R = TypeVar("R")
 
@@ -53,19 +57,20 @@ def map_on_cluster(
     address: str | None = None,
     label: str = "",
     purpose: str = "running tasks on a cluster",
+    failure_wait: float = FAILURE_WAIT_SECONDS,
 ) -> list[R]:
     """``function(item, *extra)`` for each item as Ray tasks, at most ``workers`` at once (one CPU each, and a
     placement group of ``workers`` one-CPU bundles on a given cluster or a bigger one), on the cluster at
     ``address`` (None: a local one with ``workers`` CPUs); the results in the items' order. The task's own
-    exception when one fails, once the tasks in flight have ended (an interrupt cancels them instead);
-    ClusterError without Ray (``PURPOSE needs Ray``) or a cluster."""
+    exception when one fails, once the tasks in flight have ended or ``failure_wait`` seconds have passed (an
+    interrupt cancels them instead); ClusterError without Ray (``PURPOSE needs Ray``) or a cluster."""
     if workers < 1:
         raise ValueError(f"workers must be at least 1, got {workers}")
     with ray_cluster(address, num_cpus=workers, purpose=purpose) as ray:
         shared = [ray.put(value) for value in extra]
         if address is None and ray.cluster_resources().get("CPU", 0.0) <= workers:  # a given cluster may grow
             task = ray.remote(function).options(num_cpus=1, max_retries=RETRIES)
-            return _in_order(ray, task, items, shared, 2 * workers, label)
+            return _in_order(ray, task, items, shared, 2 * workers, label, failure_wait)
         from ray.util.placement_group import placement_group, remove_placement_group
         from ray.util.scheduling_strategies import PlacementGroupSchedulingStrategy
 
@@ -75,14 +80,16 @@ def map_on_cluster(
             task = ray.remote(function).options(
                 num_cpus=1, max_retries=RETRIES, scheduling_strategy=PlacementGroupSchedulingStrategy(group)
             )
-            return _in_order(ray, task, items, shared, 2 * workers, label)
+            return _in_order(ray, task, items, shared, 2 * workers, label, failure_wait)
         finally:
             remove_placement_group(group)
 
 
-def _in_order(ray: Any, task: Any, items: Sequence[T], shared: list[Any], in_flight: int, label: str) -> list[Any]:
+def _in_order(
+    ray: Any, task: Any, items: Sequence[T], shared: list[Any], in_flight: int, label: str, failure_wait: float
+) -> list[Any]:
     """``task`` on each item with the ``shared`` arguments, ``in_flight`` handed to Ray at a time; the results in
-    the items' order."""
+    the items' order. A failure is raised once the tasks in flight have ended, or after ``failure_wait`` seconds."""
     results: list[Any] = [None] * len(items)
     running: dict[Any, int] = {}
     upcoming = iter(enumerate(items))
@@ -105,7 +112,7 @@ def _in_order(ray: Any, task: Any, items: Sequence[T], shared: list[Any], in_fli
             # a task failed: the ones in flight (at most ``in_flight``) end on their own and their results are dropped;
             # cancelling them would race with their end, which aborts Ray 2.60's whole process
             if running:
-                ray.wait(list(running), num_returns=len(running))
+                ray.wait(list(running), num_returns=len(running), timeout=failure_wait)
             raise
         except BaseException:  # interrupted (Ctrl-C): stop the work in flight rather than wait for it
             _cancel_unfinished(ray, list(running))

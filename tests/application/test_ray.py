@@ -425,6 +425,34 @@ def test_fewer_workers_than_the_cluster_has_cpus_run_one_task_at_a_time(cluster:
     assert all(end <= next_start for (_, end), (next_start, _) in itertools.pairwise(spans))
 
 
+def fail_or_hold(item: str, folder: Path) -> str:
+    """A task that fails at once for ``"fail"``; otherwise it runs until ``folder/release`` exists (at most 60 s)
+    and then leaves ``folder/ended``."""
+    if item == "fail":
+        raise ValueError("this task failed")
+    deadline = time.monotonic() + 60.0
+    while not (folder / "release").exists() and time.monotonic() < deadline:
+        time.sleep(0.05)
+    (folder / "ended").touch()
+    return item
+
+
+def test_a_failure_is_reported_without_waiting_longer_than_asked_for_a_task_still_running(
+    cluster: ModuleType, tmp_path: Path
+) -> None:
+    """A failed map waits for its tasks in flight only ``failure_wait`` seconds: one that runs on is left to the
+    cluster, and the failure is raised while it still runs."""
+    with pytest.raises(ValueError, match="this task failed"):
+        map_on_cluster(fail_or_hold, ["hold", "fail"], tmp_path, workers=2, failure_wait=1.0)
+    still_running = not (tmp_path / "ended").exists()
+    (tmp_path / "release").touch()
+    assert still_running
+    deadline = time.monotonic() + 60.0
+    while not (tmp_path / "ended").exists():  # the held task ends once released, freeing its CPU for the next tests
+        assert time.monotonic() < deadline, "the held task did not end once released"
+        time.sleep(0.05)
+
+
 @pytest.mark.real_data
 def test_eval_with_two_workers_gives_exactly_the_sequential_figures(
     cluster: ModuleType, capsys: pytest.CaptureFixture[str]
