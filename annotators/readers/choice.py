@@ -9,6 +9,7 @@ None                                                                   KitchenSc
 ROS 1 ``.bag`` file, ROS 2 bag folder (``metadata.yaml``) or its       BagReader(path, frame) (BagCloudReader
 ``.mcap`` / ``.db3`` file                                               when it holds only PointCloud2 topics)
 folder with ``rgb.txt`` and ``depth.txt``                              TumSequenceReader(folder, frame)
+folder with ``depth/`` and ``color/`` (or ``image/``) image folders    Open3dFolderReader(folder, frame)
 folder with ``camera_params.json`` and ``NNNNNN-color.png`` files       ColorDepthPairReader(folder, frame)
 folder with ``tiff/`` (and ``pclzf/*.xml``), or that ``tiff/`` folder  TiffSequenceReader(folder, frame)
 folder of ``.pcd`` files                                               PcdReader(the frame-th file, natural order)
@@ -33,17 +34,19 @@ from dataclasses import dataclass, field
 from pathlib import Path
 
 from annotators.readers.bag_io import IMAGE, bag_message_types, is_bag
-from annotators.readers.frame_io import CAMERA_PARAMS_FILE, FrameError
+from annotators.readers.frame_io import CAMERA_PARAMS_FILE, IMAGE_SUFFIXES, FrameError, natural_order_key
 from annotators.readers.frame_readers import (
     BagCloudReader,
     BagReader,
     ColorDepthPairReader,
     KitchenSceneReader,
+    Open3dFolderReader,
     PcdReader,
     TiffSequenceReader,
     TumPairReader,
     TumSequenceReader,
 )
+from annotators.readers.open3d_io import frame_pairs, is_open3d_folder
 from annotators.readers.tiff_io import frame_stamps, is_tiff_sequence, tiff_folder
 from annotators.readers.tum_io import associate, is_tum_pair, is_tum_sequence, pair_color_files, read_image_list
 from robokudo.core.annotator import Annotator
@@ -53,6 +56,7 @@ SUPPORTED_LAYOUTS = (
     "no path: the built-in kitchen scene",
     "a ROS 1 .bag file, or a ROS 2 bag (folder with metadata.yaml, .mcap or .db3 file)",
     "a TUM RGB-D sequence folder (rgb.txt, depth.txt)",
+    "an Open3D RGB-D folder (color/ or image/ and depth/ image folders, a camera JSON, optional trajectory.log)",
     "a uoc folder (NNNNNN-color.png, NNNNNN-depth.png, camera_params.json) or one of its NNNNNN-color.png",
     "a PCL ImageGrabber folder (tiff/ with pclzf/*.xml) or its tiff/ folder",
     "a .pcd file, organized or unorganized (HEIGHT 1; --intrinsics gives its camera), or a folder of them",
@@ -63,6 +67,7 @@ SUPPORTED_LAYOUTS = (
 READER_NAMES: tuple[str, ...] = (
     "KitchenSceneReader",
     "TumSequenceReader",
+    "Open3dFolderReader",
     "ColorDepthPairReader",
     "TiffSequenceReader",
     "PcdReader",
@@ -73,7 +78,6 @@ READER_NAMES: tuple[str, ...] = (
 """Every reader the entry point can choose, by ontology name (classes of :mod:`annotators.readers.frame_readers`)."""
 
 _UOC_COLOR = re.compile(r"^(\d{6})-color\.png$")
-_IMAGE_SUFFIXES = (".png", ".jpg", ".jpeg", ".tif", ".tiff")
 
 
 @dataclass(frozen=True)
@@ -91,10 +95,6 @@ class ReaderChoice:
     def create(self) -> Annotator:
         """A new reader annotator."""
         return self.reader(**self.parameters)
-
-
-def _natural_key(path: Path) -> list[object]:
-    return [int(part) if part.isdigit() else part for part in re.split(r"(\d+)", path.name)]
 
 
 def _unsupported(path: Path, why: str) -> ValueError:
@@ -126,6 +126,14 @@ def _describe_numbers(numbers: list[int]) -> str:
 def _folder_choice(folder: Path, frame: int, intrinsics: CameraIntrinsics | None = None) -> ReaderChoice:
     if is_tum_sequence(folder):
         return ReaderChoice(TumSequenceReader, {"folder": str(folder), "frame": frame})
+    if is_open3d_folder(folder):
+        try:
+            count = len(frame_pairs(folder))
+        except FrameError as error:
+            raise _unsupported(folder, str(error)) from None
+        if not 0 <= frame < count:
+            raise ValueError(f"{folder} holds {count} colour/depth frames, no frame {frame}")
+        return ReaderChoice(Open3dFolderReader, {"folder": str(folder), "frame": frame})
     numbers = sorted(int(m.group(1)) for p in folder.iterdir() if (m := _UOC_COLOR.match(p.name)))
     if (folder / CAMERA_PARAMS_FILE).is_file() and numbers:
         if frame not in numbers:
@@ -133,14 +141,14 @@ def _folder_choice(folder: Path, frame: int, intrinsics: CameraIntrinsics | None
         return ReaderChoice(ColorDepthPairReader, {"folder": str(folder), "frame": frame})
     if is_tiff_sequence(folder):
         return ReaderChoice(TiffSequenceReader, {"folder": str(folder), "frame": frame})
-    clouds = sorted((p for p in folder.iterdir() if p.suffix.lower() == ".pcd"), key=_natural_key)
+    clouds = sorted((p for p in folder.iterdir() if p.suffix.lower() == ".pcd"), key=natural_order_key)
     if clouds:
         if not 0 <= frame < len(clouds):
             raise ValueError(f"{folder} holds {len(clouds)} .pcd files, no frame {frame}")
         return ReaderChoice(PcdReader, _with_intrinsics({"path": str(clouds[frame])}, intrinsics))
     # uoc-named files without camera_params.json are not pairs: their intrinsics would be guessed
     pairs = sorted(
-        (p for p in pair_color_files(folder, _IMAGE_SUFFIXES) if not _UOC_COLOR.match(p.name)), key=_natural_key
+        (p for p in pair_color_files(folder, IMAGE_SUFFIXES) if not _UOC_COLOR.match(p.name)), key=natural_order_key
     )
     if pairs:
         if not 0 <= frame < len(pairs):
@@ -162,7 +170,7 @@ def _file_choice(path: Path, frame: int, intrinsics: CameraIntrinsics | None = N
     if uoc and (path.parent / CAMERA_PARAMS_FILE).is_file():
         _single_frame(path, frame)
         return ReaderChoice(ColorDepthPairReader, {"folder": str(path.parent), "frame": int(uoc.group(1))})
-    if suffix in _IMAGE_SUFFIXES and is_tum_pair(path):
+    if suffix in IMAGE_SUFFIXES and is_tum_pair(path):
         _single_frame(path, frame)
         return ReaderChoice(TumPairReader, {"path": str(path)})
     raise _unsupported(path, "the file matches no known layout")
@@ -200,12 +208,14 @@ def reader_name_for(path: str | None, frame: int = 0) -> str:
 def _folder_frame_count(folder: Path) -> int:
     if is_tum_sequence(folder):
         return len(associate(read_image_list(folder / "rgb.txt"), read_image_list(folder / "depth.txt")))
+    if is_open3d_folder(folder):
+        return len(frame_pairs(folder))
     if is_tiff_sequence(folder):
         return len(frame_stamps(tiff_folder(folder)))
     clouds = [p for p in folder.iterdir() if p.suffix.lower() == ".pcd"]
     if clouds:
         return len(clouds)
-    return len([p for p in pair_color_files(folder, _IMAGE_SUFFIXES) if not _UOC_COLOR.match(p.name)])
+    return len([p for p in pair_color_files(folder, IMAGE_SUFFIXES) if not _UOC_COLOR.match(p.name)])
 
 
 def recorded_frames(path: str) -> tuple[ReaderChoice, ...]:

@@ -18,6 +18,7 @@ from __future__ import annotations
 
 import json
 import math
+import re
 import zlib
 from dataclasses import dataclass
 from pathlib import Path
@@ -34,6 +35,14 @@ CAMERA_PARAMS_FILE = "camera_params.json"
 
 PNG_SIGNATURE = b"\x89PNG\r\n\x1a\n"
 
+IMAGE_SUFFIXES = (".png", ".jpg", ".jpeg", ".tif", ".tiff")
+"""File suffixes (lower case) of the colour and depth images the readers decode."""
+
+
+def natural_order_key(path: Path) -> list[object]:
+    """Sort key of a file name in natural order: ``frame2`` before ``frame10``."""
+    return [int(part) if part.isdigit() else part for part in re.split(r"(\d+)", path.name)]
+
 
 class FrameError(Exception):
     """A frame could not be read or is inconsistent; the message says why."""
@@ -44,7 +53,8 @@ class Frame:
     """One decoded RGB-D frame: RGB uint8 HxWx3, depth float32 metres HxW (0 = no data), intrinsics.
 
     ``points`` is the organized HxWx3 float32 cloud when the file holds one (NaN where invalid), ``labels`` HxW
-    ground-truth labels when the file has them, ``timestamp`` the recording time in seconds when known.
+    ground-truth labels when the file has them, ``timestamp`` the recording time in seconds when known,
+    ``cam_to_world`` the 4x4 camera pose in the recording's world when the recording gives one.
     """
 
     color: np.ndarray
@@ -54,6 +64,7 @@ class Frame:
     points: np.ndarray | None = None
     labels: np.ndarray | None = None
     timestamp: float | None = None
+    cam_to_world: np.ndarray | None = None
 
 
 def check_intrinsics(intrinsics: CameraIntrinsics, where: str) -> CameraIntrinsics:

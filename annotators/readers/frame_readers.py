@@ -6,13 +6,15 @@
 * :class:`PcdReader` reads an organized PCD file and also writes its point cloud (:mod:`annotators.readers.pcd_io`).
 * :class:`TiffSequenceReader` reads the PCL ImageGrabber TIFF layout (:mod:`annotators.readers.tiff_io`).
 * :class:`BagReader` reads a frame of a ROS 1 or ROS 2 bag (:mod:`annotators.readers.bag_io`).
+* :class:`Open3dFolderReader` reads a frame of an Open3D RGB-D folder (:mod:`annotators.readers.open3d_io`).
 
 :func:`annotators.readers.choice.reader_for` picks the reader from a path. Every reader decodes once and keeps the frame
 on the instance, so repeated ticks of the same frame cost nothing but the CAS writes; the arrays are shared with
-the CAS, never copied, and must not be modified downstream. Recorded frames have no camera pose
-(``cam_to_world`` is None). Every reader names the recording its frame belongs to (``CameraInfo.recording``): a
-sequence folder (TUM, TIFF) is one continuous recording, while each file of a uoc folder, a TUM pair or a PCD file
-is a snapshot of its own; all views of the built-in kitchen show one world (``KITCHEN_RECORDING``).
+the CAS, never copied, and must not be modified downstream. Recorded frames have no camera pose (``cam_to_world`` is
+None) unless the recording gives one (an Open3D folder's ``trajectory.log``). Every reader names the recording its
+frame belongs to (``CameraInfo.recording``): a sequence folder (TUM, TIFF, Open3D) is one continuous recording,
+while each file of a uoc folder, a TUM pair or a PCD file is a snapshot of its own; all views of the built-in
+kitchen show one world (``KITCHEN_RECORDING``).
 """
 
 from __future__ import annotations
@@ -27,6 +29,7 @@ import numpy as np
 
 from annotators.readers.bag_io import MILLIMETRES, BagTopics, read_bag_frame
 from annotators.readers.frame_io import Frame, FrameError, read_color_depth_pair
+from annotators.readers.open3d_io import OPEN3D_DEPTH_SCALE, read_open3d_frame
 from annotators.readers.pcd_io import read_pcd
 from annotators.readers.tiff_io import read_tiff_frame
 from annotators.readers.tum_io import TUM_DEPTH_SCALE, read_tum_pair, read_tum_sequence
@@ -163,7 +166,13 @@ class FileFrameReader(Annotator):
         self.write(DepthImage(frame.depth))
         stamp = frame.timestamp if frame.timestamp is not None else time.time()
         self.write(
-            CameraInfo(intrinsics=frame.intrinsics, frame_id="camera", timestamp=stamp, recording=self.recording())
+            CameraInfo(
+                intrinsics=frame.intrinsics,
+                cam_to_world=frame.cam_to_world,
+                frame_id="camera",
+                timestamp=stamp,
+                recording=self.recording(),
+            )
         )
         if PointCloud in self.outputs:
             if frame.points is None:
@@ -273,6 +282,44 @@ class TumPairReader(FileFrameReader):
     def recording(self) -> str:
         """The pair's file: a snapshot of its own."""
         return str(self.path.resolve())
+
+
+class Open3dFolderReader(FileFrameReader):
+    """Reads frame ``frame`` of an Open3D RGB-D folder (``color/`` or ``image/``, ``depth/``, camera JSON), with its
+    camera pose when the folder has a ``trajectory.log``.
+
+    ``depth_scale`` is in units per metre (Open3D: 1000); ``intrinsics`` default to the folder's Open3D camera JSON,
+    else the PrimeSense default.
+    """
+
+    capability: ClassVar[Capability] = Capability(
+        label="Open3D folder reader",
+        description="Reads a frame of an Open3D RGB-D folder (color/ and depth/ images, camera JSON, poses).",
+        cost_ms=15.0,
+        reliability=1.0,
+    )
+
+    def __init__(
+        self,
+        folder: str | Path,
+        frame: int = 0,
+        depth_scale: float = OPEN3D_DEPTH_SCALE,
+        intrinsics: CameraIntrinsics | None = None,
+        name: str | None = None,
+    ) -> None:
+        super().__init__(name=name)
+        self.folder = Path(folder)
+        self.frame = frame
+        self.depth_scale = depth_scale
+        self.intrinsics = intrinsics
+
+    def decode(self) -> Frame:
+        """Pair the frame's colour and depth images and decode them, with the frame's pose when there is one."""
+        return read_open3d_frame(self.folder, self.frame, self.depth_scale, self.intrinsics)
+
+    def recording(self) -> str:
+        """The folder: one continuous recording."""
+        return str(self.folder.resolve())
 
 
 class PcdReader(FileFrameReader):

@@ -27,6 +27,7 @@ import sys
 from pathlib import Path
 
 import numpy as np
+from scipy import ndimage
 
 ROOT = Path(__file__).resolve().parents[2]
 sys.path.insert(0, str(ROOT))
@@ -54,6 +55,7 @@ class SurfaceRule:
 
     def __init__(self) -> None:
         self.on = False
+        self.behind_only = False
         self.surfaces: np.ndarray | None = None
         self._next_parts_are_surfaces = False
 
@@ -97,6 +99,11 @@ class SurfaceRule:
         has_seed[surfaces[seeds]] = True
         grown = (labels > 0) & ~seeds & (surfaces > 0)
         keep = seeded[surfaces[grown] + count * labels[grown]] | ~has_seed[surfaces[grown]]
+        if self.behind_only:  # only pixels farther than the seed they grew from (what an occluder hides) are dropped
+            _, (seed_rows, seed_cols) = ndimage.distance_transform_edt(~seeds, return_indices=True)
+            depth = points[..., 2]
+            farther = depth[grown] > depth[seed_rows[grown], seed_cols[grown]]
+            keep |= ~farther
         kept = labels.copy()
         rows, cols = np.nonzero(grown)
         kept[rows[~keep], cols[~keep]] = 0
@@ -167,9 +174,11 @@ def main() -> None:
     parser.add_argument("--offsets", type=int, default=3, help="n: n x n offsets")
     parser.add_argument("--scale", type=int, default=2, help="offsets in steps of this many coarse pixels")
     parser.add_argument("--at", type=int, nargs=2, default=(0, 0), metavar=("DY", "DX"))
+    parser.add_argument("--behind-only", action="store_true", help="drop only pixels farther than their seed")
     args = parser.parse_args()
     inputs = load(args.inputs)
     rule = SurfaceRule()
+    rule.behind_only = args.behind_only
     rule.install()
     if args.part == "mosd":
         offsets = [(args.scale * dy, args.scale * dx) for dy in range(args.offsets) for dx in range(args.offsets)]

@@ -45,6 +45,7 @@ from annotators.readers.frame_readers import (
     BagReader,
     ColorDepthPairReader,
     KitchenSceneReader,
+    Open3dFolderReader,
     PcdReader,
     TiffSequenceReader,
     TumPairReader,
@@ -414,6 +415,27 @@ def write_tum_sequence(folder: Path, depth_list: str = "1.0 a_depth.png\n", trun
     return folder
 
 
+def write_open3d(
+    folder: Path,
+    camera: str | None = '{"width": 64, "height": 48, "intrinsic_matrix": [60, 0, 0, 0, 60, 0, 32, 24, 1]}',
+    trajectory: str | None = None,
+    truncate: bool = False,
+) -> Path:
+    """An Open3D RGB-D folder with one frame (color/, depth/, camera_intrinsic.json, optional trajectory.log)."""
+    (folder / "color").mkdir(parents=True, exist_ok=True)
+    (folder / "depth").mkdir(parents=True, exist_ok=True)
+    cv2.imwrite(str(folder / "color" / "000000.jpg"), np.zeros((H, W, 3), np.uint8))
+    depth = folder / "depth" / "000000.png"
+    cv2.imwrite(str(depth), np.full((H, W), 1000, np.uint16))
+    if truncate:
+        depth.write_bytes(depth.read_bytes()[: depth.stat().st_size // 2])
+    if camera is not None:
+        (folder / "camera_intrinsic.json").write_text(camera)
+    if trajectory is not None:
+        (folder / "trajectory.log").write_text(trajectory)
+    return folder
+
+
 def write_pcd(path: Path, organized: bool = True, truncate: bool = False, depth: float = 1.0) -> Path:
     """A small ASCII PCD (x y z rgb), organized 4x3 or a single row, ``depth`` m ahead; optionally cut short."""
     width, height = (4, 3) if organized else (12, 1)
@@ -470,6 +492,16 @@ BROKEN_READERS: dict[type[Annotator], dict[str, Callable[[Path], Annotator]]] = 
             write_tum_sequence(tmp), intrinsics=CameraIntrinsics(0, 0, 0, 0, 0, 0)
         ),
         "intrinsics for another image size": lambda tmp: TumSequenceReader(write_tum_sequence(tmp), intrinsics=K),
+    },
+    Open3dFolderReader: {
+        "missing folder": lambda tmp: Open3dFolderReader(tmp / "nowhere"),
+        "missing frame": lambda tmp: Open3dFolderReader(write_open3d(tmp / "a"), frame=1),
+        "truncated depth file": lambda tmp: Open3dFolderReader(write_open3d(tmp / "b", truncate=True)),
+        "camera JSON that is not JSON": lambda tmp: Open3dFolderReader(write_open3d(tmp / "c", camera="{fx: 60")),
+        "camera for the default size": lambda tmp: Open3dFolderReader(write_open3d(tmp / "d", camera=None)),
+        "pose row of three numbers": lambda tmp: Open3dFolderReader(
+            write_open3d(tmp / "e", trajectory="0 0 1\n1 0 0 0\n0 1 0 0\n0 0 1\n0 0 0 1\n")
+        ),
     },
     TumPairReader: {
         "missing depth file": lambda tmp: TumPairReader((write_tum_pair(tmp), (tmp / "a_depth.png").unlink())[0]),

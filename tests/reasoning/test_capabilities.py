@@ -121,6 +121,7 @@ def test_providers_include_subtypes_and_views(kb: KnowledgeBase) -> None:
     assert set(names(kb.providers("ColorImage"))) == {
         "KitchenSceneReader", "ColorDepthPairReader", "TumSequenceReader", "TumPairReader", "PcdReader",
         "TiffSequenceReader", "BagReader", "BagCloudReader", "StreamReader", "PerceivedFrameReader",
+        "Open3dFolderReader",
     }  # fmt: skip
     assert "SemanticColorAnnotator" in names(kb.providers("Annotation"))
 
