@@ -86,6 +86,16 @@ def check_depth_scale(scale: float) -> float:
     return value
 
 
+def require_frame_folder(folder: str | Path, frame: int) -> Path:
+    """``folder`` as a Path when it is a folder and ``frame`` a frame number (>= 0); else FrameError."""
+    folder = Path(folder)
+    if not folder.is_dir():
+        raise FrameError(f"no such folder {folder}")
+    if frame < 0:
+        raise FrameError(f"frame number must be >= 0, got {frame}")
+    return folder
+
+
 def require_file(path: Path) -> Path:
     """``path`` when it is a file; else FrameError."""
     if not path.is_file():
@@ -241,11 +251,7 @@ def read_camera_params(path: str | Path) -> tuple[CameraIntrinsics, float | None
 
 def read_color_depth_pair(folder: str | Path, frame: int = 0, depth_scale: float | None = None) -> Frame:
     """Decode frame ``frame`` of a uoc-layout folder; ``depth_scale`` (units per metre) overrides the file's."""
-    folder = Path(folder)
-    if not folder.is_dir():
-        raise FrameError(f"no such folder {folder}")
-    if frame < 0:
-        raise FrameError(f"frame number must be >= 0, got {frame}")
+    folder = require_frame_folder(folder, frame)
     color_path, depth_path = frame_paths(folder, frame)
     for path in (color_path, depth_path):
         require_file(path)

@@ -213,7 +213,32 @@ class ColorDepthPairReader(FileFrameReader):
         return f"{self.folder.resolve()}#{self.frame:06d}"
 
 
-class TumSequenceReader(FileFrameReader):
+class _RecordingFolderReader(FileFrameReader):
+    """Base of the readers of frame ``frame`` of a folder holding one continuous recording. ``depth_scale`` is in
+    units per metre (None: the layout's ``default_depth_scale``); ``intrinsics`` given replace the folder's."""
+
+    default_depth_scale: ClassVar[float]
+
+    def __init__(
+        self,
+        folder: str | Path,
+        frame: int = 0,
+        depth_scale: float | None = None,
+        intrinsics: CameraIntrinsics | None = None,
+        name: str | None = None,
+    ) -> None:
+        super().__init__(name=name)
+        self.folder = Path(folder)
+        self.frame = frame
+        self.depth_scale = self.default_depth_scale if depth_scale is None else depth_scale
+        self.intrinsics = intrinsics
+
+    def recording(self) -> str:
+        """The folder: one continuous recording."""
+        return str(self.folder.resolve())
+
+
+class TumSequenceReader(_RecordingFolderReader):
     """Reads frame ``frame`` (time order) of a TUM RGB-D sequence folder (rgb.txt, depth.txt).
 
     ``depth_scale`` is in units per metre (TUM: 5000); ``intrinsics`` default to the folder's camera_params.json,
@@ -227,27 +252,11 @@ class TumSequenceReader(FileFrameReader):
         reliability=1.0,
     )
 
-    def __init__(
-        self,
-        folder: str | Path,
-        frame: int = 0,
-        depth_scale: float = TUM_DEPTH_SCALE,
-        intrinsics: CameraIntrinsics | None = None,
-        name: str | None = None,
-    ) -> None:
-        super().__init__(name=name)
-        self.folder = Path(folder)
-        self.frame = frame
-        self.depth_scale = depth_scale
-        self.intrinsics = intrinsics
+    default_depth_scale: ClassVar[float] = TUM_DEPTH_SCALE
 
     def decode(self) -> Frame:
         """Associate colour and depth by time stamp and decode the chosen pair."""
         return read_tum_sequence(self.folder, self.frame, self.depth_scale, self.intrinsics)
-
-    def recording(self) -> str:
-        """The sequence folder: one continuous recording."""
-        return str(self.folder.resolve())
 
 
 class TumPairReader(FileFrameReader):
@@ -284,7 +293,7 @@ class TumPairReader(FileFrameReader):
         return str(self.path.resolve())
 
 
-class Open3dFolderReader(FileFrameReader):
+class Open3dFolderReader(_RecordingFolderReader):
     """Reads frame ``frame`` of an Open3D RGB-D folder (``color/`` or ``image/``, ``depth/``, camera JSON), with its
     camera pose when the folder has a ``trajectory.log``.
 
@@ -299,27 +308,11 @@ class Open3dFolderReader(FileFrameReader):
         reliability=1.0,
     )
 
-    def __init__(
-        self,
-        folder: str | Path,
-        frame: int = 0,
-        depth_scale: float = OPEN3D_DEPTH_SCALE,
-        intrinsics: CameraIntrinsics | None = None,
-        name: str | None = None,
-    ) -> None:
-        super().__init__(name=name)
-        self.folder = Path(folder)
-        self.frame = frame
-        self.depth_scale = depth_scale
-        self.intrinsics = intrinsics
+    default_depth_scale: ClassVar[float] = OPEN3D_DEPTH_SCALE
 
     def decode(self) -> Frame:
         """Pair the frame's colour and depth images and decode them, with the frame's pose when there is one."""
         return read_open3d_frame(self.folder, self.frame, self.depth_scale, self.intrinsics)
-
-    def recording(self) -> str:
-        """The folder: one continuous recording."""
-        return str(self.folder.resolve())
 
 
 class PcdReader(FileFrameReader):

@@ -20,7 +20,14 @@ from pathlib import Path
 
 import numpy as np
 
-from annotators.readers.frame_io import IMAGE_SUFFIXES, Frame, FrameError, decode_rgbd, natural_order_key
+from annotators.readers.frame_io import (
+    IMAGE_SUFFIXES,
+    Frame,
+    FrameError,
+    decode_rgbd,
+    natural_order_key,
+    require_frame_folder,
+)
 from annotators.readers.tum_io import PRIMESENSE_INTRINSICS
 from robokudo.core.types import CameraIntrinsics
 
@@ -149,11 +156,7 @@ def read_open3d_frame(
     intrinsics: CameraIntrinsics | None = None,
 ) -> Frame:
     """Decode frame ``frame`` of an Open3D RGB-D folder, with its camera pose when the folder has a trajectory."""
-    folder = Path(folder)
-    if not folder.is_dir():
-        raise FrameError(f"no such folder {folder}")
-    if frame < 0:
-        raise FrameError(f"frame number must be >= 0, got {frame}")
+    folder = require_frame_folder(folder, frame)
     pairs = frame_pairs(folder)
     if frame >= len(pairs):
         raise FrameError(f"{folder} has {len(pairs)} colour/depth frames, no frame {frame}")

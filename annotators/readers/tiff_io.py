@@ -16,7 +16,15 @@ import xml.etree.ElementTree as ElementTree
 from datetime import UTC, datetime
 from pathlib import Path
 
-from annotators.readers.frame_io import Frame, FrameError, assemble_frame, check_depth_scale, decode_color, decode_depth
+from annotators.readers.frame_io import (
+    Frame,
+    FrameError,
+    assemble_frame,
+    check_depth_scale,
+    decode_color,
+    decode_depth,
+    require_frame_folder,
+)
 from robokudo.core.types import CameraIntrinsics
 
 _RGB_NAME = re.compile(r"^frame_(?P<stamp>.+)_rgb\.tiff?$", re.IGNORECASE)
@@ -95,11 +103,7 @@ def read_tiff_frame(
     intrinsics: CameraIntrinsics | None = None,
 ) -> Frame:
     """Decode frame ``frame`` of a TIFF sequence; explicit ``depth_scale`` / ``intrinsics`` override the XML."""
-    path = Path(path)
-    if not path.is_dir():
-        raise FrameError(f"no such folder {path}")
-    if frame < 0:
-        raise FrameError(f"frame number must be >= 0, got {frame}")
+    path = require_frame_folder(path, frame)
     folder = tiff_folder(path)
     stamps = frame_stamps(folder)
     if frame >= len(stamps):

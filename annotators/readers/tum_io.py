@@ -22,7 +22,14 @@ from pathlib import Path
 
 import numpy as np
 
-from annotators.readers.frame_io import CAMERA_PARAMS_FILE, Frame, FrameError, decode_rgbd, read_camera_params
+from annotators.readers.frame_io import (
+    CAMERA_PARAMS_FILE,
+    Frame,
+    FrameError,
+    decode_rgbd,
+    read_camera_params,
+    require_frame_folder,
+)
 from robokudo.core.types import CameraIntrinsics
 
 TUM_DEPTH_SCALE = 5000.0
@@ -112,11 +119,7 @@ def read_tum_sequence(
     intrinsics: CameraIntrinsics | None = None,
 ) -> Frame:
     """Decode frame ``frame`` (0-based, in time order) of a TUM sequence folder."""
-    folder = Path(folder)
-    if not folder.is_dir():
-        raise FrameError(f"no such folder {folder}")
-    if frame < 0:
-        raise FrameError(f"frame number must be >= 0, got {frame}")
+    folder = require_frame_folder(folder, frame)
     pairs = associate(read_image_list(folder / "rgb.txt"), read_image_list(folder / "depth.txt"))
     if frame >= len(pairs):
         raise FrameError(f"{folder} has {len(pairs)} associated colour/depth frames, no frame {frame}")
