@@ -11,10 +11,10 @@
 :func:`annotators.readers.choice.reader_for` picks the reader from a path. Every reader decodes once and keeps the frame
 on the instance, so repeated ticks of the same frame cost nothing but the CAS writes; the arrays are shared with
 the CAS, never copied, and must not be modified downstream. Recorded frames have no camera pose (``cam_to_world`` is
-None) unless the recording gives one (an Open3D folder's ``trajectory.log``). Every reader names the recording its
-frame belongs to (``CameraInfo.recording``): a sequence folder (TUM, TIFF, Open3D) is one continuous recording,
-while each file of a uoc folder, a TUM pair or a PCD file is a snapshot of its own; all views of the built-in
-kitchen show one world (``KITCHEN_RECORDING``).
+None) unless the recording gives one (an Open3D folder's ``trajectory.log``, a TUM sequence's ``groundtruth.txt``).
+Every reader names the recording its frame belongs to (``CameraInfo.recording``): a sequence folder (TUM, TIFF,
+Open3D) is one continuous recording, while each file of a uoc folder, a TUM pair or a PCD file is a snapshot of its
+own; all views of the built-in kitchen show one world (``KITCHEN_RECORDING``).
 """
 
 from __future__ import annotations

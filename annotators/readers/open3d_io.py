@@ -16,6 +16,7 @@ the PrimeSense default. A ``trajectory.log`` (Open3D's log format: per frame a l
 from __future__ import annotations
 
 import json
+from dataclasses import replace
 from pathlib import Path
 
 import numpy as np
@@ -175,4 +176,4 @@ def read_open3d_frame(
         if "the intrinsics say" in str(error):
             raise FrameError(f"{error} (intrinsics: {where})") from None
         raise
-    return Frame(decoded.color, decoded.depth, decoded.intrinsics, decoded.source, cam_to_world=pose)
+    return replace(decoded, cam_to_world=pose)

@@ -7,6 +7,9 @@ depth image within ``max_time_difference`` seconds (the nearest one; each depth 
 Depth PNGs hold 16-bit values of 1/5000 m (``TUM_DEPTH_SCALE``). TUM ships no intrinsics with the images; the
 default is the PrimeSense default TUM documents for its registered images (fx = fy = 525, cx = 319.5, cy = 239.5,
 640x480). A ``camera_params.json`` (uoc format) in the sequence folder overrides it; an explicit argument wins.
+A ``groundtruth.txt`` in the folder (``timestamp tx ty tz qx qy qz qw`` per line: the colour camera's optical centre
+in the motion-capture world) gives a frame the pose nearest its colour image's time, when one lies within
+``max_time_difference``; a frame without one has no camera pose.
 
 A single pair is a colour file whose name contains ``color`` or ``rgb`` with the depth file beside it, named the
 same with the last ``color``/``rgb`` replaced by ``depth`` (``TUM_color.png`` -> ``TUM_depth.png``); the depth
@@ -17,7 +20,7 @@ pair: :func:`pair_color_files` lists their colour files.
 from __future__ import annotations
 
 import re
-from dataclasses import dataclass
+from dataclasses import dataclass, replace
 from pathlib import Path
 
 import numpy as np
@@ -30,6 +33,7 @@ from annotators.readers.frame_io import (
     read_camera_params,
     require_frame_folder,
 )
+from robokudo.core.geometry import pose_matrix
 from robokudo.core.types import CameraIntrinsics
 
 TUM_DEPTH_SCALE = 5000.0
@@ -39,7 +43,9 @@ PRIMESENSE_INTRINSICS = CameraIntrinsics(fx=525.0, fy=525.0, cx=319.5, cy=239.5,
 """The PrimeSense default intrinsics TUM documents for its registered 640x480 images."""
 
 MAX_TIME_DIFFERENCE = 0.02
-"""Largest time gap (seconds) between a colour image and the depth image associated with it."""
+"""Largest time gap (seconds) between a colour image and the depth image (or ground-truth pose) associated with it."""
+
+GROUND_TRUTH_FILE = "groundtruth.txt"
 
 _COLOR_WORD = re.compile(r"(color|colour|rgb)", re.IGNORECASE)
 _DEPTH_WORD = re.compile(r"depth", re.IGNORECASE)
@@ -112,6 +118,42 @@ def sequence_intrinsics(folder: Path, intrinsics: CameraIntrinsics | None) -> Ca
     return PRIMESENSE_INTRINSICS
 
 
+def read_ground_truth(path: Path) -> tuple[np.ndarray, np.ndarray]:
+    """The times (N) and 4x4 camera-to-world poses (Nx4x4) of a TUM ``groundtruth.txt``, in time order; FrameError
+    naming the line of a malformed entry."""
+    times, poses = [], []
+    for number, line in enumerate(path.read_text(errors="replace").splitlines(), start=1):
+        text = line.strip()
+        if not text or text.startswith("#"):
+            continue
+        try:
+            values = [float(v) for v in text.split()]
+        except ValueError:
+            values = []
+        if len(values) != 8 or not np.all(np.isfinite(values)):
+            raise FrameError(f"{path}:{number}: expected 'timestamp tx ty tz qx qy qz qw', got {text!r}")
+        quaternion = np.array(values[4:])
+        norm = float(np.linalg.norm(quaternion))
+        if norm < 1e-6:
+            raise FrameError(f"{path}:{number}: the orientation quaternion is zero")
+        times.append(values[0])
+        poses.append(pose_matrix(values[1:4], quaternion / norm))
+    order = np.argsort(times, kind="stable")
+    return np.array(times, dtype=np.float64)[order], np.array(poses).reshape(-1, 4, 4)[order]
+
+
+def pose_at(
+    times: np.ndarray, poses: np.ndarray, timestamp: float, max_difference: float = MAX_TIME_DIFFERENCE
+) -> np.ndarray | None:
+    """The pose nearest ``timestamp`` among ``times`` (sorted), None when none lies within ``max_difference``."""
+    after = int(np.searchsorted(times, timestamp))
+    near = [j for j in (after - 1, after) if 0 <= j < times.size]
+    if not near:
+        return None
+    best = min(near, key=lambda j: abs(times[j] - timestamp))
+    return poses[best] if abs(times[best] - timestamp) <= max_difference else None
+
+
 def read_tum_sequence(
     folder: str | Path,
     frame: int = 0,
@@ -124,7 +166,10 @@ def read_tum_sequence(
     if frame >= len(pairs):
         raise FrameError(f"{folder} has {len(pairs)} associated colour/depth frames, no frame {frame}")
     color, depth = pairs[frame]
-    return decode_rgbd(color.path, depth.path, sequence_intrinsics(folder, intrinsics), depth_scale, color.timestamp)
+    decoded = decode_rgbd(color.path, depth.path, sequence_intrinsics(folder, intrinsics), depth_scale, color.timestamp)
+    if not (folder / GROUND_TRUTH_FILE).is_file():
+        return decoded
+    return replace(decoded, cam_to_world=pose_at(*read_ground_truth(folder / GROUND_TRUTH_FILE), color.timestamp))
 
 
 def pair_paths(path: str | Path) -> tuple[Path, Path]:

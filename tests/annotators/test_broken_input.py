@@ -487,6 +487,9 @@ BROKEN_READERS: dict[type[Annotator], dict[str, Callable[[Path], Annotator]]] = 
         "no depth within the time tolerance": lambda tmp: TumSequenceReader(write_tum_sequence(tmp, "9.0 a.png\n")),
         "malformed list line": lambda tmp: TumSequenceReader(write_tum_sequence(tmp, "not-a-time\n")),
         "missing frame": lambda tmp: TumSequenceReader(write_tum_sequence(tmp), frame=3),
+        "malformed ground-truth line": lambda tmp: TumSequenceReader(
+            (write_tum_sequence(tmp), (tmp / "groundtruth.txt").write_text("1.0 0 0 0 0 0 1\n"))[0]
+        ),
         "truncated depth file": lambda tmp: TumSequenceReader(write_tum_sequence(tmp, truncate="depth")),
         "zero intrinsics": lambda tmp: TumSequenceReader(
             write_tum_sequence(tmp), intrinsics=CameraIntrinsics(0, 0, 0, 0, 0, 0)
