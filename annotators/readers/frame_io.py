@@ -19,6 +19,7 @@ from __future__ import annotations
 import json
 import math
 import re
+import time
 import zlib
 from dataclasses import dataclass
 from pathlib import Path
@@ -26,7 +27,7 @@ from pathlib import Path
 import cv2
 import numpy as np
 
-from robokudo.core.types import CameraIntrinsics
+from robokudo.core.types import CameraInfo, CameraIntrinsics
 
 DEFAULT_DEPTH_SCALE = 1000.0
 """Sensor units per metre when camera_params.json does not say (millimetres)."""
@@ -65,6 +66,19 @@ class Frame:
     labels: np.ndarray | None = None
     timestamp: float | None = None
     cam_to_world: np.ndarray | None = None
+
+
+def frame_camera(frame: Frame, recording: str) -> CameraInfo:
+    """The camera info of a recorded frame: its intrinsics and camera pose, frame id ``camera``, its recording time
+    (now when the file has none) and ``recording``."""
+    stamp = frame.timestamp if frame.timestamp is not None else time.time()
+    return CameraInfo(
+        intrinsics=frame.intrinsics,
+        cam_to_world=frame.cam_to_world,
+        frame_id="camera",
+        timestamp=stamp,
+        recording=recording,
+    )
 
 
 def check_intrinsics(intrinsics: CameraIntrinsics, where: str) -> CameraIntrinsics:

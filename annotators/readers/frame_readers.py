@@ -28,7 +28,7 @@ from typing import ClassVar
 import numpy as np
 
 from annotators.readers.bag_io import MILLIMETRES, BagTopics, read_bag_frame
-from annotators.readers.frame_io import Frame, FrameError, read_color_depth_pair
+from annotators.readers.frame_io import Frame, FrameError, frame_camera, read_color_depth_pair
 from annotators.readers.open3d_io import OPEN3D_DEPTH_SCALE, read_open3d_frame
 from annotators.readers.pcd_io import read_pcd
 from annotators.readers.tiff_io import read_tiff_frame
@@ -164,16 +164,7 @@ class FileFrameReader(Annotator):
             self.fail(f"cannot read the frame: {type(error).__name__}: {error}")
         self.write(ColorImage(frame.color))
         self.write(DepthImage(frame.depth))
-        stamp = frame.timestamp if frame.timestamp is not None else time.time()
-        self.write(
-            CameraInfo(
-                intrinsics=frame.intrinsics,
-                cam_to_world=frame.cam_to_world,
-                frame_id="camera",
-                timestamp=stamp,
-                recording=self.recording(),
-            )
-        )
+        self.write(frame_camera(frame, self.recording()))
         if PointCloud in self.outputs:
             if frame.points is None:
                 self.fail(f"{frame.source} holds no point cloud")

@@ -33,7 +33,7 @@ from py_trees.common import Status
 
 from annotators.readers.bag_io import ANY_TOPICS, BagTopics, bag_frames, is_bag
 from annotators.readers.choice import recorded_frames
-from annotators.readers.frame_io import Frame, FrameError
+from annotators.readers.frame_io import Frame, FrameError, frame_camera
 from annotators.readers.frame_readers import DEFAULT_KITCHEN_VIEW, KITCHEN_RECORDING, FileFrameReader
 from annotators.simulation import kitchen_scene
 from annotators.simulation.kitchen_person import PERSON_VIEWS, PersonPose, PersonScript, person_view
@@ -481,9 +481,7 @@ class PlaybackStream(FrameStream):
         self._wait_until(self._due)
         frame, recording, index = self._pending
         self._pending = None
-        stamp = frame.timestamp if frame.timestamp is not None else time.time()
-        camera = CameraInfo(intrinsics=frame.intrinsics, frame_id="camera", timestamp=stamp, recording=recording)
-        delivered = StreamFrame(frame, camera, index=index, sequence=self._delivered)
+        delivered = StreamFrame(frame, frame_camera(frame, recording), index=index, sequence=self._delivered)
         self._delivered += 1
         return delivered
 

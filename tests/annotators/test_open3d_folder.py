@@ -16,6 +16,7 @@ from annotators.readers.choice import reader_choice, reader_for, recorded_frames
 from annotators.readers.frame_io import FrameError
 from annotators.readers.frame_readers import Open3dFolderReader
 from annotators.readers.open3d_io import read_open3d_frame, read_trajectory
+from annotators.readers.streams import stream_for
 from annotators.readers.tum_io import PRIMESENSE_INTRINSICS
 from robokudo.core.pipeline import Pipeline
 from robokudo.core.types import CameraInfo, DepthImage
@@ -187,3 +188,17 @@ def test_open3ds_sample_frames_are_read_with_their_poses(shared_data: Path) -> N
     assert np.degrees(np.arccos(min(1.0, abs(first_normal @ last_normal)))) < 1.0
     assert abs(first_offset - last_offset) < 0.01
     assert np.degrees(np.arccos(min(1.0, abs(first_in_camera @ last_in_camera)))) > 2.0  # the camera moved
+
+
+@pytest.mark.real_data
+def test_a_playback_stream_of_the_sample_frames_delivers_their_poses(shared_data: Path) -> None:
+    """What a long-running server perceives from: each delivered frame's camera info carries the trajectory's pose."""
+    folder = require_folder(shared_data / "redwood_synthetic_open3d")
+    poses = read_trajectory(folder / "trajectory.log")
+    stream = stream_for(str(folder), rate_hz=1000.0, loop=False)
+    try:
+        delivered = [stream.next_frame() for _ in range(len(poses))]
+    finally:
+        stream.close()
+    assert all(np.array_equal(d.camera.cam_to_world, pose) for d, pose in zip(delivered, poses, strict=True))
+    assert {d.camera.recording for d in delivered} == {str(folder.resolve())}
