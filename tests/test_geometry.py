@@ -6,7 +6,13 @@ import numpy as np
 from hypothesis import given
 from hypothesis import strategies as st
 
-from robokudo.core.geometry import IDENTITY_QUATERNION, pose_matrix, quaternion_from_matrix, rotation_matrix
+from robokudo.core.geometry import (
+    IDENTITY_QUATERNION,
+    pose_matrix,
+    quaternion_from_matrix,
+    rotation_matrices,
+    rotation_matrix,
+)
 from robokudo.core.types import Pose
 
 components = st.floats(min_value=-1.0, max_value=1.0, allow_nan=False)
@@ -27,6 +33,12 @@ def test_matrix_to_quaternion_to_matrix_round_trips(q: tuple[float, float, float
     assert abs(np.linalg.norm(recovered) - 1.0) < 1e-9
     assert recovered[3] >= 0.0
     np.testing.assert_allclose(rotation_matrix(recovered), rotation, atol=1e-9)
+
+
+@given(st.lists(quaternions, min_size=1, max_size=5))
+def test_many_quaternions_at_once_give_the_matrices_of_each(qs: list[tuple[float, float, float, float]]) -> None:
+    units = np.array([unit(q) for q in qs])
+    np.testing.assert_allclose(rotation_matrices(units), [rotation_matrix(q) for q in units], atol=1e-12)
 
 
 @given(quaternions)

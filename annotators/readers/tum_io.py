@@ -33,7 +33,7 @@ from annotators.readers.frame_io import (
     read_camera_params,
     require_frame_folder,
 )
-from robokudo.core.geometry import pose_matrix
+from robokudo.core.geometry import rotation_matrices
 from robokudo.core.types import CameraIntrinsics
 
 TUM_DEPTH_SCALE = 5000.0
@@ -121,25 +121,37 @@ def sequence_intrinsics(folder: Path, intrinsics: CameraIntrinsics | None) -> Ca
 def read_ground_truth(path: Path) -> tuple[np.ndarray, np.ndarray]:
     """The times (N) and 4x4 camera-to-world poses (Nx4x4) of a TUM ``groundtruth.txt``, in time order; FrameError
     naming the line of a malformed entry."""
-    times, poses = [], []
+    numbers, rows = [], []
     for number, line in enumerate(path.read_text(errors="replace").splitlines(), start=1):
-        text = line.strip()
-        if not text or text.startswith("#"):
-            continue
-        try:
-            values = [float(v) for v in text.split()]
-        except ValueError:
-            values = []
-        if len(values) != 8 or not np.all(np.isfinite(values)):
-            raise FrameError(f"{path}:{number}: expected 'timestamp tx ty tz qx qy qz qw', got {text!r}")
-        quaternion = np.array(values[4:])
-        norm = float(np.linalg.norm(quaternion))
-        if norm < 1e-6:
-            raise FrameError(f"{path}:{number}: the orientation quaternion is zero")
-        times.append(values[0])
-        poses.append(pose_matrix(values[1:4], quaternion / norm))
-    order = np.argsort(times, kind="stable")
-    return np.array(times, dtype=np.float64)[order], np.array(poses).reshape(-1, 4, 4)[order]
+        fields = line.split()
+        if fields and not fields[0].startswith("#"):
+            numbers.append(number)
+            rows.append(fields)
+    try:
+        values = np.array(rows, dtype=np.float64).reshape(len(rows), 8)
+        bad = ~np.isfinite(values).all(axis=1)
+    except ValueError:  # a line of another length or a word: find it
+        bad = np.array([len(r) != 8 or not all(_is_number(v) for v in r) for r in rows])
+        values = np.zeros((len(rows), 8))
+    if bad.any():
+        first = int(np.argmax(bad))
+        text = " ".join(rows[first])
+        raise FrameError(f"{path}:{numbers[first]}: expected 'timestamp tx ty tz qx qy qz qw', got {text!r}")
+    norms = np.linalg.norm(values[:, 4:], axis=1)
+    if (norms < 1e-6).any():
+        raise FrameError(f"{path}:{numbers[int(np.argmax(norms < 1e-6))]}: the orientation quaternion is zero")
+    poses = np.tile(np.eye(4), (len(rows), 1, 1))
+    poses[:, :3, :3] = rotation_matrices(values[:, 4:] / norms[:, None])
+    poses[:, :3, 3] = values[:, 1:4]
+    order = np.argsort(values[:, 0], kind="stable")
+    return values[order, 0], poses[order]
+
+
+def _is_number(text: str) -> bool:
+    try:
+        return np.isfinite(float(text))
+    except ValueError:
+        return False
 
 
 def pose_at(

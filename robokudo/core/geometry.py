@@ -28,6 +28,20 @@ def rotation_matrix(quaternion: Sequence[float] | np.ndarray) -> np.ndarray:
     )
 
 
+def rotation_matrices(quaternions: np.ndarray) -> np.ndarray:
+    """The Nx3x3 rotation matrices of N unit quaternions (Nx4, x, y, z, w), at once: ``I + 2 w K + 2 K K`` with
+    ``K`` the cross-product matrix of (x, y, z), which is :func:`rotation_matrix` written for arrays (one call per
+    quaternion would cost tens of microseconds each; a sequence's ground truth holds thousands)."""
+    q = np.asarray(quaternions, dtype=np.float64).reshape(-1, 4)
+    x, y, z, w = q.T
+    zero = np.zeros_like(x)
+    cross = np.stack(
+        [np.stack([zero, -z, y], axis=-1), np.stack([z, zero, -x], axis=-1), np.stack([-y, x, zero], axis=-1)],
+        axis=-2,
+    )
+    return np.eye(3) + 2 * w[:, None, None] * cross + 2 * cross @ cross
+
+
 def pose_matrix(position: Sequence[float] | np.ndarray, quaternion: Sequence[float] | np.ndarray) -> np.ndarray:
     """The 4x4 homogeneous transform of a position and a unit quaternion (x, y, z, w)."""
     transform = np.eye(4)
