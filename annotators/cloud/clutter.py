@@ -86,7 +86,7 @@ from annotators.geometry.grid_segmentation import (
 from annotators.geometry.inner_walls import InnerWallRules, join_inner_walls
 from annotators.geometry.necks import NeckRules, join_necked_pieces
 from annotators.geometry.occlusion import OcclusionRules, join_occluded
-from annotators.geometry.rims import RimRules, join_rim_pieces, one_stands_inside
+from annotators.geometry.rims import RimRules, join_rim_pieces, join_single_rims, one_stands_inside
 from annotators.geometry.slabs import SlabRules, join_slab_pieces
 from annotators.geometry.support import (
     FOOTPRINT_ROWS,
@@ -252,6 +252,7 @@ SAMPLING_PERIOD = math.lcm(
     SlabRules.sample_step,
     NeckRules.sample_step,
     FloorRules.sample_step,
+    RimRules.sample_step,
 )
 """Coarse pixels: the later steps read every few pixels or rows counted from the crop's corner; with the corner on a
 multiple of all their spacings they read the same pixels of the image wherever the candidates' box starts."""
@@ -302,6 +303,8 @@ def segment_clutter(
     labels = merge_parts(
         labels, depth, plane_grid, p.merge_rules(), stand_apart=one_stands_inside if p.join_rims else None
     )
+    if p.join_rims:  # a bowl's inside and outside, which share no footprint to merge by
+        labels = join_single_rims(labels, plane_grid, RimRules())
     if colors is not None and p.use_color:
         colors_crop = strided_crop(colors, step, (x0, y0, x1, y1))
         labels = split_by_color(labels, grid, normals, colors_crop, p, footprint)

@@ -15,6 +15,11 @@ keeps the concave wall apart from the front of the outer wall anyway. The rim st
   radius) that stays below the rim and reaches out to the circle (at least ``reach``) or lies in front of the
   centre is its outer wall seen below the front rim.
 
+One inner wall alone tells its container too when nothing cuts its rim (:func:`single_rim_joins`): its top edge runs
+around at least a quarter of a rim circle, and a touching piece that is its outer wall (below the rim, within the
+circle, reaching out to it) joins it. The inside and the outside of a bowl meet only along the front rim, where
+the inside lies behind a depth jump, and their footprints barely overlap, so nothing else joins them.
+
 An object standing in the container and rising above the rim is never joined (:func:`join_rim_pieces`); one
 lying in it below the rim, in front of its centre, would be (the convexity grouping keeps most of them apart
 before). :func:`stands_inside` tells an object standing in a container from the inner wall around it.
@@ -23,6 +28,7 @@ before). :func:`stands_inside` tells an object standing in a container from the 
 from __future__ import annotations
 
 import functools
+import math
 from dataclasses import dataclass
 from types import ModuleType
 
@@ -40,7 +46,10 @@ class RimRules:
     wall toward the circle (``reach``, ``hold``), the reach from the centre of an object standing inside
     (``inside``: its median distance, well within the rim), how much more tightly than their joint rim two pieces' top
     edges may each curve (``curvature``: the joint radius at most this many times each edge's own; a short arc
-    fixes its own circle loosely) and the fewest top-edge points a circle is fitted to (``min_points``)."""
+    fixes its own circle loosely), the fewest top-edge points a circle is fitted to (``min_points``) and the angle
+    (radians) around its rim one inner wall's top edge must run to fix the rim alone (``single_turn``: the back half
+    of a rim seen over its front shows about half a turn), and the spacing of the grid pixels :func:`single_rim_joins`
+    samples (``sample_step``)."""
 
     band: float = 0.01
     fit: float = 0.1
@@ -50,6 +59,8 @@ class RimRules:
     inside: float = 0.75
     curvature: float = 2.0
     min_points: int = 20
+    single_turn: float = math.pi / 2
+    sample_step: int = 2
 
 
 @dataclass(frozen=True)
@@ -256,6 +267,58 @@ def rim_joins(
                             frontier.append(piece)
                             joins.append((first, piece))
     return joins
+
+
+def single_rim_joins(labels: np.ndarray, plane_points: np.ndarray, rules: RimRules) -> list[tuple[int, int]]:
+    """Label pairs ``(inner wall, outer wall)`` of one open container whose rim one inner wall shows alone (see
+    the module docstring; ``plane_points``: the ``(u, v, height)`` of every pixel, HxWx3, of which every
+    ``rules.sample_step``-th row and column is read). The outer wall must
+    reach out to the rim circle (``rules.reach`` of its radius): a piece in front of the centre but well within the
+    circle may be something standing in the container, below its rim."""
+    pairs = touching_pairs(labels)
+    if pairs.shape[0] == 0:
+        return []
+    step = max(1, rules.sample_step)
+    pixels, starts = label_groups(np.ascontiguousarray(labels[::step, ::step]))
+    flat = np.ascontiguousarray(plane_points[::step, ::step]).reshape(-1, 3)
+    coordinates: dict[int, np.ndarray] = {}
+
+    def points_of(label: int) -> np.ndarray:
+        if label not in coordinates:
+            own = flat[pixels[starts[label] : starts[label + 1]]]
+            coordinates[label] = own[np.isfinite(own).all(axis=1)]
+        return coordinates[label]
+
+    rims: dict[int, Rim | None] = {}
+
+    def rim_of(label: int) -> Rim | None:
+        if label not in rims:
+            arc = rim_arc(points_of(label), rules)
+            rim = rim_circle([arc.edge], [arc.height], rules) if arc is not None else None
+            turn = _loops().arc_turn(arc.edge, rim.centre[0], rim.centre[1]) if rim is not None else 0.0
+            rims[label] = rim if turn >= rules.single_turn else None
+        return rims[label]
+
+    joins = []
+    for first, second in pairs.tolist():
+        for wall, piece in ((first, second), (second, first)):
+            rim = rim_of(wall)
+            if rim is None or one_stands_inside(points_of(wall), points_of(piece), rules):
+                continue
+            other = points_of(piece)
+            if _distance_share(other, rim.centre, 0.95) >= rules.reach * rim.radius and is_outer_wall(
+                other, rim, rules
+            ):
+                joins.append((wall, piece))
+                break
+    return joins
+
+
+def join_single_rims(labels: np.ndarray, plane_points: np.ndarray, rules: RimRules | None = None) -> np.ndarray:
+    """Labels with each inner wall that shows a rim alone joined to its outer wall (:func:`single_rim_joins`); the
+    same array when nothing joined."""
+    joins = single_rim_joins(labels, plane_points.reshape(*labels.shape, 3), rules or RimRules())
+    return join_labels(labels, joins) if joins else labels
 
 
 def is_outer_wall(points: np.ndarray, rim: Rim, rules: RimRules) -> bool:

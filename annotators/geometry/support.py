@@ -61,7 +61,7 @@ class SupportRules:
     (metres) and
     the spacing of the grid pixels sampled for heights and footprints (``sample_step``); with ``standing_inside``
     a piece that stands inside a holder that is an open container (:func:`~annotators.geometry.rims.stands_inside`)
-    is never held: it rests on the container's floor."""
+    is never held, alone or jointly (:func:`jointly_held`): it rests on the container's floor."""
 
     held_share: float = 0.5
     tolerance: float = 0.003
@@ -463,6 +463,10 @@ def jointly_held(
         alone = max(held_share(hull, pieces.hull(holder), support.cell) for holder in (first, second))
         if alone >= support.held_share:
             continue  # one holder holds it: join_unsupported's case
+        if support.standing_inside and any(
+            _stands_inside(labels, plane_points, pieces, piece, holder) for holder in (first, second)
+        ):
+            continue  # it rests on a container's floor, as in join_unsupported
         share = held_share(hull, joint_hull(pieces, first, second), support.cell)
         if share >= support.held_share and share > best.get(piece, (-1.0, 0, 0))[0]:
             best[piece] = (share, first, second)
