@@ -272,9 +272,9 @@ def rim_joins(
 def single_rim_joins(labels: np.ndarray, plane_points: np.ndarray, rules: RimRules) -> list[tuple[int, int]]:
     """Label pairs ``(inner wall, outer wall)`` of one open container whose rim one inner wall shows alone (see
     the module docstring; ``plane_points``: the ``(u, v, height)`` of every pixel, HxWx3, of which every
-    ``rules.sample_step``-th row and column is read). The outer wall must
-    reach out to the rim circle (``rules.reach`` of its radius): a piece in front of the centre but well within the
-    circle may be something standing in the container, below its rim."""
+    ``rules.sample_step``-th row and column is read). The outer wall must reach out to the rim circle
+    (``rules.reach`` of its radius): a piece in front of the centre but well within the circle may be something
+    standing in the container, below its rim."""
     pairs = touching_pairs(labels)
     if pairs.shape[0] == 0:
         return []
@@ -293,10 +293,11 @@ def single_rim_joins(labels: np.ndarray, plane_points: np.ndarray, rules: RimRul
 
     def rim_of(label: int) -> Rim | None:
         if label not in rims:
+            rims[label] = None
             arc = rim_arc(points_of(label), rules)
             rim = rim_circle([arc.edge], [arc.height], rules) if arc is not None else None
-            turn = _loops().arc_turn(arc.edge, rim.centre[0], rim.centre[1]) if rim is not None else 0.0
-            rims[label] = rim if turn >= rules.single_turn else None
+            if rim is not None and _loops().arc_turn(arc.edge, rim.centre[0], rim.centre[1]) >= rules.single_turn:
+                rims[label] = rim
         return rims[label]
 
     joins = []
@@ -306,9 +307,8 @@ def single_rim_joins(labels: np.ndarray, plane_points: np.ndarray, rules: RimRul
             if rim is None or one_stands_inside(points_of(wall), points_of(piece), rules):
                 continue
             other = points_of(piece)
-            if _distance_share(other, rim.centre, 0.95) >= rules.reach * rim.radius and is_outer_wall(
-                other, rim, rules
-            ):
+            reaches_out = _distance_share(other, rim.centre, 0.95) >= rules.reach * rim.radius
+            if reaches_out and is_outer_wall(other, rim, rules):
                 joins.append((wall, piece))
                 break
     return joins
