@@ -11,7 +11,7 @@ keeps the concave wall apart from the front of the outer wall anyway. The rim st
   one another) and that are cut apart by one neighbour (both touch it; it reaches up to their rim, which it hides
   between them) are the inner wall of one container, on both sides of what stands in it;
 * a piece touching that container (directly or through its outer wall's other pieces, never through the
-  neighbour that cuts the rim) within its rim circle (its 95 % distance from the centre at most ``hold`` of the
+  neighbour that cuts the rim) within its rim circle (its median distance from the centre at most ``hold`` of the
   radius) that stays below the rim and reaches out to the circle (at least ``reach``) or lies in front of the
   centre is its outer wall seen below the front rim.
 
@@ -323,17 +323,18 @@ def join_single_rims(labels: np.ndarray, plane_points: np.ndarray, rules: RimRul
 
 def is_outer_wall(points: np.ndarray, rim: Rim, rules: RimRules) -> bool:
     """Is a piece (Nx3 ``(u, v, height)``, the camera's foot at the origin) the container's outer wall below its
-    rim: within the rim circle (95 % distance from the centre at most ``rules.hold`` of the radius), no higher than
-    the rim (95 % height), and reaching out to the circle (at least ``rules.reach`` of the radius) or lying in
-    front of the centre, nearer the camera (the front of a tapering wall, toward the foot)?"""
+    rim: within the rim circle (its median distance from the centre at most ``rules.hold`` of the radius; a pot's
+    handles stick out of the circle, and the fitted centre errs along the line of sight), no higher than the rim (95 %
+    height), and reaching out to the circle (at least ``rules.reach`` of the radius) or lying in front of the centre,
+    nearer the camera (the front of a tapering wall, toward the foot)?"""
     points = points[np.isfinite(points).all(axis=1)]
     if points.shape[0] < rules.min_points:
         return False
     if share_value(points[:, 2], 0.95) > rim.height + rules.tolerance:
         return False
-    reach = _distance_share(points, rim.centre, 0.95)
-    if reach > rules.hold * rim.radius:
+    if _distance_share(points, rim.centre, 0.5) > rules.hold * rim.radius:
         return False
+    reach = _distance_share(points, rim.centre, 0.95)
     in_front = _distance_share(points, np.zeros(2), 0.5) < float(np.hypot(*rim.centre))
     return reach >= rules.reach * rim.radius or in_front
 

@@ -13,7 +13,9 @@ With the grid cells started elsewhere (the crop moved, as a candidate appearing 
 container's inside and outside came out as two objects at 25 of the 432 pairs of a cylindric scene (learn33-44)
 and one of 36 offsets: on learn33, 34, 35, 36 and 44. They meet only along the front rim, behind a depth jump, and
 their footprints barely overlap. One inner wall's top edge fixing a rim, with the outer wall below its front
-(annotators/geometry/rims.py, single_rim_joins), now joins them (bench/profiles/seg11-analysis.txt).
+(annotators/geometry/rims.py, single_rim_joins), now joins them (bench/profiles/seg11-analysis.txt). The outer
+wall must lie within the rim's circle by its median distance from the centre, not its 95 % one: learn38's pot has
+handles, and at 12 more pairs (learn36, 37, 38, 44) the outer wall reached past the circle at its sides.
 """
 
 from __future__ import annotations
@@ -43,7 +45,16 @@ def test_every_object_of_the_scene_is_found_once(shared_data: Path, scene: str, 
 
 @pytest.mark.parametrize(
     ("scene", "offset"),
-    [("learn36", (2, 2)), ("learn36", (3, 1)), ("learn34", (1, 0)), ("learn33", (3, 2)), ("learn44", (4, 0))],
+    [
+        ("learn36", (2, 2)),
+        ("learn36", (3, 1)),
+        ("learn34", (1, 0)),
+        ("learn33", (3, 2)),
+        ("learn44", (4, 0)),
+        ("learn38", (0, 1)),
+        ("learn37", (0, 2)),
+        ("learn36", (0, 2)),
+    ],
 )
 def test_a_container_stays_one_object_wherever_the_cells_start(
     shared_data: Path, scene: str, offset: tuple[int, int], monkeypatch: pytest.MonkeyPatch
