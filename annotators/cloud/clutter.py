@@ -147,6 +147,7 @@ class ClutterParameters(ClusterParameters):
     min_votes: int = ConvexityRules.min_votes
     gap_width: float = ConvexityRules.gap_width
     close_factor: float = ConvexityRules.close_factor
+    crease_degrees: float = ConvexityRules.crease_degrees
     creased_share: float = 0.2
     use_color: bool = True
     complete_occluded: bool = True

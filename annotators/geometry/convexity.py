@@ -82,7 +82,9 @@ class ConvexityRules:
     neighbour (the one it agrees with most), so a string of small faces cannot carry a join from one object to the
     next; a small face still joins every large face it agrees with (a sliver along a box's edge); with
     ``grazing_degrees`` a connection touching a patch whose normal lies more than that many degrees from its line of
-    sight votes convex only where it bends outward (:func:`grazing_patches`)."""
+    sight votes convex only where it bends outward (:func:`grazing_patches`); between two large faces, a connection
+    across a crease (normals at least ``crease_degrees`` apart) votes convex only where it bends outward
+    (:func:`inward_creases`)."""
 
     smooth_degrees: float = 20.0
     concave_bending: float = 20.0
@@ -97,6 +99,7 @@ class ConvexityRules:
     close_factor: float = 3.0
     small_joins_once: bool = False
     grazing_degrees: float | None = None
+    crease_degrees: float = 45.0
 
 
 @dataclass(frozen=True, eq=False)
@@ -186,8 +189,9 @@ def convex_groups(
        the centroids within that angle of both tangent planes (one surface going on, flat or gently curved, not a
        step between parallel surfaces) and no concave bend.
     2. *Objects*: faces joined where they meet convexly. Every connection between two faces votes (convex, or
-       concave when it bends inward faster than ``rules.concave_bending``; a step votes neither); two faces join
-       when more than ``rules.convex_share`` of the votes are convex and at most ``rules.concave_share`` concave.
+       concave when it bends inward faster than ``rules.concave_bending``; a step votes neither; between two large
+       faces, a connection across a crease that bends inward votes no convex, :func:`inward_creases`); two faces
+       join when more than ``rules.convex_share`` of the votes are convex and at most ``rules.concave_share`` concave.
        Joins are made strongest first, and two large faces that do not agree are kept apart: a sliver along a
        crease that agrees with both sides cannot join them.
 
@@ -250,6 +254,19 @@ def grazing_patches(planes: PatchPlanes, degrees: float) -> np.ndarray:
     return np.concatenate([[False], facing < np.cos(np.radians(degrees))])
 
 
+def inward_creases(planes: PatchPlanes, pairs: np.ndarray, degrees: float) -> np.ndarray:
+    """For Kx2 touching patch labels: does the connection cross a crease (normals at least ``degrees`` apart) bending
+    inward, however gently?
+
+    One object's faces meet at a crease bending outward (a box's edge). Two objects meet there bending inward: a
+    box's side and the face of a box behind it, at right angles across the depth gap between them. Across that gap
+    the bending (:func:`connection_bending`) is weak - the centroids lie far apart for the turn - and may not reach
+    the concave limit, but its sign still tells the two apart."""
+    a, b = pairs[:, 0] - 1, pairs[:, 1] - 1
+    crease = np.einsum("ij,ij->i", planes.normals[a], planes.normals[b]) < np.cos(np.radians(degrees))
+    return crease & (connection_bending(planes, pairs) < 0)
+
+
 def _alignment(planes: PatchPlanes, pairs: np.ndarray, degrees: float) -> tuple[np.ndarray, np.ndarray]:
     """For Kx2 patch labels: normals within ``degrees``; the centroid line within ``degrees`` of both planes."""
     a, b = pairs[:, 0] - 1, pairs[:, 1] - 1
@@ -279,11 +296,13 @@ def _join_faces(
     low, high = np.minimum(face_a, face_b)[apart], np.maximum(face_a, face_b)[apart]
     keys, inverse = distinct_keys(low * count + high)
     votes = np.maximum(np.bincount(inverse, minlength=keys.size), 1)
+    large = np.bincount(faces, weights=planes_sizes(planes, count), minlength=count) >= rules.min_face
+    between_large = large[face_a] & large[face_b]
+    convex = convex & ~(between_large & inward_creases(planes, pairs, rules.crease_degrees))
     share = np.bincount(inverse, weights=convex[apart], minlength=keys.size) / votes
     concave_votes = np.bincount(inverse, weights=concave[apart], minlength=keys.size)
     share = np.where((concave_votes > rules.concave_share * votes) & (concave_votes >= rules.min_votes), 0.0, share)
     first, second = keys // count, keys % count
-    large = np.bincount(faces, weights=planes_sizes(planes, count), minlength=count) >= rules.min_face
     both_large = large[first] & large[second]
     strength = share * votes
     agree = (share > rules.convex_share) & ((strength >= rules.min_votes) | ~both_large)

@@ -1,13 +1,21 @@
 """Connection votes of the convexity grouping (annotators/geometry/convexity.py) between hand-placed patch planes:
 a patch seen nearly edge-on that bends inward into its neighbour - the wall of a step, or the stereo depth ramp
 between an occluding edge and the surface behind it - casts no convex vote with ``grazing_degrees``; a round
-object's limb, bending outward, still does."""
+object's limb, bending outward, still does. Across a crease, a connection bending inward - two boxes' faces
+meeting at right angles across the depth gap between them - is told from a box's edge, which bends outward, even
+when it bends too gently for the concave limit."""
 
 from __future__ import annotations
 
 import numpy as np
 
-from annotators.geometry.convexity import ConvexityRules, PatchPlanes, connection_votes, grazing_patches
+from annotators.geometry.convexity import (
+    ConvexityRules,
+    PatchPlanes,
+    connection_votes,
+    grazing_patches,
+    inward_creases,
+)
 
 PAIR = np.array([[1, 2]])
 
@@ -56,3 +64,24 @@ def test_without_a_grazing_patch_the_votes_are_those_of_the_plain_rules() -> Non
     plain = connection_votes(planes, PAIR, ConvexityRules())
     grazing = connection_votes(planes, PAIR, ConvexityRules(grazing_degrees=70.0))
     assert all(a.tolist() == b.tolist() for a, b in zip(plain, grazing, strict=True))
+
+
+def test_two_boxes_faces_meeting_across_a_gap_are_an_inward_crease_too_gentle_for_the_concave_limit() -> None:
+    # a face turned 45 degrees right and one turned 45 degrees left, 8 cm apart, the right one 5 cm deeper
+    planes = two_patches((45.0, np.array([-0.04, 0.0, 0.90])), (-45.0, np.array([0.04, 0.0, 0.95])))
+    _, convex, concave = connection_votes(planes, PAIR, ConvexityRules())
+    assert convex.tolist() == [True] and concave.tolist() == [False]
+    assert inward_creases(planes, PAIR, ConvexityRules().crease_degrees).tolist() == [True]
+
+
+def test_a_box_edge_bends_outward_and_is_no_inward_crease() -> None:
+    # the two side faces of a box whose edge points at the camera
+    planes = two_patches((-45.0, np.array([-0.02, 0.0, 0.92])), (45.0, np.array([0.02, 0.0, 0.92])))
+    assert inward_creases(planes, PAIR, 45.0).tolist() == [False]
+    assert connection_votes(planes, PAIR, ConvexityRules())[1].tolist() == [True]
+
+
+def test_a_gentle_inward_turn_is_no_crease() -> None:
+    # normals 20 degrees apart bending slightly inward: a dent in one surface, left to the concave limit
+    planes = two_patches((10.0, np.array([-0.02, 0.0, 0.90])), (-10.0, np.array([0.02, 0.0, 0.905])))
+    assert inward_creases(planes, PAIR, 45.0).tolist() == [False]
