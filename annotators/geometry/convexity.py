@@ -22,6 +22,7 @@ from annotators.geometry.grid_kernels import (
     graph_components,
     label_centres,
     label_moments,
+    label_pieces,
     labelled_values,
     normal_halves,
     symmetric_eigen,
@@ -38,8 +39,20 @@ from annotators.geometry.grid_segmentation import (
 
 def grid_patches(surfaces: np.ndarray, cell: int) -> np.ndarray:
     """Patch labels (int32, 0 = none, 1..n): each labelled surface of ``surfaces`` cut into ``cell`` x ``cell``
-    grid cells; a cell that two surfaces share gives one patch to each."""
-    return cell_patches(np.ascontiguousarray(surfaces), cell)
+    grid cells; a cell that two surfaces share gives one patch to each, and so does a cell holding two pieces of one
+    surface that meet only outside it - the two sides of a depth seam the surface runs around at its end, a step
+    between two parallel faces: two strips, one on either side, always fit one plane, tilted between the faces."""
+    patches = cell_patches(np.ascontiguousarray(surfaces), cell)
+    pieces = label_pieces(patches)
+    count = int(pieces.max(initial=0))
+    if count == int(patches.max(initial=0)):
+        return patches  # no cell holds two pieces
+    owner = np.zeros(count + 1, dtype=np.int64)
+    owner[pieces.reshape(-1)] = patches.reshape(-1)
+    # numbered by patch, a patch's pieces in the raster order of their first pixels
+    number = np.zeros(count + 1, dtype=np.int32)
+    number[1 + np.argsort(owner[1:], kind="stable")] = np.arange(1, count + 1, dtype=np.int32)
+    return number[pieces]
 
 
 def dense_labels(keys: np.ndarray) -> np.ndarray:

@@ -187,6 +187,12 @@ def connected_parts(region: np.ndarray, min_points: int) -> np.ndarray:
     return _loops().connected_parts(region, min_points)
 
 
+def label_pieces(labels: np.ndarray) -> np.ndarray:
+    """HxW int32: the 4-connected pieces of each label of HxW integer ``labels`` (0 = none), neighbours joined only
+    where their labels are equal, numbered 1..n in the raster order of their first pixels; 0 elsewhere."""
+    return _loops().label_pieces(np.ascontiguousarray(labels))
+
+
 def object_pieces(labels: np.ndarray, parts: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
     """The pieces objects are cut into: HxW int32 labels 1..n of the pixels of each (object, part) pair of
     ``labels`` and ``parts`` (HxW; parts lie within objects), numbered in increasing (object, part) order; each

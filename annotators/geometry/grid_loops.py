@@ -535,9 +535,23 @@ def standing_candidates(
 @njit(cache=True, nogil=True)
 def connected_parts(region: np.ndarray, min_points: int) -> np.ndarray:
     """See :func:`annotators.geometry.grid_kernels.connected_parts`."""
-    rows, cols = region.shape
+    return _equal_parts(region, min_points)
+
+
+@njit(cache=True, nogil=True)
+def label_pieces(labels: np.ndarray) -> np.ndarray:
+    """See :func:`annotators.geometry.grid_kernels.label_pieces`."""
+    return _equal_parts(labels, 1)
+
+
+@njit(cache=True, nogil=True)
+def _equal_parts(values: np.ndarray, min_points: int) -> np.ndarray:
+    """HxW int32: the 4-connected parts of the pixels whose ``values`` are non-zero, neighbours joined where their
+    values are equal, with at least ``min_points`` pixels, labelled 1..n in the raster order of their first pixels;
+    0 elsewhere."""
+    rows, cols = values.shape
     provisional = np.zeros((rows, cols), dtype=np.int32)
-    parent = np.empty(rows * cols // 2 + 2, dtype=np.int32)
+    parent = np.empty(rows * cols + 1, dtype=np.int32)
     count = 0
 
     def root(node: int) -> int:
@@ -548,12 +562,13 @@ def connected_parts(region: np.ndarray, min_points: int) -> np.ndarray:
 
     for r in range(rows):
         for c in range(cols):
-            if not region[r, c]:
+            value = values[r, c]
+            if not value:
                 continue
-            left = provisional[r, c - 1] if c > 0 else 0
-            up = provisional[r - 1, c] if r > 0 else 0
+            left = provisional[r, c - 1] if c > 0 and values[r, c - 1] == value else 0
+            up = provisional[r - 1, c] if r > 0 and values[r - 1, c] == value else 0
             if left == 0 and up == 0:
-                count += 1  # at most every other pixel starts a label: the parent table is large enough
+                count += 1
                 parent[count] = count
                 provisional[r, c] = count
             elif left == 0 or up == 0:

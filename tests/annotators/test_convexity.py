@@ -3,7 +3,8 @@ a patch seen nearly edge-on that bends inward into its neighbour - the wall of a
 between an occluding edge and the surface behind it - casts no convex vote with ``grazing_degrees``; a round
 object's limb, bending outward, still does. Across a crease, a connection bending inward - two boxes' faces
 meeting at right angles across the depth gap between them - is told from a box's edge, which bends outward, even
-when it bends too gently for the concave limit."""
+when it bends too gently for the concave limit. A grid cell holding two pieces of one surface that meet only outside
+it - the two sides of a depth seam the surface runs around - gives a patch to each piece."""
 
 from __future__ import annotations
 
@@ -14,6 +15,7 @@ from annotators.geometry.convexity import (
     PatchPlanes,
     connection_votes,
     grazing_patches,
+    grid_patches,
     inward_creases,
 )
 
@@ -85,3 +87,15 @@ def test_a_gentle_inward_turn_is_no_crease() -> None:
     # normals 20 degrees apart bending slightly inward: a dent in one surface, left to the concave limit
     planes = two_patches((10.0, np.array([-0.02, 0.0, 0.90])), (-10.0, np.array([0.02, 0.0, 0.905])))
     assert inward_creases(planes, PAIR, 45.0).tolist() == [False]
+
+
+def test_a_cell_across_a_seam_gives_a_patch_to_each_side() -> None:
+    # one surface: two bands joined at the right, around the end of a seam (rows 2-3) that cuts the left cell
+    surfaces = np.ones((6, 12), dtype=np.int32)
+    surfaces[2:4, :9] = 0
+    patches = grid_patches(surfaces, 6)
+    left = patches[:, :6]
+    assert left[0, 0] != left[5, 0] and left[0, 0] > 0 and left[5, 0] > 0  # two strips: two patches
+    right = patches[:, 6:]
+    assert len(np.unique(right[right > 0])) == 1  # the band's end joins both sides within the right cell
+    assert sorted(np.unique(patches[patches > 0]).tolist()) == [1, 2, 3]

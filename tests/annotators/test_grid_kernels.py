@@ -20,6 +20,7 @@ from annotators.geometry.grid_kernels import (
     joined_labels,
     jump_between,
     label_masks,
+    label_pieces,
     label_pixels,
     nearest_seed_labels,
     plane_coordinates,
@@ -52,6 +53,19 @@ def test_connected_parts_number_parts_as_opencv(seed: int) -> None:
     keep[0] = False
     expected = (np.cumsum(keep) * keep).astype(np.int32)[reference]
     assert np.array_equal(connected_parts(region, 5), expected)
+
+
+@pytest.mark.parametrize("seed", range(5))
+def test_label_pieces_are_the_connected_parts_of_each_label_in_raster_order(seed: int) -> None:
+    labels = _blobs(seed)
+    parts = []  # (first pixel's flat index, mask) of every 4-connected part of every label
+    for label in np.unique(labels[labels > 0]):
+        count, numbered = cv2.connectedComponents((labels == label).astype(np.uint8), connectivity=4)
+        parts += [(int(np.argmax(numbered == part)), numbered == part) for part in range(1, count)]
+    expected = np.zeros(labels.shape, dtype=np.int64)
+    for number, (_, mask) in enumerate(sorted(parts, key=lambda part: part[0]), start=1):
+        expected[mask] = number
+    assert np.array_equal(label_pieces(labels), expected)
 
 
 @pytest.mark.parametrize("seed", range(5))
