@@ -7,7 +7,9 @@ from collections.abc import Callable
 from pathlib import Path
 
 import numpy as np
+import pytest
 
+import annotators.cloud.clutter as clutter
 from annotators.cloud.clutter import ClutterParameters, segment_clutter
 from annotators.cloud.filters import range_mask
 from annotators.cloud.point_cloud import back_project, pixel_rays
@@ -16,6 +18,7 @@ from annotators.geometry.grid_segmentation import bounding_box
 from annotators.readers.frame_io import read_color_depth_pair
 from annotators.readers.pcd_io import read_pcd
 from reasoning.evaluation.mosd import object_labels
+from reasoning.evaluation.segmentation import SegmentationScore, score_segmentation
 
 REPO_ROOT = Path(__file__).resolve().parents[2]
 SHARED_DATA = REPO_ROOT.parent / "shared" / "data"
@@ -69,3 +72,13 @@ def crop_moved(dy: int, dx: int) -> Callable[[np.ndarray, int], tuple[int, int, 
         return x0, y0, x1, y1
 
     return box
+
+
+def mosd_score_with_cells_moved(
+    path: Path, offset: tuple[int, int], monkeypatch: pytest.MonkeyPatch
+) -> SegmentationScore:
+    """The default segmenter's score on a labelled mOSD scene with its grid cells started ``offset`` (dy, dx) coarse
+    pixels earlier (:func:`crop_moved`)."""
+    monkeypatch.setattr(clutter, "bounding_box", crop_moved(*offset))
+    labels, truth, valid = segment_mosd_scene(path, ClutterParameters())
+    return score_segmentation(truth, labels, valid)

@@ -25,11 +25,10 @@ from pathlib import Path
 
 import pytest
 
-import annotators.cloud.clutter as clutter
 from annotators.cloud.clutter import ClutterParameters
 from reasoning.evaluation.segmentation import score_segmentation
 from tests.annotators.conftest import require_folder
-from tests.annotators.guard_frames import crop_moved, segment_mosd_scene
+from tests.annotators.guard_frames import mosd_score_with_cells_moved, segment_mosd_scene
 
 pytestmark = pytest.mark.real_data
 
@@ -60,7 +59,5 @@ def test_a_container_stays_one_object_wherever_the_cells_start(
     shared_data: Path, scene: str, offset: tuple[int, int], monkeypatch: pytest.MonkeyPatch
 ) -> None:
     path = require_folder(shared_data / "pcl_mosd_tabletop" / "learn") / f"{scene}.pcd"
-    monkeypatch.setattr(clutter, "bounding_box", crop_moved(*offset))
-    labels, truth, valid = segment_mosd_scene(path, ClutterParameters())
-    score = score_segmentation(truth, labels, valid)
+    score = mosd_score_with_cells_moved(path, offset, monkeypatch)
     assert (score.recall, score.precision) == (1.0, 1.0)

@@ -21,11 +21,8 @@ from pathlib import Path
 
 import pytest
 
-import annotators.cloud.clutter as clutter
-from annotators.cloud.clutter import ClutterParameters
-from reasoning.evaluation.segmentation import score_segmentation
 from tests.annotators.conftest import require_folder
-from tests.annotators.guard_frames import crop_moved, segment_mosd_scene
+from tests.annotators.guard_frames import mosd_score_with_cells_moved
 
 pytestmark = pytest.mark.real_data
 
@@ -35,9 +32,7 @@ def test_every_stacked_box_is_found_wherever_the_cells_start(
     shared_data: Path, offset: tuple[int, int], monkeypatch: pytest.MonkeyPatch
 ) -> None:
     path = require_folder(shared_data / "pcl_mosd_tabletop" / "learn") / "learn24.pcd"
-    monkeypatch.setattr(clutter, "bounding_box", crop_moved(*offset))
-    labels, truth, valid = segment_mosd_scene(path, ClutterParameters())
-    score = score_segmentation(truth, labels, valid)
+    score = mosd_score_with_cells_moved(path, offset, monkeypatch)
     assert score.matched == score.objects == 3
 
 
@@ -48,7 +43,5 @@ def test_a_box_lying_on_a_box_stays_apart_wherever_the_cells_start(
     shared_data: Path, scene: str, offset: tuple[int, int], monkeypatch: pytest.MonkeyPatch
 ) -> None:
     path = require_folder(shared_data / "pcl_mosd_tabletop" / "learn") / f"{scene}.pcd"
-    monkeypatch.setattr(clutter, "bounding_box", crop_moved(*offset))
-    labels, truth, valid = segment_mosd_scene(path, ClutterParameters())
-    score = score_segmentation(truth, labels, valid)
+    score = mosd_score_with_cells_moved(path, offset, monkeypatch)
     assert score.matched == score.objects
