@@ -48,7 +48,7 @@ from annotators.readers.frame_readers import (
 )
 from annotators.readers.open3d_io import frame_pairs, is_open3d_folder
 from annotators.readers.tiff_io import frame_stamps, is_tiff_sequence, tiff_folder
-from annotators.readers.tum_io import associate, is_tum_pair, is_tum_sequence, pair_color_files, read_image_list
+from annotators.readers.tum_io import is_tum_pair, is_tum_sequence, pair_color_files
 from robokudo.core.annotator import Annotator
 from robokudo.core.types import CameraIntrinsics
 
@@ -206,10 +206,7 @@ def reader_name_for(path: str | None, frame: int = 0) -> str:
 
 
 def _folder_frame_count(folder: Path) -> int:
-    if is_tum_sequence(folder):
-        return len(associate(read_image_list(folder / "rgb.txt"), read_image_list(folder / "depth.txt")))
-    if is_open3d_folder(folder):
-        return len(frame_pairs(folder))
+    """The frames of a folder of a layout read frame by frame (TIFF sequence, clouds, colour/depth pairs)."""
     if is_tiff_sequence(folder):
         return len(frame_stamps(tiff_folder(folder)))
     clouds = [p for p in folder.iterdir() if p.suffix.lower() == ".pcd"]
@@ -234,4 +231,11 @@ def recorded_frames(path: str) -> tuple[ReaderChoice, ...]:
     if first.reader is ColorDepthPairReader:
         numbers = sorted(int(m.group(1)) for p in resolved.iterdir() if (m := _UOC_COLOR.match(p.name)))
         return tuple(ReaderChoice(ColorDepthPairReader, {"folder": str(resolved), "frame": n}) for n in numbers)
+    if first.reader is TumSequenceReader or first.reader is Open3dFolderReader:
+        # the recording's lists (a long ground truth or trajectory among them) read once for all its frames
+        opened = first.reader.open(resolved)
+        return tuple(
+            ReaderChoice(first.reader, {"folder": str(resolved), "frame": frame, "opened": opened})
+            for frame in range(len(opened.pairs))
+        )
     return tuple(_folder_choice(resolved, frame) for frame in range(_folder_frame_count(resolved)))

@@ -23,16 +23,16 @@ import time
 from abc import abstractmethod
 from collections.abc import Mapping, Sequence
 from pathlib import Path
-from typing import ClassVar
+from typing import ClassVar, Generic, TypeVar
 
 import numpy as np
 
 from annotators.readers.bag_io import MILLIMETRES, BagTopics, read_bag_frame
-from annotators.readers.frame_io import Frame, FrameError, frame_camera, read_color_depth_pair
-from annotators.readers.open3d_io import OPEN3D_DEPTH_SCALE, read_open3d_frame
+from annotators.readers.frame_io import Frame, FrameError, frame_camera, read_color_depth_pair, require_frame_folder
+from annotators.readers.open3d_io import OPEN3D_DEPTH_SCALE, Open3dRecording
 from annotators.readers.pcd_io import read_pcd
 from annotators.readers.tiff_io import read_tiff_frame
-from annotators.readers.tum_io import TUM_DEPTH_SCALE, read_tum_pair, read_tum_sequence
+from annotators.readers.tum_io import TUM_DEPTH_SCALE, TumSequence, read_tum_pair
 from annotators.simulation import kitchen_person, kitchen_scene
 from robokudo.core.annotator import Annotator
 from robokudo.core.capability import Capability
@@ -204,9 +204,14 @@ class ColorDepthPairReader(FileFrameReader):
         return f"{self.folder.resolve()}#{self.frame:06d}"
 
 
-class _RecordingFolderReader(FileFrameReader):
+OpenedRecording = TypeVar("OpenedRecording", TumSequence, Open3dRecording)
+
+
+class _RecordingFolderReader(FileFrameReader, Generic[OpenedRecording]):
     """Base of the readers of frame ``frame`` of a folder holding one continuous recording. ``depth_scale`` is in
-    units per metre (None: the layout's ``default_depth_scale``); ``intrinsics`` given replace the folder's."""
+    units per metre (None: the layout's ``default_depth_scale``); ``intrinsics`` given replace the folder's;
+    ``opened`` is the folder's lists read once, shared by the readers of all its frames (a playback stream), else
+    each decode reads them."""
 
     default_depth_scale: ClassVar[float]
 
@@ -217,19 +222,31 @@ class _RecordingFolderReader(FileFrameReader):
         depth_scale: float | None = None,
         intrinsics: CameraIntrinsics | None = None,
         name: str | None = None,
+        opened: OpenedRecording | None = None,
     ) -> None:
         super().__init__(name=name)
         self.folder = Path(folder)
         self.frame = frame
         self.depth_scale = self.default_depth_scale if depth_scale is None else depth_scale
         self.intrinsics = intrinsics
+        self.opened = opened
 
     def recording(self) -> str:
         """The folder: one continuous recording."""
         return str(self.folder.resolve())
 
+    def decode(self) -> Frame:
+        """Decode the frame from the folder's lists, read now unless opened already."""
+        opened = self.opened or self.open(require_frame_folder(self.folder, self.frame))
+        return opened.read(self.frame, self.depth_scale, self.intrinsics)
 
-class TumSequenceReader(_RecordingFolderReader):
+    @staticmethod
+    @abstractmethod
+    def open(folder: Path) -> OpenedRecording:
+        """Read the folder's lists."""
+
+
+class TumSequenceReader(_RecordingFolderReader[TumSequence]):
     """Reads frame ``frame`` (time order) of a TUM RGB-D sequence folder (rgb.txt, depth.txt).
 
     ``depth_scale`` is in units per metre (TUM: 5000); ``intrinsics`` default to the folder's camera_params.json,
@@ -245,9 +262,10 @@ class TumSequenceReader(_RecordingFolderReader):
 
     default_depth_scale: ClassVar[float] = TUM_DEPTH_SCALE
 
-    def decode(self) -> Frame:
-        """Associate colour and depth by time stamp and decode the chosen pair."""
-        return read_tum_sequence(self.folder, self.frame, self.depth_scale, self.intrinsics)
+    @staticmethod
+    def open(folder: Path) -> TumSequence:
+        """Associate colour and depth by time stamp; read the ground truth."""
+        return TumSequence.open(folder)
 
 
 class TumPairReader(FileFrameReader):
@@ -284,7 +302,7 @@ class TumPairReader(FileFrameReader):
         return str(self.path.resolve())
 
 
-class Open3dFolderReader(_RecordingFolderReader):
+class Open3dFolderReader(_RecordingFolderReader[Open3dRecording]):
     """Reads frame ``frame`` of an Open3D RGB-D folder (``color/`` or ``image/``, ``depth/``, camera JSON), with its
     camera pose when the folder has a ``trajectory.log``.
 
@@ -301,9 +319,10 @@ class Open3dFolderReader(_RecordingFolderReader):
 
     default_depth_scale: ClassVar[float] = OPEN3D_DEPTH_SCALE
 
-    def decode(self) -> Frame:
-        """Pair the frame's colour and depth images and decode them, with the frame's pose when there is one."""
-        return read_open3d_frame(self.folder, self.frame, self.depth_scale, self.intrinsics)
+    @staticmethod
+    def open(folder: Path) -> Open3dRecording:
+        """Pair the colour and depth images; read the trajectory."""
+        return Open3dRecording.open(folder)
 
 
 class PcdReader(FileFrameReader):

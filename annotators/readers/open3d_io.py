@@ -16,7 +16,7 @@ the PrimeSense default. A ``trajectory.log`` (Open3D's log format: per frame a l
 from __future__ import annotations
 
 import json
-from dataclasses import replace
+from dataclasses import dataclass, replace
 from pathlib import Path
 
 import numpy as np
@@ -150,6 +150,47 @@ def read_trajectory(path: Path) -> list[np.ndarray]:
     return poses
 
 
+@dataclass(frozen=True, eq=False)
+class Open3dRecording:
+    """An Open3D RGB-D folder's lists, read once: its colour/depth image pairs in order and, with a
+    ``trajectory.log``, each frame's camera-to-world pose. A reader of every frame (a playback stream) shares one;
+    reading a frame decodes that frame's two images only."""
+
+    folder: Path
+    pairs: tuple[tuple[Path, Path], ...]
+    poses: tuple[np.ndarray, ...] | None
+
+    @classmethod
+    def open(cls, folder: str | Path) -> Open3dRecording:
+        """Pair the folder's images and read its trajectory (when there is one); FrameError when the folders or the
+        trajectory do not agree (the counts, a line of the trajectory by number)."""
+        folder = Path(folder)
+        pairs = tuple(frame_pairs(folder))
+        trajectory = folder / TRAJECTORY_FILE
+        if not trajectory.is_file():
+            return cls(folder, pairs, None)
+        poses = read_trajectory(trajectory)
+        if len(poses) != len(pairs):
+            raise FrameError(f"{trajectory} holds {len(poses)} poses for {len(pairs)} frames")
+        return cls(folder, pairs, tuple(poses))
+
+    def read(
+        self, frame: int = 0, depth_scale: float = OPEN3D_DEPTH_SCALE, intrinsics: CameraIntrinsics | None = None
+    ) -> Frame:
+        """Decode frame ``frame``, with its camera pose when the folder has a trajectory."""
+        if not 0 <= frame < len(self.pairs):
+            raise FrameError(f"{self.folder} has {len(self.pairs)} colour/depth frames, no frame {frame}")
+        color, depth = self.pairs[frame]
+        camera, where = open3d_intrinsics(self.folder, intrinsics)
+        try:
+            decoded = decode_rgbd(color, depth, camera, depth_scale)
+        except FrameError as error:
+            if "the intrinsics say" in str(error):
+                raise FrameError(f"{error} (intrinsics: {where})") from None
+            raise
+        return replace(decoded, cam_to_world=self.poses[frame] if self.poses is not None else None)
+
+
 def read_open3d_frame(
     folder: str | Path,
     frame: int = 0,
@@ -157,23 +198,4 @@ def read_open3d_frame(
     intrinsics: CameraIntrinsics | None = None,
 ) -> Frame:
     """Decode frame ``frame`` of an Open3D RGB-D folder, with its camera pose when the folder has a trajectory."""
-    folder = require_frame_folder(folder, frame)
-    pairs = frame_pairs(folder)
-    if frame >= len(pairs):
-        raise FrameError(f"{folder} has {len(pairs)} colour/depth frames, no frame {frame}")
-    pose = None
-    trajectory = folder / TRAJECTORY_FILE
-    if trajectory.is_file():
-        poses = read_trajectory(trajectory)
-        if len(poses) != len(pairs):
-            raise FrameError(f"{trajectory} holds {len(poses)} poses for {len(pairs)} frames")
-        pose = poses[frame]
-    color, depth = pairs[frame]
-    camera, where = open3d_intrinsics(folder, intrinsics)
-    try:
-        decoded = decode_rgbd(color, depth, camera, depth_scale)
-    except FrameError as error:
-        if "the intrinsics say" in str(error):
-            raise FrameError(f"{error} (intrinsics: {where})") from None
-        raise
-    return replace(decoded, cam_to_world=pose)
+    return Open3dRecording.open(require_frame_folder(folder, frame)).read(frame, depth_scale, intrinsics)

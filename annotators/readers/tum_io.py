@@ -31,7 +31,6 @@ from annotators.readers.frame_io import (
     FrameError,
     decode_rgbd,
     read_camera_params,
-    require_frame_folder,
 )
 from robokudo.core.geometry import rotation_matrices
 from robokudo.core.types import CameraIntrinsics
@@ -166,22 +165,37 @@ def pose_at(
     return poses[best] if abs(times[best] - timestamp) <= max_difference else None
 
 
-def read_tum_sequence(
-    folder: str | Path,
-    frame: int = 0,
-    depth_scale: float = TUM_DEPTH_SCALE,
-    intrinsics: CameraIntrinsics | None = None,
-) -> Frame:
-    """Decode frame ``frame`` (0-based, in time order) of a TUM sequence folder."""
-    folder = require_frame_folder(folder, frame)
-    pairs = associate(read_image_list(folder / "rgb.txt"), read_image_list(folder / "depth.txt"))
-    if frame >= len(pairs):
-        raise FrameError(f"{folder} has {len(pairs)} associated colour/depth frames, no frame {frame}")
-    color, depth = pairs[frame]
-    decoded = decode_rgbd(color.path, depth.path, sequence_intrinsics(folder, intrinsics), depth_scale, color.timestamp)
-    if not (folder / GROUND_TRUTH_FILE).is_file():
-        return decoded
-    return replace(decoded, cam_to_world=pose_at(*read_ground_truth(folder / GROUND_TRUTH_FILE), color.timestamp))
+@dataclass(frozen=True, eq=False)
+class TumSequence:
+    """A TUM sequence folder's lists, read once: its colour/depth pairs in time order and, with a
+    ``groundtruth.txt``, the times and camera-to-world poses of its ground truth. A reader of every frame (a playback
+    stream) shares one; reading a frame decodes that frame's two images only."""
+
+    folder: Path
+    pairs: tuple[tuple[TimedImage, TimedImage], ...]
+    ground_truth: tuple[np.ndarray, np.ndarray] | None
+
+    @classmethod
+    def open(cls, folder: str | Path) -> TumSequence:
+        """Read the folder's ``rgb.txt``, ``depth.txt`` and ``groundtruth.txt`` (when there is one); FrameError
+        names a line that is not ``timestamp path`` or a ground-truth pose."""
+        folder = Path(folder)
+        pairs = tuple(associate(read_image_list(folder / "rgb.txt"), read_image_list(folder / "depth.txt")))
+        truth = folder / GROUND_TRUTH_FILE
+        return cls(folder, pairs, read_ground_truth(truth) if truth.is_file() else None)
+
+    def read(
+        self, frame: int = 0, depth_scale: float = TUM_DEPTH_SCALE, intrinsics: CameraIntrinsics | None = None
+    ) -> Frame:
+        """Decode frame ``frame`` (0-based, in time order), with its pose when the ground truth has one near it."""
+        if not 0 <= frame < len(self.pairs):
+            raise FrameError(f"{self.folder} has {len(self.pairs)} associated colour/depth frames, no frame {frame}")
+        color, depth = self.pairs[frame]
+        camera = sequence_intrinsics(self.folder, intrinsics)
+        decoded = decode_rgbd(color.path, depth.path, camera, depth_scale, color.timestamp)
+        if self.ground_truth is None:
+            return decoded
+        return replace(decoded, cam_to_world=pose_at(*self.ground_truth, color.timestamp))
 
 
 def pair_paths(path: str | Path) -> tuple[Path, Path]:

@@ -1,4 +1,5 @@
-"""A TUM sequence's groundtruth.txt gives its frames their camera poses (sequences made here, with known poses)."""
+"""A TUM sequence's groundtruth.txt gives its frames their camera poses (sequences made here, with known poses), also
+through a playback stream, which reads the sequence's lists once for all its frames."""
 
 from __future__ import annotations
 
@@ -10,9 +11,10 @@ import numpy as np
 import pytest
 from py_trees.common import Status
 
-from annotators.readers.choice import reader_for
+from annotators.readers.choice import reader_for, recorded_frames
 from annotators.readers.frame_io import FrameError
 from annotators.readers.frame_readers import TumSequenceReader
+from annotators.readers.streams import stream_for
 from annotators.readers.tum_io import read_ground_truth
 from robokudo.core.pipeline import Pipeline
 from robokudo.core.types import CameraInfo
@@ -78,3 +80,21 @@ def test_a_malformed_ground_truth_names_its_line(tmp_path: Path, text: str, mess
     path.write_text(text)
     with pytest.raises(FrameError, match=message):
         read_ground_truth(path)
+
+
+def test_a_playback_stream_delivers_each_frames_pose_from_the_lists_it_read_once(tmp_path: Path) -> None:
+    x, y, z, w = QUARTER_TURN_ABOUT_Z
+    lines = ["# timestamp tx ty tz qx qy qz qw"] + [f"{10.0 + k:.3f} {k} 0 0 {x} {y} {z} {w}" for k in range(3)]
+    folder = write_sequence(tmp_path / "seq", [10.0, 11.0, 12.0], "\n".join(lines) + "\n")
+    choices = recorded_frames(str(folder))
+    assert len({id(choice.parameters["opened"]) for choice in choices}) == 1  # one reading shared by all frames
+    stream = stream_for(str(folder), rate_hz=1000.0, loop=False)
+    try:
+        first = stream.next_frame()
+        (folder / "groundtruth.txt").unlink()  # the stream goes on from the lists it read when it started
+        delivered = [first] + [stream.next_frame() for _ in range(2)]
+    finally:
+        stream.close()
+    positions = [d.camera.cam_to_world[:3, 3] for d in delivered]
+    assert np.allclose(positions, [(0, 0, 0), (1, 0, 0), (2, 0, 0)])
+    assert camera_pose(folder, 1) is None  # a reader alone reads the lists as they are now
