@@ -21,8 +21,10 @@ import math
 import re
 import time
 import zlib
+from collections.abc import Sequence
 from dataclasses import dataclass
 from pathlib import Path
+from typing import TypeVar
 
 import cv2
 import numpy as np
@@ -100,6 +102,10 @@ def check_depth_scale(scale: float) -> float:
     return value
 
 
+FrameItem = TypeVar("FrameItem")
+"""What a recording lists per frame (a colour/depth pair of paths or of timed images)."""
+
+
 def require_frame_folder(folder: str | Path, frame: int) -> Path:
     """``folder`` as a Path when it is a folder and ``frame`` a frame number (>= 0); else FrameError."""
     folder = Path(folder)
@@ -108,6 +114,14 @@ def require_frame_folder(folder: str | Path, frame: int) -> Path:
     if frame < 0:
         raise FrameError(f"frame number must be >= 0, got {frame}")
     return folder
+
+
+def frame_of(frames: Sequence[FrameItem], frame: int, folder: Path, what: str) -> FrameItem:
+    """Item ``frame`` of a recording's ``frames`` (its ``what``, e.g. "colour/depth frames"); FrameError naming the
+    folder and how many it has when there is no such frame."""
+    if not 0 <= frame < len(frames):
+        raise FrameError(f"{folder} has {len(frames)} {what}, no frame {frame}")
+    return frames[frame]
 
 
 def require_file(path: Path) -> Path:

@@ -214,6 +214,8 @@ class _RecordingFolderReader(FileFrameReader, Generic[OpenedRecording]):
     each decode reads them."""
 
     default_depth_scale: ClassVar[float]
+    layout: ClassVar[type[TumSequence] | type[Open3dRecording]]
+    """The folder's lists, read by its ``open``."""
 
     def __init__(
         self,
@@ -240,10 +242,10 @@ class _RecordingFolderReader(FileFrameReader, Generic[OpenedRecording]):
         opened = self.opened or self.open(require_frame_folder(self.folder, self.frame))
         return opened.read(self.frame, self.depth_scale, self.intrinsics)
 
-    @staticmethod
-    @abstractmethod
-    def open(folder: Path) -> OpenedRecording:
-        """Read the folder's lists."""
+    @classmethod
+    def open(cls, folder: Path) -> OpenedRecording:
+        """Read the folder's lists, for the readers of all its frames to share."""
+        return cls.layout.open(folder)
 
 
 class TumSequenceReader(_RecordingFolderReader[TumSequence]):
@@ -261,11 +263,7 @@ class TumSequenceReader(_RecordingFolderReader[TumSequence]):
     )
 
     default_depth_scale: ClassVar[float] = TUM_DEPTH_SCALE
-
-    @staticmethod
-    def open(folder: Path) -> TumSequence:
-        """Associate colour and depth by time stamp; read the ground truth."""
-        return TumSequence.open(folder)
+    layout: ClassVar[type[TumSequence]] = TumSequence
 
 
 class TumPairReader(FileFrameReader):
@@ -318,11 +316,7 @@ class Open3dFolderReader(_RecordingFolderReader[Open3dRecording]):
     )
 
     default_depth_scale: ClassVar[float] = OPEN3D_DEPTH_SCALE
-
-    @staticmethod
-    def open(folder: Path) -> Open3dRecording:
-        """Pair the colour and depth images; read the trajectory."""
-        return Open3dRecording.open(folder)
+    layout: ClassVar[type[Open3dRecording]] = Open3dRecording
 
 
 class PcdReader(FileFrameReader):

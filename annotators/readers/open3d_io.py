@@ -15,6 +15,7 @@ the PrimeSense default. A ``trajectory.log`` (Open3D's log format: per frame a l
 
 from __future__ import annotations
 
+import functools
 import json
 from dataclasses import dataclass, replace
 from pathlib import Path
@@ -26,6 +27,7 @@ from annotators.readers.frame_io import (
     Frame,
     FrameError,
     decode_rgbd,
+    frame_of,
     natural_order_key,
     require_frame_folder,
 )
@@ -174,14 +176,18 @@ class Open3dRecording:
             raise FrameError(f"{trajectory} holds {len(poses)} poses for {len(pairs)} frames")
         return cls(folder, pairs, tuple(poses))
 
+    @functools.cached_property
+    def folder_intrinsics(self) -> tuple[CameraIntrinsics, str]:
+        """Those of the folder's camera JSON, else the PrimeSense default, with where they come from (read on the
+        first frame)."""
+        return open3d_intrinsics(self.folder)
+
     def read(
         self, frame: int = 0, depth_scale: float = OPEN3D_DEPTH_SCALE, intrinsics: CameraIntrinsics | None = None
     ) -> Frame:
         """Decode frame ``frame``, with its camera pose when the folder has a trajectory."""
-        if not 0 <= frame < len(self.pairs):
-            raise FrameError(f"{self.folder} has {len(self.pairs)} colour/depth frames, no frame {frame}")
-        color, depth = self.pairs[frame]
-        camera, where = open3d_intrinsics(self.folder, intrinsics)
+        color, depth = frame_of(self.pairs, frame, self.folder, "colour/depth frames")
+        camera, where = (intrinsics, "given") if intrinsics is not None else self.folder_intrinsics
         try:
             decoded = decode_rgbd(color, depth, camera, depth_scale)
         except FrameError as error:

@@ -19,6 +19,7 @@ pair: :func:`pair_color_files` lists their colour files.
 
 from __future__ import annotations
 
+import functools
 import re
 from dataclasses import dataclass, replace
 from pathlib import Path
@@ -30,6 +31,7 @@ from annotators.readers.frame_io import (
     Frame,
     FrameError,
     decode_rgbd,
+    frame_of,
     read_camera_params,
 )
 from robokudo.core.geometry import rotation_matrices
@@ -184,14 +186,17 @@ class TumSequence:
         truth = folder / GROUND_TRUTH_FILE
         return cls(folder, pairs, read_ground_truth(truth) if truth.is_file() else None)
 
+    @functools.cached_property
+    def folder_intrinsics(self) -> CameraIntrinsics:
+        """Those of the folder's camera_params.json, else the PrimeSense default (read on the first frame)."""
+        return sequence_intrinsics(self.folder, None)
+
     def read(
         self, frame: int = 0, depth_scale: float = TUM_DEPTH_SCALE, intrinsics: CameraIntrinsics | None = None
     ) -> Frame:
         """Decode frame ``frame`` (0-based, in time order), with its pose when the ground truth has one near it."""
-        if not 0 <= frame < len(self.pairs):
-            raise FrameError(f"{self.folder} has {len(self.pairs)} associated colour/depth frames, no frame {frame}")
-        color, depth = self.pairs[frame]
-        camera = sequence_intrinsics(self.folder, intrinsics)
+        color, depth = frame_of(self.pairs, frame, self.folder, "associated colour/depth frames")
+        camera = intrinsics if intrinsics is not None else self.folder_intrinsics
         decoded = decode_rgbd(color.path, depth.path, camera, depth_scale, color.timestamp)
         if self.ground_truth is None:
             return decoded
