@@ -13,8 +13,8 @@ Works like :mod:`annotators.cloud.clusters` on every ``stride``-th pixel of the 
    its rim, whose inner wall's heights lie within its own (:func:`annotators.geometry.rims.one_stands_inside`);
 4. an object is split along a hue edge only where a concave crease runs along it (:func:`split_by_color`: a can
    standing flush on a can is one convex surface but two colours with a crease between);
-5. pieces that an occluder in front splits apart join when they continue one plane behind it
-   (:func:`annotators.geometry.occlusion.join_occluded`);
+5. pieces that an occluder in front splits apart join when they continue one plane behind it, even where they meet
+   at a corner beyond its end (:func:`annotators.geometry.occlusion.join_occluded`);
 6. a piece that could not stand by itself - smaller than a neighbour whose footprint holds much of its own, not
    reaching the table and reaching down too far into the neighbour's heights to rest on its top - joins it: the
    inside of a mug seen over its rim, cut off with the rim and the handle along the inner wall's concave fold
@@ -225,6 +225,12 @@ class ClutterParameters(ClusterParameters):
             jump_relative=self.jump_relative,
         )
 
+    def occlusion_rules(self) -> OcclusionRules:
+        """The thresholds of :func:`annotators.geometry.occlusion.join_occluded`: pieces touching along a border
+        shorter than the merge rules trust (their shortest border and its share) count as apart."""
+        rules = self.merge_rules()
+        return OcclusionRules(boundary_share=rules.boundary_share, min_boundary=rules.min_boundary)
+
     def border_rules(self) -> BorderRules:
         """The thresholds of :func:`annotators.geometry.border_pixels.claim_border_pixels` at full resolution: the
         depth jumps, the span of the normals (``normal_step`` coarse pixels), the smoothness angle, the concave
@@ -311,7 +317,7 @@ def segment_clutter(
         labels = split_by_color(labels, grid, normals, colors_crop, p, footprint)
     if p.complete_occluded:
         labels = join_occluded(
-            labels, grid, normals, plane_grid.reshape(grid.shape), p.jump_absolute, p.jump_relative, OcclusionRules()
+            labels, grid, normals, plane_grid.reshape(grid.shape), p.jump_absolute, p.jump_relative, p.occlusion_rules()
         )
     support = SupportRules() if p.join_unsupported else None
     appendages = p.appendage_rules() if p.join_appendages else None

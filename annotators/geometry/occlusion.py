@@ -6,7 +6,9 @@ behind an occluder):
 
 * both lie behind a common occluder: near it (within ``rules.band`` pixels, which also bridges the sensor's
   shadow beside an occluding edge, where no depth is measured) they are farther than it by a depth jump;
-* they do not touch each other;
+* they do not touch each other, or only along a border shorter than the touching joins trust (``rules.min_boundary``
+  pixel pairs and ``rules.boundary_share`` times the square root of the smaller piece's size): two pieces of a
+  box's top on either side of a box lying across it may meet at a corner beyond the occluder's end;
 * the surface goes on from one to the other along the line between them: that line lies in the tangent planes
   of both pieces near the occluder (within ``rules.degrees`` for most of their pixels). This holds for one plane
   continuing behind the occluder, for a box's top and front together, and for a can lying on its side seen at
@@ -29,7 +31,7 @@ from types import ModuleType
 import numpy as np
 
 from annotators.geometry.grid_kernels import label_pixels
-from annotators.geometry.grid_segmentation import join_labels, touching_pairs
+from annotators.geometry.grid_segmentation import MergeRules, join_labels
 
 
 @dataclass(frozen=True)
@@ -44,6 +46,8 @@ class OcclusionRules:
     flat: float = 0.005
     through_occluder: float = 0.5
     min_points: int = 20
+    boundary_share: float = MergeRules.boundary_share
+    min_boundary: int = MergeRules.min_boundary
 
 
 @dataclass(frozen=True, eq=False)
@@ -89,7 +93,7 @@ def join_occluded(
         return labels
     depth = points[..., 2]
     flat_labels = labels.reshape(-1)
-    touching = _touching(labels, count)
+    touching = _touching(labels, count, rules)
     joined: list[tuple[int, int]] = []
     for occluder, behind in _pieces_behind(labels, points, normals, on_plane, touching, absolute, relative, rules):
         for index, first in enumerate(behind):
@@ -219,13 +223,22 @@ def _same_section(first: _Piece, second: _Piece, rules: OcclusionRules) -> bool:
     return low_a >= low_b - width and high_a <= high_b + width
 
 
-def _touching(labels: np.ndarray, count: int) -> np.ndarray:
-    """The symmetric (count+1)x(count+1) bool matrix of the labels that touch as 4-neighbours."""
-    pairs = touching_pairs(labels)
-    touching = np.zeros((count + 1, count + 1), dtype=bool)
-    touching[pairs[:, 0], pairs[:, 1]] = True
-    touching[pairs[:, 1], pairs[:, 0]] = True
-    return touching
+def _touching(labels: np.ndarray, count: int, rules: OcclusionRules) -> np.ndarray:
+    """The symmetric (count+1)x(count+1) bool matrix of the labels that touch as 4-neighbours along a border the
+    touching joins would trust: at least ``rules.min_boundary`` pixel pairs and ``rules.boundary_share`` times the
+    square root of the smaller label's size."""
+    span = count + 1
+    lengths = np.zeros(span * span, dtype=np.int64)
+    for first, second in ((labels[:, :-1], labels[:, 1:]), (labels[:-1, :], labels[1:, :])):
+        border = (first != second) & (first > 0) & (second > 0)
+        low = np.minimum(first[border], second[border]).astype(np.int64)
+        high = np.maximum(first[border], second[border]).astype(np.int64)
+        lengths += np.bincount(low * span + high, minlength=span * span)
+    lengths = lengths.reshape(span, span)
+    lengths = lengths + lengths.T
+    sizes = np.bincount(labels.reshape(-1), minlength=span)
+    needed = np.maximum(rules.min_boundary, rules.boundary_share * np.sqrt(np.minimum.outer(sizes, sizes)))
+    return (lengths > 0) & (lengths >= needed)
 
 
 def _across(
