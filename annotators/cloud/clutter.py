@@ -6,11 +6,12 @@ Works like :mod:`annotators.cloud.clusters` on every ``stride``-th pixel of the 
 2. they are cut at depth discontinuities and into cells, split where their normals disagree; each cell gets a
    plane fit, cells join into smooth faces and faces into objects where they meet convexly - where a can stands on
    a box or a box leans on another the surfaces fold inward and stay apart
-   (:func:`annotators.geometry.convexity.convex_groups`); colour plays no part, so a printed box is one object;
+   (:func:`annotators.geometry.convexity.convex_objects`); colour plays no part, so a printed box is one object;
 3. the cut pixels are given back, and a container's inside joins its outside (a handle its body): the footprints on
    the plane overlap and the heights nest, which an object standing on another never does
-   (:func:`annotators.geometry.grid_segmentation.merge_parts`) - nor one standing in a container and rising above
-   its rim, whose inner wall's heights lie within its own (:func:`annotators.geometry.rims.one_stands_inside`);
+   (:func:`annotators.geometry.grid_segmentation.merge_parts`; with and without the pixels whose label was grown
+   past an object's outline onto the surface behind) - nor one standing in a container and rising above its rim,
+   whose inner wall's heights lie within its own (:func:`annotators.geometry.rims.one_stands_inside`);
 4. an object is split along a hue edge only where a concave crease runs along it (:func:`split_by_color`: a can
    standing flush on a can is one convex surface but two colours with a crease between);
 5. pieces that an occluder in front splits apart join when they continue one plane behind it, even where they meet
@@ -68,7 +69,7 @@ from annotators.cloud.normals import grid_normals
 from annotators.cloud.plane import plane_basis, plane_distances
 from annotators.geometry.border_pixels import BorderRules, claim_border_pixels, plane_noise
 from annotators.geometry.container_floors import FloorRules, claim_container_floors, touches_other_labels
-from annotators.geometry.convexity import ConvexityRules, convex_groups, dense_labels, grid_patches, split_by_normals
+from annotators.geometry.convexity import ConvexityRules, convex_objects, dense_labels, grid_patches, split_by_normals
 from annotators.geometry.flat_patches import flat_patches
 from annotators.geometry.grid_kernels import object_pieces, plane_coordinates, strided_crop
 from annotators.geometry.grid_segmentation import (
@@ -163,7 +164,7 @@ class ClutterParameters(ClusterParameters):
     claim_borders: bool = True
 
     def convexity_rules(self) -> ConvexityRules:
-        """The thresholds of :func:`annotators.geometry.convexity.convex_groups`. With grown patches two small
+        """The thresholds of :func:`annotators.geometry.convexity.convex_objects`. With grown patches two small
         faces join on a weak vote only as one's best neighbour (``small_joins_once``), and a grazing patch's
         inward bend casts no convex vote (``grazing_degrees``): grown patches follow the data, so the stereo depth
         ramp at an occluding edge is a patch of its own, where the grid's cells average it into the faces beside
@@ -300,15 +301,20 @@ def segment_clutter(
     reach = max(2.0 * p.cell, p.grow_distance / step)
     # the angle between neighbouring pixels, a property of the camera: measured once, on every few rows
     footprint = pixel_footprint(np.ascontiguousarray(grid[::FOOTPRINT_ROWS]))
-    labels = convex_groups(patches, grid, p.convexity_rules(), region & ~seams, grow=reach, footprint=footprint)
-    labels = grow_on_surface(labels, region, depth, p.jump_absolute, p.jump_relative)
+    objects = convex_objects(patches, grid, p.convexity_rules(), region & ~seams, grow=reach, footprint=footprint)
+    labels = grow_on_surface(objects.labels, region, depth, p.jump_absolute, p.jump_relative)
     basis = plane_basis(np.asarray(model[:3], dtype=np.float64)).T.astype(np.float32)
     to_plane = np.column_stack([basis, np.asarray(model[:3], dtype=np.float32)])
     offset = np.array([0.0, 0.0, model[3]], dtype=np.float32)
     # (u, v, height) of every grid point on the plane
     plane_grid = plane_coordinates(grid.reshape(-1, 3), to_plane, offset)
     labels = merge_parts(
-        labels, depth, plane_grid, p.merge_rules(), stand_apart=one_stands_inside if p.join_rims else None
+        labels,
+        depth,
+        plane_grid,
+        p.merge_rules(),
+        stand_apart=one_stands_inside if p.join_rims else None,
+        spilled=objects.spilled(surfaces, depth, p.jump_absolute, p.jump_relative),
     )
     if p.join_rims:  # a bowl's inside and outside, which share no footprint to merge by
         labels = join_single_rims(labels, plane_grid, RimRules())

@@ -427,11 +427,28 @@ def _median(values: np.ndarray) -> np.floating:
     return (ordered[low] + ordered[high]) / values.dtype.type(2)
 
 
+def _without_spilled(
+    coordinates: np.ndarray, offsets: np.ndarray, spilled: np.ndarray
+) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """Each part's coordinates (``coordinates[offsets[k]:offsets[k + 1]]``) without those ``spilled`` marks, where
+    at least half of the part's and three remain (a part made mostly of such pixels keeps them all), the new
+    offsets, and which parts lost some (bool per part)."""
+    counts = np.diff(offsets)
+    part = np.repeat(np.arange(counts.size), counts)
+    spilled_counts = np.bincount(part[spilled], minlength=counts.size)
+    remaining = counts - spilled_counts
+    thinned = (spilled_counts > 0) & (remaining >= np.maximum(3, counts / 2))
+    keep = ~(spilled & thinned[part])
+    kept_offsets = np.concatenate([[0], np.cumsum(np.where(thinned, remaining, counts))]).astype(offsets.dtype)
+    return np.ascontiguousarray(coordinates[keep]), kept_offsets, thinned
+
+
 class _PartEvidence:
     """What :func:`merge_parts` asks of the touching parts (those of ``pairs``, Kx2): each part's plane coordinates
     (of about 400 of its pixels, evenly sampled), their heights sorted and the footprint hull, computed at once
     (:func:`~annotators.geometry.grid_kernels.part_hulls`); the nesting, floor and container tests of the pairs
-    (:meth:`evidence`)."""
+    (:meth:`evidence`). Where ``spilled`` (flat bool, or None) marks some of a part's samples, the part has a
+    second hull without them (:meth:`kept_hull`; it keeps them where they are half its samples or more)."""
 
     def __init__(
         self,
@@ -439,6 +456,7 @@ class _PartEvidence:
         depth: np.ndarray,
         plane_coordinates: Callable[[np.ndarray], np.ndarray] | np.ndarray,
         pairs: np.ndarray,
+        spilled: np.ndarray | None = None,
     ):
         self.pixels, self.starts = label_groups(labels)
         self.depth = depth
@@ -456,6 +474,10 @@ class _PartEvidence:
         for k in touching:
             self.heights[self.offsets[k] : self.offsets[k + 1]].sort()
         self.hulls, self.hull_offsets = part_hulls(self.points, self.offsets)
+        self.thinned = np.zeros(self.offsets.size - 1, dtype=bool)
+        if spilled is not None and spilled[sampled].any():
+            kept, kept_offsets, self.thinned = _without_spilled(self.points, self.offsets, spilled[sampled])
+            self.kept_hulls, self.kept_hull_offsets = part_hulls(kept, kept_offsets)
 
     def coordinates(self, label: int) -> np.ndarray:
         """Plane coordinates of about 400 of the part's pixels, evenly sampled."""
@@ -464,6 +486,12 @@ class _PartEvidence:
     def hull(self, label: int) -> np.ndarray:
         """The convex hull of the part's footprint (Kx2)."""
         return self.hulls[self.hull_offsets[label] : self.hull_offsets[label + 1]]
+
+    def kept_hull(self, label: int) -> np.ndarray:
+        """The convex hull of the part's footprint without its spilled pixels (:meth:`hull` when it has none)."""
+        if not self.thinned[label]:
+            return self.hull(label)
+        return self.kept_hulls[self.kept_hull_offsets[label] : self.kept_hull_offsets[label + 1]]
 
     def evidence(
         self, overlapping: np.ndarray, unjoined: np.ndarray, rules: MergeRules
@@ -621,6 +649,7 @@ def merge_parts(
     rules: MergeRules,
     surface: Boundaries | None = None,
     stand_apart: Callable[[np.ndarray, np.ndarray], bool] | None = None,
+    spilled: np.ndarray | None = None,
 ) -> np.ndarray:
     """Join touching parts that are pieces of one object; labels renumbered 1..n (0 = none).
 
@@ -643,6 +672,13 @@ def merge_parts(
     can standing in a bowl shares the footprint of the bowl's inner wall around it, and the wall's heights lie
     within the can's when the can rises above the rim.
 
+    ``spilled`` (HxW bool, when given) marks labelled pixels seen past their object's outline on the surface behind
+    (:meth:`~annotators.geometry.convexity.ConvexObjects.spilled`). The footprint rule then joins only footprints
+    that overlap both with and without them, while footprints that overlap with them and whose heights do not nest
+    still stand one on the other. A few pixels of the box behind a box that took the front box's label stretch its
+    footprint over the one behind, and where they fall depends on where the grid cells start: a join must not rest
+    on them.
+
     A pair whose shared boundary is mostly a depth jump (continuous on less than ``rules.occlusion`` of it) is an
     occluder and what it hides, or a container's rim and its inside: only the inside rule may join it. Parts
     smaller than ``rules.small_part`` pixels join at most one neighbour among those a rule allows, so a crumb
@@ -653,7 +689,7 @@ def merge_parts(
     pairs = touching_pairs(labels)
     if pairs.shape[0] == 0:
         return labels
-    parts = _PartEvidence(labels, depth, plane_coordinates, pairs)
+    parts = _PartEvidence(labels, depth, plane_coordinates, pairs, None if spilled is None else spilled.reshape(-1))
     sizes = np.diff(parts.starts)
     lengths: dict[tuple[int, int], float] = {}
     smooth: set[tuple[int, int]] = set()
@@ -694,6 +730,16 @@ def merge_parts(
     overlapping = {
         pair for pair, share in zip(footprint_pairs, overlaps.tolist(), strict=True) if share > rules.overlap
     }
+    # the pairs that overlap without the spilled pixels as well: only those may join by footprint
+    overlapping_kept = set(overlapping)
+    doubtful = [pair for pair in overlapping if parts.thinned[pair[0]] or parts.thinned[pair[1]]]
+    if doubtful:
+        kept = footprint_overlaps(
+            [parts.kept_hull(a) for a, _ in doubtful], [parts.kept_hull(b) for _, b in doubtful], rules.cell
+        )
+        overlapping_kept -= {
+            pair for pair, share in zip(doubtful, kept.tolist(), strict=True) if share <= rules.overlap
+        }
     listed = pairs.tolist()
     nests, floor_tests, holding = parts.evidence(
         np.array([tuple(pair) in overlapping for pair in listed], dtype=bool),
@@ -709,12 +755,13 @@ def merge_parts(
             continue
         stacked = False
         if (first, second) in overlapping:
-            if (not rules.nested or nest or parts.floor_within(first, second, floors, rules.cell)) and (
+            joinable = (not rules.nested or nest or parts.floor_within(first, second, floors, rules.cell)) and (
                 stand_apart is None or not stand_apart(parts.coordinates(first), parts.coordinates(second))
-            ):
+            )
+            if joinable and (first, second) in overlapping_kept:
                 allowed.append((first, second))
                 continue
-            stacked = True
+            stacked = not joinable
         if holds:
             allowed.append((first, second))
         elif stacked:

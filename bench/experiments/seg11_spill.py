@@ -44,14 +44,14 @@ from reasoning.evaluation.mosd import object_labels, scene_category  # noqa: E40
 from reasoning.evaluation.segmentation import SegmentationScore, score_segmentation, summarize  # noqa: E402
 
 CATEGORIES = ("boxes", "stacked", "occluded", "cylindric", "all")
-ORIGINAL_GROUPS = clutter.convex_groups
+ORIGINAL_GROUPS = clutter.convex_objects
 ORIGINAL_PARTS = clutter.label_parts
 ORIGINAL_NORMALS = clutter.grid_normals
 
 
 class SurfaceRule:
     """The rule as hooks on the segmenter's module: the first ``label_parts`` after the normals are the surfaces;
-    ``convex_groups`` drops grown pixels whose surface holds trusted patches but none of their label."""
+    ``convex_objects`` drops grown pixels whose surface holds trusted patches but none of their label."""
 
     def __init__(self) -> None:
         self.on = False
@@ -63,7 +63,7 @@ class SurfaceRule:
         """Put the hooks in place of the segmenter module's functions (the rule is off until ``on``)."""
         clutter.grid_normals = self.normals
         clutter.label_parts = self.parts
-        clutter.convex_groups = self.groups
+        clutter.convex_objects = self.groups
 
     def normals(self, *args: object, **kwargs: object) -> np.ndarray:
         self._next_parts_are_surfaces = True
@@ -83,10 +83,11 @@ class SurfaceRule:
         between: np.ndarray | None = None,
         grow: float = 0.0,
         footprint: float | None = None,
-    ) -> np.ndarray:
-        labels = ORIGINAL_GROUPS(patches, points, rules, between, grow, footprint)
+    ) -> convexity.ConvexObjects:
+        objects = ORIGINAL_GROUPS(patches, points, rules, between, grow, footprint)
+        labels = objects.labels
         if not self.on or grow <= 0 or self.surfaces is None:
-            return labels
+            return objects
         planes = convexity.patch_planes(patches, points)
         trusted = (planes.thickness <= rules.max_thickness) & (planes.width >= rules.min_width)
         usable = np.concatenate([[False], (planes.counts >= rules.min_patch) & trusted])
@@ -107,7 +108,7 @@ class SurfaceRule:
         kept = labels.copy()
         rows, cols = np.nonzero(grown)
         kept[rows[~keep], cols[~keep]] = 0
-        return kept
+        return convexity.ConvexObjects(kept, objects.seeded, objects.grow)
 
 
 def truths(inputs: dict[str, dict]) -> dict[str, tuple[np.ndarray, np.ndarray]]:
