@@ -9,9 +9,9 @@ Works like :mod:`annotators.cloud.clusters` on every ``stride``-th pixel of the 
    (:func:`annotators.geometry.convexity.convex_objects`); colour plays no part, so a printed box is one object;
 3. the cut pixels are given back, and a container's inside joins its outside (a handle its body): the footprints on
    the plane overlap and the heights nest, which an object standing on another never does
-   (:func:`annotators.geometry.grid_segmentation.merge_parts`; with and without the pixels whose label was grown
-   past an object's outline onto the surface behind) - nor one standing in a container and rising above its rim,
-   whose inner wall's heights lie within its own (:func:`annotators.geometry.rims.one_stands_inside`);
+   (:func:`annotators.geometry.grid_segmentation.merge_parts`; with and without the few pixels whose label was
+   grown across an object's outline onto another's surface) - nor one standing in a container and rising above its
+   rim, whose inner wall's heights lie within its own (:func:`annotators.geometry.rims.one_stands_inside`);
 4. an object is split along a hue edge only where a concave crease runs along it (:func:`split_by_color`: a can
    standing flush on a can is one convex surface but two colours with a crease between);
 5. pieces that an occluder in front splits apart join when they continue one plane behind it, even where they meet
@@ -314,7 +314,7 @@ def segment_clutter(
         plane_grid,
         p.merge_rules(),
         stand_apart=one_stands_inside if p.join_rims else None,
-        spilled=objects.spilled(surfaces, depth, p.jump_absolute, p.jump_relative),
+        spilled=objects.spilled(surfaces),
     )
     if p.join_rims:  # a bowl's inside and outside, which share no footprint to merge by
         labels = join_single_rims(labels, plane_grid, RimRules())

@@ -14,7 +14,6 @@ from __future__ import annotations
 
 from dataclasses import dataclass
 
-import cv2
 import numpy as np
 
 from annotators.geometry.grid_kernels import (
@@ -29,7 +28,6 @@ from annotators.geometry.grid_kernels import (
     symmetric_eigen,
 )
 from annotators.geometry.grid_segmentation import (
-    depth_jump,
     distinct_keys,
     grow_from_seeds,
     join_unless_apart,
@@ -192,57 +190,31 @@ def close_in_space(
 
 @dataclass(frozen=True, eq=False)
 class ConvexObjects:
-    """What :func:`convex_objects` found: the object ``labels`` (int32 HxW, 0 = none, 1..n), which pixels were
+    """What :func:`convex_objects` found: the object ``labels`` (int32 HxW, 0 = none, 1..n) and which pixels were
     ``seeded`` (bool HxW: those of trusted patches, whose labels the convexity votes decided; the other labelled
-    pixels were grown from them) and how far they were grown (``grow``, pixels)."""
+    pixels were grown from them)."""
 
     labels: np.ndarray
     seeded: np.ndarray
-    grow: float
 
-    def spilled(self, surfaces: np.ndarray, depth: np.ndarray, absolute: float, relative: float) -> np.ndarray:
-        """The grown pixels (bool HxW) seen past their object's outline: they lie on a surface of ``surfaces``
-        (labels of depth-continuous parts, 0 = none) that holds seeded pixels of other objects but none of their
-        own, and farther than all of their own object's seeded pixels within the growth's reach, by a depth jump
-        (more than ``absolute + relative`` x the nearer ``depth``). Growth that looks only at distances in the
-        image carries an object's label over its outline onto the object behind."""
+    def spilled(self, surfaces: np.ndarray) -> np.ndarray:
+        """The grown pixels (bool HxW) that lie on a surface of ``surfaces`` (labels of depth-continuous parts,
+        0 = none) holding seeded pixels of other objects but none of their own: growth that looks only at distances
+        in the image carries an object's label over its outline, onto the object behind it or in front of it."""
         labels = self.labels
-        candidates = _on_others_surfaces(labels, self.seeded, surfaces)
-        if not candidates.any():
-            return candidates
-        reach = int(np.ceil(self.grow))
-        kernel = np.ones((2 * reach + 1, 2 * reach + 1), dtype=np.uint8)
-        height, width = labels.shape
+        seeds = self.seeded & (labels > 0) & (surfaces > 0)
+        grown = (labels > 0) & ~self.seeded & (surfaces > 0)
+        if not grown.any() or not seeds.any():
+            return np.zeros(labels.shape, dtype=bool)
+        span = np.int64(labels.max()) + 1
+        seed_keys = surfaces[seeds].astype(np.int64) * span + labels[seeds]
+        seeded_surfaces = np.zeros(int(surfaces.max()) + 1, dtype=bool)
+        seeded_surfaces[surfaces[seeds]] = True
+        grown_surfaces = surfaces[grown]
+        own = np.isin(grown_surfaces.astype(np.int64) * span + labels[grown], seed_keys)
         spilled = np.zeros(labels.shape, dtype=bool)
-        for label in np.unique(labels[candidates]).tolist():
-            rows, cols = np.nonzero(candidates & (labels == label))
-            y0, y1 = max(int(rows.min()) - reach, 0), min(int(rows.max()) + reach + 1, height)
-            x0, x1 = max(int(cols.min()) - reach, 0), min(int(cols.max()) + reach + 1, width)
-            own = self.seeded[y0:y1, x0:x1] & (labels[y0:y1, x0:x1] == label)
-            own_depth = np.where(own & np.isfinite(depth[y0:y1, x0:x1]), depth[y0:y1, x0:x1], np.inf)
-            nearest = cv2.erode(own_depth.astype(np.float32), kernel)[rows - y0, cols - x0]  # a minimum filter
-            here = depth[rows, cols]
-            behind = (here > nearest) & depth_jump(here, nearest, absolute, relative)
-            spilled[rows[behind], cols[behind]] = True
+        spilled[grown] = seeded_surfaces[grown_surfaces] & ~own
         return spilled
-
-
-def _on_others_surfaces(labels: np.ndarray, seeded: np.ndarray, surfaces: np.ndarray) -> np.ndarray:
-    """The labelled pixels not ``seeded`` (grown) on a surface of ``surfaces`` that holds seeded pixels of other
-    labels but none of their own (bool HxW)."""
-    seeds = seeded & (labels > 0) & (surfaces > 0)
-    grown = (labels > 0) & ~seeded & (surfaces > 0)
-    if not grown.any() or not seeds.any():
-        return np.zeros(labels.shape, dtype=bool)
-    span = np.int64(labels.max()) + 1
-    seed_keys = surfaces[seeds].astype(np.int64) * span + labels[seeds]
-    seeded_surfaces = np.zeros(int(surfaces.max()) + 1, dtype=bool)
-    seeded_surfaces[surfaces[seeds]] = True
-    grown_surfaces = surfaces[grown]
-    own = np.isin(grown_surfaces.astype(np.int64) * span + labels[grown], seed_keys)
-    found = np.zeros(labels.shape, dtype=bool)
-    found[grown] = seeded_surfaces[grown_surfaces] & ~own
-    return found
 
 
 def convex_groups(
@@ -304,7 +276,7 @@ def convex_objects(
     seeded = kept > 0
     if grow > 0:
         labels = grow_from_seeds(labels, seeds, grow)
-    return ConvexObjects(labels, seeded, grow)
+    return ConvexObjects(labels, seeded)
 
 
 def connection_votes(

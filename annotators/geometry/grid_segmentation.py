@@ -427,17 +427,17 @@ def _median(values: np.ndarray) -> np.floating:
     return (ordered[low] + ordered[high]) / values.dtype.type(2)
 
 
-def _without_spilled(
-    coordinates: np.ndarray, offsets: np.ndarray, spilled: np.ndarray
+def _without_strays(
+    coordinates: np.ndarray, offsets: np.ndarray, spilled: np.ndarray, share: float
 ) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
-    """Each part's coordinates (``coordinates[offsets[k]:offsets[k + 1]]``) without those ``spilled`` marks, where
-    at least half of the part's and three remain (a part made mostly of such pixels keeps them all), the new
-    offsets, and which parts lost some (bool per part)."""
+    """Each part's coordinates (``coordinates[offsets[k]:offsets[k + 1]]``) without those ``spilled`` marks where
+    they are strays, at most ``share`` of the part's (more are the shape of a piece cut at an outline, kept) and at
+    least three remain; the new offsets, and which parts lost some (bool per part)."""
     counts = np.diff(offsets)
     part = np.repeat(np.arange(counts.size), counts)
     spilled_counts = np.bincount(part[spilled], minlength=counts.size)
     remaining = counts - spilled_counts
-    thinned = (spilled_counts > 0) & (remaining >= np.maximum(3, counts / 2))
+    thinned = (spilled_counts > 0) & (spilled_counts <= share * counts) & (remaining >= 3)
     keep = ~(spilled & thinned[part])
     kept_offsets = np.concatenate([[0], np.cumsum(np.where(thinned, remaining, counts))]).astype(offsets.dtype)
     return np.ascontiguousarray(coordinates[keep]), kept_offsets, thinned
@@ -447,8 +447,8 @@ class _PartEvidence:
     """What :func:`merge_parts` asks of the touching parts (those of ``pairs``, Kx2): each part's plane coordinates
     (of about 400 of its pixels, evenly sampled), their heights sorted and the footprint hull, computed at once
     (:func:`~annotators.geometry.grid_kernels.part_hulls`); the nesting, floor and container tests of the pairs
-    (:meth:`evidence`). Where ``spilled`` (flat bool, or None) marks some of a part's samples, the part has a
-    second hull without them (:meth:`kept_hull`; it keeps them where they are half its samples or more)."""
+    (:meth:`evidence`). Where ``spilled`` (flat bool, or None) marks a few of a part's samples (at most
+    ``stray_share`` of them), the part has a second hull without them (:meth:`kept_hull`)."""
 
     def __init__(
         self,
@@ -457,6 +457,7 @@ class _PartEvidence:
         plane_coordinates: Callable[[np.ndarray], np.ndarray] | np.ndarray,
         pairs: np.ndarray,
         spilled: np.ndarray | None = None,
+        stray_share: float = 0.0,
     ):
         self.pixels, self.starts = label_groups(labels)
         self.depth = depth
@@ -476,7 +477,7 @@ class _PartEvidence:
         self.hulls, self.hull_offsets = part_hulls(self.points, self.offsets)
         self.thinned = np.zeros(self.offsets.size - 1, dtype=bool)
         if spilled is not None and spilled[sampled].any():
-            kept, kept_offsets, self.thinned = _without_spilled(self.points, self.offsets, spilled[sampled])
+            kept, kept_offsets, self.thinned = _without_strays(self.points, self.offsets, spilled[sampled], stray_share)
             self.kept_hulls, self.kept_hull_offsets = part_hulls(kept, kept_offsets)
 
     def coordinates(self, label: int) -> np.ndarray:
@@ -629,6 +630,7 @@ class MergeRules:
     inside: bool = True
     nested: bool = False
     nest_tolerance: float = 0.003
+    stray_share: float = 0.1
 
     def pair_tolerances(self) -> tuple[float, float, float, float, float, float]:
         """The tolerances :func:`~annotators.geometry.grid_kernels.pair_evidence` takes, in its order."""
@@ -672,11 +674,12 @@ def merge_parts(
     can standing in a bowl shares the footprint of the bowl's inner wall around it, and the wall's heights lie
     within the can's when the can rises above the rim.
 
-    ``spilled`` (HxW bool, when given) marks labelled pixels seen past their object's outline on the surface behind
-    (:meth:`~annotators.geometry.convexity.ConvexObjects.spilled`). The footprint rule then joins only footprints
-    that overlap both with and without them, while footprints that overlap with them and whose heights do not nest
-    still stand one on the other. A few pixels of the box behind a box that took the front box's label stretch its
-    footprint over the one behind, and where they fall depends on where the grid cells start: a join must not rest
+    ``spilled`` (HxW bool, when given) marks labelled pixels that lie on another object's surface
+    (:meth:`~annotators.geometry.convexity.ConvexObjects.spilled`). Where they are strays, at most
+    ``rules.stray_share`` of a part's pixels, the footprint rule joins only footprints that overlap both with and
+    without them, while footprints that overlap with them and whose heights do not nest still stand one on the
+    other. A few pixels of the box behind a box that took the front box's label (or the other way round) stretch
+    its footprint over the other's, and where they fall depends on where the grid cells start: a join must not rest
     on them.
 
     A pair whose shared boundary is mostly a depth jump (continuous on less than ``rules.occlusion`` of it) is an
@@ -689,7 +692,8 @@ def merge_parts(
     pairs = touching_pairs(labels)
     if pairs.shape[0] == 0:
         return labels
-    parts = _PartEvidence(labels, depth, plane_coordinates, pairs, None if spilled is None else spilled.reshape(-1))
+    flat_spilled = None if spilled is None else spilled.reshape(-1)
+    parts = _PartEvidence(labels, depth, plane_coordinates, pairs, flat_spilled, rules.stray_share)
     sizes = np.diff(parts.starts)
     lengths: dict[tuple[int, int], float] = {}
     smooth: set[tuple[int, int]] = set()

@@ -102,28 +102,26 @@ def test_a_cell_across_a_seam_gives_a_patch_to_each_side() -> None:
     assert sorted(np.unique(patches[patches > 0]).tolist()) == [1, 2, 3]
 
 
-def _front_box_and_box_behind() -> tuple[ConvexObjects, np.ndarray, np.ndarray]:
-    """A front box (label 1, 0.6 m away, columns 0-9) beside the box behind it (label 2, 0.8 m, columns 10-19), each
-    its own depth-continuous surface (1 and 2); each label was grown two pixels onto the other's surface."""
+def _front_box_and_box_behind() -> tuple[ConvexObjects, np.ndarray]:
+    """A front box (label 1, columns 0-9) beside the box behind it (label 2, columns 10-19), each its own
+    depth-continuous surface (1 and 2); each label was grown two pixels onto the other's surface."""
     labels = np.zeros((10, 20), dtype=np.int32)
     labels[:, :12], labels[:, 12:] = 1, 2
     labels[:, 8:10] = 2  # the box behind's label grown onto the front box
     surfaces = np.where(np.arange(20) < 10, 1, 2)[None, :].repeat(10, axis=0).astype(np.int32)
-    depth = np.where(surfaces == 1, 0.6, 0.8).astype(np.float32)
     seeded = np.zeros(labels.shape, dtype=bool)
     seeded[:, :8], seeded[:, 12:] = True, True
-    return ConvexObjects(labels, seeded, grow=4.0), surfaces, depth
+    return ConvexObjects(labels, seeded), surfaces
 
 
-def test_a_label_grown_past_its_objects_outline_onto_the_surface_behind_is_spilled() -> None:
-    objects, surfaces, depth = _front_box_and_box_behind()
-    spilled = objects.spilled(surfaces, depth, 0.01, 0.01)
-    assert spilled[:, 10:12].all()  # the front box's label on the box behind, 20 cm farther
-    assert not spilled[:, 8:10].any()  # the label behind grown onto the nearer front box is not seen past an outline
+def test_a_label_grown_across_its_objects_outline_onto_another_surface_is_spilled() -> None:
+    objects, surfaces = _front_box_and_box_behind()
+    spilled = objects.spilled(surfaces)
+    assert spilled[:, 8:12].all()  # each label on the other box's surface, behind or in front
     assert not spilled[:, :8].any() and not spilled[:, 12:].any()  # seeded pixels
 
 
 def test_a_label_grown_on_its_own_surface_is_not_spilled() -> None:
-    objects, surfaces, depth = _front_box_and_box_behind()
+    objects, surfaces = _front_box_and_box_behind()
     one_surface = np.ones_like(surfaces)  # no depth seam: the grown pixels lie on a surface the label has seeds on
-    assert not objects.spilled(one_surface, depth, 0.01, 0.01).any()
+    assert not objects.spilled(one_surface).any()
