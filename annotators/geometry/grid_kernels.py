@@ -415,10 +415,12 @@ def sampled_pixels(
 
 def part_hulls(coordinates: np.ndarray, offsets: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
     """The :func:`convex_hull` of the ``(u, v)`` of each part k's plane coordinates ``coordinates[offsets[k]:offsets[k
-    + 1]]`` (float32, Nx3), concatenated, and their offsets (the same form; empty for a part without coordinates)."""
-    return _merge_loops().part_hulls(
-        np.ascontiguousarray(coordinates, dtype=np.float32), np.ascontiguousarray(offsets, dtype=np.int64)
-    )
+    + 1]]`` (float32, Nx3), concatenated, and their offsets (the same form; empty for a part without coordinates).
+    Raises ValueError for a coordinate that is not finite (the compiled hull would come out wrong, or crash)."""
+    coordinates = np.ascontiguousarray(coordinates, dtype=np.float32)
+    if not np.isfinite(coordinates[:, :2]).all():
+        raise ValueError("part_hulls: plane coordinates must be finite (a labelled pixel without depth?)")
+    return _merge_loops().part_hulls(coordinates, np.ascontiguousarray(offsets, dtype=np.int64))
 
 
 def pair_evidence(
