@@ -630,7 +630,7 @@ class MergeRules:
     inside: bool = True
     nested: bool = False
     nest_tolerance: float = 0.003
-    stray_share: float = 0.1
+    stray_share: float = 0.03
 
     def pair_tolerances(self) -> tuple[float, float, float, float, float, float]:
         """The tolerances :func:`~annotators.geometry.grid_kernels.pair_evidence` takes, in its order."""

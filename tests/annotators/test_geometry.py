@@ -233,14 +233,14 @@ def test_color_edges_are_the_canny_edges_of_the_chroma_channels() -> None:
 
 
 def _box_beside_a_lower_box() -> tuple[np.ndarray, np.ndarray, np.ndarray]:
-    """Labels, depth and plane coordinates ``(u, v, height)`` of two touching parts on a 10x40 grid: a box 0-10 cm
-    along u and 10 cm tall (label 1, columns 0-19) and a lower box 20-30 cm along u, 2-8 cm tall (label 2, columns
-    20-39); label 1's last column took points of the lower box (u 25 cm)."""
-    rows, cols = np.mgrid[0:10, 0:40].astype(np.float32)
-    u = np.where(cols < 19, cols * 0.1 / 18, np.where(cols < 20, 0.25, 0.2 + (cols - 20) * 0.1 / 19))
-    height = np.where(cols < 19, rows * 0.1 / 9, np.where(cols < 20, 0.05, 0.02 + rows * 0.06 / 9))
+    """Labels, depth and plane coordinates ``(u, v, height)`` of two touching parts on a 10x60 grid: a box 0-10 cm
+    along u and 10 cm tall (label 1, columns 0-39) and a lower box 20-30 cm along u, 2-8 cm tall (label 2, columns
+    40-59); label 1's last column took points of the lower box (u 25 cm)."""
+    rows, cols = np.mgrid[0:10, 0:60].astype(np.float32)
+    u = np.where(cols < 39, cols * 0.1 / 38, np.where(cols < 40, 0.25, 0.2 + (cols - 40) * 0.1 / 19))
+    height = np.where(cols < 39, rows * 0.1 / 9, np.where(cols < 40, 0.05, 0.02 + rows * 0.06 / 9))
     table = np.stack([u, rows * 0.01, height], axis=-1).reshape(-1, 3).astype(np.float32)
-    labels = np.where(cols < 20, 1, 2).astype(np.int32)
+    labels = np.where(cols < 40, 1, 2).astype(np.int32)
     return labels, np.ones(labels.shape, dtype=np.float32), table
 
 
@@ -249,7 +249,7 @@ def test_footprints_that_overlap_only_through_stray_pixels_do_not_join() -> None
     rules = ClutterParameters().merge_rules()
     assert merge_parts(labels, depth, table, rules).max() == 1  # the stray points stretch the box over its neighbour
     spilled = np.zeros(labels.shape, dtype=bool)
-    spilled[:, 19] = True  # strays: 5 % of the box's pixels
+    spilled[:, 39] = True  # strays: 2.5 % of the box's pixels
     assert merge_parts(labels, depth, table, rules, spilled=spilled).max() == 2
-    spilled[:, 12:19] = True  # 40 %: the shape of a piece cut at an outline, not strays; the join stands
+    spilled[:, 24:39] = True  # 40 %: the shape of a piece cut at an outline, not strays; the join stands
     assert merge_parts(labels, depth, table, rules, spilled=spilled).max() == 1
