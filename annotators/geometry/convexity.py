@@ -83,7 +83,7 @@ def split_by_normals(patches: np.ndarray, normals: np.ndarray, spread: float) ->
 
 @dataclass(frozen=True)
 class ConvexityRules:
-    """Thresholds of :func:`convex_groups`: ``smooth_degrees`` between the normals (and of the centroid line off
+    """Thresholds of :func:`convex_objects`: ``smooth_degrees`` between the normals (and of the centroid line off
     both planes) of a smooth connection; ``concave_bending`` (1/m, a turn tighter than a 5 cm radius) makes a
     connection concave; two faces join when more than ``convex_share`` of their votes are convex, at least
     ``min_votes`` when both faces are large, and not when more than ``concave_share`` are concave; a patch needs
@@ -217,18 +217,6 @@ class ConvexObjects:
         return spilled
 
 
-def convex_groups(
-    patches: np.ndarray,
-    points: np.ndarray,
-    rules: ConvexityRules,
-    between: np.ndarray | None = None,
-    grow: float = 0.0,
-    footprint: float | None = None,
-) -> np.ndarray:
-    """The object labels of :func:`convex_objects` (int32, 0 = none, 1..n)."""
-    return convex_objects(patches, points, rules, between, grow, footprint).labels
-
-
 def convex_objects(
     patches: np.ndarray,
     points: np.ndarray,
@@ -283,7 +271,7 @@ def connection_votes(
     planes: PatchPlanes, pairs: np.ndarray, rules: ConvexityRules
 ) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
     """For Kx2 touching patch labels: is each connection continuous (one face: normals and the centroid line within
-    ``rules.smooth_degrees``, no concave bend), and does it vote convex or concave (see :func:`convex_groups`)?"""
+    ``rules.smooth_degrees``, no concave bend), and does it vote convex or concave (see :func:`convex_objects`)?"""
     parallel, in_planes = _alignment(planes, pairs, rules.smooth_degrees)
     bending = connection_bending(planes, pairs)
     concave = bending < -rules.concave_bending
