@@ -30,7 +30,7 @@ from types import ModuleType
 
 import numpy as np
 
-from annotators.geometry.grid_kernels import label_pixels
+from annotators.geometry.grid_kernels import label_pixels, touching_keys
 from annotators.geometry.grid_segmentation import MergeRules, join_labels
 
 
@@ -228,13 +228,8 @@ def _touching(labels: np.ndarray, count: int, rules: OcclusionRules) -> np.ndarr
     touching joins would trust: at least ``rules.min_boundary`` pixel pairs and ``rules.boundary_share`` times the
     square root of the smaller label's size."""
     span = count + 1
-    lengths = np.zeros(span * span, dtype=np.int64)
-    for first, second in ((labels[:, :-1], labels[:, 1:]), (labels[:-1, :], labels[1:, :])):
-        border = (first != second) & (first > 0) & (second > 0)
-        low = np.minimum(first[border], second[border]).astype(np.int64)
-        high = np.maximum(first[border], second[border]).astype(np.int64)
-        lengths += np.bincount(low * span + high, minlength=span * span)
-    lengths = lengths.reshape(span, span)
+    keys = touching_keys(np.ascontiguousarray(labels), span)  # one per 4-neighbour pixel pair of two labels
+    lengths = np.bincount(keys, minlength=span * span).reshape(span, span)
     lengths = lengths + lengths.T
     sizes = np.bincount(labels.reshape(-1), minlength=span)
     needed = np.maximum(rules.min_boundary, rules.boundary_share * np.sqrt(np.minimum.outer(sizes, sizes)))
