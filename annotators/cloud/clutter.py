@@ -32,8 +32,9 @@ Works like :mod:`annotators.cloud.clusters` on every ``stride``-th pixel of the 
    where the pieces' top edges lie on one rim circle at one height, with the outer wall below the front rim
    within that circle; the object rising above the rim stays apart, and no piece standing inside a container is
    joined to it as unable to stand by itself (:func:`annotators.geometry.rims.join_rim_pieces`);
-8. touching pieces that fill one slab - their lowest heights and tops agree, no depth jump along most of their
-   shared border - join: a drill lying on its side, cut where its grip ends behind the battery's raised edge
+8. touching pieces that fill one slab - their lowest heights and tops (on the pixels the convexity votes
+   labelled, not those grown to them) agree, no depth jump along most of their shared border - join: a drill lying
+   on its side, cut where its grip ends behind the battery's raised edge
    (:func:`annotators.geometry.slabs.join_slab_pieces`);
 9. the pieces of a tinted transparent object - touching in the image, one saturated hue, and pixels of that hue
    without depth inside their joint outline - join: a blue water bottle the projector's pattern passes, read in
@@ -347,7 +348,7 @@ def segment_clutter(
     if p.join_slabs:
         slab_rules = p.slab_rules()
         known = pieces if summary_step == slab_rules.sample_step else None
-        labels = join_slab_pieces(labels, grid, normals, plane_grid, slab_rules, known)
+        labels = join_slab_pieces(labels, grid, normals, plane_grid, slab_rules, known, objects.seeded)
     if p.join_necks:
         labels = join_necked_pieces(labels, plane_grid, NeckRules())
     valid = mask[::step, ::step][y0:y1, x0:x1] & np.isfinite(depth)  # measured, within the range filter's

@@ -10,11 +10,16 @@ Separate objects rarely do all of this: objects standing side by side show a dep
 shared border in the image (one hides the other, or a gap parts them), an object standing on another starts at
 the other's top, and objects of different heights do not share a top. Those pieces stay apart
 (:func:`join_slab_pieces`).
+
+The heights are read from the pixels the convexity votes labelled (``trusted``), not from those grown to them:
+growth goes by distance in the image, so where another object's edge touches a piece without a depth seam (a
+bowl's rim beside the drill's battery), a strip of that edge takes the piece's label and lifts its top by the
+other object's height. Where that strip falls depends on where the grid cells start.
 """
 
 from __future__ import annotations
 
-from dataclasses import dataclass
+from dataclasses import dataclass, replace
 
 import numpy as np
 
@@ -68,6 +73,19 @@ def continuous_borders(
     return pairs, np.column_stack([smooth, smooth / length])
 
 
+def trusted_heights(
+    pieces: PieceSummary, labels: np.ndarray, plane_points: np.ndarray, trusted: np.ndarray, sample_step: int
+) -> PieceSummary:
+    """``pieces`` (the summary of ``labels``) with each label's lowest heights and top read from its ``trusted``
+    pixels (HxW bool) alone; a label without a sampled trusted pixel keeps those of all its pixels."""
+    own = summarize_pieces(np.where(trusted, labels, 0), plane_points, sample_step)
+    count = pieces.low.size
+    low, top = np.full(count, np.nan), np.full(count, np.nan)
+    low[: own.low.size], top[: own.top.size] = own.low[:count], own.top[:count]
+    missing = np.isnan(low)
+    return replace(pieces, low=np.where(missing, pieces.low, low), top=np.where(missing, pieces.top, top))
+
+
 def slab_partners(
     labels: np.ndarray,
     points: np.ndarray,
@@ -75,11 +93,15 @@ def slab_partners(
     plane_points: np.ndarray,
     rules: SlabRules,
     pieces: PieceSummary | None = None,
+    trusted: np.ndarray | None = None,
 ) -> list[tuple[int, int]]:
     """The touching label pairs of one slab (see the module docstring); ``points`` and ``normals`` HxWx3 in the
-    camera frame, ``plane_points`` the pixels' ``(u, v, height)``, ``pieces`` their summary when already made.
+    camera frame, ``plane_points`` the pixels' ``(u, v, height)``, ``pieces`` their summary when already made,
+    ``trusted`` (HxW bool, or None: all) the pixels whose heights count.
     Heights are checked first; the borders are measured only in the window around the pairs that pass."""
     pieces = pieces or summarize_pieces(labels, plane_points, rules.sample_step)
+    if trusted is not None:
+        pieces = trusted_heights(pieces, labels, plane_points, trusted, rules.sample_step)
     candidates = slab_candidates(pieces, labels, rules)
     if candidates.shape[0] == 0:
         return []
@@ -110,9 +132,11 @@ def join_slab_pieces(
     plane_points: np.ndarray,
     rules: SlabRules | None = None,
     pieces: PieceSummary | None = None,
+    trusted: np.ndarray | None = None,
 ) -> np.ndarray:
-    """Labels with the pieces of one slab joined: touching pieces whose lowest heights and tops agree within the
-    height noise and whose shared border has no depth jump along most of it (see :class:`SlabRules`); renumbered
-    1..n when anything joined (``pieces``: the labels' summary when already made, with the rules' sample step)."""
-    joins = slab_partners(labels, points, normals, plane_points, rules or SlabRules(), pieces)
+    """Labels with the pieces of one slab joined: touching pieces whose lowest heights and tops (on their
+    ``trusted`` pixels, HxW bool, when given) agree within the height noise and whose shared border has no depth
+    jump along most of it (see :class:`SlabRules`); renumbered 1..n when anything joined (``pieces``: the labels'
+    summary when already made, with the rules' sample step)."""
+    joins = slab_partners(labels, points, normals, plane_points, rules or SlabRules(), pieces, trusted)
     return join_labels(labels, joins) if joins else labels

@@ -37,3 +37,19 @@ def test_pieces_behind_a_depth_jump_of_another_height_or_standing_on_top_stay_ap
     points, normals = camera_points(labels, {1: 1.0, 2: 1.0})
     assert slab_partners(labels, points, normals, plane_points, SlabRules()) == []
     assert np.array_equal(join_slab_pieces(labels, points, normals, plane_points), labels)
+
+
+def test_a_strip_grown_onto_a_neighbours_edge_does_not_lift_a_pieces_top() -> None:
+    # the battery took a strip of a bowl's rim (6-7 cm high) by growth; its patches (trusted pixels) are 1-5 cm high
+    labels, plane_points = scene({1: BODY, 2: ((40, 12, 55, 28), (0.01, 0.05))})
+    plane_points[12:28, 52:55, 2] = np.linspace(0.06, 0.07, 16, dtype=np.float32)[:, None]
+    points, normals = camera_points(labels, {1: 1.0, 2: 0.988})
+    trusted = labels > 0
+    trusted[12:28, 52:55] = False
+    assert slab_partners(labels, points, normals, plane_points, SlabRules()) == []
+    assert slab_partners(labels, points, normals, plane_points, SlabRules(), trusted=trusted) == [(1, 2)]
+    # a piece without a trusted pixel is measured on all of its pixels
+    assert slab_partners(labels, points, normals, plane_points, SlabRules(), trusted=labels == 1) == []
+    trusted[:, 40:55] = False
+    plane_points[12:28, 52:55, 2] = np.linspace(0.01, 0.05, 16, dtype=np.float32)[:, None]
+    assert slab_partners(labels, points, normals, plane_points, SlabRules(), trusted=trusted) == [(1, 2)]
