@@ -150,6 +150,7 @@ class ClutterParameters(ClusterParameters):
     gap_width: float = ConvexityRules.gap_width
     close_factor: float = ConvexityRules.close_factor
     crease_degrees: float = ConvexityRules.crease_degrees
+    decisive_bending: float = ConvexityRules.decisive_bending
     creased_share: float = 0.2
     use_color: bool = True
     complete_occluded: bool = True

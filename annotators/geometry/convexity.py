@@ -97,7 +97,9 @@ class ConvexityRules:
     ``grazing_degrees`` a connection touching a patch whose normal lies more than that many degrees from its line of
     sight votes convex only where it bends outward (:func:`grazing_patches`); between two large faces, a connection
     across a crease (normals at least ``crease_degrees`` apart) votes convex only where it bends outward
-    (:func:`inward_creases`)."""
+    (:func:`inward_creases`); two large faces without a convex majority are kept apart on ``min_votes`` votes, or
+    on one connection bending inward faster than ``decisive_bending`` (1/m, a turn tighter than a 1 cm radius: the
+    normals of neighbouring patches are not that noisy)."""
 
     smooth_degrees: float = 20.0
     concave_bending: float = 20.0
@@ -113,6 +115,7 @@ class ConvexityRules:
     small_joins_once: bool = False
     grazing_degrees: float | None = None
     crease_degrees: float = 45.0
+    decisive_bending: float = 100.0
 
 
 @dataclass(frozen=True, eq=False)
@@ -259,7 +262,7 @@ def convex_objects(
     pairs = pairs[close_in_space(patches, planes, pairs, footprint, rules.close_factor)]
     continuous, convex, concave = connection_votes(planes, pairs, rules)
     faces = _components(pairs[continuous], count)
-    objects = _join_faces(faces, pairs, convex, concave, planes, rules)
+    objects = join_faces(faces, pairs, convex, concave, planes, rules)
     labels = _dense(objects[faces], usable)[kept]
     seeded = kept > 0
     if grow > 0:
@@ -324,7 +327,7 @@ def _alignment(planes: PatchPlanes, pairs: np.ndarray, degrees: float) -> tuple[
     return parallel, in_planes
 
 
-def _join_faces(
+def join_faces(
     faces: np.ndarray,
     pairs: np.ndarray,
     convex: np.ndarray,
@@ -332,7 +335,9 @@ def _join_faces(
     planes: PatchPlanes,
     rules: ConvexityRules,
 ) -> np.ndarray:
-    """The object of each face (indexed by face label): faces joined by the votes of the patch connections."""
+    """The object of each face (indexed by face label; ``faces`` gives each patch label's face, index 0 no patch):
+    faces joined by the votes of the patch connections ``pairs`` (Kx2 patch labels, :func:`connection_votes`' verdicts
+    ``convex`` and ``concave``; see :func:`convex_objects`)."""
     count = faces.size
     face_a, face_b = faces[pairs[:, 0]], faces[pairs[:, 1]]
     apart = face_a != face_b
@@ -344,15 +349,17 @@ def _join_faces(
     convex = convex & ~(between_large & inward_creases(planes, pairs, rules.crease_degrees))
     share = np.bincount(inverse, weights=convex[apart], minlength=keys.size) / votes
     concave_votes = np.bincount(inverse, weights=concave[apart], minlength=keys.size)
+    sharpest = np.full(keys.size, np.inf)
+    np.minimum.at(sharpest, inverse, connection_bending(planes, pairs[apart]))
     share = np.where((concave_votes > rules.concave_share * votes) & (concave_votes >= rules.min_votes), 0.0, share)
     first, second = keys // count, keys % count
     both_large = large[first] & large[second]
     strength = share * votes
     agree = (share > rules.convex_share) & ((strength >= rules.min_votes) | ~both_large)
-    # one vote decides nothing: a single noisy connection neither joins two large faces nor keeps them apart
-    kept_apart = np.column_stack([first, second])[
-        (share <= rules.convex_share) & both_large & (votes >= rules.min_votes)
-    ]
+    # one vote decides nothing - a single noisy connection neither joins two large faces nor keeps them apart -
+    # unless it bends inward far beyond the noise: a can standing in a bowl, its side against the inner wall
+    decisive = (votes >= rules.min_votes) | (sharpest < -rules.decisive_bending)
+    kept_apart = np.column_stack([first, second])[(share <= rules.convex_share) & both_large & decisive]
     if rules.small_joins_once:
         # a small face joins a large one on its convex majority, another small face only as its best neighbour
         small_pair = ~large[first] & ~large[second]

@@ -18,6 +18,7 @@ from annotators.geometry.convexity import (
     grazing_patches,
     grid_patches,
     inward_creases,
+    join_faces,
 )
 
 PAIR = np.array([[1, 2]])
@@ -88,6 +89,28 @@ def test_a_gentle_inward_turn_is_no_crease() -> None:
     # normals 20 degrees apart bending slightly inward: a dent in one surface, left to the concave limit
     planes = two_patches((10.0, np.array([-0.02, 0.0, 0.90])), (-10.0, np.array([0.02, 0.0, 0.905])))
     assert inward_creases(planes, PAIR, 45.0).tolist() == [False]
+
+
+def test_two_large_faces_meeting_in_one_sharp_inward_crease_stay_apart_though_a_small_face_agrees_with_both() -> None:
+    # a can's side (patch 2) against a bowl's inner wall (patch 1), normals 120 degrees apart, facing each other 1.5 cm
+    # apart; a small patch (3) between them, facing the camera, meets each gently enough to vote convex
+    planes = PatchPlanes(
+        counts=np.array([100, 100, 12]),
+        centroids=np.array([[-0.0075, 0.0, 0.9], [0.0075, 0.0, 0.9], [0.0, 0.0, 0.89]]),
+        normals=np.array([normal(60.0), normal(-60.0), normal(0.0)]),
+        thickness=np.zeros(3),
+        width=np.ones(3),
+    )
+    pairs = np.array([[1, 2], [1, 3], [2, 3]])
+    _, convex, concave = connection_votes(planes, pairs, ConvexityRules())
+    assert convex.tolist() == [False, True, True] and concave.tolist() == [True, False, False]
+    faces = np.arange(4)  # each patch a face of its own
+    objects = join_faces(faces, pairs, convex, concave, planes, ConvexityRules())
+    assert objects[1] != objects[2] and objects[3] in (objects[1], objects[2])
+    # one vote alone, bending inward more gently than decisive_bending, decides nothing: the small face joins all
+    gentle = ConvexityRules(decisive_bending=200.0)
+    objects = join_faces(faces, pairs, convex, concave, planes, gentle)
+    assert objects[1] == objects[2] == objects[3]
 
 
 def test_a_cell_across_a_seam_gives_a_patch_to_each_side() -> None:
