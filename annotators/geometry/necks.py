@@ -22,7 +22,7 @@ import cv2
 import numpy as np
 
 from annotators.geometry.grid_segmentation import join_labels
-from annotators.geometry.support import PieceSummary, summarize_pieces
+from annotators.geometry.support import PieceSummary, span, summarize_pieces
 
 
 @dataclass(frozen=True)
@@ -43,17 +43,6 @@ class NeckRules:
     min_slice: int = 5
     one_surface: float = 0.9
     sample_step: int = 2
-
-
-def span(feet: np.ndarray, share: float = 0.05) -> float:
-    """The extent (metres) of Nx2 plane coordinates along their principal axis, from their ``share`` to their
-    ``1 - share`` quantile there (a few stray readings at a depth edge do not stretch it)."""
-    if feet.shape[0] < 2:
-        return 0.0
-    centred = feet - feet.mean(axis=0)
-    _, _, axes = np.linalg.svd(centred, full_matrices=False)
-    low, high = np.quantile(centred @ axes[0], [share, 1.0 - share])
-    return float(high - low)
 
 
 def stacked_candidates(pieces: PieceSummary, labels: np.ndarray, rules: NeckRules) -> np.ndarray:

@@ -8,8 +8,10 @@ shared border, and their lowest heights and their tops agree within the height n
 
 Separate objects rarely do all of this: objects standing side by side show a depth jump along most of their
 shared border in the image (one hides the other, or a gap parts them), an object standing on another starts at
-the other's top, and objects of different heights do not share a top. Those pieces stay apart
-(:func:`join_slab_pieces`).
+the other's top, and objects of different heights do not share a top. Two objects standing side by side as tall as
+each other - a mug and a can - can touch without a depth jump where the one's rim meets the other's side; but a
+slab lies flat, each of its pieces spanning more on the table than it is high, while a mug or a can is taller than
+wide. Those pieces stay apart (:func:`join_slab_pieces`).
 
 The heights are read from the pixels the convexity votes labelled (``trusted``), not from those grown to them:
 growth goes by distance in the image, so where another object's edge touches a piece without a depth seam (a
@@ -33,8 +35,9 @@ class SlabRules:
     (5 %) and tops (99 %) must agree (``tolerance``); the share of their shared border without a depth jump
     (``continuous``, depth jumps as the segmenter's: ``jump_absolute + jump_relative * nearer depth``) and its
     length, at least ``boundary_share`` times the square root of the smaller piece's size and ``min_boundary``
-    pixel pairs (a joint :func:`~annotators.geometry.grid_segmentation.merge_parts` trusts); heights sampled on
-    every ``sample_step``-th pixel."""
+    pixel pairs (a joint :func:`~annotators.geometry.grid_segmentation.merge_parts` trusts); each piece's span on
+    the table plane (:meth:`~annotators.geometry.support.PieceSummary.span`) at least ``flatness`` times its top
+    height; heights sampled on every ``sample_step``-th pixel."""
 
     tolerance: float = 0.005
     continuous: float = 0.6
@@ -42,12 +45,13 @@ class SlabRules:
     min_boundary: int = 3
     jump_absolute: float = 0.01
     jump_relative: float = 0.01
+    flatness: float = 1.0
     sample_step: int = 2
 
 
 def slab_candidates(pieces: PieceSummary, labels: np.ndarray, rules: SlabRules) -> np.ndarray:
-    """Kx2 touching label pairs whose lowest heights and tops agree within ``rules.tolerance`` and whose shared
-    border is long enough to carry a joint."""
+    """Kx2 touching label pairs whose lowest heights and tops agree within ``rules.tolerance``, whose shared
+    border is long enough to carry a joint, and each of which lies flat (``rules.flatness``)."""
     pairs = pieces.touching_pairs(labels)
     if pairs.shape[0] == 0:
         return pairs
@@ -59,7 +63,11 @@ def slab_candidates(pieces: PieceSummary, labels: np.ndarray, rules: SlabRules) 
             np.abs(pieces.top[a] - pieces.top[b]) <= rules.tolerance
         )
     long_enough = border >= np.maximum(rules.min_boundary, rules.boundary_share * np.sqrt(smaller))
-    return pairs[level & long_enough]
+    pairs = pairs[level & long_enough]
+    if pairs.shape[0] == 0:
+        return pairs
+    flat = {label: pieces.span(label) >= rules.flatness * pieces.top[label] for label in np.unique(pairs).tolist()}
+    return pairs[[flat[a] and flat[b] for a, b in pairs.tolist()]]
 
 
 def continuous_borders(

@@ -99,12 +99,27 @@ class PieceSummary:
         """The touching label pairs of ``labels`` (the labelling summarized), found now unless known."""
         return self.touching if self.touching is not None else touching_pairs(labels)
 
+    def span(self, label: int) -> float:
+        """The extent (metres) of the label's sampled feet along their principal axis (:func:`span`)."""
+        return span(self.feet[self.starts[label] : self.starts[label + 1]])
+
     def hull(self, label: int) -> np.ndarray:
         """The convex hull (Kx2) of the label's sampled feet."""
         feet = self.feet[self.starts[label] : self.starts[label + 1]]
         if feet.shape[0] < 3:
             return feet
         return cv2.convexHull(hull_candidates(feet) if feet.shape[0] >= _FEW_FEET else feet).reshape(-1, 2)
+
+
+def span(feet: np.ndarray, share: float = 0.05) -> float:
+    """The extent (metres) of Nx2 plane coordinates along their principal axis, from their ``share`` to their
+    ``1 - share`` quantile there (a few stray readings at a depth edge do not stretch it)."""
+    if feet.shape[0] < 2:
+        return 0.0
+    centred = feet - feet.mean(axis=0)
+    _, _, axes = np.linalg.svd(centred, full_matrices=False)
+    low, high = np.quantile(centred @ axes[0], [share, 1.0 - share])
+    return float(high - low)
 
 
 def summarize_pieces(labels: np.ndarray, plane_points: np.ndarray, sample_step: int) -> PieceSummary:

@@ -1,5 +1,6 @@
 """join_slab_pieces: touching pieces with the same lowest heights and tops and no depth jump along their shared
-border are one object lying on the table; a depth jump, another top or another foot keeps them apart."""
+border are one object lying on the table; a depth jump, another top or another foot keeps them apart, and so does
+standing taller than wide (a mug and a can side by side); heights are read from the trusted pixels when given."""
 
 from __future__ import annotations
 
@@ -53,3 +54,14 @@ def test_a_strip_grown_onto_a_neighbours_edge_does_not_lift_a_pieces_top() -> No
     trusted[:, 40:55] = False
     plane_points[12:28, 52:55, 2] = np.linspace(0.01, 0.05, 16, dtype=np.float32)[:, None]
     assert slab_partners(labels, points, normals, plane_points, SlabRules(), trusted=trusted) == [(1, 2)]
+
+
+def test_two_objects_standing_side_by_side_as_tall_as_each_other_but_taller_than_wide_stay_apart() -> None:
+    # a mug and a can, 7 cm across and 1-10 cm high, touching without a depth jump where a rim meets a side
+    mug, can = ((10, 10, 24, 24), (0.01, 0.10)), ((24, 10, 38, 24), (0.01, 0.10))
+    labels, plane_points = scene({1: mug, 2: can})
+    points, normals = camera_points(labels, {1: 1.0, 2: 1.0})
+    assert slab_partners(labels, points, normals, plane_points, SlabRules()) == []
+    # the same two pieces 1-5 cm high lie flat: two pieces of one slab
+    labels, plane_points = scene({1: (mug[0], (0.01, 0.05)), 2: (can[0], (0.01, 0.05))})
+    assert slab_partners(labels, points, normals, plane_points, SlabRules()) == [(1, 2)]
