@@ -23,44 +23,29 @@ import pytest
 
 import annotators.cloud.clutter as clutter
 from annotators.cloud.clutter import ClutterParameters
-from reasoning.evaluation.object_verdicts import Verdict, load_labelled_objects, object_verdicts
+from reasoning.evaluation.object_verdicts import load_labelled_objects, object_verdicts
 from tests.annotators.guard_frames import LABELS, crop_moved, segment_frame
 
 pytestmark = pytest.mark.real_data
 
 
-def verdicts_with_cells_moved(
-    frame: int, offset: tuple[int, int], monkeypatch: pytest.MonkeyPatch
-) -> dict[str, Verdict]:
-    """The verdict on each labelled object of a uoc frame with the segmenter's crop started ``offset`` (dy, dx)
-    earlier."""
+CASES = [
+    # (uoc frame, crop offset (dy, dx), the objects that must be whole)
+    pytest.param(3, (0, 1), ("power drill", "teal bowl"), id="drill-beside-bowl-rim-0-1"),
+    pytest.param(3, (0, 2), ("power drill", "teal bowl"), id="drill-beside-bowl-rim-0-2"),
+    pytest.param(3, (2, 1), ("power drill", "teal bowl"), id="drill-beside-bowl-rim-2-1"),
+    pytest.param(3, (0, 4), ("black can", "teal bowl"), id="can-standing-in-bowl-0-4"),
+    pytest.param(3, (3, 4), ("black can", "teal bowl"), id="can-standing-in-bowl-3-4"),
+    pytest.param(1, (0, 1), ("blue mug", "soup can"), id="mug-and-can-as-tall-0-1"),
+    pytest.param(1, (0, 3), ("blue mug", "soup can"), id="mug-and-can-as-tall-0-3"),
+]
+
+
+@pytest.mark.parametrize(("frame", "offset", "names"), CASES)
+def test_objects_whose_wholeness_hung_on_the_cell_phase_are_whole(
+    uoc_folder: Path, frame: int, offset: tuple[int, int], names: tuple[str, ...], monkeypatch: pytest.MonkeyPatch
+) -> None:
     monkeypatch.setattr(clutter, "bounding_box", crop_moved(*offset))
     key = ("uoc_tabletop_realsense", frame)
-    return object_verdicts(segment_frame(*key, ClutterParameters()), load_labelled_objects(LABELS)[key])
-
-
-@pytest.mark.parametrize("offset", [(0, 1), (0, 2), (2, 1)])
-def test_the_drill_lying_on_its_side_is_whole_where_the_bowls_rim_touches_its_battery(
-    uoc_folder: Path, offset: tuple[int, int], monkeypatch: pytest.MonkeyPatch
-) -> None:
-    verdicts = verdicts_with_cells_moved(3, offset, monkeypatch)
-    assert str(verdicts["power drill"]) == "whole"
-    assert str(verdicts["teal bowl"]) == "whole"
-
-
-@pytest.mark.parametrize("offset", [(0, 4), (3, 4)])
-def test_the_can_standing_in_the_bowl_stays_apart_from_it(
-    uoc_folder: Path, offset: tuple[int, int], monkeypatch: pytest.MonkeyPatch
-) -> None:
-    verdicts = verdicts_with_cells_moved(3, offset, monkeypatch)
-    assert str(verdicts["black can"]) == "whole"
-    assert str(verdicts["teal bowl"]) == "whole"
-
-
-@pytest.mark.parametrize("offset", [(0, 1), (0, 3)])
-def test_a_mug_and_a_can_as_tall_as_each_other_stay_apart(
-    uoc_folder: Path, offset: tuple[int, int], monkeypatch: pytest.MonkeyPatch
-) -> None:
-    verdicts = verdicts_with_cells_moved(1, offset, monkeypatch)
-    assert str(verdicts["blue mug"]) == "whole"
-    assert str(verdicts["soup can"]) == "whole"
+    verdicts = object_verdicts(segment_frame(*key, ClutterParameters()), load_labelled_objects(LABELS)[key])
+    assert {name: str(verdicts[name]) for name in names} == dict.fromkeys(names, "whole")
