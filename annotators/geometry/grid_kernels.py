@@ -29,6 +29,12 @@ def touching_keys(labels: np.ndarray, base: int) -> np.ndarray:
     return _loops().touching_keys(labels, base)
 
 
+def near_label_pairs(labels: np.ndarray, reach: int) -> np.ndarray:
+    """Kx2 distinct label pairs ``(a, b)``, ``0 < a < b``, in increasing order, of the pixels of different non-zero
+    labels (HxW integers) within ``reach`` pixels of each other along both axes (a square window)."""
+    return _loops().near_label_pairs(np.ascontiguousarray(labels), int(reach))
+
+
 def facing_values(
     rows: np.ndarray, cols: np.ndarray, target: np.ndarray, values: np.ndarray, radius: int
 ) -> np.ndarray:

@@ -48,6 +48,40 @@ def touching_keys(labels: np.ndarray, base: int) -> np.ndarray:
 
 
 @njit(cache=True, nogil=True)
+def near_label_pairs(labels: np.ndarray, reach: int) -> np.ndarray:
+    """See :func:`annotators.geometry.grid_kernels.near_label_pairs`."""
+    count = 0
+    rows, cols = labels.shape
+    for r in range(rows):
+        for c in range(cols):
+            count = max(count, labels[r, c])
+    near = np.zeros((count + 1, count + 1), dtype=np.bool_)
+    for r in range(rows):
+        for c in range(cols):
+            a = labels[r, c]
+            if a <= 0:
+                continue
+            for dy in range(0, min(reach, rows - 1 - r) + 1):
+                first = 1 if dy == 0 else max(-reach, -c)
+                for dx in range(first, min(reach, cols - 1 - c) + 1):
+                    b = labels[r + dy, c + dx]
+                    if b > 0 and b != a:
+                        near[min(a, b), max(a, b)] = True
+    found = 0
+    for a in range(count + 1):
+        for b in range(count + 1):
+            found += near[a, b]
+    pairs = np.empty((found, 2), dtype=np.int64)
+    found = 0
+    for a in range(count + 1):
+        for b in range(count + 1):
+            if near[a, b]:
+                pairs[found, 0], pairs[found, 1] = a, b
+                found += 1
+    return pairs
+
+
+@njit(cache=True, nogil=True)
 def facing_values(
     rows: np.ndarray, cols: np.ndarray, target: np.ndarray, values: np.ndarray, radius: int
 ) -> np.ndarray:

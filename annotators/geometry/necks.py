@@ -60,13 +60,20 @@ def stacked_candidates(pieces: PieceSummary, labels: np.ndarray, rules: NeckRule
     return np.column_stack([upper, lower])[on_top & clear]
 
 
-def neck_and_body(labels: np.ndarray, plane_points: np.ndarray, label: int, rules: NeckRules) -> tuple[float, float]:
+def neck_and_body(
+    labels: np.ndarray, plane_points: np.ndarray, label: int, rules: NeckRules, box: np.ndarray | None = None
+) -> tuple[float, float]:
     """The span on the table plane of a piece's neck - its narrowest ``rules.band`` thick slice of heights from
     its 5 % height up to the middle of its heights, slices of fewer than ``rules.min_slice`` sampled points
-    skipped - and of the whole piece, from every ``rules.sample_step``-th pixel (``(inf, 0)`` without a slice)."""
+    skipped - and of the whole piece, from every ``rules.sample_step``-th pixel (``(inf, 0)`` without a slice);
+    ``box`` ``(x0, y0, x1, y1)`` holds the piece's pixels when known (only it is read)."""
     step = max(1, rules.sample_step)
-    sampled = plane_points.reshape(*labels.shape, 3)[::step, ::step]
-    chosen = sampled[(labels[::step, ::step] == label) & np.isfinite(sampled[..., 2])].astype(np.float64)
+    height, width = labels.shape
+    x0, y0, x1, y1 = (0, 0, width, height) if box is None else (int(value) for value in box)
+    x0, y0 = x0 - x0 % step, y0 - y0 % step  # the same sampled pixels as on the whole grid
+    sampled = plane_points.reshape(height, width, 3)[y0:y1:step, x0:x1:step]
+    mine = labels[y0:y1:step, x0:x1:step] == label
+    chosen = sampled[mine & np.isfinite(sampled[..., 2])].astype(np.float64)
     if chosen.shape[0] < rules.min_slice:
         return np.inf, 0.0
     low, high = np.percentile(chosen[:, 2], [5, 95])
@@ -95,11 +102,16 @@ def neck_partners(
     docstring); ``plane_points`` the pixels' ``(u, v, height)``, ``pieces`` the labels' summary when already made."""
     pieces = pieces or summarize_pieces(labels, plane_points, rules.sample_step)
     joins = []
+    necked: dict[int, bool] = {}  # a piece standing on several lower ones is measured once
     for upper, lower in stacked_candidates(pieces, labels, rules).tolist():
-        if not one_surface(labels, upper, pieces.boxes[upper], rules.one_surface):
-            continue
-        neck, body = neck_and_body(labels, plane_points, upper, rules)
-        if neck < rules.neck_share * body:
+        if upper not in necked:
+            box = pieces.boxes[upper]
+            if one_surface(labels, upper, box, rules.one_surface):
+                neck, body = neck_and_body(labels, plane_points, upper, rules, box)
+                necked[upper] = neck < rules.neck_share * body
+            else:
+                necked[upper] = False
+        if necked[upper]:
             joins.append((upper, lower))
     return joins
 

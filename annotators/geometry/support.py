@@ -46,6 +46,7 @@ from annotators.geometry.support_kernels import (
     hull_candidates,
     kept_labels,
     piece_summary,
+    principal_span,
     raster_vertices,
     unsupported_candidates,
 )
@@ -113,7 +114,12 @@ class PieceSummary:
 
 def span(feet: np.ndarray, share: float = 0.05) -> float:
     """The extent (metres) of Nx2 plane coordinates along their principal axis, from their ``share`` to their
-    ``1 - share`` quantile there (a few stray readings at a depth edge do not stretch it)."""
+    ``1 - share`` quantile there (a few stray readings at a depth edge do not stretch it); one compiled pass."""
+    return principal_span(feet, share)
+
+
+def span_numpy(feet: np.ndarray, share: float = 0.05) -> float:
+    """:func:`span` in NumPy (SVD, quantiles): the reference form its compiled pass is tested against."""
     if feet.shape[0] < 2:
         return 0.0
     centred = feet - feet.mean(axis=0)

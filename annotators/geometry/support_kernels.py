@@ -66,6 +66,13 @@ def pixel_footprint(points: np.ndarray) -> float:
     return float((ordered[low] + ordered[high]) / np.float32(2))
 
 
+def principal_span(feet: np.ndarray, share: float) -> float:
+    """The extent of Nx2 plane coordinates (metres) along their principal axis - the major axis of their scatter -
+    from their ``share`` to their ``1 - share`` quantile there (linear interpolation, NumPy's default), in one
+    compiled pass; 0 for fewer than two points."""
+    return float(_loops().principal_span(np.ascontiguousarray(feet), float(share)))
+
+
 def unsupported_candidates(
     pairs: np.ndarray, sizes: np.ndarray, low: np.ndarray, high: np.ndarray, tolerance: float, reach_down: float
 ) -> np.ndarray:

@@ -270,3 +270,43 @@ def box_label_points(labels: np.ndarray, points: np.ndarray, label: int, box: np
                     found[index, k] = points[r, c, k]
                 index += 1
     return found
+
+
+@njit(cache=True, nogil=True)
+def principal_span(feet: np.ndarray, share: float) -> float:
+    """See :func:`annotators.geometry.support_kernels.principal_span`."""
+    count = feet.shape[0]
+    if count < 2:
+        return 0.0
+    mean_u, mean_v = 0.0, 0.0
+    for i in range(count):
+        mean_u += feet[i, 0]
+        mean_v += feet[i, 1]
+    mean_u, mean_v = mean_u / count, mean_v / count
+    uu, uv, vv = 0.0, 0.0, 0.0
+    for i in range(count):
+        du, dv = feet[i, 0] - mean_u, feet[i, 1] - mean_v
+        uu += du * du
+        uv += du * dv
+        vv += dv * dv
+    angle = 0.5 * np.arctan2(2.0 * uv, uu - vv)  # the major axis of the scatter
+    axis_u, axis_v = np.cos(angle), np.sin(angle)
+    along = np.empty(count)
+    for i in range(count):
+        along[i] = (feet[i, 0] - mean_u) * axis_u + (feet[i, 1] - mean_v) * axis_v
+    along.sort()
+    return _linear_quantile(along, 1.0 - share) - _linear_quantile(along, share)
+
+
+@njit(cache=True, nogil=True)
+def _linear_quantile(ordered: np.ndarray, share: float) -> float:
+    """The ``share`` quantile of sorted values, interpolated linearly between the two nearest ranks as NumPy's
+    default method does."""
+    position = share * (ordered.shape[0] - 1)
+    below = int(np.floor(position))
+    above = min(below + 1, ordered.shape[0] - 1)
+    fraction = position - below
+    gap = ordered[above] - ordered[below]
+    if fraction >= 0.5:
+        return ordered[above] - gap * (1.0 - fraction)
+    return ordered[below] + gap * fraction

@@ -28,7 +28,7 @@ import cv2
 import numpy as np
 from scipy.ndimage import find_objects
 
-from annotators.geometry.grid_kernels import graph_components
+from annotators.geometry.grid_kernels import graph_components, near_label_pairs
 from annotators.geometry.grid_segmentation import chroma_image, join_labels
 
 
@@ -63,26 +63,9 @@ def tinted_neighbours(labels: np.ndarray, tints: np.ndarray, rules: Transparency
     tinted[0] = False
     if np.count_nonzero(tinted) < 2:
         return []
-    kept = np.where(tinted[labels], labels, 0)
-    ys, xs = np.nonzero(kept)
-    kept = kept[ys.min() : ys.max() + 1, xs.min() : xs.max() + 1]  # the tinted pixels' box
-    rows, cols = kept.shape
-    count = tints.shape[0]
-    codes = []
-    for dy in range(0, rules.reach + 1):
-        for dx in range(-rules.reach, rules.reach + 1):
-            if dy == 0 and dx <= 0:
-                continue
-            a = kept[: rows - dy, max(0, -dx) : cols - max(0, dx)]
-            b = kept[dy:, max(0, dx) : cols - max(0, -dx)]
-            touching = (a > 0) & (b > 0) & (a != b)
-            low, high = np.minimum(a[touching], b[touching]), np.maximum(a[touching], b[touching])
-            codes.append(low.astype(np.int64) * count + high)
-    pairs = np.unique(np.concatenate(codes))
+    pairs = near_label_pairs(np.where(tinted[labels], labels, 0), rules.reach)
     return [
-        (int(a), int(b))
-        for a, b in zip(pairs // count, pairs % count, strict=True)
-        if float(np.hypot(*(tints[a] - tints[b]))) <= rules.hue_distance
+        (int(a), int(b)) for a, b in pairs.tolist() if float(np.hypot(*(tints[a] - tints[b]))) <= rules.hue_distance
     ]
 
 

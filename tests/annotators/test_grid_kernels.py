@@ -22,6 +22,7 @@ from annotators.geometry.grid_kernels import (
     label_masks,
     label_pieces,
     label_pixels,
+    near_label_pairs,
     nearest_seed_labels,
     plane_coordinates,
     sampled_median,
@@ -77,6 +78,18 @@ def test_touching_keys_find_every_adjacent_pair(seed: int) -> None:
         touching = (a != b) & (a > 0) & (b > 0)
         expected.append(np.minimum(a, b)[touching] * base + np.maximum(a, b)[touching])
     assert np.array_equal(np.sort(touching_keys(labels, base)), np.sort(np.concatenate(expected)))
+
+
+@pytest.mark.parametrize("seed", range(5))
+@pytest.mark.parametrize("reach", [1, 2, 3])
+def test_near_label_pairs_are_the_labels_within_reach_of_each_other(seed: int, reach: int) -> None:
+    labels = _blobs(seed, labels=9)
+    expected = set()
+    for a in range(1, int(labels.max()) + 1):
+        grown = cv2.dilate((labels == a).astype(np.uint8), np.ones((2 * reach + 1, 2 * reach + 1), np.uint8)) > 0
+        expected |= {(a, int(b)) for b in np.unique(labels[grown]) if b > a}
+    pairs = near_label_pairs(labels, reach)
+    assert [tuple(pair) for pair in pairs.tolist()] == sorted(expected)
 
 
 @pytest.mark.parametrize("seed", range(3))

@@ -11,6 +11,8 @@ from annotators.geometry.support import (
     AppendageRules,
     close_borders,
     held_share,
+    span,
+    span_numpy,
     summarize_pieces,
     summarize_pieces_numpy,
 )
@@ -180,3 +182,16 @@ def test_box_label_points_match_the_masked_box(seed: int) -> None:
         x0, y0, x1, y1 = pieces.boxes[label]
         expected = plane[y0:y1, x0:x1][labels[y0:y1, x0:x1] == label]
         assert np.array_equal(box_label_points(labels, plane, label, pieces.boxes[label]), expected, equal_nan=True)
+
+
+@pytest.mark.parametrize("seed", range(4))
+@pytest.mark.parametrize("count", [1, 2, 3, 40, 900])
+def test_the_compiled_span_is_the_numpy_one(seed: int, count: int) -> None:
+    rng = np.random.default_rng(seed)
+    scale = rng.uniform(0.005, 0.3, 2)
+    feet = (rng.normal(size=(count, 2)) * scale @ np.array([[0.8, 0.6], [-0.6, 0.8]]) + rng.uniform(-1, 1, 2)).astype(
+        np.float32
+    )
+    # the float32 points' spans agree to float32 rounding (the NumPy form computes in float32)
+    assert span(feet) == pytest.approx(span_numpy(feet), rel=1e-5, abs=1e-7)
+    assert span(feet.astype(np.float64), 0.2) == pytest.approx(span_numpy(feet.astype(np.float64), 0.2), rel=1e-9)
