@@ -23,6 +23,7 @@ import numpy as np
 
 from annotators.geometry.grid_segmentation import join_labels
 from annotators.geometry.support import PieceSummary, span, summarize_pieces
+from annotators.geometry.support_kernels import narrowest_slice_span
 
 
 @dataclass(frozen=True)
@@ -77,12 +78,8 @@ def neck_and_body(
     if chosen.shape[0] < rules.min_slice:
         return np.inf, 0.0
     low, high = np.percentile(chosen[:, 2], [5, 95])
-    neck = np.inf
-    for bottom in np.arange(low, low + 0.5 * (high - low), rules.band):
-        inside = chosen[(chosen[:, 2] >= bottom) & (chosen[:, 2] < bottom + rules.band), :2]
-        if inside.shape[0] >= rules.min_slice:
-            neck = min(neck, span(inside))
-    return neck, span(chosen[:, :2])
+    bottoms = np.arange(low, low + 0.5 * (high - low), rules.band)
+    return narrowest_slice_span(chosen, bottoms, rules.band, rules.min_slice), span(chosen[:, :2])
 
 
 def one_surface(labels: np.ndarray, label: int, box: np.ndarray, share: float) -> bool:

@@ -73,6 +73,23 @@ def principal_span(feet: np.ndarray, share: float) -> float:
     return float(_loops().principal_span(np.ascontiguousarray(feet), float(share)))
 
 
+def narrowest_slice_span(
+    points: np.ndarray, bottoms: np.ndarray, band: float, min_slice: int, share: float = 0.05
+) -> float:
+    """The least :func:`principal_span` (``share``) of the ``(u, v)`` of the Nx3 ``(u, v, height)`` points in any
+    slice of heights ``[bottom, bottom + band)`` (one per value of ``bottoms``) holding at least ``min_slice`` of
+    them; inf when none does."""
+    return float(
+        _loops().narrowest_slice_span(
+            np.ascontiguousarray(points, dtype=np.float64),
+            np.ascontiguousarray(bottoms, dtype=np.float64),
+            float(band),
+            int(min_slice),
+            float(share),
+        )
+    )
+
+
 def unsupported_candidates(
     pairs: np.ndarray, sizes: np.ndarray, low: np.ndarray, high: np.ndarray, tolerance: float, reach_down: float
 ) -> np.ndarray:

@@ -310,3 +310,20 @@ def _linear_quantile(ordered: np.ndarray, share: float) -> float:
     if fraction >= 0.5:
         return ordered[above] - gap * (1.0 - fraction)
     return ordered[below] + gap * fraction
+
+
+@njit(cache=True, nogil=True)
+def narrowest_slice_span(points: np.ndarray, bottoms: np.ndarray, band: float, min_slice: int, share: float) -> float:
+    """See :func:`annotators.geometry.support_kernels.narrowest_slice_span`."""
+    narrowest = np.inf
+    inside = np.empty((points.shape[0], 2))
+    for bottom in bottoms:
+        top = bottom + band
+        count = 0
+        for i in range(points.shape[0]):
+            if points[i, 2] >= bottom and points[i, 2] < top:
+                inside[count, 0], inside[count, 1] = points[i, 0], points[i, 1]
+                count += 1
+        if count >= min_slice:
+            narrowest = min(narrowest, principal_span(inside[:count], share))
+    return narrowest

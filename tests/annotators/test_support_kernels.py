@@ -21,6 +21,7 @@ from annotators.geometry.support_kernels import (
     box_label_points,
     hull_candidates,
     kept_labels,
+    narrowest_slice_span,
     unsupported_candidates,
 )
 from annotators.geometry.support_kernels import pixel_footprint as compiled_footprint
@@ -195,3 +196,19 @@ def test_the_compiled_span_is_the_numpy_one(seed: int, count: int) -> None:
     # the float32 points' spans agree to float32 rounding (the NumPy form computes in float32)
     assert span(feet) == pytest.approx(span_numpy(feet), rel=1e-5, abs=1e-7)
     assert span(feet.astype(np.float64), 0.2) == pytest.approx(span_numpy(feet.astype(np.float64), 0.2), rel=1e-9)
+
+
+@pytest.mark.parametrize("seed", range(4))
+def test_the_narrowest_slice_is_the_least_span_of_the_slices_measured_one_by_one(seed: int) -> None:
+    rng = np.random.default_rng(seed)
+    points = rng.normal(0.0, 0.05, (600, 3))
+    points[:, 2] = rng.uniform(0.0, 0.2, 600)
+    points[points[:, 2] < 0.06, :2] *= 0.2  # a narrow neck low down
+    bottoms = np.arange(0.0, 0.1, 0.01)
+    expected = np.inf
+    for bottom in bottoms:
+        inside = points[(points[:, 2] >= bottom) & (points[:, 2] < bottom + 0.01), :2]
+        if inside.shape[0] >= 5:
+            expected = min(expected, span_numpy(inside))
+    assert narrowest_slice_span(points, bottoms, 0.01, 5) == pytest.approx(expected, rel=1e-9)
+    assert narrowest_slice_span(points, bottoms, 0.01, 10_000) == np.inf
