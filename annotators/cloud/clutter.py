@@ -77,7 +77,8 @@ from annotators.geometry.grid_segmentation import (
     MergeRules,
     boundaries,
     bounding_box,
-    color_edges,
+    chroma_edges,
+    chroma_image,
     depth_seams,
     grow_labels_nearby,
     grow_on_surface,
@@ -320,9 +321,10 @@ def segment_clutter(
     )
     if p.join_rims:  # a bowl's inside and outside, which share no footprint to merge by
         labels = join_single_rims(labels, plane_grid, RimRules())
-    if colors is not None and p.use_color:
-        colors_crop = strided_crop(colors, step, (x0, y0, x1, y1))
-        labels = split_by_color(labels, grid, normals, colors_crop, p, footprint)
+    # the hue of every grid pixel, for the hue edges and the tints of transparent objects
+    chroma = chroma_image(strided_crop(colors, step, (x0, y0, x1, y1))) if colors is not None and p.use_color else None
+    if chroma is not None:
+        labels = split_by_color(labels, grid, normals, chroma, p, footprint)
     if p.complete_occluded:
         labels = join_occluded(
             labels, grid, normals, plane_grid.reshape(grid.shape), p.jump_absolute, p.jump_relative, p.occlusion_rules()
@@ -353,8 +355,8 @@ def segment_clutter(
     if p.join_necks:
         labels = join_necked_pieces(labels, plane_grid, NeckRules())
     valid = mask[::step, ::step][y0:y1, x0:x1] & np.isfinite(depth)  # measured, within the range filter's
-    if colors is not None and p.use_color and p.join_see_through:
-        labels = join_see_through(labels, valid, strided_crop(colors, step, (x0, y0, x1, y1)), TransparencyRules())
+    if chroma is not None and p.join_see_through:
+        labels = join_see_through(labels, valid, chroma, TransparencyRules())
     floors = None
     if p.claim_floors:
         rules = FloorRules(min_height=p.min_height, margin=p.hull_margin, cell=p.hull_cell)
@@ -374,7 +376,7 @@ def split_by_color(
     labels: np.ndarray,
     grid: np.ndarray,
     normals: np.ndarray,
-    colors: np.ndarray,
+    chroma: np.ndarray,
     p: ClutterParameters,
     footprint: float | None = None,
 ) -> np.ndarray:
@@ -389,12 +391,13 @@ def split_by_color(
     creased pixel pairs between a large piece and a crumb are noise, not two objects meeting. Everything else of
     the object joins again - longest shared boundaries first, so a piece goes with the side it shares most with. A
     print on a box (no crease) or the pieces of one object seen on both sides of an occluder never split.
-    ``footprint`` is the :func:`~annotators.geometry.grid_segmentation.pixel_footprint` of ``grid`` when the caller
+    ``chroma`` is the :func:`~annotators.geometry.grid_segmentation.chroma_image` of the grid's colours;
+    ``footprint`` the :func:`~annotators.geometry.grid_segmentation.pixel_footprint` of ``grid`` when the caller
     has measured it.
     """
     step = max(1, p.stride)
     objects = labels > 0
-    edges = color_edges(colors, p.edge_low, p.edge_high) & objects
+    edges = chroma_edges(chroma, p.edge_low, p.edge_high) & objects
     parts = label_parts(objects & ~edges, max(1, p.min_part_points // (step * step)))
     pieces, owner, piece_sizes = object_pieces(np.ascontiguousarray(labels), parts)
     # only an object with two pieces that could each be an object (min_points) can split

@@ -92,7 +92,12 @@ def chroma_image(colors: np.ndarray) -> np.ndarray:
 def color_edges(colors: np.ndarray, low: float, high: float) -> np.ndarray:
     """HxW bool: Canny edges (thresholds ``low``/``high``) of the :func:`chroma_image` - changes of hue (Canny
     follows, at each pixel, the channel with the larger gradient)."""
-    return cv2.Canny(chroma_image(np.ascontiguousarray(colors)), low, high) > 0
+    return chroma_edges(chroma_image(np.ascontiguousarray(colors)), low, high)
+
+
+def chroma_edges(chroma: np.ndarray, low: float, high: float) -> np.ndarray:
+    """:func:`color_edges` of the colours whose :func:`chroma_image` is ``chroma``."""
+    return cv2.Canny(chroma, low, high) > 0
 
 
 def label_parts(region: np.ndarray, min_points: int) -> np.ndarray:

@@ -29,15 +29,16 @@ import numpy as np
 from scipy.ndimage import find_objects
 
 from annotators.geometry.grid_kernels import graph_components, near_label_pairs
-from annotators.geometry.grid_segmentation import chroma_image, join_labels
+from annotators.geometry.grid_segmentation import join_labels
 
 
 @dataclass(frozen=True)
 class TransparencyRules:
     """Thresholds of :func:`join_see_through`: pieces touch when their pixels come within ``reach`` grid pixels
-    of each other (a depth seam between them is unlabelled). Their mean :func:`chroma_image` vectors must lie within
-    ``hue_distance`` of each other, and each must be at least ``min_chroma`` from grey (a tint: shadows and white,
-    grey or black surfaces have no hue to follow). The pixels without depth inside the group's convex hull whose
+    of each other (a depth seam between them is unlabelled). Their mean
+    :func:`~annotators.geometry.grid_segmentation.chroma_image` vectors must lie within ``hue_distance`` of each
+    other, and each must be at least ``min_chroma`` from grey (a tint: shadows and white, grey or black surfaces
+    have no hue to follow). The pixels without depth inside the group's convex hull whose
     chroma lies within ``hue_distance`` of the group's must number at least ``hole_share`` of the group's pixels."""
 
     reach: int = 2
@@ -111,14 +112,15 @@ def group_box(boxes: list[tuple[slice, slice] | None], group: list[int]) -> tupl
 
 
 def see_through_groups(
-    labels: np.ndarray, valid: np.ndarray, colors: np.ndarray, rules: TransparencyRules | None = None
+    labels: np.ndarray, valid: np.ndarray, chroma: np.ndarray, rules: TransparencyRules | None = None
 ) -> list[list[int]]:
     """The groups of labels (two or more) that are one tinted transparent object (see the module docstring);
-    ``valid`` marks the grid pixels with a depth reading, ``colors`` the grid's RGB (uint8)."""
+    ``valid`` marks the grid pixels with a depth reading, ``chroma`` is the
+    :func:`~annotators.geometry.grid_segmentation.chroma_image` of the grid's colours."""
     rules = rules or TransparencyRules()
     if labels.max(initial=0) < 2:
         return []
-    chroma = chroma_image(np.ascontiguousarray(colors)).astype(np.float32) - 128.0
+    chroma = chroma.astype(np.float32) - 128.0
     tints = label_chroma(labels, chroma)
     pairs = tinted_neighbours(labels, tints, rules)
     if not pairs:
@@ -138,10 +140,11 @@ def see_through_groups(
 
 
 def join_see_through(
-    labels: np.ndarray, valid: np.ndarray, colors: np.ndarray, rules: TransparencyRules | None = None
+    labels: np.ndarray, valid: np.ndarray, chroma: np.ndarray, rules: TransparencyRules | None = None
 ) -> np.ndarray:
-    """Labels with the pieces of each tinted transparent object joined (:func:`see_through_groups`), renumbered
-    1..n when anything joined."""
-    groups = see_through_groups(labels, valid, colors, rules)
+    """Labels with the pieces of each tinted transparent object joined (:func:`see_through_groups`; ``chroma`` the
+    :func:`~annotators.geometry.grid_segmentation.chroma_image` of the grid's colours), renumbered 1..n when
+    anything joined."""
+    groups = see_through_groups(labels, valid, chroma, rules)
     pairs = [(group[0], other) for group in groups for other in group[1:]]
     return join_labels(labels, pairs) if pairs else labels
