@@ -350,10 +350,16 @@ def segment_clutter(
             pieces, summary_step, labels = None, 0, joined
     if p.join_slabs:
         slab_rules = p.slab_rules()
-        known = pieces if summary_step == slab_rules.sample_step else None
-        labels = join_slab_pieces(labels, grid, normals, plane_grid, slab_rules, known, objects.seeded)
+        if pieces is None or summary_step != slab_rules.sample_step:  # made here, it serves the necks too
+            summary_step = slab_rules.sample_step
+            pieces = summarize_pieces(labels, plane_grid, summary_step)
+        joined = join_slab_pieces(labels, grid, normals, plane_grid, slab_rules, pieces, objects.seeded)
+        if joined is not labels:
+            pieces, summary_step, labels = None, 0, joined
     if p.join_necks:
-        labels = join_necked_pieces(labels, plane_grid, NeckRules())
+        neck_rules = NeckRules()
+        known = pieces if summary_step == neck_rules.sample_step else None
+        labels = join_necked_pieces(labels, plane_grid, neck_rules, known)
     valid = mask[::step, ::step][y0:y1, x0:x1] & np.isfinite(depth)  # measured, within the range filter's
     if chroma is not None and p.join_see_through:
         labels = join_see_through(labels, valid, chroma, TransparencyRules())
