@@ -225,6 +225,13 @@ def join_inner_walls(
     the module docstring; ``points`` and ``normals`` HxWx3 in the camera frame, normals toward the camera,
     ``plane_points`` the pixels' ``(u, v, height)``, ``to_plane`` the 3x3 rotation from camera directions to
     ``(u, v, height)``; ``pieces`` the labels' summary when already made, with the rules' sample step); the same
-    array when nothing joined."""
-    joins = inner_wall_holders(labels, points, normals, plane_points, to_plane, rules or InnerWallRules(), pieces)
-    return join_labels(labels, joins) if joins else labels
+    array when nothing joined.
+
+    Rounds repeat while anything joins: each piece joins one holder per round (the one it shares the longest close
+    border with), so an inside cut in two may join its other half first and, as one piece, the outside in the next
+    round."""
+    rules = rules or InnerWallRules()
+    joined = labels
+    while joins := inner_wall_holders(joined, points, normals, plane_points, to_plane, rules, pieces):
+        joined, pieces = join_labels(joined, joins), None
+    return joined

@@ -13,6 +13,9 @@ cells start (bench/profiles/seg11-analysis.txt, section 8).
 * uoc 1's blue mug and the soup can beside it are as tall as each other (1-10 cm above the table) and touch without
   a depth jump where the mug's rim meets the can's side; at some phases the slab join took them for pieces of one
   object lying flat. A slab's pieces now each span more on the table than they are high.
+* uoc 1's white mug: at some phases the inside seen over its rim comes out in two halves beside the outer wall.
+  Each half joined one holder, the other half (their shared border the longest), and the whole inside never met the
+  outside. The inner-wall join now repeats while anything joins, so the joined inside joins the outside next.
 """
 
 from __future__ import annotations
@@ -38,6 +41,8 @@ CASES = [
     pytest.param(3, (3, 4), ("black can", "teal bowl"), id="can-standing-in-bowl-3-4"),
     pytest.param(1, (0, 1), ("blue mug", "soup can"), id="mug-and-can-as-tall-0-1"),
     pytest.param(1, (0, 3), ("blue mug", "soup can"), id="mug-and-can-as-tall-0-3"),
+    pytest.param(1, (1, 2), ("white mug",), id="mug-inside-in-two-1-2"),
+    pytest.param(1, (4, 2), ("white mug",), id="mug-inside-in-two-4-2"),
 ]
 
 
