@@ -9,7 +9,10 @@ over T ticks (medians per tick, wall ms; the tick's CPU ms too, the least distur
 * the ClutterSegmenter's steps: each function :func:`~annotators.cloud.clutter.segment_clutter` calls by name is
   wrapped and timed inclusively (what a step calls is in its time);
 * cProfile of as many ticks (before the steps are wrapped): the functions with the most own time and the most
-  calls (cProfile's own overhead inflates functions called often, so its milliseconds are for ranking only).
+  calls (cProfile's own overhead inflates functions called often, so its milliseconds are for ranking only);
+* with ``--alone R``: each step run by itself R times on a copy of the inputs it had in one tick, the least time
+  (what it calls included, the tree and the steps around it not: steadier than the medians in the tree when the
+  machine is busy).
 
 The machine is shared: compare runs of this script only side by side (alternating), by ratios.
 """
@@ -18,6 +21,7 @@ from __future__ import annotations
 
 import argparse
 import collections
+import copy
 import cProfile
 import io
 import pstats
@@ -53,12 +57,47 @@ def step_timers(module: types.ModuleType) -> dict[str, list[float]]:
     return seconds
 
 
+def captured_steps(module: types.ModuleType) -> dict[str, tuple[Callable[..., object], tuple, dict]]:
+    """Wrap every function ``module`` imported from the annotators so that its first call's arguments are kept (a
+    deep copy, made before the call); returns the function and arguments by name, filled while the wrappers stay in
+    place."""
+    calls: dict[str, tuple[Callable[..., object], tuple, dict]] = {}
+
+    def keeping(name: str, original: Callable[..., object]) -> Callable[..., object]:
+        def call(*args: object, **kwargs: object) -> object:
+            if name not in calls:
+                calls[name] = (original, copy.deepcopy(args), copy.deepcopy(kwargs))
+            return original(*args, **kwargs)
+
+        return call
+
+    for name, value in list(vars(module).items()):
+        if isinstance(value, types.FunctionType) and value.__module__.startswith("annotators."):
+            setattr(module, name, keeping(name, value))
+    return calls
+
+
+def least_alone(calls: dict[str, tuple[Callable[..., object], tuple, dict]], rounds: int) -> dict[str, float]:
+    """The least wall seconds of each kept call, run ``rounds`` times on fresh copies of its arguments."""
+    least = {}
+    for name, (function, args, kwargs) in calls.items():
+        times = []
+        for _ in range(rounds):
+            fresh_args, fresh_kwargs = copy.deepcopy(args), copy.deepcopy(kwargs)
+            start = time.perf_counter()
+            function(*fresh_args, **fresh_kwargs)
+            times.append(time.perf_counter() - start)
+        least[name] = min(times)
+    return least
+
+
 def main() -> None:
     parser = argparse.ArgumentParser(description=__doc__.split("\n")[0])
     parser.add_argument("--checkout", type=Path, default=ROOT, help="the checkout whose tree is profiled")
     parser.add_argument("--frame", type=int, default=3)
     parser.add_argument("--ticks", type=int, default=40)
     parser.add_argument("--top", type=int, default=30, help="functions listed from cProfile")
+    parser.add_argument("--alone", type=int, default=0, metavar="R", help="time each step alone, R runs (least)")
     args = parser.parse_args()
     sys.path.insert(0, str(args.checkout))
     import annotators.cloud.clutter as clutter
@@ -101,6 +140,16 @@ def main() -> None:
         pstats.Stats(profile, stream=text).sort_stats(order).print_stats(args.top)
         listing = text.getvalue().replace(str(args.checkout) + "/", "")
         print(f"\ncProfile of {args.ticks} ticks, by {order}:\n{listing.split('Ordered by', 1)[-1]}")
+
+    if args.alone > 0:
+        original = dict(vars(clutter))
+        calls = captured_steps(clutter)
+        engine.tick()
+        vars(clutter).update(original)
+        print(f"\nClutterSegmenter steps alone on one tick's inputs (least wall ms of {args.alone} runs; what a step")
+        print("calls is in its time, the tree and the steps around it are not):")
+        for name, least in sorted(least_alone(calls, args.alone).items(), key=lambda item: -item[1]):
+            print(f"  {name:34s} {least * 1e3:7.3f}")
 
     seconds = step_timers(clutter)
     for _ in range(args.ticks):
