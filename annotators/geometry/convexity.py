@@ -300,17 +300,20 @@ def grazing_patches(planes: PatchPlanes, degrees: float) -> np.ndarray:
     return np.concatenate([[False], facing < np.cos(np.radians(degrees))])
 
 
-def inward_creases(planes: PatchPlanes, pairs: np.ndarray, degrees: float) -> np.ndarray:
+def inward_creases(
+    planes: PatchPlanes, pairs: np.ndarray, degrees: float, bending: np.ndarray | None = None
+) -> np.ndarray:
     """For Kx2 touching patch labels: does the connection cross a crease (normals at least ``degrees`` apart) bending
     inward, however gently?
 
     One object's faces meet at a crease bending outward (a box's edge). Two objects meet there bending inward: a
     box's side and the face of a box behind it, at right angles across the depth gap between them. Across that gap
     the bending (:func:`connection_bending`) is weak - the centroids lie far apart for the turn - and may not reach
-    the concave limit, but its sign still tells the two apart."""
+    the concave limit, but its sign still tells the two apart. ``bending`` is the pairs' :func:`connection_bending`
+    when the caller has it."""
     a, b = pairs[:, 0] - 1, pairs[:, 1] - 1
     crease = np.einsum("ij,ij->i", planes.normals[a], planes.normals[b]) < np.cos(np.radians(degrees))
-    return crease & (connection_bending(planes, pairs) < 0)
+    return crease & ((connection_bending(planes, pairs) if bending is None else bending) < 0)
 
 
 def _alignment(planes: PatchPlanes, pairs: np.ndarray, degrees: float) -> tuple[np.ndarray, np.ndarray]:
@@ -346,11 +349,12 @@ def join_faces(
     votes = np.maximum(np.bincount(inverse, minlength=keys.size), 1)
     large = np.bincount(faces, weights=planes_sizes(planes, count), minlength=count) >= rules.min_face
     between_large = large[face_a] & large[face_b]
-    convex = convex & ~(between_large & inward_creases(planes, pairs, rules.crease_degrees))
+    bending = connection_bending(planes, pairs)
+    convex = convex & ~(between_large & inward_creases(planes, pairs, rules.crease_degrees, bending))
     share = np.bincount(inverse, weights=convex[apart], minlength=keys.size) / votes
     concave_votes = np.bincount(inverse, weights=concave[apart], minlength=keys.size)
     sharpest = np.full(keys.size, np.inf)
-    np.minimum.at(sharpest, inverse, connection_bending(planes, pairs[apart]))
+    np.minimum.at(sharpest, inverse, bending[apart])
     share = np.where((concave_votes > rules.concave_share * votes) & (concave_votes >= rules.min_votes), 0.0, share)
     first, second = keys // count, keys % count
     both_large = large[first] & large[second]
