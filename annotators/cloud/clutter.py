@@ -106,6 +106,21 @@ from robokudo.core.annotator import Annotator
 from robokudo.core.capability import Capability
 from robokudo.core.types import CasType, ObjectHypothesis, Plane, PointCloud
 
+REFERENCE_FOCAL = 570.0
+"""Focal length (pixels) of the camera the segmenter's pixel thresholds are stated for: between a Kinect's (525) and
+a RealSense D400's colour camera at 640x480 (613), the cameras it was developed on; both keep the stride of 2."""
+
+
+CAMERA_ROWS = 16
+"""About this many rows of the cloud, evenly spread, tell the angle between its pixels (the camera's, on every row)."""
+
+
+def nearest_stride(ideal: float) -> int:
+    """The whole stride (at least 1) nearest ``ideal`` by ratio: a scale is as far off at half as at twice, so
+    between ``k`` and ``k + 1`` the choice turns at their geometric mean."""
+    low = max(1, math.floor(ideal))
+    return low + 1 if ideal > math.sqrt(low * (low + 1)) else low
+
 
 @dataclass(frozen=True)
 class ClutterParameters(ClusterParameters):
@@ -128,7 +143,8 @@ class ClutterParameters(ClusterParameters):
     ``join_see_through`` joins the pieces of a tinted transparent object (one hue, depth holes of that hue inside);
     ``claim_floors`` gives an open container the floor seen over its rim, at table level;
     ``claim_borders`` gives the outline pixels the coarse grid
-    left unlabelled and each object's foot (below ``min_height``) to the object they continue."""
+    left unlabelled and each object's foot (below ``min_height``) to the object they continue. Pixel thresholds are
+    stated for a camera of focal length ``reference_focal`` and scaled to the camera seen (:meth:`for_camera`)."""
 
     jump_relative: float = 0.01
     normal_step: int = 2
@@ -165,6 +181,32 @@ class ClutterParameters(ClusterParameters):
     join_see_through: bool = True
     claim_floors: bool = True
     claim_borders: bool = True
+    reference_focal: float = REFERENCE_FOCAL
+
+    def for_camera(self, pixel_angle: float) -> ClutterParameters:
+        """These parameters for a camera whose neighbouring pixels lie ``pixel_angle`` radians apart (1 / its
+        focal length in pixels). Every pixel threshold is stated for a camera of focal length ``reference_focal``.
+        On a camera that sees finer or coarser, the grid's stride scales with the focal length
+        (:func:`nearest_stride`), so the grid sees the same angles, and the pixel counts and distances given at
+        full resolution (``min_points``, ``min_part_points``, ``small_part_points``, ``grow_distance``) scale with
+        the stride: the same objects, measured in grid pixels, whatever the image's size. Unchanged when
+        ``reference_focal`` is 0, the angle unknown (0) or the stride comes out the same."""
+        if self.reference_focal <= 0.0 or not pixel_angle > 0.0:
+            return self
+        reference = max(1, self.stride)
+        step = nearest_stride(reference / (pixel_angle * self.reference_focal))
+        if step == reference:
+            return self
+        length = step / reference
+        area = length * length
+        return replace(
+            self,
+            stride=step,
+            min_points=max(1, round(self.min_points * area)),
+            min_part_points=max(1, round(self.min_part_points * area)),
+            small_part_points=max(1, round(self.small_part_points * area)),
+            grow_distance=self.grow_distance * length,
+        )
 
     def convexity_rules(self) -> ConvexityRules:
         """The thresholds of :func:`annotators.geometry.convexity.convex_objects`. With grown patches two small
@@ -279,7 +321,9 @@ def segment_clutter(
 ) -> list[Segment]:
     """The objects standing on the plane ``model`` (unit normal toward the camera) in an organized cloud, largest
     first; ``plane_indices`` are the plane's inliers (flat indices) and define its extent."""
-    p = parameters or ClutterParameters()
+    # the pixels' angle, a property of the camera, sets the grid: the same angles on any image size
+    camera_rows = np.ascontiguousarray(points[:: max(1, points.shape[0] // CAMERA_ROWS)])
+    p = (parameters or ClutterParameters()).for_camera(pixel_footprint(camera_rows))
     step = max(1, p.stride)
     distances = plane_distances(points, model)  # the heights of all points, for the candidates and the segments
     coarse = standing_region(points, mask, model, plane_indices, p, distances)

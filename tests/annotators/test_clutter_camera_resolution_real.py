@@ -1,0 +1,131 @@
+"""The clutter segmenter finds the same objects whatever the image size of the camera (issue 15: real tables and
+cameras the system has never seen).
+
+Its pixel thresholds are stated for a 640x480 camera of focal length ~570 px. A camera with finer pixels (a 1280x960
+image of the same view) or coarser ones (320x240) sees the same scene; the segmenter picks its grid stride from the
+angle between the cloud's pixels so that its grid sees the same angles. The real mOSD learn scenes (Kinect, 640x480,
+read in place) are resampled here into the same view at twice and half the resolution: each pixel repeated 2x2 with
+the focal length doubled, or every other pixel kept with it halved. With the stride fixed at 2, the half-size image
+merged learn15's three stacked objects into two and the double-size one cut learn38's four boxes into six.
+"""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+import pytest
+from hypothesis import given
+from hypothesis import strategies as st
+
+from annotators.cloud.clutter import ClutterParameters, nearest_stride
+from annotators.readers.frame_io import Frame
+from annotators.readers.frame_readers import FileFrameReader, PcdReader
+from reasoning.evaluation.mosd import object_labels
+from reasoning.evaluation.segmentation import score_segmentation
+from robokudo.core.types import CameraIntrinsics
+from tests.annotators.conftest import SHARED_DATA, require_folder
+from trees.segmenters import segmenter
+
+LEARN = SHARED_DATA / "pcl_mosd_tabletop" / "learn"
+
+
+class GivenFrame(FileFrameReader):
+    """A reader of one frame already in memory, with its organized cloud."""
+
+    outputs = PcdReader.outputs
+
+    def __init__(self, frame: Frame) -> None:
+        super().__init__()
+        self.frame = frame
+
+    def decode(self) -> Frame:
+        return self.frame
+
+    def recording(self) -> str:
+        return self.frame.source
+
+
+def resampled(frame: Frame, factor: int, finer: bool) -> Frame:
+    """The same view seen by a camera with ``factor`` times finer pixels (each pixel repeated) or coarser ones
+    (every ``factor``-th pixel kept); the cloud is cast again along the new camera's rays at the same depths."""
+    k = frame.intrinsics
+    if finer:
+
+        def pick(a: np.ndarray) -> np.ndarray:
+            return np.repeat(np.repeat(a, factor, axis=0), factor, axis=1)
+
+        shift = (factor - 1) / 2
+        scale = float(factor)
+    else:
+
+        def pick(a: np.ndarray) -> np.ndarray:
+            return np.ascontiguousarray(a[::factor, ::factor])
+
+        shift = 0.0
+        scale = 1.0 / factor
+    depth = pick(frame.points[..., 2])
+    rows, cols = depth.shape
+    camera = CameraIntrinsics(k.fx * scale, k.fy * scale, k.cx * scale + shift, k.cy * scale + shift, cols, rows)
+    v, u = np.mgrid[0:rows, 0:cols].astype(np.float32)
+    points = np.stack(
+        [(u - camera.cx) / camera.fx * depth, (v - camera.cy) / camera.fy * depth, depth], axis=-1
+    ).astype(np.float32)
+    return Frame(
+        color=pick(frame.color),
+        depth=pick(frame.depth),
+        intrinsics=camera,
+        source=frame.source,
+        points=points,
+        labels=pick(frame.labels),
+    )
+
+
+def found(frame: Frame) -> tuple[int, int, int]:
+    """(objects found at box IoU >= 0.5, objects, segments) of the clutter segmenter on ``frame``."""
+    labels = segmenter("clutter").segment(GivenFrame(frame)).labels
+    score = score_segmentation(object_labels(frame.labels), labels, np.isfinite(frame.points[..., 2]))
+    return score.matched, score.objects, score.segments
+
+
+def learn_scene(name: str) -> Frame:
+    return PcdReader(require_folder(LEARN) / f"{name}.pcd").load()
+
+
+@given(st.floats(min_value=0.05, max_value=40.0))
+def test_the_stride_is_the_whole_number_nearest_by_ratio(ideal: float) -> None:
+    chosen = nearest_stride(ideal)
+    assert chosen >= 1
+    off = abs(math.log(chosen / ideal))
+    assert all(off <= abs(math.log(other / ideal)) + 1e-9 for other in range(1, 45))
+
+
+def test_kinect_and_realsense_at_640x480_keep_the_thresholds() -> None:
+    parameters = ClutterParameters()
+    assert parameters.for_camera(1 / 525.0) is parameters
+    assert parameters.for_camera(1 / 612.9) is parameters
+    assert parameters.for_camera(0.0) is parameters  # the angle could not be measured
+
+
+def test_pixel_thresholds_follow_the_stride_on_finer_and_coarser_cameras() -> None:
+    parameters = ClutterParameters()
+    finer = parameters.for_camera(1 / 1050.0)  # 1280x960
+    assert finer.stride == 4 and finer.min_points == 4 * parameters.min_points
+    assert finer.grow_distance == 2 * parameters.grow_distance and finer.cell == parameters.cell
+    coarser = parameters.for_camera(1 / 262.5)  # 320x240
+    assert coarser.stride == 1 and coarser.min_points == parameters.min_points // 4
+    assert ClutterParameters(reference_focal=0.0).for_camera(1 / 1050.0).stride == parameters.stride
+
+
+@pytest.mark.real_data
+@pytest.mark.parametrize("finer", [True, False], ids=["1280x960", "320x240"])
+def test_three_stacked_objects_are_found_at_twice_and_half_the_resolution(finer: bool) -> None:
+    scene = learn_scene("learn15")
+    assert found(scene) == (3, 3, 3)
+    assert found(resampled(scene, 2, finer)) == (3, 3, 3)
+
+
+@pytest.mark.real_data
+def test_four_boxes_are_not_cut_apart_by_a_finer_camera() -> None:
+    scene = learn_scene("learn38")
+    assert found(resampled(scene, 2, finer=True)) == (4, 4, 4)
