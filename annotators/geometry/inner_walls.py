@@ -79,21 +79,61 @@ def wall_points(
     return plane_points[wall, :2].astype(np.float64), normals
 
 
-def wall_axis(points: np.ndarray, normals: np.ndarray, rules: InnerWallRules) -> tuple[np.ndarray, float] | None:
-    """The ``(u, v)`` point that a wall's horizontal normals (Nx2 ``points`` and unit ``normals`` of
-    :func:`wall_points`, normals toward the camera) point at, and the wall's median distance from it, when the wall
-    curves around it concavely toward the camera: the least-squares meeting point of the normal lines, in front of
-    most of the wall (see :class:`InnerWallRules`); None for a flat, convex or too small wall."""
+def _meeting_point(points: np.ndarray, normals: np.ndarray, rules: InnerWallRules) -> np.ndarray | None:
+    """The least-squares meeting point of the normal lines of a wall (Nx2 ``points`` and unit ``normals`` of
+    :func:`wall_points`); None for a wall too small or too flat (its normals turn less than ``rules.min_turn``)."""
     if points.shape[0] < _MIN_WALL_POINTS:
         return None
     across = np.eye(2)[None] - normals[:, :, None] * normals[:, None, :]  # projections across each normal line
     matrix = across.sum(axis=0)
     if np.linalg.eigvalsh(matrix / points.shape[0])[0] < rules.min_turn:
         return None
-    axis = np.linalg.solve(matrix, np.einsum("nij,nj->i", across, points))
+    return np.linalg.solve(matrix, np.einsum("nij,nj->i", across, points))
+
+
+def wall_axis(points: np.ndarray, normals: np.ndarray, rules: InnerWallRules) -> tuple[np.ndarray, float] | None:
+    """The ``(u, v)`` point that a wall's horizontal normals (Nx2 ``points`` and unit ``normals`` of
+    :func:`wall_points`, normals toward the camera) point at, and the wall's median distance from it, when the wall
+    curves around it concavely toward the camera: the least-squares meeting point of the normal lines, in front of
+    most of the wall (see :class:`InnerWallRules`); None for a flat, convex or too small wall."""
+    axis = _meeting_point(points, normals, rules)
+    if axis is None:
+        return None
     facing = float(np.mean(np.einsum("ni,ni->n", axis - points, normals) > 0))
     distance = float(np.median(np.linalg.norm(axis - points, axis=1)))
     return (axis, distance) if facing > rules.facing else None
+
+
+def outer_wall_circle(
+    points: np.ndarray, normals: np.ndarray, rules: InnerWallRules
+) -> tuple[np.ndarray, float] | None:
+    """The ``(u, v)`` axis a wall's horizontal normals point away from, and the wall's median distance from it, when
+    the wall curves around it convexly (the outside of a round body: the meeting point of :func:`wall_axis`, behind
+    most of the wall); None for a flat, concave or too small wall."""
+    axis = _meeting_point(points, normals, rules)
+    if axis is None:
+        return None
+    away = float(np.mean(np.einsum("ni,ni->n", points - axis, normals) > 0))
+    distance = float(np.median(np.linalg.norm(axis - points, axis=1)))
+    return (axis, distance) if away > rules.facing else None
+
+
+def within_outer_wall(
+    inner: np.ndarray, outside: np.ndarray, outside_normals: np.ndarray, floor: np.ndarray, rules: InnerWallRules
+) -> bool:
+    """Does a round outer wall (Nx2 ``outside`` points and unit normals, :func:`wall_points`) hold the inner wall's
+    Mx2 points ``inner``: it curves convexly around an axis (:func:`outer_wall_circle`) inside the Kx1x2 float32
+    ``floor`` polygon and the inner wall lies within its circle (their median distance from that axis no more than
+    its radius)? Fitted on the back arc of a small inside, the inner wall's own axis may lie a centimetre off, so
+    far that the outer wall's front arc comes nearer it than the inside; the outer wall's front arc, wider, places
+    the common axis better. An object standing in a bowl does not hold the bowl's inside within its own circle."""
+    circle = outer_wall_circle(outside, outside_normals, rules)
+    if circle is None or inner.shape[0] == 0:
+        return False
+    axis, radius = circle
+    if cv2.pointPolygonTest(floor, (float(axis[0]), float(axis[1])), False) <= 0:
+        return False
+    return bool(np.median(np.linalg.norm(inner - axis, axis=1)) <= radius)
 
 
 def one_wall(first: tuple[np.ndarray, float], second: tuple[np.ndarray, float] | None, share: float) -> bool:
@@ -178,6 +218,9 @@ def inner_wall_holders(
             continue
         outside, outside_normals = walls(holder)  # the outer wall surrounds the inner one: no nearer the axis
         if outside.shape[0] >= _MIN_WALL_POINTS and np.median(np.linalg.norm(outside - axis, axis=1)) >= radius:
+            shaped.append((piece, holder))
+            continue
+        if within_outer_wall(walls(piece)[0], outside, outside_normals, floor, rules):
             shaped.append((piece, holder))
             continue
         if holder not in axes:

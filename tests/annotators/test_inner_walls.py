@@ -1,12 +1,23 @@
 """The inner-wall axis: a wall concave toward the camera (the back of a container's inside) has an axis in front of
-it, a convex (a solid's front) or flat wall none, and floor points are no wall. The join itself is tested on real
-frames in test_segmentation_real.py (the blue mug; the can in the teal bowl)."""
+it, a convex (a solid's front) or flat wall none, and floor points are no wall; a round outer wall holds its own
+inside within its circle, not the inside of a bowl an object stands in. The join itself is tested on real frames in
+test_segmentation_real.py (the blue mug; the can in the teal bowl) and test_clutter_camera_resolution_real.py (the
+stereo camera's mug)."""
 
 from __future__ import annotations
 
+import cv2
 import numpy as np
 
-from annotators.geometry.inner_walls import InnerWallRules, inside_candidates, one_wall, wall_axis, wall_points
+from annotators.geometry.inner_walls import (
+    InnerWallRules,
+    inside_candidates,
+    one_wall,
+    outer_wall_circle,
+    wall_axis,
+    wall_points,
+    within_outer_wall,
+)
 
 
 def arc(centre: tuple[float, float], radius: float, start: float, stop: float, inward: bool) -> np.ndarray:
@@ -74,3 +85,34 @@ def test_two_halves_of_one_inner_wall_are_one_wall_and_a_neighbouring_inside_is_
     nested = axis_of((0.7, 0.3), 0.03, -np.pi / 2, np.pi / 2)  # a cup standing in the bowl's middle
     assert not one_wall(left, nested, rules.same_axis)
     assert not one_wall(left, None, rules.same_axis)
+
+
+def footprint(centre: tuple[float, float], radius: float) -> np.ndarray:
+    """The float32 Kx1x2 polygon of a disc's footprint, as the join's floor."""
+    angles = np.linspace(0.0, 2 * np.pi, 24, endpoint=False)
+    ring = np.column_stack([np.cos(angles), np.sin(angles)]) * radius + centre
+    return cv2.convexHull(ring.astype(np.float32))
+
+
+def test_a_round_front_wall_curves_around_its_axis_behind_it() -> None:
+    rules = InnerWallRules()
+    points, normals = arc((0.6, 0.1), 0.045, 2 * np.pi / 3, 4 * np.pi / 3, inward=False)  # a mug's outer front
+    found = outer_wall_circle(*wall_points(points, normals, rules), rules)
+    assert found is not None
+    axis, radius = found
+    assert np.allclose(axis, (0.6, 0.1), atol=1e-6) and abs(radius - 0.045) < 1e-6
+    back, back_normals = arc((0.6, 0.1), 0.04, -np.pi / 3, np.pi / 3, inward=True)  # its inside: concave
+    assert outer_wall_circle(*wall_points(back, back_normals, rules), rules) is None
+
+
+def test_a_mugs_outer_wall_holds_its_inside_and_a_can_in_a_bowl_does_not_hold_the_bowls() -> None:
+    rules = InnerWallRules()
+    outside = wall_points(*arc((0.6, 0.1), 0.045, 2 * np.pi / 3, 4 * np.pi / 3, inward=False), rules)
+    inside, _ = wall_points(*arc((0.6, 0.1), 0.041, -np.pi / 3, np.pi / 3, inward=True), rules)
+    assert within_outer_wall(inside, *outside, footprint((0.6, 0.1), 0.046), rules)
+    # a can (radius 3.3 cm) standing in a bowl (inner radius 7 cm), off its middle: the bowl's inside lies outside it
+    can = wall_points(*arc((0.58, 0.12), 0.033, 2 * np.pi / 3, 4 * np.pi / 3, inward=False), rules)
+    bowl_inside, _ = wall_points(*arc((0.6, 0.1), 0.07, -np.pi / 3, np.pi / 3, inward=True), rules)
+    assert not within_outer_wall(bowl_inside, *can, footprint((0.6, 0.1), 0.08), rules)
+    # a round body whose axis lies outside the floor the two pieces stand on holds nothing
+    assert not within_outer_wall(inside, *outside, footprint((0.8, 0.3), 0.02), rules)
