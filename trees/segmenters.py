@@ -61,7 +61,7 @@ def hypothesis_labels(hypotheses: list[ObjectHypothesis], shape: tuple[int, int]
     return labels
 
 
-def _with_front(make: Callable[[], Annotator]) -> Callable[[FileFrameReader], SegmentedFrame]:
+def with_front(make: Callable[[], Annotator]) -> Callable[[FileFrameReader], SegmentedFrame]:
     """Run reader, range filter (0.2-2.5 m), support plane and the segmenter ``make()`` once on the frame."""
 
     def segment(reader: FileFrameReader) -> SegmentedFrame:
@@ -86,15 +86,15 @@ def _open3d(reader: FileFrameReader) -> SegmentedFrame:
 SEGMENTERS: Mapping[str, Segmenter] = MappingProxyType(
     {
         "clutter": Segmenter(
-            "clutter", "ClutterSegmenter: convexly connected surfaces (new)", _with_front(ClutterSegmenter)
+            "clutter", "ClutterSegmenter: convexly connected surfaces (new)", with_front(ClutterSegmenter)
         ),
         "clutter-grown": Segmenter(
             "clutter-grown",
             "ClutterSegmenter with patches grown from the flattest pixels: no cell phase (alternative)",
-            _with_front(lambda: ClutterSegmenter(grown_patches=True)),
+            with_front(lambda: ClutterSegmenter(grown_patches=True)),
         ),
         "clusters": Segmenter(
-            "clusters", "ClusterExtractor: cuts and footprint merging (old)", _with_front(ClusterExtractor)
+            "clusters", "ClusterExtractor: cuts and footprint merging (old)", with_front(ClusterExtractor)
         ),
         "open3d": Segmenter("open3d", "untuned Open3D plane RANSAC + DBSCAN at 2 cm (baseline)", _open3d),
     }

@@ -25,66 +25,15 @@ from hypothesis import strategies as st
 
 from annotators.cloud.clutter import ClutterParameters, nearest_stride
 from annotators.readers.frame_io import Frame
-from annotators.readers.frame_readers import FileFrameReader, PcdReader
+from annotators.readers.frame_readers import PcdReader
 from reasoning.evaluation.mosd import object_labels
 from reasoning.evaluation.segmentation import score_segmentation
-from robokudo.core.types import CameraIntrinsics
+from tests.annotators.camera_resampling import GivenFrame, resampled
 from tests.annotators.conftest import SHARED_DATA, require_folder
 from trees.segmenters import segmenter
 
 LEARN = SHARED_DATA / "pcl_mosd_tabletop" / "learn"
 STEREO_MUG = SHARED_DATA / "pcl_tabletop_pcd" / "table_scene_mug_stereo_textured.pcd"
-
-
-class GivenFrame(FileFrameReader):
-    """A reader of one frame already in memory, with its organized cloud."""
-
-    outputs = PcdReader.outputs
-
-    def __init__(self, frame: Frame) -> None:
-        super().__init__()
-        self.frame = frame
-
-    def decode(self) -> Frame:
-        return self.frame
-
-    def recording(self) -> str:
-        return self.frame.source
-
-
-def resampled(frame: Frame, factor: int, finer: bool) -> Frame:
-    """The same view seen by a camera with ``factor`` times finer pixels (each pixel repeated) or coarser ones
-    (every ``factor``-th pixel kept); the cloud is cast again along the new camera's rays at the same depths."""
-    k = frame.intrinsics
-    if finer:
-
-        def pick(a: np.ndarray) -> np.ndarray:
-            return np.repeat(np.repeat(a, factor, axis=0), factor, axis=1)
-
-        shift = (factor - 1) / 2
-        scale = float(factor)
-    else:
-
-        def pick(a: np.ndarray) -> np.ndarray:
-            return np.ascontiguousarray(a[::factor, ::factor])
-
-        shift = 0.0
-        scale = 1.0 / factor
-    depth = pick(frame.points[..., 2])
-    rows, cols = depth.shape
-    camera = CameraIntrinsics(k.fx * scale, k.fy * scale, k.cx * scale + shift, k.cy * scale + shift, cols, rows)
-    v, u = np.mgrid[0:rows, 0:cols].astype(np.float32)
-    points = np.stack(
-        [(u - camera.cx) / camera.fx * depth, (v - camera.cy) / camera.fy * depth, depth], axis=-1
-    ).astype(np.float32)
-    return Frame(
-        color=pick(frame.color),
-        depth=pick(frame.depth),
-        intrinsics=camera,
-        source=frame.source,
-        points=points,
-        labels=pick(frame.labels),
-    )
 
 
 def found(frame: Frame) -> tuple[int, int, int]:
