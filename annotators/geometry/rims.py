@@ -280,6 +280,8 @@ def single_rim_joins(labels: np.ndarray, plane_points: np.ndarray, rules: RimRul
         return []
     step = max(1, rules.sample_step)
     pixels, starts = label_groups(np.ascontiguousarray(labels[::step, ::step]))
+    # a small piece may have no pixel on the sampled rows and columns (above the sampled labels): it owns none
+    starts = np.pad(starts, (0, max(0, int(labels.max()) + 2 - starts.size)), mode="edge")
     flat = np.ascontiguousarray(plane_points[::step, ::step]).reshape(-1, 3)
     coordinates: dict[int, np.ndarray] = {}
 

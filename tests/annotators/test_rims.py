@@ -15,6 +15,7 @@ from annotators.geometry.rims import (
     curves_like_a_rim,
     fit_circle,
     join_rim_pieces,
+    join_single_rims,
     stands_inside,
 )
 from annotators.geometry.support import SupportRules, join_unsupported
@@ -143,3 +144,15 @@ def test_a_can_standing_in_a_whole_bowl_is_no_piece_of_it() -> None:
     assert apart[5, 5] != apart[25, 20]
     joined = join_unsupported(labels, plane, SupportRules(standing_inside=False))
     assert joined[5, 5] == joined[25, 20]  # without the rim test it would be taken for a piece of the bowl
+
+
+def test_a_piece_the_sampled_rows_miss_joins_nothing_and_breaks_nothing() -> None:
+    """join_single_rims reads every second row and column: a piece of one pixel on an odd row and column (the highest
+    label) has none of them. It crashed the segmenter on mOSD learn4 seen by a camera rolled by 270 degrees."""
+    labels, plane = grid_of(
+        {1: (slice(0, 20), slice(0, 40), inner_wall(-90.0, 90.0)), 2: (slice(20, 30), slice(0, 40), outer_wall())},
+        (30, 40),
+    )
+    labels[21, 21] = 3
+    joined = join_single_rims(labels, plane)
+    assert joined[21, 21] != 0 and joined[5, 5] == joined[25, 5]  # the inner wall still joins its outer wall
