@@ -1,6 +1,7 @@
 """The clutter segmenter on cameras of other image sizes: the 45 labelled mOSD learn scenes (Kinect, 640x480) seen
 through finer pixels (1280x960: each pixel repeated 2x2, focal length doubled) and coarser ones (320x240: every other
-pixel, focal length halved), scored as ``robokudo eval segmentation`` scores them, per category.
+pixel, focal length halved) and through the camera rolled about its axis by 90, 180 and 270 degrees, scored as
+``robokudo eval segmentation`` scores them, per category.
 
     python bench/bench_camera_resolution.py
 
@@ -8,7 +9,9 @@ Two segmenters side by side in one run, on the same resampled frames: the Clutte
 follows the camera's pixel angle, ``ClutterParameters.for_camera``) and with the stride fixed at 2 whatever the camera
 (``reference_focal=0``). Both are identical at 640x480. Also the median time of the tree's front and segmenter per
 scene (reading excluded). The pixels' repetition adds no detail a real finer camera would see: this measures that
-the thresholds scale with the camera, not how a real 1280x960 sensor's noise behaves.
+the thresholds scale with the camera, not how a real 1280x960 sensor's noise behaves. A roll changes no stride: both
+segmenters answer alike there, and what moves is where the grid's cells fall on the objects and which way ties in
+the growth from seeds break.
 """
 
 from __future__ import annotations
@@ -28,11 +31,13 @@ from annotators.readers.frame_io import Frame  # noqa: E402
 from annotators.readers.frame_readers import PcdReader  # noqa: E402
 from reasoning.evaluation.mosd import object_labels, scene_category  # noqa: E402
 from reasoning.evaluation.segmentation import SegmentationScore, score_segmentation, summarize  # noqa: E402
-from tests.annotators.camera_resampling import GivenFrame, resampled  # noqa: E402
+from tests.annotators.camera_resampling import GivenFrame, resampled, rolled  # noqa: E402
 from trees.segmenters import with_front  # noqa: E402
 
 MOSD = (ROOT.parent / "shared" / "data" / "pcl_mosd_tabletop" / "learn").resolve()
-CAMERAS = {"640x480": (1, True), "1280x960": (2, True), "320x240": (2, False)}
+CAMERAS = {"640x480": (1, True, 0), "1280x960": (2, True, 0), "320x240": (2, False, 0)} | {
+    f"roll {90 * turns}": (1, True, turns) for turns in (1, 2, 3)
+}
 SEGMENTERS = {
     "follows the camera": with_front(ClutterSegmenter),
     "stride fixed at 2": with_front(lambda: ClutterSegmenter(reference_focal=0.0)),
@@ -41,8 +46,9 @@ CATEGORIES = ("boxes", "stacked", "occluded", "cylindric")
 
 
 def camera_view(frame: Frame, camera: str) -> Frame:
-    factor, finer = CAMERAS[camera]
-    return frame if factor == 1 else resampled(frame, factor, finer)
+    factor, finer, turns = CAMERAS[camera]
+    seen = frame if factor == 1 else resampled(frame, factor, finer)
+    return rolled(seen, turns) if turns else seen
 
 
 def main() -> None:

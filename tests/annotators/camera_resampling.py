@@ -1,6 +1,7 @@
 """One recorded view as other cameras would see it, shared by the tests and bench/bench_camera_resolution.py: the same
 scene through finer pixels (each pixel repeated, focal length multiplied) or coarser ones (every few pixels kept,
-focal length divided), and a reader that hands such a frame to a tree."""
+focal length divided), or through the camera rolled by quarter turns about its axis, and a reader that hands such a
+frame to a tree."""
 
 from __future__ import annotations
 
@@ -62,4 +63,33 @@ def resampled(frame: Frame, factor: int, finer: bool) -> Frame:
         source=frame.source,
         points=points,
         labels=None if frame.labels is None else pick(frame.labels),
+    )
+
+
+def rolled(frame: Frame, quarter_turns: int) -> Frame:
+    """``frame`` (with its organized cloud) seen by the camera rolled about its optical axis so that the image turns
+    by ``quarter_turns`` x 90 degrees counter-clockwise (``np.rot90``); the cloud turns with the camera."""
+    if frame.points is None:
+        raise ValueError(f"{frame.source} has no organized cloud to roll")
+    turns = quarter_turns % 4
+    points = frame.points
+    for _ in range(turns):  # a pixel's image column becomes its row: (x, y) -> (y, -x) in the camera frame
+        points = np.stack([points[..., 1], -points[..., 0], points[..., 2]], axis=-1)
+
+    def turned(a: np.ndarray) -> np.ndarray:
+        return np.ascontiguousarray(np.rot90(a, turns))
+
+    k = frame.intrinsics
+    rows, cols = (k.width, k.height) if turns % 2 else (k.height, k.width)
+    fx, fy = (k.fy, k.fx) if turns % 2 else (k.fx, k.fy)
+    cx, cy = {0: (k.cx, k.cy), 1: (k.cy, k.width - 1 - k.cx), 2: (k.width - 1 - k.cx, k.height - 1 - k.cy)}.get(
+        turns, (k.height - 1 - k.cy, k.cx)
+    )
+    return Frame(
+        color=turned(frame.color),
+        depth=turned(frame.depth),
+        intrinsics=CameraIntrinsics(fx, fy, cx, cy, cols, rows),
+        source=frame.source,
+        points=turned(points).astype(np.float32),
+        labels=None if frame.labels is None else turned(frame.labels),
     )

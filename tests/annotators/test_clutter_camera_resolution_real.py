@@ -12,6 +12,9 @@ The one real camera of the shared data with finer pixels is PCL's active stereo 
 640x480, table_scene_mug_stereo_textured.pcd): its grid stride is 3. There the mug's inside, seen over the rim, fitted
 an axis a centimetre in front of the true one, and the inside stayed apart from the outer wall; the inner-wall join
 now also takes the outer wall's own circle (annotators/geometry/inner_walls.py, within_outer_wall).
+
+A camera rolled about its axis (a tilted head, a wrist camera) turns the image: on learn4 turned by 270 degrees a
+one-pixel piece fell between the rows the single-rim join samples and the segmenter failed with an IndexError.
 """
 
 from __future__ import annotations
@@ -28,7 +31,7 @@ from annotators.readers.frame_io import Frame
 from annotators.readers.frame_readers import PcdReader
 from reasoning.evaluation.mosd import object_labels
 from reasoning.evaluation.segmentation import score_segmentation
-from tests.annotators.camera_resampling import GivenFrame, resampled
+from tests.annotators.camera_resampling import GivenFrame, resampled, rolled
 from tests.annotators.conftest import SHARED_DATA, require_folder
 from trees.segmenters import segmenter
 
@@ -92,3 +95,9 @@ def test_the_stereo_cameras_mug_is_one_object() -> None:
     labels = segmenter("clutter").segment(GivenFrame(frame)).labels
     assert labels.max() == 1
     assert labels[255, 350] == labels[340, 420] == 1  # the inside seen over the rim, the outer wall
+
+
+@pytest.mark.real_data
+@pytest.mark.parametrize("quarter_turns", [1, 2, 3])
+def test_both_objects_are_found_by_a_rolled_camera(quarter_turns: int) -> None:
+    assert found(rolled(learn_scene("learn4"), quarter_turns)) == (2, 2, 2)
