@@ -79,16 +79,21 @@ def wall_points(
     return plane_points[wall, :2].astype(np.float64), normals
 
 
-def _meeting_point(points: np.ndarray, normals: np.ndarray, rules: InnerWallRules) -> np.ndarray | None:
-    """The least-squares meeting point of the normal lines of a wall (Nx2 ``points`` and unit ``normals`` of
-    :func:`wall_points`); None for a wall too small or too flat (its normals turn less than ``rules.min_turn``)."""
+def _wall_circle(
+    points: np.ndarray, normals: np.ndarray, rules: InnerWallRules
+) -> tuple[np.ndarray, float, float] | None:
+    """For a wall (Nx2 ``points`` and unit ``normals`` of :func:`wall_points`): the least-squares meeting point of
+    its normal lines, the share of its points whose normals point toward it and their median distance from it; None
+    for a wall too small or too flat (its normals turn less than ``rules.min_turn``)."""
     if points.shape[0] < _MIN_WALL_POINTS:
         return None
     across = np.eye(2)[None] - normals[:, :, None] * normals[:, None, :]  # projections across each normal line
     matrix = across.sum(axis=0)
     if np.linalg.eigvalsh(matrix / points.shape[0])[0] < rules.min_turn:
         return None
-    return np.linalg.solve(matrix, np.einsum("nij,nj->i", across, points))
+    axis = np.linalg.solve(matrix, np.einsum("nij,nj->i", across, points))
+    facing = float(np.mean(np.einsum("ni,ni->n", axis - points, normals) > 0))
+    return axis, facing, float(np.median(np.linalg.norm(axis - points, axis=1)))
 
 
 def wall_axis(points: np.ndarray, normals: np.ndarray, rules: InnerWallRules) -> tuple[np.ndarray, float] | None:
@@ -96,12 +101,10 @@ def wall_axis(points: np.ndarray, normals: np.ndarray, rules: InnerWallRules) ->
     :func:`wall_points`, normals toward the camera) point at, and the wall's median distance from it, when the wall
     curves around it concavely toward the camera: the least-squares meeting point of the normal lines, in front of
     most of the wall (see :class:`InnerWallRules`); None for a flat, convex or too small wall."""
-    axis = _meeting_point(points, normals, rules)
-    if axis is None:
+    found = _wall_circle(points, normals, rules)
+    if found is None or found[1] <= rules.facing:
         return None
-    facing = float(np.mean(np.einsum("ni,ni->n", axis - points, normals) > 0))
-    distance = float(np.median(np.linalg.norm(axis - points, axis=1)))
-    return (axis, distance) if facing > rules.facing else None
+    return found[0], found[2]
 
 
 def outer_wall_circle(
@@ -110,12 +113,10 @@ def outer_wall_circle(
     """The ``(u, v)`` axis a wall's horizontal normals point away from, and the wall's median distance from it, when
     the wall curves around it convexly (the outside of a round body: the meeting point of :func:`wall_axis`, behind
     most of the wall); None for a flat, concave or too small wall."""
-    axis = _meeting_point(points, normals, rules)
-    if axis is None:
+    found = _wall_circle(points, normals, rules)
+    if found is None or 1.0 - found[1] <= rules.facing:
         return None
-    away = float(np.mean(np.einsum("ni,ni->n", points - axis, normals) > 0))
-    distance = float(np.median(np.linalg.norm(axis - points, axis=1)))
-    return (axis, distance) if away > rules.facing else None
+    return found[0], found[2]
 
 
 def within_outer_wall(
