@@ -348,7 +348,9 @@ def segment_clutter(
     reach = max(2.0 * p.cell, p.grow_distance / step)
     # the angle between neighbouring pixels, a property of the camera: measured once, on every few rows
     footprint = pixel_footprint(np.ascontiguousarray(grid[::FOOTPRINT_ROWS]))
-    objects = convex_objects(patches, grid, p.convexity_rules(), region & ~seams, grow=reach, footprint=footprint)
+    objects = convex_objects(
+        patches, grid, p.convexity_rules(), region & ~seams, grow=reach, footprint=footprint, surfaces=surfaces
+    )
     labels = grow_on_surface(objects.labels, region, depth, p.jump_absolute, p.jump_relative)
     basis = plane_basis(np.asarray(model[:3], dtype=np.float64)).T.astype(np.float32)
     to_plane = np.column_stack([basis, np.asarray(model[:3], dtype=np.float32)])

@@ -28,9 +28,11 @@ from annotators.geometry.grid_kernels import (
     symmetric_eigen,
 )
 from annotators.geometry.grid_segmentation import (
+    SeedDistances,
     distinct_keys,
     grow_from_seeds,
     join_unless_apart,
+    label_parts,
     pixel_footprint,
     seed_distances,
     touching_pairs,
@@ -227,6 +229,7 @@ def convex_objects(
     between: np.ndarray | None = None,
     grow: float = 0.0,
     footprint: float | None = None,
+    surfaces: np.ndarray | None = None,
 ) -> ConvexObjects:
     """Objects (:class:`ConvexObjects`) from surface patches in two steps.
 
@@ -241,9 +244,11 @@ def convex_objects(
        crease that agrees with both sides cannot join them.
 
     Patches touch when they are 4-neighbours once grown by up to ``rules.gap_width`` pixels into the unlabelled
-    pixels between them that ``between`` allows (HxW bool; default: every pixel with a point) and their centroids
-    are close in 3-D (:func:`close_in_space`). Patches without a trustworthy plane (fewer than ``rules.min_patch``
-    points, thicker than ``rules.max_thickness`` or narrower than ``rules.min_width``) are left out (0).
+    pixels between them that ``between`` allows (HxW bool; default: every pixel with a point), each on its own
+    surface (:func:`bridge_gaps`; ``surfaces``: the 4-connected parts of ``between``, when the caller has them), and
+    their centroids are close in 3-D (:func:`close_in_space`). Patches without a trustworthy plane (fewer than
+    ``rules.min_patch`` points, thicker than ``rules.max_thickness`` or narrower than ``rules.min_width``) are left
+    out (0).
     With ``grow`` > 0 the object labels are grown by up to ``grow`` pixels into the unlabelled pixels of ``between``
     (what :func:`~annotators.geometry.grid_segmentation.grow_labels` gives), from the distance transform of the
     gap growth (the objects cover the kept patches' pixels). ``footprint`` is the
@@ -255,8 +260,9 @@ def convex_objects(
     usable = np.concatenate([[False], (planes.counts >= rules.min_patch) & trusted])
     kept = np.where(usable[patches], patches, 0)
     between = np.isfinite(points[..., 2]) if between is None else between
+    surfaces = label_parts(between | (kept > 0), 1) if surfaces is None else surfaces
     seeds = seed_distances(kept, between | (kept > 0), max(rules.gap_width, grow))
-    pairs = touching_pairs(grow_from_seeds(kept, seeds, rules.gap_width))
+    pairs = touching_pairs(bridge_gaps(kept, seeds, rules.gap_width, surfaces))
     if footprint is None:
         footprint = pixel_footprint(points)
     pairs = pairs[close_in_space(patches, planes, pairs, footprint, rules.close_factor)]
@@ -268,6 +274,19 @@ def convex_objects(
     if grow > 0:
         labels = grow_from_seeds(labels, seeds, grow)
     return ConvexObjects(labels, seeded)
+
+
+def bridge_gaps(kept: np.ndarray, seeds: SeedDistances | None, gap: float, surfaces: np.ndarray) -> np.ndarray:
+    """The patch labels ``kept`` grown by up to ``gap`` pixels into the gaps between them (``seeds`` from
+    :func:`~annotators.geometry.grid_segmentation.seed_distances`), a grown pixel keeping its label only on the
+    surface (``surfaces``: labels of depth-continuous parts holding every patch) its patch lies on. The growth goes by
+    distance in the image: a pixel in front of a depth jump as far from a patch behind as from one of its own would
+    otherwise go to either by the order the image is scanned in, and the two objects would touch or not as the camera
+    is rolled (mOSD learn21 turned by 180 degrees)."""
+    grown = grow_from_seeds(kept, seeds, gap)
+    surface_of = np.zeros(int(kept.max()) + 1, dtype=surfaces.dtype)
+    surface_of[kept[kept > 0]] = surfaces[kept > 0]
+    return np.where(surfaces == surface_of[grown], grown, 0)
 
 
 def connection_votes(

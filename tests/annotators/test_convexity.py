@@ -4,7 +4,9 @@ between an occluding edge and the surface behind it - casts no convex vote with 
 object's limb, bending outward, still does. Across a crease, a connection bending inward - two boxes' faces
 meeting at right angles across the depth gap between them - is told from a box's edge, which bends outward, even
 when it bends too gently for the concave limit. A grid cell holding two pieces of one surface that meet only outside
-it - the two sides of a depth seam the surface runs around - gives a patch to each piece."""
+it - the two sides of a depth seam the surface runs around - gives a patch to each piece. Patches grown into the gaps
+between them touch only on their own surfaces, so no growth across a depth seam makes a box touch the box behind it
+as the image's scan order happens to break a tie."""
 
 from __future__ import annotations
 
@@ -14,12 +16,14 @@ from annotators.geometry.convexity import (
     ConvexityRules,
     ConvexObjects,
     PatchPlanes,
+    bridge_gaps,
     connection_votes,
     grazing_patches,
     grid_patches,
     inward_creases,
     join_faces,
 )
+from annotators.geometry.grid_segmentation import seed_distances, touching_pairs
 
 PAIR = np.array([[1, 2]])
 
@@ -148,3 +152,21 @@ def test_a_label_grown_on_its_own_surface_is_not_spilled() -> None:
     objects, surfaces = _front_box_and_box_behind()
     one_surface = np.ones_like(surfaces)  # no depth seam: the grown pixels lie on a surface the label has seeds on
     assert not objects.spilled(one_surface).any()
+
+
+def test_patches_grown_into_a_gap_touch_only_on_their_own_surface() -> None:
+    # the box behind (surface 2, rows 0-2) above a depth seam (row 3, no surface) and the box in front (surface 1,
+    # rows 4-9); patch 1 holds rows 0-1 of the box behind, patch 2 rows 8-9 of the box in front. Row 4, in front,
+    # lies 3 pixels from patch 1 straight through the seam and 4 from its own patch
+    surfaces = np.zeros((10, 8), dtype=np.int32)
+    surfaces[:3], surfaces[4:] = 2, 1
+    kept = np.zeros((10, 8), dtype=np.int32)
+    kept[:2], kept[8:] = 1, 2
+    seeds = seed_distances(kept, surfaces > 0, 4.0)
+    bridged = bridge_gaps(kept, seeds, 4.0, surfaces)
+    assert (bridged[2] == 1).all() and (bridged[4] == 0).all() and (bridged[5:8] == 2).all()
+    assert touching_pairs(bridged).shape[0] == 0  # the box in front does not touch the box behind
+    for turns in range(1, 4):  # the same whichever way up the image lies
+        turned_kept, turned_surfaces = (np.ascontiguousarray(np.rot90(a, turns)) for a in (kept, surfaces))
+        grown = bridge_gaps(turned_kept, seed_distances(turned_kept, turned_surfaces > 0, 4.0), 4.0, turned_surfaces)
+        assert np.array_equal(np.rot90(grown, -turns), bridged)
