@@ -1,7 +1,7 @@
 """One recorded view as other cameras would see it, shared by the tests and bench/bench_camera_resolution.py: the same
 scene through finer pixels (each pixel repeated, focal length multiplied) or coarser ones (every few pixels kept,
-focal length divided), or through the camera rolled by quarter turns about its axis, and a reader that hands such a
-frame to a tree."""
+focal length divided), through the camera rolled by quarter turns about its axis or through a noisier sensor, and a
+reader that hands such a frame to a tree."""
 
 from __future__ import annotations
 
@@ -92,4 +92,24 @@ def rolled(frame: Frame, quarter_turns: int) -> Frame:
         source=frame.source,
         points=turned(points).astype(np.float32),
         labels=None if frame.labels is None else turned(frame.labels),
+    )
+
+
+def noisier(frame: Frame, millimetres_at_1m: float, seed: int = 0) -> Frame:
+    """``frame`` (with its organized cloud) from a noisier sensor: each point moved along its ray by Gaussian noise
+    of ``millimetres_at_1m * z^2`` (the depth noise of a structured-light or stereo camera grows with the square
+    of the depth), drawn with ``seed``."""
+    if frame.points is None:
+        raise ValueError(f"{frame.source} has no organized cloud to add noise to")
+    depth = frame.points[..., 2]
+    noise = np.random.default_rng(seed).normal(0.0, 1.0, depth.shape).astype(np.float32)
+    scale = 1.0 + noise * np.float32(millimetres_at_1m / 1000.0) * depth  # z (1 + n s z): sigma s z^2 along the ray
+    points = (frame.points * scale[..., None]).astype(np.float32)
+    return Frame(
+        color=frame.color,
+        depth=frame.depth,
+        intrinsics=frame.intrinsics,
+        source=frame.source,
+        points=points,
+        labels=frame.labels,
     )
