@@ -266,9 +266,10 @@ def convex_objects(
     if footprint is None:
         footprint = pixel_footprint(points)
     pairs = pairs[close_in_space(patches, planes, pairs, footprint, rules.close_factor)]
-    continuous, convex, concave = connection_votes(planes, pairs, rules)
+    bending = connection_bending(planes, pairs)  # the votes and the creases read it
+    continuous, convex, concave = connection_votes(planes, pairs, rules, bending)
     faces = _components(pairs[continuous], count)
-    objects = join_faces(faces, pairs, convex, concave, planes, rules)
+    objects = join_faces(faces, pairs, convex, concave, planes, rules, bending)
     labels = _dense(objects[faces], usable)[kept]
     seeded = kept > 0
     if grow > 0:
@@ -290,12 +291,13 @@ def bridge_gaps(kept: np.ndarray, seeds: SeedDistances | None, gap: float, surfa
 
 
 def connection_votes(
-    planes: PatchPlanes, pairs: np.ndarray, rules: ConvexityRules
+    planes: PatchPlanes, pairs: np.ndarray, rules: ConvexityRules, bending: np.ndarray | None = None
 ) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
     """For Kx2 touching patch labels: is each connection continuous (one face: normals and the centroid line within
-    ``rules.smooth_degrees``, no concave bend), and does it vote convex or concave (see :func:`convex_objects`)?"""
+    ``rules.smooth_degrees``, no concave bend), and does it vote convex or concave (see :func:`convex_objects`)?
+    ``bending`` is the pairs' :func:`connection_bending` when the caller has it."""
     parallel, in_planes = _alignment(planes, pairs, rules.smooth_degrees)
-    bending = connection_bending(planes, pairs)
+    bending = connection_bending(planes, pairs) if bending is None else bending
     concave = bending < -rules.concave_bending
     continuous = parallel & in_planes & ~concave
     convex = ~concave & (continuous | ~parallel)
@@ -356,10 +358,12 @@ def join_faces(
     concave: np.ndarray,
     planes: PatchPlanes,
     rules: ConvexityRules,
+    bending: np.ndarray | None = None,
 ) -> np.ndarray:
     """The object of each face (indexed by face label; ``faces`` gives each patch label's face, index 0 no patch):
     faces joined by the votes of the patch connections ``pairs`` (Kx2 patch labels, :func:`connection_votes`' verdicts
-    ``convex`` and ``concave``; see :func:`convex_objects`)."""
+    ``convex`` and ``concave``; see :func:`convex_objects`; ``bending`` their :func:`connection_bending` when the
+    caller has it)."""
     count = faces.size
     face_a, face_b = faces[pairs[:, 0]], faces[pairs[:, 1]]
     apart = face_a != face_b
@@ -368,7 +372,7 @@ def join_faces(
     votes = np.maximum(np.bincount(inverse, minlength=keys.size), 1)
     large = np.bincount(faces, weights=planes_sizes(planes, count), minlength=count) >= rules.min_face
     between_large = large[face_a] & large[face_b]
-    bending = connection_bending(planes, pairs)
+    bending = connection_bending(planes, pairs) if bending is None else bending
     convex = convex & ~(between_large & inward_creases(planes, pairs, rules.crease_degrees, bending))
     share = np.bincount(inverse, weights=convex[apart], minlength=keys.size) / votes
     concave_votes = np.bincount(inverse, weights=concave[apart], minlength=keys.size)

@@ -197,12 +197,16 @@ def inner_wall_holders(
 
     step = max(1, support.sample_step)
 
+    measured: dict[int, tuple[np.ndarray, np.ndarray]] = {}
+
     def walls(label: int) -> tuple[np.ndarray, np.ndarray]:
-        """The wall points of a label, on every ``step``-th pixel of its box."""
-        bx0, by0, bx1, by1 = pieces.boxes[label]
-        window = (slice(by0, by1, step), slice(bx0, bx1, step))
-        inside = labels[window] == label
-        return wall_points(grid_plane[window][inside], normals[window][inside] @ to_plane, rules)
+        """The wall points of a label, on every ``step``-th pixel of its box (measured once per label)."""
+        if label not in measured:
+            bx0, by0, bx1, by1 = pieces.boxes[label]
+            window = (slice(by0, by1, step), slice(bx0, bx1, step))
+            inside = labels[window] == label
+            measured[label] = wall_points(grid_plane[window][inside], normals[window][inside] @ to_plane, rules)
+        return measured[label]
 
     # the shape first (cheap, and few pieces are concave), the borders in 3-D only for the pairs it leaves
     axes: dict[int, tuple[np.ndarray, float] | None] = {}

@@ -72,23 +72,18 @@ def rolled(frame: Frame, quarter_turns: int) -> Frame:
     if frame.points is None:
         raise ValueError(f"{frame.source} has no organized cloud to roll")
     turns = quarter_turns % 4
-    points = frame.points
+    points, k = frame.points, frame.intrinsics
     for _ in range(turns):  # a pixel's image column becomes its row: (x, y) -> (y, -x) in the camera frame
         points = np.stack([points[..., 1], -points[..., 0], points[..., 2]], axis=-1)
+        k = CameraIntrinsics(k.fy, k.fx, k.cy, k.width - 1 - k.cx, k.height, k.width)
 
     def turned(a: np.ndarray) -> np.ndarray:
         return np.ascontiguousarray(np.rot90(a, turns))
 
-    k = frame.intrinsics
-    rows, cols = (k.width, k.height) if turns % 2 else (k.height, k.width)
-    fx, fy = (k.fy, k.fx) if turns % 2 else (k.fx, k.fy)
-    cx, cy = {0: (k.cx, k.cy), 1: (k.cy, k.width - 1 - k.cx), 2: (k.width - 1 - k.cx, k.height - 1 - k.cy)}.get(
-        turns, (k.height - 1 - k.cy, k.cx)
-    )
     return Frame(
         color=turned(frame.color),
         depth=turned(frame.depth),
-        intrinsics=CameraIntrinsics(fx, fy, cx, cy, cols, rows),
+        intrinsics=k,
         source=frame.source,
         points=turned(points).astype(np.float32),
         labels=None if frame.labels is None else turned(frame.labels),
