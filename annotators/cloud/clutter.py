@@ -168,6 +168,7 @@ class ClutterParameters(ClusterParameters):
     close_factor: float = ConvexityRules.close_factor
     crease_degrees: float = ConvexityRules.crease_degrees
     decisive_bending: float = ConvexityRules.decisive_bending
+    object_points: float = ConvexityRules.object_points
     creased_share: float = 0.2
     use_color: bool = True
     complete_occluded: bool = True

@@ -101,7 +101,10 @@ class ConvexityRules:
     across a crease (normals at least ``crease_degrees`` apart) votes convex only where it bends outward
     (:func:`inward_creases`); two large faces without a convex majority are kept apart on ``min_votes`` votes, or
     on one connection bending inward faster than ``decisive_bending`` (1/m, a turn tighter than a 1 cm radius: the
-    normals of neighbouring patches are not that noisy)."""
+    normals of neighbouring patches are not that noisy); a weak agreement (fewer than ``min_votes`` convex votes,
+    none bending outward faster than ``concave_bending``: no rim or edge turning) may attach faces to a group of
+    ``object_points`` points or more (four large faces' worth: an object's surface) but does not join two such
+    groups: along the seam where two objects touch, small faces agree with both on single votes."""
 
     smooth_degrees: float = 20.0
     concave_bending: float = 20.0
@@ -118,6 +121,7 @@ class ConvexityRules:
     grazing_degrees: float | None = None
     crease_degrees: float = 45.0
     decisive_bending: float = 100.0
+    object_points: float = 288.0
 
 
 @dataclass(frozen=True, eq=False)
@@ -370,14 +374,16 @@ def join_faces(
     low, high = np.minimum(face_a, face_b)[apart], np.maximum(face_a, face_b)[apart]
     keys, inverse = distinct_keys(low * count + high)
     votes = np.maximum(np.bincount(inverse, minlength=keys.size), 1)
-    large = np.bincount(faces, weights=planes_sizes(planes, count), minlength=count) >= rules.min_face
+    face_sizes = np.bincount(faces, weights=planes_sizes(planes, count), minlength=count)
+    large = face_sizes >= rules.min_face
     between_large = large[face_a] & large[face_b]
     bending = connection_bending(planes, pairs) if bending is None else bending
     convex = convex & ~(between_large & inward_creases(planes, pairs, rules.crease_degrees, bending))
     share = np.bincount(inverse, weights=convex[apart], minlength=keys.size) / votes
     concave_votes = np.bincount(inverse, weights=concave[apart], minlength=keys.size)
-    sharpest = np.full(keys.size, np.inf)
+    sharpest, steepest = np.full(keys.size, np.inf), np.full(keys.size, -np.inf)
     np.minimum.at(sharpest, inverse, bending[apart])
+    np.maximum.at(steepest, inverse, bending[apart])
     share = np.where((concave_votes > rules.concave_share * votes) & (concave_votes >= rules.min_votes), 0.0, share)
     first, second = keys // count, keys % count
     both_large = large[first] & large[second]
@@ -391,8 +397,10 @@ def join_faces(
         # a small face joins a large one on its convex majority, another small face only as its best neighbour
         small_pair = ~large[first] & ~large[second]
         agree &= (strength >= rules.min_votes) | ~small_pair | _best_of_small(first, second, strength, agree, large)
+    weak = (strength < rules.min_votes) & (steepest < rules.concave_bending)
     order = np.argsort(-strength[agree], kind="stable")
-    return join_unless_apart(count, np.column_stack([first, second])[agree][order], kept_apart)
+    joins = np.column_stack([first, second])[agree][order]
+    return join_unless_apart(count, joins, kept_apart, weak[agree][order], face_sizes, rules.object_points)
 
 
 def _best_of_small(

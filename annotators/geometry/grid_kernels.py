@@ -302,14 +302,26 @@ def strided_crop(values: np.ndarray, step: int, box: tuple[int, int, int, int]) 
     return _loops().strided_crop(values, step, x0, y0, x1, y1)
 
 
-def groups_unless_apart(count: int, pairs: np.ndarray, apart: np.ndarray) -> np.ndarray:
+def groups_unless_apart(
+    count: int,
+    pairs: np.ndarray,
+    apart: np.ndarray,
+    weak: np.ndarray | None = None,
+    sizes: np.ndarray | None = None,
+    least: float = np.inf,
+) -> np.ndarray:
     """The group (its root node, int64) of each of ``count`` nodes: the ``pairs`` (Kx2) joined in the order given,
     the second's group under the first's root, except where that would put the two nodes of an ``apart`` pair (Mx2)
-    into one group."""
+    into one group, or where a ``weak`` pair (K bools) would join two groups whose node ``sizes`` (``count``) each sum
+    to ``least`` or more."""
+    pairs = np.ascontiguousarray(pairs, dtype=np.int64).reshape(-1, 2)
     return _loops().groups_unless_apart(
         count,
-        np.ascontiguousarray(pairs, dtype=np.int64).reshape(-1, 2),
+        pairs,
         np.ascontiguousarray(apart, dtype=np.int64).reshape(-1, 2),
+        np.zeros(pairs.shape[0], dtype=np.bool_) if weak is None else np.ascontiguousarray(weak, dtype=np.bool_),
+        np.zeros(count) if sizes is None else np.ascontiguousarray(sizes, dtype=np.float64),
+        float(least),
     )
 
 

@@ -933,13 +933,18 @@ def strided_crop(values: np.ndarray, step: int, x0: int, y0: int, x1: int, y1: i
 
 
 @njit(cache=True, nogil=True)
-def groups_unless_apart(count: int, pairs: np.ndarray, apart: np.ndarray) -> np.ndarray:
+def groups_unless_apart(
+    count: int, pairs: np.ndarray, apart: np.ndarray, weak: np.ndarray, sizes: np.ndarray, least: float
+) -> np.ndarray:
     """See :func:`annotators.geometry.grid_kernels.groups_unless_apart`."""
     parent = np.arange(count)
+    total = sizes.copy()  # per root: the sizes of its group's nodes summed
     apart_roots = apart.copy()  # the groups of the two nodes of every apart pair, kept up to date
     for k in range(pairs.shape[0]):
         first, second = _root(parent, pairs[k, 0]), _root(parent, pairs[k, 1])
         if first == second:
+            continue
+        if weak[k] and total[first] >= least and total[second] >= least:
             continue
         kept_apart = False
         for m in range(apart_roots.shape[0]):
@@ -950,6 +955,7 @@ def groups_unless_apart(count: int, pairs: np.ndarray, apart: np.ndarray) -> np.
         if kept_apart:
             continue
         parent[second] = first
+        total[first] += total[second]
         for m in range(apart_roots.shape[0]):
             for side in range(2):
                 if apart_roots[m, side] == second:

@@ -313,9 +313,19 @@ def test_upsampled_labels_keep_the_cell_label_where_no_depth_jump_parts_them(ste
     assert np.array_equal(upsampled_labels(labels, coarse_depth, depth, keep, step, 0.01, 0.01), expected)
 
 
-def _groups_unless_apart_in_python(count: int, pairs: np.ndarray, apart: np.ndarray) -> np.ndarray:
-    """The union-find with a set of kept-apart nodes per group that :func:`groups_unless_apart` replaces."""
+def _groups_unless_apart_in_python(
+    count: int,
+    pairs: np.ndarray,
+    apart: np.ndarray,
+    weak: np.ndarray | None = None,
+    sizes: np.ndarray | None = None,
+    least: float = np.inf,
+) -> np.ndarray:
+    """The union-find with a set of kept-apart nodes per group that :func:`groups_unless_apart` replaces, and with
+    each group's summed size, which a weak pair may not join when both sides hold ``least``."""
     parent = list(range(count))
+    total = [0.0] * count if sizes is None else sizes.astype(float).tolist()
+    weak_pairs = [False] * len(pairs) if weak is None else weak.tolist()
     keep_apart: dict[int, set[int]] = {}
     for a, b in apart.tolist():
         keep_apart.setdefault(a, set()).add(b)
@@ -327,14 +337,17 @@ def _groups_unless_apart_in_python(count: int, pairs: np.ndarray, apart: np.ndar
             node = parent[node]
         return node
 
-    for a, b in pairs.tolist():
+    for (a, b), is_weak in zip(pairs.tolist(), weak_pairs, strict=True):
         ra, rb = root(a), root(b)
         if ra == rb:
             continue
         against_a, against_b = keep_apart.get(ra, set()), keep_apart.get(rb, set())
         if any(root(n) == rb for n in against_a) or any(root(n) == ra for n in against_b):
             continue
+        if is_weak and total[ra] >= least and total[rb] >= least:
+            continue
         parent[rb] = ra
+        total[ra] += total[rb]
         keep_apart[ra] = against_a | against_b
     return np.array([root(node) for node in range(count)], dtype=np.int64)
 
@@ -352,6 +365,37 @@ def test_groups_unless_apart_give_what_the_python_union_find_gives(seed: int) ->
         joined_regardless = _groups_unless_apart_in_python(count, pairs, apart[:0])
         kept_apart += int(np.unique(expected).size > np.unique(joined_regardless).size)
     assert kept_apart > 0  # some apart pairs did keep groups apart
+
+
+@pytest.mark.parametrize("seed", range(5))
+def test_weak_pairs_group_as_the_python_union_find_groups_them(seed: int) -> None:
+    rng = np.random.default_rng(seed)
+    refused = 0
+    for _ in range(60):
+        count = int(rng.integers(1, 60))
+        pairs = rng.integers(0, count, (int(rng.integers(0, 80)), 2))
+        apart = rng.integers(0, count, (int(rng.integers(0, 6)), 2))
+        weak = rng.random(pairs.shape[0]) < 0.5
+        sizes = rng.integers(1, 40, count).astype(float)
+        expected = _groups_unless_apart_in_python(count, pairs, apart, weak, sizes, 60.0)
+        np.testing.assert_array_equal(groups_unless_apart(count, pairs, apart, weak, sizes, 60.0), expected)
+        refused += int(np.unique(expected).size > np.unique(groups_unless_apart(count, pairs, apart)).size)
+    assert refused > 0  # some weak pairs did keep two large groups apart
+
+
+def test_a_weak_pair_attaches_a_small_group_but_does_not_join_two_large_ones() -> None:
+    # nodes 0-1 and 2-3 are two objects of 100 points each, node 4 a 10-point face on the seam between them
+    sizes = np.array([50.0, 50.0, 50.0, 50.0, 10.0])
+    strong = np.array([[0, 1], [2, 3]])
+    seam = np.array([[1, 4], [4, 2], [1, 2]])
+    pairs = np.concatenate([strong, seam])
+    weak = np.array([False, False, True, True, True])
+    groups = groups_unless_apart(5, pairs, np.zeros((0, 2)), weak, sizes, 80.0)
+    assert groups[4] == groups[0] != groups[2]  # the seam face goes with the first object it agrees with
+    assert np.unique(groups).size == 2
+    # the same agreements counted strong join all, and no pair is refused without a size limit
+    assert np.unique(groups_unless_apart(5, pairs, np.zeros((0, 2)))).size == 1
+    assert np.unique(groups_unless_apart(5, pairs, np.zeros((0, 2)), weak, sizes)).size == 1
 
 
 def _joined_labels_in_python(labels: np.ndarray, pairs: np.ndarray) -> np.ndarray:
