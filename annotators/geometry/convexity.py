@@ -244,8 +244,9 @@ def convex_objects(
        concave when it bends inward faster than ``rules.concave_bending``; a step votes neither; between two large
        faces, a connection across a crease that bends inward votes no convex, :func:`inward_creases`); two faces
        join when more than ``rules.convex_share`` of the votes are convex and at most ``rules.concave_share`` concave.
-       Joins are made strongest first, and two large faces that do not agree are kept apart: a sliver along a
-       crease that agrees with both sides cannot join them.
+       Joins are made strongest first, the weak agreements (see :class:`ConvexityRules`) after all others, and two
+       large faces that do not agree are kept apart: a sliver along a crease that agrees with both sides cannot
+       join them; nor can a weak agreement join two groups that each hold ``rules.object_points`` points.
 
     Patches touch when they are 4-neighbours once grown by up to ``rules.gap_width`` pixels into the unlabelled
     pixels between them that ``between`` allows (HxW bool; default: every pixel with a point), each on its own
@@ -398,7 +399,9 @@ def join_faces(
         small_pair = ~large[first] & ~large[second]
         agree &= (strength >= rules.min_votes) | ~small_pair | _best_of_small(first, second, strength, agree, large)
     weak = (strength < rules.min_votes) & (steepest < rules.concave_bending)
-    order = np.argsort(-strength[agree], kind="stable")
+    # strongest first, and the weak agreements after all others: a seam face goes with the object its other
+    # agreements tie it to before a weak one can take it to the object beside
+    order = np.lexsort((-strength[agree], weak[agree]))
     joins = np.column_stack([first, second])[agree][order]
     return join_unless_apart(count, joins, kept_apart, weak[agree][order], face_sizes, rules.object_points)
 

@@ -6,7 +6,8 @@ mOSD learn19's two boxes into one segment at some grid cell phases (and seen by 
 learn42's two cylinders at others, and uoc 2's cheez-it box into the power drill beside it at half of them. A weak
 agreement may still attach a few faces to an object (a pot's handle, hanging on its body by single votes), but it no
 longer joins two groups that are each an object's surface (ConvexityRules.object_points;
-bench/profiles/seam-analysis.txt).
+bench/profiles/seam-analysis.txt), and it is made after every other agreement: on uoc 3 a face of the drill, tied to
+it by single votes that bend outward as an edge does, first went with the box on a weak vote and took the drill along.
 """
 
 from __future__ import annotations
@@ -45,7 +46,9 @@ def test_two_touching_boxes_are_found_by_a_camera_rolled_a_quarter_turn() -> Non
     assert found(rolled(scene, 1)) == (2, 2, 2)
 
 
-@pytest.mark.parametrize(("frame", "offset"), [(2, (0, 1)), (2, (2, 2)), (2, (4, 5)), (3, (0, 5))])
+@pytest.mark.parametrize(
+    ("frame", "offset"), [(2, (0, 1)), (2, (2, 2)), (2, (4, 5)), (3, (0, 3)), (3, (2, 4)), (3, (0, 5))]
+)
 def test_the_cheez_it_box_and_the_drill_beside_it_stay_apart(
     uoc_folder: Path, frame: int, offset: tuple[int, int], monkeypatch: pytest.MonkeyPatch
 ) -> None:
