@@ -72,7 +72,7 @@ from annotators.geometry.border_pixels import BorderRules, claim_border_pixels, 
 from annotators.geometry.container_floors import FloorRules, claim_container_floors, touches_other_labels
 from annotators.geometry.convexity import ConvexityRules, convex_objects, dense_labels, grid_patches, split_by_normals
 from annotators.geometry.flat_patches import flat_patches
-from annotators.geometry.grid_kernels import object_pieces, plane_coordinates, strided_crop
+from annotators.geometry.grid_kernels import groups_unless_apart, object_pieces, plane_coordinates, strided_crop
 from annotators.geometry.grid_segmentation import (
     MergeRules,
     boundaries,
@@ -82,7 +82,6 @@ from annotators.geometry.grid_segmentation import (
     depth_seams,
     grow_labels_nearby,
     grow_on_surface,
-    join_unless_apart,
     label_parts,
     merge_parts,
 )
@@ -486,7 +485,7 @@ def split_by_color(
         first_piece[owner[piece]] = piece
     rest = np.arange(1, owner.size)
     chained = np.column_stack([first_piece[owner[rest]], rest])
-    groups = join_unless_apart(owner.size, np.concatenate([touching, chained]), surface.pairs[creased])
+    groups = groups_unless_apart(owner.size, np.concatenate([touching, chained]), surface.pairs[creased])
     result = dense_labels(np.where(pieces > 0, groups[pieces] + 1, 0))
     return grow_labels_nearby(result, objects, p.grow_distance / step)
 

@@ -20,6 +20,7 @@ from annotators.geometry.grid_kernels import (
     cell_patches,
     dense_keys,
     graph_components,
+    groups_unless_apart,
     label_centres,
     label_moments,
     label_pieces,
@@ -31,7 +32,6 @@ from annotators.geometry.grid_segmentation import (
     SeedDistances,
     distinct_keys,
     grow_from_seeds,
-    join_unless_apart,
     label_parts,
     pixel_footprint,
     seed_distances,
@@ -403,7 +403,7 @@ def join_faces(
     # agreements tie it to before a weak one can take it to the object beside
     order = np.lexsort((-strength[agree], weak[agree]))
     joins = np.column_stack([first, second])[agree][order]
-    return join_unless_apart(count, joins, kept_apart, weak[agree][order], face_sizes, rules.object_points)
+    return groups_unless_apart(count, joins, kept_apart, weak[agree][order], face_sizes, rules.object_points)
 
 
 def _best_of_small(

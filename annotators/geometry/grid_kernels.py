@@ -312,8 +312,9 @@ def groups_unless_apart(
 ) -> np.ndarray:
     """The group (its root node, int64) of each of ``count`` nodes: the ``pairs`` (Kx2) joined in the order given,
     the second's group under the first's root, except where that would put the two nodes of an ``apart`` pair (Mx2)
-    into one group, or where a ``weak`` pair (K bools) would join two groups whose node ``sizes`` (``count``) each sum
-    to ``least`` or more."""
+    into one group (direct evidence that two parts are separate outweighs an indirect path between them), or where a
+    ``weak`` pair (K bools) would join two groups whose node ``sizes`` (``count``) each sum to ``least`` or more
+    (weak evidence may attach a small group to a large one, not join two large ones)."""
     pairs = np.ascontiguousarray(pairs, dtype=np.int64).reshape(-1, 2)
     return _loops().groups_unless_apart(
         count,

@@ -786,26 +786,9 @@ def merge_parts(
     if creases:
         # a crease along part of two parts' boundary keeps them apart, also through a third part they both join
         joined.sort(key=lambda pair: -lengths.get((min(pair), max(pair)), 1.0))
-        groups = join_unless_apart(int(labels.max()) + 1, np.array(joined).reshape(-1, 2), np.array(creases))
+        groups = groups_unless_apart(int(labels.max()) + 1, np.array(joined).reshape(-1, 2), np.array(creases))
         joined = [(int(a), int(b)) for a, b in enumerate(groups.tolist()) if a != b]
     return join_labels(labels, joined)
-
-
-def join_unless_apart(
-    count: int,
-    pairs: np.ndarray,
-    apart: np.ndarray,
-    weak: np.ndarray | None = None,
-    sizes: np.ndarray | None = None,
-    least: float = np.inf,
-) -> np.ndarray:
-    """Group labels of ``count`` nodes: the ``pairs`` (Kx2) joined in the order given, except where joining would
-    put the two nodes of an ``apart`` pair (Mx2) into one group (direct evidence that two parts are separate
-    outweighs an indirect path between them), or where a ``weak`` pair (K bools) would join two groups that each
-    hold ``least`` or more of the nodes' ``sizes`` (weak evidence may attach a small group to a large one, not join
-    two large ones). Each node's group is its root node (int64), the first node of the pair that founded or
-    extended the group."""
-    return groups_unless_apart(count, pairs, apart, weak, sizes, least)
 
 
 def bounding_box(mask: np.ndarray, margin: int = 0) -> tuple[int, int, int, int]:
